@@ -1,0 +1,43 @@
+"""randvib: random-vibration analysis of nonlinear energy harvesters with friction.
+
+Implements and extends Green, Worden & Sims, "On the identification and
+modelling of friction in a randomly excited energy harvester". SI units
+throughout; S is the one-sided PSD of the base acceleration in (m/s^2)^2/Hz.
+"""
+
+from randvib.friction import Coulomb, FrictionModel, LuGre, Tanh
+from randvib.harvester import ElectricalCoupling, Harvester
+from randvib.linearisation import coulomb_equivalent_damping, equivalent_damping
+from randvib.prediction import (
+    METHODS,
+    PowerPrediction,
+    expected_power,
+    optimal_load_resistance,
+    optimal_load_resistance_linear,
+    predict,
+    velocity_variance,
+)
+from randvib.presets import MAGNET_MASS, PRESETS, preset
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "Coulomb",
+    "ElectricalCoupling",
+    "FrictionModel",
+    "Harvester",
+    "LuGre",
+    "MAGNET_MASS",
+    "METHODS",
+    "PRESETS",
+    "PowerPrediction",
+    "Tanh",
+    "coulomb_equivalent_damping",
+    "equivalent_damping",
+    "expected_power",
+    "optimal_load_resistance",
+    "optimal_load_resistance_linear",
+    "predict",
+    "preset",
+    "velocity_variance",
+]

@@ -1,0 +1,5 @@
+import sys
+
+from randvib.cli import main
+
+sys.exit(main())

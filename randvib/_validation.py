@@ -1,0 +1,79 @@
+"""Input validation shared by every public entry point.
+
+All checks raise :class:`ValueError` with a message that names the argument,
+shows the offending value and states what is allowed, so that a user (or the
+CLI, which prints the message as one line) knows what to change.
+"""
+
+from __future__ import annotations
+
+import numbers
+
+import numpy as np
+
+
+def as_float_array(name: str, value) -> np.ndarray:
+    """Convert ``value`` to a float array, refusing non-numeric input."""
+    if isinstance(value, bool | np.bool_):
+        raise ValueError(f"`{name}` must be a real number, got {value!r}")
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"`{name}` must be a real number, got {value!r}") from None
+    return arr
+
+
+def _first_bad(arr: np.ndarray, mask: np.ndarray):
+    return arr[mask].ravel()[0] if arr.ndim else arr.item()
+
+
+def check_finite(name: str, value) -> np.ndarray:
+    arr = as_float_array(name, value)
+    bad = ~np.isfinite(arr)
+    if np.any(bad):
+        raise ValueError(
+            f"`{name}` must be finite, got {_first_bad(arr, bad)!r}; "
+            "NaN and infinite values are not allowed"
+        )
+    return arr
+
+
+def check_positive(name: str, value, unit: str = "") -> np.ndarray:
+    """Finite and strictly greater than zero (scalar or array)."""
+    arr = check_finite(name, value)
+    bad = arr <= 0
+    if np.any(bad):
+        raise ValueError(f"`{name}` must be > 0{_unit(unit)}, got {_first_bad(arr, bad)!r}")
+    return arr
+
+
+def check_nonnegative(name: str, value, unit: str = "") -> np.ndarray:
+    """Finite and greater than or equal to zero (scalar or array)."""
+    arr = check_finite(name, value)
+    bad = arr < 0
+    if np.any(bad):
+        raise ValueError(f"`{name}` must be >= 0{_unit(unit)}, got {_first_bad(arr, bad)!r}")
+    return arr
+
+
+def check_choice(name: str, value, allowed) -> str:
+    if value not in allowed:
+        raise ValueError(f"`{name}` must be one of {', '.join(map(repr, allowed))}; got {value!r}")
+    return value
+
+
+def check_int(name: str, value, minimum: int = 0) -> int:
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise ValueError(f"`{name}` must be an integer >= {minimum}, got {value!r}")
+    if value < minimum:
+        raise ValueError(f"`{name}` must be an integer >= {minimum}, got {value!r}")
+    return int(value)
+
+
+def scalar_or_array(arr: np.ndarray):
+    """Return a Python float for 0-d arrays, the array otherwise."""
+    return float(arr) if np.ndim(arr) == 0 else arr
+
+
+def _unit(unit: str) -> str:
+    return f" (in {unit})" if unit else ""

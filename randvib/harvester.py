@@ -1,0 +1,247 @@
+"""The device model: paper Eq. 1-3.
+
+    m z'' + (c_e + c_m) z' + k z + k3 z^3 + F(z', theta) = -m y''
+
+``z`` is the displacement of the centre magnet relative to the base (m),
+``y`` the base displacement (m) and ``F`` the friction force (N) of one of the
+models in :mod:`randvib.friction`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+from randvib._validation import check_nonnegative, check_positive, scalar_or_array
+from randvib.friction import FrictionModel
+
+
+@dataclass(frozen=True, eq=False)
+class ElectricalCoupling:
+    """Electromagnetic transducer and circuit (paper Eq. 3, Fig. 2b).
+
+    Parameters
+    ----------
+    alpha : float
+        Flux gradient (Wb/m = V s/m), > 0. The paper's device: 0.1992 Wb/m.
+    r_load : float
+        Load resistance R_L (ohm), > 0.
+    r_coil : float
+        Coil resistance R_C (ohm), >= 0. The paper's device: 0.48 ohm.
+    """
+
+    alpha: float
+    r_load: float
+    r_coil: float
+
+    def __post_init__(self):
+        object.__setattr__(
+            self, "alpha", scalar_or_array(check_positive("alpha", self.alpha, "Wb/m"))
+        )
+        object.__setattr__(
+            self, "r_load", scalar_or_array(check_positive("r_load", self.r_load, "ohm"))
+        )
+        object.__setattr__(
+            self, "r_coil", scalar_or_array(check_nonnegative("r_coil", self.r_coil, "ohm"))
+        )
+
+    @property
+    def electrical_damping(self):
+        """c_e = alpha^2 / (R_L + R_C) (Ns/m), paper Eq. 3."""
+        return self.alpha**2 / (self.r_load + self.r_coil)
+
+    @property
+    def load_fraction(self):
+        """R_L / (R_L + R_C): the share of the electrical power reaching the load."""
+        return self.r_load / (self.r_load + self.r_coil)
+
+
+@dataclass(frozen=True, eq=False)
+class Harvester:
+    """Single-degree-of-freedom electromagnetic harvester (paper Eq. 1).
+
+    Immutable; numeric parameters may be numpy arrays that broadcast together,
+    so that one analytic call evaluates a whole sweep (simulation needs
+    scalars).
+
+    Parameters
+    ----------
+    m : float
+        Moving (centre-magnet) mass (kg), > 0. The paper never prints it; its
+        presets use 0.0226 kg, from k = 57.4 N/m and f_n = 8 Hz.
+    c_m : float
+        Mechanical viscous damping (Ns/m), >= 0.
+    c_e : float
+        Electrical damping (Ns/m), >= 0; see :meth:`from_electrical` for Eq. 3.
+    k : float
+        Linear stiffness (N/m), > 0.
+    k3 : float, optional
+        Cubic (Duffing) stiffness (N/m^3), >= 0 (hardening, monostable).
+    friction : FrictionModel or None, optional
+        Friction model; ``None`` for none.
+    electrical : ElectricalCoupling or None, optional
+        Circuit data; when given, ``c_e`` must equal alpha^2 / (R_L + R_C)
+        (use :meth:`from_electrical`), and load voltage and power are defined.
+    """
+
+    m: float
+    c_m: float
+    c_e: float
+    k: float
+    k3: float = 0.0
+    friction: FrictionModel | None = None
+    electrical: ElectricalCoupling | None = None
+
+    def __post_init__(self):
+        for name, check, unit in (
+            ("m", check_positive, "kg"),
+            ("c_m", check_nonnegative, "Ns/m"),
+            ("c_e", check_nonnegative, "Ns/m"),
+            ("k", check_positive, "N/m"),
+            ("k3", check_nonnegative, "N/m^3"),
+        ):
+            object.__setattr__(self, name, scalar_or_array(check(name, getattr(self, name), unit)))
+        if self.friction is not None and not isinstance(self.friction, FrictionModel):
+            raise ValueError(
+                f"`friction` must be a randvib friction model (Coulomb, Tanh, LuGre) "
+                f"or None, got {self.friction!r}"
+            )
+        if self.electrical is not None:
+            expected = self.electrical.electrical_damping
+            if not np.allclose(self.c_e, expected, rtol=1e-12, atol=0):
+                raise ValueError(
+                    f"`c_e` = {self.c_e!r} Ns/m disagrees with alpha^2/(R_L+R_C) = "
+                    f"{expected!r} Ns/m from `electrical`; use Harvester.from_electrical"
+                )
+        if np.any(self.c_m + self.c_e <= 0) and self.friction is None:
+            raise ValueError(
+                "total damping `c_m + c_e` must be > 0 without friction, got "
+                f"{self.c_m!r} + {self.c_e!r}; the undamped oscillator has no stationary state"
+            )
+
+    @classmethod
+    def from_electrical(cls, m, c_m, k, alpha, r_load, r_coil, k3=0.0, friction=None):
+        """Build a harvester whose c_e follows from the circuit (paper Eq. 3).
+
+        Parameters
+        ----------
+        alpha : float
+            Flux gradient (Wb/m).
+        r_load, r_coil : float
+            Load and coil resistances (ohm).
+
+        Other parameters are as for :class:`Harvester`.
+        """
+        electrical = ElectricalCoupling(alpha, r_load, r_coil)
+        return cls(
+            m=m,
+            c_m=c_m,
+            c_e=electrical.electrical_damping,
+            k=k,
+            k3=k3,
+            friction=friction,
+            electrical=electrical,
+        )
+
+    # ----------------------------------------------------------------- derived
+    @property
+    def c(self):
+        """Total viscous damping c = c_m + c_e (Ns/m)."""
+        return self.c_m + self.c_e
+
+    @property
+    def natural_frequency(self):
+        """Linear natural frequency omega_n = sqrt(k/m) (rad/s)."""
+        return np.sqrt(self.k / self.m)
+
+    @property
+    def friction_name(self) -> str:
+        return "none" if self.friction is None else self.friction.name
+
+    def electrical_power(self, velocity):
+        """Instantaneous power into the electrical domain c_e z'^2 (W)."""
+        return self.c_e * np.asarray(velocity, dtype=float) ** 2
+
+    def _require_electrical(self, what: str):
+        if self.electrical is None:
+            raise ValueError(
+                f"{what} needs the circuit: build the harvester with "
+                "Harvester.from_electrical(alpha=..., r_load=..., r_coil=...)"
+            )
+        return self.electrical
+
+    def load_current(self, velocity):
+        """Current i = alpha z' / (R_L + R_C) (A)."""
+        e = self._require_electrical("load current")
+        return e.alpha * np.asarray(velocity, dtype=float) / (e.r_load + e.r_coil)
+
+    def load_voltage(self, velocity):
+        """Load voltage V = alpha z' R_L / (R_L + R_C) (V)."""
+        e = self._require_electrical("load voltage")
+        return self.load_current(velocity) * e.r_load
+
+    def load_power(self, velocity):
+        """Instantaneous power into the load i^2 R_L (W)."""
+        e = self._require_electrical("load power")
+        return self.load_current(velocity) ** 2 * e.r_load
+
+    # ----------------------------------------------------------------- updates
+    def parameters(self) -> dict:
+        """Every parameter by name (SI units), friction and circuit included."""
+        out = {name: getattr(self, name) for name in ("m", "c_m", "c_e", "k", "k3")}
+        out["friction"] = self.friction_name
+        if self.friction is not None:
+            out.update(self.friction.parameters())
+        if self.electrical is not None:
+            out.update({f.name: getattr(self.electrical, f.name) for f in fields(self.electrical)})
+        return out
+
+    def updated(self, **changes) -> Harvester:
+        """A copy with some parameters changed, friction and circuit ones included.
+
+        Keys may be any of ``m, c_m, c_e, k, k3``, the friction model's
+        parameters (``fc``, ``beta``, ...) or the circuit's (``alpha``,
+        ``r_load``, ``r_coil``; c_e then follows Eq. 3). ``c`` sets the total
+        damping, split in the current ratio of c_m to c_e.
+        """
+        own = {
+            name: changes.pop(name)
+            for name in ("m", "c_m", "c_e", "k", "k3", "friction")
+            if name in changes
+        }
+        if "c" in changes:
+            c_new = np.asarray(changes.pop("c"), dtype=float)
+            share = self.c_m / self.c if np.all(self.c > 0) else 0.5
+            own.setdefault("c_m", c_new * share)
+            own.setdefault("c_e", c_new * (1 - share))
+        friction = own.pop("friction", self.friction)
+        if friction is not None:
+            names = {f.name for f in fields(friction)}
+            mine = {key: changes.pop(key) for key in list(changes) if key in names}
+            if mine:
+                friction = dataclasses.replace(friction, **mine)
+        electrical = self.electrical
+        circuit = {
+            key: changes.pop(key) for key in list(changes) if key in ("alpha", "r_load", "r_coil")
+        }
+        if circuit:
+            if electrical is None:
+                raise ValueError(
+                    f"cannot set {sorted(circuit)}: this harvester has no circuit "
+                    "(build it with Harvester.from_electrical)"
+                )
+            electrical = dataclasses.replace(electrical, **circuit)
+            own["c_e"] = electrical.electrical_damping
+        elif electrical is not None and "c_e" in own:
+            electrical = None  # an explicit c_e overrides the circuit
+        if changes:
+            allowed = sorted(
+                {"m", "c", "c_m", "c_e", "k", "k3", "alpha", "r_load", "r_coil"}
+                | ({f.name for f in fields(friction)} if friction else set())
+            )
+            raise ValueError(
+                f"unknown parameter name(s) {sorted(changes)}; allowed: {', '.join(allowed)}"
+            )
+        return dataclasses.replace(self, friction=friction, electrical=electrical, **own)
