@@ -1,0 +1,1 @@
+"""Packaged studies, one module each; see ``randvib.cli.study.STUDIES``."""
