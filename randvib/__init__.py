@@ -7,6 +7,7 @@ throughout; S is the one-sided PSD of the base acceleration in (m/s^2)^2/Hz.
 
 from randvib.friction import Coulomb, FrictionModel, LuGre, Tanh
 from randvib.harvester import ElectricalCoupling, Harvester
+from randvib.integrators import INTEGRATORS, Integrator
 from randvib.linearisation import coulomb_equivalent_damping, equivalent_damping
 from randvib.prediction import (
     METHODS,
@@ -18,6 +19,13 @@ from randvib.prediction import (
     velocity_variance,
 )
 from randvib.presets import MAGNET_MASS, PRESETS, preset
+from randvib.simulation import (
+    SimulationDivergedError,
+    SimulationResult,
+    Statistic,
+    StepSizeWarning,
+    simulate,
+)
 
 __version__ = "0.1.0"
 
@@ -26,11 +34,17 @@ __all__ = [
     "ElectricalCoupling",
     "FrictionModel",
     "Harvester",
+    "INTEGRATORS",
+    "Integrator",
     "LuGre",
     "MAGNET_MASS",
     "METHODS",
     "PRESETS",
     "PowerPrediction",
+    "SimulationDivergedError",
+    "SimulationResult",
+    "Statistic",
+    "StepSizeWarning",
     "Tanh",
     "coulomb_equivalent_damping",
     "equivalent_damping",
@@ -39,5 +53,6 @@ __all__ = [
     "optimal_load_resistance_linear",
     "predict",
     "preset",
+    "simulate",
     "velocity_variance",
 ]

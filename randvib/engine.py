@@ -1,0 +1,233 @@
+"""Compiled ensemble kernel: one time loop for every method and friction model.
+
+Paths are processed in chunks of :data:`LANES` independent paths that advance
+together, step by step: the per-step dependency chain of one path is short
+and latency-bound, so interleaving a few paths keeps the core busy. Chunks run
+in parallel (``numba.prange``). Every path draws from its own stream
+(:mod:`randvib.rng`) and owns its accumulators, and the cross-path reductions
+happen afterwards in path order, so results are bit-identical for any number
+of threads and any batching of paths.
+
+Memory is O(n_paths): per-path running sums only, unless histograms or
+recorded histories are requested.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from randvib.friction import friction_force_and_rate
+from randvib.rng import seed_path_state, standard_normal
+
+#: Paths advanced together inside one chunk.
+LANES = 8
+
+# Columns of the per-path accumulator array (time averages over the window).
+ACC_V2 = 0  # mean v^2 ((m/s)^2)
+ACC_Z2 = 1  # mean z^2 (m^2)
+ACC_ABS_V = 2  # mean |v| (m/s)
+ACC_VF = 3  # mean v F (W): friction power
+ACC_VDW = 4  # sum v_n dW_n / T (m/s / sqrt(s)): Ito integral, mean exactly 0
+ACC_H0 = 5  # mechanical energy at the start of the window (J)
+ACC_H1 = 6  # mechanical energy at the end of the window (J)
+ACC_COMP_V2 = 7  # companion (same noise, no friction) mean v^2
+ACC_COMP_Z2 = 8  # companion mean z^2
+N_ACC = 9
+
+#: How often (steps) the kernel checks for a non-finite state.
+CHECK_EVERY = 256
+
+
+@numba.njit(cache=True, inline="always")
+def _acceleration(z, v, theta, inv_m, c, k, k3, fr_kind, fr_p):
+    force, rate = friction_force_and_rate(fr_kind, fr_p, v, theta)
+    return -(c * v + k * z + k3 * z * z * z + force) * inv_m, rate, force
+
+
+@numba.njit(cache=True, parallel=True)
+def run_ensemble(
+    method,
+    fr_kind,
+    fr_p,
+    m,
+    c,
+    k,
+    k3,
+    noise_amp,
+    dt,
+    n_steps,
+    n_burn,
+    seed,
+    first_path,
+    n_paths,
+    init_mode,
+    init_z,
+    init_v,
+    dw,
+    companion,
+    hist_lo,
+    hist_hi,
+    hist_bins,
+    n_record,
+    record_every,
+    ki,
+    wi,
+    fi,
+):
+    """Integrate ``n_paths`` paths and return per-path time averages.
+
+    Parameters
+    ----------
+    method : int
+        Integrator kernel code (0 Euler-Maruyama, 1 stochastic Heun).
+    fr_kind, fr_p : int, float64[5]
+        Friction kernel code and parameters (:mod:`randvib.friction`).
+    m, c, k, k3 : float
+        Mass (kg), total viscous damping (Ns/m), stiffnesses (N/m, N/m^3).
+    noise_amp : float
+        sqrt(S/2) (m/s^1.5): the diffusion of the velocity.
+    dt : float
+        Step (s). ``n_steps`` total steps, the first ``n_burn`` discarded.
+    seed, first_path, n_paths : int
+        Streams of paths ``first_path .. first_path + n_paths - 1``.
+    init_mode : int
+        0: start at (init_z, init_v); 1: start from N(0, init_z^2) x
+        N(0, init_v^2) drawn from the path's own stream.
+    dw : float64[:, :]
+        Given Brownian increments (n_paths, n_steps), or shape (0, 0) to draw.
+    companion : bool
+        Also integrate the friction-free device with the same noise.
+    hist_lo, hist_hi, hist_bins : float64[2], float64[2], int
+        Histogram ranges of (z, v) over the window; ``hist_bins`` 0 for none.
+    n_record, record_every : int
+        Record (z, v, theta) of the first ``n_record`` paths every
+        ``record_every`` steps (including the initial state).
+
+    Returns
+    -------
+    acc : float64[n_paths, N_ACC]
+    failed_step : int64[n_paths]
+        First checked step with a non-finite state, or -1.
+    hist : int64[n_chunks, 2, hist_bins]
+    records : float64[n_record, n_records, 3]
+    """
+    n_chunks = (n_paths + LANES - 1) // LANES
+    acc = np.zeros((n_paths, N_ACC))
+    failed = np.full(n_paths, -1, dtype=np.int64)
+    hist = np.zeros((n_chunks if hist_bins > 0 else 0, 2, max(hist_bins, 1)), dtype=np.int64)
+    n_rec_points = n_steps // record_every + 1 if n_record > 0 else 0
+    records = np.zeros((n_record, n_rec_points, 3))
+    given_noise = dw.shape[0] > 0
+    inv_m = 1.0 / m
+    window = (n_steps - n_burn) * dt
+    inv_window_steps = 1.0 / (n_steps - n_burn)
+    sqdt = np.sqrt(dt)
+    half_dt = 0.5 * dt
+    hist_scale_z = hist_bins / (hist_hi[0] - hist_lo[0]) if hist_bins > 0 else 0.0
+    hist_scale_v = hist_bins / (hist_hi[1] - hist_lo[1]) if hist_bins > 0 else 0.0
+
+    for chunk in numba.prange(n_chunks):
+        start = chunk * LANES
+        lanes = min(LANES, n_paths - start)
+        rng = np.empty((LANES, 4), dtype=np.uint64)
+        z = np.zeros(LANES)
+        v = np.zeros(LANES)
+        th = np.zeros(LANES)
+        zc = np.zeros(LANES)
+        vc = np.zeros(LANES)
+        a = np.zeros((LANES, N_ACC))
+        for j in range(lanes):
+            seed_path_state(seed, first_path + start + j, rng, j)
+            if init_mode == 1:
+                z[j] = init_z * standard_normal(rng, j, ki, wi, fi)
+                v[j] = init_v * standard_normal(rng, j, ki, wi, fi)
+            else:
+                z[j] = init_z
+                v[j] = init_v
+            zc[j] = z[j]
+            vc[j] = v[j]
+            if start + j < n_record:
+                records[start + j, 0, 0] = z[j]
+                records[start + j, 0, 1] = v[j]
+        stopped = False
+        for n in range(n_steps):
+            in_window = n >= n_burn
+            for j in range(lanes):
+                if given_noise:
+                    dwj = dw[start + j, n]
+                else:
+                    dwj = sqdt * standard_normal(rng, j, ki, wi, fi)
+                noise = noise_amp * dwj
+                zj = z[j]
+                vj = v[j]
+                tj = th[j]
+                acc1, rate1, f1 = _acceleration(zj, vj, tj, inv_m, c, k, k3, fr_kind, fr_p)
+                if in_window:
+                    if n == n_burn:
+                        a[j, ACC_H0] = 0.5 * m * vj * vj + 0.5 * k * zj * zj + 0.25 * k3 * zj**4
+                    a[j, ACC_V2] += vj * vj
+                    a[j, ACC_Z2] += zj * zj
+                    a[j, ACC_ABS_V] += abs(vj)
+                    a[j, ACC_VF] += vj * f1
+                    a[j, ACC_VDW] += vj * dwj
+                    if hist_bins > 0:
+                        bz = int(np.floor((zj - hist_lo[0]) * hist_scale_z))
+                        bv = int(np.floor((vj - hist_lo[1]) * hist_scale_v))
+                        if 0 <= bz < hist_bins:
+                            hist[chunk, 0, bz] += 1
+                        if 0 <= bv < hist_bins:
+                            hist[chunk, 1, bv] += 1
+                if method == 0:  # Euler-Maruyama
+                    z[j] = zj + vj * dt
+                    v[j] = vj + acc1 * dt + noise
+                    th[j] = tj + rate1 * dt
+                else:  # stochastic Heun: Euler predictor, trapezoidal corrector
+                    zp = zj + vj * dt
+                    vp = vj + acc1 * dt + noise
+                    tp = tj + rate1 * dt
+                    acc2, rate2, f2 = _acceleration(zp, vp, tp, inv_m, c, k, k3, fr_kind, fr_p)
+                    z[j] = zj + (vj + vp) * half_dt
+                    v[j] = vj + (acc1 + acc2) * half_dt + noise
+                    th[j] = tj + (rate1 + rate2) * half_dt
+                if companion:
+                    zcj = zc[j]
+                    vcj = vc[j]
+                    ac1 = -(c * vcj + k * zcj + k3 * zcj * zcj * zcj) * inv_m
+                    if in_window:
+                        a[j, ACC_COMP_V2] += vcj * vcj
+                        a[j, ACC_COMP_Z2] += zcj * zcj
+                    if method == 0:
+                        zc[j] = zcj + vcj * dt
+                        vc[j] = vcj + ac1 * dt + noise
+                    else:
+                        zp = zcj + vcj * dt
+                        vp = vcj + ac1 * dt + noise
+                        ac2 = -(c * vp + k * zp + k3 * zp * zp * zp) * inv_m
+                        zc[j] = zcj + (vcj + vp) * half_dt
+                        vc[j] = vcj + (ac1 + ac2) * half_dt + noise
+                if start + j < n_record and (n + 1) % record_every == 0:
+                    r = (n + 1) // record_every
+                    records[start + j, r, 0] = z[j]
+                    records[start + j, r, 1] = v[j]
+                    records[start + j, r, 2] = th[j]
+            if (n + 1) % CHECK_EVERY == 0 or n == n_steps - 1:
+                for j in range(lanes):
+                    if not (np.isfinite(z[j]) and np.isfinite(v[j]) and np.isfinite(th[j])):
+                        failed[start + j] = n + 1
+                        stopped = True
+                if stopped:
+                    break
+        for j in range(lanes):
+            p = start + j
+            zj = z[j]
+            vj = v[j]
+            a[j, ACC_H1] = 0.5 * m * vj * vj + 0.5 * k * zj * zj + 0.25 * k3 * zj**4
+            for q in range(N_ACC):
+                if q == ACC_H0 or q == ACC_H1:
+                    acc[p, q] = a[j, q]
+                elif q == ACC_VDW:
+                    acc[p, q] = a[j, q] / window
+                else:
+                    acc[p, q] = a[j, q] * inv_window_steps
+    return acc, failed, hist, records

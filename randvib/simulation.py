@@ -1,0 +1,621 @@
+"""Monte Carlo simulation of the white-noise driven harvester: ``simulate``.
+
+The SDE (CONVENTIONS.md, paper Eq. 1 and 15-17) for the state (z, v = z') and,
+for LuGre friction, the bristle state theta:
+
+    dz = v dt
+    dv = -(c v + k z + k3 z^3 + F(v, theta)) / m dt + sqrt(S/2) dW
+    dtheta = theta'(v, theta) dt
+
+Each path is an independent realisation; statistics are time averages over
+the window [burn_in, t_end) on each path, and their confidence intervals come
+from the spread between paths (independent by construction), so they do not
+depend on any assumption about correlation times.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+import warnings
+from dataclasses import dataclass, field
+
+import numba
+import numpy as np
+from scipy import stats
+
+from randvib import engine, exact
+from randvib._validation import check_choice, check_int, check_positive
+from randvib.harvester import Harvester
+from randvib.integrators import integrator
+from randvib.linearisation import equivalent_damping, linear_displacement_variance
+from randvib.rng import ZIG_FI, ZIG_KI, ZIG_WI
+
+#: Largest stationary-variance bias (relative) of the scheme on the linearised
+#: device for which a step is accepted; see :func:`step_bias`.
+MAX_STEP_BIAS = 0.10
+#: Bias above which a warning is issued.
+WARN_STEP_BIAS = 0.01
+
+
+class SimulationDivergedError(ValueError):
+    """The state became non-finite during a simulation."""
+
+
+class StepSizeWarning(RuntimeWarning):
+    """The time step gives a noticeable discretisation bias."""
+
+
+@dataclass(frozen=True)
+class Statistic:
+    """A Monte Carlo estimate with its 95 % confidence half-width.
+
+    Attributes
+    ----------
+    mean : float
+        Estimate (mean over paths of per-path time averages).
+    ci95 : float
+        Half-width of the 95 % confidence interval (Student t over paths).
+    std_error : float
+        Standard error of ``mean``.
+    n_paths : int
+        Number of independent paths behind it.
+    """
+
+    mean: float
+    ci95: float
+    std_error: float
+    n_paths: int
+
+    @property
+    def relative_ci95(self) -> float:
+        """ci95 / |mean| (nan for a zero mean)."""
+        return self.ci95 / abs(self.mean) if self.mean != 0 else float("nan")
+
+    def to_dict(self) -> dict:
+        return {"mean": self.mean, "ci95": self.ci95}
+
+    def __format__(self, spec):
+        spec = spec or ".6g"
+        return f"{self.mean:{spec}} ± {self.ci95:{spec}}"
+
+
+def estimate(samples, controls=None) -> Statistic:
+    """Mean of independent ``samples`` with a t-based 95 % half-width.
+
+    Parameters
+    ----------
+    samples : array_like, shape (n,)
+        One value per independent path.
+    controls : array_like, shape (n, p), optional
+        Control variates with known mean zero. The estimator
+        ``mean(Y - X beta)`` with ``beta`` from least squares is unbiased up to
+        O(1/n) and its half-width uses the residual variance with n - 1 - p
+        degrees of freedom (Glasserman 2004, Sec. 4.1).
+    """
+    y = np.asarray(samples, dtype=float)
+    n = y.size
+    if n < 2:
+        raise ValueError(f"need at least 2 paths for a confidence interval, got {n}")
+    if controls is None or np.size(controls) == 0:
+        residual, dof = y, n - 1
+        mean = float(np.mean(y))
+    else:
+        x = np.asarray(controls, dtype=float).reshape(n, -1)
+        x = x[:, np.std(x, axis=0) > 0]  # drop constant columns (e.g. unused controls)
+        p = x.shape[1]
+        if n - 1 - p < 1:
+            raise ValueError(f"need more than {p + 1} paths to use {p} control variates, got {n}")
+        design = np.column_stack([np.ones(n), x - x.mean(axis=0)])
+        coef, *_ = np.linalg.lstsq(design, y, rcond=None)
+        beta = coef[1:]
+        mean = float(np.mean(y) - x.mean(axis=0) @ beta)
+        residual, dof = y - (x - x.mean(axis=0)) @ beta, n - 1 - p
+    var = float(np.sum((residual - residual.mean()) ** 2) / dof)
+    se = np.sqrt(var / n)
+    return Statistic(
+        mean=mean, ci95=float(stats.t.ppf(0.975, dof) * se), std_error=float(se), n_paths=n
+    )
+
+
+@dataclass(frozen=True)
+class Histogram:
+    """Stationary histograms of displacement and velocity over the window."""
+
+    z_edges: np.ndarray
+    z_density: np.ndarray
+    v_edges: np.ndarray
+    v_density: np.ndarray
+    #: Fraction of samples that fell outside the ranges.
+    outside: tuple
+
+
+@dataclass(frozen=True)
+class Histories:
+    """Decimated time histories of the first few paths."""
+
+    time: np.ndarray  # (n_records,) s
+    z: np.ndarray  # (n_paths, n_records) m
+    v: np.ndarray  # (n_paths, n_records) m/s
+    theta: np.ndarray  # (n_paths, n_records) m (LuGre bristle state, else 0)
+
+
+@dataclass(frozen=True)
+class SimulationResult:
+    """Result of :func:`simulate`: per-path averages and statistics.
+
+    The statistics (``power_electrical``, ``velocity_variance``,
+    ``displacement_variance``, ``mean_abs_velocity``, ``friction_power``,
+    ``power_load``) are :class:`Statistic` objects; with
+    ``control_variates=True`` they use the zero-mean controls of
+    :meth:`controls`, otherwise plain path means.
+    """
+
+    harvester: Harvester
+    psd: float
+    method: str
+    dt: float
+    t_end: float
+    burn_in: float
+    seed: int
+    first_path: int
+    per_path: np.ndarray = field(repr=False)
+    control_variates: bool = False
+    histogram: Histogram | None = field(default=None, repr=False)
+    histories: Histories | None = field(default=None, repr=False)
+    wall_time: float = 0.0
+
+    @property
+    def n_paths(self) -> int:
+        return self.per_path.shape[0]
+
+    @property
+    def averaging_time(self) -> float:
+        """Length of the averaging window per path (s)."""
+        return self.t_end - self.burn_in
+
+    def column(self, index: int) -> np.ndarray:
+        return self.per_path[:, index]
+
+    def controls(self) -> np.ndarray:
+        """Zero-mean control variates per path, shape (n_paths, p).
+
+        * the Ito integral (1/T) sum v_n dW_n: mean exactly zero;
+        * the energy change (H(T) - H(0)) / T: zero mean in the stationary state;
+        * with ``companion=True``, the friction-free companion's mean v^2 and
+          z^2 minus their exact values (S m / (4c), Gibbs E[z^2]): same noise,
+          exactly known mean in continuous time (bias O(dt) at finite step).
+        """
+        h = self.harvester
+        cols = [
+            self.column(engine.ACC_VDW),
+            (self.column(engine.ACC_H1) - self.column(engine.ACC_H0)) / self.averaging_time,
+        ]
+        if np.any(self.column(engine.ACC_COMP_V2) != 0) and h.c > 0:
+            cols.append(
+                self.column(engine.ACC_COMP_V2) - exact.linear_velocity_variance(h.m, h.c, self.psd)
+            )
+            cols.append(
+                self.column(engine.ACC_COMP_Z2)
+                - exact.gibbs_displacement_moment(h.m, h.c, h.k, h.k3, self.psd)
+            )
+        return np.column_stack(cols)
+
+    def statistic(self, samples, control_variates: bool | None = None) -> Statistic:
+        use = self.control_variates if control_variates is None else control_variates
+        return estimate(samples, self.controls() if use else None)
+
+    @property
+    def velocity_variance(self) -> Statistic:
+        """E[z'^2] ((m/s)^2); the mean velocity is zero by symmetry."""
+        return self.statistic(self.column(engine.ACC_V2))
+
+    @property
+    def displacement_variance(self) -> Statistic:
+        """E[z^2] (m^2)."""
+        return self.statistic(self.column(engine.ACC_Z2))
+
+    @property
+    def mean_abs_velocity(self) -> Statistic:
+        """E|z'| (m/s)."""
+        return self.statistic(self.column(engine.ACC_ABS_V))
+
+    @property
+    def power_electrical(self) -> Statistic:
+        """E[P_e] = c_e E[z'^2] (W) (paper Eq. 31)."""
+        return self.statistic(self.harvester.c_e * self.column(engine.ACC_V2))
+
+    @property
+    def friction_power(self) -> Statistic:
+        """E[z' F] (W): power dissipated by friction."""
+        return self.statistic(self.column(engine.ACC_VF))
+
+    @property
+    def power_load(self) -> Statistic | None:
+        """E[i^2 R_L] (W), with a circuit; else None."""
+        e = self.harvester.electrical
+        if e is None:
+            return None
+        return self.statistic(self.harvester.c_e * e.load_fraction * self.column(engine.ACC_V2))
+
+    def energy_balance_residual(self) -> Statistic:
+        """c E[v^2] + E[v F] - S m / 4 (W): zero up to O(dt) and noise."""
+        h = self.harvester
+        return self.statistic(
+            h.c * self.column(engine.ACC_V2) + self.column(engine.ACC_VF) - self.psd * h.m / 4.0
+        )
+
+    def summary(self) -> dict:
+        """Statistics as {name: {"mean", "ci95"}} plus run settings (JSON-ready)."""
+        out = {
+            name: getattr(self, name).to_dict()
+            for name in (
+                "power_electrical",
+                "velocity_variance",
+                "displacement_variance",
+                "mean_abs_velocity",
+                "friction_power",
+            )
+        }
+        if self.power_load is not None:
+            out["power_load"] = self.power_load.to_dict()
+        out.update(
+            n_paths=self.n_paths,
+            dt=self.dt,
+            t_end=self.t_end,
+            burn_in=self.burn_in,
+            method=self.method,
+            seed=self.seed,
+            psd=self.psd,
+            control_variates=self.control_variates,
+            wall_time=self.wall_time,
+        )
+        return out
+
+
+# ----------------------------------------------------------------- step size
+def effective_linear_device(harvester: Harvester, psd: float) -> tuple[float, float]:
+    """(k_eff, c_eff) of the linearised device, for step-size checks.
+
+    k_eff = k + 3 k3 E[z^2] with E[z^2] from the exact friction-free density
+    (friction only shrinks the motion, so this stiffness is an upper bound in
+    the mean); c_eff = c_eq from equivalent linearisation, or c for LuGre.
+    """
+    h = harvester
+    c_eff = float(h.c)
+    if h.friction is None or h.friction.has_equivalent_damping:
+        c_eff = float(equivalent_damping(h, psd))
+    if h.c > 0:
+        z2 = exact.gibbs_displacement_moment(h.m, h.c, h.k, h.k3, psd)
+    else:
+        vv = psd * h.m / (4.0 * c_eff)
+        z2 = float(linear_displacement_variance(h, vv))
+    return float(h.k + 3.0 * h.k3 * z2), c_eff
+
+
+def step_bias(method: str, harvester: Harvester, psd: float, dt: float) -> float:
+    """Relative bias of the scheme's stationary E[v^2] on the linearised device.
+
+    The scheme applied to ``m z'' + c_eff z' + k_eff z = m w`` is a linear
+    Gaussian recursion whose stationary variance is exact
+    (:func:`randvib.exact.scheme_stationary_covariance`); its departure from
+    S m / (4 c_eff) measures the time-step bias. Euler-Maruyama's bias is about
+    x / (1 - x) with x = k_eff dt / c_eff (energy gain per step against
+    damping), so it needs far smaller steps than Heun on lightly damped
+    devices. Returns inf where the recursion is unstable.
+    """
+    k_eff, c_eff = effective_linear_device(harvester, psd)
+    try:
+        cov = exact.scheme_stationary_covariance(method, harvester.m, c_eff, k_eff, psd, dt)
+    except ValueError:
+        return float("inf")
+    return abs(cov[1, 1] / exact.linear_velocity_variance(harvester.m, c_eff, psd) - 1.0)
+
+
+def largest_step(
+    method: str, harvester: Harvester, psd: float, bias: float = MAX_STEP_BIAS
+) -> float:
+    """Largest dt (s) whose :func:`step_bias` stays below ``bias`` (bisection)."""
+    k_eff, _ = effective_linear_device(harvester, psd)
+    lo, hi = 0.0, 2.0 / np.sqrt(k_eff / harvester.m)
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if step_bias(method, harvester, psd, mid) <= bias:
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
+def _check_step(method, harvester, psd, dt):
+    bias = step_bias(method, harvester, psd, dt)
+    if bias > MAX_STEP_BIAS:
+        limit = largest_step(method, harvester, psd)
+        raise ValueError(
+            f"`dt` = {dt!r} s is too large for this device with {method}: on the linearised "
+            f"device its stationary variance is off by {bias:.3g} (allowed {MAX_STEP_BIAS:.0%}); "
+            f"use dt <= {limit:.3g} s"
+        )
+    if bias > WARN_STEP_BIAS:
+        warnings.warn(
+            f"dt = {dt!r} s gives {method} a stationary-variance bias of about {bias:.2%} "
+            "on the linearised device",
+            StepSizeWarning,
+            stacklevel=3,
+        )
+
+
+# ----------------------------------------------------------------- simulate
+def simulate(
+    harvester: Harvester,
+    psd: float,
+    *,
+    t_end: float,
+    dt: float,
+    n_paths: int,
+    burn_in: float = 0.0,
+    method: str = "heun",
+    seed: int = 0,
+    dW=None,
+    initial="stationary",
+    first_path: int = 0,
+    companion: bool = False,
+    control_variates: bool = False,
+    histogram_bins: int = 0,
+    histogram_range=None,
+    record_paths: int = 0,
+    record_every: int = 1,
+    threads: int | None = None,
+    batch_paths: int | None = None,
+    progress: bool | None = None,
+    check_step: bool = True,
+) -> SimulationResult:
+    """Simulate an ensemble of the white-noise driven harvester.
+
+    Parameters
+    ----------
+    harvester : Harvester
+        Device with scalar parameters; any friction model.
+    psd : float
+        One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0: the velocity
+        noise is sqrt(S/2) dW (paper Eq. 17).
+    t_end : float
+        Simulated time per path (s), burn-in included.
+    dt : float
+        Time step (s). Steps whose scheme bias on the linearised device exceeds
+        :data:`MAX_STEP_BIAS` are refused (see :func:`step_bias`).
+    n_paths : int
+        Number of independent paths (>= 2 for confidence intervals).
+    burn_in : float
+        Initial time discarded from the statistics (s), 0 <= burn_in < t_end.
+    method : {"heun", "euler-maruyama"}
+        Integrator (:data:`randvib.integrators.INTEGRATORS`).
+    seed : int
+        Seed; path i uses stream (seed, first_path + i) (:mod:`randvib.rng`).
+    dW : array_like, optional
+        Brownian increments of shape (n_paths, n_steps) (s^0.5, variance dt)
+        to drive the simulation instead of the internal streams.
+    initial : "stationary", "rest" or (z0, v0)
+        Start from independent Gaussians with the linearised stationary
+        variances (drawn from each path's stream), from rest, or from a state.
+    first_path : int
+        Index of the first path's stream; a later batch with
+        first_path = n_paths continues the same ensemble.
+    companion : bool
+        Integrate the friction-free device with the same noise alongside
+        (control variates, :meth:`SimulationResult.controls`).
+    control_variates : bool
+        Report control-variate estimates (plain path means otherwise).
+    histogram_bins, histogram_range
+        Stationary histograms of z and v: number of bins and
+        ((z_lo, z_hi), (v_lo, v_hi)) (default +-5 linearised std).
+    record_paths, record_every : int
+        Keep (z, v, theta) of the first ``record_paths`` paths every
+        ``record_every`` steps.
+    threads : int, optional
+        Number of threads (default: all cores). Results do not depend on it.
+    batch_paths : int, optional
+        Paths per compiled call (default: all, or chunks of about a second when
+        a progress bar is shown). Results do not depend on it.
+    progress : bool, optional
+        Progress bar (default: on when stderr is a terminal).
+    check_step : bool
+        Refuse steps that are too large (default True).
+
+    Returns
+    -------
+    SimulationResult
+    """
+    if not isinstance(harvester, Harvester):
+        raise ValueError(f"`harvester` must be a randvib.Harvester, got {type(harvester).__name__}")
+    for name in ("m", "c_m", "c_e", "k", "k3"):
+        if np.ndim(getattr(harvester, name)) != 0:
+            raise ValueError(f"simulate needs scalar harvester parameters; `{name}` is an array")
+    scheme = integrator(method)
+    psd = float(check_positive("psd", psd, "(m/s^2)^2/Hz"))
+    t_end = float(check_positive("t_end", t_end, "s"))
+    dt = float(check_positive("dt", dt, "s"))
+    burn_in = float(np.asarray(burn_in, dtype=float))
+    if not (np.isfinite(burn_in) and 0.0 <= burn_in < t_end):
+        raise ValueError(
+            f"`burn_in` must satisfy 0 <= burn_in < t_end = {t_end!r} s, got {burn_in!r}"
+        )
+    n_paths = check_int("n_paths", n_paths, 1)
+    seed = check_int("seed", seed, 0)
+    first_path = check_int("first_path", first_path, 0)
+    record_paths = check_int("record_paths", record_paths, 0)
+    record_every = check_int("record_every", record_every, 1)
+    histogram_bins = check_int("histogram_bins", histogram_bins, 0)
+    n_steps = int(round(t_end / dt))
+    n_burn = int(round(burn_in / dt))
+    if n_steps - n_burn < 1:
+        raise ValueError(
+            f"`t_end` - `burn_in` = {t_end - burn_in!r} s holds no step of dt = {dt!r} s"
+        )
+    if check_step:
+        _check_step(method, harvester, psd, dt)
+
+    friction = harvester.friction
+    fr_kind = 0 if friction is None else friction.kernel_code
+    fr_p = np.zeros(5) if friction is None else friction.kernel_parameters()
+
+    # Initial state.
+    if isinstance(initial, str):
+        check_choice("initial", initial, ("stationary", "rest"))
+        if initial == "rest":
+            init_mode, init_z, init_v = 0, 0.0, 0.0
+        else:
+            c_eff = effective_linear_device(harvester, psd)[1]
+            vv = psd * harvester.m / (4.0 * c_eff)
+            init_mode, init_z, init_v = (
+                1,
+                float(np.sqrt(linear_displacement_variance(harvester, vv))),
+                float(np.sqrt(vv)),
+            )
+    else:
+        z0, v0 = (float(x) for x in initial)
+        if not (np.isfinite(z0) and np.isfinite(v0)):
+            raise ValueError(f"`initial` state must be finite, got {initial!r}")
+        init_mode, init_z, init_v = 0, z0, v0
+
+    if dW is not None:
+        dW = np.ascontiguousarray(dW, dtype=float)
+        if dW.shape != (n_paths, n_steps):
+            raise ValueError(
+                f"`dW` must have shape (n_paths, n_steps) = {(n_paths, n_steps)}, got {dW.shape}"
+            )
+        if not np.all(np.isfinite(dW)):
+            raise ValueError("`dW` must be finite")
+    if histogram_bins > 0:
+        if histogram_range is None:
+            c_eff = effective_linear_device(harvester, psd)[1]
+            vv = psd * harvester.m / (4.0 * c_eff)
+            sz, sv = float(np.sqrt(linear_displacement_variance(harvester, vv))), float(np.sqrt(vv))
+            histogram_range = ((-5 * sz, 5 * sz), (-5 * sv, 5 * sv))
+        rng_arr = np.asarray(histogram_range, dtype=float)
+        if rng_arr.shape != (2, 2) or np.any(rng_arr[:, 1] <= rng_arr[:, 0]):
+            raise ValueError(
+                f"`histogram_range` must be ((z_lo, z_hi), (v_lo, v_hi)) with lo < hi, got {histogram_range!r}"
+            )
+        hist_lo, hist_hi = rng_arr[:, 0].copy(), rng_arr[:, 1].copy()
+    else:
+        hist_lo, hist_hi = np.zeros(2), np.ones(2)
+
+    if threads is not None:
+        threads = check_int("threads", threads, 1)
+        numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+    if progress is None:
+        progress = sys.stderr.isatty() and os.environ.get("CI") is None
+
+    batches = _batches(n_paths, batch_paths, n_steps, progress, record_paths)
+    per_path = np.empty((n_paths, engine.N_ACC))
+    hist_total = np.zeros((2, max(histogram_bins, 1)), dtype=np.int64)
+    records = None
+    bar = None
+    if progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=n_paths, unit="path", desc="simulate", leave=False, delay=3.0)
+    started = time.perf_counter()
+    try:
+        for lo, hi in batches:
+            dw_batch = dW[lo:hi] if dW is not None else np.zeros((0, 0))
+            acc, failed, hist, rec = engine.run_ensemble(
+                scheme.kernel_code,
+                fr_kind,
+                fr_p,
+                float(harvester.m),
+                float(harvester.c),
+                float(harvester.k),
+                float(harvester.k3),
+                np.sqrt(psd / 2.0),
+                dt,
+                n_steps,
+                n_burn,
+                np.uint64(seed),
+                first_path + lo,
+                hi - lo,
+                init_mode,
+                init_z,
+                init_v,
+                dw_batch,
+                companion,
+                hist_lo,
+                hist_hi,
+                histogram_bins,
+                max(0, min(record_paths - lo, hi - lo)),
+                record_every,
+                ZIG_KI,
+                ZIG_WI,
+                ZIG_FI,
+            )
+            bad = np.flatnonzero(failed >= 0)
+            if bad.size:
+                p = bad[0]
+                raise SimulationDivergedError(
+                    f"simulation diverged: path {first_path + lo + p} became non-finite by step "
+                    f"{failed[p]} (t = {failed[p] * dt:.6g} s) with dt = {dt!r} s, method {method}, "
+                    f"psd = {psd!r}, parameters {harvester.parameters()}"
+                )
+            per_path[lo:hi] = acc
+            if histogram_bins > 0:
+                hist_total += hist.sum(axis=0)
+            if lo == 0 and record_paths > 0:
+                records = rec
+            if bar is not None:
+                bar.update(hi - lo)
+    finally:
+        if bar is not None:
+            bar.close()
+    wall = time.perf_counter() - started
+
+    histogram = None
+    if histogram_bins > 0:
+        n_samples = n_paths * (n_steps - n_burn)
+        z_edges = np.linspace(hist_lo[0], hist_hi[0], histogram_bins + 1)
+        v_edges = np.linspace(hist_lo[1], hist_hi[1], histogram_bins + 1)
+        histogram = Histogram(
+            z_edges,
+            hist_total[0] / (n_samples * np.diff(z_edges)),
+            v_edges,
+            hist_total[1] / (n_samples * np.diff(v_edges)),
+            (1 - hist_total[0].sum() / n_samples, 1 - hist_total[1].sum() / n_samples),
+        )
+    histories = None
+    if records is not None:
+        n_rec = records.shape[1]
+        histories = Histories(
+            np.arange(n_rec) * record_every * dt,
+            records[:, :, 0].copy(),
+            records[:, :, 1].copy(),
+            records[:, :, 2].copy(),
+        )
+    return SimulationResult(
+        harvester=harvester,
+        psd=psd,
+        method=method,
+        dt=dt,
+        t_end=n_steps * dt,
+        burn_in=n_burn * dt,
+        seed=seed,
+        first_path=first_path,
+        per_path=per_path,
+        control_variates=control_variates,
+        histogram=histogram,
+        histories=histories,
+        wall_time=wall,
+    )
+
+
+def _batches(n_paths, batch_paths, n_steps, progress, record_paths):
+    if batch_paths is None:
+        if progress:
+            # about 1e8 path-steps per call: a second or so, for a live bar
+            batch_paths = max(engine.LANES * numba.get_num_threads(), int(1e8 // max(n_steps, 1)))
+        else:
+            batch_paths = n_paths
+    batch_paths = check_int("batch_paths", batch_paths, 1)
+    batch_paths = max(batch_paths, min(record_paths, n_paths))  # records come from batch 0
+    edges = list(range(0, n_paths, batch_paths)) + [n_paths]
+    return list(zip(edges[:-1], edges[1:], strict=True))
