@@ -13,6 +13,8 @@ import numpy as np
 from scipy import optimize
 
 from randvib._validation import check_choice, check_nonnegative, check_positive
+from randvib.averaging import averaging_statistics
+from randvib.fokker_planck import fpk_statistics
 from randvib.harvester import Harvester
 from randvib.linearisation import equivalent_damping, linear_displacement_variance
 
@@ -97,8 +99,28 @@ def _linearisation(harvester: Harvester, psd) -> PowerPrediction:
     )
 
 
+def _averaging(harvester: Harvester, psd) -> PowerPrediction:
+    r = averaging_statistics(harvester, psd)
+    return _finish(
+        harvester,
+        "averaging",
+        r.velocity_variance,
+        r.displacement_variance,
+        r.mean_abs_velocity,
+        psd,
+    )
+
+
+def _fpk(harvester: Harvester, psd) -> PowerPrediction:
+    vv, zz, av = fpk_statistics(harvester, psd)
+    return _finish(harvester, "fpk", vv, zz, av, psd)
+
+
 #: Analytic methods by name: callables (harvester, psd) -> PowerPrediction.
-METHODS = {"linearisation": _linearisation}
+#: ``"averaging"``: energy-envelope stochastic averaging (randvib.averaging);
+#: ``"fpk"``: finite-volume stationary FPK solution (randvib.fokker_planck),
+#: the slow reference.
+METHODS = {"linearisation": _linearisation, "averaging": _averaging, "fpk": _fpk}
 
 
 def predict(harvester: Harvester, psd, method: str = "linearisation") -> PowerPrediction:
@@ -111,7 +133,10 @@ def predict(harvester: Harvester, psd, method: str = "linearisation") -> PowerPr
     psd : array_like
         One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0 (paper Eq. 17).
     method : str
-        A key of :data:`METHODS` (``"linearisation"``: paper Eq. 19-32).
+        A key of :data:`METHODS`: ``"linearisation"`` (paper Eq. 19-32),
+        ``"averaging"`` (stochastic averaging, beyond Gaussian closure) or
+        ``"fpk"`` (grid solution of the stationary FPK equation; reference,
+        about 0.5 s per point).
     """
     check_choice("method", method, tuple(METHODS))
     check_positive("psd", psd, "(m/s^2)^2/Hz")
