@@ -5,6 +5,13 @@ modelling of friction in a randomly excited energy harvester". SI units
 throughout; S is the one-sided PSD of the base acceleration in (m/s^2)^2/Hz.
 """
 
+from randvib.averaging import (
+    AveragingValidityWarning,
+    averaging_statistics,
+    energy_density,
+    orbit_averages,
+)
+from randvib.fokker_planck import fpk_statistics, solve_fpk
 from randvib.friction import Coulomb, FrictionModel, LuGre, Tanh
 from randvib.harvester import ElectricalCoupling, Harvester
 from randvib.integrators import INTEGRATORS, Integrator
@@ -30,6 +37,7 @@ from randvib.simulation import (
 __version__ = "0.1.0"
 
 __all__ = [
+    "AveragingValidityWarning",
     "Coulomb",
     "ElectricalCoupling",
     "FrictionModel",
@@ -55,4 +63,9 @@ __all__ = [
     "preset",
     "simulate",
     "velocity_variance",
+    "averaging_statistics",
+    "energy_density",
+    "fpk_statistics",
+    "orbit_averages",
+    "solve_fpk",
 ]

@@ -20,7 +20,9 @@ def register(sub) -> None:
     p.add_argument(
         "--method",
         default="linearisation",
-        help=f"analytic method: {', '.join(METHODS)} (default linearisation)",
+        help=f"analytic method: {', '.join(METHODS)} (default linearisation, paper Eq. 32; "
+        "averaging: stochastic averaging, non-Gaussian velocity and k3 effects; "
+        "fpk: grid solution of the FPK equation, slow reference)",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(handler=run)
