@@ -1,0 +1,156 @@
+"""Engine speed and memory (issue 3), as ratios to baselines measured in the same run.
+
+Run:  python -m pytest benchmarks/bench_engine.py --benchmark-only -s
+
+Device: figure9 preset with k3 = 5e5 N/m^3 (Duffing + Coulomb), dt = 1e-4 s,
+10^4 paths, all cores. Baselines:
+* the random-number floor: numpy's default Generator drawing the same number
+  of standard normals, one generator per core, in threads;
+* sdeint.itoEuler on one path;
+* a plain vectorised numpy Euler-Maruyama loop over all paths.
+A module fixture prints ns per path-step and the ratios, and writes
+.benchmarks/engine_ratios.json. Set RANDVIB_BENCH_FULL_MEMORY=1 to also run the
+10^5 paths x 10^6 steps memory case (about 10 minutes on 2 cores).
+"""
+
+import os
+import subprocess
+import sys
+import textwrap
+from concurrent.futures import ThreadPoolExecutor
+
+import numba
+import numpy as np
+import pytest
+import sdeint
+from conftest import TIMINGS, record, write_report
+
+import randvib as rv
+from randvib.simulation import simulate
+
+DEVICE = rv.preset("figure9").updated(k3=5e5)
+PSD, DT, N_PATHS, N_STEPS = 1.0, 1e-4, 10_000, 1_000
+WORK = N_PATHS * N_STEPS
+CORES = numba.config.NUMBA_NUM_THREADS
+
+
+def _run(method):
+    return simulate(
+        DEVICE,
+        PSD,
+        t_end=N_STEPS * DT,
+        dt=DT,
+        n_paths=N_PATHS,
+        method=method,
+        seed=1,
+        check_step=False,
+        progress=False,
+    )
+
+
+def test_random_number_floor(benchmark):
+    generators = [np.random.default_rng(i) for i in range(CORES)]
+    out = np.empty((CORES, WORK // CORES))
+
+    def draw():
+        with ThreadPoolExecutor(CORES) as pool:
+            list(pool.map(lambda i: generators[i].standard_normal(out=out[i]), range(CORES)))
+
+    benchmark.pedantic(draw, rounds=5, warmup_rounds=1)
+    record(benchmark, "floor", WORK)
+
+
+@pytest.mark.parametrize("method", ["euler-maruyama", "heun"])
+def test_engine(benchmark, method):
+    _run(method)  # compile / load cache
+    benchmark.pedantic(_run, args=(method,), rounds=5, warmup_rounds=1)
+    record(benchmark, method, WORK)
+
+
+def test_sdeint_one_path(benchmark):
+    m, c, k, k3, fc = DEVICE.m, DEVICE.c, DEVICE.k, DEVICE.k3, DEVICE.friction.fc
+    amp = np.sqrt(PSD / 2)
+    n = 2_000
+    tspan = np.linspace(0, n * DT, n + 1)
+    dw = np.random.default_rng(0).normal(0, np.sqrt(DT), (n, 1))
+
+    def f(y, t):
+        return np.array([y[1], -(c * y[1] + k * y[0] + k3 * y[0] ** 3 + fc * np.sign(y[1])) / m])
+
+    def g(y, t):
+        return np.array([[0.0], [amp]])
+
+    benchmark.pedantic(lambda: sdeint.itoEuler(f, g, np.zeros(2), tspan, dW=dw), rounds=3)
+    record(benchmark, "sdeint", n)
+
+
+def test_numpy_loop(benchmark):
+    m, c, k, k3, fc = DEVICE.m, DEVICE.c, DEVICE.k, DEVICE.k3, DEVICE.friction.fc
+    amp = np.sqrt(PSD / 2) * np.sqrt(DT)
+    n_steps = 200
+
+    def loop():
+        rng = np.random.default_rng(0)
+        z = np.zeros(N_PATHS)
+        v = np.zeros(N_PATHS)
+        acc = np.zeros(N_PATHS)
+        for _ in range(n_steps):
+            a = -(c * v + k * z + k3 * z**3 + fc * np.sign(v)) / m
+            z = z + v * DT
+            v = v + a * DT + amp * rng.standard_normal(N_PATHS)
+            acc += v * v
+        return acc
+
+    benchmark.pedantic(loop, rounds=3, warmup_rounds=1)
+    record(benchmark, "numpy", N_PATHS * n_steps)
+
+
+MEMORY_SCRIPT = textwrap.dedent(
+    """
+    import resource, sys
+    import randvib as rv
+    from randvib.simulation import simulate
+    device = rv.preset("figure9").updated(k3=5e5)
+    n_paths, n_steps = int(sys.argv[1]), int(sys.argv[2])
+    simulate(device, 1.0, t_end=0.01, dt=1e-4, n_paths=16, progress=False)  # compile
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    simulate(device, 1.0, t_end=n_steps * 1e-4, dt=1e-4, n_paths=n_paths, progress=False)
+    after = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    print(before / 1024, after / 1024)
+    """
+)
+
+
+def _peak_memory(n_paths, n_steps):
+    out = subprocess.run(
+        [sys.executable, "-c", MEMORY_SCRIPT, str(n_paths), str(n_steps)],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout.split()
+    return float(out[0]), float(out[1])
+
+
+@pytest.fixture(scope="module", autouse=True)
+def ratios_and_memory():
+    """After the module: print and store ns per path-step, ratios and peak memory."""
+    yield
+    needed = {"floor", "euler-maruyama", "heun", "sdeint", "numpy"}
+    if not needed <= TIMINGS.keys():
+        return  # a subset was run: no ratios
+    ns = {name: TIMINGS[name] * 1e9 for name in needed}
+    cases = [(100_000, 1_000), (100_000, 10_000)]
+    if os.environ.get("RANDVIB_BENCH_FULL_MEMORY"):
+        cases.append((100_000, 1_000_000))
+    memory = {f"{p}x{s}": _peak_memory(p, s) for p, s in cases}
+    report = {
+        "cores": CORES,
+        "ns_per_path_step": ns,
+        "euler_maruyama_over_floor": ns["euler-maruyama"] / ns["floor"],
+        "heun_over_floor": ns["heun"] / ns["floor"],
+        "sdeint_over_euler_maruyama": ns["sdeint"] / ns["euler-maruyama"],
+        "numpy_loop_over_euler_maruyama": ns["numpy"] / ns["euler-maruyama"],
+        "peak_rss_mb_before_after": memory,
+    }
+    path = write_report("engine_ratios", report)
+    print("\n" + "\n".join(f"{k}: {v}" for k, v in report.items()) + f"\n(written to {path})")
