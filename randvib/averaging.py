@@ -105,9 +105,14 @@ AVERAGING_ZETA_LIMIT = 0.5
 _N_PHI = 16
 _SIN2 = np.sin((np.arange(_N_PHI) + 0.5) * (0.5 * np.pi / _N_PHI)) ** 2
 
-# Energy grid in x = sqrt(H): composite Gauss-Legendre, equal panels on [0, 1]
-# scaled by x_max per point.
-_N_PANELS = 10
+# Energy grid in x = sqrt(H): composite Gauss-Legendre on panels of [0, 1]
+# scaled by x_max per point: uniform (width 0.1) above 0.1 and geometric below,
+# down to 1e-6. The orbit quantities change character near x_t = omega /
+# sqrt(k3/k) (quadratic to quartic potential), which can sit anywhere in
+# [0, x_max]; a panel never exceeds its distance from the origin, so such a
+# near-singularity at distance x_t is resolved wherever it falls.
+_EDGES = np.concatenate(([0.0], np.geomspace(1e-6, 0.1, 11)[:-1], np.linspace(0.1, 1.0, 10)))
+_N_PANELS = len(_EDGES) - 1
 _N_GL = 12
 _GL_T, _GL_W = np.polynomial.legendre.leggauss(_N_GL)
 #: Psi at the end of the energy grid: the density there is exp(-70).
@@ -126,8 +131,9 @@ def _integration_matrix(t: np.ndarray) -> np.ndarray:
 
 
 _GL_Q = _integration_matrix(_GL_T)
-_X_UNIT = ((np.arange(_N_PANELS)[:, None] + 0.5 * (1.0 + _GL_T[None, :])) / _N_PANELS).ravel()
-_W_UNIT = np.tile(_GL_W / (2.0 * _N_PANELS), _N_PANELS)
+_HALF_UNIT = 0.5 * np.diff(_EDGES)  # panel half-widths
+_X_UNIT = (_EDGES[:-1, None] + _HALF_UNIT[:, None] * (1.0 + _GL_T[None, :])).ravel()
+_W_UNIT = (_HALF_UNIT[:, None] * _GL_W[None, :]).ravel()
 
 # Tanh friction: the boundary layer where tanh(beta v) departs from sgn(v)
 # sits at the turning point (t = pi/2 - phi -> 0) with a width 1/(beta omega A)
@@ -286,7 +292,7 @@ def _moments_on_grid(x_max, gamma, omega, lam, fcm, beta, dd):
     # dPsi/dx = 2x dPsi/dH; finite at x -> 0 because J/Phi ~ 1/x there.
     dpsi = 2.0 * x * (2.0 * gamma / ddc + 8.0 * work / (ddc * area))
     panels = dpsi.reshape(len(x_max), _N_PANELS, _N_GL)
-    half = 0.5 * x_max[:, None, None] / _N_PANELS
+    half = x_max[:, None, None] * _HALF_UNIT[None, :, None]
     within = half * np.einsum("ij,bpj->bpi", _GL_Q, panels)  # from each panel's start
     totals = half[..., 0] * np.einsum("j,bpj->bp", _GL_W, panels)
     ends = np.cumsum(totals, axis=1)
@@ -362,9 +368,18 @@ def averaging_statistics(harvester: Harvester, psd, *, warn: bool = True) -> Ave
     flat = [np.ravel(a) for a in (m, c, k, k3, fc, beta, psd)]
     n = flat[0].size
     vv, abs_v, zz, fpow = (np.empty(n) for _ in range(4))
-    for start in range(0, n, _CHUNK):
-        sl = slice(start, start + _CHUNK)
-        vv[sl], abs_v[sl], zz[sl], fpow[sl], _ = _moments(*(a[sl] for a in flat))
+    # Absurd inputs (no damping to speak of) overflow; they are refused below.
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        for start in range(0, n, _CHUNK):
+            sl = slice(start, start + _CHUNK)
+            vv[sl], abs_v[sl], zz[sl], fpow[sl], _ = _moments(*(a[sl] for a in flat))
+    if not np.all(np.isfinite(vv) & np.isfinite(zz) & (zz > 0)):
+        bad = int(np.argmin(np.isfinite(vv) & np.isfinite(zz) & (zz > 0)))
+        raise ValueError(
+            "stochastic averaging found no finite stationary moments for c = "
+            f"{flat[1][bad]!r} Ns/m, fc = {flat[4][bad]!r} N, psd = {flat[6][bad]!r}: "
+            "damping and friction are too small for this excitation"
+        )
     m_f, psd_f = flat[0], flat[-1]
     c_eq = psd_f * m_f / (4.0 * vv)
     k_eq = m_f * vv / zz

@@ -21,7 +21,11 @@ Discretisation (finite volumes, zero-flux box):
 * the null vector of the sparse matrix, normalised to unit mass, by one
   sparse LU solve with one balance equation replaced by the normalisation.
 
-The scheme is second order in the cell size away from the Coulomb kink; the
+Central fluxes do not guarantee positivity: the density undershoots by
+about 1e-8 of its peak in the far tails, which no moment notices.
+
+The scheme is second order in the cell size (the Coulomb kink sits on a
+face and does not spoil it); the
 convergence test (tests/test_fokker_planck.py) measures the order against the
 exact Gibbs density of the frictionless oscillator. Domain size is set from
 the frictionless Gibbs density, whose tails bound the frictional ones: the
