@@ -1,0 +1,307 @@
+"""Study ``figure9``: the paper's Figure 9, with error bars and statistical verdicts.
+
+Paper Section 5: c_m = c_e = 0.1 Ns/m, S = 1, 0.5, 0.1 (m/s^2)^2/Hz,
+k3 = 0 (panel a) and 5e5 N/m^3 (panel b), other parameters from Table 2
+(Coulomb, training data 1; m = 0.0226 kg assumed). Expected electrical power
+against Fc: Monte Carlo points with 95 % intervals over the Eq. 32 curves.
+
+Verdicts: equivalent linearisation vs Monte Carlo at every point, and the
+Duffing-Coulomb interaction contrast
+[P(Fc, k3) - P(Fc, 0)] - [P(0, k3) - P(0, 0)] from paired
+common-random-number paths; plus a half-step re-run showing the time-step
+bias is below the statistical error.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from randvib._io import atomic_write_text, prepare_output_dir
+from randvib.prediction import METHODS, expected_power
+from randvib.presets import preset
+from randvib.studies._common import (
+    fc_where_power_halves,
+    markdown_table,
+    save_figure,
+    step_size_check,
+    write_report,
+)
+from randvib.sweep import (
+    SweepSettings,
+    cartesian,
+    holm_significant,
+    linearisation_verdicts,
+    make_executor,
+    paired_contrast,
+    run_sweep,
+    two_sided_p_value,
+)
+
+PSDS = (1.0, 0.5, 0.1)
+K3S = (0.0, 5e5)
+
+
+def study_points(n_fc: int) -> list[dict]:
+    base = preset("figure9")
+    points = []
+    for psd in PSDS:
+        fc_max = 2.0 * fc_where_power_halves(base, psd)  # well past half power
+        points += cartesian(psd=[psd], k3=list(K3S), fc=np.linspace(0, fc_max, n_fc))
+    return points
+
+
+def settings_for(quick: bool, seed: int) -> SweepSettings:
+    if quick:
+        return SweepSettings(
+            target_rel_ci=0.01, window=1.0, burn_in=0.5, seed=seed, min_paths=64, batch_paths=64
+        )
+    # 128 paths at least: paired contrasts regress on up to a dozen controls
+    return SweepSettings(
+        target_rel_ci=0.005, window=2.0, burn_in=0.5, seed=seed, min_paths=128, batch_paths=64
+    )
+
+
+def interaction_table(result, base, points) -> pd.DataFrame:
+    """Paired contrasts for every (S, Fc > 0, k3 > 0) of the sweep."""
+    index = {(p["psd"], p["k3"], p["fc"]): i for i, p in enumerate(points)}
+    rows = []
+    for (psd, k3, fc), i in index.items():
+        if k3 == 0 or fc == 0:
+            continue
+        w = {
+            i: 1.0,
+            index[(psd, 0.0, fc)]: -1.0,
+            index[(psd, k3, 0.0)]: -1.0,
+            index[(psd, 0.0, 0.0)]: 1.0,
+        }
+        s = paired_contrast(result, base, w)
+        reference = result.table.loc[index[(psd, 0.0, fc)], "power_electrical"]
+        rows.append(
+            {
+                "psd": psd,
+                "k3": k3,
+                "fc": fc,
+                "contrast": s.mean,
+                "contrast_ci95": s.ci95,
+                "relative_contrast": s.mean / reference,
+                "relative_ci95": s.ci95 / reference,
+                "p_value": two_sided_p_value(s),
+                "detectable": abs(s.mean) > s.ci95,
+            }
+        )
+    table = pd.DataFrame(rows)
+    table["detectable_holm"] = holm_significant(table.p_value)
+    return table
+
+
+def plot(table: pd.DataFrame, base, out: Path) -> Path:
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(len(PSDS), 2, figsize=(10, 10), sharex="row", squeeze=False)
+    for col, k3 in enumerate(K3S):
+        for row, psd in enumerate(PSDS):
+            ax = axes[row, col]
+            sub = table[(table.psd == psd) & (table.k3 == k3)].sort_values("fc")
+            fc = np.linspace(0, sub.fc.max(), 200)
+            device = base.updated(k3=k3, fc=fc)
+            ax.plot(fc, expected_power(device, psd) * 1e3, "k-", label="Eq. 32 (linearisation)")
+            if "averaging" in METHODS:
+                try:
+                    ax.plot(
+                        fc,
+                        np.asarray(expected_power(device, psd, "averaging")) * 1e3,
+                        "b--",
+                        lw=1,
+                        label="stochastic averaging",
+                    )
+                except Exception:  # noqa: BLE001 - the extra curve is optional
+                    pass
+            ax.errorbar(
+                sub.fc,
+                sub.power_electrical * 1e3,
+                yerr=sub.power_electrical_ci95 * 1e3,
+                fmt="rx",
+                ms=6,
+                capsize=3,
+                label="Monte Carlo (95 % CI)",
+            )
+            ax.set_title(
+                f"({'ab'[col]}) k3 = {k3:g} N/m$^3$, S = {psd:g} (m/s$^2$)$^2$/Hz", fontsize=9
+            )
+            ax.set_ylabel("E[P$_e$] (mW)")
+            ax.grid(alpha=0.3)
+            if row == len(PSDS) - 1:
+                ax.set_xlabel("Coulomb friction Fc (N)")
+    axes[0, 0].legend(fontsize=8)
+    fig.suptitle("Paper Figure 9: expected electrical power against Coulomb friction")
+    return save_figure(fig, out / "figure9.png")
+
+
+def plot_interaction(inter: pd.DataFrame, out: Path) -> Path:
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for psd in PSDS:
+        sub = inter[inter.psd == psd].sort_values("fc")
+        ax.errorbar(
+            sub.fc,
+            100 * sub.relative_contrast,
+            yerr=100 * sub.relative_ci95,
+            fmt="o-",
+            capsize=3,
+            label=f"S = {psd:g}",
+        )
+    ax.axhline(0, color="k", lw=0.8)
+    ax.set_xlabel("Coulomb friction Fc (N)")
+    ax.set_ylabel("interaction contrast / P(Fc, k3=0) (%)")
+    ax.set_title("Duffing-Coulomb interaction at k3 = 5e5 N/m$^3$ (95 % CI, paired paths)")
+    ax.legend()
+    ax.grid(alpha=0.3)
+    return save_figure(fig, out / "interaction.png")
+
+
+def run_study(
+    out_dir,
+    *,
+    quick: bool = False,
+    seed: int = 0,
+    workers=None,
+    scheduler=None,
+    progress: bool = True,
+) -> Path:
+    """Run the Figure 9 study; write figures, CSVs and ``report.md`` into ``out_dir``."""
+    base = preset("figure9")
+    n_fc = 7 if quick else 13
+    points = study_points(n_fc)
+    settings = settings_for(quick, seed)
+    out = prepare_output_dir(out_dir, {"study": "figure9", "quick": quick, "seed": seed})
+    executor, close = make_executor(workers, scheduler)
+    try:
+        result = run_sweep(
+            base,
+            points,
+            settings,
+            out_dir=out / "sweep",
+            executor=executor,
+            progress=progress,
+            name="figure9",
+        )
+        # half-step check on the highest-friction points (largest nonlinearity)
+        check_points = [
+            p for p in points if p["fc"] == max(q["fc"] for q in points if q["psd"] == p["psd"])
+        ]
+        check = step_size_check(
+            base,
+            check_points,
+            settings,
+            out / "step-check",
+            result.table,
+            executor=executor,
+            progress=progress,
+        )
+    finally:
+        close()
+    table = linearisation_verdicts(result.table)
+    inter = interaction_table(result, base, points)
+    atomic_write_text(out / "results.csv", table.to_csv(index=False))
+    atomic_write_text(out / "interaction.csv", inter.to_csv(index=False))
+    atomic_write_text(out / "step_check.csv", check.to_csv(index=False))
+    curves = []
+    for psd in PSDS:
+        for k3 in K3S:
+            fc = np.linspace(0, table[table.psd == psd].fc.max(), 200)
+            curves.append(
+                pd.DataFrame(
+                    {
+                        "psd": psd,
+                        "k3": k3,
+                        "fc": fc,
+                        "linearisation_power": expected_power(base.updated(k3=k3, fc=fc), psd),
+                    }
+                )
+            )
+    atomic_write_text(out / "curves.csv", pd.concat(curves).to_csv(index=False))
+    fig_main = plot(table, base, out)
+    fig_inter = plot_interaction(inter, out)
+
+    err = table["linearisation_rel_error"]
+    worst = table.loc[err.abs().idxmax()]
+    n_bad = int((~table["linearisation_consistent"]).sum())
+    lin_body = (
+        f"{len(table)} points; the Monte Carlo 95 % half-width is at most "
+        f"{100 * (table.power_electrical_ci95 / table.power_electrical).max():.2f} % of the power "
+        f"(target {100 * settings.target_rel_ci:g} %; {int(table.n_paths.sum())} paths in all).\n\n"
+        f"Equivalent linearisation (Eq. 32) lies inside the Monte Carlo 95 % interval at "
+        f"{len(table) - n_bad} of {len(table)} points. Its largest error is "
+        f"{100 * worst.linearisation_rel_error:+.2f} % ± {100 * worst.linearisation_rel_error_ci95:.2f} % "
+        f"(S = {worst.psd:g}, k3 = {worst.k3:g}, Fc = {worst.fc:.4g} N). "
+        f"Errors beyond 1 %: {int((err.abs() > 0.01).sum())} points; beyond 5 %: "
+        f"{int((err.abs() > 0.05).sum())}.\n\n"
+        "Verdict on the paper's first claim: Eq. 32 tracks the simulated power closely over the "
+        "figure's range, but at the resolution of these intervals it is statistically distinguishable "
+        "at the higher friction levels, where it over-predicts the power (the velocity is no longer "
+        "Gaussian: sticking concentrates probability at z' = 0).\n\n"
+        + markdown_table(
+            table[
+                [
+                    "psd",
+                    "k3",
+                    "fc",
+                    "linearisation_power",
+                    "power_electrical",
+                    "power_electrical_ci95",
+                    "linearisation_rel_error",
+                    "linearisation_consistent",
+                    "n_paths",
+                ]
+            ]
+        )
+    )
+    n_det = int(inter.detectable.sum())
+    n_holm = int(inter.detectable_holm.sum())
+    big = inter.loc[inter.relative_contrast.abs().idxmax()]
+    inter_body = (
+        f"Contrast [P(Fc,k3) - P(Fc,0)] - [P(0,k3) - P(0,0)] at k3 = 5e5 N/m^3 from paired paths "
+        f"(same noise at every point). Detectable (|contrast| > 95 % half-width) at {n_det} of "
+        f"{len(inter)} (S, Fc) points; the largest relative contrast is "
+        f"{100 * big.relative_contrast:+.2f} % ± {100 * big.relative_ci95:.2f} % "
+        f"(S = {big.psd:g}, Fc = {big.fc:.4g} N). The points share their paths (common random "
+        f"numbers), so their verdicts are correlated; with Holm's correction for {len(inter)} tests "
+        f"at family level 5 %, {n_holm} remain.\n\n"
+        "Verdict on the paper's second claim at its own k3: "
+        + (
+            "no interaction is detectable at this precision; any effect of the Duffing spring on "
+            "the friction-affected power is within the intervals above."
+            if n_holm == 0
+            else "an interaction is detectable: the Duffing spring changes the friction-affected "
+            "power by the amounts above (relative to P(Fc, 0)), which Eq. 32 cannot show."
+        )
+        + "\n\n"
+        + markdown_table(inter)
+    )
+    step_body = (
+        f"Re-run of {len(check)} highest-friction points at dt/2 = {settings.dt / 2:g} s (independent "
+        f"noise). Time-step bias below statistical error at {int(check.bias_below_error.sum())} of "
+        f"{len(check)} points.\n\n" + markdown_table(check)
+    )
+    return write_report(
+        out,
+        "Figure 9 study: equivalent linearisation and the Duffing-Coulomb interaction",
+        [
+            (
+                "Set-up",
+                f"Device: paper Section 5 (preset `figure9`: c_m = c_e = 0.1 Ns/m, k = 57.4 N/m, "
+                f"k3 as given, m = 0.0226 kg assumed). S = {', '.join(map(str, PSDS))} (m/s^2)^2/Hz; "
+                f"Fc from 0 to twice the level where Eq. 32 halves the power. Heun, dt = "
+                f"{settings.dt:g} s, {settings.burn_in:g} s burn-in + {settings.window:g} s per path, "
+                f"seed {seed}, control variates {'on' if settings.control_variates else 'off'}."
+                f"{' Quick mode.' if quick else ''}\n\n![Figure 9]({fig_main.name})",
+            ),
+            ("Equivalent linearisation against Monte Carlo", lin_body),
+            ("Duffing-Coulomb interaction", f"![interaction]({fig_inter.name})\n\n" + inter_body),
+            ("Time-step check", step_body),
+        ],
+    )
