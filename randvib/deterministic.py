@@ -193,9 +193,10 @@ def _hermite_root(hh, q0, d0, q1, d1):
 
 @numba.njit(cache=True)
 def _run_one(
-    par, kind, base_input, u, dt, nsub, linear, z0, v0, th0, zref, zlim, out_z, out_v, store
+    par, kind, base_input, u, dt, nsub, linear, z0, v0, th0, zref, skip, zlim, out_z, out_v, store
 ):
-    """Simulate one parameter set; return the sum of squared errors against zref."""
+    """Simulate one parameter set; return the sum of squared errors against zref
+    over the samples from index ``skip`` on."""
     m = par[0]
     c = par[1]
     k = par[2]
@@ -253,7 +254,7 @@ def _run_one(
             sgn = 1.0 if v > 0 else -1.0
 
     sse = 0.0
-    if have_ref:
+    if have_ref and skip == 0:
         sse = (z - zref[0]) ** 2
     if store:
         out_z[0] = z
@@ -344,7 +345,7 @@ def _run_one(
                     out_z[r] = math.nan
                     out_v[r] = math.nan
             return math.inf
-        if have_ref:
+        if have_ref and i + 1 >= skip:
             sse += (z - zref[i + 1]) ** 2
         if store:
             out_z[i + 1] = z
@@ -354,7 +355,22 @@ def _run_one(
 
 @numba.njit(cache=True, parallel=True)
 def _run_batch(
-    params, kind, base_input, u, dt, nsub, linear, z0, v0, th0, zref, zlim, out_z, out_v, store
+    params,
+    kind,
+    base_input,
+    u,
+    dt,
+    nsub,
+    linear,
+    z0,
+    v0,
+    th0,
+    zref,
+    skip,
+    zlim,
+    out_z,
+    out_v,
+    store,
 ):
     n_pop = params.shape[0]
     sse = np.empty(n_pop)
@@ -362,12 +378,12 @@ def _run_batch(
         if store:
             sse[i] = _run_one(
                 params[i], kind, base_input, u, dt, nsub, linear, z0[i], v0[i], th0[i],
-                zref, zlim, out_z[i], out_v[i], True,
+                zref, skip, zlim, out_z[i], out_v[i], True,
             )  # fmt: skip
         else:
             sse[i] = _run_one(
                 params[i], kind, base_input, u, dt, nsub, linear, z0[i], v0[i], th0[i],
-                zref, zlim, out_z[0], out_v[0], False,
+                zref, skip, zlim, out_z[0], out_v[0], False,
             )  # fmt: skip
     return sse
 
@@ -510,6 +526,7 @@ def run_kernel(
     v0=0.0,
     theta0=0.0,
     reference=None,
+    skip=0,
     response_limit=np.inf,
     store=True,
 ):
@@ -535,6 +552,7 @@ def run_kernel(
         v0,
         th0,
         zref,
+        int(skip),
         float(response_limit),
         out_z,
         out_v,

@@ -110,7 +110,8 @@ class _Space:
 
     def to_x(self, unit):
         y = self.lo + np.asarray(unit) * (self.hi - self.lo)
-        x = np.where(self.log, np.exp(y), y)
+        x = np.array(y, dtype=float)
+        x[..., self.log] = np.exp(y[..., self.log])
         # exact bounds despite exp/log round-off
         return np.clip(x, self.bounds[:, 0], self.bounds[:, 1])
 

@@ -1,0 +1,101 @@
+"""Record and simulation options shared by ``identify`` and ``validate``."""
+
+from __future__ import annotations
+
+import argparse
+
+from randvib.deterministic import HOLDS, INPUT_KINDS
+from randvib.identification import OUTPUT_COLUMN, TIME_COLUMN, read_record
+
+
+def add_record_arguments(parser: argparse.ArgumentParser) -> None:
+    g = parser.add_argument_group("record (CSV columns)")
+    g.add_argument(
+        "--input-column", metavar="NAME", help="input column (default: the one named like its kind)"
+    )
+    g.add_argument("--input-kind", choices=INPUT_KINDS, help="what the input column holds")
+    g.add_argument(
+        "--output-column",
+        metavar="NAME",
+        default=OUTPUT_COLUMN,
+        help=f"relative-displacement column (default {OUTPUT_COLUMN})",
+    )
+    g.add_argument(
+        "--time-column", metavar="NAME", default=TIME_COLUMN, help="time column (s, uniform)"
+    )
+    g.add_argument(
+        "--sample-rate", type=float, metavar="HZ", help="sample rate when there is no time column"
+    )
+    g.add_argument(
+        "--rows",
+        metavar="START:STOP",
+        help="use data rows START:STOP only (0-based, STOP excluded)",
+    )
+    s = parser.add_argument_group("simulation")
+    s.add_argument("--substeps", type=int, default=None, help="integration steps per sample (4)")
+    s.add_argument("--hold", choices=HOLDS, default=None, help="input interpolation (linear)")
+    s.add_argument("--lowpass", type=float, metavar="HZ", help="low-pass the driving signal")
+    s.add_argument("--skip", type=int, default=None, help="samples left out of J at the start (0)")
+
+
+def parse_rows(text):
+    if text is None:
+        return None
+    parts = text.split(":")
+    try:
+        if len(parts) != 2:
+            raise ValueError
+        return tuple(int(p) if p.strip() else None for p in parts)
+    except ValueError:
+        raise ValueError(f"`--rows` must be START:STOP with integers, got {text!r}") from None
+
+
+def record_from_args(path, args, name=None):
+    return read_record(
+        path,
+        input_column=args.input_column,
+        input_kind=args.input_kind,
+        output_column=args.output_column,
+        time_column=args.time_column,
+        sample_rate=args.sample_rate,
+        rows=parse_rows(args.rows),
+        name=name,
+    )
+
+
+def simulation_settings(args, defaults=None) -> dict:
+    out = {"substeps": 4, "hold": "linear", "lowpass": None, "skip": 0}
+    out.update({k: v for k, v in (defaults or {}).items() if k in out})
+    for key in out:
+        value = getattr(args, key)
+        if value is not None:
+            out[key] = value
+    return out
+
+
+def parse_assignments(items, option: str) -> dict:
+    """``NAME=VALUE`` strings to a dict of floats."""
+    out = {}
+    for item in items or []:
+        name, sep, value = item.partition("=")
+        if not sep or not name.strip():
+            raise ValueError(f"`{option}` expects NAME=VALUE, got {item!r}")
+        try:
+            out[name.strip()] = float(value)
+        except ValueError:
+            raise ValueError(f"`{option} {name}`: value {value!r} is not a number") from None
+    return out
+
+
+def parse_bounds(items) -> dict:
+    out = {}
+    for item in items or []:
+        name, sep, value = item.partition("=")
+        lo, sep2, hi = value.partition(":")
+        try:
+            if not sep or not sep2:
+                raise ValueError
+            out[name.strip()] = (float(lo), float(hi))
+        except ValueError:
+            raise ValueError(f"`--bounds` expects NAME=LOWER:UPPER, got {item!r}") from None
+    return out

@@ -1,0 +1,102 @@
+"""``randvib validate PARAMS.json DATA.csv ...``: score identified parameters on other records."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from randvib.cli._output import print_table
+from randvib.cli._records import (
+    add_record_arguments,
+    parse_assignments,
+    record_from_args,
+    simulation_settings,
+)
+from randvib.identification import MODELS, validate
+
+
+def register(sub) -> None:
+    p = sub.add_parser(
+        "validate",
+        help="J (Eq. 11) of identified parameters on other records",
+        description="Simulate each record with parameters saved by `randvib identify --save` "
+        "(or printed by --json) and report J (Eq. 11) and the RMS error per record.",
+    )
+    p.add_argument(
+        "params", metavar="PARAMS.json", help="output of `randvib identify --json/--save`"
+    )
+    p.add_argument("data", nargs="+", metavar="DATA.csv", help="records to score")
+    p.add_argument(
+        "--set", action="append", metavar="NAME=VALUE", help="override a parameter value"
+    )
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument(
+        "--plot", metavar="DIR", help="write one measured-vs-simulated PNG per record into DIR"
+    )
+    add_record_arguments(p)
+    p.set_defaults(handler=run)
+
+
+def _load_parameters(path):
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"parameter file {str(path)!r} does not exist")
+    try:
+        data = json.loads(path.read_text())
+        model = data["model"]
+        parameters = {k: float(v) for k, v in data["parameters"].items()}
+    except (ValueError, KeyError, TypeError, AttributeError):
+        raise ValueError(
+            f"{str(path)!r} is not an identification result (JSON with 'model' and 'parameters')"
+        ) from None
+    if model not in MODELS:
+        raise ValueError(f"{str(path)!r}: model {model!r} is not one of {', '.join(MODELS)}")
+    return model, parameters, data.get("settings", {})
+
+
+def run(args) -> int:
+    model, parameters, saved = _load_parameters(args.params)
+    parameters.update(parse_assignments(args.set, "--set"))
+    settings = simulation_settings(args, saved)
+    plot_dir = None
+    if args.plot is not None:
+        plot_dir = Path(args.plot)
+        if plot_dir.exists() and any(plot_dir.iterdir()):
+            raise FileExistsError(f"`--plot` folder {str(plot_dir)!r} is not empty")
+        plot_dir.mkdir(parents=True, exist_ok=True)
+    records = [record_from_args(path, args) for path in args.data]
+    rows = validate(parameters, model, records, **settings)
+    if plot_dir is not None:
+        from randvib.identification import predict
+        from randvib.identification_plots import figure_fit
+
+        for i, record in enumerate(records):
+            pred = predict(parameters, model, record, **settings)
+            figure_fit(
+                pred, plot_dir / f"{i:02d}_{record.name}.png", title=f"{model} on {record.name}"
+            )
+    if args.json:
+        print(
+            json.dumps(
+                {
+                    "model": model,
+                    "parameters": parameters,
+                    "records": [
+                        {
+                            "record": r.record,
+                            "cost": r.cost,
+                            "rms_error": r.rms_error,
+                            "samples": r.samples,
+                        }
+                        for r in rows
+                    ],
+                }
+            )
+        )
+        return 0
+    print(f"model {model}")
+    print_table(
+        [[r.record, r.samples, r.cost, r.rms_error] for r in rows],
+        ["record", "samples", "J", "RMS error"],
+    )
+    return 0

@@ -1,0 +1,852 @@
+"""Identification of the device and friction models from time histories (paper Sec. 3-4).
+
+The model (paper Eq. 1) with one of four friction laws is fitted to a record
+by minimising the normalised cost (paper Eq. 11)
+
+    J(theta) = 100 / (N sigma_z^2) * sum_i (z_i - zhat_i(theta))^2
+
+with self-adaptive differential evolution (:func:`randvib.sade.sade`); a
+model that predicts the mean scores 100 (Eq. 12), J < 5 is a good fit and
+J < 1 excellent. Every generation's population is simulated in one batched,
+compiled call (:mod:`randvib.deterministic`).
+
+Models and their parameters (SI units):
+
+========  ============================================================
+viscous   c (Ns/m), k (N/m), k3 (N/m^3)  -- the paper's "no friction"
+coulomb   + fc (N)                                      (Eq. 4-5)
+tanh      + fc (N), beta (s/m)                          (Eq. 6)
+lugre     + sigma0 (N/m), sigma1 (Ns/m), fc (N), fs (N), vs (m/s)  (Eq. 8-10)
+========  ============================================================
+
+plus the mass ``m`` (kg). With base excitation the mass cannot be identified
+(dividing Eq. 1 by m leaves c/m, k/m, k3/m, F/m), so it must be given; with a
+force input it may be left free and is identified.
+
+The simulation starts from the measured first displacement and a velocity
+estimated from the first five samples (fourth-order one-sided difference);
+LuGre's bristle state starts at zero.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from randvib._validation import check_finite, check_int, check_positive
+from randvib.deterministic import (
+    FRICTION_PARAMETERS,
+    HOLDS,
+    INPUT_KINDS,
+    driving_signal,
+    parameter_matrix,
+    run_kernel,
+)
+from randvib.sade import sade
+
+#: Identification model name -> friction model of the simulator.
+MODELS = {"viscous": "none", "coulomb": "coulomb", "tanh": "tanh", "lugre": "lugre"}
+#: Parameters of each model, in reporting order (``m`` comes in addition).
+MODEL_PARAMETERS = {
+    name: ("c", "k", "k3") + FRICTION_PARAMETERS[friction] for name, friction in MODELS.items()
+}
+UNITS = {
+    "m": "kg",
+    "c": "Ns/m",
+    "k": "N/m",
+    "k3": "N/m^3",
+    "fc": "N",
+    "beta": "s/m",
+    "sigma0": "N/m",
+    "sigma1": "Ns/m",
+    "fs": "N",
+    "vs": "m/s",
+}
+#: Parameters searched on a log scale (they span decades); k3 may be zero.
+LOG_PARAMETERS = frozenset({"m", "c", "k", "fc", "beta", "sigma0", "sigma1", "fs", "vs"})
+OUTPUT_COLUMN = "relative_displacement"
+TIME_COLUMN = "time"
+#: Fewest samples per free parameter that a record must have.
+SAMPLES_PER_PARAMETER = 10
+
+
+# ----------------------------------------------------------------------- records
+@dataclass(frozen=True, eq=False)
+class Record:
+    """A measured (or synthetic) test: input and relative displacement on a uniform grid.
+
+    Attributes
+    ----------
+    dt : float
+        Sample interval (s).
+    input_kind : {'base_displacement', 'base_acceleration', 'force'}
+        What ``input`` is: base displacement y (m), base acceleration y''
+        (m/s^2) or force on the mass u (N).
+    input : ndarray
+        Input samples.
+    z : ndarray
+        Measured relative displacement (m).
+    name : str
+        Label used in tables and plots.
+    voltage : ndarray or None
+        Measured load voltage (V), if recorded.
+    """
+
+    dt: float
+    input_kind: str
+    input: np.ndarray
+    z: np.ndarray
+    name: str = "record"
+    voltage: np.ndarray | None = None
+
+    def __post_init__(self):
+        object.__setattr__(self, "dt", float(check_positive("dt", self.dt, "s")))
+        if self.input_kind not in INPUT_KINDS:
+            raise ValueError(
+                f"`input_kind` must be one of {', '.join(INPUT_KINDS)}; got {self.input_kind!r}"
+            )
+        inp = _finite_column(self.input_kind, self.input)
+        z = _finite_column(OUTPUT_COLUMN, self.z)
+        if inp.shape != z.shape:
+            raise ValueError(
+                f"input `{self.input_kind}` has {inp.size} samples but `{OUTPUT_COLUMN}` has {z.size}"
+            )
+        if z.size < 5:
+            raise ValueError(f"record {self.name!r} has {z.size} samples; at least 5 are needed")
+        object.__setattr__(self, "input", inp)
+        object.__setattr__(self, "z", z)
+        if self.voltage is not None:
+            object.__setattr__(self, "voltage", _finite_column("voltage", self.voltage))
+
+    @property
+    def n(self) -> int:
+        return self.z.size
+
+    @property
+    def time(self) -> np.ndarray:
+        return np.arange(self.n) * self.dt
+
+    @property
+    def sample_rate(self) -> float:
+        return 1.0 / self.dt
+
+    def rows(self, start=None, stop=None, name=None) -> Record:
+        """The samples ``start:stop`` as a new record."""
+        sl = slice(start, stop)
+        return Record(
+            self.dt,
+            self.input_kind,
+            self.input[sl],
+            self.z[sl],
+            name or f"{self.name}[{start or 0}:{'' if stop is None else stop}]",
+            None if self.voltage is None else self.voltage[sl],
+        )
+
+    def to_frame(self):
+        """The record as a DataFrame with the CSV column names."""
+        import pandas as pd
+
+        data = {TIME_COLUMN: self.time, self.input_kind: self.input, OUTPUT_COLUMN: self.z}
+        if self.voltage is not None:
+            data["voltage"] = self.voltage
+        return pd.DataFrame(data)
+
+    def to_csv(self, path) -> None:
+        """Write the record as CSV (refuses to overwrite an existing file)."""
+        path = Path(path)
+        if path.exists():
+            raise FileExistsError(f"{str(path)!r} exists; records are never overwritten")
+        self.to_frame().to_csv(path, index=False, float_format="%.10g")
+
+
+def _finite_column(name, values):
+    try:
+        arr = np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"column `{name}` must be numeric") from None
+    if arr.ndim != 1:
+        raise ValueError(f"column `{name}` must be one-dimensional, got shape {arr.shape}")
+    bad = np.flatnonzero(~np.isfinite(arr))
+    if bad.size:
+        raise ValueError(
+            f"column `{name}` has {bad.size} NaN or infinite sample(s), first at data row "
+            f"{bad[0]} (value {arr[bad[0]]!r}); clean or cut the record"
+        )
+    return arr
+
+
+def read_record(
+    path,
+    *,
+    input_column: str | None = None,
+    input_kind: str | None = None,
+    output_column: str = OUTPUT_COLUMN,
+    time_column: str = TIME_COLUMN,
+    sample_rate: float | None = None,
+    rows: tuple[int | None, int | None] | None = None,
+    name: str | None = None,
+) -> Record:
+    """Read a record from CSV (the file is only read, never modified).
+
+    The CSV needs a time column (s, uniform) or ``sample_rate``; one input
+    column named ``base_displacement`` (m), ``base_acceleration`` (m/s^2) or
+    ``force`` (N); and ``relative_displacement`` (m). Other names are mapped
+    with ``input_column``/``input_kind`` and ``output_column``.
+
+    Parameters
+    ----------
+    path : path-like
+    input_column : str, optional
+        Column holding the input; its kind is its name unless ``input_kind``
+        is given.
+    input_kind : {'base_displacement', 'base_acceleration', 'force'}, optional
+    output_column : str
+        Column holding the relative displacement.
+    time_column : str
+        Column of sample times (s); ignored when absent and ``sample_rate``
+        is given.
+    sample_rate : float, optional
+        Sample rate (Hz) for files without a time column.
+    rows : (start, stop), optional
+        Keep data rows ``start:stop`` (0-based, stop exclusive).
+    name : str, optional
+        Record label (default: the file name).
+
+    Raises
+    ------
+    ValueError
+        Missing or ambiguous columns, non-numeric, NaN or infinite samples,
+        a non-uniform time column, an inconsistent sample rate.
+    """
+    import pandas as pd
+
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"record file {str(path)!r} does not exist")
+    try:
+        frame = pd.read_csv(path)
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
+        raise ValueError(f"cannot read {str(path)!r} as CSV: {exc}") from None
+    columns = [str(c) for c in frame.columns]
+    frame.columns = columns
+    if input_kind is not None and input_kind not in INPUT_KINDS:
+        raise ValueError(
+            f"`input_kind` must be one of {', '.join(INPUT_KINDS)}; got {input_kind!r}"
+        )
+    if input_column is None:
+        present = [c for c in INPUT_KINDS if c in columns]
+        if input_kind is not None:
+            present = [input_kind] if input_kind in columns else []
+        if not present:
+            raise ValueError(
+                f"{path.name}: no input column; expected one of {', '.join(INPUT_KINDS)} "
+                f"(or name it with `--input-column`); columns are {columns}"
+            )
+        if len(present) > 1:
+            raise ValueError(
+                f"{path.name}: several input columns {present}; choose one with `--input-kind`"
+            )
+        input_column = present[0]
+    if input_column not in columns:
+        raise ValueError(
+            f"{path.name}: input column `{input_column}` not found; columns are {columns}"
+        )
+    if input_kind is None:
+        if input_column not in INPUT_KINDS:
+            raise ValueError(
+                f"input column `{input_column}` is not one of {', '.join(INPUT_KINDS)}; "
+                "say what it holds with `--input-kind`"
+            )
+        input_kind = input_column
+    if output_column not in columns:
+        raise ValueError(
+            f"{path.name}: output column `{output_column}` not found (relative displacement, m); "
+            f"columns are {columns}; map another name with `--output-column`"
+        )
+    if rows is not None:
+        frame = frame.iloc[slice(*rows)]
+    if len(frame) < 5:
+        raise ValueError(f"{path.name}: {len(frame)} data rows selected; at least 5 are needed")
+    if time_column in columns:
+        t = _finite_column(time_column, frame[time_column])
+        steps = np.diff(t)
+        dt = float(np.median(steps))
+        if dt <= 0:
+            raise ValueError(f"column `{time_column}` must increase, median step is {dt!r} s")
+        bad = np.flatnonzero(np.abs(steps - dt) > 1e-3 * dt)
+        if bad.size:
+            raise ValueError(
+                f"column `{time_column}` is not uniformly sampled: step {steps[bad[0]]!r} s "
+                f"at data row {bad[0] + 1}, median step {dt!r} s; resample the record"
+            )
+        if sample_rate is not None and abs(float(sample_rate) * dt - 1) > 1e-3:
+            raise ValueError(
+                f"`sample_rate` = {sample_rate} Hz disagrees with column `{time_column}` "
+                f"(step {dt} s, {1 / dt:.6g} Hz)"
+            )
+    elif sample_rate is not None:
+        dt = 1.0 / float(check_positive("sample_rate", sample_rate, "Hz"))
+    else:
+        raise ValueError(
+            f"{path.name}: no `{time_column}` column; give the sample rate with `--sample-rate`"
+        )
+    return Record(
+        dt=dt,
+        input_kind=input_kind,
+        input=_finite_column(input_column, frame[input_column]),
+        z=_finite_column(output_column, frame[output_column]),
+        name=name or path.stem,
+        voltage=(
+            _finite_column("voltage", frame["voltage"])
+            if "voltage" in columns and output_column != "voltage"
+            else None
+        ),
+    )
+
+
+# ------------------------------------------------------------------- cost (Eq. 11)
+def initial_velocity(z, dt):
+    """Velocity at the first sample from the first five (fourth-order one-sided, m/s)."""
+    return (-25 * z[0] + 48 * z[1] - 36 * z[2] + 16 * z[3] - 3 * z[4]) / (12 * dt)
+
+
+def normalised_cost(z_measured, z_model):
+    """J of paper Eq. 11 for one or many simulated responses (last axis: time)."""
+    z_measured = np.asarray(z_measured, dtype=float)
+    err = np.mean((np.asarray(z_model) - z_measured) ** 2, axis=-1)
+    return 100.0 * err / np.var(z_measured)
+
+
+class CostFunction:
+    """Batched J(theta) (Eq. 11) of one model on one record.
+
+    Calling it with an array ``X`` of shape (n, d), columns in the order of
+    :attr:`free`, returns the n costs; every row is simulated in one
+    parallel compiled call. Diverged candidates cost ``inf``.
+    """
+
+    def __init__(
+        self,
+        record: Record,
+        model: str,
+        *,
+        fixed: dict,
+        free,
+        substeps: int = 4,
+        hold: str = "linear",
+        lowpass: float | None = None,
+        skip: int = 0,
+    ):
+        self.record = record
+        self.model = model
+        self.friction = MODELS[model]
+        self.fixed = dict(fixed)
+        self.free = tuple(free)
+        self.substeps = substeps
+        self.hold = hold
+        self.skip = skip
+        self.drive, self.base_input = driving_signal(
+            record.input, record.dt, record.input_kind, lowpass
+        )
+        scored = record.z[skip:]
+        self.variance = float(np.var(scored))
+        if self.variance == 0:
+            raise ValueError(
+                f"`{OUTPUT_COLUMN}` of record {record.name!r} is constant; J (Eq. 11) is undefined"
+            )
+        self.n_scored = scored.size
+        self.z0 = float(record.z[0])
+        self.v0 = float(initial_velocity(record.z, record.dt))
+        self.limit = 100.0 * float(np.max(np.abs(record.z)))
+        self.evaluations = 0
+        self.seconds = 0.0
+
+    def parameters(self, X) -> dict:
+        X = np.atleast_2d(np.asarray(X, dtype=float))
+        out = {name: X[:, j] for j, name in enumerate(self.free)}
+        for name, value in self.fixed.items():
+            out[name] = np.full(X.shape[0], float(value))
+        return out
+
+    def __call__(self, X):
+        params = self.parameters(X)
+        matrix = parameter_matrix(params, self.friction)
+        start = time.perf_counter()
+        sse, _, _ = run_kernel(
+            matrix,
+            self.friction,
+            self.drive,
+            self.base_input,
+            self.record.dt,
+            substeps=self.substeps,
+            hold=self.hold,
+            z0=self.z0,
+            v0=self.v0,
+            reference=self.record.z,
+            skip=self.skip,
+            response_limit=self.limit,
+            store=False,
+        )
+        self.seconds += time.perf_counter() - start
+        self.evaluations += matrix.shape[0]
+        return 100.0 * sse / (self.n_scored * self.variance)
+
+    def simulate(self, parameters: dict, electrical=None):
+        """Responses (z, v) of one parameter set, c raised by c_e when a circuit is given."""
+        params = {k: np.atleast_1d(np.asarray(v, dtype=float)) for k, v in parameters.items()}
+        if electrical is not None:
+            params["c"] = params["c"] + electrical.electrical_damping
+        matrix = parameter_matrix(params, self.friction)
+        _, z, v = run_kernel(
+            matrix,
+            self.friction,
+            self.drive,
+            self.base_input,
+            self.record.dt,
+            substeps=self.substeps,
+            hold=self.hold,
+            z0=self.z0,
+            v0=self.v0,
+            response_limit=self.limit,
+        )
+        return z[0], v[0]
+
+
+# ------------------------------------------------------------------------ bounds
+def _scales(record: Record, m: float | None):
+    """Characteristic frequency, displacement, velocity and force of a record."""
+    z = record.z - np.mean(record.z)
+    v = np.gradient(z, record.dt)
+    omega = float(np.sqrt(np.mean(v**2) / np.mean(z**2)))  # zero-crossing frequency of z
+    drive, base = driving_signal(record.input, record.dt, record.input_kind)
+    if m is None:
+        # force input, free mass: equation-error least squares m z'' + c z' + k z = u
+        acc = np.gradient(v, record.dt)
+        a = np.column_stack([acc, v, z, np.ones_like(z)])
+        coef = np.linalg.lstsq(a, drive, rcond=None)[0]
+        m_ref = float(coef[0]) if coef[0] > 0 else float(np.std(drive) / np.std(acc))
+    else:
+        m_ref = float(m)
+    force = float(np.sqrt(np.mean(drive**2))) * (m_ref if base else 1.0)
+    return omega, float(np.max(np.abs(z))), float(np.sqrt(np.mean(v**2))), force, m_ref
+
+
+def default_bounds(record: Record, model: str, m: float | None = None) -> dict:
+    """Search bounds derived from the record's own scales.
+
+    With the characteristic angular frequency ``w = rms(z')/rms(z)``, the
+    largest displacement ``z_max``, the RMS velocity ``v_rms``, the RMS
+    external force ``F`` (``m rms(y'')`` or ``rms(u)``) and the mass ``m``
+    (given, or an equation-error least-squares estimate when free):
+
+    ======  ==========================================  =====
+    m       [0.1, 10] x m_ls (free mass only)           log
+    c       2 m w x [1e-4, 2] (damping ratio)           log
+    k       m w^2 x [0.1, 10]                           log
+    k3      [0, 2 m w^2 / z_max^2]                      linear
+    fc, fs  F x [1e-4, 1]                               log
+    beta    [1, 1e10] / v_rms                           log
+    sigma0  m w^2 x [1e-3, 10]                          log
+    sigma1  2 m w x [1e-4, 10]                          log
+    vs      v_rms x [1e-4, 10]                          log
+    ======  ==========================================  =====
+
+    These cover the paper's Table 2 for its records; override any of them
+    with ``bounds=`` in :func:`identify` (``--bounds NAME=LO:HI``).
+    """
+    _check_model(model)
+    omega, z_max, v_rms, force, m_ref = _scales(record, m)
+    k_ref = m_ref * omega**2
+    c_ref = 2 * m_ref * omega
+    table = {
+        "m": (0.1 * m_ref, 10 * m_ref),
+        "c": (1e-4 * c_ref, 2 * c_ref),
+        "k": (0.1 * k_ref, 10 * k_ref),
+        "k3": (0.0, 2 * k_ref / z_max**2),
+        "fc": (1e-4 * force, force),
+        "fs": (1e-4 * force, force),
+        "beta": (1.0 / v_rms, 1e10 / v_rms),
+        "sigma0": (1e-3 * k_ref, 10 * k_ref),
+        "sigma1": (1e-4 * c_ref, 10 * c_ref),
+        "vs": (1e-4 * v_rms, 10 * v_rms),
+    }
+    names = MODEL_PARAMETERS[model] + (("m",) if m is None else ())
+    return {name: table[name] for name in names}
+
+
+def _check_model(model):
+    if model not in MODELS:
+        raise ValueError(f"`model` must be one of {', '.join(MODELS)}; got {model!r}")
+
+
+# ---------------------------------------------------------------------- identify
+@dataclass
+class IdentificationResult:
+    """Identified parameters of one model on one record.
+
+    Attributes
+    ----------
+    model : str
+        ``viscous``, ``coulomb``, ``tanh`` or ``lugre``.
+    parameters : dict
+        Every parameter (SI units), ``m`` included, fixed ones too.
+    free : tuple of str
+        The identified ones.
+    cost : float
+        J (Eq. 11) on the training record.
+    bounds : dict
+        Search bounds of the free parameters.
+    nfev, generations : int
+        Simulations spent and SaDE generations run.
+    elapsed : float
+        Wall time (s).
+    simulations_per_second : float
+        Simulation throughput of the batched kernel.
+    message : str
+        Why the search stopped.
+    history : dict
+        Best cost and simulations spent per generation.
+    record : str
+        Name of the training record.
+    settings : dict
+        Simulation settings (substeps, hold, lowpass, skip, seed, ...).
+    """
+
+    model: str
+    parameters: dict
+    free: tuple
+    cost: float
+    bounds: dict
+    nfev: int
+    generations: int
+    elapsed: float
+    simulations_per_second: float
+    message: str
+    history: dict = field(default_factory=dict)
+    record: str = ""
+    settings: dict = field(default_factory=dict)
+
+    def to_dict(self) -> dict:
+        """JSON-ready summary."""
+        return {
+            "model": self.model,
+            "parameters": {k: float(v) for k, v in self.parameters.items()},
+            "units": {k: UNITS[k] for k in self.parameters},
+            "cost": float(self.cost),
+            "free": list(self.free),
+            "bounds": {k: [float(a), float(b)] for k, (a, b) in self.bounds.items()},
+            "record": self.record,
+            "simulations": int(self.nfev),
+            "generations": int(self.generations),
+            "elapsed_s": float(self.elapsed),
+            "simulations_per_second": float(self.simulations_per_second),
+            "message": self.message,
+            "settings": self.settings,
+        }
+
+    def predict(self, record: Record, electrical=None) -> Prediction:
+        """Simulate ``record`` with these parameters (see :func:`predict`)."""
+        return predict(
+            self.parameters,
+            self.model,
+            record,
+            electrical=electrical,
+            **_sim_settings(self.settings),
+        )
+
+    def harvester(self, electrical=None):
+        """The identified device as a :class:`randvib.Harvester` (c as c_m)."""
+        from randvib.friction import Coulomb, LuGre, Tanh
+        from randvib.harvester import Harvester
+
+        p = self.parameters
+        friction = {
+            "viscous": lambda: None,
+            "coulomb": lambda: Coulomb(p["fc"]),
+            "tanh": lambda: Tanh(p["fc"], p["beta"]),
+            "lugre": lambda: LuGre(p["sigma0"], p["sigma1"], p["fc"], p["fs"], p["vs"]),
+        }[self.model]()
+        if electrical is None:
+            return Harvester(m=p["m"], c_m=p["c"], c_e=0.0, k=p["k"], k3=p["k3"], friction=friction)
+        return Harvester.from_electrical(
+            m=p["m"], c_m=p["c"], k=p["k"], k3=p["k3"], alpha=electrical.alpha,
+            r_load=electrical.r_load, r_coil=electrical.r_coil, friction=friction,
+        )  # fmt: skip
+
+
+def _sim_settings(settings):
+    return {k: settings[k] for k in ("substeps", "hold", "lowpass", "skip") if k in settings}
+
+
+def _resolve_fixed(model, fixed, m, record):
+    names = MODEL_PARAMETERS[model]
+    fixed = dict(fixed or {})
+    for key, value in fixed.items():
+        if key not in names and key != "m":
+            raise ValueError(
+                f"`--fix {key}`: unknown parameter for model {model!r}; allowed: "
+                f"{', '.join(names + ('m',))}"
+            )
+        fixed[key] = float(check_finite(f"--fix {key}", value))
+    if m is not None:
+        if "m" in fixed and fixed["m"] != float(m):
+            raise ValueError(f"`m` given twice with different values: {m} and --fix m={fixed['m']}")
+        fixed["m"] = float(check_positive("m", m, "kg"))
+    if "m" not in fixed and record.input_kind != "force":
+        raise ValueError(
+            f"`m` (kg) is required with a `{record.input_kind}` input: under base excitation "
+            "the mass is not identifiable (Eq. 1 divided by m leaves c/m, k/m, k3/m, F/m)"
+        )
+    if "m" in fixed and fixed["m"] <= 0:
+        raise ValueError(f"`m` must be > 0 (kg), got {fixed['m']!r}")
+    return fixed
+
+
+def identify(
+    record: Record,
+    model: str,
+    *,
+    m: float | None = None,
+    fixed: dict | None = None,
+    bounds: dict | None = None,
+    popsize: int = 50,
+    maxiter: int = 200,
+    seed=0,
+    tol: float = 1e-6,
+    patience: int | None = 40,
+    polish: bool = True,
+    substeps: int = 4,
+    hold: str = "linear",
+    lowpass: float | None = None,
+    skip: int = 0,
+    init: dict | None = None,
+    progress: bool = False,
+    callback=None,
+) -> IdentificationResult:
+    """Fit a model to a record by minimising J (Eq. 11) with SaDE.
+
+    Parameters
+    ----------
+    record : Record
+        Training record.
+    model : {'viscous', 'coulomb', 'tanh', 'lugre'}
+        Friction model (``viscous`` is the paper's no-friction model).
+    m : float, optional
+        Mass (kg); required with base excitation, identified when omitted
+        with a force input.
+    fixed : dict, optional
+        Parameters held at given values, e.g. ``{"k3": 0.0}`` for a linear
+        spring.
+    bounds : dict, optional
+        ``name -> (lower, upper)`` overriding :func:`default_bounds`.
+    popsize, maxiter, seed, tol, patience, polish
+        SaDE settings (see :func:`randvib.sade.sade`).
+    substeps : int
+        Integration steps per sample interval.
+    hold : {'linear', 'zero'}
+        Interpolation of the input between samples.
+    lowpass : float, optional
+        Zero-phase low-pass (Hz) for the driving signal (useful for a
+        base displacement differentiated twice).
+    skip : int
+        Samples at the start left out of J (initial-condition transient).
+    init : dict, optional
+        A starting guess ``name -> value`` placed in the initial population.
+    progress : bool
+        Progress bar.
+    callback : callable, optional
+        ``callback(generation, parameters_dict, cost)``; True stops.
+
+    Returns
+    -------
+    IdentificationResult
+    """
+    _check_model(model)
+    if not isinstance(record, Record):
+        raise ValueError(f"`record` must be a randvib Record, got {type(record).__name__}")
+    substeps = check_int("substeps", substeps, minimum=1)
+    skip = check_int("skip", skip, minimum=0)
+    if hold not in HOLDS:
+        raise ValueError(f"`hold` must be one of {', '.join(HOLDS)}; got {hold!r}")
+    fixed = _resolve_fixed(model, fixed, m, record)
+    free = tuple(n for n in MODEL_PARAMETERS[model] + ("m",) if n not in fixed)
+    needed = max(20, SAMPLES_PER_PARAMETER * len(free)) + skip
+    if record.n < needed:
+        raise ValueError(
+            f"record {record.name!r} has {record.n} samples; the {model} model with "
+            f"{len(free)} free parameters needs at least {needed}"
+        )
+    box = default_bounds(record, model, fixed.get("m"))
+    for name, pair in (bounds or {}).items():
+        if name not in MODEL_PARAMETERS[model] and name != "m":
+            raise ValueError(
+                f"`--bounds {name}`: unknown parameter for model {model!r}; allowed: "
+                f"{', '.join(MODEL_PARAMETERS[model] + ('m',))}"
+            )
+        lo, hi = (float(check_finite(f"bounds {name}", x)) for x in pair)
+        if lo > hi:
+            raise ValueError(f"`--bounds {name}`: lower {lo!r} > upper {hi!r}")
+        box[name] = (lo, hi)
+    box = {name: box[name] for name in free}
+    log = [name in LOG_PARAMETERS and box[name][0] > 0 for name in free]
+    cost = CostFunction(
+        record,
+        model,
+        fixed=fixed,
+        free=free,
+        substeps=substeps,
+        hold=hold,
+        lowpass=lowpass,
+        skip=skip,
+    )
+    x0 = None
+    if init:
+        x0 = [[np.clip(init.get(n, np.mean(box[n])), *box[n]) for n in free]]
+    user_callback = None
+    if callback is not None:
+
+        def user_callback(gen, x, f):
+            return callback(gen, dict(zip(free, map(float, x), strict=True)), f)
+
+    start = time.perf_counter()
+    res = sade(
+        cost,
+        [box[n] for n in free],
+        log=log,
+        names=free,
+        popsize=popsize,
+        maxiter=maxiter,
+        seed=seed,
+        tol=tol,
+        patience=patience,
+        init=x0,
+        polish=polish,
+        callback=user_callback,
+        progress=progress,
+    )
+    elapsed = time.perf_counter() - start
+    parameters = {**dict(zip(free, map(float, res.x), strict=True)), **fixed}
+    order = ("m",) + MODEL_PARAMETERS[model]
+    parameters = {name: parameters[name] for name in order}
+    return IdentificationResult(
+        model=model,
+        parameters=parameters,
+        free=free,
+        cost=float(res.fun),
+        bounds={n: tuple(map(float, box[n])) for n in free},
+        nfev=res.nfev,
+        generations=res.nit,
+        elapsed=elapsed,
+        simulations_per_second=cost.evaluations / cost.seconds if cost.seconds else float("nan"),
+        message=res.message + (" (polished)" if res.polished else ""),
+        history={"best": res.history["best"], "nfev": res.history["nfev"]},
+        record=record.name,
+        settings={
+            "substeps": substeps,
+            "hold": hold,
+            "lowpass": lowpass,
+            "skip": skip,
+            "popsize": popsize,
+            "maxiter": maxiter,
+            "seed": seed if isinstance(seed, int | None) else "generator",
+        },
+    )
+
+
+# ----------------------------------------------------------------- predict/validate
+@dataclass(frozen=True, eq=False)
+class Prediction:
+    """Simulated response of a parameter set to a record.
+
+    Attributes
+    ----------
+    record : Record
+    z, v : ndarray
+        Simulated relative displacement (m) and velocity (m/s).
+    cost : float
+        J (Eq. 11) against the record.
+    rms_error : float
+        RMS of z - zhat (units of z).
+    voltage : ndarray or None
+        Simulated load voltage (V) when a circuit was given:
+        ``V = alpha z' R_L / (R_L + R_C)``.
+    """
+
+    record: Record
+    z: np.ndarray
+    v: np.ndarray
+    cost: float
+    rms_error: float
+    voltage: np.ndarray | None = None
+
+
+def _check_parameters(parameters, model):
+    _check_model(model)
+    names = ("m",) + MODEL_PARAMETERS[model]
+    missing = [n for n in names if n not in parameters]
+    if missing:
+        raise ValueError(
+            f"parameters for model {model!r} lack {missing}; needed: {', '.join(names)}"
+        )
+    return {n: float(check_finite(n, parameters[n])) for n in names}
+
+
+def predict(
+    parameters: dict,
+    model: str,
+    record: Record,
+    *,
+    electrical=None,
+    substeps: int = 4,
+    hold: str = "linear",
+    lowpass: float | None = None,
+    skip: int = 0,
+) -> Prediction:
+    """Simulate a record with given parameters and score it with J (Eq. 11).
+
+    ``electrical`` (a :class:`randvib.ElectricalCoupling`) adds the coil's
+    damping c_e = alpha^2/(R_L + R_C) (Eq. 3) to the identified c and returns
+    the load voltage.
+    """
+    params = _check_parameters(parameters, model)
+    cost = CostFunction(
+        record,
+        model,
+        fixed=params,
+        free=(),
+        substeps=substeps,
+        hold=hold,
+        lowpass=lowpass,
+        skip=skip,
+    )
+    z, v = cost.simulate(params, electrical)
+    if np.all(np.isfinite(z)):
+        j = float(normalised_cost(record.z[skip:], z[skip:]))
+        rms = float(np.sqrt(np.mean((record.z[skip:] - z[skip:]) ** 2)))
+    else:
+        j = rms = float("inf")
+    voltage = None
+    if electrical is not None:
+        voltage = electrical.alpha * v * electrical.load_fraction
+    return Prediction(record=record, z=z, v=v, cost=j, rms_error=rms, voltage=voltage)
+
+
+@dataclass(frozen=True)
+class ValidationRow:
+    record: str
+    model: str
+    cost: float
+    rms_error: float
+    samples: int
+
+
+def validate(parameters: dict, model: str, records, **settings) -> list[ValidationRow]:
+    """J (Eq. 11) and RMS error of given parameters on each of several records."""
+    rows = []
+    for record in records:
+        pred = predict(parameters, model, record, **settings)
+        rows.append(ValidationRow(record.name, model, pred.cost, pred.rms_error, record.n))
+    return rows
