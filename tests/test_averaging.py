@@ -241,3 +241,35 @@ def test_validity_warning_names_the_ratio():
     assert r.zeta_friction > AVERAGING_ZETA_LIMIT
     with pytest.warns(rv.AveragingValidityWarning):
         rv.expected_power(BASE.updated(fc=np.array([0.0, 0.2])), 1.0, method="averaging")
+
+
+# ------------------------------------------------------------- CLI and study
+def test_cli_power_method_averaging(capsys):
+    import json
+
+    from randvib.cli import main
+
+    code = main(["power", "--preset", "figure9", "--psd", "0.5", "--method", "averaging", "--json"])
+    data = json.loads(capsys.readouterr().out)
+    assert code == 0 and data["method"] == "averaging"
+    assert data["power_electrical"] == pytest.approx(
+        rv.expected_power(BASE, 0.5, method="averaging"), rel=1e-14
+    )
+
+
+def test_quick_study_meets_the_accuracy_criteria(tmp_path):
+    import pandas as pd
+
+    from randvib.studies.linearisation_vs_averaging import run_study, verdicts
+
+    report = run_study(tmp_path / "lva", quick=True, seed=0, progress=False)
+    assert report.name == "report.md" and report.exists()
+    assert (report.parent / "error_vs_friction.png").exists()
+    assert (report.parent / "interaction.png").exists()
+    v = verdicts(pd.read_csv(report.parent / "results.csv"))
+    assert v["lin_over_3pct"] > 0 and v["avg_third_where_lin_over_3pct"]
+    assert v["avg_within_5pct"]
+    # Re-running with the same settings resumes; other settings are refused.
+    assert run_study(tmp_path / "lva", quick=True, seed=0, progress=False) == report
+    with pytest.raises(FileExistsError):
+        run_study(tmp_path / "lva", quick=True, seed=1, progress=False)
