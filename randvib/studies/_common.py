@@ -9,9 +9,18 @@ import numpy as np
 import pandas as pd
 
 from randvib._io import atomic_write_text
+from randvib._validation import check_int
 from randvib.harvester import Harvester
 from randvib.linearisation import coulomb_equivalent_damping
-from randvib.sweep import SweepSettings, run_sweep
+from randvib.sweep import (
+    SweepResult,
+    SweepSettings,
+    holm_significant,
+    make_executor,
+    paired_contrast,
+    run_sweep,
+    two_sided_p_value,
+)
 
 
 def fc_where_power_halves(device: Harvester, psd: float) -> float:
@@ -96,3 +105,116 @@ def save_figure(fig, path: Path) -> Path:
     fig.savefig(path, dpi=120, bbox_inches="tight")
     plt.close(fig)
     return path
+
+
+def interaction_contrasts(
+    result: SweepResult,
+    base: Harvester,
+    a: str = "fc",
+    b: str = "k3",
+    *,
+    level: float = 0.05,
+) -> pd.DataFrame:
+    """Interaction contrasts of two factors of a sweep, from paired paths.
+
+    For every point with ``a != 0`` and ``b != 0`` the contrast
+
+        [P(a, b) - P(a, 0)] - [P(0, b) - P(0, 0)]
+
+    is estimated with :func:`randvib.sweep.paired_contrast` from the four
+    points that share all other parameters (e.g. ``psd``). It is zero when the
+    effect of ``b`` on the expected power does not depend on ``a``. The
+    ``relative_*`` columns divide by the Monte Carlo P(a, 0). ``detectable``
+    tests each contrast at ``level`` (two-sided); ``detectable_holm`` applies
+    Holm's correction over the whole family (the contrasts share paths, so
+    their verdicts are correlated).
+
+    Returns
+    -------
+    DataFrame
+        The point's parameters, then ``contrast`` and ``contrast_ci95`` (W),
+        ``relative_contrast``, ``relative_ci95``, ``p_value``, ``detectable``,
+        ``detectable_holm``; one row per contrast, in sweep order.
+    """
+    points = result.points
+    keys = list(points[0])
+    for name in (a, b):
+        if name not in keys:
+            raise ValueError(f"factor `{name}` is not a parameter of the sweep; it has {keys}")
+
+    def key(point, **override):
+        return tuple(float(override.get(k, point[k])) for k in keys)
+
+    index = {key(p): i for i, p in enumerate(points)}
+    power = dict(zip(result.table.point, result.table.power_electrical, strict=True))
+    rows = []
+    for i, p in enumerate(points):
+        if p[a] == 0 or p[b] == 0:
+            continue
+        partner = {}
+        for va, vb in ((p[a], 0.0), (0.0, p[b]), (0.0, 0.0)):
+            k = key(p, **{a: va, b: vb})
+            if k not in index:
+                raise ValueError(
+                    f"the contrast at {p} needs the point {dict(zip(keys, k, strict=True))}, "
+                    "which is not in the sweep; include 0 in both factors' grids"
+                )
+            partner[(va, vb)] = index[k]
+        weights = {i: 1.0}
+        weights[partner[(p[a], 0.0)]] = -1.0
+        weights[partner[(0.0, p[b])]] = -1.0
+        weights[partner[(0.0, 0.0)]] = 1.0
+        s = paired_contrast(result, base, weights)
+        reference = power[partner[(p[a], 0.0)]]
+        p_value = two_sided_p_value(s)
+        rows.append(
+            {
+                **{k: float(p[k]) for k in keys},
+                "contrast": s.mean,
+                "contrast_ci95": s.ci95,
+                "relative_contrast": s.mean / reference,
+                "relative_ci95": s.ci95 / reference,
+                "p_value": p_value,
+                "detectable": p_value < level,
+            }
+        )
+    if not rows:
+        raise ValueError(f"no point of the sweep has both `{a}` and `{b}` non-zero")
+    table = pd.DataFrame(rows)
+    table["detectable_holm"] = holm_significant(table.p_value, level)
+    return table
+
+
+def _quiet_worker() -> None:
+    import warnings
+
+    from randvib.averaging import AveragingValidityWarning
+
+    warnings.simplefilter("ignore", AveragingValidityWarning)
+
+
+def study_executor(workers=None, scheduler=None):
+    """:func:`randvib.sweep.make_executor`, with quiet local workers.
+
+    Local worker processes ignore :class:`~randvib.averaging.AveragingValidityWarning`
+    (the sweep evaluates the averaging prediction at every point, and at high
+    friction it would repeat once per point); the studies flag those points in
+    their reports instead, from ``zeta_friction``.
+    """
+    import os
+
+    if scheduler is not None:
+        return make_executor(workers, scheduler)
+    workers = os.cpu_count() or 1 if workers is None else check_int("workers", workers, 1)
+    if workers == 1:
+        return make_executor(1)
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    # spawn, as make_executor: forking a process whose numba threads run is unsafe
+    pool = ProcessPoolExecutor(
+        max_workers=workers,
+        mp_context=multiprocessing.get_context("spawn"),
+        initializer=_quiet_worker,
+    )
+    return pool, lambda: pool.shutdown(cancel_futures=True)

@@ -24,6 +24,7 @@ from randvib.prediction import METHODS, expected_power
 from randvib.presets import preset
 from randvib.studies._common import (
     fc_where_power_halves,
+    interaction_contrasts,
     markdown_table,
     save_figure,
     step_size_check,
@@ -32,12 +33,9 @@ from randvib.studies._common import (
 from randvib.sweep import (
     SweepSettings,
     cartesian,
-    holm_significant,
     linearisation_verdicts,
     make_executor,
-    paired_contrast,
     run_sweep,
-    two_sided_p_value,
 )
 
 PSDS = (1.0, 0.5, 0.1)
@@ -62,39 +60,6 @@ def settings_for(quick: bool, seed: int) -> SweepSettings:
     return SweepSettings(
         target_rel_ci=0.005, window=2.0, burn_in=0.5, seed=seed, min_paths=128, batch_paths=64
     )
-
-
-def interaction_table(result, base, points) -> pd.DataFrame:
-    """Paired contrasts for every (S, Fc > 0, k3 > 0) of the sweep."""
-    index = {(p["psd"], p["k3"], p["fc"]): i for i, p in enumerate(points)}
-    rows = []
-    for (psd, k3, fc), i in index.items():
-        if k3 == 0 or fc == 0:
-            continue
-        w = {
-            i: 1.0,
-            index[(psd, 0.0, fc)]: -1.0,
-            index[(psd, k3, 0.0)]: -1.0,
-            index[(psd, 0.0, 0.0)]: 1.0,
-        }
-        s = paired_contrast(result, base, w)
-        reference = result.table.loc[index[(psd, 0.0, fc)], "power_electrical"]
-        rows.append(
-            {
-                "psd": psd,
-                "k3": k3,
-                "fc": fc,
-                "contrast": s.mean,
-                "contrast_ci95": s.ci95,
-                "relative_contrast": s.mean / reference,
-                "relative_ci95": s.ci95 / reference,
-                "p_value": two_sided_p_value(s),
-                "detectable": abs(s.mean) > s.ci95,
-            }
-        )
-    table = pd.DataFrame(rows)
-    table["detectable_holm"] = holm_significant(table.p_value)
-    return table
 
 
 def plot(table: pd.DataFrame, base, out: Path) -> Path:
@@ -205,7 +170,7 @@ def run_study(
     finally:
         close()
     table = linearisation_verdicts(result.table)
-    inter = interaction_table(result, base, points)
+    inter = interaction_contrasts(result, base, "fc", "k3")
     atomic_write_text(out / "results.csv", table.to_csv(index=False))
     atomic_write_text(out / "interaction.csv", inter.to_csv(index=False))
     atomic_write_text(out / "step_check.csv", check.to_csv(index=False))
