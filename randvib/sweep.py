@@ -223,7 +223,11 @@ def make_executor(workers: int | None = None, scheduler: str | None = None):
     workers = os.cpu_count() or 1 if workers is None else check_int("workers", workers, 1)
     if workers == 1:
         return None, lambda: None
-    pool = ProcessPoolExecutor(max_workers=workers)
+    # spawn, not fork: numba's OpenMP threading layer may already be running
+    # in this process, and forking it is unsafe (the child aborts)
+    import multiprocessing
+
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
     return pool, lambda: pool.shutdown(cancel_futures=True)
 
 
