@@ -40,7 +40,7 @@ def test_variance_reduction(benchmark):
                 y = r.harvester.c_e * r.per_path[:, 0]
                 plain, cv = estimate(y), estimate(y, r.controls())
 
-                def power(key):
+                def power(key, pts=pts):
                     return pts[key].harvester.c_e * pts[key].per_path[:, 0]
 
                 paired = estimate(
