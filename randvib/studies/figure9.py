@@ -207,8 +207,8 @@ def run_study(
         f"{int((err.abs() > 0.05).sum())}.\n\n"
         "Verdict on the paper's first claim: Eq. 32 tracks the simulated power closely over the "
         "figure's range, but at the resolution of these intervals it is statistically distinguishable "
-        "at the higher friction levels, where it over-predicts the power (the velocity is no longer "
-        "Gaussian: sticking concentrates probability at z' = 0).\n\n"
+        f"at the higher friction levels, where it {'under' if worst.linearisation_rel_error < 0 else 'over'}"
+        "-predicts the power (the velocity is no longer Gaussian once the magnet sticks).\n\n"
         + markdown_table(
             table[
                 [
