@@ -35,6 +35,34 @@ def fc_where_power_halves(device: Harvester, psd: float) -> float:
     return float(fc)
 
 
+def friction_level(device: Harvester, psd, fc):
+    """Dimensionless Coulomb level phi = Fc / (c sigma_v0).
+
+    sigma_v0^2 = S m / (4 c) is the friction-free velocity variance (paper
+    Eq. 20). Eq. 30-32 depend on Fc only through phi: with
+    kappa = phi^2 / pi, P / P(0) = 1 / (1 + kappa + sqrt(kappa (2 + kappa))),
+    so Eq. 32 halves the power at phi = sqrt(pi) / 2 (about 0.886). For
+    k3 = 0 the SDE itself scales exactly (z, z' and Fc all with sqrt(S)), so
+    any statistic of P / P(0) depends on phi and the damping ratio only.
+    """
+    c, m = float(device.c), float(device.m)
+    return np.asarray(fc, dtype=float) / (c * np.sqrt(np.asarray(psd, dtype=float) * m / (4 * c)))
+
+
+def fc_at_friction_level(device: Harvester, psd, phi):
+    """Coulomb level Fc (N) of the dimensionless level phi (inverse of :func:`friction_level`)."""
+    c, m = float(device.c), float(device.m)
+    return np.asarray(phi, dtype=float) * c * np.sqrt(np.asarray(psd, dtype=float) * m / (4 * c))
+
+
+def plus_minus(value, ci, scale: float = 100.0, fmt: str = "+.2f") -> list[str]:
+    """'value ± ci' strings (default: fractions as percent) for report tables."""
+    return [
+        f"{scale * v:{fmt}} ± {scale * c:{fmt.lstrip('+')}}"
+        for v, c in zip(np.atleast_1d(value), np.atleast_1d(ci), strict=True)
+    ]
+
+
 def step_size_check(
     base: Harvester,
     points: list,
@@ -114,6 +142,7 @@ def interaction_contrasts(
     b: str = "k3",
     *,
     level: float = 0.05,
+    zero_baseline: bool = False,
 ) -> pd.DataFrame:
     """Interaction contrasts of two factors of a sweep, from paired paths.
 
@@ -129,12 +158,22 @@ def interaction_contrasts(
     Holm's correction over the whole family (the contrasts share paths, so
     their verdicts are correlated).
 
+    ``zero_baseline=True`` is for factors whose effect at ``a = 0`` is zero
+    by theory, as k3's is without friction (E[z'^2] = S m / (4c) for every k3,
+    exact stationary density). The paired estimate then uses only the two
+    ``a != 0`` points, over all the paths they share: the ``a = 0`` points,
+    whose power the friction-free companion makes exact, stop at the sweep's
+    first batch and would otherwise cap the paths of every contrast. Their
+    bracket P(0, b) - P(0, 0) is reported from the sweep's estimates
+    (``baseline``, ``baseline_ci95``) as a check.
+
     Returns
     -------
     DataFrame
         The point's parameters, then ``contrast`` and ``contrast_ci95`` (W),
-        ``relative_contrast``, ``relative_ci95``, ``p_value``, ``detectable``,
-        ``detectable_holm``; one row per contrast, in sweep order.
+        ``reference`` (P(a, 0), W), ``relative_contrast``, ``relative_ci95``, ``p_value``, ``detectable``,
+        ``n_paths`` (paths behind the paired estimate), ``detectable_holm``
+        (and the ``baseline`` columns); one row per contrast, in sweep order.
     """
     points = result.points
     keys = list(points[0])
@@ -147,6 +186,7 @@ def interaction_contrasts(
 
     index = {key(p): i for i, p in enumerate(points)}
     power = dict(zip(result.table.point, result.table.power_electrical, strict=True))
+    ci95 = dict(zip(result.table.point, result.table.power_electrical_ci95, strict=True))
     rows = []
     for i, p in enumerate(points):
         if p[a] == 0 or p[b] == 0:
@@ -162,22 +202,28 @@ def interaction_contrasts(
             partner[(va, vb)] = index[k]
         weights = {i: 1.0}
         weights[partner[(p[a], 0.0)]] = -1.0
-        weights[partner[(0.0, p[b])]] = -1.0
-        weights[partner[(0.0, 0.0)]] = 1.0
+        if not zero_baseline:
+            weights[partner[(0.0, p[b])]] = -1.0
+            weights[partner[(0.0, 0.0)]] = 1.0
         s = paired_contrast(result, base, weights)
         reference = power[partner[(p[a], 0.0)]]
         p_value = two_sided_p_value(s)
-        rows.append(
-            {
-                **{k: float(p[k]) for k in keys},
-                "contrast": s.mean,
-                "contrast_ci95": s.ci95,
-                "relative_contrast": s.mean / reference,
-                "relative_ci95": s.ci95 / reference,
-                "p_value": p_value,
-                "detectable": p_value < level,
-            }
-        )
+        row = {
+            **{k: float(p[k]) for k in keys},
+            "contrast": s.mean,
+            "contrast_ci95": s.ci95,
+            "reference": reference,
+            "relative_contrast": s.mean / reference,
+            "relative_ci95": s.ci95 / reference,
+            "p_value": p_value,
+            "detectable": p_value < level,
+            "n_paths": s.n_paths,
+        }
+        if zero_baseline:
+            j, j0 = partner[(0.0, p[b])], partner[(0.0, 0.0)]
+            row["baseline"] = power[j] - power[j0]
+            row["baseline_ci95"] = float(np.hypot(ci95[j], ci95[j0]))
+        rows.append(row)
     if not rows:
         raise ValueError(f"no point of the sweep has both `{a}` and `{b}` non-zero")
     table = pd.DataFrame(rows)
