@@ -41,6 +41,7 @@ from randvib.deterministic import (
     FRICTION_PARAMETERS,
     HOLDS,
     INPUT_KINDS,
+    SEARCH_SUBCYCLES,
     driving_signal,
     parameter_matrix,
     run_kernel,
@@ -389,6 +390,7 @@ class CostFunction:
             skip=self.skip,
             response_limit=self.limit,
             store=False,
+            max_subcycles=SEARCH_SUBCYCLES,
         )
         self.seconds += time.perf_counter() - start
         self.evaluations += matrix.shape[0]

@@ -316,7 +316,7 @@ def sade(
             if callback is not None and callback(nit, space.to_x(pop[best]), float(costs[best])):
                 message = "stopped by callback"
                 break
-            if spread <= atol + tol * abs(float(np.mean(costs))):
+            if np.isfinite(spread) and spread <= atol + tol * abs(float(np.mean(costs))):
                 message = f"converged: cost spread {spread:.3g} <= atol + tol * |mean cost|"
                 break
             if patience is not None and stall >= patience:
