@@ -85,12 +85,12 @@ def seed_path_state(seed, path, state, row):
 
 
 @numba.njit(cache=True, inline="always")
-def next_uint64(state, row):
-    """xoshiro256++ output; advances ``state[row]``."""
-    s0 = state[row, 0]
-    s1 = state[row, 1]
-    s2 = state[row, 2]
-    s3 = state[row, 3]
+def xoshiro_next(s0, s1, s2, s3):
+    """xoshiro256++ on a state held in four local words: (output, new state).
+
+    Kernels keep a path's state in locals while they draw a block of normals,
+    so the state stays in registers instead of memory.
+    """
     result = _rotl(s0 + s3, 23) + s0
     t = s1 << _U64(17)
     s2 ^= s0
@@ -99,59 +99,91 @@ def next_uint64(state, row):
     s0 ^= s3
     s2 ^= t
     s3 = _rotl(s3, 45)
-    state[row, 0] = s0
-    state[row, 1] = s1
-    state[row, 2] = s2
-    state[row, 3] = s3
-    return result
+    return result, s0, s1, s2, s3
 
 
 @numba.njit(cache=True, inline="always")
-def next_double(state, row):
-    """Uniform on [0, 1) with 53 random bits."""
-    return (next_uint64(state, row) >> _U64(11)) * (1.0 / 9007199254740992.0)
+def _uniform(r):
+    return (r >> _U64(11)) * (1.0 / 9007199254740992.0)  # 53 random bits in [0, 1)
 
 
 @numba.njit(cache=True)
-def _normal_slow(state, row, idx, rabs, x, ki, wi, fi):
+def _normal_slow(s0, s1, s2, s3, idx, rabs, x, ki, wi, fi):
     # Rare branch of the ziggurat (about 1 % of draws), kept out of line.
     while True:
-        if idx == 0:
+        if idx == 0:  # base strip: the tail beyond r, by Marsaglia's method
             while True:
-                xx = -(1.0 / 3.6541528853610088) * np.log1p(-next_double(state, row))
-                yy = -np.log1p(-next_double(state, row))
+                r, s0, s1, s2, s3 = xoshiro_next(s0, s1, s2, s3)
+                xx = -(1.0 / 3.6541528853610088) * np.log1p(-_uniform(r))
+                r, s0, s1, s2, s3 = xoshiro_next(s0, s1, s2, s3)
+                yy = -np.log1p(-_uniform(r))
                 if yy + yy > xx * xx:
                     if (rabs >> _U64(8)) & _U64(1):
-                        return -(3.6541528853610088 + xx)
-                    return 3.6541528853610088 + xx
-        if (fi[idx - 1] - fi[idx]) * next_double(state, row) + fi[idx] < np.exp(-0.5 * x * x):
-            return x
-        r = next_uint64(state, row)
+                        return -(3.6541528853610088 + xx), s0, s1, s2, s3
+                    return 3.6541528853610088 + xx, s0, s1, s2, s3
+        r, s0, s1, s2, s3 = xoshiro_next(s0, s1, s2, s3)
+        if (fi[idx - 1] - fi[idx]) * _uniform(r) + fi[idx] < np.exp(-0.5 * x * x):
+            return x, s0, s1, s2, s3
+        r, s0, s1, s2, s3 = xoshiro_next(s0, s1, s2, s3)
         idx = np.int64(r & _U64(0xFF))
         r = r >> _U64(8)
         sign = r & _U64(1)
         rabs = (r >> _U64(1)) & _U64(0x000FFFFFFFFFFFFF)
-        x = rabs * wi[idx]
+        x = np.int64(rabs) * wi[idx]
         if sign:
             x = -x
         if rabs < ki[idx]:
-            return x
+            return x, s0, s1, s2, s3
 
 
 @numba.njit(cache=True, inline="always")
-def standard_normal(state, row, ki, wi, fi):
-    """One N(0, 1) draw from the stream in ``state[row]`` (ziggurat)."""
-    r = next_uint64(state, row)
+def normal_from_state(s0, s1, s2, s3, ki, wi, fi):
+    """One N(0, 1) draw (ziggurat) from a state in locals: (x, new state)."""
+    r, s0, s1, s2, s3 = xoshiro_next(s0, s1, s2, s3)
     idx = np.int64(r & _U64(0xFF))
     r = r >> _U64(8)
     sign = r & _U64(1)
     rabs = (r >> _U64(1)) & _U64(0x000FFFFFFFFFFFFF)
-    x = rabs * wi[idx]
+    # rabs < 2^52 fits an int64, whose conversion to double is one instruction
+    x = np.int64(rabs) * wi[idx]
     if sign:
         x = -x
     if rabs < ki[idx]:
-        return x
-    return _normal_slow(state, row, idx, rabs, x, ki, wi, fi)
+        return x, s0, s1, s2, s3
+    return _normal_slow(s0, s1, s2, s3, idx, rabs, x, ki, wi, fi)
+
+
+@numba.njit(cache=True, inline="always")
+def standard_normal(state, row, ki, wi, fi):
+    """One N(0, 1) draw from the stream in ``state[row]``, advancing it."""
+    x, s0, s1, s2, s3 = normal_from_state(
+        state[row, 0], state[row, 1], state[row, 2], state[row, 3], ki, wi, fi
+    )
+    state[row, 0] = s0
+    state[row, 1] = s1
+    state[row, 2] = s2
+    state[row, 3] = s3
+    return x
+
+
+@numba.njit(cache=True)
+def fill_normals(state, row, out, count, scale, ki, wi, fi):
+    """Write ``count`` draws times ``scale`` into ``out[:count]``, advancing ``state[row]``.
+
+    The same draws as ``count`` calls of :func:`standard_normal`, with the
+    state kept in registers for the whole block.
+    """
+    s0 = state[row, 0]
+    s1 = state[row, 1]
+    s2 = state[row, 2]
+    s3 = state[row, 3]
+    for i in range(count):
+        x, s0, s1, s2, s3 = normal_from_state(s0, s1, s2, s3, ki, wi, fi)
+        out[i] = scale * x
+    state[row, 0] = s0
+    state[row, 1] = s1
+    state[row, 2] = s2
+    state[row, 3] = s3
 
 
 @numba.njit(cache=True, parallel=True)
@@ -159,8 +191,7 @@ def _normals_kernel(seed, first_path, n_paths, n_per_path, out, ki, wi, fi):
     for p in numba.prange(n_paths):
         state = np.empty((1, 4), dtype=np.uint64)
         seed_path_state(seed, first_path + p, state, 0)
-        for j in range(n_per_path):
-            out[p, j] = standard_normal(state, 0, ki, wi, fi)
+        fill_normals(state, 0, out[p], n_per_path, 1.0, ki, wi, fi)
 
 
 def path_normals(seed: int, n_paths: int, n_per_path: int, first_path: int = 0) -> np.ndarray:
