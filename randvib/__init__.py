@@ -11,9 +11,18 @@ from randvib.averaging import (
     energy_density,
     orbit_averages,
 )
+from randvib.deterministic import BatchSimulation, simulate_record
+from randvib.excitation import BaseExcitation, band_limited_excitation
 from randvib.fokker_planck import fpk_statistics, solve_fpk
 from randvib.friction import Coulomb, FrictionModel, LuGre, Tanh
 from randvib.harvester import ElectricalCoupling, Harvester
+from randvib.identification import (
+    IdentificationResult,
+    Record,
+    identify,
+    normalised_cost,
+    read_record,
+)
 from randvib.integrators import INTEGRATORS, Integrator
 from randvib.linearisation import coulomb_equivalent_damping, equivalent_damping
 from randvib.prediction import (
@@ -26,6 +35,7 @@ from randvib.prediction import (
     velocity_variance,
 )
 from randvib.presets import MAGNET_MASS, PRESETS, preset
+from randvib.sade import SADEResult, sade
 from randvib.simulation import (
     SimulationDivergedError,
     SimulationResult,
@@ -38,10 +48,13 @@ __version__ = "0.1.0"
 
 __all__ = [
     "AveragingValidityWarning",
+    "BaseExcitation",
+    "BatchSimulation",
     "Coulomb",
     "ElectricalCoupling",
     "FrictionModel",
     "Harvester",
+    "IdentificationResult",
     "INTEGRATORS",
     "Integrator",
     "LuGre",
@@ -49,19 +62,27 @@ __all__ = [
     "METHODS",
     "PRESETS",
     "PowerPrediction",
+    "Record",
+    "SADEResult",
     "SimulationDivergedError",
     "SimulationResult",
     "Statistic",
     "StepSizeWarning",
     "Tanh",
+    "band_limited_excitation",
     "coulomb_equivalent_damping",
     "equivalent_damping",
     "expected_power",
+    "identify",
+    "normalised_cost",
     "optimal_load_resistance",
     "optimal_load_resistance_linear",
     "predict",
     "preset",
+    "read_record",
+    "sade",
     "simulate",
+    "simulate_record",
     "velocity_variance",
     "averaging_statistics",
     "energy_density",

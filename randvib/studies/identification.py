@@ -15,8 +15,9 @@ displacement records (the twice-differentiated base displacement is low-passed
 at 50 Hz), every identified model is scored on all nine tests (Figure 7), and
 the identified parameters are tabulated beside the truth (Table 2 analogue).
 A noise-free identification of the Coulomb model checks exact recovery
-(within 1 %, J < 1). Figure 8: test 6 repeated with the coil and a 10 ohm load;
-load voltage predicted by the Coulomb and viscous models identified on test 3.
+(within 1 %, J < 1). Figure 8: test 6, and a low level of 0.3 m/s^2, repeated
+with the coil and a 10 ohm load; load voltage predicted by the Coulomb and
+viscous models identified on test 3.
 """
 
 from __future__ import annotations
@@ -52,6 +53,7 @@ LASER_NOISE = 2e-6  # laser noise, m RMS
 LOWPASS = 50.0  # Hz, for the differentiated base displacement
 R_LOAD = 10.0  # ohm, Figure 8 analogue
 WARMUP = 2.0  # s simulated before each record starts
+LOW_RMS = 0.3  # m/s^2, Figure 8 at a level where the magnet sticks often
 
 
 def _settings(quick: bool) -> dict:
@@ -60,11 +62,12 @@ def _settings(quick: bool) -> dict:
     return dict(duration=10.0, fs=1000.0, popsize=50, generations=200, substeps=4)
 
 
-def make_test(number: int, *, duration, fs, seed, noise=True, electrical=None):
+def make_test(number: int, *, duration, fs, seed, noise=True, electrical=None, rms=None):
     """One synthetic test: (Record, true relative velocity)."""
     rng = np.random.default_rng([seed, number])
     n_warm = int(round(WARMUP * fs))
-    ex = band_limited_excitation(duration + WARMUP, fs, TEST_RMS[number - 1], seed=rng)
+    rms = TEST_RMS[number - 1] if rms is None else rms
+    ex = band_limited_excitation(duration + WARMUP, fs, rms, seed=rng)
     truth = dict(TRUTH)
     if electrical is not None:
         truth["c"] = truth["c"] + electrical.electrical_damping
@@ -228,23 +231,34 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
 
     # Figure 8: load voltage on test 6 with the coil
     electrical = ElectricalCoupling(ALPHA, R_LOAD, R_COIL)
-    wired, _ = make_test(6, electrical=electrical, **common)
-    fig8 = {}
-    for model in ("coulomb", "viscous"):
-        pred = predict(results[(3, model)].parameters, model, wired, electrical=electrical, **sim)
-        figure_fit(
-            pred,
-            out / f"figure8_{model}.png",
-            window=(0, 2),
-            scale=1e3,
-            unit="mm",
-            title=f"Test 6 with coil (R_L = {R_LOAD:g} ohm): {model} model identified on test 3",
-        )
-        near_zero = np.mean(np.abs(pred.voltage) < 1e-4)
-        fig8[model] = dict(J=pred.cost, fraction_below_0_1mV=near_zero)
-    fig8["measured"] = dict(
-        J=0.0, fraction_below_0_1mV=float(np.mean(np.abs(wired.voltage) < 1e-4))
-    )
+    fig8 = []
+    for label, rms in (("test 6", None), ("low level", LOW_RMS)):
+        wired, _ = make_test(6, electrical=electrical, rms=rms, **common)
+        level = TEST_RMS[5] if rms is None else rms
+        measured = float(np.mean(np.abs(wired.voltage) < 5e-4))
+        for model in ("coulomb", "viscous"):
+            pred = predict(
+                results[(3, model)].parameters, model, wired, electrical=electrical, **sim
+            )
+            tag = "test6" if rms is None else "low"
+            figure_fit(
+                pred,
+                out / f"figure8_{tag}_{model}.png",
+                window=(0, 2),
+                scale=1e3,
+                unit="mm",
+                title=f"{label} ({level:g} m/s^2 RMS) with coil, R_L = {R_LOAD:g} ohm: "
+                f"{model} model identified on test 3",
+            )
+            fig8.append(
+                {
+                    "excitation": f"{label}, {level:g} m/s^2",
+                    "model": model,
+                    "J": pred.cost,
+                    "share |V| < 0.5 mV, simulated": float(np.mean(np.abs(pred.voltage) < 5e-4)),
+                    "share |V| < 0.5 mV, measured": measured,
+                }
+            )
     elapsed = time.perf_counter() - start
 
     pivot = costs.pivot_table(
@@ -287,19 +301,21 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
         "",
         f"Test 6 repeated with the coil: alpha = {ALPHA} Wb/m, R_C = {R_COIL} ohm, "
         f"R_L = {R_LOAD:g} ohm (c_e = {electrical.electrical_damping:.4g} Ns/m added to the "
-        "identified c). Share of samples with |V| < 0.1 mV (the spike at zero volts caused by "
-        "sticking):",
+        "identified c). Share of samples with |V| < 0.5 mV (the spike at zero volts caused by "
+        "sticking; the measured voltage carries 0.1 mV RMS noise):",
         "",
-        _md_table(
-            pd.DataFrame([dict(source=k, **v) for k, v in fig8.items()]).rename(
-                columns={"fraction_below_0_1mV": "share |V| < 0.1 mV"}
-            ),
-            ".3g",
-        ),
+        _md_table(pd.DataFrame(fig8), ".3g"),
         "",
-        "![Figure 8, Coulomb](figure8_coulomb.png)",
+        "With m = 0.0226 kg the Table 2 friction level is small against the test-6 inertia "
+        "force (m rms(y'') = 0.04 N against Fc = 0.0058 N), so the magnet rarely sticks "
+        f"there; the spike at zero volts is clear at the low level ({LOW_RMS:g} m/s^2), and "
+        "the viscous model, which cannot stick, misses it.",
         "",
-        "![Figure 8, viscous](figure8_viscous.png)",
+        "![Figure 8, test 6, Coulomb](figure8_test6_coulomb.png)",
+        "",
+        "![Figure 8, low level, Coulomb](figure8_low_coulomb.png)",
+        "",
+        "![Figure 8, low level, viscous](figure8_low_viscous.png)",
         "",
         "Files: `records/test*.csv` (the synthetic records, usable with `randvib identify`), "
         "`identified.json`, `costs.csv`, `table2_identified.csv`, `noise_free_recovery.csv`.",
