@@ -1,0 +1,188 @@
+"""Studies ``interaction`` and ``linearisation-accuracy``: building blocks and tiny end-to-end runs.
+
+The end-to-end runs use a grid of a few points, short windows and one
+process (private ``_grid``/``_settings`` overrides), so they check the
+plumbing (files, verdicts, resuming, refusing another run's folder) and the
+exact scaling laws, not the studies' numbers.
+"""
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import randvib as rv
+from randvib.prediction import expected_power
+from randvib.studies import interaction, linearisation_accuracy
+from randvib.studies._common import (
+    fc_at_friction_level,
+    fc_where_power_halves,
+    friction_level,
+    plus_minus,
+)
+from randvib.sweep import SweepSettings
+
+BASE = rv.preset("figure9")
+TINY = SweepSettings(dt=1e-4, window=0.3, burn_in=0.1, min_paths=48, max_paths=48, batch_paths=48)
+
+
+# ----------------------------------------------------------------- friction level phi
+@pytest.mark.parametrize("psd", [0.1, 1.0, 10.0])
+def test_friction_level_round_trip_and_half_power(psd):
+    device = BASE.updated(c_m=0.03, c_e=0.07)
+    fc = np.array([0.0, 1e-3, 0.05, 0.3])
+    assert np.allclose(fc_at_friction_level(device, psd, friction_level(device, psd, fc)), fc)
+    # Eq. 32 halves the power at phi = sqrt(pi)/2 whatever S and c
+    assert np.isclose(
+        friction_level(device, psd, fc_where_power_halves(device, psd)), np.sqrt(np.pi) / 2
+    )
+
+
+def test_eq32_depends_on_fc_and_s_only_through_phi():
+    phi = np.array([0.05, 0.5, 1.0, 3.0])
+    for psd in (0.1, 1.0, 10.0):
+        fc = fc_at_friction_level(BASE, psd, phi)
+        ratio = expected_power(BASE.updated(fc=fc), psd) / expected_power(BASE.updated(fc=0), psd)
+        assert np.allclose(ratio, linearisation_accuracy.power_ratio(phi), rtol=1e-10)
+
+
+def test_duffing_strength_repeats_for_equal_k3_times_s():
+    mu = interaction.duffing_strength(BASE, np.array([0.1, 1.0]), np.array([5e7, 5e6]))
+    assert mu[0] == pytest.approx(mu[1])
+    # mu = k3 sigma_z0^2 / k with sigma_z0^2 the linear oscillator's E[z^2]
+    vv = 1.0 * BASE.m / (4 * BASE.c)
+    assert interaction.duffing_strength(BASE, 1.0, 5e5) == pytest.approx(
+        5e5 * vv * BASE.m / BASE.k**2
+    )
+
+
+def test_plus_minus_formats_percent():
+    assert plus_minus([0.0123, -0.004], [0.001, 0.0005]) == ["+1.23 ± 0.10", "-0.40 ± 0.05"]
+
+
+# ----------------------------------------------------------------- threshold interpolation
+def test_trusted_limit_interpolates_first_crossing_in_log_phi():
+    phi = np.array([0.1, 1.0, 10.0])
+    # bound = |error| + ci: 0.5 %, 2.5 %, 12.5 %; each crossing a quarter of a decade in
+    error, ci = np.array([-0.004, -0.024, -0.124]), np.full(3, 0.001)
+    assert linearisation_accuracy.trusted_limit(phi, error, ci, 0.01) == pytest.approx(10**-0.75)
+    assert linearisation_accuracy.trusted_limit(phi, error, ci, 0.05) == pytest.approx(10**0.25)
+    assert linearisation_accuracy.trusted_limit(phi, error, ci, 0.2) == np.inf
+    assert linearisation_accuracy.trusted_limit(phi, error, ci, 0.001) == 0.0
+    # order of the rows does not matter
+    assert linearisation_accuracy.trusted_limit(phi[::-1], error[::-1], ci, 0.01) == pytest.approx(
+        10**-0.75
+    )
+
+
+def test_trusted_limit_takes_the_interval_and_first_crossing():
+    phi = np.array([0.1, 0.2, 0.4, 0.8])
+    # the estimate alone stays below 1 % at 0.2, the upper bound does not
+    error, ci = np.array([0.002, 0.009, 0.004, 0.03]), np.array([0.001, 0.003, 0.001, 0.001])
+    limit = linearisation_accuracy.trusted_limit(phi, error, ci, 0.01)
+    assert 0.1 < limit < 0.2
+    # a later dip back below the tolerance does not extend the trusted range
+    assert limit == pytest.approx(
+        np.exp(np.log(0.1) + (0.01 - 0.003) / (0.012 - 0.003) * np.log(2))
+    )
+
+
+def test_trusted_limit_rejects_bad_input():
+    with pytest.raises(ValueError, match="one length"):
+        linearisation_accuracy.trusted_limit([0.1, 1.0], [0.0], [0.0], 0.01)
+    with pytest.raises(ValueError, match="> 0"):
+        linearisation_accuracy.trusted_limit([0.0, 1.0], [0.0, 0.0], [0.0, 0.0], 0.01)
+
+
+# ----------------------------------------------------------------- grids
+def test_interaction_grid_holds_every_contrast_partner():
+    points = interaction.study_points(BASE, (1.0, 0.1), (0.0, 5e7), 3)
+    assert len(points) == 2 * 2 * 3
+    for p in points:
+        fc_max = 2 * fc_where_power_halves(BASE, p["psd"])
+        assert 0.0 <= p["fc"] <= fc_max * (1 + 1e-12)
+        for fc, k3 in ((p["fc"], 0.0), (0.0, p["k3"]), (0.0, 0.0)):
+            assert {**p, "fc": fc, "k3": k3} in points
+    with pytest.raises(ValueError, match="include 0"):
+        interaction.study_points(BASE, (1.0,), (5e5,), 3)
+
+
+def test_linearisation_accuracy_grid_sets_fc_by_phi():
+    series = ((1.0, 0.0, 0.1), (10.0, 5e5, 0.025))
+    points = linearisation_accuracy.study_points(BASE, series, (0.1, 2.0))
+    assert len(points) == 4
+    for p in points:
+        device = BASE.updated(c_m=p["c_m"], c_e=p["c_e"])
+        assert np.round(friction_level(device, p["psd"], p["fc"]), 9) in (0.1, 2.0)
+    with pytest.raises(ValueError, match="phis"):
+        linearisation_accuracy.study_points(BASE, series, (0.0, 1.0))
+
+
+# ----------------------------------------------------------------- end to end (tiny)
+def _mtimes(folder):
+    return {p.name: p.stat().st_mtime_ns for p in sorted((folder / "sweep" / "points").glob("*"))}
+
+
+def test_interaction_study_end_to_end(tmp_path):
+    grid = {"psds": (1.0,), "k3s": (0.0, 5e7), "n_fc": 2}
+    out = tmp_path / "inter"
+    kw = dict(workers=1, progress=False, _grid=grid, _settings=TINY)
+    report = interaction.run_study(out, **kw)
+    for name in (
+        "report.md",
+        "interaction.png",
+        "linearisation_error.png",
+        "interaction.csv",
+        "results.csv",
+        "step_check.csv",
+    ):
+        assert (out / name).is_file(), name
+    inter = pd.read_csv(out / "interaction.csv")
+    assert len(inter) == 1 and inter.k3[0] == 5e7 and inter.fc[0] > 0
+    assert np.isfinite(inter[["contrast", "contrast_ci95", "p_value"]].to_numpy()).all()
+    assert inter.contrast_ci95[0] > 0
+    # the Fc = 0 bracket is zero by theory and exact through the companion control
+    assert abs(inter.baseline[0]) < 1e-9 * inter.reference[0]
+    text = report.read_text()
+    assert "**Verdict.**" in text and "Holm" in text and "Time-step check" in text
+    assert len(pd.read_csv(out / "results.csv")) == 4
+
+    # same run again: resumes from the stored points, recomputes nothing
+    before = _mtimes(out)
+    interaction.run_study(out, **kw)
+    assert _mtimes(out) == before
+    assert pd.read_csv(out / "interaction.csv").equals(inter)
+
+    with pytest.raises(FileExistsError, match="different run"):
+        interaction.run_study(out, **{**kw, "_grid": {**grid, "n_fc": 3}})
+
+
+def test_linearisation_accuracy_study_end_to_end(tmp_path):
+    grid = {"series": ((1.0, 0.0, 0.1), (10.0, 0.0, 0.1)), "phis": (0.5, 3.0)}
+    out = tmp_path / "acc"
+    kw = dict(workers=1, progress=False, _grid=grid, _settings=TINY)
+    report = linearisation_accuracy.run_study(out, **kw)
+    for name in ("report.md", "linearisation_accuracy.png", "results.csv", "thresholds.csv"):
+        assert (out / name).is_file(), name
+    table = pd.read_csv(out / "results.csv")
+    assert np.allclose(table.phi, np.tile([0.5, 3.0], 2))
+    # k3 = 0: the series at S = 1 and 10 are the same paths rescaled (exact scaling)
+    a, b = (table[table.psd == s].sort_values("phi") for s in (1.0, 10.0))
+    assert np.allclose(
+        a.linearisation_rel_error.to_numpy(), b.linearisation_rel_error.to_numpy(), atol=1e-9
+    )
+    assert (table.linearisation_rel_error_ci95 > 0).all()
+    limits = pd.read_csv(out / "thresholds.csv")
+    assert set(limits.method) >= {"linearisation"}
+    assert {"phi_1pct", "phi_5pct", "phi_10pct"} <= set(limits.columns)
+    text = report.read_text()
+    assert "**Verdict.**" in text and "trusted" in text and "**Collapse.**" in text
+    meta = json.loads((out / "metadata.json").read_text())["identity"]
+    assert meta["study"] == "linearisation-accuracy" and meta["grid"]["phis"] == [0.5, 3.0]
+
+    before = _mtimes(out)
+    linearisation_accuracy.run_study(out, **kw)
+    assert _mtimes(out) == before
+    with pytest.raises(FileExistsError, match="different run"):
+        linearisation_accuracy.run_study(out, **{**kw, "seed": 1})
