@@ -83,7 +83,9 @@ def make_test(number: int, *, duration, fs, seed, noise=True, electrical=None, r
         voltage = electrical.alpha * v * electrical.load_fraction
         if noise:
             voltage = voltage + 1e-4 * rng.standard_normal(v.size)  # 0.1 mV RMS
-    name = f"test{number}" + ("" if noise else "-noise-free")
+    name = (f"test{number}" if rms == TEST_RMS[number - 1] else f"{rms:g} m/s^2") + (
+        "" if noise else "-noise-free"
+    )
     return Record(1 / fs, "base_displacement", y, z, name, voltage), v
 
 
