@@ -64,6 +64,8 @@ def run_ensemble(
     init_mode,
     init_z,
     init_v,
+    comp_init_z,
+    comp_init_v,
     dw,
     companion,
     hist_lo,
@@ -94,6 +96,10 @@ def run_ensemble(
     init_mode : int
         0: start at (init_z, init_v); 1: start from N(0, init_z^2) x
         N(0, init_v^2) drawn from the path's own stream.
+    comp_init_z, comp_init_v : float
+        With init_mode 1, the companion starts from the same two normal draws
+        scaled by these (its own stationary standard deviations), so that its
+        exactly known stationary moments hold from the start.
     dw : float64[:, :]
         Given Brownian increments (n_paths, n_steps), or shape (0, 0) to draw.
     companion : bool
@@ -140,13 +146,17 @@ def run_ensemble(
         for j in range(lanes):
             seed_path_state(seed, first_path + start + j, rng, j)
             if init_mode == 1:
-                z[j] = init_z * standard_normal(rng, j, ki, wi, fi)
-                v[j] = init_v * standard_normal(rng, j, ki, wi, fi)
+                nz = standard_normal(rng, j, ki, wi, fi)
+                nv = standard_normal(rng, j, ki, wi, fi)
+                z[j] = init_z * nz
+                v[j] = init_v * nv
+                zc[j] = comp_init_z * nz
+                vc[j] = comp_init_v * nv
             else:
                 z[j] = init_z
                 v[j] = init_v
-            zc[j] = z[j]
-            vc[j] = v[j]
+                zc[j] = init_z
+                vc[j] = init_v
             if start + j < n_record:
                 records[start + j, 0, 0] = z[j]
                 records[start + j, 0, 1] = v[j]

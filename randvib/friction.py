@@ -53,6 +53,11 @@ class FrictionModel:
     def force(self, v, theta=None):  # pragma: no cover - abstract
         raise NotImplementedError
 
+    @property
+    def vanishes(self) -> bool:
+        """True when the model exerts no force at all (e.g. Fc = 0)."""
+        return False
+
     def mean_velocity_force(self, sigma_v):
         """E[v F(v)] (W) for v ~ N(0, sigma_v^2), by quadrature (paper Eq. 19)."""
         sigma_v = np.asarray(sigma_v, dtype=float)
@@ -106,6 +111,10 @@ class Coulomb(FrictionModel):
     def force(self, v, theta=None):
         return self.fc * np.sign(v)
 
+    @property
+    def vanishes(self) -> bool:
+        return bool(np.all(np.asarray(self.fc) == 0))
+
     def mean_velocity_force(self, sigma_v):
         # E[v Fc sgn v] = Fc E|v| = Fc sqrt(2/pi) sigma_v (paper Eq. 22-26).
         return self.fc * np.sqrt(2.0 / np.pi) * np.asarray(sigma_v, dtype=float)
@@ -135,6 +144,10 @@ class Tanh(FrictionModel):
 
     def force(self, v, theta=None):
         return self.fc * np.tanh(self.beta * np.asarray(v, dtype=float))
+
+    @property
+    def vanishes(self) -> bool:
+        return bool(np.all(np.asarray(self.fc) == 0))
 
     def mean_velocity_force(self, sigma_v):
         # Written as Fc E|v| minus a boundary-layer correction of width 1/beta so

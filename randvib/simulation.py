@@ -491,6 +491,16 @@ def simulate(
         if not (np.isfinite(z0) and np.isfinite(v0)):
             raise ValueError(f"`initial` state must be finite, got {initial!r}")
         init_mode, init_z, init_v = 0, z0, v0
+    # The friction-free companion starts from its own stationary spread (exact
+    # Gaussian velocity, Gibbs displacement variance), so its known moments
+    # hold from t = 0 and its control mean is right without a long burn-in.
+    comp_init_z, comp_init_v = init_z, init_v
+    if companion and init_mode == 1 and harvester.c > 0:
+        h = harvester
+        comp_init_v = float(np.sqrt(exact.linear_velocity_variance(h.m, h.c, psd)))
+        comp_init_z = float(np.sqrt(exact.gibbs_displacement_moment(h.m, h.c, h.k, h.k3, psd)))
+        if h.friction is None or h.friction.vanishes:  # the device is its own companion
+            init_z, init_v = comp_init_z, comp_init_v
 
     if dW is not None:
         dW = np.ascontiguousarray(dW, dtype=float)
@@ -552,6 +562,8 @@ def simulate(
                 init_mode,
                 init_z,
                 init_v,
+                comp_init_z,
+                comp_init_v,
                 dw_batch,
                 companion,
                 hist_lo,

@@ -52,11 +52,12 @@ def study_points(n_fc: int) -> list[dict]:
 
 
 def settings_for(quick: bool, seed: int) -> SweepSettings:
+    # 128 paths at least, quick mode too: the paired interaction contrasts use
+    # eight control variates and need ten paths per control (sweep.paired_contrast)
     if quick:
         return SweepSettings(
-            target_rel_ci=0.01, window=1.0, burn_in=0.5, seed=seed, min_paths=64, batch_paths=64
+            target_rel_ci=0.01, window=1.0, burn_in=0.5, seed=seed, min_paths=128, batch_paths=64
         )
-    # 128 paths at least: paired contrasts regress on up to a dozen controls
     return SweepSettings(
         target_rel_ci=0.005, window=2.0, burn_in=0.5, seed=seed, min_paths=128, batch_paths=64
     )
