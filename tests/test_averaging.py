@@ -266,9 +266,17 @@ def test_quick_study_meets_the_accuracy_criteria(tmp_path):
     assert report.name == "report.md" and report.exists()
     assert (report.parent / "error_vs_friction.png").exists()
     assert (report.parent / "interaction.png").exists()
-    v = verdicts(pd.read_csv(report.parent / "results.csv"))
+    df = pd.read_csv(report.parent / "results.csv")
+    v = verdicts(df)
     assert v["lin_over_3pct"] > 0 and v["avg_third_where_lin_over_3pct"]
     assert v["avg_within_5pct"]
+    # The fast FPK grids meet every accuracy criterion, the interaction included.
+    assert v["fpk_fast_third_where_lin_over_3pct"] and v["fpk_fast_within_5pct"]
+    assert v["fpk_fast_interaction_met"]
+    assert v["interaction_fpk_fast_inside"] == v["interaction_points"]
+    assert "power_fpk_fast" in df and "dk3_fpk_fast" in df
+    text = report.read_text()
+    assert "fast FPK" in text and "one point < 10 ms" in text
     # Re-running with the same settings resumes; other settings are refused.
     assert run_study(tmp_path / "lva", quick=True, seed=0, progress=False) == report
     with pytest.raises(FileExistsError):
