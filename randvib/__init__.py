@@ -13,7 +13,7 @@ from randvib.averaging import (
 )
 from randvib.deterministic import BatchSimulation, simulate_record
 from randvib.excitation import BaseExcitation, band_limited_excitation
-from randvib.fokker_planck import fpk_statistics, solve_fpk
+from randvib.fokker_planck import fast_fpk_statistics, fpk_statistics, solve_fpk
 from randvib.friction import Coulomb, FrictionModel, LuGre, Tanh
 from randvib.harvester import ElectricalCoupling, Harvester
 from randvib.identification import (
@@ -86,6 +86,7 @@ __all__ = [
     "velocity_variance",
     "averaging_statistics",
     "energy_density",
+    "fast_fpk_statistics",
     "fpk_statistics",
     "orbit_averages",
     "solve_fpk",
