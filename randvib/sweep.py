@@ -209,8 +209,11 @@ def _merge(first, per_path):
 
 
 # ------------------------------------------------------------------ executors
-def make_executor(workers: int | None = None, scheduler: str | None = None):
-    """An executor and a closer: local processes, or a Dask cluster at ``scheduler``."""
+def make_executor(workers: int | None = None, scheduler: str | None = None, initializer=None):
+    """An executor and a closer: local processes, or a Dask cluster at ``scheduler``.
+
+    ``initializer`` runs once in each local worker process (not on Dask).
+    """
     if scheduler is not None:
         try:
             from distributed import Client
@@ -227,7 +230,11 @@ def make_executor(workers: int | None = None, scheduler: str | None = None):
     # in this process, and forking it is unsafe (the child aborts)
     import multiprocessing
 
-    pool = ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("spawn"))
+    pool = ProcessPoolExecutor(
+        max_workers=workers,
+        mp_context=multiprocessing.get_context("spawn"),
+        initializer=initializer,
+    )
     return pool, lambda: pool.shutdown(cancel_futures=True)
 
 

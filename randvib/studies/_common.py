@@ -9,7 +9,6 @@ import numpy as np
 import pandas as pd
 
 from randvib._io import atomic_write_text
-from randvib._validation import check_int
 from randvib.harvester import Harvester
 from randvib.linearisation import coulomb_equivalent_damping
 from randvib.sweep import (
@@ -18,6 +17,7 @@ from randvib.sweep import (
     holm_significant,
     make_executor,
     paired_contrast,
+    point_device,
     run_sweep,
     two_sided_p_value,
 )
@@ -262,20 +262,80 @@ def study_executor(workers=None, scheduler=None):
     friction it would repeat once per point); the studies flag those points in
     their reports instead, from ``zeta_friction``.
     """
-    import os
+    return make_executor(workers, scheduler, initializer=_quiet_worker)
 
-    if scheduler is not None:
-        return make_executor(workers, scheduler)
-    workers = os.cpu_count() or 1 if workers is None else check_int("workers", workers, 1)
-    if workers == 1:
-        return make_executor(1)
-    import multiprocessing
-    from concurrent.futures import ProcessPoolExecutor
 
-    # spawn, as make_executor: forking a process whose numba threads run is unsafe
-    pool = ProcessPoolExecutor(
-        max_workers=workers,
-        mp_context=multiprocessing.get_context("spawn"),
-        initializer=_quiet_worker,
+def check_step_bias(base: Harvester, points: list, settings: SweepSettings) -> float:
+    """The largest linearised step bias over ``points``; refuse it above the warning level.
+
+    Uses :func:`randvib.simulation.step_bias` (the scheme's exact stationary
+    bias on each point's linearised device).
+    """
+    from randvib.simulation import WARN_STEP_BIAS, step_bias
+
+    worst = max(
+        step_bias(settings.method, point_device(base, p), p["psd"], settings.dt) for p in points
     )
-    return pool, lambda: pool.shutdown(cancel_futures=True)
+    if worst > WARN_STEP_BIAS:
+        raise ValueError(
+            f"dt = {settings.dt:g} s gives a linearised step bias of {worst:.2%}; "
+            "use a smaller step"
+        )
+    return worst
+
+
+def highest_friction_points(points: list, group=("psd",)) -> list:
+    """The points with the largest Fc within each group: the hardest dynamics."""
+    top: dict = {}
+    for p in points:
+        key = tuple(p[g] for g in group)
+        top[key] = max(top.get(key, -np.inf), p["fc"])
+    return [p for p in points if p["fc"] == top[tuple(p[g] for g in group)]]
+
+
+def sweep_with_step_check(
+    base: Harvester,
+    points: list,
+    settings: SweepSettings,
+    out: Path,
+    name: str,
+    check_points: list,
+    *,
+    workers=None,
+    scheduler=None,
+    progress=True,
+):
+    """Run a study's sweep into ``out/sweep`` and its half-step re-run of ``check_points``.
+
+    Returns the :class:`~randvib.sweep.SweepResult` and the table of
+    :func:`step_size_check`.
+    """
+    import warnings
+
+    from randvib.averaging import AveragingValidityWarning
+
+    executor, close = study_executor(workers, scheduler)
+    try:
+        with warnings.catch_warnings():  # in-process runs; the reports flag these points
+            warnings.simplefilter("ignore", AveragingValidityWarning)
+            result = run_sweep(
+                base,
+                points,
+                settings,
+                out_dir=out / "sweep",
+                executor=executor,
+                progress=progress,
+                name=name,
+            )
+            check = step_size_check(
+                base,
+                check_points,
+                settings,
+                out / "step-check",
+                result.table,
+                executor=executor,
+                progress=progress,
+            )
+    finally:
+        close()
+    return result, check

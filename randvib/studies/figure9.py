@@ -24,18 +24,17 @@ from randvib.prediction import METHODS, expected_power
 from randvib.presets import preset
 from randvib.studies._common import (
     fc_where_power_halves,
+    highest_friction_points,
     interaction_contrasts,
     markdown_table,
     save_figure,
-    step_size_check,
+    sweep_with_step_check,
     write_report,
 )
 from randvib.sweep import (
     SweepSettings,
     cartesian,
     linearisation_verdicts,
-    make_executor,
-    run_sweep,
 )
 
 PSDS = (1.0, 0.5, 0.1)
@@ -144,32 +143,18 @@ def run_study(
     points = study_points(n_fc)
     settings = settings_for(quick, seed)
     out = prepare_output_dir(out_dir, {"study": "figure9", "quick": quick, "seed": seed})
-    executor, close = make_executor(workers, scheduler)
-    try:
-        result = run_sweep(
-            base,
-            points,
-            settings,
-            out_dir=out / "sweep",
-            executor=executor,
-            progress=progress,
-            name="figure9",
-        )
-        # half-step check on the highest-friction points (largest nonlinearity)
-        check_points = [
-            p for p in points if p["fc"] == max(q["fc"] for q in points if q["psd"] == p["psd"])
-        ]
-        check = step_size_check(
-            base,
-            check_points,
-            settings,
-            out / "step-check",
-            result.table,
-            executor=executor,
-            progress=progress,
-        )
-    finally:
-        close()
+    # half-step check on the highest-friction points (largest nonlinearity)
+    result, check = sweep_with_step_check(
+        base,
+        points,
+        settings,
+        out,
+        "figure9",
+        highest_friction_points(points),
+        workers=workers,
+        scheduler=scheduler,
+        progress=progress,
+    )
     table = linearisation_verdicts(result.table)
     inter = interaction_contrasts(result, base, "fc", "k3")
     atomic_write_text(out / "results.csv", table.to_csv(index=False))

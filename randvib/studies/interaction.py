@@ -37,20 +37,20 @@ from randvib._io import atomic_write_text, prepare_output_dir
 from randvib.averaging import AveragingValidityWarning, averaging_statistics
 from randvib.prediction import METHODS, expected_power
 from randvib.presets import preset
-from randvib.simulation import WARN_STEP_BIAS, step_bias
 from randvib.studies._common import (
     burn_in_for,
+    check_step_bias,
     fc_where_power_halves,
     friction_level,
+    highest_friction_points,
     interaction_contrasts,
     markdown_table,
     plus_minus,
     save_figure,
-    step_size_check,
-    study_executor,
+    sweep_with_step_check,
     write_report,
 )
-from randvib.sweep import SweepSettings, cartesian, linearisation_verdicts, run_sweep
+from randvib.sweep import SweepSettings, cartesian, linearisation_verdicts
 
 NAME = "interaction"
 PSDS = (1.0, 0.5, 0.1)
@@ -375,15 +375,7 @@ def run_study(
     psds, k3s, n_fc = tuple(axes["psds"]), tuple(axes["k3s"]), int(axes["n_fc"])
     settings = _settings or settings_for(quick, seed)
     points = study_points(base, psds, k3s, n_fc)
-    biases = [
-        step_bias(settings.method, base.updated(k3=p["k3"], fc=p["fc"]), p["psd"], settings.dt)
-        for p in points
-    ]
-    if max(biases) > WARN_STEP_BIAS:
-        raise ValueError(
-            f"dt = {settings.dt:g} s gives a linearised step bias of {max(biases):.2%}; "
-            "use a smaller step"
-        )
+    worst_bias = check_step_bias(base, points, settings)
     out = prepare_output_dir(
         out_dir,
         {
@@ -394,38 +386,19 @@ def run_study(
             "settings": asdict(settings),
         },
     )
-    executor, close = study_executor(workers, scheduler)
-    try:
-        with warnings.catch_warnings():  # in-process runs; the report flags these points
-            warnings.simplefilter("ignore", AveragingValidityWarning)
-            result = run_sweep(
-                base,
-                points,
-                settings,
-                out_dir=out / "sweep",
-                executor=executor,
-                progress=progress,
-                name=NAME,
-            )
-            # half-step check where the dynamics is hardest: most friction, with and
-            # without the stiffest spring
-            check_points = [
-                p
-                for p in points
-                if p["fc"] == max(q["fc"] for q in points if q["psd"] == p["psd"])
-                and (p["k3"] == max(k3s) or (not quick and p["k3"] == 0))
-            ]
-            check = step_size_check(
-                base,
-                check_points,
-                settings,
-                out / "step-check",
-                result.table,
-                executor=executor,
-                progress=progress,
-            )
-    finally:
-        close()
+    # half-step check where the dynamics is hardest: most friction, with and
+    # without the stiffest spring
+    result, check = sweep_with_step_check(
+        base,
+        points,
+        settings,
+        out,
+        NAME,
+        highest_friction_points(points),
+        workers=workers,
+        scheduler=scheduler,
+        progress=progress,
+    )
 
     table = linearisation_verdicts(result.table)
     has_avg = "averaging" in METHODS and "averaging_power" in table
@@ -537,7 +510,7 @@ def run_study(
         + ("the stiffest spring" if quick else "k3 = 0 and the stiffest spring")
         + f") at dt/2 = {settings.dt / 2:g} s, independent noise. Time-step bias below the "
         f"statistical error at {int(check.bias_below_error.sum())} of {len(check)} points. "
-        f"Linearised step bias at dt (randvib.simulation.step_bias) at most {max(biases):.1e}.\n\n"
+        f"Linearised step bias at dt (randvib.simulation.step_bias) at most {worst_bias:.1e}.\n\n"
         + markdown_table(check)
     )
     setup = (

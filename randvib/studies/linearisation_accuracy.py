@@ -23,7 +23,6 @@ Stochastic averaging (:mod:`randvib.averaging`) is mapped alongside.
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import asdict
 from pathlib import Path
 
@@ -31,22 +30,22 @@ import numpy as np
 import pandas as pd
 
 from randvib._io import atomic_write_text, prepare_output_dir
-from randvib.averaging import AveragingValidityWarning, averaging_statistics
+from randvib.averaging import averaging_statistics
 from randvib.prediction import METHODS
 from randvib.presets import preset
-from randvib.simulation import WARN_STEP_BIAS, step_bias
 from randvib.studies._common import (
     burn_in_for,
+    check_step_bias,
     fc_at_friction_level,
     friction_level,
+    highest_friction_points,
     markdown_table,
     plus_minus,
     save_figure,
-    step_size_check,
-    study_executor,
+    sweep_with_step_check,
     write_report,
 )
-from randvib.sweep import SweepSettings, linearisation_verdicts, run_sweep
+from randvib.sweep import SweepSettings, linearisation_verdicts
 
 NAME = "linearisation-accuracy"
 TOLERANCES = (0.01, 0.05, 0.10)
@@ -309,20 +308,7 @@ def run_study(
     phis = tuple(float(p) for p in axes["phis"])
     settings = _settings or settings_for(quick, seed, series)
     points = study_points(base, series, phis)
-    biases = [
-        step_bias(
-            settings.method,
-            base.updated(**{k: v for k, v in p.items() if k != "psd"}),
-            p["psd"],
-            settings.dt,
-        )
-        for p in points
-    ]
-    if max(biases) > WARN_STEP_BIAS:
-        raise ValueError(
-            f"dt = {settings.dt:g} s gives a linearised step bias of {max(biases):.2%}; "
-            "use a smaller step"
-        )
+    worst_bias = check_step_bias(base, points, settings)
     out = prepare_output_dir(
         out_dir,
         {
@@ -333,45 +319,25 @@ def run_study(
             "settings": asdict(settings),
         },
     )
-    executor, close = study_executor(workers, scheduler)
-    try:
-        with warnings.catch_warnings():  # in-process runs; the report flags these points
-            warnings.simplefilter("ignore", AveragingValidityWarning)
-            result = run_sweep(
-                base,
-                points,
-                settings,
-                out_dir=out / "sweep",
-                executor=executor,
-                progress=progress,
-                name=NAME,
-            )
-            # half-step check at the strongest friction of each (k3, damping), largest S
-            check_points = []
-            for k3, c_each in sorted({(s[1], s[2]) for s in series}):
-                psd = max(s[0] for s in series if (s[1], s[2]) == (k3, c_each))
-                check_points += [
-                    p
-                    for p in points
-                    if (p["psd"], p["k3"], p["c_m"]) == (psd, k3, c_each)
-                    and p["fc"]
-                    == max(
-                        q["fc"]
-                        for q in points
-                        if (q["psd"], q["k3"], q["c_m"]) == (psd, k3, c_each)
-                    )
-                ]
-            check = step_size_check(
-                base,
-                check_points,
-                settings,
-                out / "step-check",
-                result.table,
-                executor=executor,
-                progress=progress,
-            )
-    finally:
-        close()
+    # half-step check at the strongest friction of each (k3, damping), largest S
+    largest_s: dict = {}
+    for p in points:
+        key = (p["k3"], p["c_m"])
+        largest_s[key] = max(largest_s.get(key, 0.0), p["psd"])
+    check_points = highest_friction_points(
+        [p for p in points if p["psd"] == largest_s[(p["k3"], p["c_m"])]], ("psd", "k3", "c_m")
+    )
+    result, check = sweep_with_step_check(
+        base,
+        points,
+        settings,
+        out,
+        NAME,
+        check_points,
+        workers=workers,
+        scheduler=scheduler,
+        progress=progress,
+    )
 
     table = linearisation_verdicts(result.table)
     methods = ["linearisation"]
@@ -518,7 +484,7 @@ def run_study(
         f"Re-run of {len(check)} points (strongest friction of each k3 and damping, at its "
         f"largest S) at dt/2 = {settings.dt / 2:g} s, independent noise. Time-step bias below "
         f"the statistical error at {int(check.bias_below_error.sum())} of {len(check)} points. "
-        f"Linearised step bias at dt at most {max(biases):.1e}.\n\n" + markdown_table(check)
+        f"Linearised step bias at dt at most {worst_bias:.1e}.\n\n" + markdown_table(check)
     )
     return write_report(
         out,
