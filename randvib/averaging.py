@@ -314,8 +314,13 @@ def _moments_on_grid(x_max, gamma, omega, lam, fcm, beta, dd):
     return vv, abs_v, zz, fpow, z, ends[:, -1]
 
 
-def _parameters(harvester: Harvester, psd):
-    """Broadcast (m, c, k, k3, fc, beta, psd); beta = inf marks Coulomb."""
+def memoryless_parameters(harvester: Harvester, psd, method: str = "stochastic averaging"):
+    """Broadcast (m, c, k, k3, fc, beta, psd) for the semi-analytic methods.
+
+    ``beta = inf`` marks Coulomb friction (or none, with ``fc = 0``). Methods
+    that need a memoryless friction law (averaging, the FPK solvers) share
+    this; ``method`` names the caller in the error raised for LuGre.
+    """
     friction = harvester.friction
     if friction is None:
         fc, beta = 0.0, np.inf
@@ -325,7 +330,7 @@ def _parameters(harvester: Harvester, psd):
         fc, beta = friction.fc, np.inf
     else:
         raise ValueError(
-            f"stochastic averaging needs a memoryless friction law (coulomb, tanh or none); "
+            f"{method} needs a memoryless friction law (coulomb, tanh or none); "
             f"{friction.name!r} has internal state. Use randvib.simulate for it."
         )
     psd = check_positive("psd", psd, "(m/s^2)^2/Hz")
@@ -336,8 +341,7 @@ def _parameters(harvester: Harvester, psd):
         )
     )
     m, c, k, k3, fc, beta, psd = arrays
-    stuck = (c <= 0) & (fc <= 0)
-    if np.any(stuck):
+    if np.any((c <= 0) & (fc <= 0)):
         raise ValueError(
             "total damping `c_m + c_e` and friction `fc` are both 0 at some parameter point; "
             "the undamped oscillator has no stationary state"
@@ -371,7 +375,7 @@ def averaging_statistics(harvester: Harvester, psd, *, warn: bool = True) -> Ave
         drift is not a function of the energy alone), and for points with
         neither damping nor friction.
     """
-    m, c, k, k3, fc, beta, psd = _parameters(harvester, psd)
+    m, c, k, k3, fc, beta, psd = memoryless_parameters(harvester, psd)
     shape = m.shape
     flat = [np.ravel(a) for a in (m, c, k, k3, fc, beta, psd)]
     n = flat[0].size
@@ -467,7 +471,9 @@ def energy_density(harvester: Harvester, psd, energy):
     energy : array_like
         Energies E (J), >= 0.
     """
-    m, c, k, k3, fc, beta, psd = (float(np.ravel(a)[0]) for a in _parameters(harvester, psd))
+    m, c, k, k3, fc, beta, psd = (
+        float(np.ravel(a)[0]) for a in memoryless_parameters(harvester, psd)
+    )
     if any(np.ndim(v) for v in (harvester.m, harvester.c, harvester.k, harvester.k3)):
         raise ValueError("energy_density needs scalar harvester parameters")
     energy = check_nonnegative("energy", energy, "J")

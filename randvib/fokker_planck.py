@@ -51,6 +51,7 @@ from scipy.linalg import lapack
 from scipy.sparse import linalg as sparse_linalg
 
 from randvib._validation import check_int, check_positive
+from randvib.averaging import memoryless_parameters
 from randvib.friction import Coulomb, Tanh
 from randvib.harvester import Harvester
 from randvib.linearisation import equivalent_damping
@@ -472,7 +473,7 @@ def fast_fpk_statistics(harvester: Harvester, psd, *, nz=FAST_NZ, nv=FAST_NV):
     velocity_variance, displacement_variance, mean_abs_velocity : float or ndarray
     """
     nzs, nvs = _grid_pair("nz", nz), _grid_pair("nv", nv)
-    arrays = _broadcast_parameters(harvester, psd)
+    arrays = memoryless_parameters(harvester, psd, "the FPK solver")
     shape = arrays[0].shape
     out = np.empty((3,) + shape)
     for index in np.ndindex(shape):
@@ -517,33 +518,3 @@ def _fast_point(m, c, k, k3, fcm, beta, dd, nzs, nvs):
         coarse_z, _ = _half_moments(m, c, k, k3, fcm, beta, dd, e_edge, nzs[1], nvs[-1])
         best[1] += (coarse_v[1] - coarse_z[1]) / ((nzs[0] / nzs[1]) ** 2 - 1.0)
     return best
-
-
-def _broadcast_parameters(harvester: Harvester, psd):
-    """Broadcast (m, c, k, k3, fc, beta, psd); beta = inf marks Coulomb (or none)."""
-    friction = harvester.friction
-    if friction is None:
-        fc, beta = 0.0, np.inf
-    elif isinstance(friction, Tanh):
-        fc, beta = friction.fc, friction.beta
-    elif isinstance(friction, Coulomb):
-        fc, beta = friction.fc, np.inf
-    else:
-        raise ValueError(
-            f"the FPK solver needs a memoryless friction law (coulomb, tanh or none); "
-            f"{friction.name!r} has internal state (the density would need a third "
-            "dimension). Use randvib.simulate for it."
-        )
-    psd = check_positive("psd", psd, "(m/s^2)^2/Hz")
-    arrays = np.broadcast_arrays(
-        *(
-            np.asarray(x, dtype=float)
-            for x in (harvester.m, harvester.c, harvester.k, harvester.k3, fc, beta, psd)
-        )
-    )
-    if np.any((arrays[1] <= 0) & (arrays[4] <= 0)):
-        raise ValueError(
-            "total damping `c_m + c_e` and friction `fc` are both 0 at some parameter point; "
-            "the undamped oscillator has no stationary state"
-        )
-    return arrays
