@@ -107,6 +107,22 @@ def _uniform(r):
     return (r >> _U64(11)) * (1.0 / 9007199254740992.0)  # 53 random bits in [0, 1)
 
 
+@numba.njit(cache=True, inline="always")
+def _ziggurat_candidate(r, wi):
+    """Split a 64-bit draw into (layer, 52-bit mantissa, signed candidate x).
+
+    Bits 0-7 pick the layer, bit 8 the sign, bits 9-60 the mantissa. The
+    mantissa is < 2^52 and fits an int64, whose conversion to double is one
+    instruction (uint64 to double is several).
+    """
+    idx = np.int64(r & _U64(0xFF))
+    rabs = (r >> _U64(9)) & _U64(0x000FFFFFFFFFFFFF)
+    x = np.int64(rabs) * wi[idx]
+    if (r >> _U64(8)) & _U64(1):
+        x = -x
+    return idx, rabs, x
+
+
 @numba.njit(cache=True)
 def _normal_slow(s0, s1, s2, s3, idx, rabs, x, ki, wi, fi):
     # Rare branch of the ziggurat (about 1 % of draws), kept out of line.
@@ -125,13 +141,7 @@ def _normal_slow(s0, s1, s2, s3, idx, rabs, x, ki, wi, fi):
         if (fi[idx - 1] - fi[idx]) * _uniform(r) + fi[idx] < np.exp(-0.5 * x * x):
             return x, s0, s1, s2, s3
         r, s0, s1, s2, s3 = xoshiro_next(s0, s1, s2, s3)
-        idx = np.int64(r & _U64(0xFF))
-        r = r >> _U64(8)
-        sign = r & _U64(1)
-        rabs = (r >> _U64(1)) & _U64(0x000FFFFFFFFFFFFF)
-        x = np.int64(rabs) * wi[idx]
-        if sign:
-            x = -x
+        idx, rabs, x = _ziggurat_candidate(r, wi)
         if rabs < ki[idx]:
             return x, s0, s1, s2, s3
 
@@ -140,14 +150,7 @@ def _normal_slow(s0, s1, s2, s3, idx, rabs, x, ki, wi, fi):
 def normal_from_state(s0, s1, s2, s3, ki, wi, fi):
     """One N(0, 1) draw (ziggurat) from a state in locals: (x, new state)."""
     r, s0, s1, s2, s3 = xoshiro_next(s0, s1, s2, s3)
-    idx = np.int64(r & _U64(0xFF))
-    r = r >> _U64(8)
-    sign = r & _U64(1)
-    rabs = (r >> _U64(1)) & _U64(0x000FFFFFFFFFFFFF)
-    # rabs < 2^52 fits an int64, whose conversion to double is one instruction
-    x = np.int64(rabs) * wi[idx]
-    if sign:
-        x = -x
+    idx, rabs, x = _ziggurat_candidate(r, wi)
     if rabs < ki[idx]:
         return x, s0, s1, s2, s3
     return _normal_slow(s0, s1, s2, s3, idx, rabs, x, ki, wi, fi)
