@@ -5,89 +5,67 @@ modelling of friction in a randomly excited energy harvester". SI units
 throughout; S is the one-sided PSD of the base acceleration in (m/s^2)^2/Hz.
 """
 
-from randvib.averaging import (
-    AveragingValidityWarning,
-    averaging_statistics,
-    energy_density,
-    orbit_averages,
-)
-from randvib.deterministic import BatchSimulation, simulate_record
-from randvib.excitation import BaseExcitation, band_limited_excitation
-from randvib.fokker_planck import fast_fpk_statistics, fpk_statistics, solve_fpk
-from randvib.friction import Coulomb, FrictionModel, LuGre, Tanh
-from randvib.harvester import ElectricalCoupling, Harvester
-from randvib.identification import (
-    IdentificationResult,
-    Record,
-    identify,
-    normalised_cost,
-    read_record,
-)
-from randvib.integrators import INTEGRATORS, Integrator
-from randvib.linearisation import coulomb_equivalent_damping, equivalent_damping
-from randvib.prediction import (
-    METHODS,
-    PowerPrediction,
-    expected_power,
-    optimal_load_resistance,
-    optimal_load_resistance_linear,
-    predict,
-    velocity_variance,
-)
-from randvib.presets import MAGNET_MASS, PRESETS, preset
-from randvib.sade import SADEResult, sade
-from randvib.simulation import (
-    SimulationDivergedError,
-    SimulationResult,
-    Statistic,
-    StepSizeWarning,
-    simulate,
-)
+# Public names load on first use (PEP 562): ``import randvib`` stays light, and
+# a script that only simulates never pays for the identification, FPK or
+# plotting stacks (time and memory; see benchmarks/bench_engine.py).
+import importlib
 
 __version__ = "0.1.0"
 
-__all__ = [
-    "AveragingValidityWarning",
-    "BaseExcitation",
-    "BatchSimulation",
-    "Coulomb",
-    "ElectricalCoupling",
-    "FrictionModel",
-    "Harvester",
-    "IdentificationResult",
-    "INTEGRATORS",
-    "Integrator",
-    "LuGre",
-    "MAGNET_MASS",
-    "METHODS",
-    "PRESETS",
-    "PowerPrediction",
-    "Record",
-    "SADEResult",
-    "SimulationDivergedError",
-    "SimulationResult",
-    "Statistic",
-    "StepSizeWarning",
-    "Tanh",
-    "band_limited_excitation",
-    "coulomb_equivalent_damping",
-    "equivalent_damping",
-    "expected_power",
-    "identify",
-    "normalised_cost",
-    "optimal_load_resistance",
-    "optimal_load_resistance_linear",
-    "predict",
-    "preset",
-    "read_record",
-    "sade",
-    "simulate",
-    "simulate_record",
-    "velocity_variance",
-    "averaging_statistics",
-    "energy_density",
-    "fast_fpk_statistics",
-    "fpk_statistics",
-    "orbit_averages",
-    "solve_fpk",
-]
+#: Submodule -> public names it provides, re-exported here.
+_EXPORTS = {
+    "randvib.averaging": (
+        "averaging_statistics",
+        "AveragingValidityWarning",
+        "energy_density",
+        "orbit_averages",
+    ),
+    "randvib.deterministic": ("BatchSimulation", "simulate_record"),
+    "randvib.excitation": ("band_limited_excitation", "BaseExcitation"),
+    "randvib.fokker_planck": ("fast_fpk_statistics", "fpk_statistics", "solve_fpk"),
+    "randvib.friction": ("Coulomb", "FrictionModel", "LuGre", "Tanh"),
+    "randvib.harvester": ("ElectricalCoupling", "Harvester"),
+    "randvib.identification": (
+        "IdentificationResult",
+        "identify",
+        "normalised_cost",
+        "read_record",
+        "Record",
+    ),
+    "randvib.integrators": ("Integrator", "INTEGRATORS"),
+    "randvib.linearisation": ("coulomb_equivalent_damping", "equivalent_damping"),
+    "randvib.prediction": (
+        "expected_power",
+        "METHODS",
+        "optimal_load_resistance",
+        "optimal_load_resistance_linear",
+        "PowerPrediction",
+        "predict",
+        "velocity_variance",
+    ),
+    "randvib.presets": ("MAGNET_MASS", "preset", "PRESETS"),
+    "randvib.sade": ("sade", "SADEResult"),
+    "randvib.simulation": (
+        "simulate",
+        "SimulationDivergedError",
+        "SimulationResult",
+        "Statistic",
+        "StepSizeWarning",
+    ),
+}
+_WHERE = {name: module for module, names in _EXPORTS.items() for name in names}
+
+__all__ = sorted(_WHERE, key=str.lower)
+
+
+def __getattr__(name):
+    module = _WHERE.get(name)
+    if module is None:
+        raise AttributeError(f"module 'randvib' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value  # later lookups skip this function
+    return value
+
+
+def __dir__():
+    return sorted(set(globals()) | set(__all__))
