@@ -66,13 +66,12 @@ def plus_minus(value, ci, scale: float = 100.0, fmt: str = "+.2f") -> list[str]:
 def burn_in_for(devices, relaxation_times: float = 6.0, resolution: float = 0.5) -> float:
     """Burn-in (s): ``relaxation_times`` energy relaxation times m/c of the slowest device.
 
-    Paths start from the linearised (Gaussian, Eq. 30) state, and the
-    friction-free companion behind the control variates starts from the same
-    state rather than from its own stationary one, so the companion's known
-    mean S m / (4c) only holds once that start is forgotten: the mean energy
-    relaxes as exp(-c t / m). With friction the start is far off (Eq. 32's
-    P/P(0) of the friction-free variance), so a burn-in of a few m/c keeps
-    the controls unbiased; rounded up to ``resolution``.
+    Paths start from the linearised (Gaussian, Eq. 30) state, which is not
+    the stationary law of a friction-affected device; the mean energy relaxes
+    as exp(-c t / m), so a burn-in of a few m/c makes the start's bias in the
+    time averages (and in the energy-change control) negligible. (The
+    friction-free companion starts from its own stationary spread.) Rounded
+    up to ``resolution``.
     """
     tau = max(float(d.m) / float(d.c) for d in devices)
     return float(np.ceil(relaxation_times * tau / resolution) * resolution)

@@ -472,8 +472,8 @@ def run_study(
         f"phi = {', '.join(f'{p:.3g}' for p in phis)}. Series (S, k3, c_m = c_e): "
         + "; ".join(f"({s:g}, {k:.3g}, {c:g})" for s, k, c in series)
         + f". Heun, dt = {settings.dt:g} s, {settings.burn_in:g} s burn-in "
-        "(at least six energy relaxation times m/c, so that the friction-free companion "
-        "behind the control variates, started from the linearised state, has forgotten "
+        "(at least six energy relaxation times m/c, so that each path, started from the "
+        "Gaussian linearised state, has forgotten "
         "its start) + "
         f"{settings.window:g} s per path, paths added until each power's 95 % half-width is "
         f"{100 * settings.target_rel_ci:g} % ({int(table.n_paths.sum())} paths in all), seed "
