@@ -234,7 +234,9 @@ def sade(
     if progress:
         from tqdm.auto import tqdm
 
-        bar = tqdm(total=maxiter, desc="SaDE", unit="gen", leave=False)
+        bar = tqdm(
+            total=maxiter, desc="SaDE", unit="gen", leave=False, disable=None
+        )  # None: terminals only
     nit = 0
     try:
         for gen in range(maxiter):

@@ -324,7 +324,13 @@ def run_sweep(
     if progress and todo:
         from tqdm import tqdm
 
-        bar = tqdm(total=len(points), initial=len(points) - len(todo), unit="point", desc=name)
+        bar = tqdm(  # disable=None: shown on terminals only, not in logs or CI
+            total=len(points),
+            initial=len(points) - len(todo),
+            unit="point",
+            desc=name,
+            disable=None,
+        )
     own_close = None
     if executor is None and todo:
         executor, own_close = make_executor(workers, scheduler)

@@ -155,7 +155,9 @@ def compute_table(quick: bool, seed: int, threads, progress: bool) -> pd.DataFra
     if progress:
         from tqdm import tqdm
 
-        bar = tqdm(total=len(columns), desc=NAME, unit="column")
+        bar = tqdm(
+            total=len(columns), desc=NAME, unit="column", disable=None
+        )  # None: terminals only
     rows = []
     for i, (psd, kappa) in enumerate(columns):
         # A fresh seed per (S, kappa) column; shared within it (paired k3).
