@@ -319,26 +319,39 @@ def step_bias(method: str, harvester: Harvester, psd: float, dt: float) -> float
     devices. Returns inf where the recursion is unstable.
     """
     k_eff, c_eff = effective_linear_device(harvester, psd)
+    return _scheme_bias(method, float(harvester.m), k_eff, c_eff, psd, dt)
+
+
+def _scheme_bias(method, m, k_eff, c_eff, psd, dt) -> float:
+    """:func:`step_bias` for an already linearised device (inf where unstable)."""
     try:
-        cov = exact.scheme_stationary_covariance(method, harvester.m, c_eff, k_eff, psd, dt)
+        cov = exact.scheme_stationary_covariance(method, m, c_eff, k_eff, psd, dt)
     except ValueError:
         return float("inf")
-    return abs(cov[1, 1] / exact.linear_velocity_variance(harvester.m, c_eff, psd) - 1.0)
+    return abs(cov[1, 1] / exact.linear_velocity_variance(m, c_eff, psd) - 1.0)
 
 
 def largest_step(
     method: str, harvester: Harvester, psd: float, bias: float = MAX_STEP_BIAS
 ) -> float:
     """Largest dt (s) whose :func:`step_bias` stays below ``bias`` (bisection)."""
-    k_eff, _ = effective_linear_device(harvester, psd)
-    lo, hi = 0.0, 2.0 / np.sqrt(k_eff / harvester.m)
+    k_eff, c_eff = effective_linear_device(harvester, psd)  # once, not per bisection step
+    m = float(harvester.m)
+    lo, hi = 0.0, 2.0 / np.sqrt(k_eff / m)
     for _ in range(60):
         mid = 0.5 * (lo + hi)
-        if step_bias(method, harvester, psd, mid) <= bias:
+        if _scheme_bias(method, m, k_eff, c_eff, psd, mid) <= bias:
             lo = mid
         else:
             hi = mid
     return lo
+
+
+def _linearised_spread(harvester: Harvester, psd: float) -> tuple[float, float]:
+    """(std of z (m), std of v (m/s)) of the linearised stationary state (Eq. 20, 30)."""
+    c_eff = effective_linear_device(harvester, psd)[1]
+    vv = psd * harvester.m / (4.0 * c_eff)
+    return float(np.sqrt(linear_displacement_variance(harvester, vv))), float(np.sqrt(vv))
 
 
 def _check_step(method, harvester, psd, dt):
@@ -479,13 +492,8 @@ def simulate(
         if initial == "rest":
             init_mode, init_z, init_v = 0, 0.0, 0.0
         else:
-            c_eff = effective_linear_device(harvester, psd)[1]
-            vv = psd * harvester.m / (4.0 * c_eff)
-            init_mode, init_z, init_v = (
-                1,
-                float(np.sqrt(linear_displacement_variance(harvester, vv))),
-                float(np.sqrt(vv)),
-            )
+            init_mode = 1
+            init_z, init_v = _linearised_spread(harvester, psd)
     else:
         z0, v0 = (float(x) for x in initial)
         if not (np.isfinite(z0) and np.isfinite(v0)):
@@ -512,9 +520,7 @@ def simulate(
             raise ValueError("`dW` must be finite")
     if histogram_bins > 0:
         if histogram_range is None:
-            c_eff = effective_linear_device(harvester, psd)[1]
-            vv = psd * harvester.m / (4.0 * c_eff)
-            sz, sv = float(np.sqrt(linear_displacement_variance(harvester, vv))), float(np.sqrt(vv))
+            sz, sv = _linearised_spread(harvester, psd)
             histogram_range = ((-5 * sz, 5 * sz), (-5 * sv, 5 * sv))
         rng_arr = np.asarray(histogram_range, dtype=float)
         if rng_arr.shape != (2, 2) or np.any(rng_arr[:, 1] <= rng_arr[:, 0]):

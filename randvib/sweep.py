@@ -26,6 +26,7 @@ Design choices a careful user expects:
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import json
 import math
@@ -176,7 +177,7 @@ def run_point(base: Harvester, point: Mapping, settings: SweepSettings, threads:
     n = settings.min_paths
     while True:
         per_path = np.vstack([b.per_path for b in batches])
-        result = _merge(batches[0], per_path)
+        result = dataclasses.replace(batches[0], per_path=per_path)
         stat = result.power_electrical
         rel = stat.relative_ci95
         if not (rel > settings.target_rel_ci) or n >= settings.max_paths:
@@ -200,12 +201,6 @@ def run_point(base: Harvester, point: Mapping, settings: SweepSettings, threads:
         wall_time=time.perf_counter() - started,
     )
     return row, per_path
-
-
-def _merge(first, per_path):
-    from dataclasses import replace
-
-    return replace(first, per_path=per_path)
 
 
 # ------------------------------------------------------------------ executors
