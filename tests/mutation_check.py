@@ -1,0 +1,326 @@
+"""Mutation check: would the test suite notice a wrong number?
+
+Each entry of :data:`MUTATIONS` is a small *semantic* error of the kind that
+passes every type check and most smoke tests (a variance 1 % too large, a mass
+0.9 % off, a forgotten initial state, a weight in a scheme changed). The check
+copies the project into a scratch folder, applies one mutation there, runs the
+tests named in the entry (the ones documented to catch it) and requires that
+they **fail** (pytest exit status 1: tests ran and failed, not a collection or
+import error). A mutation the suite lets through is a hole in the suite.
+
+The named tests are the documentation of which test catches which mutation;
+``python tests/mutation_check.py --full`` runs the whole suite against each
+mutant instead, to find every test that notices it.
+
+The project's own tree is never modified. numba's on-disk cache is copied for
+the modules the mutation cannot reach (numba keys a cached kernel on its own
+bytecode only, not on the functions it calls from other modules, so every
+module that imports the mutated one, directly or not, is recompiled).
+
+Run by hand::
+
+    python tests/mutation_check.py            # every mutation, its own tests
+    python tests/mutation_check.py --list     # the table of mutations
+    python tests/mutation_check.py --only noise-variance --full
+
+and in the test suite by ``tests/test_mutations.py`` (marked ``slow``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import ast
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGE = "randvib"
+COPIED = ("randvib", "tests", "studies", "pyproject.toml", "README.md", ".ci")
+NUMBA_CACHE_SUFFIXES = (".nbi", ".nbc")
+
+
+@dataclass(frozen=True)
+class Mutation:
+    """One deliberate error and the tests that must catch it.
+
+    Attributes
+    ----------
+    name : str
+        Short identifier (used by ``--only`` and as the pytest id).
+    path : str
+        File to mutate, relative to the project root.
+    edits : tuple of (str, str)
+        ``(original, mutated)`` source fragments; each ``original`` must occur
+        exactly once in the file, so that the list cannot rot silently.
+    tests : tuple of str
+        pytest node ids that must fail on the mutant.
+    why : str
+        What the mutation models and why these tests see it.
+    """
+
+    name: str
+    path: str
+    edits: tuple[tuple[str, str], ...]
+    tests: tuple[str, ...]
+    why: str
+
+
+MUTATIONS: tuple[Mutation, ...] = (
+    Mutation(
+        name="noise-variance",
+        path="randvib/engine.py",
+        edits=(
+            (
+                "dwj = sqdt * standard_normal(rng, j, ki, wi, fi)",
+                "dwj = 1.004987562112089 * sqdt * standard_normal(rng, j, ki, wi, fi)",
+            ),
+        ),
+        tests=("tests/test_simulation.py",),
+        why="The engine's Brownian increments have 1 % too much variance, so every "
+        "stationary variance is 1 % too large; the exact-variance tests are powered for 1 %.",
+    ),
+    Mutation(
+        name="control-variate-mean",
+        path="randvib/simulation.py",
+        edits=(
+            (
+                "residual[test] = y[test] - x[test] @ coef[1:]",
+                "residual[test] = 1.01 * (y[test] - x[test] @ coef[1:])",
+            ),
+        ),
+        tests=("tests/test_simulation.py",),
+        why="The controlled estimator is scaled by 1.01; a controlled estimate is "
+        "compared with an exact, independent variance (not with the friction-free "
+        "companion, which equals the device at Fc = 0 whatever the engine does).",
+    ),
+    Mutation(
+        name="coulomb-force-in-kernel",
+        path="randvib/friction.py",
+        edits=(
+            ("            return p[0], 0.0\n", "            return 1.01 * p[0], 0.0\n"),
+            ("            return -p[0], 0.0\n", "            return -1.01 * p[0], 0.0\n"),
+        ),
+        tests=("tests/test_simulation.py",),
+        why="The compiled Coulomb force is 1 % too strong in the kernels.",
+    ),
+    Mutation(
+        name="linearisation-constant",
+        path="randvib/linearisation.py",
+        edits=(
+            (
+                "a = 4.0 * fc**2 / (np.pi * psd * m)",
+                "a = 4.04 * fc**2 / (np.pi * psd * m)",
+            ),
+        ),
+        tests=("tests/test_linearisation.py",),
+        why="Eq. 30's 4 Fc^2/(pi S m) term 1 % too large; checked against Eq. 30 by hand "
+        "and against the general Eq. 19-20 fixed point.",
+    ),
+    Mutation(
+        name="heun-corrector-weight",
+        path="randvib/engine.py",
+        edits=(
+            (
+                "v[j] = vj + (acc1 + acc2) * half_dt + noise",
+                "v[j] = vj + (1.02 * acc1 + 0.98 * acc2) * half_dt + noise",
+            ),
+        ),
+        tests=("tests/test_simulation.py",),
+        why="The trapezoidal corrector weights 0.51/0.49 instead of 1/2; the pathwise "
+        "comparison with sdeint.stratHeun on the same increments sees it.",
+    ),
+)
+
+
+# ---------------------------------------------------------------------------
+# Copying and mutating
+# ---------------------------------------------------------------------------
+
+
+def _module_name(path: Path, root: Path) -> str:
+    rel = path.relative_to(root).with_suffix("")
+    parts = list(rel.parts)
+    if parts[-1] == "__init__":
+        parts.pop()
+    return ".".join(parts)
+
+
+def _imported_modules(path: Path, module: str, known: set[str]) -> set[str]:
+    """Package modules imported anywhere in ``path`` (function-level imports included)."""
+    tree = ast.parse(path.read_text())
+    package = module if path.name == "__init__.py" else module.rpartition(".")[0]
+    found: set[str] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            names = [alias.name for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base_parts = package.split(".")
+                base_parts = base_parts[: len(base_parts) - (node.level - 1)]
+                base = ".".join(base_parts + ([node.module] if node.module else []))
+            else:
+                base = node.module or ""
+            names = [base] + [f"{base}.{alias.name}" for alias in node.names]
+        else:
+            continue
+        for name in names:
+            # "randvib.engine.run_ensemble" imports randvib.engine (and randvib)
+            while name:
+                if name in known:
+                    found.add(name)
+                name = name.rpartition(".")[0]
+    return found
+
+
+def reaching_modules(root: Path, mutated_file: str) -> set[str]:
+    """Modules that are, or import directly or transitively, the mutated module."""
+    files = {_module_name(p, root): p for p in (root / PACKAGE).rglob("*.py")}
+    known = set(files)
+    imports = {name: _imported_modules(path, name, known) for name, path in files.items()}
+    target = _module_name(root / mutated_file, root)
+    reached = {target}
+    changed = True
+    while changed:
+        changed = False
+        for name, deps in imports.items():
+            if name not in reached and deps & reached:
+                reached.add(name)
+                changed = True
+    return reached
+
+
+def copy_project(dest: Path, source: Path = ROOT) -> None:
+    """Copy the files the tests need; numba caches come along, other caches do not."""
+
+    def ignore(directory, names):
+        skip = {".hypothesis", ".pytest_cache", ".benchmarks", "calibration_output"}
+        return [n for n in names if n in skip or n.endswith(".pyc")]
+
+    for name in COPIED:
+        src = source / name
+        if src.is_dir():
+            shutil.copytree(src, dest / name, ignore=ignore, copy_function=shutil.copy2)
+        elif src.exists():
+            shutil.copy2(src, dest / name)
+
+
+def drop_stale_numba_caches(root: Path, mutation: Mutation) -> list[Path]:
+    """Delete cached kernels of every module the mutation reaches (see module docstring)."""
+    removed = []
+    for module in reaching_modules(root, mutation.path):
+        parts = module.split(".")
+        path = root.joinpath(*parts)
+        if path.is_dir():  # a package: its __init__'s kernels, if any
+            cache_dir, stem = path / "__pycache__", "__init__"
+        else:
+            cache_dir, stem = path.parent / "__pycache__", parts[-1]
+        if not cache_dir.is_dir():
+            continue
+        for cached in cache_dir.iterdir():
+            if cached.name.startswith(stem + ".") and cached.suffix in NUMBA_CACHE_SUFFIXES:
+                cached.unlink()
+                removed.append(cached)
+    return removed
+
+
+def apply(mutation: Mutation, root: Path) -> None:
+    """Apply the edits in place under ``root``; each original must occur exactly once."""
+    path = root / mutation.path
+    text = path.read_text()
+    for original, mutated in mutation.edits:
+        count = text.count(original)
+        if count != 1:
+            raise ValueError(
+                f"mutation {mutation.name!r}: {original!r} occurs {count} times in "
+                f"{mutation.path} (must be exactly once); update the mutation list"
+            )
+        text = text.replace(original, mutated)
+    path.write_text(text)
+
+
+# ---------------------------------------------------------------------------
+# Running
+# ---------------------------------------------------------------------------
+
+
+@dataclass
+class Outcome:
+    mutation: Mutation
+    returncode: int
+    output: str
+    seconds: float
+
+    @property
+    def caught(self) -> bool:
+        # 1: tests were collected and at least one failed. 2 (interrupted, e.g. a
+        # collection error), 4 (usage, unknown node id) or 5 (nothing collected)
+        # mean the harness, not the suite, spoke.
+        return self.returncode == 1
+
+    def summary(self) -> str:
+        verdict = "caught" if self.caught else "NOT CAUGHT"
+        if self.returncode not in (0, 1):
+            verdict = f"harness error (pytest exit {self.returncode})"
+        tail = [line for line in self.output.splitlines() if line.startswith("FAILED")]
+        shown = "; ".join(tail[:3]) if tail else self.output.strip().splitlines()[-1:]
+        return f"{self.mutation.name}: {verdict} in {self.seconds:.0f} s ({shown})"
+
+
+def run_mutant(mutation: Mutation, workdir: Path, full: bool = False, timeout: float = 900) -> Outcome:
+    """Copy the project under ``workdir``, mutate it and run the mutation's tests."""
+    root = workdir / "project"
+    copy_project(root)
+    apply(mutation, root)
+    drop_stale_numba_caches(root, mutation)
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTEST_ADDOPTS")}
+    env["MPLBACKEND"] = "Agg"
+    # the mutant must be what the tests import (python -m puts the cwd first on sys.path)
+    where = subprocess.run(
+        [sys.executable, "-c", f"import {PACKAGE}; print({PACKAGE}.__file__)"],
+        cwd=root,
+        env=env,
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout.strip()
+    if not Path(where).resolve().is_relative_to(root.resolve()):
+        raise RuntimeError(f"the mutant copy is not the imported package ({where})")
+    targets = ["tests"] if full else list(mutation.tests)
+    cmd = [sys.executable, "-m", "pytest", "-q", "-x", "-p", "no:cacheprovider", *targets]
+    cmd += ["--ignore", "tests/test_mutations.py"]  # no mutants of mutants
+    start = time.perf_counter()
+    proc = subprocess.run(
+        cmd, cwd=root, env=env, capture_output=True, text=True, timeout=timeout, check=False
+    )
+    return Outcome(mutation, proc.returncode, proc.stdout + proc.stderr, time.perf_counter() - start)
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--only", nargs="+", metavar="NAME", help="mutations to run")
+    parser.add_argument("--full", action="store_true", help="run the whole suite per mutant")
+    parser.add_argument("--list", action="store_true", help="print the mutations and exit")
+    args = parser.parse_args(argv)
+    chosen = [m for m in MUTATIONS if not args.only or m.name in args.only]
+    if args.list:
+        for m in chosen:
+            print(f"{m.name:28s} {m.path:32s} {', '.join(m.tests)}\n    {m.why}")
+        return 0
+    survivors = 0
+    for mutation in chosen:
+        with tempfile.TemporaryDirectory(prefix=f"mutant-{mutation.name}-") as tmp:
+            outcome = run_mutant(mutation, Path(tmp), full=args.full)
+        print(outcome.summary(), flush=True)
+        survivors += not outcome.caught
+    print(f"{len(chosen) - survivors} of {len(chosen)} mutations caught")
+    return 1 if survivors else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
