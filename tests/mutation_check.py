@@ -272,7 +272,9 @@ class Outcome:
         return f"{self.mutation.name}: {verdict} in {self.seconds:.0f} s ({shown})"
 
 
-def run_mutant(mutation: Mutation, workdir: Path, full: bool = False, timeout: float = 900) -> Outcome:
+def run_mutant(
+    mutation: Mutation, workdir: Path, full: bool = False, timeout: float = 900
+) -> Outcome:
     """Copy the project under ``workdir``, mutate it and run the mutation's tests."""
     root = workdir / "project"
     copy_project(root)
@@ -298,7 +300,9 @@ def run_mutant(mutation: Mutation, workdir: Path, full: bool = False, timeout: f
     proc = subprocess.run(
         cmd, cwd=root, env=env, capture_output=True, text=True, timeout=timeout, check=False
     )
-    return Outcome(mutation, proc.returncode, proc.stdout + proc.stderr, time.perf_counter() - start)
+    return Outcome(
+        mutation, proc.returncode, proc.stdout + proc.stderr, time.perf_counter() - start
+    )
 
 
 def main(argv=None) -> int:

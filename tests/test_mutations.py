@@ -5,9 +5,8 @@ named in its entry must fail. The table of mutations, with what each models
 and which test catches it, is ``python tests/mutation_check.py --list``.
 """
 
-import pytest
-
 import mutation_check as mc
+import pytest
 
 
 @pytest.mark.parametrize("mutation", mc.MUTATIONS, ids=lambda m: m.name)
