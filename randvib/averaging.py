@@ -1,7 +1,7 @@
 """Energy-envelope stochastic averaging: power beyond equivalent linearisation.
 
 Equivalent linearisation (paper Eq. 19-32) closes the exact stationary energy
-balance (see CONVENTIONS; Ito's rule on the energy)
+balance (see docs/conventions.md; Ito's rule on the energy)
 
     c E[z'^2] + E[z' F(z')] = S m / 4                               (*)
 
@@ -17,7 +17,7 @@ Method (Stratonovich/Khasminskii energy-envelope averaging; Roberts & Spanos,
 *Random Vibration and Statistical Linearization*, ch. 7; Zhu, *Nonlinear
 Stochastic Dynamics and Control*, 2003). With per-unit-mass energy
 ``H = v^2/2 + G(z)``, ``G = (k z^2/2 + k3 z^4/4)/m``, gamma = c/m, f = F/m
-and the SDE of CONVENTIONS (noise intensity D = S/2 on the velocity),
+and the SDE of docs/conventions.md (noise intensity D = S/2 on the velocity),
 
     dH = (-gamma v^2 - v f(v) + D/2) dt + sqrt(D) v dW     (Ito, exact).
 

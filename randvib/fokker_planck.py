@@ -1,6 +1,6 @@
 """Reference solver: the stationary Fokker-Planck equation on a (z, z') grid.
 
-The stationary density p(z, v) of the harvester's SDE (CONVENTIONS; paper
+The stationary density p(z, v) of the harvester's SDE (docs/conventions.md; paper
 Eq. 1 and 17, noise intensity D = S/2 on the velocity) solves
 
     0 = -d/dz (v p) + d/dv [ (gamma v + g(z) + f(v)) p + (D/2) dp/dv ],

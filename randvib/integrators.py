@@ -1,6 +1,6 @@
 """Stochastic integrators for the white-noise driven harvester: a table of methods.
 
-The device SDE (CONVENTIONS.md) has additive noise,
+The device SDE (docs/conventions.md) has additive noise,
 
     dz = v dt,   dv = a(z, v, theta) dt + sqrt(S/2) dW,   dtheta = r(v, theta) dt,
 

@@ -1,6 +1,6 @@
 """Monte Carlo simulation of the white-noise driven harvester: ``simulate``.
 
-The SDE (CONVENTIONS.md, paper Eq. 1 and 15-17) for the state (z, v = z') and,
+The SDE (docs/conventions.md, paper Eq. 1 and 15-17) for the state (z, v = z') and,
 for LuGre friction, the bristle state theta:
 
     dz = v dt

@@ -3,7 +3,8 @@
 Fits the linear (k3 fixed at 0) and the Duffing model, force input u = V1,
 output y = V2, mass free, on the multisine part (samples 40,700 to the end)
 and validates on the arrow-head part (the first 40,700 samples); writes
-``silverbox.md`` and the fitted parameters as JSON. The same fits from the
+``silverbox.md`` and the fitted parameters as JSON. The record ships with the
+package (``randvib.datasets.silverbox_path()``); the same fits from the
 command line::
 
     randvib identify SNLS80mV.csv --input-column V1 --input-kind force \\
@@ -17,19 +18,15 @@ import json
 import sys
 from pathlib import Path
 
-from randvib.identification import identify, predict, read_record
-
-DATA = Path(__file__).resolve().parents[1] / ".." / "shared" / "data" / "silverbox" / "SNLS80mV.csv"
-FS = 1e7 / 2**14
-SPLIT = 40_700
+from randvib.datasets import silverbox
+from randvib.identification import identify, predict
 
 
 def main(out_dir, quick=False):
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=False)
-    cols = dict(input_column="V1", input_kind="force", output_column="V2", sample_rate=FS)
-    estimation = read_record(DATA, rows=(SPLIT, None), name="multisine", **cols)
-    validation = read_record(DATA, rows=(0, SPLIT), name="arrow-head", **cols)
+    estimation = silverbox("multisine")
+    validation = silverbox("arrow-head")
     opt = dict(popsize=20, maxiter=40) if quick else dict(popsize=50, maxiter=200)
     rows = []
     for label, fixed in (("linear (k3 = 0)", {"k3": 0.0}), ("Duffing", {})):

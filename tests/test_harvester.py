@@ -58,7 +58,7 @@ def test_presets_cover_table2_and_state_the_mass():
     f9 = rv.preset("figure9")
     assert (f9.c_m, f9.c_e, f9.k, f9.k3, f9.friction.fc) == (0.1, 0.1, 57.4, 70742.0, 0.0058)
     # the assumed mass gives the paper's "approximately 8 Hz": 8.02 Hz with
-    # m = 0.0226 kg as fixed in CONVENTIONS.md (the paper's 8 Hz has one digit)
+    # m = 0.0226 kg as fixed in docs/conventions.md (the paper's 8 Hz has one digit)
     assert rv.preset("coulomb-td1").natural_frequency / (2 * np.pi) == pytest.approx(8.0, abs=0.05)
     with pytest.raises(ValueError, match="unknown preset 'nope'"):
         rv.preset("nope")
