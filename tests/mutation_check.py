@@ -135,6 +135,76 @@ MUTATIONS: tuple[Mutation, ...] = (
         why="The trapezoidal corrector weights 0.51/0.49 instead of 1/2; the pathwise "
         "comparison with sdeint.stratHeun on the same increments sees it.",
     ),
+    Mutation(
+        name="tanh-force-in-kernel",
+        path="randvib/friction.py",
+        edits=(
+            (
+                "return p[0] * np.tanh(p[1] * v), 0.0",
+                "return 1.01 * p[0] * np.tanh(p[1] * v), 0.0",
+            ),
+        ),
+        tests=("tests/test_friction.py",),
+        why="The compiled tanh force 1 % too strong; the kernel is compared with the "
+        "numpy force law.",
+    ),
+    Mutation(
+        name="lugre-damping-in-kernel",
+        path="randvib/friction.py",
+        edits=(
+            (
+                "return p[0] * theta + p[1] * rate, rate",
+                "return p[0] * theta + 1.01 * p[1] * rate, rate",
+            ),
+        ),
+        tests=("tests/test_friction.py",),
+        why="LuGre's bristle damping sigma1 1 % too large in the kernels.",
+    ),
+    Mutation(
+        name="gibbs-reference",
+        path="randvib/exact.py",
+        edits=(("0.25 * eps * x**4", "0.2525 * eps * x**4"),),
+        tests=("tests/test_fokker_planck.py",),
+        why="The exact Gibbs density's quartic term 1 % too strong: the reference that "
+        "Monte Carlo, FPK and averaging are checked against must itself be checked.",
+    ),
+    Mutation(
+        name="eq11-cost-normalisation",
+        path="randvib/identification.py",
+        edits=(
+            (
+                "return 100.0 * sse / (self.n_scored * self.variance)",
+                "return 101.0 * sse / (self.n_scored * self.variance)",
+            ),
+        ),
+        tests=("tests/test_identification.py",),
+        why="The compiled-batch cost used by the search is 1 % off Eq. 11.",
+    ),
+    Mutation(
+        name="fpk-richardson-weight",
+        path="randvib/fokker_planck.py",
+        edits=(
+            (
+                "out[(row,) + index] = (4.0 * a_f - a_c) / 3.0",
+                "out[(row,) + index] = (4.04 * a_f - a_c) / 3.0",
+            ),
+        ),
+        tests=("tests/test_fokker_planck.py",),
+        why="The FPK solver's Richardson extrapolation mis-weighted (about 1.3 % on every moment).",
+    ),
+    Mutation(
+        name="load-power-share",
+        path="randvib/harvester.py",
+        edits=(
+            (
+                "return self.r_load / (self.r_load + self.r_coil)",
+                "return 1.01 * self.r_load / (self.r_load + self.r_coil)",
+            ),
+        ),
+        tests=("tests/test_harvester.py::test_expected_load_power_is_i_squared_r_load",),
+        why="The share of electrical power reaching the load 1 % too large; the expected "
+        "load power is checked against i^2 R_L written out by hand.",
+    ),
 )
 
 

@@ -18,6 +18,20 @@ def test_electrical_constructor_eq3_and_circuit_quantities():
     assert np.allclose(h.electrical_power(v), i**2 * 2.48)
 
 
+def test_expected_load_power_is_i_squared_r_load():
+    # Eq. 32 gives E[P_e] = c_e sigma_v^2; the load receives E[i^2] R_L with
+    # i = alpha v / (R_L + R_C), i.e. R_L alpha^2 sigma_v^2 / (R_L + R_C)^2,
+    # written out here independently of the package's load-fraction helper.
+    h = rv.Harvester.from_electrical(
+        m=0.0226, c_m=0.05, k=57.4, alpha=0.1992, r_load=2.0, r_coil=0.48
+    )
+    psd = 0.7
+    sigma_v2 = psd * 0.0226 / (4 * (0.05 + 0.1992**2 / 2.48))  # linear: Eq. 20
+    expected = 2.0 * 0.1992**2 * sigma_v2 / 2.48**2
+    assert rv.expected_power(h, psd, into="load") == pytest.approx(expected, rel=1e-12)
+    assert rv.expected_power(h, psd) == pytest.approx(0.1992**2 / 2.48 * sigma_v2, rel=1e-12)
+
+
 def test_harvester_is_immutable_and_updated_copies():
     h = rv.preset("figure9")
     with pytest.raises(AttributeError):
