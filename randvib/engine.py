@@ -45,9 +45,43 @@ def _acceleration(z, v, theta, inv_m, c, k, k3, fr_kind, fr_p):
     return -(c * v + k * z + k3 * z * z * z + force) * inv_m, rate, force
 
 
+@numba.njit(cache=True, inline="always")
+def scheme_step(z, v, theta, dt, noise, b1, b2, inv_m, c, k, k3, fr_kind, fr_p):
+    """One step of the additive-noise scheme with drift weights ``(b1, b2)``.
+
+    The single definition of every integrator's step
+    (:class:`randvib.integrators.Integrator`): Euler predictor
+    ``x_p = x + f(x) dt + g dW`` and update
+    ``x + (b1 f(x) + b2 f(x_p)) dt + g dW``; ``b2 = 0`` skips the predictor
+    (Euler-Maruyama), ``b1 = b2 = 1/2`` is stochastic Heun. The friction-free
+    companion takes the same step with ``fr_kind = 0``.
+
+    Returns
+    -------
+    z, v, theta : float
+        State after the step.
+    force : float
+        Friction force at the start of the step (N), for the accumulators.
+    """
+    acc1, rate1, force = _acceleration(z, v, theta, inv_m, c, k, k3, fr_kind, fr_p)
+    if b2 == 0.0:
+        return z + b1 * v * dt, v + b1 * acc1 * dt + noise, theta + b1 * rate1 * dt, force
+    zp = z + v * dt
+    vp = v + acc1 * dt + noise
+    tp = theta + rate1 * dt
+    acc2, rate2, _ = _acceleration(zp, vp, tp, inv_m, c, k, k3, fr_kind, fr_p)
+    return (
+        z + (b1 * v + b2 * vp) * dt,
+        v + (b1 * acc1 + b2 * acc2) * dt + noise,
+        theta + (b1 * rate1 + b2 * rate2) * dt,
+        force,
+    )
+
+
 @numba.njit(cache=True, parallel=True)
 def run_ensemble(
-    method,
+    b1,
+    b2,
     fr_kind,
     fr_p,
     m,
@@ -81,8 +115,9 @@ def run_ensemble(
 
     Parameters
     ----------
-    method : int
-        Integrator kernel code (0 Euler-Maruyama, 1 stochastic Heun).
+    b1, b2 : float
+        The integrator's drift weights (:attr:`Integrator.kernel_weights`),
+        used by :func:`scheme_step`.
     fr_kind, fr_p : int, float64[5]
         Friction kernel code and parameters (:mod:`randvib.friction`).
     m, c, k, k3 : float
@@ -129,7 +164,6 @@ def run_ensemble(
     window = (n_steps - n_burn) * dt
     inv_window_steps = 1.0 / (n_steps - n_burn)
     sqdt = np.sqrt(dt)
-    half_dt = 0.5 * dt
     hist_scale_z = hist_bins / (hist_hi[0] - hist_lo[0]) if hist_bins > 0 else 0.0
     hist_scale_v = hist_bins / (hist_hi[1] - hist_lo[1]) if hist_bins > 0 else 0.0
 
@@ -172,7 +206,9 @@ def run_ensemble(
                 zj = z[j]
                 vj = v[j]
                 tj = th[j]
-                acc1, rate1, f1 = _acceleration(zj, vj, tj, inv_m, c, k, k3, fr_kind, fr_p)
+                zn, vn, tn, f1 = scheme_step(
+                    zj, vj, tj, dt, noise, b1, b2, inv_m, c, k, k3, fr_kind, fr_p
+                )
                 if in_window:
                     if n == n_burn:
                         a[j, ACC_H0] = 0.5 * m * vj * vj + 0.5 * k * zj * zj + 0.25 * k3 * zj**4
@@ -188,34 +224,18 @@ def run_ensemble(
                             hist[chunk, 0, bz] += 1
                         if 0 <= bv < hist_bins:
                             hist[chunk, 1, bv] += 1
-                if method == 0:  # Euler-Maruyama
-                    z[j] = zj + vj * dt
-                    v[j] = vj + acc1 * dt + noise
-                    th[j] = tj + rate1 * dt
-                else:  # stochastic Heun: Euler predictor, trapezoidal corrector
-                    zp = zj + vj * dt
-                    vp = vj + acc1 * dt + noise
-                    tp = tj + rate1 * dt
-                    acc2, rate2, f2 = _acceleration(zp, vp, tp, inv_m, c, k, k3, fr_kind, fr_p)
-                    z[j] = zj + (vj + vp) * half_dt
-                    v[j] = vj + (acc1 + acc2) * half_dt + noise
-                    th[j] = tj + (rate1 + rate2) * half_dt
+                z[j] = zn
+                v[j] = vn
+                th[j] = tn
                 if companion:
                     zcj = zc[j]
                     vcj = vc[j]
-                    ac1 = -(c * vcj + k * zcj + k3 * zcj * zcj * zcj) * inv_m
                     if in_window:
                         a[j, ACC_COMP_V2] += vcj * vcj
                         a[j, ACC_COMP_Z2] += zcj * zcj
-                    if method == 0:
-                        zc[j] = zcj + vcj * dt
-                        vc[j] = vcj + ac1 * dt + noise
-                    else:
-                        zp = zcj + vcj * dt
-                        vp = vcj + ac1 * dt + noise
-                        ac2 = -(c * vp + k * zp + k3 * zp * zp * zp) * inv_m
-                        zc[j] = zcj + (vcj + vp) * half_dt
-                        vc[j] = vcj + (ac1 + ac2) * half_dt + noise
+                    zc[j], vc[j], _, _ = scheme_step(
+                        zcj, vcj, 0.0, dt, noise, b1, b2, inv_m, c, k, k3, 0, fr_p
+                    )
                 if start + j < n_record and (n + 1) % record_every == 0:
                     r = (n + 1) // record_every
                     records[start + j, r, 0] = z[j]

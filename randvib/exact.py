@@ -61,18 +61,16 @@ def gibbs_displacement_moment(m, c, k, k3, psd, power: int = 2) -> float:
 def scheme_matrices(method: str, m, c, k, psd, dt):
     """Transition matrix A and noise matrix B of a scheme on the linear oscillator.
 
-    The recursion is x_{n+1} = A x_n + B dW_n with x = (z, v), dW_n ~ N(0, dt).
-    Euler-Maruyama: A = I + dt F. Heun: A = I + dt F + dt^2 F^2 / 2 and
-    B = (I + dt F / 2) b, from the predictor-corrector written out.
+    The recursion is x_{n+1} = A x_n + B dW_n with x = (z, v), dW_n ~ N(0, dt),
+    from the scheme's own step table
+    (:meth:`randvib.integrators.Integrator.linear_recursion`). Euler-Maruyama:
+    A = I + dt F. Heun: A = I + dt F + dt^2 F^2 / 2 and B = (I + dt F / 2) b.
     """
+    from randvib.integrators import integrator
+
     f = np.array([[0.0, 1.0], [-k / m, -c / m]])
     b = np.array([[0.0], [np.sqrt(psd / 2.0)]])
-    eye = np.eye(2)
-    if method == "euler-maruyama":
-        return eye + dt * f, b
-    if method == "heun":
-        return eye + dt * f + 0.5 * dt * dt * f @ f, (eye + 0.5 * dt * f) @ b
-    raise ValueError(f"`method` must be 'euler-maruyama' or 'heun', got {method!r}")
+    return integrator(method).linear_recursion(f, b, dt)
 
 
 def scheme_stationary_covariance(method: str, m, c, k, psd, dt) -> np.ndarray:

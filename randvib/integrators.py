@@ -6,21 +6,36 @@ The device SDE (docs/conventions.md) has additive noise,
 
 so Ito and Stratonovich solutions coincide and stochastic Heun (a
 Stratonovich scheme) is consistent for it. Each method declares its orders for
-additive noise and smooth drift; the kernels in :mod:`randvib.engine` run the
-method selected by ``kernel_code``. Non-smooth drifts (Coulomb friction) lower
-the observed orders.
+additive noise and smooth drift and its step as a table of stage weights
+(:class:`Integrator`); the compiled kernel and the exact linear recursions
+read that table. Non-smooth drifts (Coulomb friction) lower the observed
+orders.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
+
 from randvib._validation import check_choice
 
 
 @dataclass(frozen=True)
 class Integrator:
-    """Declaration of a fixed-step SDE scheme.
+    """Declaration of a fixed-step SDE scheme: its orders and its step, as data.
+
+    Both schemes belong to one family of additive-noise predictor-corrector
+    steps with drift ``f`` and noise increment ``g dW``:
+
+        x_p     = x_n + f(x_n) dt + g dW_n                 (Euler predictor)
+        x_{n+1} = x_n + (b_1 f(x_n) + b_2 f(x_p)) dt + g dW_n
+
+    so a scheme is its weights ``(b_1, b_2)`` (``b_2 = 0``: no predictor
+    stage). The compiled kernel (:func:`randvib.engine.scheme_step`) takes the
+    weights, the device and its friction-free companion use the same step, and
+    :meth:`linear_recursion` gives the exact recursion of the same step on a
+    linear system (the tests' exact discrete references).
 
     Attributes
     ----------
@@ -32,27 +47,63 @@ class Integrator:
         Weak order (of moments) for additive noise and smooth drift.
     calculus : str
         ``"ito"`` or ``"stratonovich"``; equivalent here as the noise is additive.
-    drift_evaluations : int
-        Drift evaluations per step (cost).
-    kernel_code : int
-        Branch of the compiled step in :mod:`randvib.engine`.
+    weights : tuple of float
+        Drift weights ``(b_1,)`` or ``(b_1, b_2)`` of the stages; they sum to 1.
     """
 
     name: str
     strong_order: float
     weak_order: float
     calculus: str
-    drift_evaluations: int
-    kernel_code: int
+    weights: tuple[float, ...]
+
+    @property
+    def drift_evaluations(self) -> int:
+        """Drift evaluations per step (cost)."""
+        return len(self.weights)
+
+    @property
+    def kernel_weights(self) -> tuple[float, float]:
+        """``(b_1, b_2)`` for the compiled step, ``b_2 = 0`` for one stage."""
+        return (float(self.weights[0]), float(self.weights[1]) if len(self.weights) > 1 else 0.0)
+
+    def linear_recursion(self, drift_matrix, noise_matrix, dt):
+        """Exact recursion of this step on a linear SDE ``dx = F x dt + G dW``.
+
+        Writing the two stages out for ``f(x) = F x`` gives
+        ``x_{n+1} = A x_n + B dW_n`` with
+        ``A = I + (b_1 + b_2) dt F + b_2 dt^2 F^2`` and ``B = (I + b_2 dt F) G``.
+
+        Parameters
+        ----------
+        drift_matrix : ndarray, shape (d, d)
+            ``F``.
+        noise_matrix : ndarray, shape (d, q)
+            ``G``.
+        dt : float
+            Step (s).
+
+        Returns
+        -------
+        A : ndarray, shape (d, d)
+        B : ndarray, shape (d, q)
+        """
+        f = np.asarray(drift_matrix, dtype=float)
+        g = np.asarray(noise_matrix, dtype=float)
+        b1, b2 = self.kernel_weights
+        eye = np.eye(f.shape[0])
+        a = eye + (b1 + b2) * dt * f + b2 * dt * dt * f @ f
+        return a, (eye + b2 * dt * f) @ g
 
 
 #: Euler-Maruyama: x_{n+1} = x_n + f(x_n) dt + g dW_n. With additive noise its
 #: strong order rises from 1/2 to 1 (Kloeden & Platen 1992, Sec. 10.2).
-EULER_MARUYAMA = Integrator("euler-maruyama", 1.0, 1.0, "ito", 1, 0)
+EULER_MARUYAMA = Integrator("euler-maruyama", 1.0, 1.0, "ito", (1.0,))
 
-#: Stochastic Heun (predictor-corrector trapezoid). For additive noise it is
-#: strong order 1 and weak order 2 (Kloeden & Platen 1992, Sec. 15.1; Rumelin 1982).
-HEUN = Integrator("heun", 1.0, 2.0, "stratonovich", 2, 1)
+#: Stochastic Heun (Euler predictor, trapezoidal corrector). For additive noise
+#: it is strong order 1 and weak order 2 (Kloeden & Platen 1992, Sec. 15.1;
+#: Rumelin 1982).
+HEUN = Integrator("heun", 1.0, 2.0, "stratonovich", (0.5, 0.5))
 
 INTEGRATORS = {i.name: i for i in (EULER_MARUYAMA, HEUN)}
 

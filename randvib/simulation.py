@@ -551,7 +551,7 @@ def simulate(
         for lo, hi in batches:
             dw_batch = dW[lo:hi] if dW is not None else np.zeros((0, 0))
             acc, failed, hist, rec = engine.run_ensemble(
-                scheme.kernel_code,
+                *scheme.kernel_weights,
                 fr_kind,
                 fr_p,
                 float(harvester.m),

@@ -124,11 +124,11 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="heun-corrector-weight",
-        path="randvib/engine.py",
+        path="randvib/integrators.py",
         edits=(
             (
-                "v[j] = vj + (acc1 + acc2) * half_dt + noise",
-                "v[j] = vj + (1.02 * acc1 + 0.98 * acc2) * half_dt + noise",
+                'HEUN = Integrator("heun", 1.0, 2.0, "stratonovich", (0.5, 0.5))',
+                'HEUN = Integrator("heun", 1.0, 2.0, "stratonovich", (0.51, 0.49))',
             ),
         ),
         tests=("tests/test_simulation.py",),
