@@ -321,26 +321,23 @@ def sade(
             adaptation.learn(gen, strategy, cr, better)
             pop = np.where(better[:, None], trial, pop)
             costs = np.where(better, trial_costs, costs)
-            new_best = int(np.argmin(costs))
+            best = int(np.argmin(costs))
             prev = history["best"][-1] if history["best"] else np.inf
-            stall = 0 if costs[new_best] < prev * (1 - 1e-12) else stall + 1
-            best = new_best
+            stall = 0 if costs[best] < prev * (1 - 1e-12) else stall + 1
             spread = float(np.std(costs)) if np.isfinite(costs).all() else np.inf
-            history["best"].append(float(costs[best]))
-            history["nfev"].append(nfev)
-            history["spread"].append(spread)
-            history["probabilities"].append(adaptation.probs.tolist())
+            for key, value in zip(
+                history, (float(costs[best]), nfev, spread, adaptation.probs.tolist()), strict=True
+            ):
+                history[key].append(value)
             if bar is not None:
                 bar.update(1)
                 bar.set_postfix(best=f"{costs[best]:.4g}")
             if callback is not None and callback(nit, space.to_x(pop[best]), float(costs[best])):
                 message = "stopped by callback"
                 break
-            if np.isfinite(spread) and spread <= atol + tol * abs(float(np.mean(costs))):
-                message = f"converged: cost spread {spread:.3g} <= atol + tol * |mean cost|"
-                break
-            if patience is not None and stall >= patience:
-                message = f"no improvement of the best cost for {patience} generations"
+            reason = _converged(costs, spread, tol, atol, stall, patience)
+            if reason:
+                message = reason
                 break
     finally:
         if bar is not None:
@@ -364,6 +361,15 @@ def sade(
         elapsed=time.perf_counter() - start,
         polished=polished,
     )
+
+
+def _converged(costs, spread, tol, atol, stall, patience):
+    """Why the search should stop now, or an empty string."""
+    if np.isfinite(spread) and spread <= atol + tol * abs(float(np.mean(costs))):
+        return f"converged: cost spread {spread:.3g} <= atol + tol * |mean cost|"
+    if patience is not None and stall >= patience:
+        return f"no improvement of the best cost for {patience} generations"
+    return ""
 
 
 def _batched_cost(func, space):
