@@ -129,6 +129,98 @@ def _distinct_indices(rng, n, count):
     return np.argsort(keys, axis=1)[:, :count]
 
 
+def _latin_hypercube(rng, popsize, d):
+    """A start in the unit cube that covers every parameter's range evenly."""
+    pop = rng.permuted(np.tile(np.arange(popsize), (d, 1)), axis=1).T + rng.random((popsize, d))
+    return pop / popsize
+
+
+# The strategy pool, one function each, in the order of STRATEGIES. Each gets
+# the rows' parents ``xi``, the best vector ``xb``, five distinct partners
+# ``xs`` (x1..x5), the scale factors ``fr`` (column) and the generator.
+def _rand_1(xi, xb, xs, fr, rng):
+    return xs[0] + fr * (xs[1] - xs[2])
+
+
+def _rand_to_best_2(xi, xb, xs, fr, rng):
+    return xi + fr * (xb - xi) + fr * (xs[0] - xs[1]) + fr * (xs[2] - xs[3])
+
+
+def _rand_2(xi, xb, xs, fr, rng):
+    return xs[0] + fr * (xs[1] - xs[2]) + fr * (xs[3] - xs[4])
+
+
+def _current_to_rand_1(xi, xb, xs, fr, rng):
+    kk = rng.random((xi.shape[0], 1))
+    return xi + kk * (xs[0] - xi) + fr * (xs[1] - xs[2])
+
+
+_MUTATIONS = (_rand_1, _rand_to_best_2, _rand_2, _current_to_rand_1)
+_NO_CROSSOVER = 3  # current-to-rand/1 is rotation-invariant: no binomial crossover
+
+
+class _StrategyAdaptation:
+    """Qin-Suganthan learning of the strategy probabilities p_k and CR medians CRm_k."""
+
+    def __init__(self, learning_period: int):
+        n = len(STRATEGIES)
+        self.period = learning_period
+        self.probs = np.full(n, 1.0 / n)
+        self.crm = np.full(n, 0.5)
+        self.success = np.zeros((learning_period, n))
+        self.failure = np.zeros((learning_period, n))
+        self.cr_memory = [[] for _ in range(n)]
+
+    def draw(self, rng, popsize):
+        """Strategy, F_i ~ N(0.5, 0.3) and CR_i ~ N(CRm_k, 0.1) for each target vector."""
+        strategy = rng.choice(len(STRATEGIES), size=popsize, p=self.probs)
+        f = np.clip(rng.normal(0.5, 0.3, popsize), 0.05, 2.0)[:, None]
+        cr = np.clip(rng.normal(self.crm[strategy], 0.1), 0.0, 1.0)
+        return strategy, f, cr
+
+    def learn(self, generation, strategy, cr, better):
+        """Record this generation's successes; after a full period, update p_k and CRm_k."""
+        n = len(STRATEGIES)
+        slot = generation % self.period
+        self.success[slot] = np.bincount(strategy[better], minlength=n)
+        self.failure[slot] = np.bincount(strategy[~better], minlength=n)
+        for k in range(n):
+            self.cr_memory[k].append(cr[better & (strategy == k)])
+            if len(self.cr_memory[k]) > self.period:
+                self.cr_memory[k].pop(0)
+        if generation + 1 < self.period:
+            return
+        ns = self.success.sum(axis=0)
+        nf = self.failure.sum(axis=0)
+        rate = ns / np.maximum(ns + nf, 1) + 0.01  # + 0.01: no strategy dies out
+        self.probs = rate / rate.sum()
+        for k in range(n):
+            values = np.concatenate(self.cr_memory[k]) if self.cr_memory[k] else np.empty(0)
+            if values.size:
+                self.crm[k] = float(np.median(values))
+
+
+def _trial_vectors(rng, pop, best, strategy, f, cr):
+    """Mutation by each row's strategy, binomial crossover, bounce-back into the cube."""
+    popsize, d = pop.shape
+    r = _distinct_indices(rng, popsize, 5)
+    partners = [pop[r[:, j]] for j in range(5)]
+    mutant = np.empty_like(pop)
+    for k, mutate in enumerate(_MUTATIONS):
+        rows = strategy == k
+        if rows.any():
+            xs = [x[rows] for x in partners]
+            mutant[rows] = mutate(pop[rows], pop[best], xs, f[rows], rng)
+    cross = rng.random((popsize, d)) < cr[:, None]
+    cross[np.arange(popsize), rng.integers(0, d, popsize)] = True
+    cross[strategy == _NO_CROSSOVER] = True
+    trial = np.where(cross, mutant, pop)
+    # bounce back between parent and the violated bound
+    u = rng.random(trial.shape)
+    trial = np.where(trial < 0.0, pop * u, trial)
+    return np.where(trial > 1.0, pop + (1.0 - pop) * u, trial)
+
+
 def sade(
     func,
     bounds,
@@ -200,18 +292,9 @@ def sade(
     rng = np.random.default_rng(seed)
     d = space.lo.size
     start = time.perf_counter()
+    evaluate = _batched_cost(func, space)
 
-    def evaluate(unit):
-        costs = np.asarray(func(space.to_x(unit)), dtype=float).reshape(-1)
-        if costs.shape[0] != unit.shape[0]:
-            raise ValueError(
-                f"the cost function returned {costs.shape[0]} values for {unit.shape[0]} candidates"
-            )
-        return np.where(np.isfinite(costs), costs, np.inf)
-
-    # Latin-hypercube start: every parameter's range is covered evenly.
-    pop = rng.permuted(np.tile(np.arange(popsize), (d, 1)), axis=1).T + rng.random((popsize, d))
-    pop /= popsize
+    pop = _latin_hypercube(rng, popsize, d)
     if init is not None:
         init = np.atleast_2d(np.asarray(init, dtype=float))
         if init.shape[1] != d or init.shape[0] > popsize:
@@ -220,141 +303,52 @@ def sade(
     costs = evaluate(pop)
     nfev = popsize
 
-    n_strat = len(STRATEGIES)
-    probs = np.full(n_strat, 1.0 / n_strat)
-    crm = np.full(n_strat, 0.5)
-    success = np.zeros((learning_period, n_strat))
-    failure = np.zeros((learning_period, n_strat))
-    cr_memory = [[] for _ in range(n_strat)]
+    adaptation = _StrategyAdaptation(learning_period)
     history = {"best": [], "nfev": [], "spread": [], "probabilities": []}
     best = int(np.argmin(costs))
     stall = 0
     message = f"maximum number of generations ({maxiter}) reached"
-    bar = None
-    if progress:
-        from tqdm.auto import tqdm
-
-        bar = tqdm(
-            total=maxiter, desc="SaDE", unit="gen", leave=False, disable=None
-        )  # None: terminals only
+    bar = _progress_bar(maxiter) if progress else None
     nit = 0
     try:
         for gen in range(maxiter):
             nit = gen + 1
-            strategy = rng.choice(n_strat, size=popsize, p=probs)
-            f = np.clip(rng.normal(0.5, 0.3, popsize), 0.05, 2.0)[:, None]
-            cr = np.clip(rng.normal(crm[strategy], 0.1), 0.0, 1.0)
-            r = _distinct_indices(rng, popsize, 5)
-            x1, x2, x3, x4, x5 = (pop[r[:, j]] for j in range(5))
-            xb = pop[best]
-            mutant = np.empty_like(pop)
-            for k, rows in enumerate((strategy == 0, strategy == 1, strategy == 2, strategy == 3)):
-                if not rows.any():
-                    continue
-                fr = f[rows]
-                if k == 0:
-                    mutant[rows] = x1[rows] + fr * (x2[rows] - x3[rows])
-                elif k == 1:
-                    xi = pop[rows]
-                    mutant[rows] = (
-                        xi
-                        + fr * (xb - xi)
-                        + fr * (x1[rows] - x2[rows])
-                        + fr * (x3[rows] - x4[rows])
-                    )
-                elif k == 2:
-                    mutant[rows] = (
-                        x1[rows] + fr * (x2[rows] - x3[rows]) + fr * (x4[rows] - x5[rows])
-                    )
-                else:
-                    xi = pop[rows]
-                    kk = rng.random((int(rows.sum()), 1))
-                    mutant[rows] = xi + kk * (x1[rows] - xi) + fr * (x2[rows] - x3[rows])
-            cross = rng.random((popsize, d)) < cr[:, None]
-            cross[np.arange(popsize), rng.integers(0, d, popsize)] = True
-            cross[strategy == 3] = True  # current-to-rand/1 has no crossover
-            trial = np.where(cross, mutant, pop)
-            # bounce back between parent and the violated bound
-            low = trial < 0.0
-            high = trial > 1.0
-            u = rng.random(trial.shape)
-            trial = np.where(low, pop * u, trial)
-            trial = np.where(high, pop + (1.0 - pop) * u, trial)
-
+            strategy, f, cr = adaptation.draw(rng, popsize)
+            trial = _trial_vectors(rng, pop, best, strategy, f, cr)
             trial_costs = evaluate(trial)
             nfev += popsize
-            better = trial_costs <= costs
-            slot = gen % learning_period
-            success[slot] = np.bincount(strategy[better], minlength=n_strat)
-            failure[slot] = np.bincount(strategy[~better], minlength=n_strat)
-            for k in range(n_strat):
-                cr_memory[k].append(cr[better & (strategy == k)])
-                if len(cr_memory[k]) > learning_period:
-                    cr_memory[k].pop(0)
+            better = trial_costs <= costs  # no worse: replace the parent
+            adaptation.learn(gen, strategy, cr, better)
             pop = np.where(better[:, None], trial, pop)
             costs = np.where(better, trial_costs, costs)
-            new_best = int(np.argmin(costs))
+            best = int(np.argmin(costs))
             prev = history["best"][-1] if history["best"] else np.inf
-            stall = 0 if costs[new_best] < prev * (1 - 1e-12) else stall + 1
-            best = new_best
-            if gen + 1 >= learning_period:
-                ns = success.sum(axis=0)
-                nf = failure.sum(axis=0)
-                rate = ns / np.maximum(ns + nf, 1) + 0.01
-                probs = rate / rate.sum()
-                for k in range(n_strat):
-                    values = np.concatenate(cr_memory[k]) if cr_memory[k] else np.empty(0)
-                    if values.size:
-                        crm[k] = float(np.median(values))
-            finite = np.isfinite(costs)
-            spread = float(np.std(costs[finite])) if finite.all() else np.inf
-            history["best"].append(float(costs[best]))
-            history["nfev"].append(nfev)
-            history["spread"].append(spread)
-            history["probabilities"].append(probs.tolist())
+            stall = 0 if costs[best] < prev * (1 - 1e-12) else stall + 1
+            spread = float(np.std(costs)) if np.isfinite(costs).all() else np.inf
+            for key, value in zip(
+                history, (float(costs[best]), nfev, spread, adaptation.probs.tolist()), strict=True
+            ):
+                history[key].append(value)
             if bar is not None:
                 bar.update(1)
                 bar.set_postfix(best=f"{costs[best]:.4g}")
             if callback is not None and callback(nit, space.to_x(pop[best]), float(costs[best])):
                 message = "stopped by callback"
                 break
-            if np.isfinite(spread) and spread <= atol + tol * abs(float(np.mean(costs))):
-                message = f"converged: cost spread {spread:.3g} <= atol + tol * |mean cost|"
-                break
-            if patience is not None and stall >= patience:
-                message = f"no improvement of the best cost for {patience} generations"
+            reason = _converged(costs, spread, tol, atol, stall, patience)
+            if reason:
+                message = reason
                 break
     finally:
         if bar is not None:
             bar.close()
 
-    x_best = space.to_x(pop[best])
-    f_best = float(costs[best])
-    polished = False
+    x_best, f_best, polished = space.to_x(pop[best]), float(costs[best]), False
     if polish and d > 0:
-        from scipy.optimize import minimize
-
-        def single(unit):
-            nonlocal nfev
-            nfev += 1
-            return float(evaluate(np.clip(unit, 0.0, 1.0)[None, :])[0])
-
-        res = minimize(
-            single,
-            pop[best],
-            method="Nelder-Mead",
-            bounds=[(0.0, 1.0)] * d,
-            options={
-                "maxfev": polish_maxfev or 100 * d,
-                "xatol": 1e-10,
-                "fatol": 1e-12 * max(f_best, 1e-300),
-                "initial_simplex": _small_simplex(pop[best], pop, costs),
-            },
-        )
-        if res.fun < f_best:
-            x_best = space.to_x(np.clip(res.x, 0.0, 1.0))
-            f_best = float(res.fun)
-            polished = True
+        unit, value, spent = _polish(evaluate, pop, costs, best, polish_maxfev or 100 * d)
+        nfev += spent
+        if value < f_best:
+            x_best, f_best, polished = space.to_x(unit), value, True
     return SADEResult(
         x=x_best,
         fun=f_best,
@@ -367,6 +361,62 @@ def sade(
         elapsed=time.perf_counter() - start,
         polished=polished,
     )
+
+
+def _converged(costs, spread, tol, atol, stall, patience):
+    """Why the search should stop now, or an empty string."""
+    if np.isfinite(spread) and spread <= atol + tol * abs(float(np.mean(costs))):
+        return f"converged: cost spread {spread:.3g} <= atol + tol * |mean cost|"
+    if patience is not None and stall >= patience:
+        return f"no improvement of the best cost for {patience} generations"
+    return ""
+
+
+def _batched_cost(func, space):
+    """The user's cost on unit-cube candidates; non-finite costs become +inf (worst)."""
+
+    def evaluate(unit):
+        costs = np.asarray(func(space.to_x(unit)), dtype=float).reshape(-1)
+        if costs.shape[0] != unit.shape[0]:
+            raise ValueError(
+                f"the cost function returned {costs.shape[0]} values for {unit.shape[0]} candidates"
+            )
+        return np.where(np.isfinite(costs), costs, np.inf)
+
+    return evaluate
+
+
+def _progress_bar(maxiter):
+    from tqdm.auto import tqdm
+
+    return tqdm(total=maxiter, desc="SaDE", unit="gen", leave=False, disable=None)  # terminals only
+
+
+def _polish(evaluate, pop, costs, best, maxfev):
+    """Bounded Nelder-Mead from the best vector; returns (unit vector, cost, evaluations)."""
+    from scipy.optimize import minimize
+
+    d = pop.shape[1]
+    spent = 0
+
+    def single(unit):
+        nonlocal spent
+        spent += 1
+        return float(evaluate(np.clip(unit, 0.0, 1.0)[None, :])[0])
+
+    res = minimize(
+        single,
+        pop[best],
+        method="Nelder-Mead",
+        bounds=[(0.0, 1.0)] * d,
+        options={
+            "maxfev": maxfev,
+            "xatol": 1e-10,
+            "fatol": 1e-12 * max(float(costs[best]), 1e-300),
+            "initial_simplex": _small_simplex(pop[best], pop, costs),
+        },
+    )
+    return np.clip(res.x, 0.0, 1.0), float(res.fun), spent
 
 
 def _small_simplex(center, pop, costs):
