@@ -197,7 +197,7 @@ def noisy_coulomb_z(noise_seed, lin=None):
     if lin is None:
         lin = Linearisation(COULOMB, "coulomb", clean, FREE, skip=NOISY["skip"])
     res = identify(
-        noisy, "coulomb", m=COULOMB["m"], popsize=16, maxiter=40, seed=1, skip=NOISY["skip"]
+        noisy, "coulomb", m=COULOMB["m"], popsize=30, maxiter=80, seed=1, skip=NOISY["skip"]
     )
     err = np.array([np.log(res.parameters[n] / COULOMB[n]) for n in FREE])
     se = lin.standard_errors(NOISY["sigma"])

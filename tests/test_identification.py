@@ -51,8 +51,11 @@ def test_cost_is_eq11():
 #: Relative precision (of each identified parameter, after the linearised offset
 #: of the optimum is removed) that SaDE + Nelder-Mead polish must reach on a
 #: noise-free record: 90 times below the 0.9 % error of a mis-scaled mass.
-#: The seed study (tests/calibration/identification.py, 8 optimiser seeds x 4
-#: cases below) found at most 2.3e-6.
+#: Seed study (optimiser seeds 0-7, Coulomb record not at rest): popsize 30 x
+#: 80 generations reached <= 1.1e-7 in 7 seeds and 1.7e-4 in one (seed 3,
+#: polish stopped by its evaluation budget); popsize 16 x 40 failed in 4 of 8
+#: (up to a local minimum with J = 0.02), so the tests use 30 x 80 for
+#: Coulomb. The tanh and LuGre budgets below were checked with seed 1 only.
 TOL = 1e-4
 #: An initial state far from rest: about 1.4 z_rms and 0.8 v_rms.
 Z0, V0 = 1e-3, 0.03
@@ -110,21 +113,21 @@ def test_noise_free_coulomb_not_at_rest_recovered_to_optimiser_precision():
     every parameter by 0.9 %; a zero initial state moves them by several %.
     """
     rec = not_at_rest("coulomb", COULOMB)
-    res = identify(rec, "coulomb", m=COULOMB["m"], popsize=16, maxiter=40, seed=1)
+    res = identify(rec, "coulomb", m=COULOMB["m"], popsize=30, maxiter=80, seed=1)
     lin = H.Linearisation(COULOMB, "coulomb", rec, H.FREE)
     assert_at_optimum(res, COULOMB, lin, "coulomb")
     assert res.parameters["m"] == COULOMB["m"]  # the given mass, unchanged
     # the reported J is the J of the reported parameters
     assert res.predict(rec).cost == pytest.approx(res.cost, rel=1e-6)
-    assert res.nfev >= 16 * 41
+    assert res.nfev >= 30 * 81
     assert set(res.to_dict()["parameters"]) == {"m", "c", "k", "k3", "fc"}
 
 
 def test_identified_forces_scale_exactly_with_the_given_mass():
     """Base excitation: Eq. 1 divided by m; doubling m doubles c, k, k3 and Fc, same J."""
     rec = not_at_rest("coulomb", COULOMB)
-    one = identify(rec, "coulomb", m=COULOMB["m"], popsize=16, maxiter=40, seed=1)
-    two = identify(rec, "coulomb", m=2 * COULOMB["m"], popsize=16, maxiter=40, seed=1)
+    one = identify(rec, "coulomb", m=COULOMB["m"], popsize=30, maxiter=80, seed=1)
+    two = identify(rec, "coulomb", m=2 * COULOMB["m"], popsize=30, maxiter=80, seed=1)
     for name in H.FREE:
         assert two.parameters[name] / one.parameters[name] == pytest.approx(2.0, rel=TOL), name
     assert two.cost == pytest.approx(one.cost, rel=1e-3)
@@ -142,9 +145,11 @@ def test_noisy_record_within_linearised_standard_errors():
     4 sigma, and the test is powered to see a 0.9 % error (the mis-scaled
     mass) in c, k and Fc and 2 % in k3.
 
-    Calibration (tests/calibration/identification.py, 40 noise seeds): z-scores
-    mean / SD / max|z| c -0.09 / 1.04 / 2.3, k 0.00 / 0.99 / 2.5,
-    k3 0.00 / 0.98 / 2.5, Fc 0.09 / 1.05 / 2.4.
+    Calibration (tests/calibration/identification.py, 20 noise seeds, SaDE
+    30 x 80): z-scores mean / SD / max|z|: c -0.00 / 1.09 / 1.97,
+    k -0.60 / 0.78 / 2.00, k3 +0.64 / 0.86 / 2.14, Fc +0.01 / 1.09 / 2.37
+    (k and k3 are strongly anti-correlated, hence their shared offset over
+    only 20 seeds). With popsize 16 x 40 some seeds stop in a local minimum.
     """
     res, z, se = H.noisy_coulomb_z(noise_seed=0)
     for name, zi, sei, detect in zip(H.FREE, z, se, (0.009, 0.009, 0.02, 0.009), strict=True):

@@ -42,7 +42,7 @@ def optimiser_study(seeds):
     z = H.simulate_record(tanh, "tanh", acc, 1 / ex.fs, substeps=8, z0=T.Z0, v0=T.V0).z[0]
     trec = H.Record(1 / ex.fs, "base_displacement", y, z, "tanh")
     cases = {
-        "coulomb": (coul, H.COULOMB, "coulomb", H.FREE, dict(popsize=16, maxiter=40)),
+        "coulomb": (coul, H.COULOMB, "coulomb", H.FREE, dict(popsize=30, maxiter=80)),
         "lugre": (lugre, T.LUGRE, "lugre", H.FREE, dict(popsize=16, maxiter=40, fixed=held)),
         "tanh": (
             trec, tanh, "tanh", H.FREE + ("beta",),
