@@ -1,9 +1,12 @@
 """Identification of friction models (randvib.identification, CLI identify/validate)."""
 
 import json
+from types import SimpleNamespace
 
+import _identification as H
 import numpy as np
 import pytest
+from _stats import assert_matches
 
 from randvib.cli import main
 from randvib.deterministic import simulate_record
@@ -12,13 +15,15 @@ from randvib.identification import (
     Record,
     default_bounds,
     identify,
+    initial_velocity,
     normalised_cost,
     predict,
     read_record,
     validate,
 )
 
-TRUE = dict(m=0.0226, c=0.049, k=57.4, k3=70742.0, fc=0.0058)
+COULOMB = H.COULOMB
+TRUE = COULOMB
 
 
 def synthetic(
@@ -43,33 +48,195 @@ def test_cost_is_eq11():
     assert normalised_cost(z, z + 0.1) == pytest.approx(100 * 0.01 / np.var(z))
 
 
-def test_noise_free_coulomb_recovered_within_one_percent(record):
-    res = identify(record, "coulomb", m=TRUE["m"], popsize=30, maxiter=120, seed=1)
-    assert res.cost < 1.0
-    for name in ("c", "k", "k3", "fc"):
-        assert res.parameters[name] == pytest.approx(TRUE[name], rel=0.01), name
-    assert res.nfev >= 30 * 121
+#: Relative precision (of each identified parameter, after the linearised offset
+#: of the optimum is removed) that SaDE + Nelder-Mead polish must reach on a
+#: noise-free record: 90 times below the 0.9 % error of a mis-scaled mass.
+#: Seed study (optimiser seeds 0-7, Coulomb record not at rest): popsize 30 x
+#: 80 generations reached <= 1.1e-7 in 7 seeds and 1.7e-4 in one (seed 3,
+#: polish stopped by its evaluation budget); popsize 16 x 40 failed in 4 of 8
+#: (up to a local minimum with J = 0.02), so the tests use 30 x 80 for
+#: Coulomb. The tanh and LuGre budgets below were checked with seed 1 only.
+TOL = 1e-4
+#: An initial state far from rest: about 1.4 z_rms and 0.8 v_rms.
+Z0, V0 = 1e-3, 0.03
+
+
+def assert_at_optimum(res, truth, lin, what):
+    err = np.array([np.log(res.parameters[n] / truth[n]) for n in lin.free])
+    off = err - lin.bias
+    assert np.all(np.abs(off) <= TOL), (
+        f"{what}: ln(theta/true) - bias = {dict(zip(lin.free, off, strict=True))}"
+    )
+
+
+def not_at_rest(model, params, *, seed=0, duration=1.5, fs=500.0):
+    ex = H.excitation(seed, duration, fs)
+    z, _ = H.clean_response(params, model, ex, z0=Z0, v0=V0)
+    return H.make_record(ex, z, name=f"{model}{seed}")
+
+
+def test_initial_velocity_is_the_fourth_order_one_sided_stencil():
+    dt = 0.01
+    t = np.arange(5) * dt
+    quartic = 0.3 - 2.0 * t + 5.0 * t**2 - 7.0 * t**3 + 11.0 * t**4
+    assert initial_velocity(quartic, dt) == pytest.approx(-2.0, rel=1e-12)  # exact to t^4
+    z = np.random.default_rng(0).standard_normal(5)
+    assert initial_velocity(z, dt) == pytest.approx(H.VELOCITY_STENCIL @ z / dt, rel=1e-12)
+
+
+@pytest.mark.parametrize("skip", [0, 40])
+def test_true_parameters_score_the_residual_of_the_initial_state(skip):
+    """J of the truth on a record not at rest equals Eq. 11 of the independent residual.
+
+    The reference starts the simulation, like identify, from the first sample
+    and the stencil velocity (re-implemented in tests/_identification.py) and
+    scores the samples from ``skip`` on. What remains is the stencil's
+    truncation error (J ~ 1e-8): starting from rest instead gives J ~ 100.
+    """
+    rec = not_at_rest("coulomb", COULOMB)
+    z0, v0 = H.initial_state(rec.z, rec.dt)
+    zhat = H.sensitivities(COULOMB, "coulomb", rec, (), z0, v0)[0]
+    r = (rec.z - zhat)[skip:]
+    reference = 100 * np.mean(r**2) / np.var(rec.z[skip:])
+    assert reference < 1e-6
+    assert predict(COULOMB, "coulomb", rec, skip=skip).cost == pytest.approx(reference, rel=1e-6)
+    (row,) = validate(COULOMB, "coulomb", [rec], skip=skip)
+    assert row.cost == pytest.approx(reference, rel=1e-6)
+
+
+def test_noise_free_coulomb_not_at_rest_recovered_to_optimiser_precision():
+    """Coulomb record starting at (Z0, V0): every parameter to TOL = 1e-4 of the optimum.
+
+    The optimum differs from the truth by the linearised offset (about 5e-4
+    in k3, 1e-5 in the others; the initial-velocity stencil's error), which
+    is computed and removed. A mass scaled by 1.009 inside identify moves
+    every parameter by 0.9 %; a zero initial state moves them by several %.
+    """
+    rec = not_at_rest("coulomb", COULOMB)
+    res = identify(rec, "coulomb", m=COULOMB["m"], popsize=30, maxiter=80, seed=1)
+    lin = H.Linearisation(COULOMB, "coulomb", rec, H.FREE)
+    assert_at_optimum(res, COULOMB, lin, "coulomb")
+    assert res.parameters["m"] == COULOMB["m"]  # the given mass, unchanged
+    # the reported J is the J of the reported parameters
+    assert res.predict(rec).cost == pytest.approx(res.cost, rel=1e-6)
+    assert res.nfev >= 30 * 81
     assert set(res.to_dict()["parameters"]) == {"m", "c", "k", "k3", "fc"}
 
 
-def test_true_parameters_score_zero_and_model_ranking(record):
-    assert predict(TRUE, "coulomb", record).cost < 1e-6  # 4 vs 8 substeps, estimated v0
-    viscous = identify(record, "viscous", m=TRUE["m"], popsize=20, maxiter=40, seed=0)
+def test_identified_forces_scale_exactly_with_the_given_mass():
+    """Base excitation: Eq. 1 divided by m; doubling m doubles c, k, k3 and Fc, same J."""
+    rec = not_at_rest("coulomb", COULOMB)
+    one = identify(rec, "coulomb", m=COULOMB["m"], popsize=30, maxiter=80, seed=1)
+    two = identify(rec, "coulomb", m=2 * COULOMB["m"], popsize=30, maxiter=80, seed=1)
+    for name in H.FREE:
+        assert two.parameters[name] / one.parameters[name] == pytest.approx(2.0, rel=TOL), name
+    assert two.cost == pytest.approx(one.cost, rel=1e-3)
+
+
+def test_noisy_record_within_linearised_standard_errors():
+    """Measurement noise of 1 um (0.09 % of z_rms) on a 3 s Coulomb record, skip 1 s.
+
+    Error model (tests/_identification.py, Linearisation): noise on the
+    scored samples moves ln(theta) by P eps (standard errors from the
+    sensitivities: c 2.2e-4, k 1.4e-5, k3 2.0e-3, Fc 1.5e-4 relative);
+    noise on the first five samples moves the initial state identify starts
+    from, and its effect is computed exactly from the realised noise and
+    removed, as is the noise-free offset. Each parameter is then compared at
+    4 sigma, and the test is powered to see a 0.9 % error (the mis-scaled
+    mass) in c, k and Fc and 2 % in k3.
+
+    Calibration (tests/calibration/identification.py, 20 noise seeds, SaDE
+    30 x 80): z-scores mean / SD / max|z|: c -0.00 / 1.09 / 1.97,
+    k -0.60 / 0.78 / 2.00, k3 +0.64 / 0.86 / 2.14, Fc +0.01 / 1.09 / 2.37
+    (k and k3 are strongly anti-correlated, hence their shared offset over
+    only 20 seeds). With popsize 16 x 40 some seeds stop in a local minimum.
+    """
+    res, z, se = H.noisy_coulomb_z(noise_seed=0)
+    for name, zi, sei, detect in zip(H.FREE, z, se, (0.009, 0.009, 0.02, 0.009), strict=True):
+        # ln(theta_hat / theta_ref) as a statistic with its standard error
+        assert_matches(
+            SimpleNamespace(mean=1.0 + zi * sei, std_error=sei), 1.0, detect=detect, what=name
+        )
+    # J (Eq. 11) reported by identify is Eq. 11 over the scored samples
+    skip = H.NOISY["skip"]
+    _, noisy = H.noisy_coulomb_record(0)
+    pred = predict(res.parameters, "coulomb", noisy, skip=skip)
+    assert res.cost == pytest.approx(pred.cost, rel=1e-9)
+    # and sits at the noise floor: 100 sigma^2 / var(z) (fraction (N - d)/N of it)
+    floor = 100 * H.NOISY["sigma"] ** 2 / np.var(noisy.z[skip:])
+    n = noisy.n - skip
+    assert abs(res.cost / floor - 1) < 4 * np.sqrt(2 / n) + 4 / n
+
+
+def test_tanh_base_displacement_not_at_rest_recovered_to_optimiser_precision():
+    """tanh friction (beta = 100 s/m: beta v_rms ~ 4, a smooth law, all five
+    parameters identifiable), driven by a recorded base displacement that the
+    package differentiates, device starting at (Z0, V0).
+
+    The shaker fades in and out (tests/_identification.py, ``tapered``), so
+    the displacement record is smooth at its ends; the record is made from
+    the exact base acceleration. beta is searched in [10, 1e4] s/m: over the
+    default 10 decades, a 20 x 60 search stalls in the Coulomb-like region
+    (beta v_rms >> 1, J ~ 0.03). At the paper's beta (4.8e8 s/m) tanh is
+    Coulomb friction and beta is not identifiable (only bounded below).
+    """
+    params = dict(COULOMB, beta=100.0)
+    ex = H.excitation(0, 1.5, 500.0)
+    y, acc = H.tapered(ex)
+    z = simulate_record(params, "tanh", acc, 1 / ex.fs, substeps=8, z0=Z0, v0=V0).z[0]
+    rec = Record(1 / ex.fs, "base_displacement", y, z, "tanh")
+    res = identify(
+        rec, "tanh", m=COULOMB["m"], popsize=20, maxiter=60, seed=1, bounds={"beta": (10, 1e4)}
+    )
+    lin = H.Linearisation(params, "tanh", rec, H.FREE + ("beta",))
+    assert_at_optimum(res, params, lin, "tanh")
+    assert res.cost <= predict(params, "tanh", rec).cost
+
+
+LUGRE = dict(
+    m=0.0226, c=0.055, k=59.7, k3=64926.0, sigma0=1.98, sigma1=0.18, fc=0.0008, fs=0.008, vs=0.007
+)  # paper Table 2, training data 1
+
+
+def test_lugre_truth_scores_zero_and_the_fit_reaches_the_optimum():
+    """LuGre (Table 2 values), record not at rest.
+
+    Identifiability (linearised, 1.5 s at 1.07 m/s^2 RMS, 1 um noise): c and k
+    to a few per cent; Fc, sigma0, sigma1 to tens of per cent; k3, Fs and
+    the Stribeck velocity not at all (standard errors above 100 %): the
+    sensitivity matrix's singular values span four decades. So the full
+    8-parameter search is not tested for recovery; the truth must score
+    J ~ 0 (the residual of the initial state), and with the bristle and
+    Stribeck parameters held the fit must reach the optimum to TOL.
+    """
+    rec = not_at_rest("lugre", LUGRE)
+    truth = predict(LUGRE, "lugre", rec).cost
+    assert truth < 1e-6
+    held = {n: LUGRE[n] for n in ("sigma0", "sigma1", "fs", "vs")}
+    res = identify(rec, "lugre", m=LUGRE["m"], fixed=held, popsize=16, maxiter=40, seed=1)
+    assert res.free == H.FREE
+    assert res.cost <= truth
+    assert_at_optimum(res, LUGRE, H.Linearisation(LUGRE, "lugre", rec, H.FREE), "lugre")
+
+
+def test_viscous_model_cannot_match_a_friction_record(record):
+    viscous = identify(record, "viscous", m=COULOMB["m"], popsize=20, maxiter=40, seed=0)
     # without friction the record cannot be matched as well (paper Fig. 7)
-    assert viscous.cost > 10 * predict(TRUE, "coulomb", record).cost
+    assert viscous.cost > 10 * predict(COULOMB, "coulomb", record).cost
     assert viscous.cost < 100
 
 
 def test_force_input_identifies_the_mass():
+    """Force input, mass free: all five parameters to TOL of the optimum."""
     params = dict(m=0.5, c=2.0, k=800.0, k3=2e7)
-    ex = band_limited_excitation(3.0, 400.0, 1.0, f_lo=2.0, f_hi=40.0, seed=2)
+    ex = band_limited_excitation(2.0, 400.0, 1.0, f_lo=2.0, f_hi=40.0, seed=2)
     force = ex.acceleration
     z = simulate_record(params, "none", force, 1 / 400, input_kind="force", substeps=8).z[0]
     rec = Record(1 / 400, "force", force, z)
-    res = identify(rec, "viscous", popsize=30, maxiter=150, seed=0)
+    res = identify(rec, "viscous", popsize=30, maxiter=100, seed=0)
     assert "m" in res.free
-    for name, value in params.items():
-        assert res.parameters[name] == pytest.approx(value, rel=0.01), name
+    lin = H.Linearisation(params, "viscous", rec, ("c", "k", "k3", "m"))
+    assert_at_optimum(res, params, lin, "force")
     lin = identify(rec, "viscous", fixed={"k3": 0}, popsize=20, maxiter=40, seed=0)
     assert lin.parameters["k3"] == 0.0 and "k3" not in lin.free
 
