@@ -35,6 +35,69 @@ ACC_COMP_V2 = 7  # companion (same noise, no friction) mean v^2
 ACC_COMP_Z2 = 8  # companion mean z^2
 N_ACC = 9
 
+
+class PathAverages:
+    """Named view of the kernel's per-path accumulators (columns ``ACC_*``).
+
+    The kernel returns one row of time averages per path; consumers read them
+    through these names so that the column layout stays the kernel's business.
+
+    Parameters
+    ----------
+    per_path : ndarray, shape (n_paths, N_ACC)
+        As returned by :func:`run_ensemble` (or stored by a sweep).
+    """
+
+    def __init__(self, per_path):
+        self.per_path = per_path
+
+    def _col(self, index):
+        return self.per_path[:, index]
+
+    @property
+    def v2(self):
+        """Time average of v^2 per path ((m/s)^2)."""
+        return self._col(ACC_V2)
+
+    @property
+    def z2(self):
+        """Time average of z^2 per path (m^2)."""
+        return self._col(ACC_Z2)
+
+    @property
+    def abs_v(self):
+        """Time average of |v| per path (m/s)."""
+        return self._col(ACC_ABS_V)
+
+    @property
+    def friction_power(self):
+        """Time average of v F per path (W)."""
+        return self._col(ACC_VF)
+
+    @property
+    def ito_integral(self):
+        """(1/T) sum v_n dW_n per path (m/s^1.5): mean exactly zero."""
+        return self._col(ACC_VDW)
+
+    def energy_change(self, window):
+        """(H(T) - H(0)) / T per path (W) over an averaging ``window`` T (s)."""
+        return (self._col(ACC_H1) - self._col(ACC_H0)) / window
+
+    @property
+    def companion_v2(self):
+        """The friction-free companion's time average of v^2 ((m/s)^2); 0 without one."""
+        return self._col(ACC_COMP_V2)
+
+    @property
+    def companion_z2(self):
+        """The friction-free companion's time average of z^2 (m^2); 0 without one."""
+        return self._col(ACC_COMP_Z2)
+
+    def energy_balance_controls(self, window):
+        """The two zero-mean controls of the energy balance: Ito integral, energy change."""
+        return [self.ito_integral, self.energy_change(window)]
+
+
 #: How often (steps) the kernel checks for a non-finite state.
 CHECK_EVERY = 256
 

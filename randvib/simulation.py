@@ -191,6 +191,11 @@ class SimulationResult:
     def column(self, index: int) -> np.ndarray:
         return self.per_path[:, index]
 
+    @property
+    def averages(self) -> engine.PathAverages:
+        """The per-path time averages by name (:class:`randvib.engine.PathAverages`)."""
+        return engine.PathAverages(self.per_path)
+
     def controls(self) -> np.ndarray:
         """Zero-mean control variates per path, shape (n_paths, p).
 
@@ -201,17 +206,12 @@ class SimulationResult:
           exactly known mean in continuous time (bias O(dt) at finite step).
         """
         h = self.harvester
-        cols = [
-            self.column(engine.ACC_VDW),
-            (self.column(engine.ACC_H1) - self.column(engine.ACC_H0)) / self.averaging_time,
-        ]
-        if np.any(self.column(engine.ACC_COMP_V2) != 0) and h.c > 0:
+        avg = self.averages
+        cols = avg.energy_balance_controls(self.averaging_time)
+        if np.any(avg.companion_v2 != 0) and h.c > 0:
+            cols.append(avg.companion_v2 - exact.linear_velocity_variance(h.m, h.c, self.psd))
             cols.append(
-                self.column(engine.ACC_COMP_V2) - exact.linear_velocity_variance(h.m, h.c, self.psd)
-            )
-            cols.append(
-                self.column(engine.ACC_COMP_Z2)
-                - exact.gibbs_displacement_moment(h.m, h.c, h.k, h.k3, self.psd)
+                avg.companion_z2 - exact.gibbs_displacement_moment(h.m, h.c, h.k, h.k3, self.psd)
             )
         return np.column_stack(cols)
 
@@ -222,27 +222,27 @@ class SimulationResult:
     @property
     def velocity_variance(self) -> Statistic:
         """E[z'^2] ((m/s)^2); the mean velocity is zero by symmetry."""
-        return self.statistic(self.column(engine.ACC_V2))
+        return self.statistic(self.averages.v2)
 
     @property
     def displacement_variance(self) -> Statistic:
         """E[z^2] (m^2)."""
-        return self.statistic(self.column(engine.ACC_Z2))
+        return self.statistic(self.averages.z2)
 
     @property
     def mean_abs_velocity(self) -> Statistic:
         """E|z'| (m/s)."""
-        return self.statistic(self.column(engine.ACC_ABS_V))
+        return self.statistic(self.averages.abs_v)
 
     @property
     def power_electrical(self) -> Statistic:
         """E[P_e] = c_e E[z'^2] (W) (paper Eq. 31)."""
-        return self.statistic(self.harvester.c_e * self.column(engine.ACC_V2))
+        return self.statistic(self.harvester.c_e * self.averages.v2)
 
     @property
     def friction_power(self) -> Statistic:
         """E[z' F] (W): power dissipated by friction."""
-        return self.statistic(self.column(engine.ACC_VF))
+        return self.statistic(self.averages.friction_power)
 
     @property
     def power_load(self) -> Statistic | None:
@@ -250,13 +250,13 @@ class SimulationResult:
         e = self.harvester.electrical
         if e is None:
             return None
-        return self.statistic(self.harvester.c_e * e.load_fraction * self.column(engine.ACC_V2))
+        return self.statistic(self.harvester.c_e * e.load_fraction * self.averages.v2)
 
     def energy_balance_residual(self) -> Statistic:
         """c E[v^2] + E[v F] - S m / 4 (W): zero up to O(dt) and noise."""
         h = self.harvester
         return self.statistic(
-            h.c * self.column(engine.ACC_V2) + self.column(engine.ACC_VF) - self.psd * h.m / 4.0
+            h.c * self.averages.v2 + self.averages.friction_power - self.psd * h.m / 4.0
         )
 
     def summary(self) -> dict:

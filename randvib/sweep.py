@@ -244,15 +244,69 @@ class SweepResult:
     per_path: dict = field(repr=False)  # point index -> per-path accumulators
 
     def power_samples(self, index: int, c_e: float) -> np.ndarray:
-        return c_e * self.per_path[index][:, 0]
+        """c_e times each path's mean v^2 at point ``index``: per-path E[P_e] (W)."""
+        from randvib.engine import PathAverages
+
+        return c_e * PathAverages(self.per_path[index]).v2
 
 
-def _point_paths(out: Path, index: int) -> Path:
-    return out / "points" / f"{index:05d}.npy"
+class _PointStore:
+    """A sweep's result folder: one JSON row and one ``.npy`` of per-path data per point.
+
+    Every finished point is written atomically (temporary name, then rename),
+    so an interrupted sweep resumes from the points already on disk;
+    ``results.csv`` is rewritten from the rows after each point. A folder
+    holding another sweep (different identity) is refused untouched by
+    :func:`randvib._io.prepare_output_dir`.
+    """
+
+    def __init__(self, out_dir, identity: dict):
+        self.out = prepare_output_dir(out_dir, identity)
+        (self.out / "points").mkdir(exist_ok=True)
+
+    def _paths(self, index: int) -> Path:
+        return self.out / "points" / f"{index:05d}.npy"
+
+    def _row(self, index: int) -> Path:
+        return self.out / "points" / f"{index:05d}.json"
+
+    def load_finished(self, n_points: int):
+        """Rows and per-path arrays of the points already on disk."""
+        rows, per_path = {}, {}
+        for i in range(n_points):
+            if self._row(i).exists() and self._paths(i).exists():
+                rows[i] = json.loads(self._row(i).read_text())
+                per_path[i] = np.load(self._paths(i))
+        return rows, per_path
+
+    def save(self, index: int, row: dict, paths: np.ndarray, rows: dict) -> None:
+        tmp = self._paths(index).with_suffix(".tmp.npy")
+        np.save(tmp, paths)
+        os.replace(tmp, self._paths(index))
+        atomic_write_text(self._row(index), json.dumps(row))
+        atomic_write_text(self.out / "results.csv", _table(rows).to_csv(index=False))
 
 
-def _point_row(out: Path, index: int) -> Path:
-    return out / "points" / f"{index:05d}.json"
+def _table(rows: dict) -> pd.DataFrame:
+    return pd.DataFrame([{"point": i, **rows[i]} for i in sorted(rows)])
+
+
+def _progress_bar(total: int, done: int, name: str):
+    from tqdm import tqdm
+
+    # disable=None: shown on terminals only, not in logs or CI
+    return tqdm(total=total, initial=done, unit="point", desc=name, disable=None)
+
+
+def _computed_points(base, points, settings, todo, executor):
+    """Yield ``(index, row, per_path)`` for each point in ``todo`` as it finishes."""
+    if executor is None:
+        for i in todo:
+            yield (i, *run_point(base, points[i], settings, threads=None))
+        return
+    futures = {executor.submit(run_point, base, points[i], settings, 1): i for i in todo}
+    for fut in as_completed(futures):
+        yield (futures[fut], *fut.result())
 
 
 def run_sweep(
@@ -287,9 +341,9 @@ def run_sweep(
     """
     settings = settings or SweepSettings()
     points = validate_points(base, points)
-    per_path: dict[int, np.ndarray] = {}
     rows: dict[int, dict] = {}
-    out = None
+    per_path: dict[int, np.ndarray] = {}
+    store = None
     if out_dir is not None:
         identity = {
             "name": name,
@@ -297,62 +351,26 @@ def run_sweep(
             "points": points,
             "settings": asdict(settings),
         }
-        out = prepare_output_dir(out_dir, identity)
-        (out / "points").mkdir(exist_ok=True)
-        for i in range(len(points)):
-            if _point_row(out, i).exists() and _point_paths(out, i).exists():
-                rows[i] = json.loads(_point_row(out, i).read_text())
-                per_path[i] = np.load(_point_paths(out, i))
+        store = _PointStore(out_dir, identity)
+        rows, per_path = store.load_finished(len(points))
     todo = [i for i in range(len(points)) if i not in rows]
-
-    def finish(i, row, paths):
-        rows[i] = row
-        per_path[i] = paths
-        if out is not None:
-            tmp = _point_paths(out, i).with_suffix(".tmp.npy")
-            np.save(tmp, paths)
-            os.replace(tmp, _point_paths(out, i))
-            atomic_write_text(_point_row(out, i), json.dumps(row))
-            _write_table(out, rows)
-
-    bar = None
-    if progress and todo:
-        from tqdm import tqdm
-
-        bar = tqdm(  # disable=None: shown on terminals only, not in logs or CI
-            total=len(points),
-            initial=len(points) - len(todo),
-            unit="point",
-            desc=name,
-            disable=None,
-        )
+    bar = _progress_bar(len(points), len(points) - len(todo), name) if progress and todo else None
     own_close = None
     if executor is None and todo:
         executor, own_close = make_executor(workers, scheduler)
     try:
-        if executor is None:
-            for i in todo:
-                finish(i, *run_point(base, points[i], settings, threads=None))
-                if bar is not None:
-                    bar.update()
-        else:
-            futures = {executor.submit(run_point, base, points[i], settings, 1): i for i in todo}
-            for fut in as_completed(futures):
-                finish(futures[fut], *fut.result())
-                if bar is not None:
-                    bar.update()
+        for i, row, paths in _computed_points(base, points, settings, todo, executor):
+            rows[i], per_path[i] = row, paths
+            if store is not None:
+                store.save(i, row, paths, rows)
+            if bar is not None:
+                bar.update()
     finally:
         if bar is not None:
             bar.close()
         if own_close is not None:
             own_close()
-    table = pd.DataFrame([{"point": i, **rows[i]} for i in sorted(rows)])
-    return SweepResult(table=table, settings=settings, points=points, per_path=per_path)
-
-
-def _write_table(out: Path, rows: dict) -> None:
-    table = pd.DataFrame([{"point": i, **rows[i]} for i in sorted(rows)])
-    atomic_write_text(out / "results.csv", table.to_csv(index=False))
+    return SweepResult(table=_table(rows), settings=settings, points=points, per_path=per_path)
 
 
 # ------------------------------------------------------------------ tests on results
@@ -395,10 +413,9 @@ def paired_contrast(result: SweepResult, base: Harvester, weights: Mapping[int, 
     window = result.settings.window
     for i, w in weights.items():
         device = point_device(base, result.points[i])
-        acc = result.per_path[i][:n]
-        samples += w * device.c_e * acc[:, engine.ACC_V2]
-        controls.append(acc[:, engine.ACC_VDW])
-        controls.append((acc[:, engine.ACC_H1] - acc[:, engine.ACC_H0]) / window)
+        averages = engine.PathAverages(result.per_path[i][:n])
+        samples += w * device.c_e * averages.v2
+        controls.extend(averages.energy_balance_controls(window))
     ctrl = np.column_stack(controls) if result.settings.control_variates else None
     if ctrl is not None and ctrl.shape[1] * 10 > n:
         ctrl = None  # too few paths to fit the coefficients reliably
