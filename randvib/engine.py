@@ -17,7 +17,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from randvib.friction import friction_force_and_rate
+from randvib.friction import evaluate_friction
 from randvib.rng import seed_path_state, standard_normal
 
 #: Paths advanced together inside one chunk.
@@ -40,8 +40,8 @@ CHECK_EVERY = 256
 
 
 @numba.njit(cache=True, inline="always")
-def _acceleration(z, v, theta, inv_m, c, k, k3, fr_kind, fr_p):
-    force, rate = friction_force_and_rate(fr_kind, fr_p, v, theta)
+def _acceleration(z, v, theta, inv_m, c, k, k3, fr_kind, fr_p, fr_fn):
+    force, rate = evaluate_friction(fr_kind, fr_fn, fr_p, v, theta)
     return -(c * v + k * z + k3 * z * z * z + force) * inv_m, rate, force
 
 
@@ -50,6 +50,7 @@ def run_ensemble(
     method,
     fr_kind,
     fr_p,
+    fr_fn,
     m,
     c,
     k,
@@ -83,8 +84,9 @@ def run_ensemble(
     ----------
     method : int
         Integrator kernel code (0 Euler-Maruyama, 1 stochastic Heun).
-    fr_kind, fr_p : int, float64[5]
-        Friction kernel code and parameters (:mod:`randvib.friction`).
+    fr_kind, fr_p, fr_fn : int, float64[5], callback
+        Friction kernel code, parameters and compiled callback, from
+        :func:`randvib.friction.kernel_arguments`.
     m, c, k, k3 : float
         Mass (kg), total viscous damping (Ns/m), stiffnesses (N/m, N/m^3).
     noise_amp : float
@@ -172,7 +174,7 @@ def run_ensemble(
                 zj = z[j]
                 vj = v[j]
                 tj = th[j]
-                acc1, rate1, f1 = _acceleration(zj, vj, tj, inv_m, c, k, k3, fr_kind, fr_p)
+                acc1, rate1, f1 = _acceleration(zj, vj, tj, inv_m, c, k, k3, fr_kind, fr_p, fr_fn)
                 if in_window:
                     if n == n_burn:
                         a[j, ACC_H0] = 0.5 * m * vj * vj + 0.5 * k * zj * zj + 0.25 * k3 * zj**4
@@ -196,7 +198,9 @@ def run_ensemble(
                     zp = zj + vj * dt
                     vp = vj + acc1 * dt + noise
                     tp = tj + rate1 * dt
-                    acc2, rate2, f2 = _acceleration(zp, vp, tp, inv_m, c, k, k3, fr_kind, fr_p)
+                    acc2, rate2, f2 = _acceleration(
+                        zp, vp, tp, inv_m, c, k, k3, fr_kind, fr_p, fr_fn
+                    )
                     z[j] = zj + (vj + vp) * half_dt
                     v[j] = vj + (acc1 + acc2) * half_dt + noise
                     th[j] = tj + (rate1 + rate2) * half_dt
