@@ -51,6 +51,12 @@ parameter sets):
   otherwise. Results therefore do not depend on the step size; below the
   switch (``h <= 2 tau``) plain RK4 is stable and accurate.
 
+Which path a friction law takes is its own declaration
+(:mod:`randvib.friction`): ``stick_slip`` selects the event-located
+integrator (``Fc sgn v``) or its boundary-layer form (``Fc tanh(beta v)``),
+``kernel_relaxation_rate`` the sub-cycling of a law with memory, and
+everything else is RK4 on the law's compiled ``kernel``.
+
 A candidate whose response leaves a sanity bound (``response_limit``) or
 becomes non-finite is stopped and gets an infinite cost / NaN samples.
 """
