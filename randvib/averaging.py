@@ -84,7 +84,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from randvib._validation import check_nonnegative, check_positive
-from randvib.friction import Coulomb, Tanh
 from randvib.harvester import Harvester
 
 __all__ = [
@@ -319,20 +318,18 @@ def memoryless_parameters(harvester: Harvester, psd, method: str = "stochastic a
 
     ``beta = inf`` marks Coulomb friction (or none, with ``fc = 0``). Methods
     that need a memoryless friction law (averaging, the FPK solvers) share
-    this; ``method`` names the caller in the error raised for LuGre.
+    this; the law declares (Fc, beta) through ``coulomb_tanh_form()``, and
+    ``method`` names the caller in the error raised for any other law (LuGre).
     """
     friction = harvester.friction
-    if friction is None:
-        fc, beta = 0.0, np.inf
-    elif isinstance(friction, Tanh):
-        fc, beta = friction.fc, friction.beta
-    elif isinstance(friction, Coulomb):
-        fc, beta = friction.fc, np.inf
-    else:
+    form = (0.0, np.inf) if friction is None else friction.coulomb_tanh_form()
+    if form is None:
+        why = "has internal state" if friction.has_memory else "is not of that form"
         raise ValueError(
-            f"{method} needs a memoryless friction law (coulomb, tanh or none); "
-            f"{friction.name!r} has internal state. Use randvib.simulate for it."
+            f"{method} needs a memoryless friction law of the form Fc tanh(beta v) "
+            f"(coulomb, tanh or none); {friction.name!r} {why}. Use randvib.simulate for it."
         )
+    fc, beta = form
     psd = check_positive("psd", psd, "(m/s^2)^2/Hz")
     arrays = np.broadcast_arrays(
         *(

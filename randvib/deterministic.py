@@ -51,6 +51,12 @@ parameter sets):
   otherwise. Results therefore do not depend on the step size; below the
   switch (``h <= 2 tau``) plain RK4 is stable and accurate.
 
+Which path a friction law takes is its own declaration
+(:mod:`randvib.friction`): ``stick_slip`` selects the event-located
+integrator (``Fc sgn v``) or its boundary-layer form (``Fc tanh(beta v)``),
+``kernel_relaxation_rate`` the sub-cycling of a law with memory, and
+everything else is RK4 on the law's compiled ``kernel``.
+
 A candidate whose response leaves a sanity bound (``response_limit``) or
 becomes non-finite is stopped and gets an infinite cost / NaN samples.
 """
@@ -65,30 +71,25 @@ import numpy as np
 
 from randvib._validation import check_finite, check_int, check_positive
 from randvib.friction import (
-    KERNEL_COULOMB,
-    KERNEL_LUGRE,
+    FRICTION_MODELS,
     KERNEL_NONE,
-    KERNEL_TANH,
     N_KERNEL_PARAMETERS,
-    friction_force_and_rate,
+    STICK_SLIP_SIGN,
+    STICK_SLIP_TANH,
+    FrictionModel,
+    RegistryView,
+    evaluate_friction,
+    kernel_callback,
 )
+from randvib.harvester import Harvester
 
 #: Input kinds a record may carry, and what the kernel is driven by.
 INPUT_KINDS = ("base_displacement", "base_acceleration", "force")
-#: Friction model names accepted here (``none`` = viscous only).
-FRICTION_KINDS = {
-    "none": KERNEL_NONE,
-    "coulomb": KERNEL_COULOMB,
-    "tanh": KERNEL_TANH,
-    "lugre": KERNEL_LUGRE,
-}
-#: Parameter names per friction model, in kernel order (see randvib.friction).
-FRICTION_PARAMETERS = {
-    "none": (),
-    "coulomb": ("fc",),
-    "tanh": ("fc", "beta"),
-    "lugre": ("sigma0", "sigma1", "fc", "fs", "vs"),
-}
+#: Friction law name -> kernel code (``none`` = viscous only); a live view of
+#: the registry :data:`randvib.friction.FRICTION_MODELS`.
+FRICTION_KINDS = RegistryView(lambda law: KERNEL_NONE if law is None else law.kernel_code)
+#: Friction law name -> parameter names in kernel order (live view, as above).
+FRICTION_PARAMETERS = RegistryView(lambda law: () if law is None else law.parameter_names())
 #: Device parameters shared by every model.
 DEVICE_PARAMETERS = ("m", "c", "k", "k3")
 HOLDS = ("linear", "zero")
@@ -150,26 +151,26 @@ def _creep_velocity(tanh_mode, fc, beta, g):
 
 
 @numba.njit(cache=True)
-def _smooth_rk4(kind, p, m, c, k, k3, gain, u0, du, s, hh, z, v, th):
+def _smooth_rk4(kind, fn, p, m, c, k, k3, gain, u0, du, s, hh, z, v, th):
     e0 = gain * (u0 + du * s)
     e1 = gain * (u0 + du * (s + 0.5 * hh))
     e2 = gain * (u0 + du * (s + hh))
-    f1, r1 = friction_force_and_rate(kind, p, v, th)
+    f1, r1 = evaluate_friction(kind, fn, p, v, th)
     a1 = (e0 - c * v - k * z - k3 * z * z * z - f1) / m
     z2 = z + 0.5 * hh * v
     v2 = v + 0.5 * hh * a1
     t2 = th + 0.5 * hh * r1
-    f2, r2 = friction_force_and_rate(kind, p, v2, t2)
+    f2, r2 = evaluate_friction(kind, fn, p, v2, t2)
     a2 = (e1 - c * v2 - k * z2 - k3 * z2 * z2 * z2 - f2) / m
     z3 = z + 0.5 * hh * v2
     v3 = v + 0.5 * hh * a2
     t3 = th + 0.5 * hh * r2
-    f3, r3 = friction_force_and_rate(kind, p, v3, t3)
+    f3, r3 = evaluate_friction(kind, fn, p, v3, t3)
     a3 = (e1 - c * v3 - k * z3 - k3 * z3 * z3 * z3 - f3) / m
     z4 = z + hh * v3
     v4 = v + hh * a3
     t4 = th + hh * r3
-    f4, r4 = friction_force_and_rate(kind, p, v4, t4)
+    f4, r4 = evaluate_friction(kind, fn, p, v4, t4)
     a4 = (e2 - c * v4 - k * z4 - k3 * z4 * z4 * z4 - f4) / m
     zn = z + hh / 6.0 * (v + 2.0 * v2 + 2.0 * v3 + v4)
     vn = v + hh / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
@@ -204,6 +205,9 @@ def _hermite_root(hh, q0, d0, q1, d1):
 def _run_one(
     par,
     kind,
+    fn,
+    slip,
+    relax_rate,
     base_input,
     u,
     dt,
@@ -238,11 +242,12 @@ def _run_one(
     beta = 0.0
     vb = 0.0
     fstick = 0.0
-    if kind == KERNEL_COULOMB and p[0] > 0.0:
+    # The law declares how the stick-slip integrator reads p (``stick_slip``).
+    if slip == STICK_SLIP_SIGN and p[0] > 0.0:
         sticky = True
         fc = p[0]
         fstick = fc
-    elif kind == KERNEL_TANH and p[0] > 0.0:
+    elif slip == STICK_SLIP_TANH and p[0] > 0.0:
         tau = m / (p[0] * p[1])
         if h > 2.0 * tau:
             sticky = True
@@ -252,12 +257,9 @@ def _run_one(
             xb = max(8.0, 0.5 * math.log(4.0 * h / tau))
             vb = xb / beta
             fstick = fc * math.tanh(xb)
-    lugre_rate = 0.0
-    if kind == KERNEL_LUGRE:
-        lugre_rate = p[0] / max(min(p[2], p[3]), 1e-300)
-    if kind == KERNEL_COULOMB and not sticky:
+    if slip == STICK_SLIP_SIGN and not sticky:
         kind = KERNEL_NONE  # Fc = 0
-    if kind == KERNEL_TANH and p[0] == 0.0:
+    if slip == STICK_SLIP_TANH and p[0] == 0.0:
         kind = KERNEL_NONE
 
     z = z0
@@ -292,8 +294,8 @@ def _run_one(
             b = dt if j == nsub - 1 else a + h
             if not sticky:
                 nc = 1
-                if lugre_rate > 0.0:
-                    nc = int(abs(v) * lugre_rate * (b - a)) + 1
+                if relax_rate > 0.0:
+                    nc = int(abs(v) * relax_rate * (b - a)) + 1
                     if nc > max_sub:
                         # bristles stiffer than the step resolves: rejected as diverged
                         if store:
@@ -304,7 +306,7 @@ def _run_one(
                 hh = (b - a) / nc
                 for q in range(nc):
                     z, v, th = _smooth_rk4(
-                        kind, p, m, c, k, k3, gain, u0, du, a + q * hh, hh, z, v, th
+                        kind, fn, p, m, c, k, k3, gain, u0, du, a + q * hh, hh, z, v, th
                     )
                 continue
             s = a
@@ -389,6 +391,9 @@ def _run_one(
 def _run_batch(
     params,
     kind,
+    fn,
+    slip,
+    relax,
     base_input,
     u,
     dt,
@@ -410,13 +415,13 @@ def _run_batch(
     for i in numba.prange(n_pop):
         if store:
             sse[i] = _run_one(
-                params[i], kind, base_input, u, dt, nsub, linear, z0[i], v0[i], th0[i],
-                zref, skip, zlim, max_sub, out_z[i], out_v[i], True,
+                params[i], kind, fn, slip, relax[i], base_input, u, dt, nsub, linear,
+                z0[i], v0[i], th0[i], zref, skip, zlim, max_sub, out_z[i], out_v[i], True,
             )  # fmt: skip
         else:
             sse[i] = _run_one(
-                params[i], kind, base_input, u, dt, nsub, linear, z0[i], v0[i], th0[i],
-                zref, skip, zlim, max_sub, out_z[0], out_v[0], False,
+                params[i], kind, fn, slip, relax[i], base_input, u, dt, nsub, linear,
+                z0[i], v0[i], th0[i], zref, skip, zlim, max_sub, out_z[0], out_v[0], False,
             )  # fmt: skip
     return sse
 
@@ -510,7 +515,68 @@ class BatchSimulation:
     v: np.ndarray
 
 
-def parameter_matrix(parameters: dict, friction: str) -> np.ndarray:
+def _law(friction):
+    """The law class named ``friction`` (``none``: None); a law class or None passes through."""
+    if friction is None or isinstance(friction, type) and issubclass(friction, FrictionModel):
+        return friction
+    if friction not in FRICTION_KINDS:
+        raise ValueError(f"`friction` must be one of {', '.join(FRICTION_KINDS)}; got {friction!r}")
+    return None if friction == "none" else FRICTION_MODELS[friction]
+
+
+def device_parameters(device, friction=None) -> tuple[dict, str]:
+    """Named record-simulation parameters and friction name of a device.
+
+    The record simulator and identification work with the total viscous
+    damping ``c = c_m + c_e`` (Eq. 1): a record cannot separate the two.
+
+    Parameters
+    ----------
+    device : Harvester or dict
+        A :class:`~randvib.harvester.Harvester` (a preset included); the dict
+        of its :meth:`~randvib.harvester.Harvester.parameters` (``c_m``,
+        ``c_e``, ``friction`` and the friction and circuit parameters); or
+        ``m, c, k, k3`` and the friction parameters, with ``friction``
+        naming the law.
+    friction : str, optional
+        Friction law name; required for the last form, checked against the
+        device's own law for the others.
+
+    Returns
+    -------
+    parameters : dict
+        ``m`` (kg), ``c`` (Ns/m), ``k`` (N/m), ``k3`` (N/m^3) and the law's
+        parameters.
+    friction : str
+    """
+    if isinstance(device, Harvester):
+        params = {"m": device.m, "c": device.c, "k": device.k, "k3": device.k3}
+        if device.friction is not None:
+            params.update(device.friction.parameters())
+        own = device.friction_name
+    elif isinstance(device, dict) and ("c_m" in device or "friction" in device):
+        # Harvester.parameters(): total damping; the circuit's alpha, r_load,
+        # r_coil only explain c_e, which is already in it.
+        params = {k: v for k, v in device.items() if k not in _HARVESTER_ONLY}
+        params["c"] = np.asarray(device.get("c_m", 0.0)) + np.asarray(device.get("c_e", 0.0))
+        own = device.get("friction", "none")
+    else:
+        if friction is None:
+            raise ValueError(
+                "`friction` is required with a parameter dict (m, c, k, k3, ...); "
+                "or pass a randvib.Harvester"
+            )
+        return dict(device), friction
+    if friction is not None and friction != own:
+        raise ValueError(f"`friction` = {friction!r} disagrees with the device's {own!r}")
+    return params, own
+
+
+#: Harvester.parameters() keys that the record simulator does not take.
+_HARVESTER_ONLY = ("c_m", "c_e", "friction", "alpha", "r_load", "r_coil")
+
+
+def parameter_matrix(parameters: dict, friction) -> np.ndarray:
     """Kernel parameter rows ``[m, c, k, k3, friction...]`` from named arrays.
 
     Parameters
@@ -518,12 +584,12 @@ def parameter_matrix(parameters: dict, friction: str) -> np.ndarray:
     parameters : dict
         ``m, c, k, k3`` and the friction parameters (see
         :data:`FRICTION_PARAMETERS`); scalars or 1-D arrays of one length.
-    friction : str
-        One of :data:`FRICTION_KINDS`.
+    friction : str or FrictionModel subclass
+        One of :data:`FRICTION_KINDS`, or a law class.
     """
-    if friction not in FRICTION_KINDS:
-        raise ValueError(f"`friction` must be one of {', '.join(FRICTION_KINDS)}; got {friction!r}")
-    names = DEVICE_PARAMETERS + FRICTION_PARAMETERS[friction]
+    law = _law(friction)
+    friction = "none" if law is None else law.name
+    names = DEVICE_PARAMETERS + (() if law is None else law.parameter_names())
     missing = [name for name in names if name not in parameters]
     if missing:
         raise ValueError(
@@ -565,6 +631,7 @@ def run_kernel(
     max_subcycles=4096,
 ):
     """Low-level batched call; validated arguments. Returns (sse, z, v)."""
+    law = _law(friction)
     n_pop = matrix.shape[0]
     n = drive.shape[0]
     z0 = np.broadcast_to(np.asarray(z0, dtype=float), (n_pop,)).copy()
@@ -576,7 +643,10 @@ def run_kernel(
     out_v = np.empty(shape)
     sse = _run_batch(
         np.ascontiguousarray(matrix),
-        FRICTION_KINDS[friction],
+        KERNEL_NONE if law is None else law.kernel_code,
+        kernel_callback(law),
+        0 if law is None else law.stick_slip,
+        np.zeros(n_pop) if law is None else law.kernel_relaxation_rate(matrix[:, 4:]),
         bool(base_input),
         drive,
         float(dt),
@@ -597,10 +667,10 @@ def run_kernel(
 
 
 def simulate_record(
-    parameters: dict,
-    friction: str,
-    input_values,
-    dt: float,
+    parameters,
+    friction=None,
+    input_values=None,
+    dt: float | None = None,
     *,
     input_kind: str = "base_acceleration",
     substeps: int = 4,
@@ -613,14 +683,22 @@ def simulate_record(
 ) -> BatchSimulation:
     """Simulate Eq. 1 driven by a recorded input, for many parameter sets at once.
 
+    Called as ``simulate_record(harvester, input_values, dt, ...)`` with a
+    :class:`~randvib.harvester.Harvester` (a preset included) or its
+    ``parameters()`` dict, or as ``simulate_record(parameters, friction,
+    input_values, dt, ...)`` with a dict of named parameters.
+
     Parameters
     ----------
-    parameters : dict
-        ``m`` (kg), ``c`` (Ns/m), ``k`` (N/m), ``k3`` (N/m^3) and the friction
-        parameters (``fc`` N; ``beta`` s/m; ``sigma0`` N/m, ``sigma1`` Ns/m,
-        ``fs`` N, ``vs`` m/s); scalars or 1-D arrays (one row per candidate).
-    friction : {'none', 'coulomb', 'tanh', 'lugre'}
-        Friction model (paper Eq. 4-10).
+    parameters : Harvester or dict
+        A device (simulated with c = c_m + c_e), or ``m`` (kg), ``c`` (Ns/m),
+        ``k`` (N/m), ``k3`` (N/m^3) and the friction parameters (``fc`` N;
+        ``beta`` s/m; ``sigma0`` N/m, ``sigma1`` Ns/m, ``fs`` N, ``vs`` m/s;
+        see :data:`FRICTION_PARAMETERS`); scalars or 1-D arrays (one row per
+        candidate).
+    friction : str, optional
+        Friction law name: ``none`` or a registered law (paper Eq. 4-10:
+        ``coulomb``, ``tanh``, ``lugre``); only with a parameter dict.
     input_values : array_like, shape (n,)
         Input samples on the uniform grid ``i dt``: base displacement (m),
         base acceleration (m/s^2) or force on the mass (N).
@@ -642,6 +720,12 @@ def simulate_record(
     -------
     BatchSimulation
     """
+    if not (friction is None or isinstance(friction, str | type)):
+        # simulate_record(device, input_values, dt): the device names its law.
+        friction, input_values, dt = None, friction, input_values
+    parameters, friction = device_parameters(parameters, friction)
+    if input_values is None or dt is None:
+        raise ValueError("`input_values` and `dt` are required")
     dt = float(check_positive("dt", dt, "s"))
     substeps = check_int("substeps", substeps, minimum=1)
     if hold not in HOLDS:

@@ -17,7 +17,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from randvib.friction import friction_force_and_rate
+from randvib.friction import evaluate_friction
 from randvib.rng import seed_path_state, standard_normal
 
 #: Paths advanced together inside one chunk.
@@ -103,13 +103,13 @@ CHECK_EVERY = 256
 
 
 @numba.njit(cache=True, inline="always")
-def _acceleration(z, v, theta, inv_m, c, k, k3, fr_kind, fr_p):
-    force, rate = friction_force_and_rate(fr_kind, fr_p, v, theta)
+def _acceleration(z, v, theta, inv_m, c, k, k3, fr_kind, fr_p, fr_fn):
+    force, rate = evaluate_friction(fr_kind, fr_fn, fr_p, v, theta)
     return -(c * v + k * z + k3 * z * z * z + force) * inv_m, rate, force
 
 
 @numba.njit(cache=True, inline="always")
-def scheme_step(z, v, theta, dt, noise, b1, b2, inv_m, c, k, k3, fr_kind, fr_p):
+def scheme_step(z, v, theta, dt, noise, b1, b2, inv_m, c, k, k3, fr_kind, fr_p, fr_fn):
     """One step of the additive-noise scheme with drift weights ``(b1, b2)``.
 
     The single definition of every integrator's step
@@ -126,13 +126,13 @@ def scheme_step(z, v, theta, dt, noise, b1, b2, inv_m, c, k, k3, fr_kind, fr_p):
     force : float
         Friction force at the start of the step (N), for the accumulators.
     """
-    acc1, rate1, force = _acceleration(z, v, theta, inv_m, c, k, k3, fr_kind, fr_p)
+    acc1, rate1, force = _acceleration(z, v, theta, inv_m, c, k, k3, fr_kind, fr_p, fr_fn)
     if b2 == 0.0:
         return z + b1 * v * dt, v + b1 * acc1 * dt + noise, theta + b1 * rate1 * dt, force
     zp = z + v * dt
     vp = v + acc1 * dt + noise
     tp = theta + rate1 * dt
-    acc2, rate2, _ = _acceleration(zp, vp, tp, inv_m, c, k, k3, fr_kind, fr_p)
+    acc2, rate2, _ = _acceleration(zp, vp, tp, inv_m, c, k, k3, fr_kind, fr_p, fr_fn)
     return (
         z + (b1 * v + b2 * vp) * dt,
         v + (b1 * acc1 + b2 * acc2) * dt + noise,
@@ -147,6 +147,7 @@ def run_ensemble(
     b2,
     fr_kind,
     fr_p,
+    fr_fn,
     m,
     c,
     k,
@@ -181,8 +182,9 @@ def run_ensemble(
     b1, b2 : float
         The integrator's drift weights (:attr:`Integrator.kernel_weights`),
         used by :func:`scheme_step`.
-    fr_kind, fr_p : int, float64[5]
-        Friction kernel code and parameters (:mod:`randvib.friction`).
+    fr_kind, fr_p, fr_fn : int, float64[5], callback
+        Friction kernel code, parameters and compiled callback, from
+        :func:`randvib.friction.kernel_arguments`.
     m, c, k, k3 : float
         Mass (kg), total viscous damping (Ns/m), stiffnesses (N/m, N/m^3).
     noise_amp : float
@@ -270,7 +272,7 @@ def run_ensemble(
                 vj = v[j]
                 tj = th[j]
                 zn, vn, tn, f1 = scheme_step(
-                    zj, vj, tj, dt, noise, b1, b2, inv_m, c, k, k3, fr_kind, fr_p
+                    zj, vj, tj, dt, noise, b1, b2, inv_m, c, k, k3, fr_kind, fr_p, fr_fn
                 )
                 if in_window:
                     if n == n_burn:
@@ -297,7 +299,7 @@ def run_ensemble(
                         a[j, ACC_COMP_V2] += vcj * vcj
                         a[j, ACC_COMP_Z2] += zcj * zcj
                     zc[j], vc[j], _, _ = scheme_step(
-                        zcj, vcj, 0.0, dt, noise, b1, b2, inv_m, c, k, k3, 0, fr_p
+                        zcj, vcj, 0.0, dt, noise, b1, b2, inv_m, c, k, k3, 0, fr_p, fr_fn
                     )
                 if start + j < n_record and (n + 1) % record_every == 0:
                     r = (n + 1) // record_every

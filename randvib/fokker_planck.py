@@ -52,7 +52,6 @@ from scipy.sparse import linalg as sparse_linalg
 
 from randvib._validation import check_int, check_positive
 from randvib.averaging import memoryless_parameters
-from randvib.friction import Coulomb, Tanh
 from randvib.harvester import Harvester
 from randvib.linearisation import equivalent_damping
 
@@ -97,16 +96,14 @@ def _bernoulli(x):
     return np.where(small, 1.0 - 0.5 * x, out)
 
 
-def _friction_potential(v, friction, m):
+def _friction_potential(v, fc, beta, m):
     """int_0^v f(u) du (J/kg^1 per (m/s)): Coulomb f_c |v|; tanh (f_c/beta) log cosh."""
-    if friction is None:
-        return np.zeros_like(v)
-    fcm = friction.fc / m
-    if isinstance(friction, Coulomb):
+    fcm = fc / m
+    if np.isinf(beta):
         return fcm * np.abs(v)
-    y = friction.beta * np.abs(v)
+    y = beta * np.abs(v)
     # log cosh y = y + log1p(exp(-2y)) - log 2, stable for any y >= 0
-    return fcm / friction.beta * (y + np.log1p(np.exp(-2.0 * y)) - np.log(2.0))
+    return fcm / beta * (y + np.log1p(np.exp(-2.0 * y)) - np.log(2.0))
 
 
 def solve_fpk(harvester: Harvester, psd: float, n: int = 200, *, nz=None, nv=None):
@@ -130,15 +127,18 @@ def solve_fpk(harvester: Harvester, psd: float, n: int = 200, *, nz=None, nv=Non
     FPKSolution
     """
     friction = harvester.friction
-    if friction is not None and not isinstance(friction, Coulomb | Tanh):
+    form = (0.0, np.inf) if friction is None else friction.coulomb_tanh_form()
+    if form is None:
+        why = (
+            "has internal state (the density would need a third dimension)"
+            if friction.has_memory
+            else "is not of the form Fc tanh(beta v)"
+        )
         raise ValueError(
             f"the FPK solver needs a memoryless friction law (coulomb, tanh or none); "
-            f"{friction.name!r} has internal state (the density would need a third "
-            "dimension). Use randvib.simulate for it."
+            f"{friction.name!r} {why}. Use randvib.simulate for it."
         )
-    values = [harvester.m, harvester.c, harvester.k, harvester.k3]
-    if friction is not None:
-        values += [getattr(friction, f) for f in ("fc", "beta") if hasattr(friction, f)]
+    values = [harvester.m, harvester.c, harvester.k, harvester.k3, *form]
     if any(np.ndim(v) for v in values) or np.ndim(psd):
         raise ValueError("solve_fpk needs scalar harvester parameters and a scalar `psd`")
     psd = float(check_positive("psd", psd, "(m/s^2)^2/Hz"))
@@ -146,7 +146,7 @@ def solve_fpk(harvester: Harvester, psd: float, n: int = 200, *, nz=None, nv=Non
     nv = check_int("nv", n if nv is None else nv, 8)
     nv += nv % 2
     m, c, k, k3 = (float(x) for x in (harvester.m, harvester.c, harvester.k, harvester.k3))
-    fc = 0.0 if friction is None else float(friction.fc)
+    fc, beta = float(form[0]), float(form[1])
     if c <= 0 and fc <= 0:
         raise ValueError("`c_m + c_e` and `fc` are both 0: no stationary state")
 
@@ -184,7 +184,7 @@ def solve_fpk(harvester: Harvester, psd: float, n: int = 200, *, nz=None, nv=Non
     # The spring force g(z) is constant along v, so -g p is a Liouville flux
     # like v p and gets the same central face value; damping, friction and
     # diffusion get Scharfetter-Gummel fitting on their potential.
-    potential = (2.0 / dd) * (0.5 * gamma * v**2 + _friction_potential(v, friction, m))
+    potential = (2.0 / dd) * (0.5 * gamma * v**2 + _friction_potential(v, fc, beta, m))
     dw = np.broadcast_to(np.diff(potential), (nz, nv - 1))
     coef = 0.5 * dd / hv / hv
     gv = np.broadcast_to(g[:, None], (nz, nv - 1)) * (0.5 / hv)

@@ -10,16 +10,12 @@ model that predicts the mean scores 100 (Eq. 12), J < 5 is a good fit and
 J < 1 excellent. Every generation's population is simulated in one batched,
 compiled call (:mod:`randvib.deterministic`).
 
-Models and their parameters (SI units):
-
-========  ============================================================
-viscous   c (Ns/m), k (N/m), k3 (N/m^3)  -- the paper's "no friction"
-coulomb   + fc (N)                                      (Eq. 4-5)
-tanh      + fc (N), beta (s/m)                          (Eq. 6)
-lugre     + sigma0 (N/m), sigma1 (Ns/m), fc (N), fs (N), vs (m/s)  (Eq. 8-10)
-========  ============================================================
-
-plus the mass ``m`` (kg). With base excitation the mass cannot be identified
+Models: ``viscous`` (c (Ns/m), k (N/m), k3 (N/m^3): the paper's "no
+friction") and one per registered friction law
+(:data:`randvib.friction.FRICTION_MODELS`: ``coulomb`` Eq. 4-5, ``tanh``
+Eq. 6, ``lugre`` Eq. 8-10, and any law defined elsewhere), which adds that
+law's parameters with the units, search bounds and scales it declares; plus
+the mass ``m`` (kg). With base excitation the mass cannot be identified
 (dividing Eq. 1 by m leaves c/m, k/m, k3/m, F/m), so it must be given; with a
 force input it may be left free and is identified.
 
@@ -31,6 +27,7 @@ LuGre's bristle state starts at zero.
 from __future__ import annotations
 
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -38,36 +35,62 @@ import numpy as np
 
 from randvib._validation import check_finite, check_int, check_positive
 from randvib.deterministic import (
-    FRICTION_PARAMETERS,
     HOLDS,
     INPUT_KINDS,
     SEARCH_SUBCYCLES,
+    device_parameters,
     driving_signal,
     parameter_matrix,
     run_kernel,
 )
+from randvib.friction import FRICTION_MODELS, Parameter, RecordScales, RegistryView
 from randvib.sade import sade
 
-#: Identification model name -> friction model of the simulator.
-MODELS = {"viscous": "none", "coulomb": "coulomb", "tanh": "tanh", "lugre": "lugre"}
+#: The device's own parameters (Eq. 1; friction laws declare theirs): unit,
+#: default bounds from the record's scales, log scale (k3 may be zero).
+DEVICE_SPECS = {
+    "m": Parameter("kg", True, lambda s: (0.1 * s.m, 10 * s.m)),
+    "c": Parameter("Ns/m", False, lambda s: (1e-4 * s.c_ref, 2 * s.c_ref)),
+    "k": Parameter("N/m", True, lambda s: (0.1 * s.k_ref, 10 * s.k_ref)),
+    "k3": Parameter("N/m^3", False, lambda s: (0.0, 2 * s.k_ref / s.z_max**2), log=False),
+}
+#: Identification model name -> friction law name of the simulator (live view
+#: of the registry: ``viscous`` is no friction, every law is a model).
+MODELS = RegistryView(lambda law: "none" if law is None else law.name, none_key="viscous")
 #: Parameters of each model, in reporting order (``m`` comes in addition).
-MODEL_PARAMETERS = {
-    name: ("c", "k", "k3") + FRICTION_PARAMETERS[friction] for name, friction in MODELS.items()
-}
-UNITS = {
-    "m": "kg",
-    "c": "Ns/m",
-    "k": "N/m",
-    "k3": "N/m^3",
-    "fc": "N",
-    "beta": "s/m",
-    "sigma0": "N/m",
-    "sigma1": "Ns/m",
-    "fs": "N",
-    "vs": "m/s",
-}
-#: Parameters searched on a log scale (they span decades); k3 may be zero.
-LOG_PARAMETERS = frozenset({"m", "c", "k", "fc", "beta", "sigma0", "sigma1", "fs", "vs"})
+MODEL_PARAMETERS = RegistryView(
+    lambda law: ("c", "k", "k3") + (() if law is None else law.parameter_names()),
+    none_key="viscous",
+)
+
+
+def _specs(model) -> dict[str, Parameter]:
+    """Declarations of every parameter of a model, ``m`` included."""
+    law = _check_model(model)
+    return {**DEVICE_SPECS, **({} if law is None else law.parameter_specs())}
+
+
+class _Units(Mapping):
+    """Parameter name -> unit, from the device's and the laws' declarations."""
+
+    def _table(self):
+        out = {name: spec.unit for name, spec in DEVICE_SPECS.items()}
+        for law in FRICTION_MODELS.values():
+            out.update({name: spec.unit for name, spec in law.parameter_specs().items()})
+        return out
+
+    def __getitem__(self, key):
+        return self._table()[key]
+
+    def __iter__(self):
+        return iter(self._table())
+
+    def __len__(self):
+        return len(self._table())
+
+
+#: Parameter name -> SI unit (live view; a law's own units win in its results).
+UNITS = _Units()
 OUTPUT_COLUMN = "relative_displacement"
 TIME_COLUMN = "time"
 #: Fewest samples per free parameter that a record must have.
@@ -343,7 +366,7 @@ class CostFunction:
     ):
         self.record = record
         self.model = model
-        self.friction = MODELS[model]
+        self.friction = _check_model(model)
         self.fixed = dict(fixed)
         self.free = tuple(free)
         self.substeps = substeps
@@ -437,7 +460,7 @@ def _scales(record: Record, m: float | None):
 
 
 def default_bounds(record: Record, model: str, m: float | None = None) -> dict:
-    """Search bounds derived from the record's own scales.
+    """Search bounds derived from the record's own scales, as each parameter declares.
 
     With the characteristic angular frequency ``w = rms(z')/rms(z)``, the
     largest displacement ``z_max``, the RMS velocity ``v_rms``, the RMS
@@ -456,32 +479,34 @@ def default_bounds(record: Record, model: str, m: float | None = None) -> dict:
     vs      v_rms x [1e-4, 10]                          log
     ======  ==========================================  =====
 
-    These cover the paper's Table 2 for its records; override any of them
-    with ``bounds=`` in :func:`identify` (``--bounds NAME=LO:HI``).
+    The device's rows are :data:`DEVICE_SPECS`, the friction rows the
+    law's own :func:`~randvib.friction.parameter` declarations (the table
+    above is what the built-in laws declare). These cover the paper's
+    Table 2 for its records; override any of them with ``bounds=`` in
+    :func:`identify` (``--bounds NAME=LO:HI``). A parameter declared without
+    default bounds must be fixed or bounded there.
     """
-    _check_model(model)
+    specs = _specs(model)
     omega, z_max, v_rms, force, m_ref = _scales(record, m)
-    k_ref = m_ref * omega**2
-    c_ref = 2 * m_ref * omega
-    table = {
-        "m": (0.1 * m_ref, 10 * m_ref),
-        "c": (1e-4 * c_ref, 2 * c_ref),
-        "k": (0.1 * k_ref, 10 * k_ref),
-        "k3": (0.0, 2 * k_ref / z_max**2),
-        "fc": (1e-4 * force, force),
-        "fs": (1e-4 * force, force),
-        "beta": (1.0 / v_rms, 1e10 / v_rms),
-        "sigma0": (1e-3 * k_ref, 10 * k_ref),
-        "sigma1": (1e-4 * c_ref, 10 * c_ref),
-        "vs": (1e-4 * v_rms, 10 * v_rms),
-    }
+    scales = RecordScales(m=m_ref, omega=omega, z_max=z_max, v_rms=v_rms, force=force)
     names = MODEL_PARAMETERS[model] + (("m",) if m is None else ())
-    return {name: table[name] for name in names}
+    return {
+        name: tuple(float(x) for x in specs[name].search(scales))
+        for name in names
+        if specs[name].search is not None
+    }
 
 
 def _check_model(model):
+    """The friction law class of an identification model (``viscous``: None)."""
     if model not in MODELS:
         raise ValueError(f"`model` must be one of {', '.join(MODELS)}; got {model!r}")
+    return None if model == "viscous" else FRICTION_MODELS[model]
+
+
+def model_of(friction_name: str) -> str:
+    """Identification model of a friction law name (``none`` -> ``viscous``)."""
+    return "viscous" if friction_name == "none" else friction_name
 
 
 # ---------------------------------------------------------------------- identify
@@ -536,7 +561,7 @@ class IdentificationResult:
         return {
             "model": self.model,
             "parameters": {k: float(v) for k, v in self.parameters.items()},
-            "units": {k: UNITS[k] for k in self.parameters},
+            "units": {k: _specs(self.model)[k].unit for k in self.parameters},
             "cost": float(self.cost),
             "free": list(self.free),
             "bounds": {k: [float(a), float(b)] for k, (a, b) in self.bounds.items()},
@@ -561,16 +586,11 @@ class IdentificationResult:
 
     def harvester(self, electrical=None):
         """The identified device as a :class:`randvib.Harvester` (c as c_m)."""
-        from randvib.friction import Coulomb, LuGre, Tanh
         from randvib.harvester import Harvester
 
         p = self.parameters
-        friction = {
-            "viscous": lambda: None,
-            "coulomb": lambda: Coulomb(p["fc"]),
-            "tanh": lambda: Tanh(p["fc"], p["beta"]),
-            "lugre": lambda: LuGre(p["sigma0"], p["sigma1"], p["fc"], p["fs"], p["vs"]),
-        }[self.model]()
+        law = _check_model(self.model)
+        friction = None if law is None else law(**{n: p[n] for n in law.parameter_names()})
         if electrical is None:
             return Harvester(m=p["m"], c_m=p["c"], c_e=0.0, k=p["k"], k3=p["k3"], friction=friction)
         return Harvester.from_electrical(
@@ -655,8 +675,9 @@ def identify(
         base displacement differentiated twice).
     skip : int
         Samples at the start left out of J (initial-condition transient).
-    init : dict, optional
-        A starting guess ``name -> value`` placed in the initial population.
+    init : dict or Harvester, optional
+        A starting guess ``name -> value`` (or a device, a preset included,
+        with c = c_m + c_e) placed in the initial population.
     progress : bool
         Progress bar.
     callback : callable, optional
@@ -692,8 +713,15 @@ def identify(
         if lo > hi:
             raise ValueError(f"`--bounds {name}`: lower {lo!r} > upper {hi!r}")
         box[name] = (lo, hi)
+    unbounded = [name for name in free if name not in box]
+    if unbounded:
+        raise ValueError(
+            f"parameter(s) {unbounded} of model {model!r} declare no default search bounds; "
+            "fix them (`--fix NAME=VALUE`) or bound them (`--bounds NAME=LO:HI`)"
+        )
     box = {name: box[name] for name in free}
-    log = [name in LOG_PARAMETERS and box[name][0] > 0 for name in free]
+    specs = _specs(model)
+    log = [specs[name].log and box[name][0] > 0 for name in free]
     cost = CostFunction(
         record,
         model,
@@ -705,6 +733,8 @@ def identify(
         skip=skip,
     )
     x0 = None
+    if init is not None and not isinstance(init, dict) or isinstance(init, dict) and "c_m" in init:
+        init = device_parameters(init)[0]  # a Harvester (or its parameters()) as the guess
     if init:
         x0 = [[np.clip(init.get(n, np.mean(box[n])), *box[n]) for n in free]]
     user_callback = None
@@ -785,6 +815,28 @@ class Prediction:
     voltage: np.ndarray | None = None
 
 
+def _device_and_model(parameters, model, record):
+    """Accept ``(device, record)`` as well as ``(parameters, model, record)``.
+
+    A device is a :class:`~randvib.harvester.Harvester` (a preset included)
+    or its ``parameters()`` dict; its friction law names the model and its
+    circuit, if any, gives the voltage. Returns (parameters, model, record,
+    circuit).
+    """
+    from randvib.harvester import Harvester
+
+    if record is None and not isinstance(model, str):
+        model, record = None, model
+    circuit = parameters.electrical if isinstance(parameters, Harvester) else None
+    if isinstance(parameters, Harvester) or isinstance(parameters, dict) and "c_m" in parameters:
+        friction = None if model is None else MODELS.get(model, model)
+        parameters, friction = device_parameters(parameters, friction)
+        model = model_of(friction)
+    elif model is None:
+        raise ValueError("`model` is required with a parameter dict; or pass a randvib.Harvester")
+    return parameters, model, record, circuit
+
+
 def _check_parameters(parameters, model):
     _check_model(model)
     names = ("m",) + MODEL_PARAMETERS[model]
@@ -797,9 +849,9 @@ def _check_parameters(parameters, model):
 
 
 def predict(
-    parameters: dict,
-    model: str,
-    record: Record,
+    parameters,
+    model: str | None = None,
+    record: Record | None = None,
     *,
     electrical=None,
     substeps: int = 4,
@@ -809,10 +861,17 @@ def predict(
 ) -> Prediction:
     """Simulate a record with given parameters and score it with J (Eq. 11).
 
+    Called as ``predict(parameters, model, record)`` with identified
+    parameters (total damping ``c``), or as ``predict(device, record)`` with a
+    :class:`~randvib.harvester.Harvester` (a preset included) or its
+    ``parameters()`` dict: the device's law names the model, c = c_m + c_e,
+    and its circuit, if any, gives the load voltage.
+
     ``electrical`` (a :class:`randvib.ElectricalCoupling`) adds the coil's
     damping c_e = alpha^2/(R_L + R_C) (Eq. 3) to the identified c and returns
     the load voltage.
     """
+    parameters, model, record, circuit = _device_and_model(parameters, model, record)
     params = _check_parameters(parameters, model)
     cost = CostFunction(
         record,
@@ -831,8 +890,9 @@ def predict(
     else:
         j = rms = float("inf")
     voltage = None
-    if electrical is not None:
-        voltage = electrical.alpha * v * electrical.load_fraction
+    circuit = electrical if electrical is not None else circuit
+    if circuit is not None:
+        voltage = circuit.alpha * v * circuit.load_fraction
     return Prediction(record=record, z=z, v=v, cost=j, rms_error=rms, voltage=voltage)
 
 
@@ -845,8 +905,15 @@ class ValidationRow:
     samples: int
 
 
-def validate(parameters: dict, model: str, records, **settings) -> list[ValidationRow]:
-    """J (Eq. 11) and RMS error of given parameters on each of several records."""
+def validate(parameters, model, records=None, **settings) -> list[ValidationRow]:
+    """J (Eq. 11) and RMS error of given parameters on each of several records.
+
+    Called as ``validate(parameters, model, records)`` or
+    ``validate(device, records)`` with a Harvester (see :func:`predict`).
+    """
+    if records is None:
+        model, records = None, model
+    parameters, model, _, _ = _device_and_model(parameters, model, records)
     rows = []
     for record in records:
         pred = predict(parameters, model, record, **settings)

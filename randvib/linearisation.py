@@ -28,33 +28,10 @@ from __future__ import annotations
 import numpy as np
 
 from randvib._validation import check_positive
-from randvib.friction import Coulomb
+from randvib.friction import coulomb_equivalent_damping
 from randvib.harvester import Harvester
 
 _BISECTION_STEPS = 200
-
-
-def coulomb_equivalent_damping(c, fc, psd, m):
-    """Closed-form equivalent damping for Coulomb friction, paper Eq. 30 (Ns/m).
-
-    ``c_eq = c + 4 Fc^2/(pi S m) + 1/2 sqrt((2c + 8 Fc^2/(pi S m))^2 - 4 c^2)``
-
-    Parameters
-    ----------
-    c : array_like
-        Viscous damping c_m + c_e (Ns/m).
-    fc : array_like
-        Coulomb friction level (N).
-    psd : array_like
-        One-sided base-acceleration PSD S ((m/s^2)^2/Hz).
-    m : array_like
-        Mass (kg).
-    """
-    c, fc, psd, m = (np.asarray(x, dtype=float) for x in (c, fc, psd, m))
-    a = 4.0 * fc**2 / (np.pi * psd * m)
-    # (2c + 2a)^2 - 4c^2 = 4a(2c + a): written this way it never goes negative
-    # by cancellation when a << c.
-    return c + a + np.sqrt(a * (2.0 * c + a))
 
 
 def _solve_velocity_std(c, m, psd, mean_velocity_force):
@@ -96,7 +73,8 @@ def equivalent_damping(harvester: Harvester, psd, method: str = "auto"):
     psd : array_like
         One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0.
     method : {"auto", "closed-form", "fixed-point"}
-        ``closed-form`` is Eq. 30 (Coulomb or no friction only);
+        ``closed-form`` is the law's closed form where it declares one
+        (Coulomb: Eq. 30; also no friction);
         ``fixed-point`` solves Eq. 19-20 with Gaussian expectations by
         quadrature, for any memoryless odd friction law; ``auto`` picks the
         closed form where it exists.
@@ -112,7 +90,14 @@ def equivalent_damping(harvester: Harvester, psd, method: str = "auto"):
         raise ValueError(
             f"`method` must be one of 'auto', 'closed-form', 'fixed-point'; got {method!r}"
         )
-    closed_form_exists = friction is None or isinstance(friction, Coulomb)
+    c = np.asarray(harvester.c, dtype=float)
+    m = np.asarray(harvester.m, dtype=float)
+    # The law declares its closed form (Coulomb: Eq. 30); none is Eq. 30 with Fc = 0.
+    if friction is None:
+        closed_form = coulomb_equivalent_damping(c, 0.0, psd, m)
+    else:
+        closed_form = friction.closed_form_equivalent_damping(c, psd, m)
+    closed_form_exists = closed_form is not None
     if method == "closed-form" and not closed_form_exists:
         raise ValueError(
             f"`method`='closed-form' (Eq. 30) exists only for Coulomb or no friction, "
@@ -123,11 +108,8 @@ def equivalent_damping(harvester: Harvester, psd, method: str = "auto"):
             f"equivalent linearisation needs a memoryless friction law; {friction.name!r} "
             "has internal state. Use randvib.simulate for it."
         )
-    c = np.asarray(harvester.c, dtype=float)
-    m = np.asarray(harvester.m, dtype=float)
     if closed_form_exists and method != "fixed-point":
-        fc = 0.0 if friction is None else friction.fc
-        result = coulomb_equivalent_damping(c, fc, psd, m)
+        result = closed_form
     else:
         if friction is None:
             mean_vf = lambda s: 0.0 * s  # noqa: E731 - viscous only

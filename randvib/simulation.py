@@ -27,6 +27,7 @@ from scipy import special  # Student t quantile; lighter than scipy.stats
 
 from randvib import engine, exact
 from randvib._validation import check_choice, check_int, check_positive
+from randvib.friction import kernel_arguments
 from randvib.harvester import Harvester
 from randvib.integrators import integrator
 from randvib.linearisation import equivalent_damping, linear_displacement_variance
@@ -482,9 +483,7 @@ def simulate(
     if check_step:
         _check_step(method, harvester, psd, dt)
 
-    friction = harvester.friction
-    fr_kind = 0 if friction is None else friction.kernel_code
-    fr_p = np.zeros(5) if friction is None else friction.kernel_parameters()
+    fr_kind, fr_p, fr_fn = kernel_arguments(harvester.friction)
 
     # Initial state.
     if isinstance(initial, str):
@@ -554,6 +553,7 @@ def simulate(
                 *scheme.kernel_weights,
                 fr_kind,
                 fr_p,
+                fr_fn,
                 float(harvester.m),
                 float(harvester.c),
                 float(harvester.k),

@@ -103,15 +103,15 @@ MUTATIONS: tuple[Mutation, ...] = (
         name="coulomb-force-in-kernel",
         path="randvib/friction.py",
         edits=(
-            ("            return p[0], 0.0\n", "            return 1.01 * p[0], 0.0\n"),
-            ("            return -p[0], 0.0\n", "            return -1.01 * p[0], 0.0\n"),
+            ("        return p[0], 0.0\n", "        return 1.01 * p[0], 0.0\n"),
+            ("        return -p[0], 0.0\n", "        return -1.01 * p[0], 0.0\n"),
         ),
         tests=("tests/test_simulation.py",),
         why="The compiled Coulomb force is 1 % too strong in the kernels.",
     ),
     Mutation(
         name="linearisation-constant",
-        path="randvib/linearisation.py",
+        path="randvib/friction.py",
         edits=(
             (
                 "a = 4.0 * fc**2 / (np.pi * psd * m)",

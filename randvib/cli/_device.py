@@ -4,11 +4,21 @@ from __future__ import annotations
 
 import argparse
 
-from randvib.friction import Coulomb, Tanh
+from randvib.friction import FRICTION_MODELS, RegistryView
 from randvib.harvester import Harvester
 from randvib.presets import PRESETS, preset
 
-FRICTION_CHOICES = ("none", "coulomb", "tanh")
+#: ``--friction`` choices: ``none`` and every registered law (live view).
+FRICTION_CHOICES = RegistryView(lambda law: law)
+
+
+def _friction_options() -> dict[str, list]:
+    """Parameter name -> the laws declaring it, over the registered laws."""
+    out: dict[str, list] = {}
+    for law in FRICTION_MODELS.values():
+        for name in law.parameter_names():
+            out.setdefault(name, []).append(law)
+    return out
 
 
 def add_device_arguments(parser: argparse.ArgumentParser) -> None:
@@ -23,8 +33,14 @@ def add_device_arguments(parser: argparse.ArgumentParser) -> None:
     g.add_argument("--k", type=float, help="linear stiffness (N/m)")
     g.add_argument("--k3", type=float, help="cubic stiffness (N/m^3)")
     g.add_argument("--friction", help=f"friction model: {', '.join(FRICTION_CHOICES)}")
-    g.add_argument("--fc", type=float, help="friction level Fc (N)")
-    g.add_argument("--beta", type=float, help="tanh sharpness beta (s/m)")
+    # One option per friction parameter, as the laws declare them.
+    for name, laws in _friction_options().items():
+        spec = laws[0].parameter_specs()[name]
+        g.add_argument(
+            "--" + name.replace("_", "-"),
+            type=float,
+            help=f"{spec.description or name} ({spec.unit}); {', '.join(law.name for law in laws)}",
+        )
     g.add_argument(
         "--alpha", type=float, help="flux gradient (Wb/m), with --r-load/--r-coil instead of --c-e"
     )
@@ -49,35 +65,7 @@ def harvester_from_args(args) -> Harvester:
         if given is not None:
             values[name] = given
 
-    if args.friction is not None:
-        if args.friction not in FRICTION_CHOICES:
-            raise ValueError(
-                f"`--friction` must be one of {', '.join(FRICTION_CHOICES)}; got {args.friction!r}"
-            )
-        if args.friction == "none":
-            friction = None
-        elif args.friction == "coulomb":
-            fc = args.fc if args.fc is not None else getattr(friction, "fc", None)
-            friction = Coulomb(_need(fc, "--fc", "coulomb friction"))
-        else:
-            fc = args.fc if args.fc is not None else getattr(friction, "fc", None)
-            beta = args.beta if args.beta is not None else getattr(friction, "beta", None)
-            friction = Tanh(
-                _need(fc, "--fc", "tanh friction"), _need(beta, "--beta", "tanh friction")
-            )
-    elif friction is not None and (args.fc is not None or args.beta is not None):
-        changes = {}
-        if args.fc is not None:
-            changes["fc"] = args.fc
-        if args.beta is not None:
-            if not isinstance(friction, Tanh):
-                raise ValueError(f"`--beta` applies to tanh friction, not {friction.name!r}")
-            changes["beta"] = args.beta
-        friction = type(friction)(**{**friction.parameters(), **changes})
-    elif friction is None and (args.fc is not None or args.beta is not None):
-        raise ValueError(
-            "`--fc`/`--beta` need `--friction coulomb|tanh` (or a preset with friction)"
-        )
+    friction = _friction_from_args(args, friction)
 
     circuit = [args.alpha, args.r_load, args.r_coil]
     if any(x is not None for x in circuit):
@@ -100,6 +88,34 @@ def harvester_from_args(args) -> Harvester:
     for name in ("m", "c_m", "c_e", "k"):
         _need(values[name], "--" + name.replace("_", "-"), "the device (or use --preset)")
     return Harvester(friction=friction, **values)
+
+
+def _friction_from_args(args, friction):
+    """The friction law from ``--friction`` and its parameter options (over a preset's)."""
+    options = _friction_options()
+    given = {n: getattr(args, n) for n in options if getattr(args, n, None) is not None}
+    if args.friction is not None:
+        if args.friction not in FRICTION_CHOICES:
+            raise ValueError(
+                f"`--friction` must be one of {', '.join(FRICTION_CHOICES)}; got {args.friction!r}"
+            )
+        if args.friction == "none":
+            return None
+        law = FRICTION_MODELS[args.friction]
+        # A parameter not given keeps the preset's value where its law has it.
+        values = {n: given.get(n, getattr(friction, n, None)) for n in law.parameter_names()}
+        return law(**{n: _need(x, "--" + n, f"{law.name} friction") for n, x in values.items()})
+    if not given:
+        return friction
+    if friction is None:
+        flags = "/".join(f"`--{n}`" for n in given)
+        laws = sorted({law.name for n in given for law in options[n]})
+        raise ValueError(f"{flags} need `--friction {'|'.join(laws)}` (or a preset with friction)")
+    for name in given:
+        if name not in friction.parameter_names():
+            laws = ", ".join(law.name for law in options[name])
+            raise ValueError(f"`--{name}` applies to {laws} friction, not {friction.name!r}")
+    return type(friction)(**{**friction.parameters(), **given})
 
 
 def require_psd(args) -> float:
