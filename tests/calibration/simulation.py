@@ -8,9 +8,15 @@ For every exact comparison (``case_*`` in the test module) it reruns the
 statistic over seeds 1000, 1001, ... and prints, per assertion, the number of
 seeds, the mean and standard deviation of the z-scores and the largest |z|
 (calibrated: mean near 0, SD near 1, no |z| above 4), plus the smallest power
-margin (detect * |reference| / standard error, which must be >= 6). For the
+margin (detect * |reference| / standard error, which must be >= 6). For
+test_rng.py it prints the spread of each z-score (the KS p-value and the
+largest pair correlation, in units of 1/sqrt(n), as they are). For the
 coverage test it prints the hit fractions against the binomial acceptance
 region, and for the control-variate gain the smallest ratio.
+
+Usage: ``simulation.py N [name ...]`` runs N seeds (fewer for the slow
+cases) for the named groups only (linear, load, scheme-em, scheme-heun,
+gibbs, balance, lugre, rng, gain, coverage).
 """
 
 from __future__ import annotations
@@ -59,6 +65,17 @@ def main():
         if only and name not in only:
             continue
         calibrate(name, case, range(1000, 1000 + max(20, int(n * share))))
+    if not only or "rng" in only:
+        import test_rng
+
+        rows = [test_rng.rng_z_scores(s) for s in range(1000, 1000 + max(20, 2 * n))]
+        for key in rows[0]:
+            v = np.array([r[key] for r in rows])
+            print(
+                f"rng          {key:25s} seeds {v.size}  mean {v.mean():+.3f}  SD {v.std(ddof=1):.3f}  "
+                f"min {v.min():.3g}  max {v.max():.3g}",
+                flush=True,
+            )
     if not only or "gain" in only:
         gains = [t.case_control_variate_gain(s) for s in range(1000, 1000 + max(20, n // 2))]
         print(
