@@ -97,8 +97,10 @@ def estimate(samples, controls=None, folds: int = 4) -> Statistic:
         groups. The residuals are then independent of their own coefficients,
         so the estimate is unbiased and its half-width (from the residuals'
         spread) honest even with many controls and few paths; fitting beta on
-        the same paths under-reports the error (in-sample overfitting, checked
-        over repeated seeds in the tests).
+        the same paths under-reports the error (in-sample overfitting). The
+        empirical coverage of the 95 % interval, and the under-coverage of
+        in-sample fitting, are checked over thousands of repeated estimations
+        in ``tests/test_simulation.py::test_cross_fitted_intervals_cover_at_95_percent``.
     folds : int
         Number of cross-fitting groups (>= 2).
     """
