@@ -19,7 +19,7 @@ from randvib.deterministic import simulate_record
 from randvib.excitation import band_limited_excitation
 from randvib.identification import MODELS, Record
 
-#: Paper Table 2, Coulomb model, training data 1 (m from CONVENTIONS.md).
+#: Paper Table 2, Coulomb model, training data 1 (m from docs/conventions.md).
 COULOMB = dict(m=0.0226, c=0.049, k=57.4, k3=70742.0, fc=0.0058)
 #: Fourth-order one-sided first derivative at the first sample, times 12 dt.
 VELOCITY_STENCIL = np.array([-25.0, 48.0, -36.0, 16.0, -3.0]) / 12.0

@@ -157,7 +157,7 @@ def case_load_power(seed):
 def lugre_reference(device, psd, dw, dt, n_burn, initial):
     """Stochastic Heun for (z, v, theta) with LuGre friction, in plain numpy.
 
-    Written from CONVENTIONS.md (theta' = v - |v| theta / g(v), F = sigma0
+    Written from docs/conventions.md (theta' = v - |v| theta / g(v), F = sigma0
     theta + sigma1 theta', sigma0 g = Fc + (Fs - Fc) exp(-(v/vs)^2)), not from
     the package's friction code. Returns per-path window means of v^2, z^2, v F.
     """
@@ -284,7 +284,7 @@ def test_duffing_without_friction_matches_gibbs_density():
 
 
 def test_energy_balance_identity_with_coulomb_and_duffing():
-    """c E[v^2] + Fc E|v| = S m / 4 exactly, any k3 (CONVENTIONS.md), declared Fc.
+    """c E[v^2] + Fc E|v| = S m / 4 exactly, any k3 (docs/conventions.md), declared Fc.
 
     Detects a 1 % error in the friction force applied by the kernel (about
     0.5 % of the balance). Calibration: 100 seeds, z mean -0.06, SD 0.97,
