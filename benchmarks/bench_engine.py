@@ -26,7 +26,7 @@ import sdeint
 from conftest import TIMINGS, record, write_report
 
 import randvib as rv
-from randvib.simulation import simulate
+from randvib.montecarlo.simulation import simulate
 
 DEVICE = rv.preset("figure9").updated(k3=5e5)
 PSD, DT, N_PATHS, N_STEPS = 1.0, 1e-4, 10_000, 1_000
@@ -109,7 +109,7 @@ MEMORY_SCRIPT = textwrap.dedent(
     """
     import sys
     import randvib as rv
-    from randvib.simulation import simulate
+    from randvib.montecarlo.simulation import simulate
 
     def status(field):  # kB -> MB, from /proc/self/status
         for line in open("/proc/self/status"):

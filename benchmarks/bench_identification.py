@@ -20,10 +20,15 @@ import time
 
 import numpy as np
 
-from randvib.deterministic import driving_signal, parameter_matrix, run_kernel, simulate_record
-from randvib.excitation import band_limited_excitation
-from randvib.identification import CostFunction, Record, default_bounds, identify
-from randvib.sade import _Space, sade
+from randvib.identification.fitting import CostFunction, Record, default_bounds, identify
+from randvib.identification.record_simulation import (
+    driving_signal,
+    parameter_matrix,
+    run_kernel,
+    simulate_record,
+)
+from randvib.identification.sade import _Space, sade
+from randvib.models.excitation import band_limited_excitation
 
 TRUE = dict(m=0.0226, c=0.049, k=57.4, k3=70742.0, fc=0.0058)
 

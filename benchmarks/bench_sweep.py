@@ -17,7 +17,7 @@ import pandas as pd
 from conftest import write_report
 
 import randvib as rv
-from randvib.simulation import estimate, simulate
+from randvib.montecarlo.simulation import estimate, simulate
 
 BASE = rv.preset("figure9")
 KW = dict(t_end=2.5, dt=1e-4, burn_in=0.5, seed=3, companion=True, progress=False)

@@ -14,27 +14,27 @@ __version__ = "0.1.0"
 
 #: Submodule -> public names it provides, re-exported here.
 _EXPORTS = {
-    "randvib.averaging": (
+    "randvib.analytic.averaging": (
         "averaging_statistics",
         "AveragingValidityWarning",
         "energy_density",
         "orbit_averages",
     ),
-    "randvib.deterministic": ("BatchSimulation", "simulate_record"),
-    "randvib.excitation": ("band_limited_excitation", "BaseExcitation"),
-    "randvib.fokker_planck": ("fast_fpk_statistics", "fpk_statistics", "solve_fpk"),
-    "randvib.friction": ("Coulomb", "FrictionModel", "LuGre", "Tanh"),
-    "randvib.harvester": ("ElectricalCoupling", "Harvester"),
-    "randvib.identification": (
+    "randvib.identification.record_simulation": ("BatchSimulation", "simulate_record"),
+    "randvib.models.excitation": ("band_limited_excitation", "BaseExcitation"),
+    "randvib.analytic.fokker_planck": ("fast_fpk_statistics", "fpk_statistics", "solve_fpk"),
+    "randvib.models.friction": ("Coulomb", "FrictionModel", "LuGre", "Tanh"),
+    "randvib.models.harvester": ("ElectricalCoupling", "Harvester"),
+    "randvib.identification.fitting": (
         "IdentificationResult",
         "identify",
         "normalised_cost",
         "read_record",
         "Record",
     ),
-    "randvib.integrators": ("Integrator", "INTEGRATORS"),
-    "randvib.linearisation": ("coulomb_equivalent_damping", "equivalent_damping"),
-    "randvib.prediction": (
+    "randvib.montecarlo.integrators": ("Integrator", "INTEGRATORS"),
+    "randvib.analytic.linearisation": ("coulomb_equivalent_damping", "equivalent_damping"),
+    "randvib.analytic.prediction": (
         "expected_power",
         "METHODS",
         "optimal_load_resistance",
@@ -43,9 +43,9 @@ _EXPORTS = {
         "predict",
         "velocity_variance",
     ),
-    "randvib.presets": ("MAGNET_MASS", "preset", "PRESETS"),
-    "randvib.sade": ("sade", "SADEResult"),
-    "randvib.simulation": (
+    "randvib.models.presets": ("MAGNET_MASS", "preset", "PRESETS"),
+    "randvib.identification.sade": ("sade", "SADEResult"),
+    "randvib.montecarlo.simulation": (
         "simulate",
         "SimulationDivergedError",
         "SimulationResult",

@@ -19,7 +19,7 @@ import sys
 from pathlib import Path
 
 from randvib.datasets import silverbox
-from randvib.identification import identify, predict
+from randvib.identification.fitting import identify, predict
 
 
 def main(out_dir, quick=False):

@@ -46,7 +46,7 @@ def assert_matches(
 
     Parameters
     ----------
-    stat : randvib.simulation.Statistic
+    stat : randvib.montecarlo.simulation.Statistic
         Estimate with its standard error.
     reference : float
         The independent value it must equal.

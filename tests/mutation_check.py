@@ -74,7 +74,7 @@ class Mutation:
 MUTATIONS: tuple[Mutation, ...] = (
     Mutation(
         name="noise-variance",
-        path="randvib/engine.py",
+        path="randvib/montecarlo/kernel.py",
         edits=(
             (
                 "dwj = sqdt * standard_normal(rng, j, ki, wi, fi)",
@@ -87,7 +87,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="control-variate-mean",
-        path="randvib/simulation.py",
+        path="randvib/montecarlo/simulation.py",
         edits=(
             (
                 "residual[test] = y[test] - x[test] @ coef[1:]",
@@ -101,7 +101,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="coulomb-force-in-kernel",
-        path="randvib/friction.py",
+        path="randvib/models/friction.py",
         edits=(
             ("        return p[0], 0.0\n", "        return 1.01 * p[0], 0.0\n"),
             ("        return -p[0], 0.0\n", "        return -1.01 * p[0], 0.0\n"),
@@ -112,7 +112,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="linearisation-constant",
-        path="randvib/friction.py",
+        path="randvib/models/friction.py",
         edits=(
             (
                 "a = 4.0 * fc**2 / (np.pi * psd * m)",
@@ -125,7 +125,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="heun-corrector-weight",
-        path="randvib/integrators.py",
+        path="randvib/montecarlo/integrators.py",
         edits=(
             (
                 'HEUN = Integrator("heun", 1.0, 2.0, "stratonovich", (0.5, 0.5))',
@@ -138,7 +138,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="tanh-force-in-kernel",
-        path="randvib/friction.py",
+        path="randvib/models/friction.py",
         edits=(
             (
                 "return p[0] * np.tanh(p[1] * v), 0.0",
@@ -151,7 +151,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="lugre-damping-in-kernel",
-        path="randvib/friction.py",
+        path="randvib/models/friction.py",
         edits=(
             (
                 "return p[0] * theta + p[1] * rate, rate",
@@ -163,7 +163,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="gibbs-reference",
-        path="randvib/exact.py",
+        path="randvib/analytic/exact_solutions.py",
         edits=(("0.25 * eps * x**4", "0.2525 * eps * x**4"),),
         tests=("tests/test_fokker_planck.py",),
         why="The exact Gibbs density's quartic term 1 % too strong: the reference that "
@@ -171,7 +171,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="eq11-cost-normalisation",
-        path="randvib/identification.py",
+        path="randvib/identification/fitting.py",
         edits=(
             (
                 "return 100.0 * sse / (self.n_scored * self.variance)",
@@ -183,7 +183,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="fpk-richardson-weight",
-        path="randvib/fokker_planck.py",
+        path="randvib/analytic/fokker_planck.py",
         edits=(
             (
                 "out[(row,) + index] = (4.0 * a_f - a_c) / 3.0",
@@ -195,7 +195,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="load-power-share",
-        path="randvib/harvester.py",
+        path="randvib/models/harvester.py",
         edits=(
             (
                 "return self.r_load / (self.r_load + self.r_coil)",
@@ -208,7 +208,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="identification-mass",
-        path="randvib/identification.py",
+        path="randvib/identification/fitting.py",
         edits=(
             (
                 "        fixed=fixed,\n",
@@ -223,7 +223,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="initial-velocity-zeroed",
-        path="randvib/identification.py",
+        path="randvib/identification/fitting.py",
         edits=(
             (
                 "self.v0 = float(initial_velocity(record.z, record.dt))",
@@ -238,7 +238,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="initial-displacement-zeroed",
-        path="randvib/identification.py",
+        path="randvib/identification/fitting.py",
         edits=(("self.z0 = float(record.z[0])", "self.z0 = 0.0"),),
         tests=(
             "tests/test_identification.py::test_true_parameters_score_the_residual_of_the_initial_state",
@@ -247,7 +247,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="cost-counts-skipped-samples",
-        path="randvib/identification.py",
+        path="randvib/identification/fitting.py",
         edits=(("self.n_scored = scored.size", "self.n_scored = record.n"),),
         tests=(
             "tests/test_identification.py::test_noisy_record_within_linearised_standard_errors",
@@ -290,7 +290,7 @@ def _imported_modules(path: Path, module: str, known: set[str]) -> set[str]:
         else:
             continue
         for name in names:
-            # "randvib.engine.run_ensemble" imports randvib.engine (and randvib)
+            # "randvib.montecarlo.kernel.run_ensemble" imports randvib.montecarlo.kernel (and randvib)
             while name:
                 if name in known:
                     found.add(name)

@@ -1,4 +1,4 @@
-"""Stochastic averaging (randvib.averaging): exact limits, identities, validation."""
+"""Stochastic averaging (randvib.analytic.averaging): exact limits, identities, validation."""
 
 import warnings
 
@@ -9,8 +9,8 @@ from hypothesis import strategies as st
 from scipy import integrate, optimize
 
 import randvib as rv
-from randvib.averaging import AVERAGING_ZETA_LIMIT, averaging_statistics, orbit_averages
-from randvib.exact import gibbs_displacement_moment
+from randvib.analytic.averaging import AVERAGING_ZETA_LIMIT, averaging_statistics, orbit_averages
+from randvib.analytic.exact_solutions import gibbs_displacement_moment
 
 BASE = rv.preset("figure9")  # m = 0.0226, c = 0.2, k = 57.4, k3 = 70742, Fc = 0.0058
 K3_GRID = (0.0, 7.07e4, 5e5, 7e6)

@@ -1,12 +1,12 @@
-"""Deterministic simulator of recorded input (randvib.deterministic)."""
+"""Deterministic simulator of recorded input (randvib.identification.record_simulation)."""
 
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from randvib.deterministic import second_derivative, simulate_record
-from randvib.excitation import band_limited_excitation
+from randvib.identification.record_simulation import second_derivative, simulate_record
+from randvib.models.excitation import band_limited_excitation
 
 DUFFING = dict(m=0.0226, c=0.049, k=57.4, k3=70742.0)
 

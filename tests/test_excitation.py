@@ -1,9 +1,9 @@
-"""Band-limited base excitation (randvib.excitation)."""
+"""Band-limited base excitation (randvib.models.excitation)."""
 
 import numpy as np
 import pytest
 
-from randvib.excitation import band_limited_excitation
+from randvib.models.excitation import band_limited_excitation
 
 
 def test_rms_and_band():

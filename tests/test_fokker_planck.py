@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 import randvib as rv
-from randvib.averaging import AVERAGING_ZETA_LIMIT, averaging_statistics
-from randvib.exact import gibbs_displacement_moment
-from randvib.fokker_planck import fast_fpk_statistics, fpk_statistics, solve_fpk
+from randvib.analytic.averaging import AVERAGING_ZETA_LIMIT, averaging_statistics
+from randvib.analytic.exact_solutions import gibbs_displacement_moment
+from randvib.analytic.fokker_planck import fast_fpk_statistics, fpk_statistics, solve_fpk
 
 BASE = rv.preset("figure9")
 
@@ -106,7 +106,7 @@ def test_fpk_agrees_with_monte_carlo():
         h, psd, t_end=60.0, dt=5e-4, n_paths=64, burn_in=2.0, seed=3, companion=True,
         control_variates=True, progress=False,
     )  # fmt: skip
-    from randvib.simulation import step_bias
+    from randvib.montecarlo.simulation import step_bias
 
     bias = abs(step_bias("heun", h, psd, 5e-4)) * ref[0]
     vv = mc.velocity_variance
@@ -214,7 +214,7 @@ def test_fast_fpk_tanh_limits_and_box_growth(monkeypatch):
     sharp = fast_fpk_statistics(BASE.updated(friction=rv.Tanh(0.03, 4.8e8)), 0.5)
     np.testing.assert_allclose(sharp, coulomb, rtol=1e-9)
     # A box far too small is detected by the mass in its outer cells and grown.
-    from randvib import fokker_planck
+    from randvib.analytic import fokker_planck
 
     h = BASE.updated(fc=0.03, k3=7e6)
     good = fast_fpk_statistics(h, 0.5)

@@ -4,7 +4,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 import randvib as rv
-from randvib.friction import friction_force_and_rate
+from randvib.models.friction import friction_force_and_rate
 
 
 def test_coulomb_sign_convention_zero_at_rest():

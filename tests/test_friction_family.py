@@ -38,10 +38,10 @@ from scipy import integrate
 
 import randvib as rv
 from randvib.cli._device import FRICTION_CHOICES
-from randvib.deterministic import FRICTION_PARAMETERS, simulate_record
-from randvib.excitation import band_limited_excitation
-from randvib.friction import FRICTION_MODELS, parameter
-from randvib.identification import MODELS, Record, default_bounds, identify, predict
+from randvib.identification.fitting import MODELS, Record, default_bounds, identify, predict
+from randvib.identification.record_simulation import FRICTION_PARAMETERS, simulate_record
+from randvib.models.excitation import band_limited_excitation
+from randvib.models.friction import FRICTION_MODELS, parameter
 
 
 @dataclass(frozen=True, eq=False)

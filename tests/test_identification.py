@@ -1,4 +1,4 @@
-"""Identification of friction models (randvib.identification, CLI identify/validate)."""
+"""Identification of friction models (randvib.identification.fitting, CLI identify/validate)."""
 
 import json
 from types import SimpleNamespace
@@ -9,9 +9,7 @@ import pytest
 from _stats import assert_matches
 
 from randvib.cli import main
-from randvib.deterministic import simulate_record
-from randvib.excitation import band_limited_excitation
-from randvib.identification import (
+from randvib.identification.fitting import (
     Record,
     default_bounds,
     identify,
@@ -21,6 +19,8 @@ from randvib.identification import (
     read_record,
     validate,
 )
+from randvib.identification.record_simulation import simulate_record
+from randvib.models.excitation import band_limited_excitation
 
 COULOMB = H.COULOMB
 TRUE = COULOMB

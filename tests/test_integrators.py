@@ -8,7 +8,7 @@ what the schemes are.
 import numpy as np
 import pytest
 
-from randvib.integrators import EULER_MARUYAMA, HEUN, INTEGRATORS, integrator
+from randvib.montecarlo.integrators import EULER_MARUYAMA, HEUN, INTEGRATORS, integrator
 
 
 @pytest.mark.parametrize("scheme", list(INTEGRATORS.values()), ids=list(INTEGRATORS))

@@ -1,6 +1,7 @@
 """The README's quick start and CI stay in step."""
 
 import re
+import shutil
 import subprocess
 from pathlib import Path
 
@@ -26,3 +27,11 @@ def test_ci_runs_the_readme_test_command():
     awk = re.search(r"cmd=\$\((awk .*?README\.md) \| sed -n 2p\)", script).group(1)
     extracted = subprocess.run(["bash", "-c", awk], cwd=ROOT, capture_output=True, text=True).stdout
     assert extracted.splitlines()[1] == quick_start_commands()[1]
+
+
+def test_import_layers_hold():
+    """The layer contract in pyproject.toml ([tool.importlinter]) is kept."""
+    exe = shutil.which("lint-imports")
+    assert exe is not None, "import-linter is a test dependency: pip install -e '.[test]'"
+    proc = subprocess.run([exe], cwd=ROOT, capture_output=True, text=True, check=False)
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-2000:]

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from randvib.rng import path_normals
+from randvib.montecarlo.rng import path_normals
 
 ZIG_R = 3.6541528853610088  # start of the ziggurat's tail
 N_PAIRS_PATHS = 200

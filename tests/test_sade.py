@@ -1,9 +1,9 @@
-"""Self-adaptive differential evolution (randvib.sade)."""
+"""Self-adaptive differential evolution (randvib.identification.sade)."""
 
 import numpy as np
 import pytest
 
-from randvib.sade import sade
+from randvib.identification.sade import sade
 
 
 def sphere(x):

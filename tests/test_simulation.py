@@ -26,9 +26,15 @@ from _stats import assert_matches
 from scipy import special, stats
 
 import randvib as rv
-from randvib import exact
-from randvib.integrators import INTEGRATORS
-from randvib.simulation import SimulationDivergedError, StepSizeWarning, estimate, simulate
+from randvib.analytic import exact_solutions as exact
+from randvib.montecarlo import integrators
+from randvib.montecarlo.integrators import INTEGRATORS
+from randvib.montecarlo.simulation import (
+    SimulationDivergedError,
+    StepSizeWarning,
+    estimate,
+    simulate,
+)
 
 LINEAR = rv.Harvester(m=0.0226, c_m=0.1, c_e=0.1, k=57.4)
 DUFFING_COULOMB = rv.preset("figure9").updated(k3=5e5)
@@ -62,7 +68,7 @@ def case_linear_continuous(seed):
     )
     vv = exact.linear_velocity_variance(h.m, h.c, psd)
     zz = exact.linear_displacement_variance(h.m, h.c, h.k, psd)
-    cov = exact.scheme_stationary_covariance("heun", h.m, h.c, h.k, psd, dt)
+    cov = integrators.scheme_stationary_covariance("heun", h.m, h.c, h.k, psd, dt)
     return [
         ("E[v^2]", r.velocity_variance, vv, cov[1, 1] - vv, DETECT),
         ("E[z^2]", r.displacement_variance, zz, cov[0, 0] - zz, DETECT),
@@ -76,7 +82,7 @@ SCHEME_DEVICE = rv.Harvester(m=1.0, c_m=1.0, c_e=0.0, k=4.0)
 def case_scheme_discrete(method, seed):
     """Each scheme at a coarse step against its exact discrete stationary covariance."""
     dt, psd = 0.05, 2.0
-    cov = exact.scheme_stationary_covariance(method, 1.0, 1.0, 4.0, psd, dt)
+    cov = integrators.scheme_stationary_covariance(method, 1.0, 1.0, 4.0, psd, dt)
     r = simulate(
         SCHEME_DEVICE,
         psd,
@@ -149,7 +155,7 @@ def case_load_power(seed):
         h, psd, t_end=4.0, dt=dt, n_paths=512, burn_in=0.5, seed=seed, control_variates=True
     )
     vv = exact.linear_velocity_variance(h.m, h.c, psd)
-    cov = exact.scheme_stationary_covariance("heun", h.m, h.c, h.k, psd, dt)
+    cov = integrators.scheme_stationary_covariance("heun", h.m, h.c, h.k, psd, dt)
     factor = e.r_load * e.alpha**2 / (e.r_load + e.r_coil) ** 2
     return [("E[P_L]", r.power_load, factor * vv, factor * (cov[1, 1] - vv), DETECT)]
 
@@ -382,7 +388,7 @@ def simulation_coverage(seed, groups=600, group_size=24):
     ``group_size`` paths; the reference is the exact discrete stationary value.
     """
     dt, psd = 0.05, 2.0
-    cov = exact.scheme_stationary_covariance("heun", 1.0, 1.0, 4.0, psd, dt)
+    cov = integrators.scheme_stationary_covariance("heun", 1.0, 1.0, 4.0, psd, dt)
     r = simulate(
         SCHEME_DEVICE,
         psd,
@@ -460,7 +466,9 @@ def _sde_functions(device, psd):
     return f, g
 
 
-@pytest.mark.filterwarnings("ignore::randvib.simulation.StepSizeWarning")  # EM at 1e-4 on purpose
+@pytest.mark.filterwarnings(
+    "ignore::randvib.montecarlo.simulation.StepSizeWarning"
+)  # EM at 1e-4 on purpose
 @pytest.mark.parametrize(
     ("method", "reference"), [("euler-maruyama", sdeint.itoEuler), ("heun", sdeint.stratHeun)]
 )
@@ -543,7 +551,9 @@ def test_weak_order_of_stationary_variance_bias(method, order):
     # Lyapunov): it must fall like dt^weak_order.
     dts = np.array([2e-3, 1e-3, 5e-4, 2.5e-4])
     bias = [
-        abs(exact.scheme_stationary_covariance(method, 1.0, 0.5, 4.0, 1.0, dt)[1, 1] / 0.5 - 1)
+        abs(
+            integrators.scheme_stationary_covariance(method, 1.0, 0.5, 4.0, 1.0, dt)[1, 1] / 0.5 - 1
+        )
         for dt in dts
     ]
     slope = np.polyfit(np.log(dts), np.log(bias), 1)[0]

@@ -13,7 +13,8 @@ import pandas as pd
 import pytest
 
 import randvib as rv
-from randvib.prediction import expected_power
+from randvib.analytic.prediction import expected_power
+from randvib.montecarlo.sweep import SweepSettings
 from randvib.studies import interaction, linearisation_accuracy
 from randvib.studies._common import (
     fc_at_friction_level,
@@ -21,7 +22,6 @@ from randvib.studies._common import (
     friction_level,
     plus_minus,
 )
-from randvib.sweep import SweepSettings
 
 BASE = rv.preset("figure9")
 TINY = SweepSettings(dt=1e-4, window=0.3, burn_in=0.1, min_paths=48, max_paths=48, batch_paths=48)

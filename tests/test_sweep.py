@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import randvib as rv
-import randvib.sweep as sweep_module
-from randvib.sweep import (
+import randvib.montecarlo.sweep as sweep_module
+from randvib.montecarlo.sweep import (
     SweepSettings,
     cartesian,
     holm_significant,

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import argparse
 
-from randvib.friction import FRICTION_MODELS, RegistryView
-from randvib.harvester import Harvester
-from randvib.presets import PRESETS, preset
+from randvib.models.friction import FRICTION_MODELS, RegistryView
+from randvib.models.harvester import Harvester
+from randvib.models.presets import PRESETS, preset
 
 #: ``--friction`` choices: ``none`` and every registered law (live view).
 FRICTION_CHOICES = RegistryView(lambda law: law)

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import argparse
 
-from randvib.deterministic import HOLDS, INPUT_KINDS
-from randvib.identification import OUTPUT_COLUMN, TIME_COLUMN, read_record
+from randvib.identification.fitting import OUTPUT_COLUMN, TIME_COLUMN, read_record
+from randvib.identification.record_simulation import HOLDS, INPUT_KINDS
 
 
 def add_record_arguments(parser: argparse.ArgumentParser) -> None:

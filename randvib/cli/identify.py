@@ -13,7 +13,7 @@ from randvib.cli._records import (
     record_from_args,
     simulation_settings,
 )
-from randvib.identification import MODELS, UNITS, identify
+from randvib.identification.fitting import MODELS, UNITS, identify
 
 
 def register(sub) -> None:
@@ -84,7 +84,7 @@ def run(args) -> int:
     if save is not None:
         save.write_text(json.dumps(out, indent=2))
     if plot is not None:
-        from randvib.identification_plots import figure_fit
+        from randvib.identification.plots import figure_fit
 
         figure_fit(result.predict(record), plot, title=f"{args.model} model on {record.name}")
     if args.json:

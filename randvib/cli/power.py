@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import json
 
+from randvib.analytic.prediction import METHODS, predict
 from randvib.cli._device import add_device_arguments, harvester_from_args, require_psd
 from randvib.cli._output import print_table
-from randvib.prediction import METHODS, predict
 
 
 def register(sub) -> None:

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import json
 
+from randvib.analytic.prediction import predict
 from randvib.cli._device import add_device_arguments, harvester_from_args, require_psd
 from randvib.cli._output import print_table
-from randvib.integrators import INTEGRATORS
-from randvib.prediction import predict
+from randvib.montecarlo.integrators import INTEGRATORS
 
 
 def register(sub) -> None:
@@ -36,7 +36,7 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    from randvib.simulation import simulate
+    from randvib.montecarlo.simulation import simulate
 
     harvester = harvester_from_args(args)
     psd = require_psd(args)

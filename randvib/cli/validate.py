@@ -12,7 +12,7 @@ from randvib.cli._records import (
     record_from_args,
     simulation_settings,
 )
-from randvib.identification import MODELS, validate
+from randvib.identification.fitting import MODELS, validate
 
 
 def register(sub) -> None:
@@ -67,8 +67,8 @@ def run(args) -> int:
     records = [record_from_args(path, args) for path in args.data]
     rows = validate(parameters, model, records, **settings)
     if plot_dir is not None:
-        from randvib.identification import predict
-        from randvib.identification_plots import figure_fit
+        from randvib.identification.fitting import predict
+        from randvib.identification.plots import figure_fit
 
         for i, record in enumerate(records):
             pred = predict(parameters, model, record, **settings)

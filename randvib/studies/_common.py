@@ -9,9 +9,9 @@ import numpy as np
 import pandas as pd
 
 from randvib._io import atomic_write_text
-from randvib.harvester import Harvester
-from randvib.linearisation import coulomb_equivalent_damping
-from randvib.sweep import (
+from randvib.analytic.linearisation import coulomb_equivalent_damping
+from randvib.models.harvester import Harvester
+from randvib.montecarlo.sweep import (
     SweepResult,
     SweepSettings,
     holm_significant,
@@ -164,7 +164,7 @@ def interaction_contrasts(
 
         [P(a, b) - P(a, 0)] - [P(0, b) - P(0, 0)]
 
-    is estimated with :func:`randvib.sweep.paired_contrast` from the four
+    is estimated with :func:`randvib.montecarlo.sweep.paired_contrast` from the four
     points that share all other parameters (e.g. ``psd``). It is zero when the
     effect of ``b`` on the expected power does not depend on ``a``. The
     ``relative_*`` columns divide by the Monte Carlo P(a, 0). ``detectable``
@@ -248,15 +248,15 @@ def interaction_contrasts(
 def _quiet_worker() -> None:
     import warnings
 
-    from randvib.averaging import AveragingValidityWarning
+    from randvib.analytic.averaging import AveragingValidityWarning
 
     warnings.simplefilter("ignore", AveragingValidityWarning)
 
 
 def study_executor(workers=None, scheduler=None):
-    """:func:`randvib.sweep.make_executor`, with quiet local workers.
+    """:func:`randvib.montecarlo.sweep.make_executor`, with quiet local workers.
 
-    Local worker processes ignore :class:`~randvib.averaging.AveragingValidityWarning`
+    Local worker processes ignore :class:`~randvib.analytic.averaging.AveragingValidityWarning`
     (the sweep evaluates the averaging prediction at every point, and at high
     friction it would repeat once per point); the studies flag those points in
     their reports instead, from ``zeta_friction``.
@@ -267,10 +267,10 @@ def study_executor(workers=None, scheduler=None):
 def check_step_bias(base: Harvester, points: list, settings: SweepSettings) -> float:
     """The largest linearised step bias over ``points``; refuse it above the warning level.
 
-    Uses :func:`randvib.simulation.step_bias` (the scheme's exact stationary
+    Uses :func:`randvib.montecarlo.simulation.step_bias` (the scheme's exact stationary
     bias on each point's linearised device).
     """
-    from randvib.simulation import WARN_STEP_BIAS, step_bias
+    from randvib.montecarlo.simulation import WARN_STEP_BIAS, step_bias
 
     worst = max(
         step_bias(settings.method, point_device(base, p), p["psd"], settings.dt) for p in points
@@ -306,12 +306,12 @@ def sweep_with_step_check(
 ):
     """Run a study's sweep into ``out/sweep`` and its half-step re-run of ``check_points``.
 
-    Returns the :class:`~randvib.sweep.SweepResult` and the table of
+    Returns the :class:`~randvib.montecarlo.sweep.SweepResult` and the table of
     :func:`step_size_check`.
     """
     import warnings
 
-    from randvib.averaging import AveragingValidityWarning
+    from randvib.analytic.averaging import AveragingValidityWarning
 
     executor, close = study_executor(workers, scheduler)
     try:

@@ -20,8 +20,13 @@ import numpy as np
 import pandas as pd
 
 from randvib._io import atomic_write_text, prepare_output_dir
-from randvib.prediction import METHODS, expected_power
-from randvib.presets import preset
+from randvib.analytic.prediction import METHODS, expected_power
+from randvib.models.presets import preset
+from randvib.montecarlo.sweep import (
+    SweepSettings,
+    cartesian,
+    linearisation_verdicts,
+)
 from randvib.studies._common import (
     fc_where_power_halves,
     highest_friction_points,
@@ -30,11 +35,6 @@ from randvib.studies._common import (
     save_figure,
     sweep_with_step_check,
     write_report,
-)
-from randvib.sweep import (
-    SweepSettings,
-    cartesian,
-    linearisation_verdicts,
 )
 
 PSDS = (1.0, 0.5, 0.1)

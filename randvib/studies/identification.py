@@ -30,17 +30,17 @@ import numpy as np
 import pandas as pd
 
 from randvib._io import atomic_write_text, prepare_output_dir
-from randvib.deterministic import simulate_record
-from randvib.excitation import band_limited_excitation
-from randvib.harvester import ElectricalCoupling
-from randvib.identification import (
+from randvib.identification.fitting import (
     MODEL_PARAMETERS,
     IdentificationResult,
     Record,
     identify,
     predict,
 )
-from randvib.presets import ALPHA, MAGNET_MASS, R_COIL
+from randvib.identification.record_simulation import simulate_record
+from randvib.models.excitation import band_limited_excitation
+from randvib.models.harvester import ElectricalCoupling
+from randvib.models.presets import ALPHA, MAGNET_MASS, R_COIL
 
 #: The paper's four models (Table 2). Not identification.MODELS: that lists
 #: every registered friction law, including ones a user defines later.
@@ -129,7 +129,7 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
     """
     import numba
 
-    from randvib.identification_plots import figure_costs, figure_fit
+    from randvib.identification.plots import figure_costs, figure_fit
 
     settings = _settings(quick)
     identity = {"study": "identification", "quick": bool(quick), "seed": int(seed), **settings}

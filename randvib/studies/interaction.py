@@ -19,7 +19,7 @@ At every (S, Fc > 0, k3 > 0) it estimates the interaction contrast
 from common-random-number paths (:func:`randvib.studies._common.interaction_contrasts`),
 relative to P(Fc, 0), with a 95 % interval, a per-point verdict and Holm's
 correction over the family. Beside it: the contrast predicted by stochastic
-averaging (:mod:`randvib.averaging`), which, unlike Eq. 32, does depend on
+averaging (:mod:`randvib.analytic.averaging`), which, unlike Eq. 32, does depend on
 k3, and the linearisation error at every point. A half-step re-run of the
 hardest points shows the time-step bias is below the statistical error.
 """
@@ -34,9 +34,10 @@ import numpy as np
 import pandas as pd
 
 from randvib._io import atomic_write_text, prepare_output_dir
-from randvib.averaging import AveragingValidityWarning, averaging_statistics
-from randvib.prediction import METHODS, expected_power
-from randvib.presets import preset
+from randvib.analytic.averaging import AveragingValidityWarning, averaging_statistics
+from randvib.analytic.prediction import METHODS, expected_power
+from randvib.models.presets import preset
+from randvib.montecarlo.sweep import SweepSettings, cartesian, linearisation_verdicts
 from randvib.studies._common import (
     burn_in_for,
     check_step_bias,
@@ -50,7 +51,6 @@ from randvib.studies._common import (
     sweep_with_step_check,
     write_report,
 )
-from randvib.sweep import SweepSettings, cartesian, linearisation_verdicts
 
 NAME = "interaction"
 PSDS = (1.0, 0.5, 0.1)
@@ -510,7 +510,7 @@ def run_study(
         + ("the stiffest spring" if quick else "k3 = 0 and the stiffest spring")
         + f") at dt/2 = {settings.dt / 2:g} s, independent noise. Time-step bias below the "
         f"statistical error at {int(check.bias_below_error.sum())} of {len(check)} points. "
-        f"Linearised step bias at dt (randvib.simulation.step_bias) at most {worst_bias:.1e}.\n\n"
+        f"Linearised step bias at dt (randvib.montecarlo.simulation.step_bias) at most {worst_bias:.1e}.\n\n"
         + markdown_table(check)
     )
     setup = (

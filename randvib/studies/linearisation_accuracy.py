@@ -18,7 +18,7 @@ alone; with the paper's k3 = 5e5 N/m^3 the Duffing term breaks the scaling
 Verdict: for each series, the phi up to which the error is trusted to 1 %,
 5 % and 10 %, meaning that the error's upper 95 % bound |error| + ci95 stays
 below the tolerance (first crossing, interpolated linearly in log phi).
-Stochastic averaging (:mod:`randvib.averaging`) is mapped alongside.
+Stochastic averaging (:mod:`randvib.analytic.averaging`) is mapped alongside.
 """
 
 from __future__ import annotations
@@ -30,9 +30,10 @@ import numpy as np
 import pandas as pd
 
 from randvib._io import atomic_write_text, prepare_output_dir
-from randvib.averaging import averaging_statistics
-from randvib.prediction import METHODS
-from randvib.presets import preset
+from randvib.analytic.averaging import averaging_statistics
+from randvib.analytic.prediction import METHODS
+from randvib.models.presets import preset
+from randvib.montecarlo.sweep import SweepSettings, linearisation_verdicts
 from randvib.studies._common import (
     burn_in_for,
     check_step_bias,
@@ -45,7 +46,6 @@ from randvib.studies._common import (
     sweep_with_step_check,
     write_report,
 )
-from randvib.sweep import SweepSettings, linearisation_verdicts
 
 NAME = "linearisation-accuracy"
 TOLERANCES = (0.01, 0.05, 0.10)

@@ -11,9 +11,9 @@ sqrt(kappa (2 + kappa))), half power at kappa = 1/4), from 0 to 2 (about a
 fifth of the friction-free power).
 
 At every point: E[P_e] from equivalent linearisation (Eq. 32), stochastic
-averaging (:mod:`randvib.averaging`), the fast corrected FPK grids
-(``method="fpk-fast"``, :func:`randvib.fokker_planck.fast_fpk_statistics`),
-the FPK reference grid solution (:func:`randvib.fokker_planck.fpk_statistics`)
+averaging (:mod:`randvib.analytic.averaging`), the fast corrected FPK grids
+(``method="fpk-fast"``, :func:`randvib.analytic.fokker_planck.fast_fpk_statistics`),
+the FPK reference grid solution (:func:`randvib.analytic.fokker_planck.fpk_statistics`)
 and Monte Carlo (:func:`randvib.simulate`, stochastic Heun, with the
 energy-identity and friction-free-companion control variates). Relative
 errors are taken against Monte Carlo. The two fast candidates of issue 6
@@ -37,14 +37,14 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from randvib import engine
 from randvib._io import atomic_write_text, prepare_output_dir
-from randvib.averaging import AveragingValidityWarning, averaging_statistics
-from randvib.fokker_planck import fast_fpk_statistics, fpk_statistics
-from randvib.linearisation import equivalent_damping
-from randvib.prediction import expected_power
-from randvib.presets import preset
-from randvib.simulation import estimate, simulate, step_bias
+from randvib.analytic.averaging import AveragingValidityWarning, averaging_statistics
+from randvib.analytic.fokker_planck import fast_fpk_statistics, fpk_statistics
+from randvib.analytic.linearisation import equivalent_damping
+from randvib.analytic.prediction import expected_power
+from randvib.models.presets import preset
+from randvib.montecarlo import kernel
+from randvib.montecarlo.simulation import estimate, simulate, step_bias
 
 NAME = "linearisation-vs-averaging"
 PSDS = (1.0, 0.5, 0.1)
@@ -131,7 +131,7 @@ def _simulate_column(psd, kappa, k3s, base, mc, seed, threads):
         }
         row.update(_analytic(device, psd))
         rows.append(row)
-        per_path[k3] = device.c_e * res.column(engine.ACC_V2)
+        per_path[k3] = device.c_e * res.column(kernel.ACC_V2)
         controls[k3] = res.controls()
     k0 = k3s[0]
     for row in rows:

@@ -6,10 +6,9 @@
   Duffing oscillator is exactly the Gibbs density
   p(z, v) ∝ exp(-(m v^2/2 + k z^2/2 + k3 z^4/4) / (m sigma_v^2)) with
   sigma_v^2 = S m / (4 c): velocity Gaussian, independent of z, for every k3.
-* The discrete Euler-Maruyama and Heun recursions applied to the linear
-  oscillator are linear Gaussian chains whose stationary covariance solves a
-  discrete Lyapunov equation: the exact target of a simulation at finite dt,
-  with no time-step bias left to hide a bug.
+* (The schemes' own exact recursions on the linear oscillator, the targets of
+  a simulation at finite dt, live with the schemes:
+  :func:`randvib.montecarlo.integrators.scheme_stationary_covariance`.)
 * Stationary energy balance (Ito's rule on the mechanical energy, any
   stiffness, any memoryless friction): c E[v^2] + E[v F(v)] = S m / 4.
 """
@@ -17,7 +16,7 @@
 from __future__ import annotations
 
 import numpy as np
-from scipy import integrate, linalg
+from scipy import integrate
 
 from randvib._validation import check_nonnegative, check_positive
 
@@ -56,34 +55,3 @@ def gibbs_displacement_moment(m, c, k, k3, psd, power: int = 2) -> float:
     )[0]
     den = integrate.quad(weight, 0, upper, epsabs=0, epsrel=1e-13, limit=200)[0]
     return float(num / den * scale**power)
-
-
-def scheme_matrices(method: str, m, c, k, psd, dt):
-    """Transition matrix A and noise matrix B of a scheme on the linear oscillator.
-
-    The recursion is x_{n+1} = A x_n + B dW_n with x = (z, v), dW_n ~ N(0, dt),
-    from the scheme's own step table
-    (:meth:`randvib.integrators.Integrator.linear_recursion`). Euler-Maruyama:
-    A = I + dt F. Heun: A = I + dt F + dt^2 F^2 / 2 and B = (I + dt F / 2) b.
-    """
-    from randvib.integrators import integrator
-
-    f = np.array([[0.0, 1.0], [-k / m, -c / m]])
-    b = np.array([[0.0], [np.sqrt(psd / 2.0)]])
-    return integrator(method).linear_recursion(f, b, dt)
-
-
-def scheme_stationary_covariance(method: str, m, c, k, psd, dt) -> np.ndarray:
-    """Exact stationary covariance of (z, v) for a scheme on the linear oscillator.
-
-    Solves P = A P A^T + dt B B^T. Raises if the recursion is unstable
-    (spectral radius of A >= 1), where no stationary state exists.
-    """
-    a, b = scheme_matrices(method, m, c, k, psd, dt)
-    radius = max(abs(np.linalg.eigvals(a)))
-    if radius >= 1:
-        raise ValueError(
-            f"{method} with dt = {dt!r} s is unstable for this oscillator "
-            f"(spectral radius {radius:.6g} >= 1)"
-        )
-    return linalg.solve_discrete_lyapunov(a, dt * (b @ b.T))

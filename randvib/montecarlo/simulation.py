@@ -25,13 +25,14 @@ import numba
 import numpy as np
 from scipy import special  # Student t quantile; lighter than scipy.stats
 
-from randvib import engine, exact
 from randvib._validation import check_choice, check_int, check_positive
-from randvib.friction import kernel_arguments
-from randvib.harvester import Harvester
-from randvib.integrators import integrator
-from randvib.linearisation import equivalent_damping, linear_displacement_variance
-from randvib.rng import ZIG_FI, ZIG_KI, ZIG_WI
+from randvib.analytic import exact_solutions as exact
+from randvib.analytic.linearisation import equivalent_damping, linear_displacement_variance
+from randvib.models.friction import kernel_arguments
+from randvib.models.harvester import Harvester
+from randvib.montecarlo import integrators, kernel
+from randvib.montecarlo.integrators import integrator
+from randvib.montecarlo.rng import ZIG_FI, ZIG_KI, ZIG_WI
 
 #: Largest stationary-variance bias (relative) of the scheme on the linearised
 #: device for which a step is accepted; see :func:`step_bias`.
@@ -195,9 +196,9 @@ class SimulationResult:
         return self.per_path[:, index]
 
     @property
-    def averages(self) -> engine.PathAverages:
-        """The per-path time averages by name (:class:`randvib.engine.PathAverages`)."""
-        return engine.PathAverages(self.per_path)
+    def averages(self) -> kernel.PathAverages:
+        """The per-path time averages by name (:class:`randvib.montecarlo.kernel.PathAverages`)."""
+        return kernel.PathAverages(self.per_path)
 
     def controls(self) -> np.ndarray:
         """Zero-mean control variates per path, shape (n_paths, p).
@@ -315,7 +316,7 @@ def step_bias(method: str, harvester: Harvester, psd: float, dt: float) -> float
 
     The scheme applied to ``m z'' + c_eff z' + k_eff z = m w`` is a linear
     Gaussian recursion whose stationary variance is exact
-    (:func:`randvib.exact.scheme_stationary_covariance`); its departure from
+    (:func:`randvib.montecarlo.integrators.scheme_stationary_covariance`); its departure from
     S m / (4 c_eff) measures the time-step bias. Euler-Maruyama's bias is about
     x / (1 - x) with x = k_eff dt / c_eff (energy gain per step against
     damping), so it needs far smaller steps than Heun on lightly damped
@@ -328,7 +329,7 @@ def step_bias(method: str, harvester: Harvester, psd: float, dt: float) -> float
 def _scheme_bias(method, m, k_eff, c_eff, psd, dt) -> float:
     """:func:`step_bias` for an already linearised device (inf where unstable)."""
     try:
-        cov = exact.scheme_stationary_covariance(method, m, c_eff, k_eff, psd, dt)
+        cov = integrators.scheme_stationary_covariance(method, m, c_eff, k_eff, psd, dt)
     except ValueError:
         return float("inf")
     return abs(cov[1, 1] / exact.linear_velocity_variance(m, c_eff, psd) - 1.0)
@@ -419,9 +420,9 @@ def simulate(
     burn_in : float
         Initial time discarded from the statistics (s), 0 <= burn_in < t_end.
     method : {"heun", "euler-maruyama"}
-        Integrator (:data:`randvib.integrators.INTEGRATORS`).
+        Integrator (:data:`randvib.montecarlo.integrators.INTEGRATORS`).
     seed : int
-        Seed; path i uses stream (seed, first_path + i) (:mod:`randvib.rng`).
+        Seed; path i uses stream (seed, first_path + i) (:mod:`randvib.montecarlo.rng`).
     dW : array_like, optional
         Brownian increments of shape (n_paths, n_steps) (s^0.5, variance dt)
         to drive the simulation instead of the internal streams.
@@ -539,7 +540,7 @@ def simulate(
         progress = sys.stderr.isatty() and os.environ.get("CI") is None
 
     batches = _batches(n_paths, batch_paths, n_steps, progress, record_paths)
-    per_path = np.empty((n_paths, engine.N_ACC))
+    per_path = np.empty((n_paths, kernel.N_ACC))
     hist_total = np.zeros((2, max(histogram_bins, 1)), dtype=np.int64)
     records = None
     bar = None
@@ -551,7 +552,7 @@ def simulate(
     try:
         for lo, hi in batches:
             dw_batch = dW[lo:hi] if dW is not None else np.zeros((0, 0))
-            acc, failed, hist, rec = engine.run_ensemble(
+            acc, failed, hist, rec = kernel.run_ensemble(
                 *scheme.kernel_weights,
                 fr_kind,
                 fr_p,
@@ -645,7 +646,7 @@ def _batches(n_paths, batch_paths, n_steps, progress, record_paths):
     if batch_paths is None:
         if progress:
             # about 1e8 path-steps per call: a second or so, for a live bar
-            batch_paths = max(engine.LANES * numba.get_num_threads(), int(1e8 // max(n_steps, 1)))
+            batch_paths = max(kernel.LANES * numba.get_num_threads(), int(1e8 // max(n_steps, 1)))
         else:
             batch_paths = n_paths
     batch_paths = check_int("batch_paths", batch_paths, 1)

@@ -52,7 +52,7 @@ parameter sets):
   switch (``h <= 2 tau``) plain RK4 is stable and accurate.
 
 Which path a friction law takes is its own declaration
-(:mod:`randvib.friction`): ``stick_slip`` selects the event-located
+(:mod:`randvib.models.friction`): ``stick_slip`` selects the event-located
 integrator (``Fc sgn v``) or its boundary-layer form (``Fc tanh(beta v)``),
 ``kernel_relaxation_rate`` the sub-cycling of a law with memory, and
 everything else is RK4 on the law's compiled ``kernel``.
@@ -70,7 +70,7 @@ import numba
 import numpy as np
 
 from randvib._validation import check_finite, check_int, check_positive
-from randvib.friction import (
+from randvib.models.friction import (
     FRICTION_MODELS,
     KERNEL_NONE,
     N_KERNEL_PARAMETERS,
@@ -81,12 +81,12 @@ from randvib.friction import (
     evaluate_friction,
     kernel_callback,
 )
-from randvib.harvester import Harvester
+from randvib.models.harvester import Harvester
 
 #: Input kinds a record may carry, and what the kernel is driven by.
 INPUT_KINDS = ("base_displacement", "base_acceleration", "force")
 #: Friction law name -> kernel code (``none`` = viscous only); a live view of
-#: the registry :data:`randvib.friction.FRICTION_MODELS`.
+#: the registry :data:`randvib.models.friction.FRICTION_MODELS`.
 FRICTION_KINDS = RegistryView(lambda law: KERNEL_NONE if law is None else law.kernel_code)
 #: Friction law name -> parameter names in kernel order (live view, as above).
 FRICTION_PARAMETERS = RegistryView(lambda law: () if law is None else law.parameter_names())
@@ -533,8 +533,8 @@ def device_parameters(device, friction=None) -> tuple[dict, str]:
     Parameters
     ----------
     device : Harvester or dict
-        A :class:`~randvib.harvester.Harvester` (a preset included); the dict
-        of its :meth:`~randvib.harvester.Harvester.parameters` (``c_m``,
+        A :class:`~randvib.models.harvester.Harvester` (a preset included); the dict
+        of its :meth:`~randvib.models.harvester.Harvester.parameters` (``c_m``,
         ``c_e``, ``friction`` and the friction and circuit parameters); or
         ``m, c, k, k3`` and the friction parameters, with ``friction``
         naming the law.
@@ -684,7 +684,7 @@ def simulate_record(
     """Simulate Eq. 1 driven by a recorded input, for many parameter sets at once.
 
     Called as ``simulate_record(harvester, input_values, dt, ...)`` with a
-    :class:`~randvib.harvester.Harvester` (a preset included) or its
+    :class:`~randvib.models.harvester.Harvester` (a preset included) or its
     ``parameters()`` dict, or as ``simulate_record(parameters, friction,
     input_values, dt, ...)`` with a dict of named parameters.
 

@@ -54,7 +54,7 @@ per cycle, and k3 lowers that by raising the orbit frequency: the error
 shrinks with k3 by about as much as the true change of power with k3 (0.04-
 0.17 % on the study ``linearisation-vs-averaging``), so averaging gets the
 sign of that interaction but overstates its size 1.5-5x. For the k3 change
-use ``method="fpk-fast"`` (:func:`randvib.fokker_planck.fast_fpk_statistics`),
+use ``method="fpk-fast"`` (:func:`randvib.analytic.fokker_planck.fast_fpk_statistics`),
 which explains why a next-order averaging was not pursued.
 
 Quadrature. On an orbit of amplitude A the substitution z = A sin(phi)
@@ -84,7 +84,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from randvib._validation import check_nonnegative, check_positive
-from randvib.harvester import Harvester
+from randvib.models.harvester import Harvester
 
 __all__ = [
     "AVERAGING_ZETA_LIMIT",

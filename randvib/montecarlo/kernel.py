@@ -4,7 +4,7 @@ Paths are processed in chunks of :data:`LANES` independent paths that advance
 together, step by step: the per-step dependency chain of one path is short
 and latency-bound, so interleaving a few paths keeps the core busy. Chunks run
 in parallel (``numba.prange``). Every path draws from its own stream
-(:mod:`randvib.rng`) and owns its accumulators, and the cross-path reductions
+(:mod:`randvib.montecarlo.rng`) and owns its accumulators, and the cross-path reductions
 happen afterwards in path order, so results are bit-identical for any number
 of threads and any batching of paths.
 
@@ -17,8 +17,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from randvib.friction import evaluate_friction
-from randvib.rng import seed_path_state, standard_normal
+from randvib.models.friction import evaluate_friction
+from randvib.montecarlo.rng import seed_path_state, standard_normal
 
 #: Paths advanced together inside one chunk.
 LANES = 8
@@ -113,7 +113,7 @@ def scheme_step(z, v, theta, dt, noise, b1, b2, inv_m, c, k, k3, fr_kind, fr_p, 
     """One step of the additive-noise scheme with drift weights ``(b1, b2)``.
 
     The single definition of every integrator's step
-    (:class:`randvib.integrators.Integrator`): Euler predictor
+    (:class:`randvib.montecarlo.integrators.Integrator`): Euler predictor
     ``x_p = x + f(x) dt + g dW`` and update
     ``x + (b1 f(x) + b2 f(x_p)) dt + g dW``; ``b2 = 0`` skips the predictor
     (Euler-Maruyama), ``b1 = b2 = 1/2`` is stochastic Heun. The friction-free
@@ -184,7 +184,7 @@ def run_ensemble(
         used by :func:`scheme_step`.
     fr_kind, fr_p, fr_fn : int, float64[5], callback
         Friction kernel code, parameters and compiled callback, from
-        :func:`randvib.friction.kernel_arguments`.
+        :func:`randvib.models.friction.kernel_arguments`.
     m, c, k, k3 : float
         Mass (kg), total viscous damping (Ns/m), stiffnesses (N/m, N/m^3).
     noise_amp : float

@@ -1,6 +1,6 @@
 """Figures for identification results (paper Figures 7 and 8).
 
-Numbers come from :mod:`randvib.identification` (``Prediction`` objects and
+Numbers come from :mod:`randvib.identification.fitting` (``Prediction`` objects and
 cost tables); these functions only draw them.
 """
 
@@ -30,7 +30,7 @@ def plot_time_history(prediction, ax=None, *, window=None, scale=1.0, unit="m"):
 
     Parameters
     ----------
-    prediction : randvib.identification.Prediction
+    prediction : randvib.identification.fitting.Prediction
     ax : matplotlib Axes, optional
     window : (t0, t1), optional
         Time window (s) to show; default the first 2 s.

@@ -20,10 +20,10 @@ import numpy as np
 from scipy import optimize
 
 from randvib._validation import check_choice, check_nonnegative, check_positive
-from randvib.averaging import averaging_statistics
-from randvib.fokker_planck import fast_fpk_statistics, fpk_statistics
-from randvib.harvester import Harvester
-from randvib.linearisation import equivalent_damping, linear_displacement_variance
+from randvib.analytic.averaging import averaging_statistics
+from randvib.analytic.fokker_planck import fast_fpk_statistics, fpk_statistics
+from randvib.analytic.linearisation import equivalent_damping, linear_displacement_variance
+from randvib.models.harvester import Harvester
 
 
 @dataclass(frozen=True)
@@ -129,8 +129,8 @@ def _fpk_fast(harvester: Harvester, psd) -> PowerPrediction:
 
 
 #: Analytic methods by name: callables (harvester, psd) -> PowerPrediction.
-#: ``"averaging"``: energy-envelope stochastic averaging (randvib.averaging);
-#: ``"fpk"``: finite-volume stationary FPK solution (randvib.fokker_planck),
+#: ``"averaging"``: energy-envelope stochastic averaging (randvib.analytic.averaging);
+#: ``"fpk"``: finite-volume stationary FPK solution (randvib.analytic.fokker_planck),
 #: the slow reference; ``"fpk-fast"``: the same equation on small grids made
 #: exact without friction, with kink corrections and Richardson
 #: extrapolation (fokker_planck.fast_fpk_statistics), fast enough for sweeps.

@@ -4,7 +4,7 @@
 
 ``z`` is the displacement of the centre magnet relative to the base (m),
 ``y`` the base displacement (m) and ``F`` the friction force (N) of one of the
-models in :mod:`randvib.friction`.
+models in :mod:`randvib.models.friction`.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from randvib._validation import check_nonnegative, check_positive, scalar_or_array
-from randvib.friction import FrictionModel
+from randvib.models.friction import FrictionModel
 
 
 @dataclass(frozen=True, eq=False)

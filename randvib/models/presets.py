@@ -16,8 +16,8 @@ parameters with c_m = c_e = 0.1 Ns/m.
 
 from __future__ import annotations
 
-from randvib.friction import Coulomb, LuGre, Tanh
-from randvib.harvester import Harvester
+from randvib.models.friction import Coulomb, LuGre, Tanh
+from randvib.models.harvester import Harvester
 
 #: Assumed centre-magnet mass (kg): k / (2 pi 8 Hz)^2 with k = 57.4 N/m.
 MAGNET_MASS = 0.0226

@@ -6,7 +6,7 @@ Eq. 1 and 17, noise intensity D = S/2 on the velocity) solves
     0 = -d/dz (v p) + d/dv [ (gamma v + g(z) + f(v)) p + (D/2) dp/dv ],
 
 gamma = c/m, g(z) = (k z + k3 z^3)/m, f(v) = F(v)/m. Nothing is averaged or
-closed, so the solution checks stochastic averaging (:mod:`randvib.averaging`)
+closed, so the solution checks stochastic averaging (:mod:`randvib.analytic.averaging`)
 and equivalent linearisation without Monte Carlo noise.
 
 Discretisation (finite volumes, zero-flux box):
@@ -51,9 +51,9 @@ from scipy.linalg import lapack
 from scipy.sparse import linalg as sparse_linalg
 
 from randvib._validation import check_int, check_positive
-from randvib.averaging import memoryless_parameters
-from randvib.harvester import Harvester
-from randvib.linearisation import equivalent_damping
+from randvib.analytic.averaging import memoryless_parameters
+from randvib.analytic.linearisation import equivalent_damping
+from randvib.models.harvester import Harvester
 
 __all__ = ["FPKSolution", "fast_fpk_statistics", "fpk_statistics", "solve_fpk"]
 
@@ -289,7 +289,7 @@ FAST_NZ = (36, 24)
 #: v cells (whole box) of the two main grids, Richardson-combined in v.
 FAST_NV = (48, 32)
 #: Box edge of the fast solver: where the linear-spring averaged exponent
-#: Psi(H) (randvib.averaging) reaches this value, i.e. the energy density is
+#: Psi(H) (randvib.analytic.averaging) reaches this value, i.e. the energy density is
 #: down to about exp(-13) of its peak.
 FAST_PSI_EDGE = 13.0
 #: Mass fraction in the outermost ring of cells above which the box is judged
@@ -303,7 +303,7 @@ def _box_energy(gamma, fcm, dd, psi_edge):
     """Energy per unit mass at which a x^2 + b x = psi_edge, x = sqrt(H).
 
     a x^2 + b x is the averaged exponent Psi(H) of the linear spring with
-    viscous damping gamma and Coulomb level fcm (randvib.averaging, _x_max);
+    viscous damping gamma and Coulomb level fcm (randvib.analytic.averaging, _x_max);
     for the Duffing spring it stays within 10 % of the true one.
     """
     a = 2.0 * gamma / dd

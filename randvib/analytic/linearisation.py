@@ -28,8 +28,8 @@ from __future__ import annotations
 import numpy as np
 
 from randvib._validation import check_positive
-from randvib.friction import coulomb_equivalent_damping
-from randvib.harvester import Harvester
+from randvib.models.friction import coulomb_equivalent_damping
+from randvib.models.harvester import Harvester
 
 _BISECTION_STEPS = 200
 

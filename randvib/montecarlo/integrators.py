@@ -17,6 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy import linalg
 
 from randvib._validation import check_choice
 
@@ -32,7 +33,7 @@ class Integrator:
         x_{n+1} = x_n + (b_1 f(x_n) + b_2 f(x_p)) dt + g dW_n
 
     so a scheme is its weights ``(b_1, b_2)`` (``b_2 = 0``: no predictor
-    stage). The compiled kernel (:func:`randvib.engine.scheme_step`) takes the
+    stage). The compiled kernel (:func:`randvib.montecarlo.kernel.scheme_step`) takes the
     weights, the device and its friction-free companion use the same step, and
     :meth:`linear_recursion` gives the exact recursion of the same step on a
     linear system (the tests' exact discrete references).
@@ -112,3 +113,32 @@ def integrator(name: str) -> Integrator:
     """Look up an integrator by name (``euler-maruyama`` or ``heun``)."""
     check_choice("method", name, tuple(INTEGRATORS))
     return INTEGRATORS[name]
+
+
+def scheme_matrices(method: str, m, c, k, psd, dt):
+    """Transition matrix A and noise matrix B of a scheme on the linear oscillator.
+
+    The recursion is x_{n+1} = A x_n + B dW_n with x = (z, v), dW_n ~ N(0, dt),
+    from the scheme's own step table
+    (:meth:`randvib.montecarlo.integrators.Integrator.linear_recursion`). Euler-Maruyama:
+    A = I + dt F. Heun: A = I + dt F + dt^2 F^2 / 2 and B = (I + dt F / 2) b.
+    """
+    f = np.array([[0.0, 1.0], [-k / m, -c / m]])
+    b = np.array([[0.0], [np.sqrt(psd / 2.0)]])
+    return integrator(method).linear_recursion(f, b, dt)
+
+
+def scheme_stationary_covariance(method: str, m, c, k, psd, dt) -> np.ndarray:
+    """Exact stationary covariance of (z, v) for a scheme on the linear oscillator.
+
+    Solves P = A P A^T + dt B B^T. Raises if the recursion is unstable
+    (spectral radius of A >= 1), where no stationary state exists.
+    """
+    a, b = scheme_matrices(method, m, c, k, psd, dt)
+    radius = max(abs(np.linalg.eigvals(a)))
+    if radius >= 1:
+        raise ValueError(
+            f"{method} with dt = {dt!r} s is unstable for this oscillator "
+            f"(spectral radius {radius:.6g} >= 1)"
+        )
+    return linalg.solve_discrete_lyapunov(a, dt * (b @ b.T))

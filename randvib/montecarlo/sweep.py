@@ -15,7 +15,7 @@ Design choices a careful user expects:
 * **Control variates.** Each path also integrates the friction-free device
   with the same noise, whose stationary E[v^2] = S m / (4c) and E[z^2] (Gibbs)
   are exact, and carries the Ito integral and energy change of the energy
-  balance; see :meth:`randvib.simulation.SimulationResult.controls`.
+  balance; see :meth:`randvib.montecarlo.simulation.SimulationResult.controls`.
 * **Incremental, resumable output.** Each finished point is written at once
   (one JSON row and one ``.npy`` of per-path powers, each by atomic rename);
   the CSV table is regenerated from them. An interrupted sweep resumes without
@@ -42,9 +42,9 @@ import pandas as pd
 
 from randvib._io import atomic_write_text, prepare_output_dir
 from randvib._validation import check_int, check_positive
-from randvib.harvester import Harvester
-from randvib.prediction import METHODS, predict
-from randvib.simulation import estimate
+from randvib.analytic.prediction import METHODS, predict
+from randvib.models.harvester import Harvester
+from randvib.montecarlo.simulation import estimate
 
 STATISTICS = ("power_electrical", "velocity_variance", "displacement_variance", "mean_abs_velocity")
 
@@ -151,12 +151,12 @@ def run_point(base: Harvester, point: Mapping, settings: SweepSettings, threads:
     row : dict
         Parameters, analytic predictions, estimates with ci95, paths, times.
     per_path : ndarray, shape (n_paths, n_columns)
-        Per-path accumulators (:mod:`randvib.engine` columns) for paired
+        Per-path accumulators (:mod:`randvib.montecarlo.kernel` columns) for paired
         comparisons between points.
     """
     import numba
 
-    from randvib.simulation import simulate
+    from randvib.montecarlo.simulation import simulate
 
     if threads is not None:
         numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
@@ -245,7 +245,7 @@ class SweepResult:
 
     def power_samples(self, index: int, c_e: float) -> np.ndarray:
         """c_e times each path's mean v^2 at point ``index``: per-path E[P_e] (W)."""
-        from randvib.engine import PathAverages
+        from randvib.montecarlo.kernel import PathAverages
 
         return c_e * PathAverages(self.per_path[index]).v2
 
@@ -397,7 +397,7 @@ def paired_contrast(result: SweepResult, base: Harvester, weights: Mapping[int, 
 
     Uses the paths common to all points (the same path indices saw the same
     noise), forms the weighted combination path by path and returns a
-    :class:`randvib.simulation.Statistic`. With the sweep's control variates
+    :class:`randvib.montecarlo.simulation.Statistic`. With the sweep's control variates
     on, each point's Ito integral and energy change (the energy-balance
     controls) serve as controls. The friction-free companions are left out
     here: the companions of points that differ only in Fc are nearly collinear
@@ -405,7 +405,7 @@ def paired_contrast(result: SweepResult, base: Harvester, weights: Mapping[int, 
     coefficients unstable and, over repeated seeds, the reported interval
     too narrow.
     """
-    from randvib import engine
+    from randvib.montecarlo import kernel
 
     n = min(result.per_path[i].shape[0] for i in weights)
     samples = np.zeros(n)
@@ -413,7 +413,7 @@ def paired_contrast(result: SweepResult, base: Harvester, weights: Mapping[int, 
     window = result.settings.window
     for i, w in weights.items():
         device = point_device(base, result.points[i])
-        averages = engine.PathAverages(result.per_path[i][:n])
+        averages = kernel.PathAverages(result.per_path[i][:n])
         samples += w * device.c_e * averages.v2
         controls.extend(averages.energy_balance_controls(window))
     ctrl = np.column_stack(controls) if result.settings.control_variates else None
@@ -435,7 +435,7 @@ def holm_significant(p_values, level: float = 0.05) -> np.ndarray:
 
 
 def two_sided_p_value(stat) -> float:
-    """p-value of mean = 0 for a :class:`~randvib.simulation.Statistic` (normal approximation)."""
+    """p-value of mean = 0 for a :class:`~randvib.montecarlo.simulation.Statistic` (normal approximation)."""
     from scipy import stats as _stats
 
     if stat.std_error == 0:

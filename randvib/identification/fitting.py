@@ -5,14 +5,14 @@ by minimising the normalised cost (paper Eq. 11)
 
     J(theta) = 100 / (N sigma_z^2) * sum_i (z_i - zhat_i(theta))^2
 
-with self-adaptive differential evolution (:func:`randvib.sade.sade`); a
+with self-adaptive differential evolution (:func:`randvib.identification.sade.sade`); a
 model that predicts the mean scores 100 (Eq. 12), J < 5 is a good fit and
 J < 1 excellent. Every generation's population is simulated in one batched,
-compiled call (:mod:`randvib.deterministic`).
+compiled call (:mod:`randvib.identification.record_simulation`).
 
 Models: ``viscous`` (c (Ns/m), k (N/m), k3 (N/m^3): the paper's "no
 friction") and one per registered friction law
-(:data:`randvib.friction.FRICTION_MODELS`: ``coulomb`` Eq. 4-5, ``tanh``
+(:data:`randvib.models.friction.FRICTION_MODELS`: ``coulomb`` Eq. 4-5, ``tanh``
 Eq. 6, ``lugre`` Eq. 8-10, and any law defined elsewhere), which adds that
 law's parameters with the units, search bounds and scales it declares; plus
 the mass ``m`` (kg). With base excitation the mass cannot be identified
@@ -34,7 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from randvib._validation import check_finite, check_int, check_positive
-from randvib.deterministic import (
+from randvib.identification.record_simulation import (
     HOLDS,
     INPUT_KINDS,
     SEARCH_SUBCYCLES,
@@ -43,8 +43,8 @@ from randvib.deterministic import (
     parameter_matrix,
     run_kernel,
 )
-from randvib.friction import FRICTION_MODELS, Parameter, RecordScales, RegistryView
-from randvib.sade import sade
+from randvib.identification.sade import sade
+from randvib.models.friction import FRICTION_MODELS, Parameter, RecordScales, RegistryView
 
 #: The device's own parameters (Eq. 1; friction laws declare theirs): unit,
 #: default bounds from the record's scales, log scale (k3 may be zero).
@@ -480,7 +480,7 @@ def default_bounds(record: Record, model: str, m: float | None = None) -> dict:
     ======  ==========================================  =====
 
     The device's rows are :data:`DEVICE_SPECS`, the friction rows the
-    law's own :func:`~randvib.friction.parameter` declarations (the table
+    law's own :func:`~randvib.models.friction.parameter` declarations (the table
     above is what the built-in laws declare). These cover the paper's
     Table 2 for its records; override any of them with ``bounds=`` in
     :func:`identify` (``--bounds NAME=LO:HI``). A parameter declared without
@@ -586,7 +586,7 @@ class IdentificationResult:
 
     def harvester(self, electrical=None):
         """The identified device as a :class:`randvib.Harvester` (c as c_m)."""
-        from randvib.harvester import Harvester
+        from randvib.models.harvester import Harvester
 
         p = self.parameters
         law = _check_model(self.model)
@@ -665,7 +665,7 @@ def identify(
     bounds : dict, optional
         ``name -> (lower, upper)`` overriding :func:`default_bounds`.
     popsize, maxiter, seed, tol, patience, polish
-        SaDE settings (see :func:`randvib.sade.sade`).
+        SaDE settings (see :func:`randvib.identification.sade.sade`).
     substeps : int
         Integration steps per sample interval.
     hold : {'linear', 'zero'}
@@ -818,12 +818,12 @@ class Prediction:
 def _device_and_model(parameters, model, record):
     """Accept ``(device, record)`` as well as ``(parameters, model, record)``.
 
-    A device is a :class:`~randvib.harvester.Harvester` (a preset included)
+    A device is a :class:`~randvib.models.harvester.Harvester` (a preset included)
     or its ``parameters()`` dict; its friction law names the model and its
     circuit, if any, gives the voltage. Returns (parameters, model, record,
     circuit).
     """
-    from randvib.harvester import Harvester
+    from randvib.models.harvester import Harvester
 
     if record is None and not isinstance(model, str):
         model, record = None, model
@@ -863,7 +863,7 @@ def predict(
 
     Called as ``predict(parameters, model, record)`` with identified
     parameters (total damping ``c``), or as ``predict(device, record)`` with a
-    :class:`~randvib.harvester.Harvester` (a preset included) or its
+    :class:`~randvib.models.harvester.Harvester` (a preset included) or its
     ``parameters()`` dict: the device's law names the model, c = c_m + c_e,
     and its circuit, if any, gives the load voltage.
 

@@ -1,0 +1,1 @@
+"""Model families: the device (Harvester), friction laws, excitations, presets."""

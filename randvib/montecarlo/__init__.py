@@ -1,0 +1,1 @@
+"""Monte Carlo: random streams, integrators, the compiled ensemble kernel, simulations and sweeps."""
