@@ -150,4 +150,6 @@ def sweep(n_seeds):
 
 if __name__ == "__main__":
     mode, n = sys.argv[1], int(sys.argv[2])
+    if len(sys.argv) > 3:  # optional first seed, to extend a run
+        FIRST_SEED = int(sys.argv[3])
     {"grid": grid, "trust": trust, "coverage": coverage, "sweep": sweep, "steps": steps}[mode](n)
