@@ -173,7 +173,7 @@ def test_accuracy_table_against_monte_carlo(psd, k3, kappa, n_paths):
     -0.41, -0.81, -0.66, -1.65, -1.56 %; fpk-fast within 0.04 %, fpk within
     0.015 %. (At kappa = 2 the README's -9.2 to -9.3 % and fpk-fast's -0.04 to
     -0.13 % carry its study's own time-step bias, dt = 2.5e-4 s: about
-    +0.05-0.1 % on the Monte Carlo power.) Runtime about 20 s for the 7 points.
+    +0.05-0.1 % on the Monte Carlo power.) Runtime about 16 s for the 7 points.
     """
     mc, pred = grid_point(psd, k3, kappa, n_paths, GRID_SEED)
     assert_matches(mc, pred["fpk"], detect=0.005, what=f"MC vs FPK at kappa {kappa}")
@@ -214,7 +214,7 @@ def test_eq32_trusted_up_to_the_quoted_friction_levels(phi, tol, ratio):
     Calibration (tests/calibration/claims.py, ``trust``; seeds 1000-1069):
     z-scores against FPK at the 3 levels over 70 seeds (210 values): mean
     -0.02, SD 1.04, largest |z| 3.2. Eq. 32's error there is about -0.75 %,
-    -4.6 % and -9.9 %. Runtime about 5 s.
+    -4.6 % and -9.9 %. Runtime about 3 s.
     """
     mc, lin, fpk, friction_free = trust_point(phi, TRUST_PATHS, TRUST_SEED)
     assert_matches(mc, fpk, detect=0.01, what=f"MC vs FPK at phi {phi}")

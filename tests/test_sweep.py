@@ -112,7 +112,7 @@ def test_sweep_points_match_the_fpk_reference_at_the_precision_they_report():
     Calibration (tests/calibration/claims.py, ``sweep``; seeds 1000-1023):
     z-scores of the 4 friction points over 24 seeds (96 values; the points of
     one seed share their noise): mean -0.14, SD 1.01, largest |z| 2.2.
-    Runtime about 15 s.
+    Runtime about 3 s.
     """
     _, res = sweep_z_scores(PRECISE.seed, check=True)
     t = res.table
@@ -221,7 +221,7 @@ def test_paired_contrast_intervals_cover_at_their_nominal_rate():
     over SD 1 comes from fitting eight control coefficients on 80 paths
     (800 seeds: SD 0.985 without controls, 1.025 with four-fold
     cross-fitting); the test's acceptance region then fails with probability
-    0.004 per run. Runtime about 20 s.
+    0.004 per run. Runtime about 6 s.
     """
     from scipy import stats
 
