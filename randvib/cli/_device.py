@@ -57,6 +57,8 @@ def harvester_from_args(args) -> Harvester:
         if args.friction == "none":
             friction = None
         elif args.friction == "coulomb":
+            if args.beta is not None:
+                raise ValueError("`--beta` applies to tanh friction, not 'coulomb'")
             fc = args.fc if args.fc is not None else getattr(friction, "fc", None)
             friction = Coulomb(_need(fc, "--fc", "coulomb friction"))
         else:
