@@ -205,3 +205,94 @@ def test_linearisation_accuracy_study_end_to_end(tmp_path):
     assert _mtimes(out) == before
     with pytest.raises(FileExistsError, match="different run"):
         linearisation_accuracy.run_study(out, **{**kw, "seed": 1})
+
+
+# ----------------------------------------------------------------- verdict wording follows the data
+def _inter_rows(contrasts, averaging, holm=(False, False, False, False)):
+    return pd.DataFrame(
+        {
+            "psd": 1.0,
+            "k3": [5e5, 5e5, 5e7, 5e7],
+            "fc": [0.01, 0.02, 0.01, 0.02],
+            "phi": [0.5, 1.0, 0.5, 1.0],
+            "relative_contrast": contrasts,
+            "relative_ci95": 0.002,
+            "detectable": [abs(c) > 0.002 for c in contrasts],
+            "detectable_holm": list(holm),
+            "averaging_relative_contrast": averaging,
+        }
+    )
+
+
+def test_interaction_summary_counts_holm_per_k3_and_describes_averaging():
+    inter = _inter_rows([0.001, -0.001, 0.004, 0.009], [1e-4, 3e-4, 2e-3, 6e-3])
+    verdict, _ = interaction._summary(inter, (0.0, 5e5, 5e7))
+    assert verdict.startswith("No interaction is detectable")
+    assert "±1.10 %" in verdict  # |0.009| + 0.002 at the largest k3
+    assert "all positive contrasts growing in size with k3 and Fc" in verdict
+    counts = interaction.interaction_counts(inter, (0.0, 5e5, 5e7))
+    assert counts["by_k3"]["5e+07"]["n_detectable"] == 2 and counts["n_holm"] == 0
+    inter = _inter_rows(
+        [0.001, -0.001, 0.004, 0.009], [1e-4, 3e-5, 2e-3, 6e-3], holm=(False, False, True, True)
+    )
+    verdict, _ = interaction._summary(inter, (0.0, 5e5, 5e7))
+    assert "detectable (Holm, family level 5 %) at 2 of 4" in verdict
+    assert "2 at k3 = 5e+07" in verdict
+    assert "growing in size with k3 (not monotonically with Fc)" in verdict
+
+
+def test_interaction_linearisation_by_spring_and_scaling_follow_the_data():
+    lin = pd.DataFrame(
+        {
+            "psd": 1.0,
+            "k3": [0.0, 0.0, 5e7, 5e7],
+            "fc": [0.01, 0.02, 0.01, 0.02],
+            "phi": [0.5, 1.0, 0.5, 1.0],
+            "linearisation_rel_error": [-0.01, -0.06, -0.012, -0.05],
+            "linearisation_rel_error_ci95": 0.004,
+        }
+    )
+    data = interaction.linearisation_by_spring(lin)
+    assert data["series_largest_at_top_fc"] == 2 and data["spread"] == pytest.approx(0.01)
+    assert "changes with k3 by up to 1.00 %" in data["sentence"]  # > sqrt(2) * 0.4 %
+    data = interaction.linearisation_by_spring(lin.assign(linearisation_rel_error_ci95=0.008))
+    assert "no resolved dependence on the spring" in data["sentence"]
+    lin.loc[1, "linearisation_rel_error"] = -0.005
+    assert (
+        "largest at the highest Fc in 1 of 2"
+        in interaction.linearisation_by_spring(lin)["where_largest"]
+    )
+    inter = pd.DataFrame({"phi": [0.5, 0.5], "mu": [0.1, 0.1], "relative_contrast": [0.01, 0.01]})
+    assert "i.e. to rounding" in interaction.scaling_sentence(inter)
+    inter.loc[1, "relative_contrast"] = 0.012
+    assert "more than rounding" in interaction.scaling_sentence(inter)
+    assert "no two rows" in interaction.scaling_sentence(inter.assign(mu=[0.1, 0.2]))
+
+
+def test_linearisation_vs_averaging_reading_follows_the_data():
+    from randvib.studies.linearisation_vs_averaging import reading
+
+    df = pd.DataFrame(
+        {
+            "psd": 1.0,
+            "kappa": [0.0, 0.5, 2.0, 0.0, 0.5, 2.0],
+            "k3": [0.0, 0.0, 0.0, 7e6, 7e6, 7e6],
+            "err_linearisation": [0.0, -0.03, -0.09, 0.0, -0.03, -0.09],
+            "err_averaging": [0.0, 0.01, 0.02, 0.0, 0.005, 0.01],
+            "dk3_averaging": [0, 0, 0, 0.0, 0.004, 0.008],
+            "dk3_fpk": [0, 0, 0, 0.0, 0.001, 0.002],
+            "dk3_mc": [0, 0, 0, 0.0, 0.0012, 0.0019],
+            "power_fpk_fast": [1.0, 1.0, 1.0, 1.0, 1.0, 1.0002],
+            "power_fpk": 1.0,
+        }
+    )
+    text = reading(df, {"fpk_fast_point_s": 0.002})
+    assert "underestimates the power at every point with friction, increasingly with kappa" in text
+    assert "at most 0.33 times linearisation's, and shrinks as k3" in text
+    assert "overstates it (4.0-4.0x) relative to the FPK reference, with the right sign" in text
+    assert "at most 0.19 % there" in text and "within 0.020 % at every point, at 2.0 ms" in text
+    df.loc[2, "err_linearisation"] = 0.01
+    df.loc[5, "dk3_averaging"] = -0.001
+    text = reading(df)
+    assert "underestimates the power at 3 of 4 points" in text and "not monotonically" in text
+    assert "wrong sign" in text and "ms a point" not in text
