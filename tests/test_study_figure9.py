@@ -32,14 +32,17 @@ def test_figure9_power_matches_fpk_and_linearisation_under_predicts(figure9_quic
 
     Power: the quick run's standard errors are at most 0.5 % of the power, so
     each comparison detects a 3 % bias (``detect=0.03``), half of Eq. 32's
-    error at the highest friction (about -6 %). Calibration over 20 seeds
-    (36 points each): see tests/calibration/studies.py and the numbers below.
+    error at the highest friction (about -6 %). Calibration
+    (tests/calibration/studies.py, seeds 0-19, 36 points each, 720 z-scores,
+    correlated within a seed through common random numbers): mean -0.22,
+    SD 0.90, largest |z| 2.48.
 
     The verdict asserted from these numbers: at the highest Fc of every (S, k3)
     series Eq. 32 under-predicts the power by more than 4 standard errors of
     the Monte Carlo estimate, and the FPK grids, with no sampling error, give
     an Eq. 32 error of the same sign there; the study's verdict data count
-    exactly these outside points, and no over-prediction.
+    exactly these outside points, and no over-prediction. Over the 20 seeds
+    the least negative of these z-scores was -10.9.
     """
     out, _ = figure9_quick
     table = pd.read_csv(out / "results.csv")
@@ -69,11 +72,16 @@ def test_figure9_power_matches_fpk_and_linearisation_under_predicts(figure9_quic
 def test_figure9_interaction_not_detectable_at_paper_k3(figure9_quick):
     """The paper's second claim at k3 = 5e5: no interaction detectable at this precision.
 
-    Each paired contrast equals the FPK contrast within 4 standard errors;
-    the FPK contrast itself is below one standard error at every point, so
-    "not detectable" is what the exact answer predicts at this precision. The
-    study's verdict data: 0 contrasts significant after Holm, and the largest
-    relative contrast and its interval as in interaction.csv.
+    Each paired contrast equals the FPK contrast within 4 standard errors
+    (calibration, seeds 0-19, 360 z-scores: mean +0.04, SD 1.11, largest |z|
+    3.42); the FPK contrast itself is below one standard error at every
+    point, so "not detectable" is what the exact answer predicts at this
+    precision, and the verdict is asserted at the 4-sigma level: no contrast
+    is more than 4 standard errors from zero. The report's own verdict uses
+    Holm at family level 5 %; over the 20 seeds it counted 0 significant
+    contrasts in 18 (a 5 % test on correlated contrasts whose z-scores have SD
+    1.11), so its count is checked against interaction.csv and the sentence,
+    not pinned to 0.
     """
     out, _ = figure9_quick
     inter = pd.read_csv(out / "interaction.csv")
@@ -81,14 +89,17 @@ def test_figure9_interaction_not_detectable_at_paper_k3(figure9_quick):
     z = contrast_zscores(inter)
     assert (z.z.abs() <= 4).all(), z[["psd", "fc", "z"]]
     assert (z.fpk_contrast.abs() < z.se).all()
+    assert (inter.contrast.abs() <= 4 * z.se).all()
     verdict = json.loads((out / "verdicts.json").read_text())["interaction"]
-    assert verdict["n_holm"] == 0 == int(inter.detectable_holm.sum())
+    assert verdict["n_holm"] == int(inter.detectable_holm.sum())
     big = inter.loc[inter.relative_contrast.abs().idxmax()]
     assert verdict["largest_relative_contrast"] == pytest.approx(big.relative_contrast, rel=1e-12)
     assert verdict["largest_relative_ci95"] == pytest.approx(big.relative_ci95, rel=1e-12)
-    assert abs(big.relative_contrast) < 4 * big.relative_ci95 / 1.96
     report = (out / "report.md").read_text()
-    assert "no interaction is detectable at this precision (0 of 18" in report
+    if verdict["n_holm"] == 0:
+        assert "no interaction is detectable at this precision (0 of 18" in report
+    else:
+        assert f"an interaction is detectable at {verdict['n_holm']} of 18" in report
 
 
 def test_figure9_half_step_bias_below_statistical_error(figure9_quick):
@@ -97,6 +108,8 @@ def test_figure9_half_step_bias_below_statistical_error(figure9_quick):
     The linearised Heun bias at dt = 1e-4 s is below 1e-4 relative
     (randvib.simulation.step_bias), far below the combined standard error
     (about 0.3 %), so the difference must be consistent with zero.
+    Calibration (seeds 0-19, 120 z-scores): mean -0.24, SD 0.86, largest
+    |z| 1.89.
     """
     out, _ = figure9_quick
     check = pd.read_csv(out / "step_check.csv")

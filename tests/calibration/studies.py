@@ -8,6 +8,12 @@ power against the FPK grids at every point with friction, paired interaction
 contrasts against the FPK contrasts, and the half-step differences; plus how
 often the Holm count at k3 = 5e5 is zero and how often Eq. 32 is more than
 4 standard errors low at every series' highest friction.
+
+Result (seeds 0-19, recorded in tests/test_study_figure9.py):
+power 720 z-scores, mean -0.219, SD 0.904, max |z| 2.48; contrast 360,
+mean +0.043, SD 1.114, max |z| 3.42; step 120, mean -0.240, SD 0.862,
+max |z| 1.89; Holm count 0 at k3 = 5e5 in 18 of 20 seeds; largest Eq. 32
+z at the top friction -10.89.
 """
 
 import sys
