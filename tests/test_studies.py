@@ -296,3 +296,35 @@ def test_linearisation_vs_averaging_reading_follows_the_data():
     text = reading(df)
     assert "underestimates the power at 3 of 4 points" in text and "not monotonically" in text
     assert "wrong sign" in text and "ms a point" not in text
+
+
+def test_interaction_contrasts_holm_at_family_level(monkeypatch):
+    """Holm's step-down at 5 % over the family, on contrasts with known z-scores.
+
+    z = 2.2, 2.1, 0.5 give p = 0.028, 0.036, 0.62: two pass on their own at
+    5 %, none after Holm (0.028 > 0.05 / 3); at a 10 % family level two would.
+    """
+    from types import SimpleNamespace
+
+    from randvib.simulation import Statistic
+    from randvib.studies import _common
+
+    points = [{"fc": fc, "k3": k3} for k3 in (0.0, 1.0) for fc in (0.0, 0.1, 0.2, 0.3)]
+    table = pd.DataFrame(
+        {"point": range(8), "power_electrical": 1.0, "power_electrical_ci95": 0.01}
+    )
+    result = SimpleNamespace(points=points, table=table)
+    z_of_point = {5: 2.2, 6: -2.1, 7: 0.5}
+
+    def fake_contrast(result, base, weights):
+        i = max(weights)  # the (fc, k3) point itself has the largest index
+        return Statistic(z_of_point[i] * 1e-3, 1.96e-3, 1e-3, 100)
+
+    monkeypatch.setattr(_common, "paired_contrast", fake_contrast)
+    inter = _common.interaction_contrasts(result, BASE, "fc", "k3")
+    assert inter.fc.tolist() == [0.1, 0.2, 0.3]
+    assert inter.detectable.tolist() == [True, True, False]
+    assert inter.detectable_holm.tolist() == [False, False, False]
+    z_of_point[5], z_of_point[6] = 2.5, -2.3  # p = 0.012 <= 0.05 / 3, then 0.021 <= 0.05 / 2
+    inter = _common.interaction_contrasts(result, BASE, "fc", "k3")
+    assert inter.detectable_holm.tolist() == [True, True, False]
