@@ -228,35 +228,8 @@ def _study(capsys, name, out):
     return (out / "report.md").read_text()
 
 
-def test_study_interaction_cli(tmp_path, capsys, monkeypatch):
-    from randvib.studies import interaction
-
-    monkeypatch.setattr(
-        interaction, "grid", lambda quick: {"psds": (0.1,), "k3s": (0.0, 5e7), "n_fc": 2}
-    )
-    monkeypatch.setattr(interaction, "settings_for", lambda quick, seed: TINY)
-    out = tmp_path / "inter"
-    report = _study(capsys, "interaction", out)
-    verdict = json.loads((out / "verdicts.json").read_text())["interaction"]
-    assert verdict["n_contrasts"] == 1 and set(verdict["by_k3"]) == {"5e+07"}
-    assert "Duffing-Coulomb interaction beyond the paper's k3" in report
-
-
-def test_study_linearisation_accuracy_cli(tmp_path, capsys, monkeypatch):
-    from randvib.studies import linearisation_accuracy as la
-
-    monkeypatch.setattr(la, "grid", lambda quick: {"series": ((1.0, 0.0, 0.1),), "phis": (2.0,)})
-    monkeypatch.setattr(la, "settings_for", lambda quick, seed, series: TINY)
-    out = tmp_path / "acc"
-    report = _study(capsys, "linearisation-accuracy", out)
-    import pandas as pd
-
-    table = pd.read_csv(out / "results.csv")
-    assert len(table) == 1 and table.phi[0] == pytest.approx(2.0)
-    # the sentence states the trusted range the thresholds table holds
-    limits = pd.read_csv(out / "thresholds.csv")
-    assert la.limit_text(limits.phi_10pct[0], (2.0,)) in report
-    assert "from the single S = 1 series" in report
+# `study interaction` and `study linearisation-accuracy` from the CLI: the end-to-end
+# tests in tests/test_studies.py run them through main() with a monkeypatched grid.
 
 
 def test_study_identification_cli(tmp_path, capsys, monkeypatch):

@@ -1,9 +1,12 @@
 """Studies ``interaction`` and ``linearisation-accuracy``: building blocks and tiny end-to-end runs.
 
-The end-to-end runs use a grid of a few points, short windows and one
-process (private ``_grid``/``_settings`` overrides), so they check the
-plumbing (files, verdicts, resuming, refusing another run's folder) and the
-exact scaling laws, not the studies' numbers.
+The end-to-end runs go through ``randvib study NAME --quick`` (in-process
+``main``) with the quick grid and settings monkeypatched to a few points and
+short windows, so they check the command-line path, the verdict data against
+the CSV tables, the interaction contrast against the FPK grids, resuming,
+refusing another run's folder (through the private ``_grid``/``_settings``
+overrides) and the exact scaling laws; the verdict wording itself is checked
+on synthetic tables below.
 """
 
 import json
@@ -14,6 +17,7 @@ import pytest
 from study_checks import contrast_zscores
 
 import randvib as rv
+from randvib.cli import main
 from randvib.prediction import expected_power
 from randvib.studies import interaction, linearisation_accuracy
 from randvib.studies._common import (
@@ -125,11 +129,20 @@ def _mtimes(folder):
     return {p.name: p.stat().st_mtime_ns for p in sorted((folder / "sweep" / "points").glob("*"))}
 
 
-def test_interaction_study_end_to_end(tmp_path):
+def _cli_study(name, out, capsys):
+    """``randvib study NAME --quick`` in-process; the quick grid is monkeypatched small."""
+    argv = ["study", name, "--quick", "--out", str(out), "--workers", "1", "--no-progress"]
+    assert main(argv) == 0
+    assert capsys.readouterr().out.strip() == f"report: {out / 'report.md'}"
+    return out / "report.md"
+
+
+def test_interaction_study_end_to_end(tmp_path, monkeypatch, capsys):
     grid = {"psds": (1.0,), "k3s": (0.0, 5e7), "n_fc": 2}
     out = tmp_path / "inter"
-    kw = dict(workers=1, progress=False, _grid=grid, _settings=TINY)
-    report = interaction.run_study(out, **kw)
+    monkeypatch.setattr(interaction, "grid", lambda quick: grid)
+    monkeypatch.setattr(interaction, "settings_for", lambda quick, seed: TINY)
+    report = _cli_study("interaction", out, capsys)
     inter = pd.read_csv(out / "interaction.csv")
     assert len(inter) == 1 and inter.k3[0] == 5e7 and inter.fc[0] > 0
     # (The Fc = 0 bracket, zero through the companion control by construction,
@@ -159,19 +172,20 @@ def test_interaction_study_end_to_end(tmp_path):
 
     # same run again: resumes from the stored points, recomputes nothing
     before = _mtimes(out)
-    interaction.run_study(out, **kw)
+    _cli_study("interaction", out, capsys)
     assert _mtimes(out) == before
     assert pd.read_csv(out / "interaction.csv").equals(inter)
 
     with pytest.raises(FileExistsError, match="different run"):
-        interaction.run_study(out, **{**kw, "_grid": {**grid, "n_fc": 3}})
+        interaction.run_study(out, quick=True, workers=1, _grid={**grid, "n_fc": 3}, _settings=TINY)
 
 
-def test_linearisation_accuracy_study_end_to_end(tmp_path):
+def test_linearisation_accuracy_study_end_to_end(tmp_path, monkeypatch, capsys):
     grid = {"series": ((1.0, 0.0, 0.1), (10.0, 0.0, 0.1)), "phis": (0.5, 3.0)}
     out = tmp_path / "acc"
-    kw = dict(workers=1, progress=False, _grid=grid, _settings=TINY)
-    report = linearisation_accuracy.run_study(out, **kw)
+    monkeypatch.setattr(linearisation_accuracy, "grid", lambda quick: grid)
+    monkeypatch.setattr(linearisation_accuracy, "settings_for", lambda quick, seed, series: TINY)
+    report = _cli_study("linearisation-accuracy", out, capsys)
     table = pd.read_csv(out / "results.csv")
     assert np.allclose(table.phi, np.tile([0.5, 3.0], 2))
     # k3 = 0: the series at S = 1 and 10 are the same paths rescaled (exact scaling)
@@ -201,10 +215,10 @@ def test_linearisation_accuracy_study_end_to_end(tmp_path):
     assert meta["study"] == "linearisation-accuracy" and meta["grid"]["phis"] == [0.5, 3.0]
 
     before = _mtimes(out)
-    linearisation_accuracy.run_study(out, **kw)
+    _cli_study("linearisation-accuracy", out, capsys)
     assert _mtimes(out) == before
     with pytest.raises(FileExistsError, match="different run"):
-        linearisation_accuracy.run_study(out, **{**kw, "seed": 1})
+        linearisation_accuracy.run_study(out, quick=True, seed=1, _grid=grid, _settings=TINY)
 
 
 # ----------------------------------------------------------------- verdict wording follows the data
