@@ -153,6 +153,7 @@ def test_linearisation_verdict_follows_the_data():
     assert (
         "all of them in the upper half" in text and "under-predicts the power at every one" in text
     )
+    assert "Fc = 30, 40 mN" in text
     data, text = linearisation_verdict(_table([0.03, -0.002, -0.001, 0.06], [0, 1, 1, 0]))
     assert (data["n_under"], data["n_over"], data["n_outside_high_friction"]) == (0, 2, 1)
     assert "over-predicts the power at every one" in text and "1 of them in the upper" in text
@@ -161,6 +162,8 @@ def test_linearisation_verdict_follows_the_data():
     assert data["n_outside"] == 0 and "not distinguishable" in text
     data, text = linearisation_verdict(_table([-0.03, 0.0, 0.0, 0.04], [0, 1, 1, 0]))
     assert "under-predicts at 1 and over-predicts at 1" in text
+    data, text = linearisation_verdict(_table([-0.03, -0.02, -0.05, -0.06], [0, 0, 0, 0]))
+    assert "(every point with friction)" in text and "2 of them in the upper half" in text
 
 
 def test_interaction_verdict_follows_the_data():

@@ -350,7 +350,7 @@ def step_check_verdict(check: pd.DataFrame) -> dict:
         "largest_difference_over_ci95": float(worst),
     }
     if n_below == len(check):
-        data["sentence"] = ": the time-step bias is below the statistical error"
+        data["sentence"] = f" (largest difference {worst:.2f} times the combined 95 % half-width)"
     else:
         data["sentence"] = (
             f"; at {len(check) - n_below} the half-step estimate differs by more than the "

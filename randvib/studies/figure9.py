@@ -186,10 +186,15 @@ def linearisation_verdict(table: pd.DataFrame) -> tuple[dict, str]:
             sign = "Eq. 32 over-predicts the power at every one"
         else:
             sign = f"Eq. 32 under-predicts at {under} and over-predicts at {over}"
+        levels = (
+            "every point with friction"
+            if len(outside) == n_friction and (outside.fc > 0).all()
+            else _levels(outside)
+        )
         sentence = (
             f"Eq. 32 is outside the Monte Carlo 95 % interval at {len(outside)} of {len(table)} "
             f"points ({chance} among the {n_friction} with friction), {where} "
-            f"({_levels(outside)}); {sign}."
+            f"({levels}); {sign}."
         )
         if over == 0 and len(outside) > data["expected_by_chance"]:
             sentence += (
