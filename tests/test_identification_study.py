@@ -27,3 +27,20 @@ def test_synthetic_tests_are_increasing_and_noisy():
     noise = noisy.z - clean.z
     assert 1e-6 < np.std(noise) < 4e-6 and noisy.input_kind == "base_displacement"
     assert np.mean(v == 0) < 0.5 and TRUTH["fc"] == 0.0058
+
+
+def test_figure8_verdict_follows_the_shares():
+    import pandas as pd
+
+    from randvib.studies.identification import MEASURED, SIMULATED, figure8_verdict
+
+    def table(m6, mlow, coulomb, viscous):
+        rows = [("test 6", "coulomb", 0.0, m6), ("test 6", "viscous", 0.0, m6)]
+        rows += [("low", "coulomb", coulomb, mlow), ("low", "viscous", viscous, mlow)]
+        return pd.DataFrame(rows, columns=["excitation", "model", SIMULATED, MEASURED])
+
+    text = figure8_verdict(table(0.02, 0.2, 0.18, 0.03))
+    assert "2.0 % of the measured samples" in text and "20.0 % at the low level" in text
+    assert "clearer at the low level" in text and "further from the measured share" in text
+    text = figure8_verdict(table(0.1, 0.12, 0.05, 0.11))
+    assert "no clearer spike" in text and "no further from the measured share" in text

@@ -102,6 +102,10 @@ def _friction_from_args(args, friction):
         if args.friction == "none":
             return None
         law = FRICTION_MODELS[args.friction]
+        for name in given:  # refuse, rather than silently ignore, another law's option
+            if name not in law.parameter_names():
+                laws = ", ".join(other.name for other in options[name])
+                raise ValueError(f"`--{name}` applies to {laws} friction, not {law.name!r}")
         # A parameter not given keeps the preset's value where its law has it.
         values = {n: given.get(n, getattr(friction, n, None)) for n in law.parameter_names()}
         return law(**{n: _need(x, "--" + n, f"{law.name} friction") for n, x in values.items()})

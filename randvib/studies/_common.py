@@ -338,3 +338,23 @@ def sweep_with_step_check(
     finally:
         close()
     return result, check
+
+
+def step_check_verdict(check: pd.DataFrame) -> dict:
+    """Half-step re-run: how many points agree within the combined 95 % half-width."""
+    n_below = int(check.bias_below_error.sum())
+    worst = (check.difference.abs() / check.combined_ci95).max()
+    data = {
+        "n_points": len(check),
+        "n_below": n_below,
+        "largest_difference_over_ci95": float(worst),
+    }
+    if n_below == len(check):
+        data["sentence"] = f" (largest difference {worst:.2f} times the combined 95 % half-width)"
+    else:
+        data["sentence"] = (
+            f"; at {len(check) - n_below} the half-step estimate differs by more than the "
+            f"combined 95 % half-width (largest {worst:.2f} times it; "
+            f"{0.05 * len(check):.1f} expected by chance)"
+        )
+    return data
