@@ -19,6 +19,7 @@ from study_checks import contrast_zscores
 import randvib as rv
 from randvib.analytic.prediction import expected_power
 from randvib.cli import main
+from randvib.montecarlo.sweep import SweepSettings
 from randvib.studies import interaction, linearisation_accuracy
 from randvib.studies._common import (
     fc_at_friction_level,
