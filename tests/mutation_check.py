@@ -392,14 +392,23 @@ class Outcome:
         return f"{self.mutation.name}: {verdict} in {self.seconds:.0f} s ({shown})"
 
 
-def run_mutant(
-    mutation: Mutation, workdir: Path, full: bool = False, timeout: float = 900
-) -> Outcome:
-    """Copy the project under ``workdir``, mutate it and run the mutation's tests."""
+def prepare_mutant(mutation: Mutation, workdir: Path) -> Path:
+    """Copy the project under ``workdir`` and mutate the copy; returns its root.
+
+    Not thread-safe (``ast.parse`` of CPython 3.11 is not re-entrant across
+    threads): prepare mutants one at a time, then run them concurrently.
+    """
     root = workdir / "project"
     copy_project(root)
     apply(mutation, root)
     drop_stale_numba_caches(root, mutation)
+    return root
+
+
+def run_prepared(
+    mutation: Mutation, root: Path, full: bool = False, timeout: float = 900
+) -> Outcome:
+    """Run the mutation's tests (or the whole suite) in a prepared mutant copy."""
     env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTEST_ADDOPTS")}
     env["MPLBACKEND"] = "Agg"
     # the mutant must be what the tests import (python -m puts the cwd first on sys.path)
@@ -423,6 +432,13 @@ def run_mutant(
     return Outcome(
         mutation, proc.returncode, proc.stdout + proc.stderr, time.perf_counter() - start
     )
+
+
+def run_mutant(
+    mutation: Mutation, workdir: Path, full: bool = False, timeout: float = 900
+) -> Outcome:
+    """Copy the project under ``workdir``, mutate it and run the mutation's tests."""
+    return run_prepared(mutation, prepare_mutant(mutation, workdir), full=full, timeout=timeout)
 
 
 def main(argv=None) -> int:

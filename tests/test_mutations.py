@@ -36,14 +36,18 @@ def outcomes(tmp_path_factory):
     so two concurrent runs keep a two-core machine busy and halve the wall time.
     """
     root = tmp_path_factory.mktemp("mutants")
-
-    def run(mutation):
+    prepared = []
+    for mutation in mc.MUTATIONS:  # serially: copying and parsing is not thread-safe
         work = root / mutation.name
         work.mkdir()
-        return mutation.name, mc.run_mutant(mutation, work)
+        prepared.append((mutation, mc.prepare_mutant(mutation, work)))
+
+    def run(item):
+        mutation, project = item
+        return mutation.name, mc.run_prepared(mutation, project)
 
     with ThreadPoolExecutor(max_workers=2) as pool:
-        return dict(pool.map(run, mc.MUTATIONS))
+        return dict(pool.map(run, prepared))
 
 
 @pytest.mark.slow
