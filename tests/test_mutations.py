@@ -55,3 +55,9 @@ def outcomes(tmp_path_factory):
 def test_suite_catches_the_mutation(mutation, outcomes):
     outcome = outcomes[mutation.name]
     assert outcome.caught, outcome.summary() + "\n" + outcome.output[-3000:]
+
+
+def test_docs_list_every_mutation():
+    text = (mc.ROOT / "docs" / "testing.md").read_text()
+    missing = [m.name for m in mc.MUTATIONS if f"`{m.name}`" not in text]
+    assert not missing, f"docs/testing.md does not list {missing}"
