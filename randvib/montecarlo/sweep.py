@@ -404,6 +404,13 @@ def paired_contrast(result: SweepResult, base: Harvester, weights: Mapping[int, 
     (they differ only in their initial state), which makes the fitted
     coefficients unstable and, over repeated seeds, the reported interval
     too narrow.
+
+    Coverage, measured over repeated seeds against the FPK interaction
+    (``tests/test_sweep.py``): with 20 paths per control the 95 % interval
+    covers 95.0 %; with 10 per control, the fewest for which the controls are
+    used, it covers about 94 % (the energy controls absorb nearly all the
+    variance, and the residuals of few paths are not quite Gaussian), so
+    give a contrast at least 20 paths per control where its interval matters.
     """
     from randvib.montecarlo import kernel
 
