@@ -221,14 +221,22 @@ class AveragingResult:
     zeta_friction: object
 
 
+def turning_point_squared(h, omega2, lam):
+    """A^2 (m^2) of the undamped orbit at energy ``h`` per unit mass (J/kg).
+
+    The positive root of G(A) = omega2 (A^2/2 + lam A^4/4) = h, with
+    omega2 = k/m and lam = k3/k, written without cancellation. Also the
+    z half-width of the FPK solvers' boxes.
+    """
+    return 4.0 * h / omega2 / (1.0 + np.sqrt(1.0 + 4.0 * lam * h / omega2))
+
+
 def _orbit(x, omega, lam):
     """Orbit integrals at energies H = x^2 (J/kg) for omega^2 = k/m, lam = k3/k.
 
     Returns amplitude A, period T, area Phi = T <v^2>, and T <z^2>.
     """
-    h = x * x
-    # A^2 from omega^2 (A^2/2 + lam A^4/4) = H, written without cancellation.
-    a2 = 4.0 * h / omega**2 / (1.0 + np.sqrt(1.0 + 4.0 * lam * h / omega**2))
+    a2 = turning_point_squared(x * x, omega**2, lam)
     amp = np.sqrt(a2)
     q = np.sqrt(1.0 + (lam * a2)[..., None] * (0.5 * (1.0 + _SIN2)))
     inv_q = np.mean(1.0 / q, axis=-1)
@@ -257,17 +265,20 @@ def _quarter_friction_work(amp, omega, lam, fcm, beta):
     return fcm * amp * np.where(np.isinf(beta), 1.0, frac)
 
 
-def _x_max(gamma, fcm, dd):
-    """End of the x = sqrt(H) grid, where the linear-spring Psi reaches 70.
+def linear_psi_root(gamma, fcm, dd, psi):
+    """x = sqrt(H) at which the linear-spring averaged exponent reaches ``psi``.
 
-    Psi for the linear spring, a x^2 + b x, bounds the true Psi from above
-    and from below within 10 % for Coulomb friction (the orbit shape factor
-    Phi / (A v_max) only moves from pi to 3.50 as k3 A^2 / k grows), so the
-    density at the grid's end is below exp(-60).
+    For the linear spring with viscous damping gamma (1/s), Coulomb level
+    fcm (N/kg) and noise intensity dd = D (m^2/s^3), Psi = a x^2 + b x with
+    a = 2 gamma/D and b = 8 sqrt(2) fcm/(pi D); this solves a x^2 + b x = psi
+    without cancellation. It bounds the true Psi from above and from below
+    within 10 % for Coulomb friction (the orbit shape factor Phi / (A v_max)
+    only moves from pi to 3.50 as k3 A^2 / k grows), so it sizes the energy
+    grid here and the box of the fast FPK solver.
     """
     a = 2.0 * gamma / dd
     b = 8.0 * np.sqrt(2.0) * fcm / (np.pi * dd)
-    return 2.0 * _PSI_END / (b + np.sqrt(b * b + 4.0 * a * _PSI_END))
+    return 2.0 * psi / (b + np.sqrt(b * b + 4.0 * a * psi))
 
 
 def _moments(m, c, k, k3, fc, beta, psd):
@@ -277,7 +288,8 @@ def _moments(m, c, k, k3, fc, beta, psd):
     normaliser Z = int T exp(-Psi) dH.
     """
     gamma, omega, lam, fcm, dd = c / m, np.sqrt(k / m), k3 / k, fc / m, 0.5 * psd
-    x_max = _x_max(gamma, fcm, dd)
+    # The density at the grid's end is below exp(-60) (see linear_psi_root).
+    x_max = linear_psi_root(gamma, fcm, dd, _PSI_END)
     col = (slice(None), None)
     for _ in range(30):
         out = _moments_on_grid(x_max, gamma[col], omega[col], lam[col], fcm[col], beta[col], dd)
