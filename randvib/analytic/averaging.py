@@ -84,6 +84,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from randvib._validation import check_nonnegative, check_positive
+from randvib.models.friction import one_minus_tanh
 from randvib.models.harvester import Harvester
 
 __all__ = [
@@ -252,9 +253,7 @@ def _tanh_fraction(amp, omega, lam, beta):
     cos2 = np.cos(_TANH_T) ** 2  # sin^2(phi) at phi = pi/2 - t
     q = np.sqrt(1.0 + (lam * a2)[..., None] * (0.5 * (1.0 + cos2)))
     arg = (beta * omega * amp)[..., None] * np.sin(_TANH_T) * q
-    # 1 - tanh(y) = 2 / (1 + exp(2y)), accurate where tanh(y) rounds to 1.
-    one_minus = 2.0 / (1.0 + np.exp(np.minimum(2.0 * arg, 700.0)))
-    return 1.0 - np.sum(one_minus * np.sin(_TANH_T) * _TANH_W, axis=-1)
+    return 1.0 - np.sum(one_minus_tanh(arg) * np.sin(_TANH_T) * _TANH_W, axis=-1)
 
 
 def _quarter_friction_work(amp, omega, lam, fcm, beta):
