@@ -83,7 +83,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from randvib._validation import check_nonnegative, check_positive
+from randvib._validation import check_nonnegative, check_positive, scalar_or_array
 from randvib.models.friction import one_minus_tanh
 from randvib.models.harvester import Harvester
 
@@ -264,6 +264,14 @@ def _quarter_friction_work(amp, omega, lam, fcm, beta):
     return fcm * amp * np.where(np.isinf(beta), 1.0, frac)
 
 
+def _psi_slope(x, gamma, dd, area, work):
+    """dPsi/dx at x = sqrt(H): 2x (2 gamma/D + 8 J/(D Phi)) (module docstring).
+
+    ``area`` is Phi(H) and ``work`` J(H); finite at x -> 0 because J/Phi ~ 1/x.
+    """
+    return 2.0 * x * (2.0 * gamma / dd + 8.0 * work / (dd * area))
+
+
 def linear_psi_root(gamma, fcm, dd, psi):
     """x = sqrt(H) at which the linear-spring averaged exponent reaches ``psi``.
 
@@ -306,9 +314,7 @@ def _moments_on_grid(x_max, gamma, omega, lam, fcm, beta, dd):
     w = x_max[:, None] * _W_UNIT
     amp, period, area, t_z2 = _orbit(x, omega, lam)
     work = _quarter_friction_work(amp, omega, lam, fcm, beta)
-    ddc = dd[:, None]
-    # dPsi/dx = 2x dPsi/dH; finite at x -> 0 because J/Phi ~ 1/x there.
-    dpsi = 2.0 * x * (2.0 * gamma / ddc + 8.0 * work / (ddc * area))
+    dpsi = _psi_slope(x, gamma, dd[:, None], area, work)
     panels = dpsi.reshape(len(x_max), _N_PANELS, _N_GL)
     half = x_max[:, None, None] * _HALF_UNIT[None, :, None]
     within = half * np.einsum("ij,bpj->bpi", _GL_Q, panels)  # from each panel's start
@@ -418,8 +424,7 @@ def averaging_statistics(harvester: Harvester, psd, *, warn: bool = True) -> Ave
         )
 
     def shaped(a):
-        a = a.reshape(shape)
-        return float(a) if a.ndim == 0 else a
+        return scalar_or_array(a.reshape(shape))
 
     return AveragingResult(
         velocity_variance=shaped(vv),
@@ -491,8 +496,7 @@ def energy_density(harvester: Harvester, psd, energy):
     # Psi(x_e) by Gauss-Legendre on [0, x_e] with the same panel rule.
     nodes = x_e[:, None] * _X_UNIT
     amp, _, area, _ = _orbit(nodes, omega, lam)
-    work = _quarter_friction_work(amp, omega, lam, fcm, beta)
-    dpsi = 2.0 * nodes * (2.0 * gamma / dd + 8.0 * work / (dd * area))
+    dpsi = _psi_slope(nodes, gamma, dd, area, _quarter_friction_work(amp, omega, lam, fcm, beta))
     psi = np.where(x_true > 0, np.sum(dpsi * (x_e[:, None] * _W_UNIT), axis=1), 0.0)
     _, period, _, _ = _orbit(x_true, omega, lam)
     # Normalisation Z = int T exp(-Psi) dH, from the moment grid.

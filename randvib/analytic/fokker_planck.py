@@ -50,7 +50,7 @@ from scipy import sparse
 from scipy.linalg import lapack
 from scipy.sparse import linalg as sparse_linalg
 
-from randvib._validation import check_int, check_positive
+from randvib._validation import check_int, check_positive, scalar_or_array
 from randvib.analytic.averaging import (
     linear_psi_root,
     memoryless_parameters,
@@ -321,7 +321,7 @@ def fpk_statistics(harvester: Harvester, psd, n: int = 160):
         ):
             a_f, a_c = getattr(fine, name), getattr(coarse, name)
             out[(row,) + index] = (4.0 * a_f - a_c) / 3.0
-    return tuple(float(o) if o.ndim == 0 else o for o in out)
+    return tuple(scalar_or_array(o) for o in out)
 
 
 # ---------------------------------------------------------------------------
@@ -538,7 +538,7 @@ def fast_fpk_statistics(harvester: Harvester, psd, *, nz=FAST_NZ, nv=FAST_NV):
     for index in np.ndindex(shape):
         m, c, k, k3, fc, beta, s = (float(a[index]) for a in arrays)
         out[(slice(None),) + index] = _fast_point(m, c, k, k3, fc / m, beta, 0.5 * s, nzs, nvs)
-    return tuple(float(o) if o.ndim == 0 else o for o in out)
+    return tuple(scalar_or_array(o) for o in out)
 
 
 def _grid_pair(name, value):

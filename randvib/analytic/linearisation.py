@@ -29,7 +29,7 @@ import warnings
 
 import numpy as np
 
-from randvib._validation import check_choice, check_positive
+from randvib._validation import check_choice, check_positive, scalar_or_array
 from randvib.models.friction import coulomb_equivalent_damping
 from randvib.models.harvester import Harvester
 
@@ -136,7 +136,7 @@ def equivalent_damping(harvester: Harvester, psd, expectation: str = "auto", *, 
     result = np.broadcast_to(
         result, np.broadcast_shapes(np.shape(result), np.shape(psd), np.shape(m))
     )
-    return float(result) if result.ndim == 0 else np.array(result)
+    return scalar_or_array(np.array(result))
 
 
 def linear_displacement_variance(harvester: Harvester, velocity_variance):
