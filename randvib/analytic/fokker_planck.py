@@ -112,7 +112,7 @@ def _friction_potential(v, fcm, beta):
     return fcm / beta * (y + np.log1p(np.exp(-2.0 * y)) - np.log(2.0))
 
 
-def _sg_weights(v, gamma, fcm, beta, dd):
+def _sg_weights(v, point):
     """Scharfetter-Gummel weights B(-dW), B(dW) on the faces between v cells.
 
     W(v) = (2/D) (gamma v^2/2 + int_0^v f) is the potential of damping,
@@ -120,17 +120,18 @@ def _sg_weights(v, gamma, fcm, beta, dd):
     j+1 is -(D/2)/h_v [B(-dW) p_{j+1} - B(dW) p_j], exact for the velocity
     relaxation at fixed z whatever the cell Peclet number.
     """
-    dw = np.diff((2.0 / dd) * (0.5 * gamma * v**2 + _friction_potential(v, fcm, beta)))
+    pot = 0.5 * point.gamma * v**2 + _friction_potential(v, point.fcm, point.beta)
+    dw = np.diff((2.0 / point.dd) * pot)
     return _bernoulli(-dw), _bernoulli(dw)
 
 
-def _box_half_widths(m, k, k3, e_edge):
+def _box_half_widths(point, e_edge):
     """Half-widths (Z, V) (m, m/s) of the box cut at energy ``e_edge`` per unit mass.
 
     V = sqrt(2 e_edge); Z is the turning point of the Duffing well at that
     energy (the quartic root of G(Z) = e_edge).
     """
-    z_max = np.sqrt(turning_point_squared(e_edge, k / m, k3 / k))
+    z_max = np.sqrt(turning_point_squared(e_edge, point.k / point.m, point.k3 / point.k))
     return z_max, np.sqrt(2.0 * e_edge)
 
 
@@ -144,28 +145,61 @@ class _Cells:
     hv: float
 
 
-def _reference_cells(harvester, psd, m, k, k3, nz, nv):
+@dataclass(frozen=True)
+class _Point:
+    """One parameter point of the balance, in the per-unit-mass form of the SDE.
+
+    Attributes
+    ----------
+    m, k, k3 : float
+        Mass (kg) and spring constants (N/m, N/m^3) of the well.
+    gamma : float
+        Viscous damping c/m (1/s).
+    fcm, beta : float
+        Friction level Fc/m (N/kg) and tanh sharpness (s/m); ``beta = inf``
+        is Coulomb friction.
+    dd : float
+        Noise intensity D = S/2 on the velocity (m^2/s^3).
+    """
+
+    m: float
+    k: float
+    k3: float
+    gamma: float
+    fcm: float
+    beta: float
+    dd: float
+
+    @classmethod
+    def from_parameters(cls, m, c, k, k3, fc, beta, psd):
+        """From the scalars of :func:`randvib.analytic.averaging.memoryless_parameters`."""
+        return cls(m=m, k=k, k3=k3, gamma=c / m, fcm=fc / m, beta=beta, dd=0.5 * psd)
+
+
+def _reference_cells(harvester, point, nz, nv):
     """Equal cells on the whole box, v = 0 on a face (``nv`` even).
 
     The box is set from the linearised velocity variance: friction only thins
     the tails of the density.
     """
+    psd, m = 2.0 * point.dd, point.m
     var_v = psd * m / (4.0 * float(equivalent_damping(harvester, psd)))
-    z_max, v_max = _box_half_widths(m, k, k3, _ENERGY_EDGE * var_v)
+    z_max, v_max = _box_half_widths(point, _ENERGY_EDGE * var_v)
     hz, hv = 2.0 * z_max / nz, 2.0 * v_max / nv
     z = -z_max + hz * (np.arange(nz) + 0.5)
     v = -v_max + hv * (np.arange(nv) + 0.5)
     return _Cells(z, v, hz, hv)
 
 
-def _reference_operator(cells, gamma, g, fcm, beta, dd):
+def _reference_operator(cells, point):
     """The finite-volume balance d p/dt = A p as COO triplets (rows, cols, values).
 
     Unknowns are ordered u = i nv + j (cell z_i, v_j); zero flux through the
     box walls.
     """
     nz, nv = len(cells.z), len(cells.v)
-    hz, hv = cells.hz, cells.hv
+    hz, hv, dd = cells.hz, cells.hv, point.dd
+    g = (point.k * cells.z + point.k3 * cells.z**3) / point.m
     idx = np.arange(nz * nv).reshape(nz, nv)
     rows, cols, vals = [], [], []
 
@@ -186,7 +220,7 @@ def _reference_operator(cells, gamma, g, fcm, beta, dd):
     # The spring force g(z) is constant along v, so -g p is a Liouville flux
     # like v p and gets the same central face value; damping, friction and
     # diffusion get Scharfetter-Gummel fitting on their potential.
-    b_minus, b_plus = _sg_weights(cells.v, gamma, fcm, beta, dd)
+    b_minus, b_plus = _sg_weights(cells.v, point)
     coef = 0.5 * dd / hv / hv
     gv = np.broadcast_to(g[:, None], (nz, nv - 1)) * (0.5 / hv)
     to_lower = coef * b_minus + gv  # multiplies p_{j+1}
@@ -262,13 +296,12 @@ def solve_fpk(harvester: Harvester, psd: float, n: int = 200, *, nz=None, nv=Non
     arrays = memoryless_parameters(harvester, psd, "the FPK solver")
     if arrays[0].ndim:
         raise ValueError("solve_fpk needs scalar harvester parameters and a scalar `psd`")
-    m, c, k, k3, fc, beta, psd = (float(a) for a in arrays)
+    point = _Point.from_parameters(*(float(a) for a in arrays))
     nz = check_int("nz", n if nz is None else nz, 8)
     nv = check_int("nv", n if nv is None else nv, 8)
     nv += nv % 2
-    cells = _reference_cells(harvester, psd, m, k, k3, nz, nv)
-    g = (k * cells.z + k3 * cells.z**3) / m
-    rows, cols, vals = _reference_operator(cells, c / m, g, fc / m, beta, 0.5 * psd)
+    cells = _reference_cells(harvester, point, nz, nv)
+    rows, cols, vals = _reference_operator(cells, point)
     p = _normalised_null_vector(rows, cols, vals, nz * nv, cells.hz * cells.hv)
     return _reference_solution(cells, p.reshape(nz, nv), harvester.friction)
 
@@ -353,7 +386,7 @@ def _box_energy(gamma, fcm, dd, psi_edge):
     return x * x
 
 
-def _half_moments(m, c, k, k3, fcm, beta, dd, e_edge, nz, nv):
+def _half_moments(point, e_edge, nz, nv):
     """Solve the symmetric half problem on one grid; E[v^2], E[z^2], E|v|, edge mass.
 
     Unknowns are the cells with v > 0, ordered v-row by v-row (u = j nz + i);
@@ -362,24 +395,24 @@ def _half_moments(m, c, k, k3, fcm, beta, dd, e_edge, nz, nv):
     matrix is nz wide, so LAPACK's banded LU (gbsv, partial pivoting) solves
     it in O(nz^3 nv) operations.
     """
-    gamma = c / m
-    z_max, v_max = _box_half_widths(m, k, k3, e_edge)
+    z_max, v_max = _box_half_widths(point, e_edge)
     nh = nv // 2
     hz, hv = 2.0 * z_max / nz, v_max / nh
     cells = _Cells(-z_max + hz * (np.arange(nz) + 0.5), hv * (np.arange(nh) + 0.5), hz, hv)
     zg = -z_max + hz * (np.arange(-1, nz + 1) + 0.5)  # with one ghost cell each side
-    v_lv, g_lv = _gibbs_exact_liouville(cells, (0.5 * k * zg**2 + 0.25 * k3 * zg**4) / m, gamma, dd)
-    ab = _half_band_matrix(cells, v_lv, g_lv, gamma, fcm, beta, dd)
+    pot = (0.5 * point.k * zg**2 + 0.25 * point.k3 * zg**4) / point.m  # G(z) = U(z)/m
+    v_lv, g_lv = _gibbs_exact_liouville(cells, pot, point)
+    ab = _half_band_matrix(cells, v_lv, g_lv, point)
     pin = nz // 2
     rhs = np.zeros(nz * nh)
     rhs[pin] = 1.0
     _, _, p, info = lapack.dgbsv(nz, nz, ab, rhs, overwrite_ab=1, overwrite_b=1)
     if info != 0:  # pragma: no cover - the pinned matrix is regular
         raise RuntimeError(f"banded LU failed (info = {info})")
-    return _half_moments_of_density(cells, p.reshape(nh, nz), fcm, beta, dd)
+    return _half_moments_of_density(cells, p.reshape(nh, nz), point)
 
 
-def _gibbs_exact_liouville(cells, pot, gamma, dd):
+def _gibbs_exact_liouville(cells, pot, point):
     """Liouville coefficients v~ (per v cell) and g~ (per z cell) of the fast solver.
 
     ``pot`` is G(z) = U(z)/m at the z cells with one ghost cell each side.
@@ -388,7 +421,7 @@ def _gibbs_exact_liouville(cells, pot, gamma, dd):
     by -b times the function (-> v and G' as h -> 0).
     """
     v, hz, hv = cells.v, cells.hz, cells.hv
-    b = 2.0 * gamma / dd
+    b = 2.0 * point.gamma / point.dd
     if b > 0:
         v_lv = np.exp(-0.5 * b * hv * hv) * np.sinh(b * v * hv) / (b * hv)
         g_lv = -np.expm1(-b * (pot[2:] - pot[1:-1])) + np.expm1(-b * (pot[:-2] - pot[1:-1]))
@@ -399,7 +432,7 @@ def _gibbs_exact_liouville(cells, pot, gamma, dd):
     return v_lv, g_lv
 
 
-def _half_band_matrix(cells, v_lv, g_lv, gamma, fcm, beta, dd):
+def _half_band_matrix(cells, v_lv, g_lv, point):
     """The half-plane balance in LAPACK band storage (kl = ku = nz), one row pinned.
 
     A[r, c] is stored at ab[kl + ku + r - c, c]. Scharfetter-Gummel in v
@@ -409,8 +442,8 @@ def _half_band_matrix(cells, v_lv, g_lv, gamma, fcm, beta, dd):
     """
     nz, nh = len(cells.z), len(cells.v)
     hz, hv = cells.hz, cells.hv
-    b_minus, b_plus = _sg_weights(cells.v, gamma, fcm, beta, dd)
-    coef = 0.5 * dd / hv**2
+    b_minus, b_plus = _sg_weights(cells.v, point)
+    coef = 0.5 * point.dd / hv**2
     gv = (g_lv / (2.0 * hv))[None, :]
     to_lower = coef * b_minus[:, None] + gv  # (nh-1, nz): face j+1/2, multiplies p[j+1]
     to_upper = coef * b_plus[:, None] - gv  # multiplies p[j]
@@ -443,7 +476,7 @@ def _half_band_matrix(cells, v_lv, g_lv, gamma, fcm, beta, dd):
     return ab
 
 
-def _half_moments_of_density(cells, p, fcm, beta, dd):
+def _half_moments_of_density(cells, p, point):
     """E[v^2], E[z^2], E|v| of the half-plane point values p (nh, nz); outer-ring mass.
 
     The Coulomb jump of f at v = 0 puts a kink in p there, dp/dv(0+) -
@@ -455,6 +488,7 @@ def _half_moments_of_density(cells, p, fcm, beta, dd):
     layer is resolved).
     """
     z, v, hz, hv = cells.z, cells.v, cells.hz, cells.hv
+    fcm, beta, dd = point.fcm, point.beta, point.dd
     jump = 4.0 * fcm / dd * (1.0 if np.isinf(beta) else np.tanh(0.5 * beta * hv))
     # Summed over i, p[0] is the sum of the face means (mirror pairs).
     at_zero = p[0] * np.exp(0.25 * jump * hv)
@@ -536,8 +570,8 @@ def fast_fpk_statistics(harvester: Harvester, psd, *, nz=FAST_NZ, nv=FAST_NV):
     shape = arrays[0].shape
     out = np.empty((3,) + shape)
     for index in np.ndindex(shape):
-        m, c, k, k3, fc, beta, s = (float(a[index]) for a in arrays)
-        out[(slice(None),) + index] = _fast_point(m, c, k, k3, fc / m, beta, 0.5 * s, nzs, nvs)
+        point = _Point.from_parameters(*(float(a[index]) for a in arrays))
+        out[(slice(None),) + index] = _fast_point(point, nzs, nvs)
     return tuple(scalar_or_array(o) for o in out)
 
 
@@ -553,8 +587,9 @@ def _grid_pair(name, value):
     return counts
 
 
-def _fast_point(m, c, k, k3, fcm, beta, dd, nzs, nvs):
-    gamma = c / m
+def _fast_point(point, nzs, nvs):
+    """E[v^2], E[z^2], E|v| at one point: box, grids and Richardson extrapolation."""
+    gamma, fcm, beta, dd = point.gamma, point.fcm, point.beta, point.dd
     fcm_box = fcm
     if not np.isinf(beta) and fcm > 0:
         # tanh friction is weaker than Coulomb at low speed: take its level at
@@ -564,16 +599,16 @@ def _fast_point(m, c, k, k3, fcm, beta, dd, nzs, nvs):
         fcm_box = fcm * np.tanh(beta * v_top / 8.0)
     e_edge = _box_energy(gamma, fcm_box, dd, FAST_PSI_EDGE)
     for _ in range(12):
-        best, ring = _half_moments(m, c, k, k3, fcm, beta, dd, e_edge, nzs[0], nvs[0])
+        best, ring = _half_moments(point, e_edge, nzs[0], nvs[0])
         if ring <= _FAST_EDGE_MASS:
             break
         e_edge *= 1.5
     if len(nvs) == 2:
-        coarse_v, _ = _half_moments(m, c, k, k3, fcm, beta, dd, e_edge, nzs[0], nvs[1])
+        coarse_v, _ = _half_moments(point, e_edge, nzs[0], nvs[1])
         best = best + (best - coarse_v) / ((nvs[0] / nvs[1]) ** 2 - 1.0)
     if len(nzs) == 2:
         if len(nvs) == 1:
             coarse_v = best
-        coarse_z, _ = _half_moments(m, c, k, k3, fcm, beta, dd, e_edge, nzs[1], nvs[-1])
+        coarse_z, _ = _half_moments(point, e_edge, nzs[1], nvs[-1])
         best[1] += (coarse_v[1] - coarse_z[1]) / ((nzs[0] / nzs[1]) ** 2 - 1.0)
     return best
