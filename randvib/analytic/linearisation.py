@@ -69,6 +69,19 @@ def _solve_velocity_std(c, m, psd, mean_velocity_force):
 EXPECTATIONS = ("auto", "closed-form", "fixed-point")
 
 
+def _renamed_method(expectation, method):
+    """``expectation`` from the deprecated alias ``method=`` of equivalent_damping."""
+    warnings.warn(
+        "equivalent_damping's `method` is deprecated: it is called `expectation` "
+        "(how E[v F(v)] is computed), with the same values",
+        DeprecationWarning,
+        stacklevel=3,
+    )
+    if expectation != "auto" and expectation != method:
+        raise ValueError("give `expectation` or its deprecated alias `method`, not both")
+    return method
+
+
 def equivalent_damping(harvester: Harvester, psd, expectation: str = "auto", *, method=None):
     """Equivalent viscous damping c_eq (Ns/m), paper Eq. 19-20 and 30.
 
@@ -95,15 +108,7 @@ def equivalent_damping(harvester: Harvester, psd, expectation: str = "auto", *, 
         c_eq, broadcast over ``psd`` and the harvester's parameters.
     """
     if method is not None:
-        warnings.warn(
-            "equivalent_damping's `method` is deprecated: it is called `expectation` "
-            "(how E[v F(v)] is computed), with the same values",
-            DeprecationWarning,
-            stacklevel=2,
-        )
-        if expectation != "auto" and expectation != method:
-            raise ValueError("give `expectation` or its deprecated alias `method`, not both")
-        expectation = method
+        expectation = _renamed_method(expectation, method)
     psd = check_positive("psd", psd, "(m/s^2)^2/Hz")
     check_choice("expectation", expectation, EXPECTATIONS)
     friction = harvester.friction
