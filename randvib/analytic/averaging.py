@@ -412,16 +412,7 @@ def averaging_statistics(harvester: Harvester, psd, *, warn: bool = True) -> Ave
     zeta = c_eq / (2.0 * np.sqrt(k_eq * m_f))
     zeta_f = m_f * fpow / vv / (2.0 * np.sqrt(k_eq * m_f))
     if warn and np.any(zeta_f > AVERAGING_ZETA_LIMIT):
-        worst = int(np.argmax(zeta_f))
-        warnings.warn(
-            "stochastic averaging assumes friction removes little energy per cycle, but the "
-            "friction damping ratio zeta_f = (E[z'F]/E[z'^2]) / (2 sqrt(k_eq m)) = "
-            f"{zeta_f[worst]:.3g} exceeds {AVERAGING_ZETA_LIMIT} (total zeta_eff = "
-            f"{zeta[worst]:.3g}); its power may be low by 3-6 %. Use method='fpk-fast' "
-            "(or 'fpk', or Monte Carlo) there.",
-            AveragingValidityWarning,
-            stacklevel=2,
-        )
+        _warn_beyond_validity(zeta_f, zeta)
 
     def shaped(a):
         return scalar_or_array(a.reshape(shape))
@@ -433,6 +424,20 @@ def averaging_statistics(harvester: Harvester, psd, *, warn: bool = True) -> Ave
         friction_power=shaped(m_f * fpow),
         zeta_eff=shaped(zeta),
         zeta_friction=shaped(zeta_f),
+    )
+
+
+def _warn_beyond_validity(zeta_f, zeta):
+    """AveragingValidityWarning at the worst point, for the caller of averaging_statistics."""
+    worst = int(np.argmax(zeta_f))
+    warnings.warn(
+        "stochastic averaging assumes friction removes little energy per cycle, but the "
+        "friction damping ratio zeta_f = (E[z'F]/E[z'^2]) / (2 sqrt(k_eq m)) = "
+        f"{zeta_f[worst]:.3g} exceeds {AVERAGING_ZETA_LIMIT} (total zeta_eff = "
+        f"{zeta[worst]:.3g}); its power may be low by 3-6 %. Use method='fpk-fast' "
+        "(or 'fpk', or Monte Carlo) there.",
+        AveragingValidityWarning,
+        stacklevel=3,
     )
 
 
