@@ -181,7 +181,7 @@ def test_linearisation_reduces_to_eq30_and_matches_quadrature():
         rv.coulomb_equivalent_damping(DEVICE.c, FC, psd, DEVICE.m), rel=1e-10
     )
     with pytest.raises(ValueError, match="closed-form"):
-        rv.equivalent_damping(coulomb_like, psd, method="closed-form")
+        rv.equivalent_damping(coulomb_like, psd, expectation="closed-form")
     # E[v F(v)] of the law's numpy force against scipy's adaptive quadrature.
     law, sigma = Stribeck(FC, 3 * FC, 0.05, 0.0), 0.1
 

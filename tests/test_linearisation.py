@@ -26,9 +26,22 @@ def test_section5_numbers_eq30_by_hand():
 @settings(max_examples=60, deadline=None)
 def test_eq30_equals_general_fixed_point(fc, c, psd, m):
     h = rv.Harvester(m=m, c_m=c / 2, c_e=c / 2, k=50.0, friction=rv.Coulomb(fc))
-    closed = rv.equivalent_damping(h, psd, method="closed-form")
-    fixed = rv.equivalent_damping(h, psd, method="fixed-point")
+    closed = rv.equivalent_damping(h, psd, expectation="closed-form")
+    fixed = rv.equivalent_damping(h, psd, expectation="fixed-point")
     assert fixed == pytest.approx(closed, rel=1e-10)
+
+
+def test_expectation_keeps_method_as_a_deprecated_alias():
+    # `method` of equivalent_damping meant how E[v F(v)] is taken, not an analytic
+    # method as in predict(..., method=...): renamed `expectation`, old name warns.
+    h = BASE.updated(friction=rv.Tanh(0.0058, 300.0))
+    with pytest.warns(DeprecationWarning, match="`expectation`"):
+        old = rv.equivalent_damping(h, 0.5, method="fixed-point")
+    assert old == rv.equivalent_damping(h, 0.5, expectation="fixed-point")
+    with pytest.raises(ValueError, match="`expectation` must be one of"):
+        rv.equivalent_damping(h, 0.5, expectation="magic")
+    with pytest.raises(ValueError, match="not both"), pytest.warns(DeprecationWarning):
+        rv.equivalent_damping(h, 0.5, "closed-form", method="fixed-point")
 
 
 def test_zero_friction_gives_viscous_damping():

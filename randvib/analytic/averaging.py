@@ -83,7 +83,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from randvib._validation import check_nonnegative, check_positive
+from randvib._validation import check_nonnegative, check_positive, scalar_or_array
+from randvib.models.friction import one_minus_tanh
 from randvib.models.harvester import Harvester
 
 __all__ = [
@@ -221,14 +222,22 @@ class AveragingResult:
     zeta_friction: object
 
 
+def turning_point_squared(h, omega2, lam):
+    """A^2 (m^2) of the undamped orbit at energy ``h`` per unit mass (J/kg).
+
+    The positive root of G(A) = omega2 (A^2/2 + lam A^4/4) = h, with
+    omega2 = k/m and lam = k3/k, written without cancellation. Also the
+    z half-width of the FPK solvers' boxes.
+    """
+    return 4.0 * h / omega2 / (1.0 + np.sqrt(1.0 + 4.0 * lam * h / omega2))
+
+
 def _orbit(x, omega, lam):
     """Orbit integrals at energies H = x^2 (J/kg) for omega^2 = k/m, lam = k3/k.
 
     Returns amplitude A, period T, area Phi = T <v^2>, and T <z^2>.
     """
-    h = x * x
-    # A^2 from omega^2 (A^2/2 + lam A^4/4) = H, written without cancellation.
-    a2 = 4.0 * h / omega**2 / (1.0 + np.sqrt(1.0 + 4.0 * lam * h / omega**2))
+    a2 = turning_point_squared(x * x, omega**2, lam)
     amp = np.sqrt(a2)
     q = np.sqrt(1.0 + (lam * a2)[..., None] * (0.5 * (1.0 + _SIN2)))
     inv_q = np.mean(1.0 / q, axis=-1)
@@ -244,9 +253,7 @@ def _tanh_fraction(amp, omega, lam, beta):
     cos2 = np.cos(_TANH_T) ** 2  # sin^2(phi) at phi = pi/2 - t
     q = np.sqrt(1.0 + (lam * a2)[..., None] * (0.5 * (1.0 + cos2)))
     arg = (beta * omega * amp)[..., None] * np.sin(_TANH_T) * q
-    # 1 - tanh(y) = 2 / (1 + exp(2y)), accurate where tanh(y) rounds to 1.
-    one_minus = 2.0 / (1.0 + np.exp(np.minimum(2.0 * arg, 700.0)))
-    return 1.0 - np.sum(one_minus * np.sin(_TANH_T) * _TANH_W, axis=-1)
+    return 1.0 - np.sum(one_minus_tanh(arg) * np.sin(_TANH_T) * _TANH_W, axis=-1)
 
 
 def _quarter_friction_work(amp, omega, lam, fcm, beta):
@@ -257,17 +264,28 @@ def _quarter_friction_work(amp, omega, lam, fcm, beta):
     return fcm * amp * np.where(np.isinf(beta), 1.0, frac)
 
 
-def _x_max(gamma, fcm, dd):
-    """End of the x = sqrt(H) grid, where the linear-spring Psi reaches 70.
+def _psi_slope(x, gamma, dd, area, work):
+    """dPsi/dx at x = sqrt(H): 2x (2 gamma/D + 8 J/(D Phi)) (module docstring).
 
-    Psi for the linear spring, a x^2 + b x, bounds the true Psi from above
-    and from below within 10 % for Coulomb friction (the orbit shape factor
-    Phi / (A v_max) only moves from pi to 3.50 as k3 A^2 / k grows), so the
-    density at the grid's end is below exp(-60).
+    ``area`` is Phi(H) and ``work`` J(H); finite at x -> 0 because J/Phi ~ 1/x.
+    """
+    return 2.0 * x * (2.0 * gamma / dd + 8.0 * work / (dd * area))
+
+
+def linear_psi_root(gamma, fcm, dd, psi):
+    """x = sqrt(H) at which the linear-spring averaged exponent reaches ``psi``.
+
+    For the linear spring with viscous damping gamma (1/s), Coulomb level
+    fcm (N/kg) and noise intensity dd = D (m^2/s^3), Psi = a x^2 + b x with
+    a = 2 gamma/D and b = 8 sqrt(2) fcm/(pi D); this solves a x^2 + b x = psi
+    without cancellation. It bounds the true Psi from above and from below
+    within 10 % for Coulomb friction (the orbit shape factor Phi / (A v_max)
+    only moves from pi to 3.50 as k3 A^2 / k grows), so it sizes the energy
+    grid here and the box of the fast FPK solver.
     """
     a = 2.0 * gamma / dd
     b = 8.0 * np.sqrt(2.0) * fcm / (np.pi * dd)
-    return 2.0 * _PSI_END / (b + np.sqrt(b * b + 4.0 * a * _PSI_END))
+    return 2.0 * psi / (b + np.sqrt(b * b + 4.0 * a * psi))
 
 
 def _moments(m, c, k, k3, fc, beta, psd):
@@ -277,7 +295,8 @@ def _moments(m, c, k, k3, fc, beta, psd):
     normaliser Z = int T exp(-Psi) dH.
     """
     gamma, omega, lam, fcm, dd = c / m, np.sqrt(k / m), k3 / k, fc / m, 0.5 * psd
-    x_max = _x_max(gamma, fcm, dd)
+    # The density at the grid's end is below exp(-60) (see linear_psi_root).
+    x_max = linear_psi_root(gamma, fcm, dd, _PSI_END)
     col = (slice(None), None)
     for _ in range(30):
         out = _moments_on_grid(x_max, gamma[col], omega[col], lam[col], fcm[col], beta[col], dd)
@@ -295,9 +314,7 @@ def _moments_on_grid(x_max, gamma, omega, lam, fcm, beta, dd):
     w = x_max[:, None] * _W_UNIT
     amp, period, area, t_z2 = _orbit(x, omega, lam)
     work = _quarter_friction_work(amp, omega, lam, fcm, beta)
-    ddc = dd[:, None]
-    # dPsi/dx = 2x dPsi/dH; finite at x -> 0 because J/Phi ~ 1/x there.
-    dpsi = 2.0 * x * (2.0 * gamma / ddc + 8.0 * work / (ddc * area))
+    dpsi = _psi_slope(x, gamma, dd[:, None], area, work)
     panels = dpsi.reshape(len(x_max), _N_PANELS, _N_GL)
     half = x_max[:, None, None] * _HALF_UNIT[None, :, None]
     within = half * np.einsum("ij,bpj->bpi", _GL_Q, panels)  # from each panel's start
@@ -395,20 +412,10 @@ def averaging_statistics(harvester: Harvester, psd, *, warn: bool = True) -> Ave
     zeta = c_eq / (2.0 * np.sqrt(k_eq * m_f))
     zeta_f = m_f * fpow / vv / (2.0 * np.sqrt(k_eq * m_f))
     if warn and np.any(zeta_f > AVERAGING_ZETA_LIMIT):
-        worst = int(np.argmax(zeta_f))
-        warnings.warn(
-            "stochastic averaging assumes friction removes little energy per cycle, but the "
-            "friction damping ratio zeta_f = (E[z'F]/E[z'^2]) / (2 sqrt(k_eq m)) = "
-            f"{zeta_f[worst]:.3g} exceeds {AVERAGING_ZETA_LIMIT} (total zeta_eff = "
-            f"{zeta[worst]:.3g}); its power may be low by 3-6 %. Use method='fpk-fast' "
-            "(or 'fpk', or Monte Carlo) there.",
-            AveragingValidityWarning,
-            stacklevel=2,
-        )
+        _warn_beyond_validity(zeta_f, zeta)
 
     def shaped(a):
-        a = a.reshape(shape)
-        return float(a) if a.ndim == 0 else a
+        return scalar_or_array(a.reshape(shape))
 
     return AveragingResult(
         velocity_variance=shaped(vv),
@@ -417,6 +424,20 @@ def averaging_statistics(harvester: Harvester, psd, *, warn: bool = True) -> Ave
         friction_power=shaped(m_f * fpow),
         zeta_eff=shaped(zeta),
         zeta_friction=shaped(zeta_f),
+    )
+
+
+def _warn_beyond_validity(zeta_f, zeta):
+    """AveragingValidityWarning at the worst point, for the caller of averaging_statistics."""
+    worst = int(np.argmax(zeta_f))
+    warnings.warn(
+        "stochastic averaging assumes friction removes little energy per cycle, but the "
+        "friction damping ratio zeta_f = (E[z'F]/E[z'^2]) / (2 sqrt(k_eq m)) = "
+        f"{zeta_f[worst]:.3g} exceeds {AVERAGING_ZETA_LIMIT} (total zeta_eff = "
+        f"{zeta[worst]:.3g}); its power may be low by 3-6 %. Use method='fpk-fast' "
+        "(or 'fpk', or Monte Carlo) there.",
+        AveragingValidityWarning,
+        stacklevel=3,
     )
 
 
@@ -480,8 +501,7 @@ def energy_density(harvester: Harvester, psd, energy):
     # Psi(x_e) by Gauss-Legendre on [0, x_e] with the same panel rule.
     nodes = x_e[:, None] * _X_UNIT
     amp, _, area, _ = _orbit(nodes, omega, lam)
-    work = _quarter_friction_work(amp, omega, lam, fcm, beta)
-    dpsi = 2.0 * nodes * (2.0 * gamma / dd + 8.0 * work / (dd * area))
+    dpsi = _psi_slope(nodes, gamma, dd, area, _quarter_friction_work(amp, omega, lam, fcm, beta))
     psi = np.where(x_true > 0, np.sum(dpsi * (x_e[:, None] * _W_UNIT), axis=1), 0.0)
     _, period, _, _ = _orbit(x_true, omega, lam)
     # Normalisation Z = int T exp(-Psi) dH, from the moment grid.

@@ -50,8 +50,12 @@ from scipy import sparse
 from scipy.linalg import lapack
 from scipy.sparse import linalg as sparse_linalg
 
-from randvib._validation import check_int, check_positive
-from randvib.analytic.averaging import memoryless_parameters
+from randvib._validation import check_int, check_positive, scalar_or_array
+from randvib.analytic.averaging import (
+    linear_psi_root,
+    memoryless_parameters,
+    turning_point_squared,
+)
 from randvib.analytic.linearisation import equivalent_damping
 from randvib.models.harvester import Harvester
 
@@ -96,14 +100,177 @@ def _bernoulli(x):
     return np.where(small, 1.0 - 0.5 * x, out)
 
 
-def _friction_potential(v, fc, beta, m):
-    """int_0^v f(u) du (J/kg^1 per (m/s)): Coulomb f_c |v|; tanh (f_c/beta) log cosh."""
-    fcm = fc / m
+def _friction_potential(v, fcm, beta):
+    """int_0^v f(u) du per unit mass ((m/s)^2), f = F/m of ``fcm tanh(beta v)``.
+
+    Coulomb (``beta = inf``): fcm |v|; tanh: (fcm/beta) log cosh(beta v).
+    """
     if np.isinf(beta):
         return fcm * np.abs(v)
     y = beta * np.abs(v)
     # log cosh y = y + log1p(exp(-2y)) - log 2, stable for any y >= 0
     return fcm / beta * (y + np.log1p(np.exp(-2.0 * y)) - np.log(2.0))
+
+
+def _sg_weights(v, point):
+    """Scharfetter-Gummel weights B(-dW), B(dW) on the faces between v cells.
+
+    W(v) = (2/D) (gamma v^2/2 + int_0^v f) is the potential of damping,
+    friction and diffusion; the flux through the face between cells j and
+    j+1 is -(D/2)/h_v [B(-dW) p_{j+1} - B(dW) p_j], exact for the velocity
+    relaxation at fixed z whatever the cell Peclet number.
+    """
+    pot = 0.5 * point.gamma * v**2 + _friction_potential(v, point.fcm, point.beta)
+    dw = np.diff((2.0 / point.dd) * pot)
+    return _bernoulli(-dw), _bernoulli(dw)
+
+
+def _box_half_widths(point, e_edge):
+    """Half-widths (Z, V) (m, m/s) of the box cut at energy ``e_edge`` per unit mass.
+
+    V = sqrt(2 e_edge); Z is the turning point of the Duffing well at that
+    energy (the quartic root of G(Z) = e_edge).
+    """
+    z_max = np.sqrt(turning_point_squared(e_edge, point.k / point.m, point.k3 / point.k))
+    return z_max, np.sqrt(2.0 * e_edge)
+
+
+@dataclass(frozen=True)
+class _Cells:
+    """Cell centres and sizes of a (z, v) grid."""
+
+    z: np.ndarray
+    v: np.ndarray
+    hz: float
+    hv: float
+
+
+@dataclass(frozen=True)
+class _Point:
+    """One parameter point of the balance, in the per-unit-mass form of the SDE.
+
+    Attributes
+    ----------
+    m, k, k3 : float
+        Mass (kg) and spring constants (N/m, N/m^3) of the well.
+    gamma : float
+        Viscous damping c/m (1/s).
+    fcm, beta : float
+        Friction level Fc/m (N/kg) and tanh sharpness (s/m); ``beta = inf``
+        is Coulomb friction.
+    dd : float
+        Noise intensity D = S/2 on the velocity (m^2/s^3).
+    """
+
+    m: float
+    k: float
+    k3: float
+    gamma: float
+    fcm: float
+    beta: float
+    dd: float
+
+    @classmethod
+    def from_parameters(cls, m, c, k, k3, fc, beta, psd):
+        """From the scalars of :func:`randvib.analytic.averaging.memoryless_parameters`."""
+        return cls(m=m, k=k, k3=k3, gamma=c / m, fcm=fc / m, beta=beta, dd=0.5 * psd)
+
+
+def _reference_cells(harvester, point, nz, nv):
+    """Equal cells on the whole box, v = 0 on a face (``nv`` even).
+
+    The box is set from the linearised velocity variance: friction only thins
+    the tails of the density.
+    """
+    psd, m = 2.0 * point.dd, point.m
+    var_v = psd * m / (4.0 * float(equivalent_damping(harvester, psd)))
+    z_max, v_max = _box_half_widths(point, _ENERGY_EDGE * var_v)
+    hz, hv = 2.0 * z_max / nz, 2.0 * v_max / nv
+    z = -z_max + hz * (np.arange(nz) + 0.5)
+    v = -v_max + hv * (np.arange(nv) + 0.5)
+    return _Cells(z, v, hz, hv)
+
+
+def _reference_operator(cells, point):
+    """The finite-volume balance d p/dt = A p as COO triplets (rows, cols, values).
+
+    Unknowns are ordered u = i nv + j (cell z_i, v_j); zero flux through the
+    box walls.
+    """
+    nz, nv = len(cells.z), len(cells.v)
+    hz, hv, dd = cells.hz, cells.hv, point.dd
+    g = (point.k * cells.z + point.k3 * cells.z**3) / point.m
+    idx = np.arange(nz * nv).reshape(nz, nv)
+    rows, cols, vals = [], [], []
+
+    def add(r, cidx, val):
+        rows.append(r.ravel())
+        cols.append(cidx.ravel())
+        vals.append(np.broadcast_to(val, r.shape).ravel())
+
+    # z-faces between cells i and i+1 (interior only): flux v p_face / hz out
+    # of cell i into cell i+1, central face value.
+    vz = np.broadcast_to(cells.v[None, :], (nz - 1, nv)) * (0.5 / hz)
+    left, right = idx[:-1, :], idx[1:, :]
+    for cell, sign in ((left, -1.0), (right, 1.0)):
+        add(cell, left, sign * vz)
+        add(cell, right, sign * vz)
+
+    # v-faces between cells j and j+1: Scharfetter-Gummel flux in +v.
+    # The spring force g(z) is constant along v, so -g p is a Liouville flux
+    # like v p and gets the same central face value; damping, friction and
+    # diffusion get Scharfetter-Gummel fitting on their potential.
+    b_minus, b_plus = _sg_weights(cells.v, point)
+    coef = 0.5 * dd / hv / hv
+    gv = np.broadcast_to(g[:, None], (nz, nv - 1)) * (0.5 / hv)
+    to_lower = coef * b_minus + gv  # multiplies p_{j+1}
+    to_upper = coef * b_plus - gv  # multiplies p_j
+    lower, upper = idx[:, :-1], idx[:, 1:]
+    # d p_lower/dt gets -J/hv, d p_upper/dt gets +J/hv.
+    add(lower, upper, to_lower)
+    add(lower, lower, -to_upper)
+    add(upper, upper, -to_lower)
+    add(upper, lower, to_upper)
+    return tuple(np.concatenate(a) for a in (rows, cols, vals))
+
+
+def _normalised_null_vector(rows, cols, vals, size, cell_area):
+    """The density p with A p = 0 and unit mass, by one sparse LU solve.
+
+    The balance equations sum to zero (mass conservation), so one is
+    redundant: the one of the box corner (row 0) is replaced by the
+    normalisation sum(p) cell_area = 1.
+    """
+    keep = rows != 0
+    rows = np.concatenate((rows[keep], np.zeros(size, dtype=rows.dtype)))
+    cols = np.concatenate((cols[keep], np.arange(size)))
+    vals = np.concatenate((vals[keep], np.full(size, cell_area)))
+    matrix = sparse.csc_matrix((vals, (rows, cols)), shape=(size, size))
+    rhs = np.zeros(size)
+    rhs[0] = 1.0
+    return sparse_linalg.spsolve(matrix, rhs)
+
+
+def _reference_solution(cells, p, friction) -> FPKSolution:
+    """Moments of the cell density p (shape (nz, nv)) as an :class:`FPKSolution`."""
+    z, v, hz, hv = cells.z, cells.v, cells.hz, cells.hv
+    cell = hz * hv
+    pv = p.sum(axis=0) * cell
+    pz = p.sum(axis=1) * cell
+    # Cell averages of v^2 and z^2 (midpoint + h^2/12) keep the moments second order.
+    vel_var = float(np.sum(pv * (v**2 + hv**2 / 12.0)))
+    abs_v = float(np.sum(pv * np.abs(v)))
+    disp_var = float(np.sum(pz * (z**2 + hz**2 / 12.0)))
+    fpow = 0.0 if friction is None else float(np.sum(pv * v * friction.force(v)))
+    return FPKSolution(
+        z=z,
+        v=v,
+        density=p,
+        velocity_variance=vel_var,
+        mean_abs_velocity=abs_v,
+        displacement_variance=disp_var,
+        friction_power=fpow,
+    )
 
 
 def solve_fpk(harvester: Harvester, psd: float, n: int = 200, *, nz=None, nv=None):
@@ -126,107 +293,17 @@ def solve_fpk(harvester: Harvester, psd: float, n: int = 200, *, nz=None, nv=Non
     -------
     FPKSolution
     """
-    friction = harvester.friction
-    form = (0.0, np.inf) if friction is None else friction.coulomb_tanh_form()
-    if form is None:
-        why = (
-            "has internal state (the density would need a third dimension)"
-            if friction.has_memory
-            else "is not of the form Fc tanh(beta v)"
-        )
-        raise ValueError(
-            f"the FPK solver needs a memoryless friction law (coulomb, tanh or none); "
-            f"{friction.name!r} {why}. Use randvib.simulate for it."
-        )
-    values = [harvester.m, harvester.c, harvester.k, harvester.k3, *form]
-    if any(np.ndim(v) for v in values) or np.ndim(psd):
+    arrays = memoryless_parameters(harvester, psd, "the FPK solver")
+    if arrays[0].ndim:
         raise ValueError("solve_fpk needs scalar harvester parameters and a scalar `psd`")
-    psd = float(check_positive("psd", psd, "(m/s^2)^2/Hz"))
+    point = _Point.from_parameters(*(float(a) for a in arrays))
     nz = check_int("nz", n if nz is None else nz, 8)
     nv = check_int("nv", n if nv is None else nv, 8)
     nv += nv % 2
-    m, c, k, k3 = (float(x) for x in (harvester.m, harvester.c, harvester.k, harvester.k3))
-    fc, beta = float(form[0]), float(form[1])
-    if c <= 0 and fc <= 0:
-        raise ValueError("`c_m + c_e` and `fc` are both 0: no stationary state")
-
-    dd = 0.5 * psd
-    # Box from the linearised velocity variance: friction only thins the tails.
-    var_v = psd * m / (4.0 * float(equivalent_damping(harvester, psd)))
-    e_edge = _ENERGY_EDGE * var_v
-    v_max = np.sqrt(2.0 * e_edge)
-    # Largest z with (k z^2/2 + k3 z^4/4)/m = e_edge, without cancellation.
-    z_max = np.sqrt(4.0 * m * e_edge / k / (1.0 + np.sqrt(1.0 + 4.0 * k3 * m * e_edge / k**2)))
-    hz, hv = 2.0 * z_max / nz, 2.0 * v_max / nv
-    z = -z_max + hz * (np.arange(nz) + 0.5)
-    v = -v_max + hv * (np.arange(nv) + 0.5)
-    gamma = c / m
-    g = (k * z + k3 * z**3) / m
-
-    idx = np.arange(nz * nv).reshape(nz, nv)
-    rows, cols, vals = [], [], []
-
-    def add(r, cidx, val):
-        rows.append(r.ravel())
-        cols.append(cidx.ravel())
-        vals.append(np.broadcast_to(val, r.shape).ravel())
-
-    # z-faces between cells i and i+1 (interior only): flux v p_face / hz out
-    # of cell i into cell i+1, central face value.
-    vz = np.broadcast_to(v[None, :], (nz - 1, nv)) * (0.5 / hz)
-    left, right = idx[:-1, :], idx[1:, :]
-    for cell, sign in ((left, -1.0), (right, 1.0)):
-        add(cell, left, sign * vz)
-        add(cell, right, sign * vz)
-
-    # v-faces between cells j and j+1: Scharfetter-Gummel flux in +v,
-    # J = -(D/2)/hv [B(-dW) p_{j+1} - B(dW) p_j].
-    # The spring force g(z) is constant along v, so -g p is a Liouville flux
-    # like v p and gets the same central face value; damping, friction and
-    # diffusion get Scharfetter-Gummel fitting on their potential.
-    potential = (2.0 / dd) * (0.5 * gamma * v**2 + _friction_potential(v, fc, beta, m))
-    dw = np.broadcast_to(np.diff(potential), (nz, nv - 1))
-    coef = 0.5 * dd / hv / hv
-    gv = np.broadcast_to(g[:, None], (nz, nv - 1)) * (0.5 / hv)
-    to_lower = coef * _bernoulli(-dw) + gv  # multiplies p_{j+1}
-    to_upper = coef * _bernoulli(dw) - gv  # multiplies p_j
-    lower, upper = idx[:, :-1], idx[:, 1:]
-    # d p_lower/dt gets -J/hv, d p_upper/dt gets +J/hv.
-    add(lower, upper, to_lower)
-    add(lower, lower, -to_upper)
-    add(upper, upper, -to_lower)
-    add(upper, lower, to_upper)
-
-    size = nz * nv
-    rows, cols, vals = (np.concatenate(a) for a in (rows, cols, vals))
-    # The balance equations sum to zero (mass conservation), so one is
-    # redundant: replace the one of the box corner by the normalisation.
-    keep = rows != 0
-    rows = np.concatenate((rows[keep], np.zeros(size, dtype=rows.dtype)))
-    cols = np.concatenate((cols[keep], np.arange(size)))
-    vals = np.concatenate((vals[keep], np.full(size, hz * hv)))
-    matrix = sparse.csc_matrix((vals, (rows, cols)), shape=(size, size))
-    rhs = np.zeros(size)
-    rhs[0] = 1.0
-    p = sparse_linalg.spsolve(matrix, rhs).reshape(nz, nv)
-
-    cell = hz * hv
-    pv = p.sum(axis=0) * cell
-    pz = p.sum(axis=1) * cell
-    # Cell averages of v^2 and z^2 (midpoint + h^2/12) keep the moments second order.
-    vel_var = float(np.sum(pv * (v**2 + hv**2 / 12.0)))
-    abs_v = float(np.sum(pv * np.abs(v)))
-    disp_var = float(np.sum(pz * (z**2 + hz**2 / 12.0)))
-    fpow = 0.0 if friction is None else float(np.sum(pv * v * friction.force(v)))
-    return FPKSolution(
-        z=z,
-        v=v,
-        density=p,
-        velocity_variance=vel_var,
-        mean_abs_velocity=abs_v,
-        displacement_variance=disp_var,
-        friction_power=fpow,
-    )
+    cells = _reference_cells(harvester, point, nz, nv)
+    rows, cols, vals = _reference_operator(cells, point)
+    p = _normalised_null_vector(rows, cols, vals, nz * nv, cells.hz * cells.hv)
+    return _reference_solution(cells, p.reshape(nz, nv), harvester.friction)
 
 
 def fpk_statistics(harvester: Harvester, psd, n: int = 160):
@@ -277,7 +354,7 @@ def fpk_statistics(harvester: Harvester, psd, n: int = 160):
         ):
             a_f, a_c = getattr(fine, name), getattr(coarse, name)
             out[(row,) + index] = (4.0 * a_f - a_c) / 3.0
-    return tuple(float(o) if o.ndim == 0 else o for o in out)
+    return tuple(scalar_or_array(o) for o in out)
 
 
 # ---------------------------------------------------------------------------
@@ -300,19 +377,16 @@ _FAST_EDGE_MASS = 2e-4
 
 
 def _box_energy(gamma, fcm, dd, psi_edge):
-    """Energy per unit mass at which a x^2 + b x = psi_edge, x = sqrt(H).
+    """Energy per unit mass (J/kg) where the averaged exponent reaches ``psi_edge``.
 
-    a x^2 + b x is the averaged exponent Psi(H) of the linear spring with
-    viscous damping gamma and Coulomb level fcm (randvib.analytic.averaging, _x_max);
+    The linear-spring Psi of :func:`randvib.analytic.averaging.linear_psi_root`;
     for the Duffing spring it stays within 10 % of the true one.
     """
-    a = 2.0 * gamma / dd
-    b = 8.0 * np.sqrt(2.0) * fcm / (np.pi * dd)
-    x = 2.0 * psi_edge / (b + np.sqrt(b * b + 4.0 * a * psi_edge))
+    x = linear_psi_root(gamma, fcm, dd, psi_edge)
     return x * x
 
 
-def _half_moments(m, c, k, k3, fcm, beta, dd, e_edge, nz, nv):
+def _half_moments(point, e_edge, nz, nv):
     """Solve the symmetric half problem on one grid; E[v^2], E[z^2], E|v|, edge mass.
 
     Unknowns are the cells with v > 0, ordered v-row by v-row (u = j nz + i);
@@ -321,19 +395,33 @@ def _half_moments(m, c, k, k3, fcm, beta, dd, e_edge, nz, nv):
     matrix is nz wide, so LAPACK's banded LU (gbsv, partial pivoting) solves
     it in O(nz^3 nv) operations.
     """
-    gamma = c / m
+    z_max, v_max = _box_half_widths(point, e_edge)
     nh = nv // 2
-    v_max = np.sqrt(2.0 * e_edge)
-    z_max = np.sqrt(4.0 * m * e_edge / k / (1.0 + np.sqrt(1.0 + 4.0 * k3 * m * e_edge / k**2)))
     hz, hv = 2.0 * z_max / nz, v_max / nh
-    z = -z_max + hz * (np.arange(nz) + 0.5)
-    v = hv * (np.arange(nh) + 0.5)
+    cells = _Cells(-z_max + hz * (np.arange(nz) + 0.5), hv * (np.arange(nh) + 0.5), hz, hv)
     zg = -z_max + hz * (np.arange(-1, nz + 1) + 0.5)  # with one ghost cell each side
-    pot = (0.5 * k * zg**2 + 0.25 * k3 * zg**4) / m  # G(z) = U(z)/m
-    # Liouville coefficients that make the Gibbs density exp(-b H), b = 2 gamma/D,
-    # an exact discrete null vector: central differences of exp(-b v^2/2) and
-    # exp(-b G) divided by -b times the function (-> v and G' as h -> 0).
-    b = 2.0 * gamma / dd
+    pot = (0.5 * point.k * zg**2 + 0.25 * point.k3 * zg**4) / point.m  # G(z) = U(z)/m
+    v_lv, g_lv = _gibbs_exact_liouville(cells, pot, point)
+    ab = _half_band_matrix(cells, v_lv, g_lv, point)
+    pin = nz // 2
+    rhs = np.zeros(nz * nh)
+    rhs[pin] = 1.0
+    _, _, p, info = lapack.dgbsv(nz, nz, ab, rhs, overwrite_ab=1, overwrite_b=1)
+    if info != 0:  # pragma: no cover - the pinned matrix is regular
+        raise RuntimeError(f"banded LU failed (info = {info})")
+    return _half_moments_of_density(cells, p.reshape(nh, nz), point)
+
+
+def _gibbs_exact_liouville(cells, pot, point):
+    """Liouville coefficients v~ (per v cell) and g~ (per z cell) of the fast solver.
+
+    ``pot`` is G(z) = U(z)/m at the z cells with one ghost cell each side.
+    They make the Gibbs density exp(-b H), b = 2 gamma/D, an exact discrete
+    null vector: central differences of exp(-b v^2/2) and exp(-b G) divided
+    by -b times the function (-> v and G' as h -> 0).
+    """
+    v, hz, hv = cells.v, cells.hz, cells.hv
+    b = 2.0 * point.gamma / point.dd
     if b > 0:
         v_lv = np.exp(-0.5 * b * hv * hv) * np.sinh(b * v * hv) / (b * hv)
         g_lv = -np.expm1(-b * (pot[2:] - pot[1:-1])) + np.expm1(-b * (pot[:-2] - pot[1:-1]))
@@ -341,22 +429,27 @@ def _half_moments(m, c, k, k3, fcm, beta, dd, e_edge, nz, nv):
     else:
         v_lv = v
         g_lv = (pot[2:] - pot[:-2]) / (2.0 * hz)
-    # Scharfetter-Gummel in v on W = (2/D)(gamma v^2/2 + int_0^v f) (v > 0 branch).
-    if np.isinf(beta):
-        fric_pot = fcm * v
-    else:
-        y = beta * v
-        fric_pot = fcm / beta * (y + np.log1p(np.exp(-2.0 * y)) - np.log(2.0))
-    dw = np.diff((2.0 / dd) * (0.5 * gamma * v**2 + fric_pot))[:, None]
-    coef = 0.5 * dd / hv**2
+    return v_lv, g_lv
+
+
+def _half_band_matrix(cells, v_lv, g_lv, point):
+    """The half-plane balance in LAPACK band storage (kl = ku = nz), one row pinned.
+
+    A[r, c] is stored at ab[kl + ku + r - c, c]. Scharfetter-Gummel in v
+    (v > 0 branch), central Liouville fluxes with the coefficients v~, g~;
+    one balance equation is redundant (mass conservation), so a central cell
+    of the first row is pinned to 1 instead and the moments normalise.
+    """
+    nz, nh = len(cells.z), len(cells.v)
+    hz, hv = cells.hz, cells.hv
+    b_minus, b_plus = _sg_weights(cells.v, point)
+    coef = 0.5 * point.dd / hv**2
     gv = (g_lv / (2.0 * hv))[None, :]
-    to_lower = coef * _bernoulli(-dw) + gv  # (nh-1, nz): face j+1/2, multiplies p[j+1]
-    to_upper = coef * _bernoulli(dw) - gv  # multiplies p[j]
+    to_lower = coef * b_minus[:, None] + gv  # (nh-1, nz): face j+1/2, multiplies p[j+1]
+    to_upper = coef * b_plus[:, None] - gv  # multiplies p[j]
     vz = (v_lv / (2.0 * hz))[:, None]
 
-    # LAPACK band storage: A[r, c] at ab[kl + ku + r - c, c], kl = ku = nz.
-    n = nz * nh
-    ab = np.zeros((3 * nz + 1, n))
+    ab = np.zeros((3 * nz + 1, nz * nh))
     d = 2 * nz
     diag = np.zeros((nh, nz))
     diag[:, 0] -= vz[:, 0]  # wall z = -Z: only the face on the right
@@ -376,26 +469,26 @@ def _half_moments(m, c, k, k3, fcm, beta, dd, e_edge, nz, nv):
     i = np.arange(nz)
     mirror = nz - 1 - i  # face v = 0, mirrored side: A[(i,0), (nz-1-i,0)]
     ab[d + i - mirror, mirror] += coef - gv[0]
-    # One balance equation is redundant (mass conservation): pin a central
-    # cell instead and normalise afterwards.
     pin = nz // 2
     cols = np.arange(max(0, pin - nz), pin + nz + 1)
     ab[d + pin - cols, cols] = 0.0
     ab[d, pin] = 1.0
-    rhs = np.zeros(n)
-    rhs[pin] = 1.0
-    _, _, p, info = lapack.dgbsv(nz, nz, ab, rhs, overwrite_ab=1, overwrite_b=1)
-    if info != 0:  # pragma: no cover - the pinned matrix is regular
-        raise RuntimeError(f"banded LU failed (info = {info})")
-    p = p.reshape(nh, nz)
+    return ab
 
-    # Moments of the point values p. The Coulomb jump of f at v = 0 puts a
-    # kink in p there, dp/dv(0+) - dp/dv(0-) = -(4 f_c/D) p(z, 0), and |v| has
-    # one too; the midpoint sums then need their Euler-Maclaurin end terms,
-    # (h^2/24) (jump of the derivative), to stay second order. p(z, 0) is the
-    # mean of the two cells beside the face, times exp(jump h/4) for the
-    # kink. Tanh friction: the jump is scaled by tanh(beta h/2) (Coulomb for
-    # beta h >> 1, none when the layer is resolved).
+
+def _half_moments_of_density(cells, p, point):
+    """E[v^2], E[z^2], E|v| of the half-plane point values p (nh, nz); outer-ring mass.
+
+    The Coulomb jump of f at v = 0 puts a kink in p there, dp/dv(0+) -
+    dp/dv(0-) = -(4 f_c/D) p(z, 0), and |v| has one too; the midpoint sums
+    then need their Euler-Maclaurin end terms, (h^2/24) (jump of the
+    derivative), to stay second order. p(z, 0) is the mean of the two cells
+    beside the face, times exp(jump h/4) for the kink. Tanh friction: the
+    jump is scaled by tanh(beta h/2) (Coulomb for beta h >> 1, none when the
+    layer is resolved).
+    """
+    z, v, hz, hv = cells.z, cells.v, cells.hz, cells.hv
+    fcm, beta, dd = point.fcm, point.beta, point.dd
     jump = 4.0 * fcm / dd * (1.0 if np.isinf(beta) else np.tanh(0.5 * beta * hv))
     # Summed over i, p[0] is the sum of the face means (mirror pairs).
     at_zero = p[0] * np.exp(0.25 * jump * hv)
@@ -477,9 +570,9 @@ def fast_fpk_statistics(harvester: Harvester, psd, *, nz=FAST_NZ, nv=FAST_NV):
     shape = arrays[0].shape
     out = np.empty((3,) + shape)
     for index in np.ndindex(shape):
-        m, c, k, k3, fc, beta, s = (float(a[index]) for a in arrays)
-        out[(slice(None),) + index] = _fast_point(m, c, k, k3, fc / m, beta, 0.5 * s, nzs, nvs)
-    return tuple(float(o) if o.ndim == 0 else o for o in out)
+        point = _Point.from_parameters(*(float(a[index]) for a in arrays))
+        out[(slice(None),) + index] = _fast_point(point, nzs, nvs)
+    return tuple(scalar_or_array(o) for o in out)
 
 
 def _grid_pair(name, value):
@@ -494,8 +587,9 @@ def _grid_pair(name, value):
     return counts
 
 
-def _fast_point(m, c, k, k3, fcm, beta, dd, nzs, nvs):
-    gamma = c / m
+def _fast_point(point, nzs, nvs):
+    """E[v^2], E[z^2], E|v| at one point: box, grids and Richardson extrapolation."""
+    gamma, fcm, beta, dd = point.gamma, point.fcm, point.beta, point.dd
     fcm_box = fcm
     if not np.isinf(beta) and fcm > 0:
         # tanh friction is weaker than Coulomb at low speed: take its level at
@@ -505,16 +599,16 @@ def _fast_point(m, c, k, k3, fcm, beta, dd, nzs, nvs):
         fcm_box = fcm * np.tanh(beta * v_top / 8.0)
     e_edge = _box_energy(gamma, fcm_box, dd, FAST_PSI_EDGE)
     for _ in range(12):
-        best, ring = _half_moments(m, c, k, k3, fcm, beta, dd, e_edge, nzs[0], nvs[0])
+        best, ring = _half_moments(point, e_edge, nzs[0], nvs[0])
         if ring <= _FAST_EDGE_MASS:
             break
         e_edge *= 1.5
     if len(nvs) == 2:
-        coarse_v, _ = _half_moments(m, c, k, k3, fcm, beta, dd, e_edge, nzs[0], nvs[1])
+        coarse_v, _ = _half_moments(point, e_edge, nzs[0], nvs[1])
         best = best + (best - coarse_v) / ((nvs[0] / nvs[1]) ** 2 - 1.0)
     if len(nzs) == 2:
         if len(nvs) == 1:
             coarse_v = best
-        coarse_z, _ = _half_moments(m, c, k, k3, fcm, beta, dd, e_edge, nzs[1], nvs[-1])
+        coarse_z, _ = _half_moments(point, e_edge, nzs[1], nvs[-1])
         best[1] += (coarse_v[1] - coarse_z[1]) / ((nzs[0] / nzs[1]) ** 2 - 1.0)
     return best

@@ -25,9 +25,11 @@ E[w(t1) w(t2)] = (S/2) delta(t2 - t1) (Eq. 17).
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
-from randvib._validation import check_positive
+from randvib._validation import check_choice, check_positive, scalar_or_array
 from randvib.models.friction import coulomb_equivalent_damping
 from randvib.models.harvester import Harvester
 
@@ -63,7 +65,24 @@ def _solve_velocity_std(c, m, psd, mean_velocity_force):
     return np.exp(0.5 * (log_lo + log_hi))
 
 
-def equivalent_damping(harvester: Harvester, psd, method: str = "auto"):
+#: How :func:`equivalent_damping` computes E[v F(v)]: the values of ``expectation``.
+EXPECTATIONS = ("auto", "closed-form", "fixed-point")
+
+
+def _renamed_method(expectation, method):
+    """``expectation`` from the deprecated alias ``method=`` of equivalent_damping."""
+    warnings.warn(
+        "equivalent_damping's `method` is deprecated: it is called `expectation` "
+        "(how E[v F(v)] is computed), with the same values",
+        DeprecationWarning,
+        stacklevel=3,
+    )
+    if expectation != "auto" and expectation != method:
+        raise ValueError("give `expectation` or its deprecated alias `method`, not both")
+    return method
+
+
+def equivalent_damping(harvester: Harvester, psd, expectation: str = "auto", *, method=None):
     """Equivalent viscous damping c_eq (Ns/m), paper Eq. 19-20 and 30.
 
     Parameters
@@ -72,24 +91,27 @@ def equivalent_damping(harvester: Harvester, psd, method: str = "auto"):
         Device; its parameters may be arrays that broadcast with ``psd``.
     psd : array_like
         One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0.
-    method : {"auto", "closed-form", "fixed-point"}
-        ``closed-form`` is the law's closed form where it declares one
-        (Coulomb: Eq. 30; also no friction);
+    expectation : {"auto", "closed-form", "fixed-point"}
+        How the Gaussian expectation E[v F(v)] of Eq. 19 is taken (not an
+        analytic method in the sense of :func:`randvib.predict`: this is
+        always equivalent linearisation). ``closed-form`` is the law's closed
+        form where it declares one (Coulomb: Eq. 30; also no friction);
         ``fixed-point`` solves Eq. 19-20 with Gaussian expectations by
         quadrature, for any memoryless odd friction law; ``auto`` picks the
         closed form where it exists.
+    method : str, optional
+        Deprecated alias of ``expectation`` (emits a DeprecationWarning).
 
     Returns
     -------
     float or ndarray
         c_eq, broadcast over ``psd`` and the harvester's parameters.
     """
+    if method is not None:
+        expectation = _renamed_method(expectation, method)
     psd = check_positive("psd", psd, "(m/s^2)^2/Hz")
+    check_choice("expectation", expectation, EXPECTATIONS)
     friction = harvester.friction
-    if method not in ("auto", "closed-form", "fixed-point"):
-        raise ValueError(
-            f"`method` must be one of 'auto', 'closed-form', 'fixed-point'; got {method!r}"
-        )
     c = np.asarray(harvester.c, dtype=float)
     m = np.asarray(harvester.m, dtype=float)
     # The law declares its closed form (Coulomb: Eq. 30); none is Eq. 30 with Fc = 0.
@@ -97,10 +119,9 @@ def equivalent_damping(harvester: Harvester, psd, method: str = "auto"):
         closed_form = coulomb_equivalent_damping(c, 0.0, psd, m)
     else:
         closed_form = friction.closed_form_equivalent_damping(c, psd, m)
-    closed_form_exists = closed_form is not None
-    if method == "closed-form" and not closed_form_exists:
+    if expectation == "closed-form" and closed_form is None:
         raise ValueError(
-            f"`method`='closed-form' (Eq. 30) exists only for Coulomb or no friction, "
+            f"`expectation`='closed-form' (Eq. 30) exists only for Coulomb or no friction, "
             f"not {friction.name!r}; use 'fixed-point'"
         )
     if friction is not None and not friction.has_equivalent_damping:
@@ -108,7 +129,7 @@ def equivalent_damping(harvester: Harvester, psd, method: str = "auto"):
             f"equivalent linearisation needs a memoryless friction law; {friction.name!r} "
             "has internal state. Use randvib.simulate for it."
         )
-    if closed_form_exists and method != "fixed-point":
+    if closed_form is not None and expectation != "fixed-point":
         result = closed_form
     else:
         if friction is None:
@@ -120,7 +141,7 @@ def equivalent_damping(harvester: Harvester, psd, method: str = "auto"):
     result = np.broadcast_to(
         result, np.broadcast_shapes(np.shape(result), np.shape(psd), np.shape(m))
     )
-    return float(result) if result.ndim == 0 else np.array(result)
+    return scalar_or_array(np.array(result))
 
 
 def linear_displacement_variance(harvester: Harvester, velocity_variance):

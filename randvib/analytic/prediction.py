@@ -19,7 +19,12 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from scipy import optimize
 
-from randvib._validation import check_choice, check_nonnegative, check_positive
+from randvib._validation import (
+    check_choice,
+    check_nonnegative,
+    check_positive,
+    scalar_or_array,
+)
 from randvib.analytic.averaging import averaging_statistics
 from randvib.analytic.fokker_planck import fast_fpk_statistics, fpk_statistics
 from randvib.analytic.linearisation import equivalent_damping, linear_displacement_variance
@@ -79,8 +84,7 @@ def _finish(
         power_load = power * harvester.electrical.load_fraction
 
     def clean(x):
-        x = np.asarray(x, dtype=float)
-        return float(x) if x.ndim == 0 else x
+        return scalar_or_array(np.asarray(x, dtype=float))
 
     return PowerPrediction(
         method=method,

@@ -522,7 +522,7 @@ class Tanh(FrictionModel):
         beta_nodes = beta[..., None]  # broadcasts against the trailing node axis
         coulomb_part = np.sqrt(2.0 / np.pi) * sigma_v
         correction = _quadrature.gaussian_even_expectation(
-            lambda v: np.abs(v) * _one_minus_tanh(beta_nodes * np.abs(v)),
+            lambda v: np.abs(v) * one_minus_tanh(beta_nodes * np.abs(v)),
             sigma_v,
             inner_scale=1.0 / beta,
         )
@@ -532,8 +532,12 @@ class Tanh(FrictionModel):
         return self.fc, self.beta
 
 
-def _one_minus_tanh(x):
-    # 1 - tanh(x) = 2 / (1 + exp(2x)), accurate where tanh(x) rounds to 1.
+def one_minus_tanh(x):
+    """1 - tanh(x) for x >= 0, accurate where tanh(x) rounds to 1.
+
+    Written as 2 / (1 + exp(2x)); the boundary-layer corrections of tanh
+    friction (here and in :mod:`randvib.analytic.averaging`) integrate it.
+    """
     return 2.0 / (1.0 + np.exp(np.minimum(2.0 * x, 700.0)))
 
 
