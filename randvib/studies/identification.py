@@ -41,6 +41,7 @@ from randvib.identification.record_simulation import simulate_record
 from randvib.models.excitation import band_limited_excitation
 from randvib.models.harvester import ElectricalCoupling
 from randvib.models.presets import ALPHA, MAGNET_MASS, R_COIL
+from randvib.studies.report import markdown_table
 
 #: The paper's four models (Table 2). Not identification.MODELS: that lists
 #: every registered friction law, including ones a user defines later.
@@ -114,12 +115,6 @@ def _identify_cached(path: Path, record, model, **kwargs) -> IdentificationResul
     result = identify(record, model, **kwargs)
     atomic_write_text(path, json.dumps(result.to_dict(), indent=2))
     return result
-
-
-def _md_table(frame: pd.DataFrame, floatfmt=".4g") -> str:
-    from tabulate import tabulate
-
-    return tabulate(frame, headers="keys", tablefmt="pipe", floatfmt=floatfmt, showindex=False)
 
 
 def figure8_verdict(fig8: pd.DataFrame) -> str:
@@ -338,19 +333,19 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
         "",
         "## Noise-free recovery (Coulomb model, test 3)",
         "",
-        _md_table(recovery, ".6g"),
+        markdown_table(recovery, ".6g"),
         "",
         f"J = {exact.cost:.3g}; all parameters within 1 % and J < 1: **{'yes' if recovered else 'NO'}**.",
         "",
         "## Identified parameters beside the truth (Table 2 analogue)",
         "",
-        _md_table(table, ".4g"),
+        markdown_table(table, ".4g"),
         "",
         "## J on all nine tests (Figure 7)",
         "",
         "![Figure 7](figure7_costs.png)",
         "",
-        _md_table(pivot, ".3g"),
+        markdown_table(pivot, ".3g"),
         "",
         "## Load voltage (Figure 8)",
         "",
@@ -359,7 +354,7 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
         "identified c). Share of samples with |V| < 0.5 mV (the spike at zero volts caused by "
         "sticking; the measured voltage carries 0.1 mV RMS noise):",
         "",
-        _md_table(fig8, ".3g"),
+        markdown_table(fig8, ".3g"),
         "",
         fig8_sentence,
         "",
