@@ -152,11 +152,14 @@ def figure8_verdict(fig8: pd.DataFrame) -> str:
     return text
 
 
-def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, progress=True) -> Path:
+def run_study(
+    out_dir, *, quick=False, seed=0, workers=None, scheduler=None, progress=True, threads=None
+) -> Path:
     """Run the campaign; write records, figures, CSV tables and ``report.md`` into ``out_dir``.
 
-    ``workers`` sets the number of numba threads for the batched simulations;
-    ``scheduler`` is not used (each identification is one process).
+    ``threads`` sets the number of numba threads for the batched simulations
+    (``randvib study identification --threads N``). ``workers`` (processes)
+    and ``scheduler`` are not used: each identification runs in this process.
     """
     import numba
 
@@ -164,12 +167,12 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
 
     settings = _settings(quick)
     identity = {"study": "identification", "quick": bool(quick), "seed": int(seed), **settings}
-    out = prepare_output_dir(out_dir, identity, {"workers": workers, "scheduler": scheduler})
+    out = prepare_output_dir(out_dir, identity, {"threads": threads, "scheduler": scheduler})
     report = out / "report.md"
     if report.exists():
         return report
-    if workers is not None:
-        numba.set_num_threads(max(1, min(int(workers), numba.config.NUMBA_NUM_THREADS)))
+    if threads is not None:
+        numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
     start = time.perf_counter()
     common = dict(duration=settings["duration"], fs=settings["fs"], seed=seed)
     tests = {n: make_test(n, **common)[0] for n in range(1, 10)}

@@ -154,16 +154,8 @@ def interaction_counts(inter: pd.DataFrame, k3s) -> dict:
     return out
 
 
-def interaction_summary(
-    inter: pd.DataFrame, k3s, labels: dict | None = None
-) -> tuple[str, pd.DataFrame]:
-    """The verdict sentence on the contrasts over several springs, and a per-k3 summary table.
-
-    ``inter`` as for :func:`interaction_verdict`, with ``k3`` and ``phi``
-    columns (and ``averaging_relative_contrast`` when averaging is compared);
-    ``labels`` names some k3 values (e.g. {5e5: "Fig. 9"}).
-    """
-    labels = labels or {}
+def summary_by_spring(inter: pd.DataFrame, k3s, labels: dict) -> pd.DataFrame:
+    """One row per k3 > 0: detectable counts, the largest contrast, its bound (report table)."""
     rows = []
     for k3 in k3s:
         if k3 == 0:
@@ -186,7 +178,20 @@ def interaction_summary(
                 else "n/a",
             }
         )
-    summary = pd.DataFrame(rows)
+    return pd.DataFrame(rows)
+
+
+def interaction_summary(
+    inter: pd.DataFrame, k3s, labels: dict | None = None
+) -> tuple[str, pd.DataFrame]:
+    """The verdict sentence on the contrasts over several springs, and a per-k3 summary table.
+
+    ``inter`` as for :func:`interaction_verdict`, with ``k3`` and ``phi``
+    columns (and ``averaging_relative_contrast`` when averaging is compared);
+    ``labels`` names some k3 values (e.g. {5e5: "Fig. 9"}).
+    """
+    labels = labels or {}
+    summary = summary_by_spring(inter, k3s, labels)
     holm = inter[inter.detectable_holm]
     top = max(k for k in k3s)
     at_top = inter[inter.k3 == top]
