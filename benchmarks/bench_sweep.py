@@ -63,7 +63,9 @@ def test_variance_reduction(benchmark):
 
 
 def test_figure9_full_study(benchmark):
-    from randvib.studies.figure9 import run_study
+    from randvib.studies import load
+
+    run_study = load("figure9").run_study
 
     def run():
         with tempfile.TemporaryDirectory() as tmp:

@@ -1,14 +1,17 @@
-"""Synthetic identification campaign (paper Sec. 3-4): ``python studies/identification.py OUT [--quick]``.
+"""Synthetic identification campaign: paper Sec. 3-4, Figures 7-8, Table 2.
 
-Same as ``randvib study identification --out OUT``.
+``randvib study identification --out OUT [--quick]``
+
+(or ``python studies/identification.py OUT [--quick]``). Not yet split into a script
+of its own: the study's code is still :mod:`randvib.studies.identification`.
 """
 
 import sys
 
-from randvib.cli import main
+from randvib.studies import script_main
+from randvib.studies.identification import run_study
+
+__all__ = ["run_study"]
 
 if __name__ == "__main__":
-    args = sys.argv[1:]
-    if not args:
-        sys.exit("usage: python studies/identification.py OUT_DIR [--quick] [--seed N]")
-    sys.exit(main(["study", "identification", "--out", args[0], *args[1:]]))
+    sys.exit(script_main(run_study))

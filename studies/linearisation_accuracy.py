@@ -1,14 +1,17 @@
-"""Where equivalent linearisation can be trusted: ``python studies/linearisation_accuracy.py OUT [--quick]``.
+"""Where can equivalent linearisation be trusted?
 
-Same as ``randvib study linearisation-accuracy --out OUT``.
+``randvib study linearisation-accuracy --out OUT [--quick]``
+
+(or ``python studies/linearisation_accuracy.py OUT [--quick]``). Not yet split into a script
+of its own: the study's code is still :mod:`randvib.studies.linearisation_accuracy`.
 """
 
 import sys
 
-from randvib.cli import main
+from randvib.studies import script_main
+from randvib.studies.linearisation_accuracy import run_study
+
+__all__ = ["run_study"]
 
 if __name__ == "__main__":
-    args = sys.argv[1:]
-    if not args:
-        sys.exit("usage: python studies/linearisation_accuracy.py OUT_DIR [--quick] [--seed N]")
-    sys.exit(main(["study", "linearisation-accuracy", "--out", args[0], *args[1:]]))
+    sys.exit(script_main(run_study))

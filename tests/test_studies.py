@@ -20,13 +20,12 @@ import randvib as rv
 from randvib.analytic.prediction import expected_power
 from randvib.cli import main
 from randvib.montecarlo.sweep import SweepSettings
-from randvib.studies import interaction, linearisation_accuracy
-from randvib.studies._common import (
-    fc_at_friction_level,
-    fc_where_power_halves,
-    friction_level,
-    plus_minus,
-)
+from randvib.studies import linearisation_accuracy, load
+from randvib.studies.grids import fc_at_friction_level, fc_where_power_halves, friction_level
+from randvib.studies.report import plus_minus
+from randvib.studies.verdicts import interaction_summary
+
+interaction = load("interaction")  # the script studies/interaction.py
 
 BASE = rv.preset("figure9")
 TINY = SweepSettings(dt=1e-4, window=0.3, burn_in=0.1, min_paths=48, max_paths=48, batch_paths=48)
@@ -243,7 +242,7 @@ def _inter_rows(contrasts, averaging, holm=(False, False, False, False)):
 
 def test_interaction_summary_counts_holm_per_k3_and_describes_averaging():
     inter = _inter_rows([0.001, -0.001, 0.004, 0.009], [1e-4, 3e-4, 2e-3, 6e-3])
-    verdict, _ = interaction._summary(inter, (0.0, 5e5, 5e7))
+    verdict, _ = interaction_summary(inter, (0.0, 5e5, 5e7), interaction.K3_LABELS)
     assert verdict.startswith("No interaction is detectable")
     assert "±1.10 %" in verdict  # |0.009| + 0.002 at the largest k3
     assert "all positive contrasts growing in size with k3 and Fc" in verdict
@@ -252,7 +251,7 @@ def test_interaction_summary_counts_holm_per_k3_and_describes_averaging():
     inter = _inter_rows(
         [0.001, -0.001, 0.004, 0.009], [1e-4, 3e-5, 2e-3, 6e-3], holm=(False, False, True, True)
     )
-    verdict, _ = interaction._summary(inter, (0.0, 5e5, 5e7))
+    verdict, _ = interaction_summary(inter, (0.0, 5e5, 5e7), interaction.K3_LABELS)
     assert "detectable (Holm, family level 5 %) at 2 of 4" in verdict
     assert "2 at k3 = 5e+07" in verdict
     assert "growing in size with k3 (not monotonically with Fc)" in verdict
@@ -324,7 +323,7 @@ def test_interaction_contrasts_holm_at_family_level(monkeypatch):
     from types import SimpleNamespace
 
     from randvib.montecarlo.simulation import Statistic
-    from randvib.studies import _common
+    from randvib.studies import contrasts
 
     points = [{"fc": fc, "k3": k3} for k3 in (0.0, 1.0) for fc in (0.0, 0.1, 0.2, 0.3)]
     table = pd.DataFrame(
@@ -337,11 +336,11 @@ def test_interaction_contrasts_holm_at_family_level(monkeypatch):
         i = max(weights)  # the (fc, k3) point itself has the largest index
         return Statistic(z_of_point[i] * 1e-3, 1.96e-3, 1e-3, 100)
 
-    monkeypatch.setattr(_common, "paired_contrast", fake_contrast)
-    inter = _common.interaction_contrasts(result, BASE, "fc", "k3")
+    monkeypatch.setattr(contrasts, "paired_contrast", fake_contrast)
+    inter = contrasts.interaction_contrasts(result, BASE, "fc", "k3")
     assert inter.fc.tolist() == [0.1, 0.2, 0.3]
     assert inter.detectable.tolist() == [True, True, False]
     assert inter.detectable_holm.tolist() == [False, False, False]
     z_of_point[5], z_of_point[6] = 2.5, -2.3  # p = 0.012 <= 0.05 / 3, then 0.021 <= 0.05 / 2
-    inter = _common.interaction_contrasts(result, BASE, "fc", "k3")
+    inter = contrasts.interaction_contrasts(result, BASE, "fc", "k3")
     assert inter.detectable_holm.tolist() == [True, True, False]

@@ -16,7 +16,7 @@ from _stats import assert_matches
 from study_checks import contrast_zscores, power_zscores, step_zscores
 
 from randvib.cli import main
-from randvib.studies.figure9 import interaction_verdict, linearisation_verdict
+from randvib.studies.verdicts import interaction_verdict, linearisation_verdict
 
 
 @pytest.fixture(scope="module")
@@ -177,12 +177,12 @@ def test_interaction_verdict_follows_the_data():
             "detectable_holm": [False, False],
         }
     )
-    data, text = interaction_verdict(inter)
+    data, text = interaction_verdict(inter, 5e5)
     assert data["n_holm"] == 0 and data["n_detectable"] == 1
     assert data["largest_relative_contrast"] == -0.004
     assert data["bound_relative"] == pytest.approx(0.005)
     assert "no interaction is detectable" in text and "±0.50 %" in text
-    data, text = interaction_verdict(inter.assign(detectable_holm=[False, True]))
+    data, text = interaction_verdict(inter.assign(detectable_holm=[False, True]), 5e5)
     assert data["n_holm"] == 1 and "detectable at 1 of 2" in text and "all negative" in text
 
 

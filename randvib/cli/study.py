@@ -1,45 +1,32 @@
-"""``randvib study NAME --out DIR``: run one of the packaged studies.
+"""``randvib study NAME --out DIR``: run one of the study scripts.
 
-Every study is a function ``run_study(out_dir, *, quick=False, seed=0,
-workers=None, scheduler=None, progress=True) -> Path`` (the Markdown report
-it wrote) registered in :data:`STUDIES` as ``"module:function"``; the scripts
-in the repository's ``studies/`` folder call the same functions.
+The studies are scripts in the ``studies/`` folder of a randvib checkout
+(:data:`randvib.studies.STUDIES`, found by :func:`randvib.studies.load`);
+each defines ``run_study(out_dir, *, quick=False, seed=0, workers=None,
+scheduler=None, progress=True) -> Path`` (the Markdown report it wrote).
+``--workers`` is the number of local worker *processes* of a study's sweep;
+``--threads`` the numba threads of a study that simulates in-process (the
+identification study).
 """
 
 from __future__ import annotations
 
-import importlib
+import inspect
 
-#: Study name -> "module:function" (imported only when run).
-STUDIES = {
-    "figure9": "randvib.studies.figure9:run_study",
-    "interaction": "randvib.studies.interaction:run_study",
-    "linearisation-accuracy": "randvib.studies.linearisation_accuracy:run_study",
-    "identification": "randvib.studies.identification:run_study",
-    "linearisation-vs-averaging": "randvib.studies.linearisation_vs_averaging:run_study",
-}
+from randvib.studies import STUDIES, load
 
 
 def load_study(name: str):
-    """The ``run_study`` function of a registered study."""
-    if name not in STUDIES:
-        raise ValueError(f"unknown study {name!r}; available: {', '.join(STUDIES)}")
-    module_name, func = STUDIES[name].split(":")
-    try:
-        module = importlib.import_module(module_name)
-    except ModuleNotFoundError as exc:
-        if exc.name == module_name:
-            raise ValueError(f"study {name!r} is not available in this version") from None
-        raise
-    return getattr(module, func)
+    """The ``run_study`` function of a registered study script."""
+    return load(name).run_study
 
 
 def register(sub) -> None:
     p = sub.add_parser(
         "study",
-        help="run a packaged study (figures, CSV, Markdown report)",
-        description="Run a packaged study; writes PNG figures, CSV tables and "
-        "a Markdown report into --out.",
+        help="run a study script (figures, CSV, Markdown report)",
+        description="Run one of the study scripts of the checkout's studies/ folder; "
+        "writes PNG figures, CSV tables and a Markdown report into --out.",
     )
     p.add_argument("name", help=f"study: {', '.join(STUDIES)}")
     p.add_argument("--out", required=True, help="output folder (created; never overwritten)")
@@ -47,6 +34,13 @@ def register(sub) -> None:
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument(
         "--workers", type=int, default=None, help="local worker processes (default: all cores)"
+    )
+    p.add_argument(
+        "--threads",
+        type=int,
+        default=None,
+        help="numba threads of a study that simulates in-process (identification; "
+        "default: all cores)",
     )
     p.add_argument(
         "--scheduler", default=None, help="Dask distributed scheduler ADDRESS to run the sweep on"
@@ -57,6 +51,14 @@ def register(sub) -> None:
 
 def run(args) -> int:
     study = load_study(args.name)
+    extra = {}
+    if args.threads is not None:
+        if "threads" not in inspect.signature(study).parameters:
+            raise ValueError(
+                f"study {args.name!r} has no `threads` option; its sweep runs on --workers "
+                "processes"
+            )
+        extra["threads"] = args.threads
     report = study(
         args.out,
         quick=args.quick,
@@ -64,6 +66,7 @@ def run(args) -> int:
         workers=args.workers,
         scheduler=args.scheduler,
         progress=not args.no_progress,
+        **extra,
     )
     print(f"report: {report}")
     return 0

@@ -1,1 +1,101 @@
-"""Packaged studies, one module each; see ``randvib.cli.study.STUDIES``."""
+"""Building blocks for studies, and the finder of the study scripts.
+
+A study is a short script in the ``studies/`` folder of a randvib checkout,
+written against the public API the way a user would write their own sweep:
+compute (a sweep, contrasts), tables, figures, a report with verdicts. What
+such scripts share lives here:
+
+- :mod:`~randvib.studies.grids`: friction and Duffing levels, Coulomb grids, burn-in;
+- :mod:`~randvib.studies.contrasts`: paired interaction contrasts with Holm's
+  correction, and analytic predictions of the same contrasts;
+- :mod:`~randvib.studies.stepcheck`: the sweep with its half-step re-run, and its verdict;
+- :mod:`~randvib.studies.verdicts`: the verdict sentences, built from the numbers;
+- :mod:`~randvib.studies.figures`: figures of power and contrasts against Fc;
+- :mod:`~randvib.studies.report`: CSV, ``verdicts.json``, Markdown tables, ``report.md``.
+
+Every script defines ``run_study(out_dir, *, quick=False, seed=0,
+workers=None, scheduler=None, progress=True) -> Path`` (the report it wrote);
+``workers`` always means local worker *processes* (the sweeps'), and a study
+that simulates in-process on numba threads takes ``threads`` as well.
+:func:`load` finds a script by its name (``randvib study NAME`` runs it).
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.util
+import sys
+from pathlib import Path
+
+#: Where the study scripts are: ``studies/`` beside the package in a checkout.
+STUDIES_DIR = Path(__file__).resolve().parents[2] / "studies"
+
+#: The registered studies (``randvib study NAME``), each ``studies/NAME.py`` with
+#: dashes as underscores.
+STUDIES = (
+    "figure9",
+    "interaction",
+    "linearisation-accuracy",
+    "identification",
+    "linearisation-vs-averaging",
+    "silverbox",
+)
+
+
+def load(name: str):
+    """The module of the study script ``name`` (loaded once, then the same object).
+
+    Raises
+    ------
+    ValueError
+        ``name`` is not a registered study, or its script is not in
+        :data:`STUDIES_DIR` (an installed copy without the checkout's
+        ``studies/`` folder).
+    """
+    if name not in STUDIES:
+        raise ValueError(f"unknown study {name!r}; available: {', '.join(STUDIES)}")
+    stem = name.replace("-", "_")
+    module_name = f"randvib_study_{stem}"
+    # cached, so that a test's monkeypatch and the CLI see the same module
+    if module_name in sys.modules:
+        return sys.modules[module_name]
+    path = STUDIES_DIR / f"{stem}.py"
+    if not path.is_file():
+        raise ValueError(
+            f"study {name!r} is a script in the `studies/` folder of a randvib checkout, "
+            f"and {path} does not exist; run it from a clone of the repository "
+            "(pip install -e .)"
+        )
+    spec = importlib.util.spec_from_file_location(module_name, path)
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[module_name] = module
+    try:
+        spec.loader.exec_module(module)
+    except BaseException:
+        del sys.modules[module_name]
+        raise
+    return module
+
+
+def script_main(run_study, argv=None) -> int:
+    """``python studies/NAME.py OUT_DIR [--quick] [--seed N] [--workers N]``: run one study.
+
+    The same as ``randvib study NAME --out OUT_DIR ...``; for the ``__main__``
+    block of a study script.
+    """
+    parser = argparse.ArgumentParser(description=(run_study.__doc__ or "").splitlines()[0])
+    parser.add_argument("out", help="output folder (created; never overwritten)")
+    parser.add_argument("--quick", action="store_true", help="small, fast version")
+    parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    parser.add_argument("--workers", type=int, default=None, help="local worker processes")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bars")
+    args = parser.parse_args(argv)
+    report = run_study(
+        args.out,
+        quick=args.quick,
+        seed=args.seed,
+        workers=args.workers,
+        progress=not args.no_progress,
+    )
+    print(f"report: {report}")
+    return 0

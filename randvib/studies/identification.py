@@ -41,6 +41,7 @@ from randvib.identification.record_simulation import simulate_record
 from randvib.models.excitation import band_limited_excitation
 from randvib.models.harvester import ElectricalCoupling
 from randvib.models.presets import ALPHA, MAGNET_MASS, R_COIL
+from randvib.studies.report import markdown_table
 
 #: The paper's four models (Table 2). Not identification.MODELS: that lists
 #: every registered friction law, including ones a user defines later.
@@ -116,12 +117,6 @@ def _identify_cached(path: Path, record, model, **kwargs) -> IdentificationResul
     return result
 
 
-def _md_table(frame: pd.DataFrame, floatfmt=".4g") -> str:
-    from tabulate import tabulate
-
-    return tabulate(frame, headers="keys", tablefmt="pipe", floatfmt=floatfmt, showindex=False)
-
-
 def figure8_verdict(fig8: pd.DataFrame) -> str:
     """The Figure 8 reading, from the shares of samples with |V| < 0.5 mV.
 
@@ -157,11 +152,14 @@ def figure8_verdict(fig8: pd.DataFrame) -> str:
     return text
 
 
-def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, progress=True) -> Path:
+def run_study(
+    out_dir, *, quick=False, seed=0, workers=None, scheduler=None, progress=True, threads=None
+) -> Path:
     """Run the campaign; write records, figures, CSV tables and ``report.md`` into ``out_dir``.
 
-    ``workers`` sets the number of numba threads for the batched simulations;
-    ``scheduler`` is not used (each identification is one process).
+    ``threads`` sets the number of numba threads for the batched simulations
+    (``randvib study identification --threads N``). ``workers`` (processes)
+    and ``scheduler`` are not used: each identification runs in this process.
     """
     import numba
 
@@ -169,12 +167,12 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
 
     settings = _settings(quick)
     identity = {"study": "identification", "quick": bool(quick), "seed": int(seed), **settings}
-    out = prepare_output_dir(out_dir, identity, {"workers": workers, "scheduler": scheduler})
+    out = prepare_output_dir(out_dir, identity, {"threads": threads, "scheduler": scheduler})
     report = out / "report.md"
     if report.exists():
         return report
-    if workers is not None:
-        numba.set_num_threads(max(1, min(int(workers), numba.config.NUMBA_NUM_THREADS)))
+    if threads is not None:
+        numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
     start = time.perf_counter()
     common = dict(duration=settings["duration"], fs=settings["fs"], seed=seed)
     tests = {n: make_test(n, **common)[0] for n in range(1, 10)}
@@ -338,19 +336,19 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
         "",
         "## Noise-free recovery (Coulomb model, test 3)",
         "",
-        _md_table(recovery, ".6g"),
+        markdown_table(recovery, ".6g"),
         "",
         f"J = {exact.cost:.3g}; all parameters within 1 % and J < 1: **{'yes' if recovered else 'NO'}**.",
         "",
         "## Identified parameters beside the truth (Table 2 analogue)",
         "",
-        _md_table(table, ".4g"),
+        markdown_table(table, ".4g"),
         "",
         "## J on all nine tests (Figure 7)",
         "",
         "![Figure 7](figure7_costs.png)",
         "",
-        _md_table(pivot, ".3g"),
+        markdown_table(pivot, ".3g"),
         "",
         "## Load voltage (Figure 8)",
         "",
@@ -359,7 +357,7 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
         "identified c). Share of samples with |V| < 0.5 mV (the spike at zero volts caused by "
         "sticking; the measured voltage carries 0.1 mV RMS noise):",
         "",
-        _md_table(fig8, ".3g"),
+        markdown_table(fig8, ".3g"),
         "",
         fig8_sentence,
         "",

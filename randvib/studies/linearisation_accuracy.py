@@ -35,19 +35,14 @@ from randvib.analytic.averaging import averaging_statistics
 from randvib.analytic.prediction import METHODS
 from randvib.models.presets import preset
 from randvib.montecarlo.sweep import SweepSettings, linearisation_verdicts
-from randvib.studies._common import (
+from randvib.studies.grids import (
     burn_in_for,
-    check_step_bias,
     fc_at_friction_level,
     friction_level,
     highest_friction_points,
-    markdown_table,
-    plus_minus,
-    save_figure,
-    step_check_verdict,
-    sweep_with_step_check,
-    write_report,
 )
+from randvib.studies.report import markdown_table, plus_minus, save_figure, write_report
+from randvib.studies.stepcheck import check_step_bias, step_check_verdict, sweep_with_step_check
 
 NAME = "linearisation-accuracy"
 TOLERANCES = (0.01, 0.05, 0.10)

@@ -46,6 +46,7 @@ from randvib.analytic.prediction import expected_power
 from randvib.models.presets import preset
 from randvib.montecarlo import kernel
 from randvib.montecarlo.simulation import estimate, simulate, step_bias
+from randvib.studies.report import markdown_table
 
 NAME = "linearisation-vs-averaging"
 PSDS = (1.0, 0.5, 0.1)
@@ -350,8 +351,6 @@ def _yes(flag) -> str:
 
 
 def _criteria_table(df: pd.DataFrame, v: dict, timings: dict) -> str:
-    from tabulate import tabulate
-
     n_int = v["interaction_points"]
     rows = []
     if timings:
@@ -386,11 +385,8 @@ def _criteria_table(df: pd.DataFrame, v: dict, timings: dict) -> str:
             for n in CANDIDATES
         ]
     )
-    return tabulate(
-        rows,
-        headers=["criterion (issue 6)"] + [ANALYTIC[n][1] for n in CANDIDATES],
-        tablefmt="github",
-    )
+    headers = ["criterion (issue 6)"] + [ANALYTIC[n][1] for n in CANDIDATES]
+    return markdown_table(pd.DataFrame(rows, columns=headers), floatfmt="g")
 
 
 def _monotone(df: pd.DataFrame, column: str, by, along: str, sign: int) -> bool:
@@ -473,8 +469,6 @@ def reading(df: pd.DataFrame, timings: dict | None = None) -> str:
 def _report(
     df: pd.DataFrame, v: dict, timings: dict, quick: bool, mc, wall: float, out: Path
 ) -> Path:
-    from tabulate import tabulate
-
     def pct(x):
         return f"{100 * x:+.2f}"
 
@@ -559,14 +553,14 @@ def _report(
         "",
         "## Errors of E[P_e] against Monte Carlo",
         "",
-        tabulate(table, headers="keys", tablefmt="github", showindex=False, floatfmt=".4g"),
+        markdown_table(table),
         "",
         "## Change of power with k3 at fixed Fc (paired Monte Carlo)",
         "",
         "MC: mean ± the widened interval used by the verdict; '(out)' marks a prediction "
         "outside it.",
         "",
-        tabulate(inter, headers="keys", tablefmt="github", showindex=False, disable_numparse=True),
+        markdown_table(inter, floatfmt="g", numparse=False),
         "",
         "Files: `results.csv` (every column), the two PNG figures, `metadata.json`.",
         "",

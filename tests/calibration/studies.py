@@ -28,7 +28,9 @@ import pandas as pd
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from study_checks import contrast_zscores, power_zscores, step_zscores  # noqa: E402
 
-from randvib.studies.figure9 import run_study  # noqa: E402
+from randvib.studies import load  # noqa: E402
+
+run_study = load("figure9").run_study
 
 
 def figure9_seed(seed: int) -> dict:
@@ -54,7 +56,9 @@ def interaction_tiny_seed(seed: int) -> float:
     from dataclasses import replace
 
     from randvib.montecarlo.sweep import SweepSettings
-    from randvib.studies import interaction
+    from randvib.studies import load
+
+    interaction = load("interaction")
 
     tiny = SweepSettings(
         dt=1e-4, window=0.3, burn_in=0.1, min_paths=48, max_paths=48, batch_paths=48

@@ -1,0 +1,192 @@
+"""Figures the studies share: power and contrasts against the Coulomb level.
+
+Each function draws from a study's table, saves one PNG at ``path``
+(:func:`randvib.studies.report.save_figure`) and returns the path; nothing
+is computed here except the analytic curves drawn for comparison.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from randvib.analytic.prediction import METHODS, expected_power
+from randvib.studies.report import save_figure
+
+
+def power_against_friction(table: pd.DataFrame, base, psds, k3s, path: Path) -> Path:
+    """Expected power against Fc, one panel per (S, k3): Monte Carlo with 95 % bars over Eq. 32.
+
+    The paper's Figure 9 layout (rows S, columns k3), with the averaging
+    curve where that method is available. ``table`` is a sweep table with
+    ``psd``, ``k3``, ``fc``, ``power_electrical`` and its ``_ci95`` (W).
+    """
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(len(psds), 2, figsize=(10, 10), sharex="row", squeeze=False)
+    for col, k3 in enumerate(k3s):
+        for row, psd in enumerate(psds):
+            ax = axes[row, col]
+            sub = table[(table.psd == psd) & (table.k3 == k3)].sort_values("fc")
+            fc = np.linspace(0, sub.fc.max(), 200)
+            device = base.updated(k3=k3, fc=fc)
+            ax.plot(fc, expected_power(device, psd) * 1e3, "k-", label="Eq. 32 (linearisation)")
+            if "averaging" in METHODS:
+                try:
+                    ax.plot(
+                        fc,
+                        np.asarray(expected_power(device, psd, "averaging")) * 1e3,
+                        "b--",
+                        lw=1,
+                        label="stochastic averaging",
+                    )
+                except Exception:  # noqa: BLE001 - the extra curve is optional
+                    pass
+            ax.errorbar(
+                sub.fc,
+                sub.power_electrical * 1e3,
+                yerr=sub.power_electrical_ci95 * 1e3,
+                fmt="rx",
+                ms=6,
+                capsize=3,
+                label="Monte Carlo (95 % CI)",
+            )
+            ax.set_title(
+                f"({'ab'[col]}) k3 = {k3:g} N/m$^3$, S = {psd:g} (m/s$^2$)$^2$/Hz", fontsize=9
+            )
+            ax.set_ylabel("E[P$_e$] (mW)")
+            ax.grid(alpha=0.3)
+            if row == len(psds) - 1:
+                ax.set_xlabel("Coulomb friction Fc (N)")
+    axes[0, 0].legend(fontsize=8)
+    fig.suptitle("Paper Figure 9: expected electrical power against Coulomb friction")
+    return save_figure(fig, path)
+
+
+def contrast_against_friction(inter: pd.DataFrame, title: str, path: Path) -> Path:
+    """Relative interaction contrasts against Fc, one line per S, with 95 % bars."""
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for psd in inter.psd.unique():
+        sub = inter[inter.psd == psd].sort_values("fc")
+        ax.errorbar(
+            sub.fc,
+            100 * sub.relative_contrast,
+            yerr=100 * sub.relative_ci95,
+            fmt="o-",
+            capsize=3,
+            label=f"S = {psd:g}",
+        )
+    ax.axhline(0, color="k", lw=0.8)
+    ax.set_xlabel("Coulomb friction Fc (N)")
+    ax.set_ylabel("interaction contrast / P(Fc, k3=0) (%)")
+    ax.set_title(title)
+    ax.legend()
+    ax.grid(alpha=0.3)
+    return save_figure(fig, path)
+
+
+def _colours(k3s) -> dict:
+    import matplotlib.pyplot as plt
+
+    cycle = plt.get_cmap("tab10").colors
+    return {k3: cycle[i % len(cycle)] for i, k3 in enumerate(sorted(k3s))}
+
+
+def _k3_label(k3: float, labels: dict) -> str:
+    extra = labels.get(k3)
+    return f"k3 = {k3:.3g} N/m$^3$" + (f" ({extra})" if extra else "")
+
+
+def contrast_bands(
+    inter: pd.DataFrame, curves: pd.DataFrame | None, path: Path, labels: dict | None = None
+) -> Path:
+    """Relative interaction contrasts against Fc (mN), one panel per S, one band per k3.
+
+    ``curves`` (optional) adds an analytic prediction, dashed
+    (:func:`randvib.studies.contrasts.predicted_contrast_curves`, averaging);
+    ``labels`` names some k3 values in the legend.
+    """
+    labels = labels or {}
+    import matplotlib.pyplot as plt
+
+    psds = sorted(inter.psd.unique(), reverse=True)
+    k3s = sorted(inter.k3.unique())
+    colours = _colours(k3s)
+    fig, axes = plt.subplots(1, len(psds), figsize=(4.6 * len(psds), 4.4), squeeze=False)
+    for ax, psd in zip(axes[0], psds, strict=True):
+        for k3 in k3s:
+            sub = inter[(inter.psd == psd) & (inter.k3 == k3)].sort_values("fc")
+            # the contrast is zero by definition at Fc = 0
+            fc = np.r_[0.0, sub.fc] * 1e3
+            y = 100 * np.r_[0.0, sub.relative_contrast]
+            ci = 100 * np.r_[0.0, sub.relative_ci95]
+            ax.fill_between(fc, y - ci, y + ci, color=colours[k3], alpha=0.2, lw=0)
+            ax.plot(fc, y, "o-", color=colours[k3], ms=4, label=_k3_label(k3, labels))
+            if curves is not None:
+                cur = curves[(curves.psd == psd) & (curves.k3 == k3)]
+                ax.plot(
+                    np.r_[0.0, cur.fc] * 1e3,
+                    100 * np.r_[0.0, cur.averaging_relative_contrast],
+                    "--",
+                    color=colours[k3],
+                    lw=1,
+                )
+        ax.axhline(0.0, color="k", lw=0.8)
+        ax.set_title(f"S = {psd:g} (m/s$^2$)$^2$/Hz", fontsize=10)
+        ax.set_xlabel("Coulomb friction Fc (mN)")
+        ax.grid(alpha=0.3)
+    axes[0, 0].set_ylabel("interaction contrast / P(Fc, k3 = 0)  (%)")
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    if curves is not None:
+        from matplotlib.lines import Line2D
+
+        handles.append(Line2D([], [], color="grey", ls="--", lw=1))
+        labels.append("stochastic averaging (prediction)")
+    fig.legend(handles, labels, loc="lower center", ncol=min(len(labels), 3), fontsize=9)
+    fig.suptitle(
+        "Duffing-Coulomb interaction [P(Fc,k3) - P(Fc,0)] - [P(0,k3) - P(0,0)]: "
+        "Monte Carlo, paired paths, 95 % bands"
+    )
+    fig.tight_layout(rect=(0, 0.1 if len(labels) > 3 else 0.07, 1, 1))
+    return save_figure(fig, path)
+
+
+def linearisation_error_bands(table: pd.DataFrame, path: Path, labels: dict | None = None) -> Path:
+    """Eq. 32's relative error against Fc (mN) with 95 % bars, one panel per S, one line per k3."""
+    labels = labels or {}
+    import matplotlib.pyplot as plt
+
+    psds = sorted(table.psd.unique(), reverse=True)
+    k3s = sorted(table.k3.unique())
+    colours = _colours(k3s)
+    fig, axes = plt.subplots(
+        1, len(psds), figsize=(4.6 * len(psds), 4.0), squeeze=False, sharey=True
+    )
+    for ax, psd in zip(axes[0], psds, strict=True):
+        for j, k3 in enumerate(k3s):
+            sub = table[(table.psd == psd) & (table.k3 == k3) & (table.fc > 0)].sort_values("fc")
+            # small horizontal offsets keep overlapping error bars apart
+            shift = (j - (len(k3s) - 1) / 2) * 0.006 * sub.fc.max()
+            ax.errorbar(
+                (sub.fc + shift) * 1e3,
+                100 * sub.linearisation_rel_error,
+                yerr=100 * sub.linearisation_rel_error_ci95,
+                fmt="o-",
+                ms=3,
+                capsize=2,
+                color=colours[k3],
+                label=_k3_label(k3, labels),
+            )
+        ax.axhline(0.0, color="k", lw=0.8)
+        ax.set_title(f"S = {psd:g} (m/s$^2$)$^2$/Hz", fontsize=10)
+        ax.set_xlabel("Coulomb friction Fc (mN)")
+        ax.grid(alpha=0.3)
+    axes[0, 0].set_ylabel("Eq. 32 error (P$_{lin}$ - P$_{MC}$) / P$_{MC}$  (%)")
+    axes[0, 0].legend(fontsize=8)
+    fig.suptitle("Equivalent linearisation error at every k3 (95 % CI)")
+    fig.tight_layout()
+    return save_figure(fig, path)

@@ -1,0 +1,98 @@
+"""Where a study puts its points: friction levels, Coulomb grids, burn-in.
+
+The dimensionless levels used across the studies: the friction level
+phi = Fc / (c sigma_v0) (:func:`friction_level`) and the Duffing strength
+mu = k3 sigma_z0^2 / k (:func:`duffing_strength`), with sigma_v0, sigma_z0 the
+friction-free linear oscillator's rms velocity and displacement (paper Eq. 20).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from randvib.analytic.linearisation import coulomb_equivalent_damping
+from randvib.models.harvester import Harvester
+from randvib.montecarlo.sweep import cartesian
+
+
+def fc_where_power_halves(device: Harvester, psd: float) -> float:
+    """Coulomb level (N) at which Eq. 32 predicts half the friction-free power.
+
+    Half power means c_eq = 2c; Eq. 27 then gives
+    Fc = c sqrt(2 pi) / 4 * sqrt(S m / (2c)).
+    """
+    c, m = float(device.c), float(device.m)
+    fc = c * np.sqrt(2 * np.pi) / 4 * np.sqrt(psd * m / (2 * c))
+    assert np.isclose(coulomb_equivalent_damping(c, fc, psd, m), 2 * c)
+    return float(fc)
+
+
+def friction_level(device: Harvester, psd, fc):
+    """Dimensionless Coulomb level phi = Fc / (c sigma_v0).
+
+    sigma_v0^2 = S m / (4 c) is the friction-free velocity variance (paper
+    Eq. 20). Eq. 30-32 depend on Fc only through phi: with
+    kappa = phi^2 / pi, P / P(0) = 1 / (1 + kappa + sqrt(kappa (2 + kappa))),
+    so Eq. 32 halves the power at phi = sqrt(pi) / 2 (about 0.886). For
+    k3 = 0 the SDE itself scales exactly (z, z' and Fc all with sqrt(S)), so
+    any statistic of P / P(0) depends on phi and the damping ratio only.
+    """
+    c, m = float(device.c), float(device.m)
+    return np.asarray(fc, dtype=float) / (c * np.sqrt(np.asarray(psd, dtype=float) * m / (4 * c)))
+
+
+def fc_at_friction_level(device: Harvester, psd, phi):
+    """Coulomb level Fc (N) of the dimensionless level phi (inverse of :func:`friction_level`)."""
+    c, m = float(device.c), float(device.m)
+    return np.asarray(phi, dtype=float) * c * np.sqrt(np.asarray(psd, dtype=float) * m / (4 * c))
+
+
+def duffing_strength(device, psd, k3):
+    """mu = k3 sigma_z0^2 / k: cubic against linear spring force at the friction-free rms z.
+
+    sigma_z0^2 = S m^2 / (4 c k) (linear oscillator, Eq. 20 with E[z^2] = E[z'^2] m / k).
+    With z scaled by sqrt(S), the Duffing-Coulomb SDE depends on S and k3 only
+    through phi and mu, so grid points with equal k3 S repeat one problem.
+    """
+    c, m, k = float(device.c), float(device.m), float(device.k)
+    return np.asarray(k3, dtype=float) * np.asarray(psd, dtype=float) * m**2 / (4 * c * k**2)
+
+
+def coulomb_grid(base: Harvester, psds, k3s, n_fc: int, reach: float = 2.0) -> list[dict]:
+    """(psd, k3, fc) points: at each S, ``n_fc`` Coulomb levels from 0 to ``reach`` times
+    the level where Eq. 32 halves the power (:func:`fc_where_power_halves`).
+
+    ``reach = 2`` takes the friction level phi from 0 to sqrt(pi) at every S,
+    well past half power. Points come S by S, then k3, then Fc (the order of
+    :func:`randvib.montecarlo.sweep.cartesian`).
+    """
+    if n_fc < 2:
+        raise ValueError(f"`n_fc` must be >= 2 (Fc = 0 and at least one level), got {n_fc}")
+    points = []
+    for psd in psds:
+        fc_max = reach * fc_where_power_halves(base, psd)
+        points += cartesian(psd=[psd], k3=list(k3s), fc=np.linspace(0.0, fc_max, n_fc))
+    return points
+
+
+def highest_friction_points(points: list, group=("psd",)) -> list:
+    """The points with the largest Fc within each group: the hardest dynamics."""
+    top: dict = {}
+    for p in points:
+        key = tuple(p[g] for g in group)
+        top[key] = max(top.get(key, -np.inf), p["fc"])
+    return [p for p in points if p["fc"] == top[tuple(p[g] for g in group)]]
+
+
+def burn_in_for(devices, relaxation_times: float = 6.0, resolution: float = 0.5) -> float:
+    """Burn-in (s): ``relaxation_times`` energy relaxation times m/c of the slowest device.
+
+    Paths start from the linearised (Gaussian, Eq. 30) state, which is not
+    the stationary law of a friction-affected device; the mean energy relaxes
+    as exp(-c t / m), so a burn-in of a few m/c makes the start's bias in the
+    time averages (and in the energy-change control) negligible. (The
+    friction-free companion starts from its own stationary spread.) Rounded
+    up to ``resolution``.
+    """
+    tau = max(float(d.m) / float(d.c) for d in devices)
+    return float(np.ceil(relaxation_times * tau / resolution) * resolution)
