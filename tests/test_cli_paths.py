@@ -109,7 +109,10 @@ def test_simulate_bad_options(capsys, argv, fragment):
             "`--beta` applies to tanh",
         ),
         (["--preset", "figure9", "--beta", "5"], "`--beta` applies to tanh"),
-        (["--m", "1", "--c-m", "1", "--c-e", "1", "--k", "1", "--fc", "1"], "`--fc`/`--beta` need"),
+        (
+            ["--m", "1", "--c-m", "1", "--c-e", "1", "--k", "1", "--fc", "1"],
+            "`--fc` needs `--friction",
+        ),
         (["--preset", "figure9", "--friction", "tanh"], "`--beta` is required for tanh friction"),
         (["--m", "1", "--c-m", "1", "--c-e", "1"], "`--k` is required"),
         (

@@ -114,7 +114,10 @@ def _friction_from_args(args, friction):
     if friction is None:
         flags = "/".join(f"`--{n}`" for n in given)
         laws = sorted({law.name for n in given for law in options[n]})
-        raise ValueError(f"{flags} need `--friction {'|'.join(laws)}` (or a preset with friction)")
+        verb = "needs" if len(given) == 1 else "need"
+        raise ValueError(
+            f"{flags} {verb} `--friction {'|'.join(laws)}` (or a preset with friction)"
+        )
     for name in given:
         if name not in friction.parameter_names():
             laws = ", ".join(law.name for law in options[name])
