@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import json
 import warnings
-from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
@@ -488,7 +487,7 @@ def run_study(
             "quick": quick,
             "seed": seed,
             "grid": {"psds": psds, "k3s": k3s, "n_fc": n_fc},
-            "settings": asdict(settings),
+            "settings": settings.to_dict(),
         },
     )
     # half-step check where the dynamics is hardest: most friction, with and
