@@ -667,6 +667,7 @@ def test_too_large_step_refused_with_bound():
         ({"seed": -1}, "`seed`"),
     ],
 )
+@pytest.mark.filterwarnings("ignore:`method=`:DeprecationWarning")  # the alias row
 def test_bad_arguments(kwargs, fragment):
     base = dict(t_end=1.0, dt=1e-4, n_paths=4)
     with pytest.raises(ValueError, match=fragment):
