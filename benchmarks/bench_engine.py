@@ -41,7 +41,7 @@ def _run(method):
         t_end=N_STEPS * DT,
         dt=DT,
         n_paths=N_PATHS,
-        method=method,
+        scheme=method,
         seed=1,
         check_step=False,
         progress=False,

@@ -28,7 +28,6 @@ time-step bias is below the statistical error.
 from __future__ import annotations
 
 import sys
-from dataclasses import asdict
 
 import numpy as np
 import pandas as pd
@@ -276,7 +275,7 @@ def run_study(
     worst_bias = check_step_bias(base, points, settings)
     identity = {"study": NAME, "quick": quick, "seed": seed}
     identity["grid"] = {"psds": psds, "k3s": k3s, "n_fc": n_fc}
-    out = prepare_output_dir(out_dir, {**identity, "settings": asdict(settings)})
+    out = prepare_output_dir(out_dir, {**identity, "settings": settings.to_dict()})
 
     # compute: half-step check where the dynamics is hardest (most friction,
     # with and without the stiffest spring)

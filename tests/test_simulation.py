@@ -90,7 +90,7 @@ def case_scheme_discrete(method, seed):
         dt=dt,
         n_paths=1600,
         burn_in=20.0,
-        method=method,
+        scheme=method,
         seed=seed,
         check_step=False,
         control_variates=True,
@@ -492,7 +492,7 @@ def test_pathwise_equal_to_sdeint(method, reference, device):
         n_paths=2,
         dW=dw,
         initial=(0.002, -0.05),
-        method=method,
+        scheme=method,
         record_paths=2,
         record_every=1,
     )
@@ -528,7 +528,7 @@ def test_strong_order_against_fine_reference(method, order):
             n_paths=n_paths,
             dW=coarse,
             initial=(0.5, 0.0),
-            method=method,
+            scheme=method,
             record_paths=n_paths,
             record_every=n_fine // factor,
             check_step=False,
@@ -637,7 +637,7 @@ def test_blow_up_is_reported_with_step_and_parameters():
             t_end=500.0,
             dt=0.05,
             n_paths=8,
-            method="euler-maruyama",
+            scheme="euler-maruyama",
             check_step=False,
         )
 
@@ -650,7 +650,7 @@ def test_too_large_step_refused_with_bound():
         simulate(DUFFING_COULOMB, 1.0, t_end=0.2, dt=bound * 0.99, n_paths=2)
     with pytest.warns(StepSizeWarning):
         # EM on this device: bias about k dt / c = 2.9 % (warned, not refused)
-        simulate(LINEAR, 1.0, t_end=0.1, dt=1e-4, n_paths=2, method="euler-maruyama")
+        simulate(LINEAR, 1.0, t_end=0.1, dt=1e-4, n_paths=2, scheme="euler-maruyama")
 
 
 @pytest.mark.parametrize(
@@ -661,17 +661,32 @@ def test_too_large_step_refused_with_bound():
         ({"dt": 0.0}, "`dt`"),
         ({"burn_in": 2.0}, "`burn_in`"),
         ({"method": "rk4"}, "`method`"),
+        ({"scheme": "rk4"}, "`scheme`"),
         ({"dW": np.zeros((3, 3))}, "`dW` must have shape"),
         ({"initial": "somewhere"}, "`initial`"),
         ({"seed": -1}, "`seed`"),
     ],
 )
+@pytest.mark.filterwarnings("ignore:`method=`:DeprecationWarning")  # the alias row
 def test_bad_arguments(kwargs, fragment):
     base = dict(t_end=1.0, dt=1e-4, n_paths=4)
     with pytest.raises(ValueError, match=fragment):
         simulate(LINEAR, 1.0, **{**base, **kwargs})
     with pytest.raises(ValueError, match="`psd`"):
         simulate(LINEAR, -1.0, **base)
+
+
+def test_method_is_a_deprecated_alias_of_scheme():
+    base = dict(t_end=0.05, dt=1e-4, n_paths=4, seed=2, check_step=False, progress=False)
+    new = simulate(LINEAR, 1.0, scheme="euler-maruyama", **base)
+    with pytest.warns(DeprecationWarning, match="scheme="):
+        old = simulate(LINEAR, 1.0, method="euler-maruyama", **base)
+    np.testing.assert_array_equal(old.per_path, new.per_path)
+    assert new.scheme == "euler-maruyama" and new.summary()["method"] == "euler-maruyama"
+    with pytest.warns(DeprecationWarning):
+        assert old.method == "euler-maruyama"
+    with pytest.raises(TypeError, match="`scheme` only"):
+        simulate(LINEAR, 1.0, scheme="heun", method="heun", **base)
 
 
 def test_cli_simulate_json(capsys):

@@ -166,7 +166,7 @@ def crn_sweep(seed: int, settings: SweepSettings = COVERAGE_SETTINGS):
         r = rv.simulate(
             sweep_module.point_device(BASE, p), p["psd"],
             t_end=settings.burn_in + settings.window, dt=settings.dt, burn_in=settings.burn_in,
-            method=settings.method, seed=seed, n_paths=settings.min_paths, companion=True,
+            scheme=settings.scheme, seed=seed, n_paths=settings.min_paths, companion=True,
             control_variates=True, progress=False,
         )  # fmt: skip
         per_path[i] = r.per_path
@@ -333,3 +333,12 @@ def test_settings_validation():
         SweepSettings(target_rel_ci=0)
     with pytest.raises(ValueError, match="`max_paths`"):
         SweepSettings(min_paths=64, max_paths=32)
+
+
+def test_sweep_settings_take_method_as_deprecated_alias_of_scheme():
+    with pytest.warns(DeprecationWarning, match="scheme="):
+        old = SweepSettings(method="euler-maruyama", dt=2e-5)
+    assert old == SweepSettings(scheme="euler-maruyama", dt=2e-5)
+    with pytest.warns(DeprecationWarning):
+        assert old.method == "euler-maruyama"
+    assert old.to_dict()["method"] == "euler-maruyama" and "scheme" not in old.to_dict()

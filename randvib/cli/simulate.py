@@ -49,7 +49,7 @@ def run(args) -> int:
         dt=args.dt,
         n_paths=args.paths,
         burn_in=args.burn_in,
-        method=args.method,
+        scheme=args.method,  # the CLI keeps its option name `--method`
         seed=args.seed,
         threads=args.threads,
         companion=args.control_variates,
@@ -80,6 +80,6 @@ def run(args) -> int:
     print_table(rows, ("statistic", "Monte Carlo", "± 95 %", "linearisation", "unit"))
     print(
         f"{result.n_paths} paths x {result.averaging_time:g} s averaged (dt {result.dt:g} s, "
-        f"{result.method}, seed {result.seed}), {result.wall_time:.2f} s wall"
+        f"{result.scheme}, seed {result.seed}), {result.wall_time:.2f} s wall"
     )
     return 0

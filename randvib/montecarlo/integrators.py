@@ -1,11 +1,11 @@
-"""Stochastic integrators for the white-noise driven harvester: a table of methods.
+"""Stochastic integrators for the white-noise driven harvester: a table of schemes.
 
 The device SDE (docs/conventions.md) has additive noise,
 
     dz = v dt,   dv = a(z, v, theta) dt + sqrt(S/2) dW,   dtheta = r(v, theta) dt,
 
 so Ito and Stratonovich solutions coincide and stochastic Heun (a
-Stratonovich scheme) is consistent for it. Each method declares its orders for
+Stratonovich scheme) is consistent for it. Each scheme declares its orders for
 additive noise and smooth drift and its step as a table of stage weights
 (:class:`Integrator`); the compiled kernel and the exact linear recursions
 read that table. Non-smooth drifts (Coulomb friction) lower the observed
@@ -14,6 +14,7 @@ orders.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -41,7 +42,7 @@ class Integrator:
     Attributes
     ----------
     name : str
-        Name used by ``simulate(method=...)`` and the CLI.
+        Name used by ``simulate(scheme=...)`` and the CLI (``--method``).
     strong_order : float
         Strong (pathwise) order for additive noise and smooth drift.
     weak_order : float
@@ -109,13 +110,47 @@ HEUN = Integrator("heun", 1.0, 2.0, "stratonovich", (0.5, 0.5))
 INTEGRATORS = {i.name: i for i in (EULER_MARUYAMA, HEUN)}
 
 
-def integrator(name: str) -> Integrator:
-    """Look up an integrator by name (``euler-maruyama`` or ``heun``)."""
-    check_choice("method", name, tuple(INTEGRATORS))
+#: The integrator used when none is named.
+DEFAULT_SCHEME = "heun"
+
+
+def integrator(name: str, argument: str = "method") -> Integrator:
+    """Look up an integrator by name (``euler-maruyama`` or ``heun``).
+
+    ``argument`` is the keyword named in the error message for an unknown name.
+    """
+    check_choice(argument, name, tuple(INTEGRATORS))
     return INTEGRATORS[name]
 
 
-def scheme_matrices(method: str, m, c, k, psd, dt):
+def scheme_argument(scheme: str | None, method: str | None, stacklevel: int = 3):
+    """The integrator's name from ``scheme=`` or its deprecated alias ``method=``.
+
+    ``method`` means several things in randvib (analytic method, optimiser);
+    the integrator is called ``scheme``. Functions that took ``method=`` for
+    it keep accepting it with a :class:`DeprecationWarning` (pointing
+    ``stacklevel`` frames up: 3 is the caller of the function calling this).
+
+    Returns
+    -------
+    name : str
+        The integrator's name (:data:`DEFAULT_SCHEME` when neither is given).
+    argument : str
+        The keyword it came by, for error messages.
+    """
+    if method is None:
+        return (DEFAULT_SCHEME if scheme is None else scheme), "scheme"
+    if scheme is not None:
+        raise TypeError("give the integrator as `scheme` only; `method` is its deprecated alias")
+    warnings.warn(
+        "`method=` for the integrator is deprecated; use `scheme=`",
+        DeprecationWarning,
+        stacklevel=stacklevel,
+    )
+    return method, "method"
+
+
+def scheme_matrices(scheme: str, m, c, k, psd, dt):
     """Transition matrix A and noise matrix B of a scheme on the linear oscillator.
 
     The recursion is x_{n+1} = A x_n + B dW_n with x = (z, v), dW_n ~ N(0, dt),
@@ -125,20 +160,20 @@ def scheme_matrices(method: str, m, c, k, psd, dt):
     """
     f = np.array([[0.0, 1.0], [-k / m, -c / m]])
     b = np.array([[0.0], [np.sqrt(psd / 2.0)]])
-    return integrator(method).linear_recursion(f, b, dt)
+    return integrator(scheme).linear_recursion(f, b, dt)
 
 
-def scheme_stationary_covariance(method: str, m, c, k, psd, dt) -> np.ndarray:
+def scheme_stationary_covariance(scheme: str, m, c, k, psd, dt) -> np.ndarray:
     """Exact stationary covariance of (z, v) for a scheme on the linear oscillator.
 
     Solves P = A P A^T + dt B B^T. Raises if the recursion is unstable
     (spectral radius of A >= 1), where no stationary state exists.
     """
-    a, b = scheme_matrices(method, m, c, k, psd, dt)
+    a, b = scheme_matrices(scheme, m, c, k, psd, dt)
     radius = max(abs(np.linalg.eigvals(a)))
     if radius >= 1:
         raise ValueError(
-            f"{method} with dt = {dt!r} s is unstable for this oscillator "
+            f"{scheme} with dt = {dt!r} s is unstable for this oscillator "
             f"(spectral radius {radius:.6g} >= 1)"
         )
     return linalg.solve_discrete_lyapunov(a, dt * (b @ b.T))

@@ -1,4 +1,4 @@
-"""Compiled ensemble kernel: one time loop for every method and friction model.
+"""Compiled ensemble kernel: one time loop for every scheme and friction model.
 
 Paths are processed in chunks of :data:`LANES` independent paths that advance
 together, step by step: the per-step dependency chain of one path is short
@@ -13,6 +13,8 @@ recorded histories are requested.
 """
 
 from __future__ import annotations
+
+from typing import NamedTuple, get_type_hints
 
 import numba
 import numpy as np
@@ -102,14 +104,130 @@ class PathAverages:
 CHECK_EVERY = 256
 
 
+# ------------------------------------------------------------- argument groups
+# The compiled loop takes its inputs in these small groups (numba accepts
+# named tuples, heterogeneous ones included, and reads their fields by name at
+# compile time). Build them with the functions below, which fix each field's
+# type: a field that is sometimes an int and sometimes a float would compile,
+# and cache, a second copy of the kernel.
+
+
+class Device(NamedTuple):
+    """The oscillator's coefficients (paper Eq. 15-17)."""
+
+    m: float  #: mass (kg)
+    c: float  #: total viscous damping c_m + c_e (Ns/m)
+    k: float  #: linear stiffness (N/m)
+    k3: float  #: cubic stiffness (N/m^3)
+    noise_amp: float  #: sqrt(S/2) (m/s^1.5): the velocity's diffusion
+
+
+class Friction(NamedTuple):
+    """A friction law's compiled form (:func:`randvib.models.friction.kernel_arguments`)."""
+
+    kind: int  #: kernel code of the law
+    p: np.ndarray  #: float64[N_KERNEL_PARAMETERS] parameters
+    fn: object  #: compiled callback, used for KERNEL_GENERIC laws only
+
+
+class Timing(NamedTuple):
+    """``n_steps`` steps of ``dt`` (s), the first ``n_burn`` outside the averaging window."""
+
+    dt: float
+    n_steps: int
+    n_burn: int
+
+
+class Paths(NamedTuple):
+    """Paths ``first .. first + count - 1``; path i draws from stream (seed, i)."""
+
+    seed: np.uint64
+    first: int
+    count: int
+
+
+class Start(NamedTuple):
+    """Initial state: (z, v) (m, m/s), or with ``random`` N(0, z^2) x N(0, v^2)."""
+
+    random: bool
+    z: float
+    v: float
+
+
+class Companion(NamedTuple):
+    """The friction-free companion: integrated alongside when ``enabled``.
+
+    It starts at (z, v) or, when the device's :class:`Start` is random, from
+    the device's two normal draws scaled by (z, v) (its own stationary spread).
+    """
+
+    enabled: bool
+    z: float
+    v: float
+
+
+class Recording(NamedTuple):
+    """What is recorded besides the time averages.
+
+    Histograms of (z, v) over the window in ``hist_bins`` bins on
+    [hist_lo, hist_hi) (``hist_bins`` 0: none); (z, v, theta) of the first
+    ``n_record`` paths every ``every`` steps, initial state included.
+    """
+
+    hist_lo: np.ndarray  #: float64[2]
+    hist_hi: np.ndarray  #: float64[2]
+    hist_bins: int
+    n_record: int
+    every: int
+
+
+class Noise(NamedTuple):
+    """Where the Brownian increments come from.
+
+    ``dw`` (n_paths, n_steps) given increments (s^0.5), or shape (0, 0) to draw
+    them from the paths' streams with the ziggurat tables ``ki, wi, fi``
+    (:mod:`randvib.montecarlo.rng`).
+    """
+
+    dw: np.ndarray
+    ki: np.ndarray
+    wi: np.ndarray
+    fi: np.ndarray
+
+
+def pack(group, *values):
+    """``group(*values)`` with each value cast to its field's declared type.
+
+    Parameters
+    ----------
+    group : type
+        One of the argument groups above (:class:`Device`, :class:`Timing`, ...).
+    *values
+        Field values in order; floats, ints, bools and the uint64 seed are cast,
+        arrays made contiguous float64 (the RNG tables are passed as they are).
+    """
+    cast = {float: float, int: int, bool: bool, np.uint64: np.uint64}
+    hints = get_type_hints(group)
+    out = []
+    for name, value in zip(group._fields, values, strict=True):
+        kind = hints[name]
+        if kind in cast:
+            value = cast[kind](value)
+        elif kind is np.ndarray and group is not Noise:
+            value = np.ascontiguousarray(value, dtype=float)
+        out.append(value)
+    return group(*out)
+
+
 @numba.njit(cache=True, inline="always")
-def _acceleration(z, v, theta, inv_m, c, k, k3, fr_kind, fr_p, fr_fn):
-    force, rate = evaluate_friction(fr_kind, fr_fn, fr_p, v, theta)
+def _acceleration(z, v, theta, drift, kind, p, fn):
+    inv_m, c, k, k3 = drift
+    force, rate = evaluate_friction(kind, fn, p, v, theta)
     return -(c * v + k * z + k3 * z * z * z + force) * inv_m, rate, force
 
 
 @numba.njit(cache=True, inline="always")
-def scheme_step(z, v, theta, dt, noise, b1, b2, inv_m, c, k, k3, fr_kind, fr_p, fr_fn):
+def scheme_step(z, v, theta, dt, noise, weights, drift, kind, p, fn):
     """One step of the additive-noise scheme with drift weights ``(b1, b2)``.
 
     The single definition of every integrator's step
@@ -117,7 +235,24 @@ def scheme_step(z, v, theta, dt, noise, b1, b2, inv_m, c, k, k3, fr_kind, fr_p, 
     ``x_p = x + f(x) dt + g dW`` and update
     ``x + (b1 f(x) + b2 f(x_p)) dt + g dW``; ``b2 = 0`` skips the predictor
     (Euler-Maruyama), ``b1 = b2 = 1/2`` is stochastic Heun. The friction-free
-    companion takes the same step with ``fr_kind = 0``.
+    companion takes the same step with friction kind 0.
+
+    Parameters
+    ----------
+    z, v, theta : float
+        State: displacement (m), velocity (m/s), friction state (law's unit).
+    dt : float
+        Step (s).
+    noise : float
+        Velocity increment of the step, sqrt(S/2) dW (m/s).
+    weights : (float, float)
+        ``(b1, b2)`` (:attr:`Integrator.kernel_weights`).
+    drift : (float, float, float, float)
+        ``(1/m, c, k, k3)`` (1/kg, Ns/m, N/m, N/m^3).
+    kind, p, fn : int, float64[:], callback
+        The friction law (:class:`Friction`); the companion passes kind 0.
+        Passed apart, not as a tuple: a tuple holding an array costs a
+        reference-count update per step (a third slower, measured).
 
     Returns
     -------
@@ -126,13 +261,14 @@ def scheme_step(z, v, theta, dt, noise, b1, b2, inv_m, c, k, k3, fr_kind, fr_p, 
     force : float
         Friction force at the start of the step (N), for the accumulators.
     """
-    acc1, rate1, force = _acceleration(z, v, theta, inv_m, c, k, k3, fr_kind, fr_p, fr_fn)
+    b1, b2 = weights
+    acc1, rate1, force = _acceleration(z, v, theta, drift, kind, p, fn)
     if b2 == 0.0:
         return z + b1 * v * dt, v + b1 * acc1 * dt + noise, theta + b1 * rate1 * dt, force
     zp = z + v * dt
     vp = v + acc1 * dt + noise
     tp = theta + rate1 * dt
-    acc2, rate2, _ = _acceleration(zp, vp, tp, inv_m, c, k, k3, fr_kind, fr_p, fr_fn)
+    acc2, rate2, _ = _acceleration(zp, vp, tp, drift, kind, p, fn)
     return (
         z + (b1 * v + b2 * vp) * dt,
         v + (b1 * acc1 + b2 * acc2) * dt + noise,
@@ -142,73 +278,30 @@ def scheme_step(z, v, theta, dt, noise, b1, b2, inv_m, c, k, k3, fr_kind, fr_p, 
 
 
 @numba.njit(cache=True, parallel=True)
-def run_ensemble(
-    b1,
-    b2,
-    fr_kind,
-    fr_p,
-    fr_fn,
-    m,
-    c,
-    k,
-    k3,
-    noise_amp,
-    dt,
-    n_steps,
-    n_burn,
-    seed,
-    first_path,
-    n_paths,
-    init_mode,
-    init_z,
-    init_v,
-    comp_init_z,
-    comp_init_v,
-    dw,
-    companion,
-    hist_lo,
-    hist_hi,
-    hist_bins,
-    n_record,
-    record_every,
-    ki,
-    wi,
-    fi,
-):
-    """Integrate ``n_paths`` paths and return per-path time averages.
+def run_ensemble(scheme, device, friction, timing, paths, initial, companion, recording, noise):
+    """Integrate ``paths.count`` paths and return per-path time averages.
 
     Parameters
     ----------
-    b1, b2 : float
-        The integrator's drift weights (:attr:`Integrator.kernel_weights`),
-        used by :func:`scheme_step`.
-    fr_kind, fr_p, fr_fn : int, float64[5], callback
-        Friction kernel code, parameters and compiled callback, from
-        :func:`randvib.models.friction.kernel_arguments`.
-    m, c, k, k3 : float
-        Mass (kg), total viscous damping (Ns/m), stiffnesses (N/m, N/m^3).
-    noise_amp : float
-        sqrt(S/2) (m/s^1.5): the diffusion of the velocity.
-    dt : float
-        Step (s). ``n_steps`` total steps, the first ``n_burn`` discarded.
-    seed, first_path, n_paths : int
-        Streams of paths ``first_path .. first_path + n_paths - 1``.
-    init_mode : int
-        0: start at (init_z, init_v); 1: start from N(0, init_z^2) x
-        N(0, init_v^2) drawn from the path's own stream.
-    comp_init_z, comp_init_v : float
-        With init_mode 1, the companion starts from the same two normal draws
-        scaled by these (its own stationary standard deviations), so that its
-        exactly known stationary moments hold from the start.
-    dw : float64[:, :]
-        Given Brownian increments (n_paths, n_steps), or shape (0, 0) to draw.
-    companion : bool
-        Also integrate the friction-free device with the same noise.
-    hist_lo, hist_hi, hist_bins : float64[2], float64[2], int
-        Histogram ranges of (z, v) over the window; ``hist_bins`` 0 for none.
-    n_record, record_every : int
-        Record (z, v, theta) of the first ``n_record`` paths every
-        ``record_every`` steps (including the initial state).
+    scheme : (float, float)
+        The integrator's drift weights ``(b1, b2)``
+        (:attr:`Integrator.kernel_weights`), used by :func:`scheme_step`.
+    device : Device
+        (m, c, k, k3, noise_amp).
+    friction : Friction
+        (kind, p, fn) from :func:`randvib.models.friction.kernel_arguments`.
+    timing : Timing
+        (dt, n_steps, n_burn).
+    paths : Paths
+        (seed, first, count): which streams.
+    initial : Start
+        Initial state of the device.
+    companion : Companion
+        Whether and from where to integrate the friction-free companion.
+    recording : Recording
+        Histograms and recorded histories.
+    noise : Noise
+        Given increments or the ziggurat tables.
 
     Returns
     -------
@@ -218,6 +311,15 @@ def run_ensemble(
     hist : int64[n_chunks, 2, hist_bins]
     records : float64[n_record, n_records, 3]
     """
+    # Unpacked once into locals; the step takes the (float) scheme and drift groups.
+    m, c, k, k3, noise_amp = device
+    fr_kind, fr_p, fr_fn = friction
+    dt, n_steps, n_burn = timing
+    seed, first_path, n_paths = paths
+    init_random, init_z, init_v = initial
+    with_companion, comp_init_z, comp_init_v = companion
+    hist_lo, hist_hi, hist_bins, n_record, record_every = recording
+    dw, ki, wi, fi = noise
     n_chunks = (n_paths + LANES - 1) // LANES
     acc = np.zeros((n_paths, N_ACC))
     failed = np.full(n_paths, -1, dtype=np.int64)
@@ -226,6 +328,7 @@ def run_ensemble(
     records = np.zeros((n_record, n_rec_points, 3))
     given_noise = dw.shape[0] > 0
     inv_m = 1.0 / m
+    drift = (inv_m, c, k, k3)
     window = (n_steps - n_burn) * dt
     inv_window_steps = 1.0 / (n_steps - n_burn)
     sqdt = np.sqrt(dt)
@@ -244,7 +347,7 @@ def run_ensemble(
         a = np.zeros((LANES, N_ACC))
         for j in range(lanes):
             seed_path_state(seed, first_path + start + j, rng, j)
-            if init_mode == 1:
+            if init_random:
                 nz = standard_normal(rng, j, ki, wi, fi)
                 nv = standard_normal(rng, j, ki, wi, fi)
                 z[j] = init_z * nz
@@ -254,8 +357,8 @@ def run_ensemble(
             else:
                 z[j] = init_z
                 v[j] = init_v
-                zc[j] = init_z
-                vc[j] = init_v
+                zc[j] = comp_init_z
+                vc[j] = comp_init_v
             if start + j < n_record:
                 records[start + j, 0, 0] = z[j]
                 records[start + j, 0, 1] = v[j]
@@ -272,7 +375,7 @@ def run_ensemble(
                 vj = v[j]
                 tj = th[j]
                 zn, vn, tn, f1 = scheme_step(
-                    zj, vj, tj, dt, noise, b1, b2, inv_m, c, k, k3, fr_kind, fr_p, fr_fn
+                    zj, vj, tj, dt, noise, scheme, drift, fr_kind, fr_p, fr_fn
                 )
                 if in_window:
                     if n == n_burn:
@@ -292,14 +395,14 @@ def run_ensemble(
                 z[j] = zn
                 v[j] = vn
                 th[j] = tn
-                if companion:
+                if with_companion:
                     zcj = zc[j]
                     vcj = vc[j]
                     if in_window:
                         a[j, ACC_COMP_V2] += vcj * vcj
                         a[j, ACC_COMP_Z2] += zcj * zcj
                     zc[j], vc[j], _, _ = scheme_step(
-                        zcj, vcj, 0.0, dt, noise, b1, b2, inv_m, c, k, k3, 0, fr_p, fr_fn
+                        zcj, vcj, 0.0, dt, noise, scheme, drift, 0, fr_p, fr_fn
                     )
                 if start + j < n_record and (n + 1) % record_every == 0:
                     r = (n + 1) // record_every

@@ -31,7 +31,7 @@ from randvib.analytic.linearisation import equivalent_damping, linear_displaceme
 from randvib.models.friction import kernel_arguments
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import integrators, kernel
-from randvib.montecarlo.integrators import integrator
+from randvib.montecarlo.integrators import Integrator, integrator
 from randvib.montecarlo.rng import ZIG_FI, ZIG_KI, ZIG_WI
 
 #: Largest stationary-variance bias (relative) of the scheme on the linearised
@@ -171,7 +171,7 @@ class SimulationResult:
 
     harvester: Harvester
     psd: float
-    method: str
+    scheme: str
     dt: float
     t_end: float
     burn_in: float
@@ -186,6 +186,16 @@ class SimulationResult:
     @property
     def n_paths(self) -> int:
         return self.per_path.shape[0]
+
+    @property
+    def method(self) -> str:
+        """Deprecated alias of :attr:`scheme` (the integrator's name)."""
+        warnings.warn(
+            "SimulationResult.method is deprecated; use SimulationResult.scheme",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return self.scheme
 
     @property
     def averaging_time(self) -> float:
@@ -282,7 +292,7 @@ class SimulationResult:
             dt=self.dt,
             t_end=self.t_end,
             burn_in=self.burn_in,
-            method=self.method,
+            method=self.scheme,  # the JSON key predates the name `scheme`
             seed=self.seed,
             psd=self.psd,
             control_variates=self.control_variates,
@@ -311,7 +321,7 @@ def effective_linear_device(harvester: Harvester, psd: float) -> tuple[float, fl
     return float(h.k + 3.0 * h.k3 * z2), c_eff
 
 
-def step_bias(method: str, harvester: Harvester, psd: float, dt: float) -> float:
+def step_bias(scheme: str, harvester: Harvester, psd: float, dt: float) -> float:
     """Relative bias of the scheme's stationary E[v^2] on the linearised device.
 
     The scheme applied to ``m z'' + c_eff z' + k_eff z = m w`` is a linear
@@ -323,20 +333,20 @@ def step_bias(method: str, harvester: Harvester, psd: float, dt: float) -> float
     devices. Returns inf where the recursion is unstable.
     """
     k_eff, c_eff = effective_linear_device(harvester, psd)
-    return _scheme_bias(method, float(harvester.m), k_eff, c_eff, psd, dt)
+    return _scheme_bias(scheme, float(harvester.m), k_eff, c_eff, psd, dt)
 
 
-def _scheme_bias(method, m, k_eff, c_eff, psd, dt) -> float:
+def _scheme_bias(scheme, m, k_eff, c_eff, psd, dt) -> float:
     """:func:`step_bias` for an already linearised device (inf where unstable)."""
     try:
-        cov = integrators.scheme_stationary_covariance(method, m, c_eff, k_eff, psd, dt)
+        cov = integrators.scheme_stationary_covariance(scheme, m, c_eff, k_eff, psd, dt)
     except ValueError:
         return float("inf")
     return abs(cov[1, 1] / exact.linear_velocity_variance(m, c_eff, psd) - 1.0)
 
 
 def largest_step(
-    method: str, harvester: Harvester, psd: float, bias: float = MAX_STEP_BIAS
+    scheme: str, harvester: Harvester, psd: float, bias: float = MAX_STEP_BIAS
 ) -> float:
     """Largest dt (s) whose :func:`step_bias` stays below ``bias`` (bisection)."""
     k_eff, c_eff = effective_linear_device(harvester, psd)  # once, not per bisection step
@@ -344,7 +354,7 @@ def largest_step(
     lo, hi = 0.0, 2.0 / np.sqrt(k_eff / m)
     for _ in range(60):
         mid = 0.5 * (lo + hi)
-        if _scheme_bias(method, m, k_eff, c_eff, psd, mid) <= bias:
+        if _scheme_bias(scheme, m, k_eff, c_eff, psd, mid) <= bias:
             lo = mid
         else:
             hi = mid
@@ -358,22 +368,161 @@ def _linearised_spread(harvester: Harvester, psd: float) -> tuple[float, float]:
     return float(np.sqrt(linear_displacement_variance(harvester, vv))), float(np.sqrt(vv))
 
 
-def _check_step(method, harvester, psd, dt):
-    bias = step_bias(method, harvester, psd, dt)
+def _check_step(scheme, harvester, psd, dt):
+    bias = step_bias(scheme, harvester, psd, dt)
     if bias > MAX_STEP_BIAS:
-        limit = largest_step(method, harvester, psd)
+        limit = largest_step(scheme, harvester, psd)
         raise ValueError(
-            f"`dt` = {dt!r} s is too large for this device with {method}: on the linearised "
+            f"`dt` = {dt!r} s is too large for this device with {scheme}: on the linearised "
             f"device its stationary variance is off by {bias:.3g} (allowed {MAX_STEP_BIAS:.0%}); "
             f"use dt <= {limit:.3g} s"
         )
     if bias > WARN_STEP_BIAS:
         warnings.warn(
-            f"dt = {dt!r} s gives {method} a stationary-variance bias of about {bias:.2%} "
+            f"dt = {dt!r} s gives {scheme} a stationary-variance bias of about {bias:.2%} "
             "on the linearised device",
             StepSizeWarning,
             stacklevel=3,
         )
+
+
+# ----------------------------------------------------------------- options
+@dataclass(frozen=True)
+class TimeGrid:
+    """The time steps of every path: ``n_steps`` of ``dt``, the first ``n_burn`` discarded.
+
+    Attributes
+    ----------
+    dt : float
+        Time step (s).
+    n_steps : int
+        Steps per path, burn-in included.
+    n_burn : int
+        Steps before the averaging window.
+    """
+
+    dt: float
+    n_steps: int
+    n_burn: int
+
+    @classmethod
+    def from_times(cls, t_end, dt, burn_in) -> TimeGrid:
+        """Validated grid for ``t_end`` and ``burn_in`` (s), rounded to whole steps."""
+        t_end = float(check_positive("t_end", t_end, "s"))
+        dt = float(check_positive("dt", dt, "s"))
+        burn_in = float(np.asarray(burn_in, dtype=float))
+        if not (np.isfinite(burn_in) and 0.0 <= burn_in < t_end):
+            raise ValueError(
+                f"`burn_in` must satisfy 0 <= burn_in < t_end = {t_end!r} s, got {burn_in!r}"
+            )
+        grid = cls(dt, int(round(t_end / dt)), int(round(burn_in / dt)))
+        if grid.window_steps < 1:
+            raise ValueError(
+                f"`t_end` - `burn_in` = {t_end - burn_in!r} s holds no step of dt = {dt!r} s"
+            )
+        return grid
+
+    @property
+    def window_steps(self) -> int:
+        """Steps inside the averaging window."""
+        return self.n_steps - self.n_burn
+
+    @property
+    def t_end(self) -> float:
+        """Simulated time per path (s)."""
+        return self.n_steps * self.dt
+
+    @property
+    def burn_in(self) -> float:
+        """Discarded time per path (s)."""
+        return self.n_burn * self.dt
+
+
+@dataclass(frozen=True)
+class InitialState:
+    """Where each path starts: ``simulate(initial=...)``, validated.
+
+    Attributes
+    ----------
+    kind : {"stationary", "rest", "state"}
+        Independent Gaussians with the linearised stationary variances (drawn
+        from each path's stream), rest, or the given state (z, v).
+    z, v : float
+        The given state (m, m/s) for ``kind == "state"``.
+    """
+
+    kind: str
+    z: float = 0.0
+    v: float = 0.0
+
+    @classmethod
+    def from_argument(cls, initial) -> InitialState:
+        """From ``"stationary"``, ``"rest"`` or a finite pair (z0, v0)."""
+        if isinstance(initial, str):
+            return cls(check_choice("initial", initial, ("stationary", "rest")))
+        z0, v0 = (float(x) for x in initial)
+        if not (np.isfinite(z0) and np.isfinite(v0)):
+            raise ValueError(f"`initial` state must be finite, got {initial!r}")
+        return cls("state", z0, v0)
+
+
+@dataclass(frozen=True)
+class RecordOptions:
+    """What :func:`simulate` records besides the per-path time averages.
+
+    Attributes
+    ----------
+    histogram_bins : int
+        Bins of the stationary histograms of z and v (0: none).
+    histogram_range : ((float, float), (float, float)) or None
+        ((z_lo, z_hi), (v_lo, v_hi)) (m, m/s); None: +-5 linearised std.
+    record_paths : int
+        Number of first paths whose (z, v, theta) are kept.
+    record_every : int
+        Keep every ``record_every``-th step of them (the initial state included).
+    """
+
+    histogram_bins: int = 0
+    histogram_range: tuple | None = None
+    record_paths: int = 0
+    record_every: int = 1
+
+    @classmethod
+    def validated(cls, histogram_bins, histogram_range, record_paths, record_every):
+        """Checked options; a given ``histogram_range`` as nested float tuples."""
+        record_paths = check_int("record_paths", record_paths, 0)
+        record_every = check_int("record_every", record_every, 1)
+        histogram_bins = check_int("histogram_bins", histogram_bins, 0)
+        if histogram_bins > 0 and histogram_range is not None:
+            histogram_range = _checked_range(histogram_range)
+        return cls(histogram_bins, histogram_range, record_paths, record_every)
+
+
+def _checked_range(histogram_range) -> tuple:
+    arr = np.asarray(histogram_range, dtype=float)
+    if arr.shape != (2, 2) or np.any(arr[:, 1] <= arr[:, 0]):
+        raise ValueError(
+            "`histogram_range` must be ((z_lo, z_hi), (v_lo, v_hi)) with lo < hi, "
+            f"got {histogram_range!r}"
+        )
+    return tuple(tuple(float(x) for x in row) for row in arr)
+
+
+@dataclass(frozen=True)
+class _Run:
+    """:func:`simulate`'s arguments, validated and grouped."""
+
+    harvester: Harvester
+    psd: float
+    scheme: Integrator
+    grid: TimeGrid
+    n_paths: int
+    seed: int
+    first_path: int
+    initial: InitialState
+    record: RecordOptions
+    dW: np.ndarray | None
+    companion: bool
 
 
 # ----------------------------------------------------------------- simulate
@@ -385,7 +534,7 @@ def simulate(
     dt: float,
     n_paths: int,
     burn_in: float = 0.0,
-    method: str = "heun",
+    scheme: str | None = None,
     seed: int = 0,
     dW=None,
     initial="stationary",
@@ -400,6 +549,7 @@ def simulate(
     batch_paths: int | None = None,
     progress: bool | None = None,
     check_step: bool = True,
+    method: str | None = None,
 ) -> SimulationResult:
     """Simulate an ensemble of the white-noise driven harvester.
 
@@ -419,8 +569,9 @@ def simulate(
         Number of independent paths (>= 2 for confidence intervals).
     burn_in : float
         Initial time discarded from the statistics (s), 0 <= burn_in < t_end.
-    method : {"heun", "euler-maruyama"}
-        Integrator (:data:`randvib.montecarlo.integrators.INTEGRATORS`).
+    scheme : {"heun", "euler-maruyama"}
+        Integrator (:data:`randvib.montecarlo.integrators.INTEGRATORS`);
+        default "heun".
     seed : int
         Seed; path i uses stream (seed, first_path + i) (:mod:`randvib.montecarlo.rng`).
     dW : array_like, optional
@@ -452,194 +603,250 @@ def simulate(
         Progress bar (default: on when stderr is a terminal).
     check_step : bool
         Refuse steps that are too large (default True).
+    method : str, optional
+        Deprecated alias of ``scheme``.
 
     Returns
     -------
     SimulationResult
+    """
+    run = _validated(
+        harvester,
+        psd,
+        integrators.scheme_argument(scheme, method),
+        t_end=t_end,
+        dt=dt,
+        burn_in=burn_in,
+        n_paths=n_paths,
+        seed=seed,
+        first_path=first_path,
+        initial=initial,
+        dW=dW,
+        companion=companion,
+        record=(histogram_bins, histogram_range, record_paths, record_every),
+    )
+    if check_step:
+        _check_step(run.scheme.name, run.harvester, run.psd, run.grid.dt)
+    setup = _KernelSetup.prepare(run)
+    if threads is not None:
+        threads = check_int("threads", threads, 1)
+        numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+    if progress is None:
+        progress = sys.stderr.isatty() and os.environ.get("CI") is None
+    batches = _batches(n_paths, batch_paths, run.grid.n_steps, progress, run.record.record_paths)
+    started = time.perf_counter()
+    per_path, hist_total, records = _run_batches(run, setup, batches, progress)
+    wall = time.perf_counter() - started
+    return SimulationResult(
+        harvester=run.harvester,
+        psd=run.psd,
+        scheme=run.scheme.name,
+        dt=run.grid.dt,
+        t_end=run.grid.t_end,
+        burn_in=run.grid.burn_in,
+        seed=run.seed,
+        first_path=run.first_path,
+        per_path=per_path,
+        control_variates=control_variates,
+        histogram=_histogram(setup.recording, hist_total, run.n_paths * run.grid.window_steps),
+        histories=_histories(records, run.record.record_every, run.grid.dt),
+        wall_time=wall,
+    )
+
+
+# ----------------------------------------------------------------- validation
+def _validated(
+    harvester,
+    psd,
+    scheme_argument,
+    *,
+    t_end,
+    dt,
+    burn_in,
+    n_paths,
+    seed,
+    first_path,
+    initial,
+    dW,
+    companion,
+    record,
+) -> _Run:
+    """:func:`simulate`'s arguments checked, in one place; messages name the argument.
+
+    ``scheme_argument`` is (scheme name, keyword it came by) and ``record``
+    (histogram_bins, histogram_range, record_paths, record_every).
     """
     if not isinstance(harvester, Harvester):
         raise ValueError(f"`harvester` must be a randvib.Harvester, got {type(harvester).__name__}")
     for name in ("m", "c_m", "c_e", "k", "k3"):
         if np.ndim(getattr(harvester, name)) != 0:
             raise ValueError(f"simulate needs scalar harvester parameters; `{name}` is an array")
-    scheme = integrator(method)
+    scheme = integrator(*scheme_argument)
     psd = float(check_positive("psd", psd, "(m/s^2)^2/Hz"))
-    t_end = float(check_positive("t_end", t_end, "s"))
-    dt = float(check_positive("dt", dt, "s"))
-    burn_in = float(np.asarray(burn_in, dtype=float))
-    if not (np.isfinite(burn_in) and 0.0 <= burn_in < t_end):
-        raise ValueError(
-            f"`burn_in` must satisfy 0 <= burn_in < t_end = {t_end!r} s, got {burn_in!r}"
-        )
+    grid = TimeGrid.from_times(t_end, dt, burn_in)
     n_paths = check_int("n_paths", n_paths, 1)
-    seed = check_int("seed", seed, 0)
-    first_path = check_int("first_path", first_path, 0)
-    record_paths = check_int("record_paths", record_paths, 0)
-    record_every = check_int("record_every", record_every, 1)
-    histogram_bins = check_int("histogram_bins", histogram_bins, 0)
-    n_steps = int(round(t_end / dt))
-    n_burn = int(round(burn_in / dt))
-    if n_steps - n_burn < 1:
+    return _Run(
+        harvester=harvester,
+        psd=psd,
+        scheme=scheme,
+        grid=grid,
+        n_paths=n_paths,
+        seed=check_int("seed", seed, 0),
+        first_path=check_int("first_path", first_path, 0),
+        initial=InitialState.from_argument(initial),
+        record=RecordOptions.validated(*record),
+        dW=_checked_increments(dW, n_paths, grid.n_steps),
+        companion=bool(companion),
+    )
+
+
+def _checked_increments(dW, n_paths, n_steps):
+    """Given Brownian increments as a contiguous (n_paths, n_steps) array, or None."""
+    if dW is None:
+        return None
+    dW = np.ascontiguousarray(dW, dtype=float)
+    if dW.shape != (n_paths, n_steps):
         raise ValueError(
-            f"`t_end` - `burn_in` = {t_end - burn_in!r} s holds no step of dt = {dt!r} s"
+            f"`dW` must have shape (n_paths, n_steps) = {(n_paths, n_steps)}, got {dW.shape}"
         )
-    if check_step:
-        _check_step(method, harvester, psd, dt)
+    if not np.all(np.isfinite(dW)):
+        raise ValueError("`dW` must be finite")
+    return dW
 
-    fr_kind, fr_p, fr_fn = kernel_arguments(harvester.friction)
 
-    # Initial state.
-    if isinstance(initial, str):
-        check_choice("initial", initial, ("stationary", "rest"))
-        if initial == "rest":
-            init_mode, init_z, init_v = 0, 0.0, 0.0
-        else:
-            init_mode = 1
-            init_z, init_v = _linearised_spread(harvester, psd)
-    else:
-        z0, v0 = (float(x) for x in initial)
-        if not (np.isfinite(z0) and np.isfinite(v0)):
-            raise ValueError(f"`initial` state must be finite, got {initial!r}")
-        init_mode, init_z, init_v = 0, z0, v0
+# ----------------------------------------------------------------- kernel set-up
+@dataclass(frozen=True)
+class _KernelSetup:
+    """The compiled loop's argument groups (:mod:`randvib.montecarlo.kernel`) for a run.
+
+    Everything but the paths, the noise and the number of recorded paths is
+    the same for every batch; :meth:`arguments` adds those for one batch.
+    """
+
+    scheme: tuple
+    device: kernel.Device
+    friction: kernel.Friction
+    timing: kernel.Timing
+    initial: kernel.Start
+    companion: kernel.Companion
+    recording: kernel.Recording
+
+    @classmethod
+    def prepare(cls, run: _Run) -> _KernelSetup:
+        h = run.harvester
+        device = (h.m, h.c, h.k, h.k3, np.sqrt(run.psd / 2.0))
+        initial, companion = _start_states(run)
+        return cls(
+            scheme=run.scheme.kernel_weights,
+            device=kernel.pack(kernel.Device, *device),
+            friction=kernel.pack(kernel.Friction, *kernel_arguments(h.friction)),
+            timing=kernel.pack(kernel.Timing, run.grid.dt, run.grid.n_steps, run.grid.n_burn),
+            initial=initial,
+            companion=companion,
+            recording=_recording(run),
+        )
+
+    def arguments(self, run: _Run, lo: int, hi: int) -> dict:
+        """:func:`kernel.run_ensemble`'s keyword arguments for paths ``lo .. hi - 1``."""
+        n_record = max(0, min(run.record.record_paths - lo, hi - lo))
+        dw = run.dW[lo:hi] if run.dW is not None else np.zeros((0, 0))
+        return dict(
+            scheme=self.scheme,
+            device=self.device,
+            friction=self.friction,
+            timing=self.timing,
+            paths=kernel.pack(kernel.Paths, run.seed, run.first_path + lo, hi - lo),
+            initial=self.initial,
+            companion=self.companion,
+            recording=self.recording._replace(n_record=n_record),
+            noise=kernel.Noise(dw, ZIG_KI, ZIG_WI, ZIG_FI),
+        )
+
+
+def _start_states(run: _Run) -> tuple[kernel.Start, kernel.Companion]:
+    """Initial states of the device and of its friction-free companion."""
+    h, psd = run.harvester, run.psd
+    random = run.initial.kind == "stationary"
+    z, v = _linearised_spread(h, psd) if random else (run.initial.z, run.initial.v)
     # The friction-free companion starts from its own stationary spread (exact
     # Gaussian velocity, Gibbs displacement variance), so its known moments
     # hold from t = 0 and its control mean is right without a long burn-in.
-    comp_init_z, comp_init_v = init_z, init_v
-    if companion and init_mode == 1 and harvester.c > 0:
-        h = harvester
-        comp_init_v = float(np.sqrt(exact.linear_velocity_variance(h.m, h.c, psd)))
-        comp_init_z = float(np.sqrt(exact.gibbs_displacement_moment(h.m, h.c, h.k, h.k3, psd)))
+    comp_z, comp_v = z, v
+    if run.companion and random and h.c > 0:
+        comp_v = float(np.sqrt(exact.linear_velocity_variance(h.m, h.c, psd)))
+        comp_z = float(np.sqrt(exact.gibbs_displacement_moment(h.m, h.c, h.k, h.k3, psd)))
         if h.friction is None or h.friction.vanishes:  # the device is its own companion
-            init_z, init_v = comp_init_z, comp_init_v
+            z, v = comp_z, comp_v
+    return (
+        kernel.pack(kernel.Start, random, z, v),
+        kernel.pack(kernel.Companion, run.companion, comp_z, comp_v),
+    )
 
-    if dW is not None:
-        dW = np.ascontiguousarray(dW, dtype=float)
-        if dW.shape != (n_paths, n_steps):
-            raise ValueError(
-                f"`dW` must have shape (n_paths, n_steps) = {(n_paths, n_steps)}, got {dW.shape}"
-            )
-        if not np.all(np.isfinite(dW)):
-            raise ValueError("`dW` must be finite")
-    if histogram_bins > 0:
-        if histogram_range is None:
-            sz, sv = _linearised_spread(harvester, psd)
-            histogram_range = ((-5 * sz, 5 * sz), (-5 * sv, 5 * sv))
-        rng_arr = np.asarray(histogram_range, dtype=float)
-        if rng_arr.shape != (2, 2) or np.any(rng_arr[:, 1] <= rng_arr[:, 0]):
-            raise ValueError(
-                f"`histogram_range` must be ((z_lo, z_hi), (v_lo, v_hi)) with lo < hi, got {histogram_range!r}"
-            )
-        hist_lo, hist_hi = rng_arr[:, 0].copy(), rng_arr[:, 1].copy()
+
+def _recording(run: _Run) -> kernel.Recording:
+    """Histogram ranges and bins (default ranges +-5 linearised std); records per batch."""
+    bins = run.record.histogram_bins
+    if bins == 0:
+        lo, hi = np.zeros(2), np.ones(2)  # unused
     else:
-        hist_lo, hist_hi = np.zeros(2), np.ones(2)
+        ranges = run.record.histogram_range
+        if ranges is None:
+            sz, sv = _linearised_spread(run.harvester, run.psd)
+            ranges = ((-5 * sz, 5 * sz), (-5 * sv, 5 * sv))
+        arr = np.asarray(ranges, dtype=float)
+        lo, hi = arr[:, 0], arr[:, 1]
+    return kernel.pack(kernel.Recording, lo, hi, bins, 0, run.record.record_every)
 
-    if threads is not None:
-        threads = check_int("threads", threads, 1)
-        numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
-    if progress is None:
-        progress = sys.stderr.isatty() and os.environ.get("CI") is None
 
-    batches = _batches(n_paths, batch_paths, n_steps, progress, record_paths)
-    per_path = np.empty((n_paths, kernel.N_ACC))
-    hist_total = np.zeros((2, max(histogram_bins, 1)), dtype=np.int64)
+# ----------------------------------------------------------------- compiled calls
+def _run_batches(run: _Run, setup: _KernelSetup, batches, progress: bool):
+    """Run the compiled loop batch by batch.
+
+    Returns
+    -------
+    per_path : ndarray, shape (n_paths, N_ACC)
+        Per-path time averages.
+    hist_total : ndarray of int64, shape (2, bins)
+        Histogram counts of z and v summed over paths.
+    records : ndarray or None
+        Recorded histories of the first paths (from the first batch).
+    """
+    per_path = np.empty((run.n_paths, kernel.N_ACC))
+    hist_total = np.zeros((2, max(run.record.histogram_bins, 1)), dtype=np.int64)
     records = None
     bar = None
     if progress:
         from tqdm import tqdm
 
-        bar = tqdm(total=n_paths, unit="path", desc="simulate", leave=False, delay=3.0)
-    started = time.perf_counter()
+        bar = tqdm(total=run.n_paths, unit="path", desc="simulate", leave=False, delay=3.0)
     try:
         for lo, hi in batches:
-            dw_batch = dW[lo:hi] if dW is not None else np.zeros((0, 0))
-            acc, failed, hist, rec = kernel.run_ensemble(
-                *scheme.kernel_weights,
-                fr_kind,
-                fr_p,
-                fr_fn,
-                float(harvester.m),
-                float(harvester.c),
-                float(harvester.k),
-                float(harvester.k3),
-                np.sqrt(psd / 2.0),
-                dt,
-                n_steps,
-                n_burn,
-                np.uint64(seed),
-                first_path + lo,
-                hi - lo,
-                init_mode,
-                init_z,
-                init_v,
-                comp_init_z,
-                comp_init_v,
-                dw_batch,
-                companion,
-                hist_lo,
-                hist_hi,
-                histogram_bins,
-                max(0, min(record_paths - lo, hi - lo)),
-                record_every,
-                ZIG_KI,
-                ZIG_WI,
-                ZIG_FI,
-            )
-            bad = np.flatnonzero(failed >= 0)
-            if bad.size:
-                p = bad[0]
-                raise SimulationDivergedError(
-                    f"simulation diverged: path {first_path + lo + p} became non-finite by step "
-                    f"{failed[p]} (t = {failed[p] * dt:.6g} s) with dt = {dt!r} s, method {method}, "
-                    f"psd = {psd!r}, parameters {harvester.parameters()}"
-                )
+            acc, failed, hist, rec = kernel.run_ensemble(**setup.arguments(run, lo, hi))
+            _raise_if_diverged(run, lo, failed)
             per_path[lo:hi] = acc
-            if histogram_bins > 0:
+            if run.record.histogram_bins > 0:
                 hist_total += hist.sum(axis=0)
-            if lo == 0 and record_paths > 0:
+            if lo == 0 and run.record.record_paths > 0:
                 records = rec
             if bar is not None:
                 bar.update(hi - lo)
     finally:
         if bar is not None:
             bar.close()
-    wall = time.perf_counter() - started
+    return per_path, hist_total, records
 
-    histogram = None
-    if histogram_bins > 0:
-        n_samples = n_paths * (n_steps - n_burn)
-        z_edges = np.linspace(hist_lo[0], hist_hi[0], histogram_bins + 1)
-        v_edges = np.linspace(hist_lo[1], hist_hi[1], histogram_bins + 1)
-        histogram = Histogram(
-            z_edges,
-            hist_total[0] / (n_samples * np.diff(z_edges)),
-            v_edges,
-            hist_total[1] / (n_samples * np.diff(v_edges)),
-            (1 - hist_total[0].sum() / n_samples, 1 - hist_total[1].sum() / n_samples),
+
+def _raise_if_diverged(run: _Run, lo: int, failed: np.ndarray) -> None:
+    bad = np.flatnonzero(failed >= 0)
+    if bad.size:
+        p = bad[0]
+        dt = run.grid.dt
+        raise SimulationDivergedError(
+            f"simulation diverged: path {run.first_path + lo + p} became non-finite by step "
+            f"{failed[p]} (t = {failed[p] * dt:.6g} s) with dt = {dt!r} s, "
+            f"scheme {run.scheme.name}, psd = {run.psd!r}, "
+            f"parameters {run.harvester.parameters()}"
         )
-    histories = None
-    if records is not None:
-        n_rec = records.shape[1]
-        histories = Histories(
-            np.arange(n_rec) * record_every * dt,
-            records[:, :, 0].copy(),
-            records[:, :, 1].copy(),
-            records[:, :, 2].copy(),
-        )
-    return SimulationResult(
-        harvester=harvester,
-        psd=psd,
-        method=method,
-        dt=dt,
-        t_end=n_steps * dt,
-        burn_in=n_burn * dt,
-        seed=seed,
-        first_path=first_path,
-        per_path=per_path,
-        control_variates=control_variates,
-        histogram=histogram,
-        histories=histories,
-        wall_time=wall,
-    )
 
 
 def _batches(n_paths, batch_paths, n_steps, progress, record_paths):
@@ -653,3 +860,33 @@ def _batches(n_paths, batch_paths, n_steps, progress, record_paths):
     batch_paths = max(batch_paths, min(record_paths, n_paths))  # records come from batch 0
     edges = list(range(0, n_paths, batch_paths)) + [n_paths]
     return list(zip(edges[:-1], edges[1:], strict=True))
+
+
+# ----------------------------------------------------------------- result assembly
+def _histogram(recording: kernel.Recording, counts, n_samples: int) -> Histogram | None:
+    """Densities of z and v from the summed counts over ``n_samples`` samples."""
+    bins = recording.hist_bins
+    if bins == 0:
+        return None
+    z_edges = np.linspace(recording.hist_lo[0], recording.hist_hi[0], bins + 1)
+    v_edges = np.linspace(recording.hist_lo[1], recording.hist_hi[1], bins + 1)
+    return Histogram(
+        z_edges,
+        counts[0] / (n_samples * np.diff(z_edges)),
+        v_edges,
+        counts[1] / (n_samples * np.diff(v_edges)),
+        (1 - counts[0].sum() / n_samples, 1 - counts[1].sum() / n_samples),
+    )
+
+
+def _histories(records, record_every: int, dt: float) -> Histories | None:
+    """Recorded (z, v, theta) of the first paths with their times (s)."""
+    if records is None:
+        return None
+    n_rec = records.shape[1]
+    return Histories(
+        np.arange(n_rec) * record_every * dt,
+        records[:, :, 0].copy(),
+        records[:, :, 1].copy(),
+        records[:, :, 2].copy(),
+    )

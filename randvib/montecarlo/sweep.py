@@ -27,11 +27,13 @@ Design choices a careful user expects:
 from __future__ import annotations
 
 import dataclasses
+import functools
 import itertools
 import json
 import math
 import os
 import time
+import warnings
 from collections.abc import Iterable, Mapping
 from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass, field
@@ -44,6 +46,7 @@ from randvib._io import atomic_write_text, prepare_output_dir
 from randvib._validation import check_int, check_positive
 from randvib.analytic.prediction import METHODS, predict
 from randvib.models.harvester import Harvester
+from randvib.montecarlo.integrators import scheme_argument
 from randvib.montecarlo.simulation import estimate
 
 STATISTICS = ("power_electrical", "velocity_variance", "displacement_variance", "mean_abs_velocity")
@@ -78,8 +81,9 @@ class SweepSettings:
         Averaging time per path (s), after ``burn_in``.
     burn_in : float
         Discarded initial time per path (s).
-    method : str
-        Integrator name.
+    scheme : str
+        Integrator name (:data:`randvib.montecarlo.integrators.INTEGRATORS`);
+        ``method=`` is accepted as a deprecated alias.
     target_rel_ci : float
         Stop adding paths when the relative 95 % half-width of E[P_e] is at or
         below this (e.g. 0.005 for 0.5 %).
@@ -94,7 +98,7 @@ class SweepSettings:
     dt: float = 1e-4
     window: float = 2.0
     burn_in: float = 0.5
-    method: str = "heun"
+    scheme: str = "heun"
     target_rel_ci: float = 0.005
     min_paths: int = 32
     max_paths: int = 4096
@@ -112,6 +116,41 @@ class SweepSettings:
         check_int("batch_paths", self.batch_paths, 1)
         check_int("max_paths", self.max_paths, self.min_paths)
         check_int("seed", self.seed, 0)
+
+    @property
+    def method(self) -> str:
+        """Deprecated alias of :attr:`scheme`."""
+        warnings.warn(
+            "SweepSettings.method is deprecated; use SweepSettings.scheme",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return self.scheme
+
+    def to_dict(self) -> dict:
+        """The settings as JSON-ready values, with the integrator under its JSON key ``method``.
+
+        Sweep folders and study metadata name the integrator ``method``; the key
+        is kept so that existing result folders keep their identity (resume).
+        """
+        out = asdict(self)
+        return {("method" if k == "scheme" else k): v for k, v in out.items()}
+
+
+def _accept_method_alias(init):
+    """Wrap ``SweepSettings.__init__`` to take ``method=`` as a deprecated ``scheme=``."""
+
+    @functools.wraps(init)
+    def wrapped(self, *args, method=None, **kwargs):
+        if method is not None:
+            name, _ = scheme_argument(kwargs.pop("scheme", None), method)
+            kwargs["scheme"] = name
+        init(self, *args, **kwargs)
+
+    return wrapped
+
+
+SweepSettings.__init__ = _accept_method_alias(SweepSettings.__init__)
 
 
 def validate_points(base: Harvester, points: Iterable[Mapping]) -> list[dict]:
@@ -167,7 +206,7 @@ def run_point(base: Harvester, point: Mapping, settings: SweepSettings, threads:
         t_end=settings.burn_in + settings.window,
         dt=settings.dt,
         burn_in=settings.burn_in,
-        method=settings.method,
+        scheme=settings.scheme,
         seed=settings.seed,
         companion=settings.control_variates,
         control_variates=settings.control_variates,
@@ -349,7 +388,7 @@ def run_sweep(
             "name": name,
             "base": base.parameters(),
             "points": points,
-            "settings": asdict(settings),
+            "settings": settings.to_dict(),
         }
         store = _PointStore(out_dir, identity)
         rows, per_path = store.load_finished(len(points))

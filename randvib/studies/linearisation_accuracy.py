@@ -24,7 +24,6 @@ Stochastic averaging (:mod:`randvib.analytic.averaging`) is mapped alongside.
 from __future__ import annotations
 
 import json
-from dataclasses import asdict
 from pathlib import Path
 
 import numpy as np
@@ -315,7 +314,7 @@ def run_study(
             "quick": quick,
             "seed": seed,
             "grid": {"series": series, "phis": phis},
-            "settings": asdict(settings),
+            "settings": settings.to_dict(),
         },
     )
     # half-step check at the strongest friction of each (k3, damping), largest S

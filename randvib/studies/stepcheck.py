@@ -102,7 +102,7 @@ def check_step_bias(base: Harvester, points: list, settings: SweepSettings) -> f
     from randvib.montecarlo.simulation import WARN_STEP_BIAS, step_bias
 
     worst = max(
-        step_bias(settings.method, point_device(base, p), p["psd"], settings.dt) for p in points
+        step_bias(settings.scheme, point_device(base, p), p["psd"], settings.dt) for p in points
     )
     if worst > WARN_STEP_BIAS:
         raise ValueError(
