@@ -190,3 +190,86 @@ def linearisation_error_bands(table: pd.DataFrame, path: Path, labels: dict | No
     fig.suptitle("Equivalent linearisation error at every k3 (95 % CI)")
     fig.tight_layout()
     return save_figure(fig, path)
+
+
+def _error_series(ax, sub, methods, style: int, shift: float, label: str) -> None:
+    """One series of :func:`error_against_friction_level`: Eq. 32 solid, averaging dashed."""
+    import matplotlib.pyplot as plt
+
+    marker = "os^Dv<>p"[style % 8]
+    colour = plt.get_cmap("tab10").colors[style % 10]
+    ax.errorbar(
+        sub.phi * shift,
+        100 * sub.linearisation_rel_error,
+        yerr=100 * sub.linearisation_rel_error_ci95,
+        fmt=marker + "-",
+        ms=4,
+        capsize=2,
+        color=colour,
+        label=f"Eq. 32, {label}",
+    )
+    if "averaging" in methods:
+        ax.errorbar(
+            sub.phi * shift,
+            100 * sub.averaging_rel_error,
+            yerr=100 * sub.averaging_rel_error_ci95,
+            fmt=marker + "--",
+            mfc="none",
+            ms=4,
+            capsize=2,
+            lw=0.8,
+            color=colour,
+            label=f"averaging, {label}",
+        )
+
+
+def error_against_friction_level(
+    table: pd.DataFrame, methods, tolerances, path: Path, phi_ticks=(0.05, 0.2, 0.5, 0.89, 2.0, 5.0)
+) -> Path:
+    """Relative errors of the analytic ``methods`` against phi, one panel per k3.
+
+    One series per (damping ratio zeta, S) with 95 % bars, green bands at
+    the ``tolerances``, and a top axis giving Eq. 32's P / P(0) at
+    ``phi_ticks``. ``table`` has ``phi``, ``zeta``, ``psd``, ``k3`` and the
+    methods' ``_rel_error`` and ``_rel_error_ci95`` columns.
+    """
+    import matplotlib.pyplot as plt
+
+    from randvib.studies.grids import power_ratio
+
+    k3s = sorted(table.k3.unique())
+    fig, axes = plt.subplots(1, len(k3s), figsize=(6.4 * len(k3s), 5.0), squeeze=False, sharey=True)
+    keys = sorted({(z, s) for z, s in zip(table.zeta, table.psd, strict=True)}, reverse=True)
+    style = {key: j for j, key in enumerate(keys)}
+    ymin = min(-0.12, 1.1 * float(table[[f"{m}_rel_error" for m in methods]].min().min()))
+    for ax, k3 in zip(axes[0], k3s, strict=True):
+        for lo, alpha in zip(sorted(tolerances, reverse=True), (0.06, 0.08, 0.12), strict=False):
+            ax.axhspan(-100 * lo, 100 * lo, color="tab:green", alpha=alpha, lw=0)
+        for tol in tolerances:
+            ax.axhline(-100 * tol, color="tab:green", lw=0.6, ls=":")
+            ax.axhline(100 * tol, color="tab:green", lw=0.6, ls=":")
+        groups = list(table[table.k3 == k3].groupby(["zeta", "psd"], sort=False))
+        for j, ((zeta, psd), sub) in enumerate(groups):
+            # small multiplicative offsets keep coincident series visible
+            shift = 1.0 + 0.025 * (j - (len(groups) - 1) / 2)
+            label = f"S = {psd:g}, zeta = {zeta:.3f}"
+            _error_series(ax, sub.sort_values("phi"), methods, style[(zeta, psd)], shift, label)
+        ax.set_xscale("log")
+        ax.set_ylim(100 * ymin, 3.0)
+        ax.set_xlabel("friction level phi = Fc / (c sigma$_{v0}$)")
+        ax.set_title(f"k3 = {k3:.3g} N/m$^3$", fontsize=10)
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=7, loc="lower left")
+        top = ax.secondary_xaxis("top", functions=(lambda p: p, lambda p: p))
+        ticks = [p for p in phi_ticks if p <= table.phi.max() * 1.01]
+        top.set_xticks(ticks, [f"{power_ratio(p):.2f}" for p in ticks], fontsize=7)
+        top.set_xlabel("Eq. 32 P / P(0) at that phi", fontsize=8)
+    axes[0, 0].set_ylabel("(P$_{method}$ - P$_{MC}$) / P$_{MC}$  (%), 95 % CI")
+    fig.suptitle(
+        "Error of equivalent linearisation (Eq. 32) and stochastic averaging against "
+        "Monte Carlo; bands at ±"
+        + ", ".join(f"{round(100 * t)}" for t in sorted(tolerances))
+        + " %"
+    )
+    fig.tight_layout()
+    return save_figure(fig, path)
