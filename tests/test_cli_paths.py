@@ -258,7 +258,9 @@ def test_study_identification_cli(tmp_path, capsys, monkeypatch):
 
 
 def test_study_linearisation_vs_averaging_cli(tmp_path, capsys, monkeypatch):
-    from randvib.studies import linearisation_vs_averaging as lva
+    from randvib.studies import load
+
+    lva = load("linearisation-vs-averaging")
 
     monkeypatch.setattr(lva, "grid", lambda quick: ((1.0,), (0.0, 0.5), (0.0, 7e6)))
     monkeypatch.setattr(lva, "QUICK_MC", (16, 0.5, 5e-4, 0.2))

@@ -287,7 +287,7 @@ def test_interaction_linearisation_by_spring_and_scaling_follow_the_data():
 
 
 def test_linearisation_vs_averaging_reading_follows_the_data():
-    from randvib.studies.linearisation_vs_averaging import reading
+    reading = load("linearisation-vs-averaging").reading
 
     df = pd.DataFrame(
         {

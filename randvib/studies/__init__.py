@@ -12,6 +12,8 @@ such scripts share lives here:
   ranges of the friction level, the collapse of series that scale exactly);
 - :mod:`~randvib.studies.campaign`: an identification campaign (synthetic shaker
   records, resumable fits, their tables);
+- :mod:`~randvib.studies.methods`: every analytic method against paired Monte Carlo
+  runs, and the accuracy criteria for a fast method;
 - :mod:`~randvib.studies.stepcheck`: the sweep with its half-step re-run, and its verdict;
 - :mod:`~randvib.studies.verdicts`: the verdict sentences, built from the numbers;
 - :mod:`~randvib.studies.figures`: figures of power and contrasts against Fc;

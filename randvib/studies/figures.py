@@ -273,3 +273,82 @@ def error_against_friction_level(
     )
     fig.tight_layout()
     return save_figure(fig, path)
+
+
+#: Colour and line style of each analytic method (:data:`randvib.studies.methods.ANALYTIC`).
+METHOD_STYLE = {
+    "linearisation": ("C3", "-"),
+    "averaging": ("C0", "-"),
+    "fpk_fast": ("C1", "--"),
+    "fpk": ("C2", ":"),
+}
+
+
+def method_errors_against_kappa(df: pd.DataFrame, labels: dict, path: Path) -> Path:
+    """Relative error of every analytic method against kappa, one panel per S, a marker per k3.
+
+    ``df`` has ``psd``, ``k3``, ``kappa``, ``mc_rel_ci95`` (drawn as a grey
+    band) and ``err_{name}`` for each ``name`` of :data:`METHOD_STYLE`;
+    ``labels`` names the methods in the legend.
+    """
+    import matplotlib.pyplot as plt
+    from matplotlib.lines import Line2D
+
+    psds = sorted(df["psd"].unique(), reverse=True)
+    k3s = sorted(df["k3"].unique())
+    markers = dict(zip(k3s, "os^D", strict=False))
+    fig, axes = plt.subplots(1, len(psds), figsize=(4.2 * len(psds), 3.8), sharey=True)
+    axes = np.atleast_1d(axes)
+    for ax, psd in zip(axes, psds, strict=True):
+        sub = df[df["psd"] == psd]
+        for k3 in k3s:
+            s = sub[sub["k3"] == k3].sort_values("kappa")
+            for name, (color, ls) in METHOD_STYLE.items():
+                ax.plot(s["kappa"], 100 * s[f"err_{name}"], ls + markers[k3], color=color,
+                        ms=3.5, lw=1)  # fmt: skip
+        band = sub.groupby("kappa")["mc_rel_ci95"].max()
+        ax.fill_between(band.index, -100 * band, 100 * band, color="0.8", zorder=-1)
+        ax.axhline(0, color="k", lw=0.6)
+        ax.axhspan(-3, 3, color="0.95", zorder=-2)
+        ax.set_title(f"S = {psd:g} (m/s$^2$)$^2$/Hz")
+        ax.set_xlabel(r"friction level $\kappa = 4F_c^2/(\pi S m c)$")
+    axes[0].set_ylabel("error in E[P_e] vs Monte Carlo (%)")
+    handles = [
+        Line2D([], [], color=c, ls=ls, label=labels[n]) for n, (c, ls) in METHOD_STYLE.items()
+    ]
+    handles += [Line2D([], [], color="0.3", ls="", marker=markers[k3], label=f"k3 = {k3:g} N/m$^3$")
+                for k3 in k3s]  # fmt: skip
+    handles.append(plt.Rectangle((0, 0), 1, 1, color="0.8", label="MC 95 % CI"))
+    fig.subplots_adjust(bottom=0.3)
+    fig.legend(handles=handles, loc="lower center", ncol=5, fontsize=7, frameon=False,
+               bbox_to_anchor=(0.5, 0.0))  # fmt: skip
+    fig.suptitle("Error of E[P_e]: linearisation (Eq. 32), averaging and the FPK grids", y=1.03)
+    return save_figure(fig, path)
+
+
+def k3_change_against_kappa(df: pd.DataFrame, labels: dict, path: Path) -> Path:
+    """The change of power with k3 at the largest k3 against kappa, one panel per S.
+
+    Paired Monte Carlo (``dk3_mc`` with ``dk3_mc_ci95``) with 95 % bars, and
+    every method's ``dk3_{name}`` as a line.
+    """
+    import matplotlib.pyplot as plt
+
+    psds = sorted(df["psd"].unique(), reverse=True)
+    k3s = sorted(df["k3"].unique())
+    inter = df[df["k3"] == max(k3s)]
+    fig, axes = plt.subplots(1, len(psds), figsize=(4.2 * len(psds), 3.6), sharey=True)
+    axes = np.atleast_1d(axes)
+    for ax, psd in zip(axes, psds, strict=True):
+        s = inter[inter["psd"] == psd].sort_values("kappa")
+        ax.errorbar(s["kappa"], 100 * s["dk3_mc"], 100 * s["dk3_mc_ci95"], fmt="ko", ms=4,
+                    capsize=3, label="Monte Carlo (paired), 95 % CI")  # fmt: skip
+        for name, (color, ls) in METHOD_STYLE.items():
+            ax.plot(s["kappa"], 100 * s[f"dk3_{name}"], ls, color=color, label=labels[name])
+        ax.axhline(0, color="k", lw=0.6)
+        ax.set_title(f"S = {psd:g}")
+        ax.set_xlabel(r"friction level $\kappa$")
+    axes[0].set_ylabel(f"P(k3={max(k3s):g}) / P(k3={min(k3s):g}) - 1 (%)")
+    axes[0].legend(fontsize=7)
+    fig.suptitle("Duffing-Coulomb interaction: change of power with k3 at fixed Fc", y=1.03)
+    return save_figure(fig, path)
