@@ -260,7 +260,10 @@ def test_cli_power_method_averaging(capsys):
 def test_quick_study_meets_the_accuracy_criteria(tmp_path):
     import pandas as pd
 
-    from randvib.studies.linearisation_vs_averaging import run_study, verdicts
+    from randvib.studies import load
+
+    study = load("linearisation-vs-averaging")  # studies/linearisation_vs_averaging.py
+    run_study, verdicts = study.run_study, study.verdicts
 
     report = run_study(tmp_path / "lva", quick=True, seed=0, progress=False)
     assert report.name == "report.md" and report.exists()

@@ -143,7 +143,9 @@ def test_simulate_api_rejects_non_finite_dw_and_bad_histogram_range():
 # ----------------------------------------------------------------- identify / validate
 @pytest.fixture(scope="module")
 def records(tmp_path_factory):
-    from randvib.studies.identification import make_test
+    from randvib.studies import load
+
+    make_test = load("identification").make_test
 
     folder = tmp_path_factory.mktemp("rec")
     paths = []
@@ -236,8 +238,9 @@ def _study(capsys, name, out):
 
 
 def test_study_identification_cli(tmp_path, capsys, monkeypatch):
-    from randvib.studies import identification
+    from randvib.studies import load
 
+    identification = load("identification")
     monkeypatch.setattr(
         identification,
         "_settings",
@@ -255,7 +258,9 @@ def test_study_identification_cli(tmp_path, capsys, monkeypatch):
 
 
 def test_study_linearisation_vs_averaging_cli(tmp_path, capsys, monkeypatch):
-    from randvib.studies import linearisation_vs_averaging as lva
+    from randvib.studies import load
+
+    lva = load("linearisation-vs-averaging")
 
     monkeypatch.setattr(lva, "grid", lambda quick: ((1.0,), (0.0, 0.5), (0.0, 7e6)))
     monkeypatch.setattr(lva, "QUICK_MC", (16, 0.5, 5e-4, 0.2))

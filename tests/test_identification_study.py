@@ -4,7 +4,15 @@ import numpy as np
 import pytest
 
 from randvib.cli.study import load_study
-from randvib.studies.identification import TEST_RMS, TRUTH, make_test, run_study
+from randvib.studies import load
+
+study = load("identification")  # the script studies/identification.py
+TEST_RMS, TRUTH, make_test, run_study = (
+    study.TEST_RMS,
+    study.TRUTH,
+    study.make_test,
+    study.run_study,
+)
 
 
 def test_registered_and_refuses_a_folder_from_another_run(tmp_path):
@@ -32,7 +40,7 @@ def test_synthetic_tests_are_increasing_and_noisy():
 def test_figure8_verdict_follows_the_shares():
     import pandas as pd
 
-    from randvib.studies.identification import MEASURED, SIMULATED, figure8_verdict
+    MEASURED, SIMULATED, figure8_verdict = study.MEASURED, study.SIMULATED, study.figure8_verdict
 
     def table(m6, mlow, coulomb, viscous):
         rows = [("test 6", "coulomb", 0.0, m6), ("test 6", "viscous", 0.0, m6)]

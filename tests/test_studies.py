@@ -20,12 +20,13 @@ import randvib as rv
 from randvib.analytic.prediction import expected_power
 from randvib.cli import main
 from randvib.montecarlo.sweep import SweepSettings
-from randvib.studies import linearisation_accuracy, load
+from randvib.studies import load
 from randvib.studies.grids import fc_at_friction_level, fc_where_power_halves, friction_level
 from randvib.studies.report import plus_minus
 from randvib.studies.verdicts import interaction_summary
 
 interaction = load("interaction")  # the script studies/interaction.py
+linearisation_accuracy = load("linearisation-accuracy")  # studies/linearisation_accuracy.py
 
 BASE = rv.preset("figure9")
 TINY = SweepSettings(dt=1e-4, window=0.3, burn_in=0.1, min_paths=48, max_paths=48, batch_paths=48)
@@ -286,7 +287,7 @@ def test_interaction_linearisation_by_spring_and_scaling_follow_the_data():
 
 
 def test_linearisation_vs_averaging_reading_follows_the_data():
-    from randvib.studies.linearisation_vs_averaging import reading
+    reading = load("linearisation-vs-averaging").reading
 
     df = pd.DataFrame(
         {

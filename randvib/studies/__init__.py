@@ -8,6 +8,12 @@ such scripts share lives here:
 - :mod:`~randvib.studies.grids`: friction and Duffing levels, Coulomb grids, burn-in;
 - :mod:`~randvib.studies.contrasts`: paired interaction contrasts with Holm's
   correction, and analytic predictions of the same contrasts;
+- :mod:`~randvib.studies.accuracy`: where an analytic method can be trusted (trusted
+  ranges of the friction level, the collapse of series that scale exactly);
+- :mod:`~randvib.studies.campaign`: an identification campaign (synthetic shaker
+  records, resumable fits, their tables);
+- :mod:`~randvib.studies.methods`: every analytic method against paired Monte Carlo
+  runs, and the accuracy criteria for a fast method;
 - :mod:`~randvib.studies.stepcheck`: the sweep with its half-step re-run, and its verdict;
 - :mod:`~randvib.studies.verdicts`: the verdict sentences, built from the numbers;
 - :mod:`~randvib.studies.figures`: figures of power and contrasts against Fc;

@@ -47,6 +47,18 @@ def fc_at_friction_level(device: Harvester, psd, phi):
     return np.asarray(phi, dtype=float) * c * np.sqrt(np.asarray(psd, dtype=float) * m / (4 * c))
 
 
+def power_ratio(phi):
+    """Eq. 32's P / P(0) at friction level phi: 1 / (1 + kappa + sqrt(kappa (2 + kappa))),
+    kappa = phi^2 / pi (Eq. 30-32 through :func:`friction_level`)."""
+    kappa = np.asarray(phi, dtype=float) ** 2 / np.pi
+    return 1.0 / (1.0 + kappa + np.sqrt(kappa * (2.0 + kappa)))
+
+
+def damping_ratio(device: Harvester) -> float:
+    """zeta = c / (2 sqrt(k m)) of the linear part (c = c_m + c_e)."""
+    return float(device.c / (2.0 * np.sqrt(device.k * device.m)))
+
+
 def duffing_strength(device, psd, k3):
     """mu = k3 sigma_z0^2 / k: cubic against linear spring force at the friction-free rms z.
 

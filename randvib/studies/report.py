@@ -73,9 +73,14 @@ def write_verdicts(out_dir: Path, verdicts: dict) -> Path:
     return path
 
 
-def write_report(out_dir: Path, title: str, sections: list[tuple[str, str]]) -> Path:
-    """Write ``out_dir/report.md``: the title, then one ``##`` section per (heading, body)."""
+def write_report(
+    out_dir: Path, title: str, sections: list[tuple[str, str]], intro: str | None = None
+) -> Path:
+    """Write ``out_dir/report.md``: the title, ``intro`` (if given), then one ``##`` section
+    per (heading, body)."""
     text = [f"# {title}", ""]
+    if intro is not None:
+        text += [intro.strip(), ""]
     for heading, body in sections:
         text += [f"## {heading}", "", body.strip(), ""]
     path = Path(out_dir) / "report.md"
