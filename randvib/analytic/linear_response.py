@@ -144,7 +144,7 @@ def frequency_rule(block: StateSpace, excitation: Excitation):
 def spectral_variances(block: StateSpace, excitation: Excitation) -> np.ndarray:
     """E[y^2] = int_0^inf |H_y(f)|^2 S(f) df for each output y of the block.
 
-    Accurate to about 1e-10 relative for the device's resonance and the
+    Accurate to about 1e-9 relative or better for the device's resonance and the
     built-in spectra (checked against the Lyapunov solution in the tests).
     """
     _require_stable(block)
