@@ -269,6 +269,50 @@ MUTATIONS: tuple[Mutation, ...] = (
         "so contrasts that pass only on their own count as detectable after correction; "
         "the test's z-scores pass at 10 % and not at 5 %.",
     ),
+    Mutation(
+        name="band-pass-psd-constant",
+        path="randvib/models/excitation.py",
+        edits=(
+            (
+                "return self.level * (2.0 * self.zeta * f * self.f0) ** 2 / self._denominator(f)",
+                "return 1.01 * self.level * (2.0 * self.zeta * f * self.f0) ** 2 / self._denominator(f)",
+            ),
+        ),
+        tests=("tests/test_excitation_models.py::test_psd_is_the_shaping_filters_gain",),
+        why="The band-pass PSD formula 1 % high; it is compared with |H|^2 S of its shaping "
+        "filter to 1e-12.",
+    ),
+    Mutation(
+        name="lyapunov-noise-intensity",
+        path="randvib/models/excitation.py",
+        edits=(("return 0.5 * self.noise_psd", "return self.noise_psd"),),
+        tests=(
+            "tests/test_linear_response.py::test_white_noise_variances_of_the_linear_oscillator",
+        ),
+        why="The Lyapunov equation driven with intensity S instead of S/2 (E[w w] = (S/2) "
+        "delta): every variance doubles; the white-noise case is checked against S m/(4c).",
+    ),
+    Mutation(
+        name="k-eq-factor",
+        path="randvib/analytic/statistical_linearisation.py",
+        edits=(
+            (
+                "return c + increment, k + 3.0 * k3 * var_z",
+                "return c + increment, k + 3.3 * k3 * var_z",
+            ),
+        ),
+        tests=("tests/test_linear_response.py::test_white_noise_reduces_to_eq30_32",),
+        why="k_eq = k + 3.3 k3 E[z^2] instead of 3 k3 E[z^2]; under white noise the "
+        "displacement variance must equal Eq. 20's with the Gaussian-closure spring.",
+    ),
+    Mutation(
+        name="synthesis-amplitude",
+        path="randvib/models/excitation.py",
+        edits=(("scale = np.full(f.size, 0.5 * n)", "scale = np.full(f.size, 0.505 * n)"),),
+        tests=("tests/test_excitation_models.py::test_synthesised_band_limited_variance_and_psd",),
+        why="Synthesised paths 1 % too large in amplitude (2 % in variance); the variance "
+        "test is powered for 2 % (standard error 0.25 %).",
+    ),
 )
 
 

@@ -1,9 +1,31 @@
-"""Band-limited Gaussian base excitation for synthetic shaker campaigns.
+"""Base excitation: the excitation family and synthetic shaker campaigns.
 
-The paper's experiments (Sec. 3) drove the shaker under displacement control
+**The excitation family.** An excitation is one class, a frozen dataclass
+subclassing :class:`Excitation`, that declares what every consumer needs
+(docs/conventions.md, "Beyond the paper"):
+
+* ``psd(f)`` - the one-sided PSD of the base acceleration,
+  (m/s^2)^2/Hz, f in Hz; ``variance`` - its integral ((m/s^2)^2, infinite
+  for white noise); ``is_white``;
+* ``shaping_filter()`` - for rational spectra (white, band-pass,
+  Kanai-Tajimi) a :class:`ShapingFilter`: a state-space block driven by the
+  white noise of the conventions, E[w(t1) w(t2)] = (S/2) delta(t2 - t1),
+  whose output has exactly this PSD; None for the others;
+* ``sample(duration, dt, n_paths, seed)`` - for the non-rational ones
+  (band-limited, tabulated, measured) a stationary Gaussian synthesis in the
+  frequency domain (:func:`synthesise`);
+* ``support``, ``features`` and ``breakpoints`` - where the spectrum lives,
+  its peaks and its kinks, so that a quadrature over frequency can resolve
+  them (:mod:`randvib.analytic.linear_response`).
+
+Defining a subclass with its own ``name`` registers it in
+:data:`EXCITATIONS`. :func:`as_excitation` turns a plain number into white
+noise, so a ``psd`` argument can take either.
+
+**Synthetic shaker campaigns.** The paper's experiments (Sec. 3) drove the shaker under displacement control
 so that the base *acceleration* had a flat power spectral density between
-4 and 20 Hz; the model was then driven by the recorded *displacement*. This
-module makes both signals from one realisation: a Gaussian acceleration with
+4 and 20 Hz; the model was then driven by the recorded *displacement*.
+:func:`band_limited_excitation` makes both signals from one realisation: a Gaussian acceleration with
 a flat one-sided PSD on ``[f_lo, f_hi]`` and the displacement (and velocity)
 a shaker table would follow to produce it.
 
@@ -16,11 +38,13 @@ the band excludes zero frequency.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
+from scipy import signal
 
-from randvib._validation import check_int, check_positive
+from randvib._validation import check_finite, check_int, check_nonnegative, check_positive
+from randvib.models.state_space import StateSpace
 
 
 @dataclass(frozen=True, eq=False)
@@ -145,3 +169,536 @@ def band_limited_excitation(
         f_hi=f_hi,
         rms=rms,
     )
+
+
+# ====================================================== the excitation family
+#: Name -> excitation class; filled by :class:`Excitation` subclasses.
+EXCITATIONS: dict[str, type] = {}
+
+_PSD_UNIT = "(m/s^2)^2/Hz"
+
+
+@dataclass(frozen=True, eq=False)
+class ShapingFilter:
+    """A rational excitation as a linear filter of white noise.
+
+    The filter's input ``w`` is the white noise of the conventions,
+    E[w(t1) w(t2)] = (S/2) delta(t2 - t1) with ``S = noise_psd``, and its
+    one output, ``acceleration``, has the one-sided PSD
+    ``|H(i 2 pi f)|^2 S`` of the excitation.
+
+    Attributes
+    ----------
+    system : StateSpace
+        The filter (states in the order the excitation documents), input w,
+        output ``acceleration`` ((m/s^2)).
+    noise_psd : float
+        One-sided PSD S of w ((m/s^2)^2/Hz).
+    """
+
+    system: StateSpace
+    noise_psd: float
+
+    @property
+    def noise_intensity(self) -> float:
+        """q = S/2: E[w(t1) w(t2)] = q delta(t2 - t1) ((m/s^2)^2 s)."""
+        return 0.5 * self.noise_psd
+
+    def psd(self, frequency) -> np.ndarray:
+        """The output's one-sided PSD |H|^2 S ((m/s^2)^2/Hz) at ``frequency`` (Hz)."""
+        return np.abs(self.system.frequency_response(frequency)[0]) ** 2 * self.noise_psd
+
+
+class Excitation:
+    """Base class of the excitations: the declaration every consumer reads.
+
+    Subclasses are frozen dataclasses; one that sets ``name`` is registered
+    in :data:`EXCITATIONS`. See the module docstring for what an excitation
+    declares.
+    """
+
+    #: Short name used by the CLI and tables.
+    name: str = "excitation"
+    #: True for ideal white noise (the paper's model; every method accepts it).
+    is_white: bool = False
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        if "name" in cls.__dict__:
+            EXCITATIONS[cls.name] = cls
+
+    def psd(self, frequency) -> np.ndarray:  # pragma: no cover - abstract
+        """One-sided PSD of the base acceleration ((m/s^2)^2/Hz) at ``frequency`` (Hz)."""
+        raise NotImplementedError
+
+    @property
+    def variance(self) -> float:  # pragma: no cover - abstract
+        """E[y''^2] = int_0^inf S(f) df ((m/s^2)^2); infinite for white noise."""
+        raise NotImplementedError
+
+    @property
+    def support(self) -> tuple[float, float]:
+        """(lowest, highest) frequency (Hz) outside which the PSD is zero."""
+        return 0.0, np.inf
+
+    def features(self) -> tuple[tuple[float, float], ...]:
+        """Spectral peaks as (centre, half-width) pairs (Hz), for quadrature."""
+        return ()
+
+    def breakpoints(self) -> tuple[float, ...]:
+        """Frequencies (Hz) where the PSD has a jump or a kink, for quadrature."""
+        return ()
+
+    def shaping_filter(self) -> ShapingFilter | None:
+        """The filter of white noise with this PSD (rational spectra), else None."""
+        return None
+
+    def sample(self, duration: float, dt: float, n_paths: int = 1, seed=None) -> np.ndarray:
+        """Stationary Gaussian paths of the base acceleration (m/s^2), see :func:`synthesise`."""
+        return synthesise(self, duration, dt, n_paths, seed)
+
+    def parameters(self) -> dict:
+        """The excitation's name and parameters (SI units), ready for JSON."""
+        out = {"excitation": self.name}
+        out.update({f.name: getattr(self, f.name) for f in fields(self)})
+        return out
+
+
+def as_excitation(value) -> Excitation:
+    """An :class:`Excitation` as is; a number S as white noise ``White(S)``."""
+    if isinstance(value, Excitation):
+        return value
+    return White(float(check_positive("psd", value, _PSD_UNIT)))
+
+
+# ------------------------------------------------------------ rational
+class _Rational(Excitation):
+    """Spectra with a shaping filter; simulated through the filter's states."""
+
+    def sample(self, duration, dt, n_paths=1, seed=None):
+        raise NotImplementedError(
+            f"the {self.name} spectrum is rational: simulate it through its shaping "
+            "filter (shaping_filter()), integrated with the device"
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class White(_Rational):
+    """Ideal white noise: S(f) = S, E[w(t1) w(t2)] = (S/2) delta (paper Eq. 17).
+
+    Parameters
+    ----------
+    level : float
+        One-sided PSD S ((m/s^2)^2/Hz), > 0.
+    """
+
+    level: float
+    name = "white"
+    is_white = True
+
+    def __post_init__(self):
+        object.__setattr__(self, "level", float(check_positive("level", self.level, _PSD_UNIT)))
+
+    def psd(self, frequency):
+        return np.full(np.shape(frequency), self.level)
+
+    @property
+    def variance(self) -> float:
+        return np.inf
+
+    def shaping_filter(self) -> ShapingFilter:
+        """No states: the acceleration is the white noise itself (D = 1)."""
+        return ShapingFilter(
+            StateSpace(np.zeros((0, 0)), [], np.zeros((1, 0)), [1.0], ("acceleration",)), self.level
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class _SecondOrder(_Rational):
+    """White noise through ``x1'' + 2 zeta omega0 x1' + omega0^2 x1 = w``.
+
+    The filter states are (x1, x1'); the excitation is a combination of them
+    (``_output_row``), omega0 = 2 pi f0.
+    """
+
+    level: float
+    f0: float
+    zeta: float
+
+    def __post_init__(self):
+        object.__setattr__(self, "level", float(check_positive("level", self.level, _PSD_UNIT)))
+        object.__setattr__(self, "f0", float(check_positive("f0", self.f0, "Hz")))
+        object.__setattr__(self, "zeta", float(check_positive("zeta", self.zeta)))
+
+    def features(self):
+        return ((self.f0, self.zeta * self.f0),)
+
+    def _denominator(self, f):
+        f = np.asarray(f, dtype=float)
+        return (self.f0**2 - f**2) ** 2 + (2.0 * self.zeta * f * self.f0) ** 2
+
+    def _output_row(self, omega0):  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def shaping_filter(self) -> ShapingFilter:
+        w0 = 2.0 * np.pi * self.f0
+        a = [[0.0, 1.0], [-(w0**2), -2.0 * self.zeta * w0]]
+        system = StateSpace(a, [0.0, 1.0], [self._output_row(w0)], [0.0], ("acceleration",))
+        return ShapingFilter(system, self.level)
+
+
+@dataclass(frozen=True, eq=False)
+class BandPass(_SecondOrder):
+    """Second-order band-pass noise: peak S at f0, half-power bandwidth 2 zeta f0.
+
+    ``S(f) = S (2 zeta f f0)^2 / ((f0^2 - f^2)^2 + (2 zeta f f0)^2)``; the
+    shaping filter's output is ``2 zeta omega0 x1'``.
+
+    Parameters
+    ----------
+    level : float
+        Peak PSD S ((m/s^2)^2/Hz), > 0.
+    f0 : float
+        Centre frequency (Hz), > 0.
+    zeta : float
+        Damping ratio of the filter, > 0 (narrow band: small zeta).
+    """
+
+    name = "band-pass"
+
+    def psd(self, frequency):
+        f = np.asarray(frequency, dtype=float)
+        return self.level * (2.0 * self.zeta * f * self.f0) ** 2 / self._denominator(f)
+
+    @property
+    def variance(self) -> float:
+        """pi zeta f0 S: the peak times the noise bandwidth pi zeta f0."""
+        return np.pi * self.zeta * self.f0 * self.level
+
+    def _output_row(self, omega0):
+        return [0.0, 2.0 * self.zeta * omega0]
+
+
+@dataclass(frozen=True, eq=False)
+class KanaiTajimi(_SecondOrder):
+    """Kanai-Tajimi noise: low-frequency level S, ground filter at f0.
+
+    ``S(f) = S (f0^4 + (2 zeta f f0)^2) / ((f0^2 - f^2)^2 + (2 zeta f f0)^2)``;
+    the shaping filter's output is ``omega0^2 x1 + 2 zeta omega0 x1'``. As
+    f0 grows it tends to white noise of level S.
+
+    Parameters
+    ----------
+    level : float
+        PSD at f = 0, S ((m/s^2)^2/Hz), > 0.
+    f0 : float
+        Filter frequency (Hz), > 0.
+    zeta : float
+        Filter damping ratio, > 0.
+    """
+
+    name = "kanai-tajimi"
+
+    def psd(self, frequency):
+        f = np.asarray(frequency, dtype=float)
+        numerator = self.f0**4 + (2.0 * self.zeta * f * self.f0) ** 2
+        return self.level * numerator / self._denominator(f)
+
+    @property
+    def variance(self) -> float:
+        """pi f0 S (1 + 4 zeta^2) / (4 zeta)."""
+        return np.pi * self.f0 * self.level * (1.0 + 4.0 * self.zeta**2) / (4.0 * self.zeta)
+
+    def _output_row(self, omega0):
+        return [omega0**2, 2.0 * self.zeta * omega0]
+
+
+# --------------------------------------------------------- non-rational
+@dataclass(frozen=True, eq=False)
+class BandLimited(Excitation):
+    """Flat PSD S between f_lo and f_hi (inclusive), zero outside.
+
+    Parameters
+    ----------
+    level : float
+        PSD in the band, S ((m/s^2)^2/Hz), > 0.
+    f_lo, f_hi : float
+        Band edges (Hz), 0 <= f_lo < f_hi (the paper's tests: 4 and 20 Hz).
+    """
+
+    level: float
+    f_lo: float
+    f_hi: float
+    name = "band-limited"
+
+    def __post_init__(self):
+        object.__setattr__(self, "level", float(check_positive("level", self.level, _PSD_UNIT)))
+        object.__setattr__(self, "f_lo", float(check_nonnegative("f_lo", self.f_lo, "Hz")))
+        object.__setattr__(self, "f_hi", float(check_positive("f_hi", self.f_hi, "Hz")))
+        if self.f_hi <= self.f_lo:
+            raise ValueError(f"`f_hi` must be > `f_lo` = {self.f_lo} Hz, got {self.f_hi} Hz")
+
+    def psd(self, frequency):
+        f = np.asarray(frequency, dtype=float)
+        return np.where((f >= self.f_lo) & (f <= self.f_hi), self.level, 0.0)
+
+    @property
+    def variance(self) -> float:
+        return self.level * (self.f_hi - self.f_lo)
+
+    @property
+    def support(self):
+        return self.f_lo, self.f_hi
+
+    def breakpoints(self):
+        return self.f_lo, self.f_hi
+
+
+@dataclass(frozen=True, eq=False)
+class Tabulated(Excitation):
+    """A PSD given as a table, linearly interpolated, zero outside the table.
+
+    Parameters
+    ----------
+    frequency : array_like
+        Frequencies (Hz), >= 0, strictly increasing, at least two.
+    density : array_like
+        One-sided PSD at those frequencies ((m/s^2)^2/Hz), >= 0, not all zero.
+    """
+
+    frequency: np.ndarray
+    density: np.ndarray
+    name = "tabulated"
+
+    def __post_init__(self):
+        f = check_nonnegative("frequency", self.frequency, "Hz")
+        p = check_nonnegative("psd", self.density, _PSD_UNIT)
+        if f.ndim != 1 or f.size < 2 or p.shape != f.shape:
+            raise ValueError(
+                "`frequency` and `psd` must be 1-D of the same length >= 2, got shapes "
+                f"{f.shape} and {p.shape}"
+            )
+        steps = np.diff(f)
+        if np.any(steps <= 0):
+            i = int(np.argmax(steps <= 0))
+            raise ValueError(
+                f"`frequency` must be strictly increasing, got {f[i + 1]!r} Hz after "
+                f"{f[i]!r} Hz (rows {i} and {i + 1})"
+            )
+        if not np.any(p > 0):
+            raise ValueError("`psd` must be > 0 somewhere; the table has no power")
+        object.__setattr__(self, "frequency", f)
+        object.__setattr__(self, "density", p)
+
+    @classmethod
+    def from_csv(cls, path) -> Tabulated:
+        """Read a table with the columns ``frequency`` (Hz) and ``psd`` ((m/s^2)^2/Hz)."""
+        frame = _read_columns(path, ("frequency", "psd"))
+        return cls(frame["frequency"], frame["psd"])
+
+    def psd(self, frequency):
+        return np.interp(frequency, self.frequency, self.density, left=0.0, right=0.0)
+
+    @property
+    def variance(self) -> float:
+        """The exact integral of the interpolated table (trapezoid rule)."""
+        return float(np.trapezoid(self.density, self.frequency))
+
+    @property
+    def support(self):
+        nonzero = np.flatnonzero(self.density > 0)
+        lo = self.frequency[max(nonzero[0] - 1, 0)]
+        hi = self.frequency[min(nonzero[-1] + 1, self.frequency.size - 1)]
+        return float(lo), float(hi)
+
+    def breakpoints(self):
+        return tuple(self.frequency)
+
+    def parameters(self) -> dict:
+        lo, hi = self.support
+        return {"excitation": self.name, "f_lo": lo, "f_hi": hi, "variance": self.variance}
+
+
+def welch_segment_length(n_samples: int) -> int:
+    """Welch segment length (samples) for a record of ``n_samples``.
+
+    The largest power of two not above n/8, so that with 50 % overlap
+    between 15 and 31 Hann-windowed segments are averaged (relative standard
+    error of each PSD value about 1/sqrt(0.95 K) for K segments), and at least
+    64 samples (or the whole record if shorter).
+    """
+    if n_samples < 8 * 64:
+        return min(n_samples, 64)
+    return 2 ** int(np.floor(np.log2(n_samples / 8)))
+
+
+@dataclass(frozen=True, eq=False)
+class Measured(Excitation):
+    """A measured base-acceleration record and its PSD (Welch's method).
+
+    The PSD is Welch's estimate (scipy.signal.welch): Hann window, 50 %
+    overlap, each segment's mean removed, ``segment_length`` samples per
+    segment (default :func:`welch_segment_length`: the largest power of
+    two <= n/8, 15 to 31 segments), linearly interpolated between its
+    frequency bins (:class:`Tabulated`). The record itself is kept
+    (``time``, ``acceleration``) for simulations driven by it; ``sample``
+    synthesises Gaussian surrogates with the estimated PSD.
+
+    Parameters
+    ----------
+    time : array_like
+        Sample times (s), evenly spaced (each within 1 % of a step of the
+        uniform grid), at least 64 samples.
+    acceleration : array_like
+        Base acceleration (m/s^2), finite.
+    segment_length : int, optional
+        Welch segment length (samples), 16 <= L <= n.
+    """
+
+    time: np.ndarray
+    acceleration: np.ndarray
+    segment_length: int | None = None
+    name = "measured"
+
+    def __post_init__(self):
+        t = check_finite("time", self.time)
+        a = check_finite("base_acceleration", self.acceleration)
+        if t.ndim != 1 or a.shape != t.shape or t.size < 64:
+            raise ValueError(
+                "`time` and `base_acceleration` must be 1-D of the same length >= 64, got "
+                f"shapes {t.shape} and {a.shape}"
+            )
+        dt = (t[-1] - t[0]) / (t.size - 1)
+        if not dt > 0:
+            raise ValueError(f"`time` must increase, got {t[0]!r} s to {t[-1]!r} s")
+        off = np.abs(t - (t[0] + dt * np.arange(t.size)))
+        if np.max(off) > 0.01 * dt:
+            i = int(np.argmax(off))
+            raise ValueError(
+                f"`time` must be evenly spaced: sample {i} is at {t[i]!r} s, {off[i]:.3g} s "
+                f"off the uniform grid of step {dt:.6g} s (allowed: 1 % of a step)"
+            )
+        length = (
+            welch_segment_length(t.size) if self.segment_length is None else self.segment_length
+        )
+        length = check_int("segment_length", length, minimum=16)
+        if length > t.size:
+            raise ValueError(
+                f"`segment_length` must be <= the record's {t.size} samples, got {length}"
+            )
+        f, p = signal.welch(a, fs=1.0 / dt, window="hann", nperseg=length, noverlap=length // 2)
+        object.__setattr__(self, "time", t)
+        object.__setattr__(self, "acceleration", a)
+        object.__setattr__(self, "segment_length", length)
+        object.__setattr__(self, "spectrum", Tabulated(f, p))
+
+    @classmethod
+    def from_csv(cls, path, segment_length: int | None = None) -> Measured:
+        """Read a record with the columns ``time`` (s) and ``base_acceleration`` (m/s^2)."""
+        frame = _read_columns(path, ("time", "base_acceleration"))
+        return cls(frame["time"], frame["base_acceleration"], segment_length)
+
+    @property
+    def dt(self) -> float:
+        """Sample step (s)."""
+        return float((self.time[-1] - self.time[0]) / (self.time.size - 1))
+
+    @property
+    def n_segments(self) -> int:
+        """Number of Welch segments averaged (50 % overlap)."""
+        step = self.segment_length - self.segment_length // 2
+        return (self.time.size - self.segment_length) // step + 1
+
+    def psd(self, frequency):
+        return self.spectrum.psd(frequency)
+
+    @property
+    def variance(self) -> float:
+        """Integral of the Welch PSD (close to the record's variance about its mean)."""
+        return self.spectrum.variance
+
+    @property
+    def support(self):
+        return self.spectrum.support
+
+    def breakpoints(self):
+        return self.spectrum.breakpoints()
+
+    def parameters(self) -> dict:
+        return {
+            "excitation": self.name,
+            "duration": float(self.time[-1] - self.time[0] + self.dt),
+            "dt": self.dt,
+            "segment_length": self.segment_length,
+            "variance": self.variance,
+        }
+
+
+def _read_columns(path, columns) -> dict:
+    import pandas as pd
+
+    frame = pd.read_csv(path)
+    missing = [c for c in columns if c not in frame.columns]
+    if missing:
+        raise ValueError(
+            f"`{path}` must have the columns {', '.join(columns)}; missing {', '.join(missing)} "
+            f"(found {', '.join(map(str, frame.columns))})"
+        )
+    return {c: frame[c].to_numpy(dtype=float) for c in columns}
+
+
+def synthesise(excitation: Excitation, duration: float, dt: float, n_paths: int = 1, seed=None):
+    """Stationary Gaussian paths with the excitation's PSD, by frequency-domain synthesis.
+
+    With n = duration/dt samples and the bins f_k = k / (n dt), each path is
+    ``sum_k A_k cos(2 pi f_k t) + B_k sin(2 pi f_k t)`` with independent
+    A_k, B_k ~ N(0, S(f_k) w_k), w_k = 1/(n dt) (half at f = 0 and at the
+    Nyquist bin). The paths are exactly Gaussian and stationary (periodic
+    with period n dt); their variance is the trapezoid rule of int S df on
+    the bins, which tends to ``excitation.variance`` as the duration grows.
+
+    Parameters
+    ----------
+    excitation : Excitation
+        Its spectrum must vanish above the Nyquist frequency 1/(2 dt).
+    duration : float
+        Length of each path (s), > 0.
+    dt : float
+        Sample step (s), > 0.
+    n_paths : int
+        Number of independent paths, >= 1.
+    seed : int, numpy.random.Generator or None
+        Random source (never the global numpy state).
+
+    Returns
+    -------
+    ndarray, shape (n_paths, n)
+        Base acceleration (m/s^2) at the times j dt.
+    """
+    duration = float(check_positive("duration", duration, "s"))
+    dt = float(check_positive("dt", dt, "s"))
+    n_paths = check_int("n_paths", n_paths, minimum=1)
+    n = check_int("number of samples (duration / dt)", round(duration / dt), minimum=8)
+    top = excitation.support[1]
+    if top > 0.5 / dt * (1 + 1e-12):
+        raise ValueError(
+            f"`dt` = {dt} s resolves frequencies up to 1/(2 dt) = {0.5 / dt:.6g} Hz, but the "
+            f"{excitation.name} spectrum has power up to {top:.6g} Hz; choose `dt` <= "
+            f"{0.5 / top:.3g} s"
+        )
+    f = np.fft.rfftfreq(n, dt)
+    weight = np.full(f.size, 1.0 / (n * dt))
+    weight[0] *= 0.5
+    if n % 2 == 0:
+        weight[-1] *= 0.5
+    std = np.sqrt(excitation.psd(f) * weight)
+    # irfft(X)_j = (1/n) [X_0 + 2 Re sum_k X_k e^{2 pi i k j/n} + X_{n/2} (-1)^j]: the
+    # coefficient (n/2)(A - iB) gives A cos + B sin; DC and Nyquist are real, with n A.
+    scale = np.full(f.size, 0.5 * n)
+    scale[0] = n
+    if n % 2 == 0:
+        scale[-1] = n
+    rng = np.random.default_rng(seed)
+    g = rng.standard_normal((2, n_paths, f.size))
+    g[1][:, scale == n] = 0.0
+    return np.fft.irfft(scale * std * (g[0] - 1j * g[1]), n, axis=-1)

@@ -1,0 +1,226 @@
+"""Statistical (equivalent) linearisation of the harvester under any excitation.
+
+The nonlinear device ``m z'' + c z' + k z + k3 z^3 + F(z') = -m y''`` is
+replaced by the linear one with
+
+    c_eq = c + E[v F(v)] / E[v^2],    k_eq = k + 3 k3 E[z^2],
+
+the expectations taken under a zero-mean Gaussian response (paper Eq. 19;
+docs/conventions.md, "Beyond the paper"). The variances E[v^2], E[z^2] are
+those of the linear device (m, c_eq, k_eq) under the excitation
+(:mod:`randvib.analytic.linear_response`: a Lyapunov equation for rational
+spectra, the spectral integral for any). The two conditions are one fixed
+point in (log E[v^2], log E[z^2]), solved by Powell's hybrid method
+(scipy ``root(method="hybr")``) from the linear device's response.
+
+Under white noise E[v^2] = S m / (4 c_eq) for any k_eq, so the fixed point
+is Eq. 19-20 and, for Coulomb friction, Eq. 30/32: the numbers of
+:func:`randvib.expected_power`. Under a coloured spectrum k_eq moves the
+resonance against the spectrum, and the spring matters.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import optimize
+
+from randvib.analytic.linear_response import mechanical_block, output_variances, response_spectra
+from randvib.models.excitation import Excitation, as_excitation
+from randvib.models.harvester import Harvester
+
+#: Largest |log residual| accepted as converged.
+_TOLERANCE = 1e-10
+
+
+@dataclass(frozen=True, eq=False)
+class ResponseSpectra:
+    """One-sided PSDs of the linearised response (SI units, f in Hz).
+
+    Attributes
+    ----------
+    frequency : ndarray
+        f (Hz).
+    excitation : ndarray
+        S(f) of the base acceleration ((m/s^2)^2/Hz).
+    displacement, velocity : ndarray
+        PSD of z (m^2/Hz) and of v ((m/s)^2/Hz).
+    power : ndarray
+        Frequency distribution of the electrical power c_e |H_v|^2 S (W/Hz):
+        its integral is E[P_e].
+    """
+
+    frequency: np.ndarray
+    excitation: np.ndarray
+    displacement: np.ndarray
+    velocity: np.ndarray
+    power: np.ndarray
+
+    def to_frame(self):
+        """The spectra as a :class:`pandas.DataFrame`, one row per frequency."""
+        import pandas as pd
+
+        return pd.DataFrame({name: getattr(self, name) for name in self.__dataclass_fields__})
+
+
+@dataclass(frozen=True, eq=False)
+class LinearisationResult:
+    """Statistical linearisation of a harvester under an excitation (SI units).
+
+    Attributes
+    ----------
+    harvester : Harvester
+    excitation : Excitation
+    c_eq : float
+        Equivalent damping c + E[v F(v)] / E[v^2] (Ns/m).
+    k_eq : float
+        Equivalent stiffness k + 3 k3 E[z^2] (N/m).
+    velocity_variance, displacement_variance : float
+        E[v^2] ((m/s)^2) and E[z^2] (m^2) of the linearised device.
+    power_electrical : float
+        E[P_e] = c_e E[v^2] (W).
+    power_load : float or None
+        The share reaching R_L (W), when the harvester has a circuit.
+    method : str
+        How the variances were computed: ``lyapunov`` or ``spectral``.
+    """
+
+    harvester: Harvester
+    excitation: Excitation
+    c_eq: float
+    k_eq: float
+    velocity_variance: float
+    displacement_variance: float
+    power_electrical: float
+    power_load: float | None
+    method: str
+
+    def block(self):
+        """The linearised device as a :class:`~randvib.models.state_space.StateSpace`."""
+        return mechanical_block(self.harvester.m, self.c_eq, self.k_eq)
+
+    def response_spectra(self, frequency) -> ResponseSpectra:
+        """PSDs of z, v and the electrical power's distribution at ``frequency`` (Hz)."""
+        f = np.asarray(frequency, dtype=float)
+        spectra = response_spectra(self.block(), self.excitation, f)
+        return ResponseSpectra(
+            frequency=f,
+            excitation=self.excitation.psd(f),
+            displacement=spectra["z"],
+            velocity=spectra["v"],
+            power=self.harvester.c_e * spectra["v"],
+        )
+
+    def to_dict(self) -> dict:
+        """The numbers and the excitation's parameters, ready for JSON."""
+        keys = ("c_eq", "k_eq", "velocity_variance", "displacement_variance")
+        out = {key: getattr(self, key) for key in keys}
+        out.update(power_electrical=self.power_electrical, power_load=self.power_load)
+        out.update(method=self.method, excitation=self.excitation.parameters())
+        return out
+
+
+def _check_harvester(harvester: Harvester):
+    values = [harvester.m, harvester.c, harvester.k, harvester.k3]
+    if any(np.ndim(v) != 0 for v in values):
+        raise ValueError(
+            "statistical_linearisation needs scalar harvester parameters; loop over a sweep"
+        )
+    friction = harvester.friction
+    if friction is not None and not friction.has_equivalent_damping:
+        raise ValueError(
+            f"statistical linearisation needs a memoryless friction law; {friction.name!r} "
+            "has internal state. Use randvib.simulate for it."
+        )
+    return None if friction is None or friction.vanishes else friction
+
+
+def statistical_linearisation(
+    harvester: Harvester, excitation, *, method: str = "auto"
+) -> LinearisationResult:
+    """Gaussian statistical linearisation for any excitation.
+
+    Parameters
+    ----------
+    harvester : Harvester
+        Device with scalar parameters and a memoryless friction law (or none).
+    excitation : Excitation or float
+        The base excitation; a number S is white noise of one-sided PSD S
+        ((m/s^2)^2/Hz).
+    method : {"auto", "lyapunov", "spectral"}
+        How the linear device's variances are computed
+        (:func:`randvib.analytic.linear_response.output_variances`).
+
+    Returns
+    -------
+    LinearisationResult
+
+    Raises
+    ------
+    ValueError
+        For a friction law with memory, array parameters or an unknown method.
+    RuntimeError
+        If the fixed point does not converge.
+    """
+    excitation = as_excitation(excitation)
+    friction = _check_harvester(harvester)
+    m, c, k, k3 = (float(x) for x in (harvester.m, harvester.c, harvester.k, harvester.k3))
+    used = (
+        method if method != "auto" else ("lyapunov" if excitation.shaping_filter() else "spectral")
+    )
+
+    def equivalent(log_variances):
+        var_v, var_z = np.exp(log_variances)
+        increment = (
+            0.0
+            if friction is None
+            else float(friction.equivalent_damping_increment(np.sqrt(var_v)))
+        )
+        return c + increment, k + 3.0 * k3 * var_z
+
+    def response(c_eq, k_eq):
+        out = output_variances(mechanical_block(m, c_eq, k_eq), excitation, used)
+        return np.log([out["v"], out["z"]])
+
+    def residual(x):
+        return response(*equivalent(x)) - x
+
+    # Start from the linear device; without viscous damping, from 5 % of critical.
+    c_start = c if c > 0 else 0.1 * np.sqrt(k * m)
+    x = _solve(residual, response(c_start, k))
+    c_eq, k_eq = equivalent(x)
+    var_v, var_z = np.exp(x)
+    power = harvester.c_e * var_v
+    load = None if harvester.electrical is None else power * harvester.electrical.load_fraction
+    return LinearisationResult(
+        harvester=harvester,
+        excitation=excitation,
+        c_eq=float(c_eq),
+        k_eq=float(k_eq),
+        velocity_variance=float(var_v),
+        displacement_variance=float(var_z),
+        power_electrical=float(power),
+        power_load=None if load is None else float(load),
+        method=used,
+    )
+
+
+def _solve(residual, x0) -> np.ndarray:
+    """Root of ``residual`` (log variances) by Powell's hybrid method.
+
+    If it stalls (a coloured spectrum can make the map stiff), damped
+    fixed-point steps x <- x + r(x)/2 bring it closer and it is tried again.
+    """
+    x = np.asarray(x0, dtype=float)
+    for _ in range(3):
+        solution = optimize.root(residual, x, method="hybr", options={"xtol": 1e-14})
+        if np.max(np.abs(residual(solution.x))) <= _TOLERANCE:
+            return solution.x
+        for _ in range(50):
+            x = x + 0.5 * residual(x)
+    raise RuntimeError(
+        "statistical linearisation did not converge (largest log-variance residual "
+        f"{np.max(np.abs(residual(solution.x))):.3g}); a narrow-band excitation near the "
+        "resonance can admit several solutions: use Monte Carlo (randvib.simulate)"
+    )
