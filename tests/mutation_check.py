@@ -499,13 +499,32 @@ def run_mutant(
     return run_prepared(mutation, prepare_mutant(mutation, workdir), full=full, timeout=timeout)
 
 
+def markdown_table(mutations=MUTATIONS) -> str:
+    """The mutation table of docs/testing.md (pipes in the texts escaped)."""
+
+    def cell(text):
+        return text.replace("|", "\\|")
+
+    rows = ["| mutation | file | what it models | caught by |", "|---|---|---|---|"]
+    for m in mutations:
+        tests = ", ".join(f"`{t.rpartition('::')[2] or t}`" for t in m.tests)
+        rows.append(f"| `{m.name}` | `{m.path}` | {cell(m.why)} | {cell(tests)} |")
+    return "\n".join(rows) + "\n"
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", nargs="+", metavar="NAME", help="mutations to run")
     parser.add_argument("--full", action="store_true", help="run the whole suite per mutant")
     parser.add_argument("--list", action="store_true", help="print the mutations and exit")
+    parser.add_argument(
+        "--markdown", action="store_true", help="print the table for docs/testing.md and exit"
+    )
     args = parser.parse_args(argv)
     chosen = [m for m in MUTATIONS if not args.only or m.name in args.only]
+    if args.markdown:
+        print(markdown_table(chosen), end="")
+        return 0
     if args.list:
         for m in chosen:
             print(f"{m.name:28s} {m.path:32s} {', '.join(m.tests)}\n    {m.why}")
