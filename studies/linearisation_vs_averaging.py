@@ -194,20 +194,28 @@ def verdicts_section(df, v, timings) -> str:
 
 
 def run_study(
-    out_dir, *, quick: bool = False, seed: int = 0, workers=None, scheduler=None, progress=True
+    out_dir,
+    *,
+    quick: bool = False,
+    seed: int = 0,
+    workers=None,
+    threads=None,
+    scheduler=None,
+    progress=True,
 ) -> Path:
     """Run the study and write ``report.md``, ``results.csv`` and two PNG figures.
 
     ``quick``: smaller grid and Monte Carlo (about half a minute); ``seed``:
-    base seed of the Monte Carlo streams; ``workers``: threads for the Monte
-    Carlo kernel (default: all cores); ``scheduler`` is not supported (this
-    study runs on local threads); ``progress``: a bar over the (S, kappa)
-    columns. Returns the Markdown report.
+    base seed of the Monte Carlo streams; ``threads``: numba threads for the
+    Monte Carlo kernel (default: all cores); ``workers`` (worker processes in
+    the sweeping studies) is accepted and unused: this study simulates
+    in-process; ``scheduler`` is not supported for the same reason;
+    ``progress``: a bar over the (S, kappa) columns. Returns the Markdown report.
     """
     if scheduler is not None:
         raise ValueError(
-            f"study {NAME!r} runs its Monte Carlo on local threads; `scheduler` is not "
-            f"supported (got {scheduler!r}); use `workers` instead"
+            f"study {NAME!r} runs its Monte Carlo in-process on local threads; `scheduler` "
+            f"is not supported (got {scheduler!r}); use `threads` instead"
         )
     psds, kappas, k3s = grid(quick)
     mc = QUICK_MC if quick else FULL_MC
@@ -216,7 +224,7 @@ def run_study(
     started = time.perf_counter()
 
     # compute (or resume), then time the fast candidates
-    df = table_of(out, quick, seed, workers, progress)
+    df = table_of(out, quick, seed, threads, progress)
     timings = time_methods(K3S)
     v = verdicts(df, timings)
 

@@ -39,8 +39,8 @@ def register(sub) -> None:
         "--threads",
         type=int,
         default=None,
-        help="numba threads of a study that simulates in-process (identification; "
-        "default: all cores)",
+        help="numba threads of a study that simulates in-process (identification, "
+        "linearisation-vs-averaging; default: all cores)",
     )
     p.add_argument(
         "--scheduler", default=None, help="Dask distributed scheduler ADDRESS to run the sweep on"
