@@ -294,12 +294,7 @@ def sade(
     start = time.perf_counter()
     evaluate = _batched_cost(func, space)
 
-    pop = _latin_hypercube(rng, popsize, d)
-    if init is not None:
-        init = np.atleast_2d(np.asarray(init, dtype=float))
-        if init.shape[1] != d or init.shape[0] > popsize:
-            raise ValueError(f"`init` must have shape (<= {popsize}, {d}), got {init.shape}")
-        pop[: init.shape[0]] = space.to_unit(init)
+    pop = _initial_population(rng, popsize, space, init)
     costs = evaluate(pop)
     nfev = popsize
 
@@ -324,11 +319,7 @@ def sade(
             best = int(np.argmin(costs))
             prev = history["best"][-1] if history["best"] else np.inf
             stall = 0 if costs[best] < prev * (1 - 1e-12) else stall + 1
-            spread = float(np.std(costs)) if np.isfinite(costs).all() else np.inf
-            for key, value in zip(
-                history, (float(costs[best]), nfev, spread, adaptation.probs.tolist()), strict=True
-            ):
-                history[key].append(value)
+            spread = _record(history, costs, best, nfev, adaptation.probs)
             if bar is not None:
                 bar.update(1)
                 bar.set_postfix(best=f"{costs[best]:.4g}")
@@ -361,6 +352,26 @@ def sade(
         elapsed=time.perf_counter() - start,
         polished=polished,
     )
+
+
+def _initial_population(rng, popsize, space, init):
+    """Latin-hypercube start in the unit cube, with the user's ``init`` vectors first."""
+    d = space.lo.size
+    pop = _latin_hypercube(rng, popsize, d)
+    if init is not None:
+        init = np.atleast_2d(np.asarray(init, dtype=float))
+        if init.shape[1] != d or init.shape[0] > popsize:
+            raise ValueError(f"`init` must have shape (<= {popsize}, {d}), got {init.shape}")
+        pop[: init.shape[0]] = space.to_unit(init)
+    return pop
+
+
+def _record(history, costs, best, nfev, probs):
+    """Append one generation to ``history``; returns the population's cost spread."""
+    spread = float(np.std(costs)) if np.isfinite(costs).all() else np.inf
+    for key, value in zip(history, (float(costs[best]), nfev, spread, probs.tolist()), strict=True):
+        history[key].append(value)
+    return spread
 
 
 def _converged(costs, spread, tol, atol, stall, patience):
