@@ -84,6 +84,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from randvib._validation import check_nonnegative, check_positive, scalar_or_array
+from randvib.models.excitation import white_level
 from randvib.models.friction import one_minus_tanh
 from randvib.models.harvester import Harvester
 
@@ -347,7 +348,7 @@ def memoryless_parameters(harvester: Harvester, psd, method: str = "stochastic a
             f"(coulomb, tanh or none); {friction.name!r} {why}. Use randvib.simulate for it."
         )
     fc, beta = form
-    psd = check_positive("psd", psd, "(m/s^2)^2/Hz")
+    psd = check_positive("psd", white_level(psd, method), "(m/s^2)^2/Hz")
     arrays = np.broadcast_arrays(
         *(
             np.asarray(v, dtype=float)
@@ -372,7 +373,9 @@ def averaging_statistics(harvester: Harvester, psd, *, warn: bool = True) -> Ave
         Device with Coulomb, tanh or no friction; parameters may be arrays
         that broadcast with ``psd``.
     psd : array_like
-        One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0 (paper Eq. 17).
+        One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0, or a
+        :class:`~randvib.models.excitation.White` excitation; white noise is
+        assumed, any other excitation is refused with a ValueError (paper Eq. 17).
     warn : bool
         Emit :class:`AveragingValidityWarning` where ``zeta_friction`` exceeds
         :data:`AVERAGING_ZETA_LIMIT`.
@@ -485,7 +488,9 @@ def energy_density(harvester: Harvester, psd, energy):
     harvester : Harvester
         Device with scalar parameters and Coulomb, tanh or no friction.
     psd : float
-        One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0.
+        One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0, or a
+        :class:`~randvib.models.excitation.White` excitation; white noise is
+        assumed, any other excitation is refused with a ValueError.
     energy : array_like
         Energies E (J), >= 0.
     """

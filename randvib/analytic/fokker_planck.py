@@ -57,6 +57,7 @@ from randvib.analytic.averaging import (
     turning_point_squared,
 )
 from randvib.analytic.linearisation import equivalent_damping
+from randvib.models.excitation import white_level
 from randvib.models.harvester import Harvester
 
 __all__ = ["FPKSolution", "fast_fpk_statistics", "fpk_statistics", "solve_fpk"]
@@ -281,7 +282,9 @@ def solve_fpk(harvester: Harvester, psd: float, n: int = 200, *, nz=None, nv=Non
     harvester : Harvester
         Device with scalar parameters and Coulomb, tanh or no friction.
     psd : float
-        One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0 (paper Eq. 17).
+        One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0, or a
+        :class:`~randvib.models.excitation.White` excitation; white noise is
+        assumed, any other excitation is refused with a ValueError (paper Eq. 17).
     n : int
         Cells per direction (>= 8) unless ``nz``/``nv`` are given. The cost is
         one sparse LU of n^2 unknowns: about 0.1 s at n = 100, 2 s at 300.
@@ -319,7 +322,9 @@ def fpk_statistics(harvester: Harvester, psd, n: int = 160):
     harvester : Harvester
         Device with Coulomb, tanh or no friction.
     psd : array_like
-        One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0.
+        One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0, or a
+        :class:`~randvib.models.excitation.White` excitation; white noise is
+        assumed, any other excitation is refused with a ValueError.
     n : int
         Finest grid, cells per direction (>= 16).
 
@@ -328,7 +333,7 @@ def fpk_statistics(harvester: Harvester, psd, n: int = 160):
     velocity_variance, displacement_variance, mean_abs_velocity : float or ndarray
     """
     n = check_int("n", n, 16)
-    psd = check_positive("psd", psd, "(m/s^2)^2/Hz")
+    psd = check_positive("psd", white_level(psd, "the FPK solver"), "(m/s^2)^2/Hz")
     friction = harvester.friction
     own = {name: getattr(harvester, name) for name in ("m", "c_m", "c_e", "k", "k3")}
     fric = {} if friction is None else friction.parameters()
@@ -555,7 +560,9 @@ def fast_fpk_statistics(harvester: Harvester, psd, *, nz=FAST_NZ, nv=FAST_NV):
         Device with Coulomb, tanh or no friction; parameters may be arrays
         broadcasting with ``psd``.
     psd : array_like
-        One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0.
+        One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0, or a
+        :class:`~randvib.models.excitation.White` excitation; white noise is
+        assumed, any other excitation is refused with a ValueError.
     nz, nv : int or pair of int
         Cells over the whole box in z and in v (even, >= 8; a pair lists the
         finer grid first). A single count switches off the extrapolation in

@@ -10,6 +10,12 @@ friction, blind to k3); ``"averaging"`` for a closed-form-like
 non-Gaussian correction (within 2 %, but it overstates the k3 effect);
 ``"fpk-fast"`` for the power and its k3 dependence to within the Monte Carlo
 intervals (about 3 ms a point); ``"fpk"`` as the slow reference.
+
+``psd`` may also be an excitation object (:mod:`randvib.models.excitation`):
+:class:`~randvib.models.excitation.White` runs exactly the code of its
+level; a non-white one is accepted by the methods of :data:`COLOURED`
+(``"linearisation"``: statistical linearisation for any spectrum) and
+refused by the others, which assume white noise.
 """
 
 from __future__ import annotations
@@ -28,6 +34,8 @@ from randvib._validation import (
 from randvib.analytic.averaging import averaging_statistics
 from randvib.analytic.fokker_planck import fast_fpk_statistics, fpk_statistics
 from randvib.analytic.linearisation import equivalent_damping, linear_displacement_variance
+from randvib.analytic.statistical_linearisation import statistical_linearisation
+from randvib.models.excitation import Excitation
 from randvib.models.harvester import Harvester
 
 
@@ -39,7 +47,9 @@ class PowerPrediction:
     ----------
     method : str
     c_eq : float or ndarray
-        Equivalent viscous damping (Ns/m), defined as S m / (4 E[v^2]).
+        Equivalent viscous damping (Ns/m), defined as S m / (4 E[v^2]) under
+        white noise; under another excitation the statistical linearisation's
+        c + E[v F(v)] / E[v^2] (the two agree under white noise).
     velocity_variance : float or ndarray
         E[z'^2] ((m/s)^2) (paper Eq. 20).
     displacement_variance : float or ndarray
@@ -132,6 +142,20 @@ def _fpk_fast(harvester: Harvester, psd) -> PowerPrediction:
     return _finish(harvester, "fpk-fast", vv, zz, av, psd)
 
 
+def _coloured_linearisation(harvester: Harvester, excitation: Excitation) -> PowerPrediction:
+    """Statistical linearisation under a non-white excitation (scalar parameters)."""
+    r = statistical_linearisation(harvester, excitation)
+    return PowerPrediction(
+        method="linearisation",
+        c_eq=r.c_eq,
+        velocity_variance=r.velocity_variance,
+        displacement_variance=r.displacement_variance,
+        mean_abs_velocity=float(np.sqrt(2.0 / np.pi * r.velocity_variance)),  # Gaussian v
+        power_electrical=r.power_electrical,
+        power_load=r.power_load,
+    )
+
+
 #: Analytic methods by name: callables (harvester, psd) -> PowerPrediction.
 #: ``"averaging"``: energy-envelope stochastic averaging (randvib.analytic.averaging);
 #: ``"fpk"``: finite-volume stationary FPK solution (randvib.analytic.fokker_planck),
@@ -145,25 +169,53 @@ METHODS = {
     "fpk": _fpk,
 }
 
+#: The methods of :data:`METHODS` that accept a non-white excitation:
+#: callables (harvester, excitation) -> PowerPrediction. The others assume
+#: white noise (paper Eq. 17) and refuse it.
+COLOURED = {"linearisation": _coloured_linearisation}
+
+
+def _refuse_coloured(method: str, excitation: Excitation):
+    accepted = ", ".join(repr(name) for name in COLOURED)
+    raise ValueError(
+        f"method {method!r} assumes white noise; the {excitation.name!r} excitation is "
+        f"accepted by method {accepted} (and randvib.statistical_linearisation)"
+    )
+
 
 def predict(harvester: Harvester, psd, method: str = "linearisation") -> PowerPrediction:
-    """Predict the stationary response and power under white noise.
+    """Predict the stationary response and power under white noise or another excitation.
 
     Parameters
     ----------
     harvester : Harvester
-        Device; parameters may be arrays broadcasting with ``psd``.
-    psd : array_like
-        One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0 (paper Eq. 17).
+        Device; parameters may be arrays broadcasting with ``psd`` (scalars
+        under a non-white excitation).
+    psd : array_like or Excitation
+        One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0 (white noise,
+        paper Eq. 17), or an excitation object: ``White(S)`` is the same as
+        S; a non-white one needs a method of :data:`COLOURED`.
     method : str
         A key of :data:`METHODS`: ``"linearisation"`` (paper Eq. 19-32),
         ``"averaging"`` (stochastic averaging, beyond Gaussian closure),
         ``"fpk-fast"`` (small corrected FPK grids; the power and its k3
         dependence to about 0.05 %, about 3 ms per point) or ``"fpk"`` (grid
         solution of the stationary FPK equation; reference, about 0.5 s per
-        point).
+        point). Only ``"linearisation"`` accepts a non-white excitation.
+
+    Raises
+    ------
+    ValueError
+        For an unknown method, a bad ``psd``, or a non-white excitation with
+        a method that assumes white noise.
     """
     check_choice("method", method, tuple(METHODS))
+    if isinstance(psd, Excitation):
+        if not psd.is_white:
+            if method not in COLOURED:
+                _refuse_coloured(method, psd)
+            return COLOURED[method](harvester, psd)
+        psd = psd.level  # white: exactly the code of a plain number
     check_positive("psd", psd, "(m/s^2)^2/Hz")
     return METHODS[method](harvester, psd)
 
@@ -171,8 +223,10 @@ def predict(harvester: Harvester, psd, method: str = "linearisation") -> PowerPr
 def expected_power(
     harvester: Harvester, psd, method: str = "linearisation", *, into: str = "electrical"
 ):
-    """Expected power (W) delivered by the harvester under white noise.
+    """Expected power (W) delivered by the harvester under white noise or an excitation.
 
+    ``psd`` is as in :func:`predict` (a number S, or an excitation object;
+    a non-white one with ``method="linearisation"``).
     ``into="electrical"`` gives E[P_e] = c_e E[z'^2] (paper Eq. 32);
     ``into="load"`` gives the share dissipated in R_L (needs a circuit).
     Broadcasts over ``psd`` and array-valued harvester parameters.
@@ -225,7 +279,8 @@ def optimal_load_resistance(
     """
     if harvester.electrical is None:
         raise ValueError("optimal_load_resistance needs Harvester.from_electrical(...)")
-    psd = float(check_positive("psd", psd, "(m/s^2)^2/Hz"))
+    if not isinstance(psd, Excitation):
+        psd = float(check_positive("psd", psd, "(m/s^2)^2/Hz"))
     lo, hi = (float(check_positive("bounds", b, "ohm")) for b in bounds)
     if not lo < hi:
         raise ValueError(f"`bounds` must satisfy lower < upper, got {bounds!r}")

@@ -1,29 +1,40 @@
-"""``randvib power``: analytic expected power (paper Eq. 19-32 and beyond)."""
+"""``randvib power``: analytic expected power (paper Eq. 19-32 and beyond).
+
+Under white noise (the default) every method of
+:data:`randvib.analytic.prediction.METHODS` applies and the output is what
+it was before excitations existed; under another excitation only the methods
+of :data:`~randvib.analytic.prediction.COLOURED` (statistical linearisation)
+do, and the JSON gains an ``excitation`` object describing it.
+"""
 
 from __future__ import annotations
 
 import json
 
-from randvib.analytic.prediction import METHODS, predict
-from randvib.cli._device import add_device_arguments, harvester_from_args, require_psd
+from randvib.analytic.prediction import COLOURED, METHODS, predict
+from randvib.cli._device import add_device_arguments, harvester_from_args
+from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
 from randvib.cli._output import print_table
+from randvib.models.excitation import Excitation
 
 
 def register(sub) -> None:
     p = sub.add_parser(
         "power",
-        help="analytic expected power under white noise",
-        description="Expected power of the harvester under white-noise base "
-        "acceleration, by an analytic method.",
+        help="analytic expected power under white noise or a coloured excitation",
+        description="Expected power of the harvester under base acceleration (white noise "
+        "by default), by an analytic method.",
     )
     add_device_arguments(p)
+    add_excitation_arguments(p)
     p.add_argument(
         "--method",
         default="linearisation",
         help=f"analytic method: {', '.join(METHODS)} (default linearisation, paper Eq. 32; "
         "averaging: stochastic averaging, non-Gaussian velocity, 0.3 ms; "
         "fpk-fast: corrected small-grid FPK solution, resolves the k3 effect, 2 ms; "
-        "fpk: fine-grid FPK solution, slow reference)",
+        "fpk: fine-grid FPK solution, slow reference); a non-white excitation: "
+        f"{', '.join(COLOURED)} only",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(handler=run)
@@ -31,16 +42,26 @@ def register(sub) -> None:
 
 def run(args) -> int:
     harvester = harvester_from_args(args)
-    psd = require_psd(args)
+    psd = excitation_from_args(args)
+    coloured = isinstance(psd, Excitation)
+    if coloured and args.method not in COLOURED:
+        accepted = ", ".join(f"`--method {name}`" for name in COLOURED)
+        raise ValueError(
+            f"`--method {args.method}` assumes white noise; the {psd.name} excitation needs "
+            f"{accepted}"
+        )
     result = predict(harvester, psd, method=args.method)
     out = {
         "method": result.method,
-        "psd": psd,
+        # The level --psd; a tabulated or measured spectrum has none (null).
+        "psd": getattr(psd, "level", None) if coloured else psd,
         "friction": harvester.friction_name,
         **result.to_dict(),
     }
     if result.power_load is None:
         out.pop("power_load")
+    if coloured:
+        out["excitation"] = psd.parameters()
     if args.json:
         print(json.dumps(out))
     else:
@@ -52,8 +73,17 @@ def run(args) -> int:
             "mean_abs_velocity": "m/s",
             "power_electrical": "W",
             "power_load": "W",
+            # the excitation's parameters
+            "level": "(m/s^2)^2/Hz",
+            "f0": "Hz",
+            "f_lo": "Hz",
+            "f_hi": "Hz",
+            "variance": "(m/s^2)^2",
+            "duration": "s",
+            "dt": "s",
+            "segment_length": "samples",
         }
-        print_table(
-            [(k, v, units.get(k, "")) for k, v in out.items()], ("quantity", "value", "unit")
-        )
+        rows = [(k, v, units.get(k, "")) for k, v in out.items() if k != "excitation"]
+        rows += [(k, v, units.get(k, "")) for k, v in out.get("excitation", {}).items()]
+        print_table(rows, ("quantity", "value", "unit"))
     return 0

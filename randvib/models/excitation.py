@@ -271,6 +271,43 @@ def as_excitation(value) -> Excitation:
     return White(float(check_positive("psd", value, _PSD_UNIT)))
 
 
+#: The methods that accept a non-white excitation, as the refusals of the
+#: white-noise-only methods (stochastic averaging, the FPK solvers) name them.
+COLOURED_METHODS = (
+    "statistical linearisation (randvib.statistical_linearisation, or "
+    "predict/expected_power with method='linearisation')",
+)
+
+
+def white_level(value, method: str):
+    """The white-noise PSD S for a method that assumes white noise.
+
+    A plain number or array is returned as is (so existing callers are
+    untouched), :class:`White` gives its ``level``; any other excitation is
+    refused, naming :data:`COLOURED_METHODS`.
+
+    Parameters
+    ----------
+    value : float, array_like or Excitation
+        The ``psd`` argument of a white-noise method ((m/s^2)^2/Hz).
+    method : str
+        The caller, named in the error ("stochastic averaging").
+
+    Raises
+    ------
+    ValueError
+        For a non-white excitation.
+    """
+    if not isinstance(value, Excitation):
+        return value
+    if value.is_white:
+        return value.level
+    raise ValueError(
+        f"{method} assumes white noise (paper Eq. 17); the {value.name!r} excitation is "
+        f"accepted by {'; '.join(COLOURED_METHODS)}"
+    )
+
+
 # ------------------------------------------------------------ rational
 class _Rational(Excitation):
     """Spectra with a shaping filter; simulated through the filter's states."""

@@ -1,0 +1,150 @@
+"""Excitation options: ``--excitation`` and its parameters, ``--psd-file``, ``--record``.
+
+The options come from the excitation registry (:data:`randvib.models.excitation.EXCITATIONS`):
+``--excitation`` offers every registered excitation built from numbers, each
+of its parameters (dataclass fields) other than the level is one option, and
+``--psd`` is the level of each. The excitations read from a file have an
+option each (:data:`FILE_OPTIONS`). An option that does not apply to the
+chosen excitation is refused, as ``--beta`` is with Coulomb friction.
+"""
+
+from __future__ import annotations
+
+import argparse
+from dataclasses import fields
+from pathlib import Path
+
+from randvib.cli._device import require_psd
+from randvib.models.excitation import EXCITATIONS
+
+#: File option (argparse dest) -> the registered excitation read from it (``from_csv``).
+FILE_OPTIONS = {"psd_file": "tabulated", "record": "measured"}
+
+#: Metavar and help of the parameter options; a parameter not listed gets its name.
+_HELP = {
+    "f0": ("HZ", "centre (band-pass) or filter (Kanai-Tajimi) frequency (Hz), > 0"),
+    "zeta": ("Z", "damping ratio of the shaping filter, > 0 (narrow band: small)"),
+    "f_lo": ("HZ", "lower band edge (Hz), >= 0"),
+    "f_hi": ("HZ", "upper band edge (Hz), > --f-lo"),
+}
+
+
+def excitation_choices() -> list[str]:
+    """``--excitation`` choices: the registered excitations not read from a file."""
+    return [name for name in EXCITATIONS if name not in FILE_OPTIONS.values()]
+
+
+def _parameters(name: str) -> list[str]:
+    """The parameters of a registered excitation other than its level ``--psd``."""
+    return [f.name for f in fields(EXCITATIONS[name]) if f.name != "level"]
+
+
+def _parameter_options() -> dict[str, list[str]]:
+    """Parameter name -> the excitations declaring it, over the ``--excitation`` choices."""
+    out: dict[str, list[str]] = {}
+    for name in excitation_choices():
+        for parameter in _parameters(name):
+            out.setdefault(parameter, []).append(name)
+    return out
+
+
+def _flag(dest: str) -> str:
+    return "--" + dest.replace("_", "-")
+
+
+def add_excitation_arguments(parser: argparse.ArgumentParser) -> None:
+    """Add ``--excitation``, its parameters, ``--psd-file`` and ``--record`` to ``parser``."""
+    g = parser.add_argument_group(
+        "excitation (one-sided base-acceleration PSD; default: white noise of level --psd)"
+    )
+    g.add_argument(
+        "--excitation",
+        choices=excitation_choices(),
+        help="spectrum; --psd is its level: white S, band-pass peak S at --f0 (half-power "
+        "bandwidth 2 zeta f0), kanai-tajimi S at f = 0, band-limited S on [--f-lo, --f-hi]",
+    )
+    for name, owners in _parameter_options().items():
+        metavar, text = _HELP.get(name, (name.upper(), name))
+        g.add_argument(
+            _flag(name), dest=name, type=float, metavar=metavar, help=f"{text}; {', '.join(owners)}"
+        )
+    g.add_argument(
+        "--psd-file",
+        metavar="FILE",
+        help="tabulated PSD: CSV with the columns frequency (Hz) and psd ((m/s^2)^2/Hz), "
+        "linearly interpolated, zero outside",
+    )
+    g.add_argument(
+        "--record",
+        metavar="FILE",
+        help="measured base acceleration: CSV with the columns time (s, evenly spaced) and "
+        "base_acceleration (m/s^2); its PSD by Welch's method",
+    )
+
+
+def excitation_from_args(args):
+    """The ``psd`` argument of :func:`randvib.predict` from the options.
+
+    Returns
+    -------
+    float or Excitation
+        ``--psd`` itself for white noise (checked downstream exactly as
+        before excitations existed), else the excitation object.
+
+    Raises
+    ------
+    ValueError
+        One line naming the option: options that do not apply, missing ones,
+        bad values, unreadable or invalid files.
+    """
+    files = {dest: getattr(args, dest) for dest in FILE_OPTIONS if getattr(args, dest) is not None}
+    options = _parameter_options()
+    given = {name: getattr(args, name) for name in options if getattr(args, name) is not None}
+    if files:
+        if len(files) > 1:
+            raise ValueError("give one of `--psd-file` and `--record`, not both")
+        ((dest, path),) = files.items()
+        extra = [_flag(name) for name in given]
+        extra += [flag for flag in ("--excitation", "--psd") if getattr(args, flag[2:]) is not None]
+        if extra:
+            flags = ", ".join(f"`{flag}`" for flag in extra)
+            raise ValueError(f"`{_flag(dest)}` gives the whole spectrum; drop {flags}")
+        return _read(_flag(dest), FILE_OPTIONS[dest], path)
+
+    name = args.excitation or "white"
+    own = _parameters(name)
+    for parameter in given:  # refuse, rather than silently ignore, another excitation's option
+        if parameter not in own:
+            owners = options[parameter]
+            if args.excitation is None:
+                raise ValueError(f"`{_flag(parameter)}` needs `--excitation {'|'.join(owners)}`")
+            raise ValueError(
+                f"`{_flag(parameter)}` applies to the {', '.join(owners)} excitation, not {name!r}"
+            )
+    level = require_psd(args)
+    if EXCITATIONS[name].is_white:
+        return level
+    for parameter in own:
+        if parameter not in given:
+            raise ValueError(f"`{_flag(parameter)}` is required for the {name} excitation")
+    try:
+        return EXCITATIONS[name](level, **given)
+    except ValueError as exc:  # name the options, not the class's fields
+        message = str(exc).replace("`level`", "`--psd`")
+        for parameter in own:
+            message = message.replace(f"`{parameter}`", f"`{_flag(parameter)}`")
+        raise ValueError(message) from None
+
+
+def _read(flag: str, name: str, path: str):
+    """``EXCITATIONS[name].from_csv(path)``, its errors as one line naming ``flag``."""
+    file = Path(path)
+    if file.is_dir():
+        raise ValueError(f"`{flag}` must be a CSV file, got the folder {path}")
+    if not file.exists():
+        raise ValueError(f"`{flag}`: no such file {path}")
+    try:
+        return EXCITATIONS[name].from_csv(file)
+    except (ValueError, OSError) as exc:  # pandas' parse errors are ValueErrors
+        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise ValueError(f"`{flag}` {path}: {first}") from None
