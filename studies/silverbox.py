@@ -19,7 +19,7 @@ import sys
 from pathlib import Path
 
 from randvib.datasets import silverbox
-from randvib.identification.fitting import identify, predict
+from randvib.identification.fitting import identify, predict_record
 
 
 def main(out_dir, quick=False):
@@ -33,7 +33,7 @@ def main(out_dir, quick=False):
         res = identify(estimation, "viscous", fixed=fixed, seed=0, substeps=4, progress=True, **opt)
         (out / f"{label.split()[0].lower()}.json").write_text(json.dumps(res.to_dict(), indent=2))
         for rec in (estimation, validation):
-            pred = predict(res.parameters, "viscous", rec, substeps=4)
+            pred = predict_record(res.parameters, "viscous", rec, substeps=4)
             rows.append((label, rec.name, pred.cost, 1e3 * pred.rms_error, res.parameters))
     lines = ["| model | record | J (Eq. 11) | RMS error (mV) |", "|---|---|---|---|"]
     lines += [f"| {m} | {r} | {j:.4g} | {e:.3g} |" for m, r, j, e, _ in rows]

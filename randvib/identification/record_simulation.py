@@ -759,17 +759,7 @@ def simulate_record(
         # simulate_record(device, input_values, dt): the device names its law.
         friction, input_values, dt = None, friction, input_values
     parameters, friction = device_parameters(parameters, friction)
-    if input_values is None or dt is None:
-        raise ValueError("`input_values` and `dt` are required")
-    dt = float(check_positive("dt", dt, "s"))
-    substeps = check_int("substeps", substeps, minimum=1)
-    if hold not in HOLDS:
-        raise ValueError(f"`hold` must be one of {', '.join(HOLDS)}; got {hold!r}")
-    values = check_finite("input_values", input_values)
-    if values.ndim != 1 or values.shape[0] < 2:
-        raise ValueError(
-            f"`input_values` must be 1-D with at least 2 samples, got shape {values.shape}"
-        )
+    values, dt, substeps = _check_record_input(input_values, dt, substeps, hold)
     matrix = parameter_matrix(parameters, friction)
     drive, base_input = driving_signal(values, dt, input_kind, lowpass)
     _, z, v = run_kernel(
@@ -786,3 +776,19 @@ def simulate_record(
         response_limit=response_limit,
     )
     return BatchSimulation(time=np.arange(values.shape[0]) * dt, z=z, v=v)
+
+
+def _check_record_input(input_values, dt, substeps, hold):
+    """(values, dt, substeps) of :func:`simulate_record`, checked."""
+    if input_values is None or dt is None:
+        raise ValueError("`input_values` and `dt` are required")
+    dt = float(check_positive("dt", dt, "s"))
+    substeps = check_int("substeps", substeps, minimum=1)
+    if hold not in HOLDS:
+        raise ValueError(f"`hold` must be one of {', '.join(HOLDS)}; got {hold!r}")
+    values = check_finite("input_values", input_values)
+    if values.ndim != 1 or values.shape[0] < 2:
+        raise ValueError(
+            f"`input_values` must be 1-D with at least 2 samples, got shape {values.shape}"
+        )
+    return values, dt, substeps

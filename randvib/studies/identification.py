@@ -35,7 +35,7 @@ from randvib.identification.fitting import (
     IdentificationResult,
     Record,
     identify,
-    predict,
+    predict_record,
 )
 from randvib.identification.record_simulation import simulate_record
 from randvib.models.excitation import band_limited_excitation
@@ -213,7 +213,7 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
                     model=model,
                     test=n,
                     rms_acceleration=TEST_RMS[n - 1],
-                    J=predict(res.parameters, model, rec, **sim).cost,
+                    J=predict_record(res.parameters, model, rec, **sim).cost,
                 )
             )
     costs = pd.DataFrame(rows)
@@ -278,7 +278,7 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
         level = TEST_RMS[5] if rms is None else rms
         measured = float(np.mean(np.abs(wired.voltage) < 5e-4))
         for model in ("coulomb", "viscous"):
-            pred = predict(
+            pred = predict_record(
                 results[(3, model)].parameters, model, wired, electrical=electrical, **sim
             )
             tag = "test6" if rms is None else "low"
