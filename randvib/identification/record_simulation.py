@@ -68,7 +68,6 @@ from dataclasses import dataclass
 
 import numba
 import numpy as np
-from numba.extending import overload
 
 from randvib._validation import check_finite, check_int, check_positive
 from randvib.models.friction import (
@@ -118,7 +117,6 @@ SEARCH_SUBCYCLES = 32
 #           with the boundary layer |v| < vb; fstick is the largest friction
 #           force a stick holds
 #   slipping = (layer, sgn)      the friction while slipping in direction sgn = +-1
-#   fr    = law or slipping      the friction of an RK4 step (see _friction)
 #   seg   = (u0, du)             input over one sample interval, u0 + du * s
 #   st    = (z, v, mode, sgn)    the stick-slip integrator's state
 @numba.njit(cache=True, inline="always")
@@ -151,56 +149,49 @@ def _slip_force(layer, sgn, v):
     return sgn * fc
 
 
-def _friction(fr, v, th):
-    """(F, theta') in an RK4 stage (compiled code only, see the overload below)."""
-    raise NotImplementedError("used only inside the compiled kernel")
-
-
-@overload(_friction, jit_options={"cache": True})
-def _friction_for(fr, v, th):
-    # Chosen while compiling, from what ``fr`` is: the law's kernel for
-    # ``law = (kind, fn, p)``, the slip force for ``slipping = (layer, sgn)``.
-    # Each use of the one RK4 step then compiles without the other's code
-    # (a run-time branch in every stage cost 12 % of the Coulomb search).
-    if len(fr.types) == 2:
-
-        def slip(fr, v, th):
-            return _slip_force(fr[0], fr[1], v), 0.0
-
-        return slip
-
-    def law(fr, v, th):
-        return evaluate_friction(fr[0], fr[1], fr[2], v, th)
-
-    return law
+@numba.njit(cache=True, inline="always")
+def _law_friction(law, v, th):
+    # (F, theta') of the law's own kernel: the smooth path
+    return evaluate_friction(law[0], law[1], law[2], v, th)
 
 
 @numba.njit(cache=True, inline="always")
-def _rk4(dev, fr, seg, s, hh, z, v, th):
+def _slip_friction(slipping, v, th):
+    # (F, 0) while the stick-slip integrator slips
+    return _slip_force(slipping[0], slipping[1], v), 0.0
+
+
+@numba.njit(cache=True, inline="always")
+def _rk4(friction, fr, dev, seg, s, hh, z, v, th):
     """Classical RK4 step of length hh from s on (z, z', theta).
 
+    ``friction(fr, v, theta) -> (F, theta')`` is :func:`_law_friction` (``fr`` =
+    ``law``) or :func:`_slip_friction` (``fr`` = ``slipping``), a compiled
+    function named where the step is used: inlined there, each use compiles
+    without the other's code (a run-time choice in every stage cost 12 % of
+    the Coulomb search, and a function passed at run time defeats caching).
     Returns the state after the step and the acceleration at its start (the
     slope that the event interpolant needs).
     """
     e0 = _input(dev, seg, s)
     e1 = _input(dev, seg, s + 0.5 * hh)
     e2 = _input(dev, seg, s + hh)
-    f1, r1 = _friction(fr, v, th)
+    f1, r1 = friction(fr, v, th)
     a1 = _acceleration(dev, e0, z, v, f1)
     z2 = z + 0.5 * hh * v
     v2 = v + 0.5 * hh * a1
     t2 = th + 0.5 * hh * r1
-    f2, r2 = _friction(fr, v2, t2)
+    f2, r2 = friction(fr, v2, t2)
     a2 = _acceleration(dev, e1, z2, v2, f2)
     z3 = z + 0.5 * hh * v2
     v3 = v + 0.5 * hh * a2
     t3 = th + 0.5 * hh * r2
-    f3, r3 = _friction(fr, v3, t3)
+    f3, r3 = friction(fr, v3, t3)
     a3 = _acceleration(dev, e1, z3, v3, f3)
     z4 = z + hh * v3
     v4 = v + hh * a3
     t4 = th + hh * r3
-    f4, r4 = _friction(fr, v4, t4)
+    f4, r4 = friction(fr, v4, t4)
     a4 = _acceleration(dev, e2, z4, v4, f4)
     zn = z + hh / 6.0 * (v + 2.0 * v2 + 2.0 * v3 + v4)
     vn = v + hh / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
@@ -315,14 +306,14 @@ def _slip(dev, layer, seg, s, b, st, accept):
     vb = layer[3]
     fr = (layer, sgn)
     hh = b - s
-    z1, v1, _, a0 = _rk4(dev, fr, seg, s, hh, z, v, 0.0)
+    z1, v1, _, a0 = _rk4(_slip_friction, fr, dev, seg, s, hh, z, v, 0.0)
     if sgn * v1 > vb or accept:
         return b, (z1, v1, mode, sgn)
     # velocity reaches the boundary inside the step: locate, redo
     a1 = _acceleration(dev, _input(dev, seg, b), z1, v1, _slip_force(layer, sgn, v1))
     frac = _hermite_root(hh, sgn * v - vb, sgn * a0, sgn * v1 - vb, sgn * a1)
     hs = frac * hh
-    z, v, _, a0 = _rk4(dev, fr, seg, s, hs, z, v, 0.0)
+    z, v, _, a0 = _rk4(_slip_friction, fr, dev, seg, s, hs, z, v, 0.0)
     s = min(s + hs, b)
     v = sgn * vb
     g = _free_force(dev, _input(dev, seg, s), z, v)
@@ -364,7 +355,7 @@ def _smooth_substep(dev, fr, seg, a, b, subcycling, z, v, th):
             return False, z, v, th
     hh = (b - a) / nc
     for q in range(nc):
-        z, v, th, _ = _rk4(dev, fr, seg, a + q * hh, hh, z, v, th)
+        z, v, th, _ = _rk4(_law_friction, fr, dev, seg, a + q * hh, hh, z, v, th)
     return True, z, v, th
 
 
