@@ -23,7 +23,7 @@ import sys
 import pandas as pd
 
 from randvib.datasets import silverbox
-from randvib.identification.fitting import identify, predict
+from randvib.identification.fitting import identify, predict_record
 from randvib.studies import script_main
 from randvib.studies.report import markdown_table, prepare_output_dir, write_report, write_table
 
@@ -38,7 +38,7 @@ def fit_and_validate(estimation, validation, label, fixed, opt, seed, progress):
     )
     rows = []
     for rec in (estimation, validation):
-        pred = predict(res.parameters, "viscous", rec, substeps=SUBSTEPS)
+        pred = predict_record(res.parameters, "viscous", rec, substeps=SUBSTEPS)
         rows.append(
             {
                 "model": label,

@@ -38,7 +38,7 @@ from scipy import integrate
 
 import randvib as rv
 from randvib.cli._device import FRICTION_CHOICES
-from randvib.identification.fitting import MODELS, Record, default_bounds, identify, predict
+from randvib.identification.fitting import MODELS, Record, default_bounds, identify, predict_record
 from randvib.identification.record_simulation import FRICTION_PARAMETERS, simulate_record
 from randvib.models.excitation import band_limited_excitation
 from randvib.models.friction import FRICTION_MODELS, parameter
@@ -262,5 +262,7 @@ def test_identification_recovers_the_law_from_a_noise_free_record(drive):
     # The identified device is a Harvester with this law, and predicts itself.
     device = res.harvester()
     assert isinstance(device.friction, Stribeck)
-    assert predict(device, record, substeps=8).cost == pytest.approx(res.cost, rel=1e-6, abs=1e-9)
+    assert predict_record(device, record, substeps=8).cost == pytest.approx(
+        res.cost, rel=1e-6, abs=1e-9
+    )
     assert res.to_dict()["units"]["vs"] == "m/s"

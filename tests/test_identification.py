@@ -11,11 +11,14 @@ from _stats import assert_matches
 from randvib.cli import main
 from randvib.identification.fitting import (
     Record,
+    SearchSettings,
+    SimulationSettings,
     default_bounds,
     identify,
     initial_velocity,
     normalised_cost,
     predict,
+    predict_record,
     read_record,
     validate,
 )
@@ -99,7 +102,9 @@ def test_true_parameters_score_the_residual_of_the_initial_state(skip):
     r = (rec.z - zhat)[skip:]
     reference = 100 * np.mean(r**2) / np.var(rec.z[skip:])
     assert reference < 1e-6
-    assert predict(COULOMB, "coulomb", rec, skip=skip).cost == pytest.approx(reference, rel=1e-6)
+    assert predict_record(COULOMB, "coulomb", rec, skip=skip).cost == pytest.approx(
+        reference, rel=1e-6
+    )
     (row,) = validate(COULOMB, "coulomb", [rec], skip=skip)
     assert row.cost == pytest.approx(reference, rel=1e-6)
 
@@ -160,7 +165,7 @@ def test_noisy_record_within_linearised_standard_errors():
     # J (Eq. 11) reported by identify is Eq. 11 over the scored samples
     skip = H.NOISY["skip"]
     _, noisy = H.noisy_coulomb_record(0)
-    pred = predict(res.parameters, "coulomb", noisy, skip=skip)
+    pred = predict_record(res.parameters, "coulomb", noisy, skip=skip)
     assert res.cost == pytest.approx(pred.cost, rel=1e-9)
     # and sits at the noise floor: 100 sigma^2 / var(z) (fraction (N - d)/N of it)
     floor = 100 * H.NOISY["sigma"] ** 2 / np.var(noisy.z[skip:])
@@ -190,7 +195,7 @@ def test_tanh_base_displacement_not_at_rest_recovered_to_optimiser_precision():
     )
     lin = H.Linearisation(params, "tanh", rec, H.FREE + ("beta",))
     assert_at_optimum(res, params, lin, "tanh")
-    assert res.cost <= predict(params, "tanh", rec).cost
+    assert res.cost <= predict_record(params, "tanh", rec).cost
 
 
 LUGRE = dict(
@@ -210,7 +215,7 @@ def test_lugre_truth_scores_zero_and_the_fit_reaches_the_optimum():
     Stribeck parameters held the fit must reach the optimum to TOL.
     """
     rec = not_at_rest("lugre", LUGRE)
-    truth = predict(LUGRE, "lugre", rec).cost
+    truth = predict_record(LUGRE, "lugre", rec).cost
     assert truth < 1e-6
     held = {n: LUGRE[n] for n in ("sigma0", "sigma1", "fs", "vs")}
     res = identify(rec, "lugre", m=LUGRE["m"], fixed=held, popsize=16, maxiter=40, seed=1)
@@ -222,7 +227,7 @@ def test_lugre_truth_scores_zero_and_the_fit_reaches_the_optimum():
 def test_viscous_model_cannot_match_a_friction_record(record):
     viscous = identify(record, "viscous", m=COULOMB["m"], popsize=20, maxiter=40, seed=0)
     # without friction the record cannot be matched as well (paper Fig. 7)
-    assert viscous.cost > 10 * predict(COULOMB, "coulomb", record).cost
+    assert viscous.cost > 10 * predict_record(COULOMB, "coulomb", record).cost
     assert viscous.cost < 100
 
 
@@ -257,6 +262,40 @@ def test_validate_scores_each_record(record):
     rows = validate(TRUE, "coulomb", [record, other])
     assert [r.record for r in rows] == ["test0", "test1"]
     assert all(r.cost < 1e-6 for r in rows)
+
+
+def test_settings_objects_are_the_keywords(record):
+    short = record.rows(0, 200)
+    by_keyword = identify(
+        short, "coulomb", m=TRUE["m"], popsize=8, maxiter=3, seed=4, polish=False, substeps=2,
+        skip=5,
+    )  # fmt: skip
+    by_object = identify(
+        short,
+        "coulomb",
+        m=TRUE["m"],
+        search=SearchSettings(popsize=8, maxiter=3, seed=4, polish=False),
+        simulation=SimulationSettings(substeps=2, skip=5),
+    )
+    assert by_object.parameters == by_keyword.parameters
+    assert by_object.settings == by_keyword.settings
+    # a keyword overrides the object's field
+    assert identify(
+        short, "coulomb", m=TRUE["m"], search=SearchSettings(popsize=8, maxiter=3, seed=4),
+        polish=False, simulation=SimulationSettings(substeps=2), skip=5,
+    ).parameters == by_keyword.parameters  # fmt: skip
+    with pytest.raises(TypeError, match="unexpected keyword argument\\(s\\) generations"):
+        identify(short, "coulomb", m=TRUE["m"], generations=3)
+    with pytest.raises(ValueError, match="`hold` must be one of linear, zero"):
+        SimulationSettings(hold="cubic")
+
+
+def test_predict_is_a_deprecated_alias_of_predict_record(record):
+    with pytest.warns(DeprecationWarning, match="use predict_record"):
+        old = predict(TRUE, "coulomb", record, skip=3)
+    new = predict_record(TRUE, "coulomb", record, simulation=SimulationSettings(skip=3))
+    assert old.cost == new.cost
+    np.testing.assert_array_equal(old.z, new.z)
 
 
 # ------------------------------------------------------------------- CSV and CLI

@@ -4,7 +4,12 @@ from __future__ import annotations
 
 import argparse
 
-from randvib.identification.fitting import OUTPUT_COLUMN, TIME_COLUMN, read_record
+from randvib.identification.fitting import (
+    OUTPUT_COLUMN,
+    TIME_COLUMN,
+    SimulationSettings,
+    read_record,
+)
 from randvib.identification.record_simulation import HOLDS, INPUT_KINDS
 
 
@@ -63,14 +68,16 @@ def record_from_args(path, args, name=None):
     )
 
 
-def simulation_settings(args, defaults=None) -> dict:
-    out = {"substeps": 4, "hold": "linear", "lowpass": None, "skip": 0}
+def simulation_settings(args, defaults=None) -> SimulationSettings:
+    """The simulation options given on the command line, else ``defaults`` (a
+    saved result's settings), else the library's."""
+    out = SimulationSettings().to_dict()
     out.update({k: v for k, v in (defaults or {}).items() if k in out})
     for key in out:
         value = getattr(args, key)
         if value is not None:
             out[key] = value
-    return out
+    return SimulationSettings(**out)
 
 
 def parse_assignments(items, option: str) -> dict:

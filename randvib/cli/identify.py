@@ -13,7 +13,7 @@ from randvib.cli._records import (
     record_from_args,
     simulation_settings,
 )
-from randvib.identification.fitting import MODELS, UNITS, identify
+from randvib.identification.fitting import MODELS, UNITS, SearchSettings, identify
 
 
 def register(sub) -> None:
@@ -66,19 +66,18 @@ def run(args) -> int:
     save = _new_file(args.save, "--save")
     plot = _new_file(args.plot, "--plot")
     record = record_from_args(args.data, args)
-    settings = simulation_settings(args)
+    search = SearchSettings(
+        popsize=args.popsize, maxiter=args.generations, seed=args.seed, polish=not args.no_polish
+    )
     result = identify(
         record,
         args.model,
         m=args.m,
         fixed=parse_assignments(args.fix, "--fix"),
         bounds=parse_bounds(args.bounds),
-        popsize=args.popsize,
-        maxiter=args.generations,
-        seed=args.seed,
-        polish=not args.no_polish,
+        search=search,
+        simulation=simulation_settings(args),
         progress=not (args.no_progress or args.json),
-        **settings,
     )
     out = result.to_dict()
     if save is not None:

@@ -65,13 +65,13 @@ def run(args) -> int:
             raise FileExistsError(f"`--plot` folder {str(plot_dir)!r} is not empty")
         plot_dir.mkdir(parents=True, exist_ok=True)
     records = [record_from_args(path, args) for path in args.data]
-    rows = validate(parameters, model, records, **settings)
+    rows = validate(parameters, model, records, simulation=settings)
     if plot_dir is not None:
-        from randvib.identification.fitting import predict
+        from randvib.identification.fitting import predict_record
         from randvib.identification.plots import figure_fit
 
         for i, record in enumerate(records):
-            pred = predict(parameters, model, record, **settings)
+            pred = predict_record(parameters, model, record, simulation=settings)
             figure_fit(
                 pred, plot_dir / f"{i:02d}_{record.name}.png", title=f"{model} on {record.name}"
             )

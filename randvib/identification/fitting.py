@@ -27,8 +27,9 @@ LuGre's bristle state starts at zero.
 from __future__ import annotations
 
 import time
+import warnings
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 
 import numpy as np
@@ -95,6 +96,96 @@ OUTPUT_COLUMN = "relative_displacement"
 TIME_COLUMN = "time"
 #: Fewest samples per free parameter that a record must have.
 SAMPLES_PER_PARAMETER = 10
+
+
+# ---------------------------------------------------------------------- settings
+@dataclass(frozen=True)
+class SimulationSettings:
+    """How a record is simulated and scored (:func:`identify`, :func:`predict_record`).
+
+    Attributes
+    ----------
+    substeps : int
+        Integration steps per sample interval (default 4).
+    hold : {'linear', 'zero'}
+        Interpolation of the input between samples.
+    lowpass : float or None
+        Zero-phase low-pass cut-off (Hz) for the driving signal (useful for a
+        base displacement differentiated twice).
+    skip : int
+        Samples at the start left out of J (initial-condition transient).
+    """
+
+    substeps: int = 4
+    hold: str = "linear"
+    lowpass: float | None = None
+    skip: int = 0
+
+    def __post_init__(self):
+        object.__setattr__(self, "substeps", check_int("substeps", self.substeps, minimum=1))
+        object.__setattr__(self, "skip", check_int("skip", self.skip, minimum=0))
+        if self.hold not in HOLDS:
+            raise ValueError(f"`hold` must be one of {', '.join(HOLDS)}; got {self.hold!r}")
+
+    def to_dict(self) -> dict:
+        return _fields_of(self)
+
+
+@dataclass(frozen=True)
+class SearchSettings:
+    """SaDE settings of an identification (see :func:`randvib.identification.sade.sade`).
+
+    Attributes
+    ----------
+    popsize : int
+        Population size.
+    maxiter : int
+        Most generations.
+    seed : int, numpy.random.Generator or None
+        Random seed or generator of the search.
+    tol : float
+        Stop when the population's spread of J falls below this.
+    patience : int or None
+        Stop after this many generations without improvement (None: never).
+    polish : bool
+        Finish with a Nelder-Mead polish of the best candidate.
+    """
+
+    popsize: int = 50
+    maxiter: int = 200
+    seed: int | np.random.Generator | None = 0
+    tol: float = 1e-6
+    patience: int | None = 40
+    polish: bool = True
+
+    def to_dict(self) -> dict:
+        return _fields_of(self)
+
+
+def _fields_of(settings) -> dict:
+    # not dataclasses.asdict: that deep-copies, and a seed Generator must be
+    # the caller's own (it advances)
+    return {f.name: getattr(settings, f.name) for f in fields(settings)}
+
+
+def _settings(caller, options: dict, **given):
+    """The settings objects ``given`` (name -> object or None), with fields named
+    as keywords in ``options`` replacing theirs: ``identify(..., popsize=20)``
+    is ``identify(..., search=SearchSettings(popsize=20))``."""
+    options = dict(options)
+    out = []
+    for name, value in given.items():
+        cls = _SETTINGS[name]
+        if value is not None and not isinstance(value, cls):
+            raise ValueError(f"`{name}` must be a {cls.__name__}, got {type(value).__name__}")
+        mine = {f.name: options.pop(f.name) for f in fields(cls) if f.name in options}
+        out.append(replace(value if value is not None else cls(), **mine))
+    if options:
+        raise TypeError(f"{caller}() got unexpected keyword argument(s) {', '.join(options)}")
+    return out
+
+
+_SETTINGS = {"search": SearchSettings, "simulation": SimulationSettings}
 
 
 # ----------------------------------------------------------------------- records
@@ -245,17 +336,54 @@ def read_record(
         Missing or ambiguous columns, non-numeric, NaN or infinite samples,
         a non-uniform time column, an inconsistent sample rate.
     """
+    path = Path(path)
+    frame = _read_csv(path)
+    columns = list(frame.columns)
+    input_column, input_kind = _input_column(path, columns, input_column, input_kind)
+    if output_column not in columns:
+        raise ValueError(
+            f"{path.name}: output column `{output_column}` not found (relative displacement, m); "
+            f"columns are {columns}; map another name with `--output-column`"
+        )
+    if rows is not None:
+        frame = frame.iloc[slice(*rows)]
+    if len(frame) < 5:
+        raise ValueError(f"{path.name}: {len(frame)} data rows selected; at least 5 are needed")
+    return Record(
+        dt=_sample_interval(path, frame, time_column, sample_rate),
+        input_kind=input_kind,
+        input=_finite_column(input_column, frame[input_column]),
+        z=_finite_column(output_column, frame[output_column]),
+        name=name or path.stem,
+        voltage=(
+            _finite_column("voltage", frame["voltage"])
+            if "voltage" in columns and output_column != "voltage"
+            else None
+        ),
+    )
+
+
+def _read_csv(path: Path):
+    """The CSV as a DataFrame with string column names; parse errors as ValueError."""
     import pandas as pd
 
-    path = Path(path)
     if not path.is_file():
         raise FileNotFoundError(f"record file {str(path)!r} does not exist")
     try:
         frame = pd.read_csv(path)
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
         raise ValueError(f"cannot read {str(path)!r} as CSV: {exc}") from None
-    columns = [str(c) for c in frame.columns]
-    frame.columns = columns
+    frame.columns = [str(c) for c in frame.columns]
+    return frame
+
+
+def _input_column(path: Path, columns, input_column, input_kind) -> tuple[str, str]:
+    """(column, kind) of the record's input.
+
+    Without ``input_column`` the input is the one column named like an input
+    kind (``input_kind``, when given, names it); without ``input_kind`` the
+    column's name must be a kind.
+    """
     if input_kind is not None and input_kind not in INPUT_KINDS:
         raise ValueError(
             f"`input_kind` must be one of {', '.join(INPUT_KINDS)}; got {input_kind!r}"
@@ -285,50 +413,35 @@ def read_record(
                 "say what it holds with `--input-kind`"
             )
         input_kind = input_column
-    if output_column not in columns:
-        raise ValueError(
-            f"{path.name}: output column `{output_column}` not found (relative displacement, m); "
-            f"columns are {columns}; map another name with `--output-column`"
-        )
-    if rows is not None:
-        frame = frame.iloc[slice(*rows)]
-    if len(frame) < 5:
-        raise ValueError(f"{path.name}: {len(frame)} data rows selected; at least 5 are needed")
-    if time_column in columns:
-        t = _finite_column(time_column, frame[time_column])
-        steps = np.diff(t)
-        dt = float(np.median(steps))
-        if dt <= 0:
-            raise ValueError(f"column `{time_column}` must increase, median step is {dt!r} s")
-        bad = np.flatnonzero(np.abs(steps - dt) > 1e-3 * dt)
-        if bad.size:
+    return input_column, input_kind
+
+
+def _sample_interval(path: Path, frame, time_column, sample_rate) -> float:
+    """dt (s): the median step of a uniform time column, checked against
+    ``sample_rate`` when both are given, or ``1 / sample_rate``."""
+    if time_column not in frame.columns:
+        if sample_rate is None:
             raise ValueError(
-                f"column `{time_column}` is not uniformly sampled: step {steps[bad[0]]!r} s "
-                f"at data row {bad[0] + 1}, median step {dt!r} s; resample the record"
+                f"{path.name}: no `{time_column}` column; give the sample rate with `--sample-rate`"
             )
-        if sample_rate is not None and abs(float(sample_rate) * dt - 1) > 1e-3:
-            raise ValueError(
-                f"`sample_rate` = {sample_rate} Hz disagrees with column `{time_column}` "
-                f"(step {dt} s, {1 / dt:.6g} Hz)"
-            )
-    elif sample_rate is not None:
-        dt = 1.0 / float(check_positive("sample_rate", sample_rate, "Hz"))
-    else:
+        return 1.0 / float(check_positive("sample_rate", sample_rate, "Hz"))
+    t = _finite_column(time_column, frame[time_column])
+    steps = np.diff(t)
+    dt = float(np.median(steps))
+    if dt <= 0:
+        raise ValueError(f"column `{time_column}` must increase, median step is {dt!r} s")
+    bad = np.flatnonzero(np.abs(steps - dt) > 1e-3 * dt)
+    if bad.size:
         raise ValueError(
-            f"{path.name}: no `{time_column}` column; give the sample rate with `--sample-rate`"
+            f"column `{time_column}` is not uniformly sampled: step {steps[bad[0]]!r} s "
+            f"at data row {bad[0] + 1}, median step {dt!r} s; resample the record"
         )
-    return Record(
-        dt=dt,
-        input_kind=input_kind,
-        input=_finite_column(input_column, frame[input_column]),
-        z=_finite_column(output_column, frame[output_column]),
-        name=name or path.stem,
-        voltage=(
-            _finite_column("voltage", frame["voltage"])
-            if "voltage" in columns and output_column != "voltage"
-            else None
-        ),
-    )
+    if sample_rate is not None and abs(float(sample_rate) * dt - 1) > 1e-3:
+        raise ValueError(
+            f"`sample_rate` = {sample_rate} Hz disagrees with column `{time_column}` "
+            f"(step {dt} s, {1 / dt:.6g} Hz)"
+        )
+    return dt
 
 
 # ------------------------------------------------------------------- cost (Eq. 11)
@@ -575,8 +688,8 @@ class IdentificationResult:
         }
 
     def predict(self, record: Record, electrical=None) -> Prediction:
-        """Simulate ``record`` with these parameters (see :func:`predict`)."""
-        return predict(
+        """Simulate ``record`` with these parameters (see :func:`predict_record`)."""
+        return predict_record(
             self.parameters,
             self.model,
             record,
@@ -634,19 +747,12 @@ def identify(
     m: float | None = None,
     fixed: dict | None = None,
     bounds: dict | None = None,
-    popsize: int = 50,
-    maxiter: int = 200,
-    seed=0,
-    tol: float = 1e-6,
-    patience: int | None = 40,
-    polish: bool = True,
-    substeps: int = 4,
-    hold: str = "linear",
-    lowpass: float | None = None,
-    skip: int = 0,
-    init: dict | None = None,
+    init=None,
+    search: SearchSettings | None = None,
+    simulation: SimulationSettings | None = None,
     progress: bool = False,
     callback=None,
+    **options,
 ) -> IdentificationResult:
     """Fit a model to a record by minimising J (Eq. 11) with SaDE.
 
@@ -655,7 +761,8 @@ def identify(
     record : Record
         Training record.
     model : {'viscous', 'coulomb', 'tanh', 'lugre'}
-        Friction model (``viscous`` is the paper's no-friction model).
+        Friction model (``viscous`` is the paper's no-friction model), or
+        any other registered law.
     m : float, optional
         Mass (kg); required with base excitation, identified when omitted
         with a force input.
@@ -664,24 +771,24 @@ def identify(
         spring.
     bounds : dict, optional
         ``name -> (lower, upper)`` overriding :func:`default_bounds`.
-    popsize, maxiter, seed, tol, patience, polish
-        SaDE settings (see :func:`randvib.identification.sade.sade`).
-    substeps : int
-        Integration steps per sample interval.
-    hold : {'linear', 'zero'}
-        Interpolation of the input between samples.
-    lowpass : float, optional
-        Zero-phase low-pass (Hz) for the driving signal (useful for a
-        base displacement differentiated twice).
-    skip : int
-        Samples at the start left out of J (initial-condition transient).
     init : dict or Harvester, optional
         A starting guess ``name -> value`` (or a device, a preset included,
         with c = c_m + c_e) placed in the initial population.
+    search : SearchSettings, optional
+        SaDE settings (popsize 50, maxiter 200, seed 0, tol 1e-6, patience
+        40, polish True).
+    simulation : SimulationSettings, optional
+        Record simulation settings (substeps 4, linear hold, no low-pass,
+        skip 0).
     progress : bool
         Progress bar.
     callback : callable, optional
         ``callback(generation, parameters_dict, cost)``; True stops.
+    **options
+        Fields of either settings object as keywords (``popsize=``,
+        ``maxiter=``, ``seed=``, ``tol=``, ``patience=``, ``polish=``;
+        ``substeps=``, ``hold=``, ``lowpass=``, ``skip=``); they override
+        ``search`` and ``simulation``.
 
     Returns
     -------
@@ -690,11 +797,36 @@ def identify(
     _check_model(model)
     if not isinstance(record, Record):
         raise ValueError(f"`record` must be a randvib Record, got {type(record).__name__}")
-    substeps = check_int("substeps", substeps, minimum=1)
-    skip = check_int("skip", skip, minimum=0)
-    if hold not in HOLDS:
-        raise ValueError(f"`hold` must be one of {', '.join(HOLDS)}; got {hold!r}")
+    search, simulation = _settings("identify", options, search=search, simulation=simulation)
     fixed = _resolve_fixed(model, fixed, m, record)
+    space = _search_space(record, model, fixed, bounds, simulation.skip)
+    cost = _identification_cost(record, model, fixed, space.free, simulation)
+    start = time.perf_counter()
+    res = sade(
+        cost,
+        [space.box[n] for n in space.free],
+        log=space.log,
+        names=space.free,
+        init=_initial_guess(init, space),
+        callback=_named_callback(callback, space.free),
+        progress=progress,
+        **search.to_dict(),
+    )
+    elapsed = time.perf_counter() - start
+    return _identification_result(cost, space, res, elapsed, search, simulation)
+
+
+@dataclass(frozen=True)
+class _SearchSpace:
+    """What SaDE searches: the free parameters, their bounds, which are log-scaled."""
+
+    free: tuple
+    box: dict
+    log: list
+
+
+def _search_space(record, model, fixed, bounds, skip) -> _SearchSpace:
+    """Free parameters and their bounds (declared defaults, then the user's)."""
     free = tuple(n for n in MODEL_PARAMETERS[model] + ("m",) if n not in fixed)
     needed = max(20, SAMPLES_PER_PARAMETER * len(free)) + skip
     if record.n < needed:
@@ -703,92 +835,94 @@ def identify(
             f"{len(free)} free parameters needs at least {needed}"
         )
     box = default_bounds(record, model, fixed.get("m"))
-    for name, pair in (bounds or {}).items():
-        if name not in MODEL_PARAMETERS[model] and name != "m":
-            raise ValueError(
-                f"`--bounds {name}`: unknown parameter for model {model!r}; allowed: "
-                f"{', '.join(MODEL_PARAMETERS[model] + ('m',))}"
-            )
-        lo, hi = (float(check_finite(f"bounds {name}", x)) for x in pair)
-        if lo > hi:
-            raise ValueError(f"`--bounds {name}`: lower {lo!r} > upper {hi!r}")
-        box[name] = (lo, hi)
+    box.update(_user_bounds(model, bounds))
     unbounded = [name for name in free if name not in box]
     if unbounded:
         raise ValueError(
             f"parameter(s) {unbounded} of model {model!r} declare no default search bounds; "
             "fix them (`--fix NAME=VALUE`) or bound them (`--bounds NAME=LO:HI`)"
         )
-    box = {name: box[name] for name in free}
     specs = _specs(model)
-    log = [specs[name].log and box[name][0] > 0 for name in free]
-    cost = CostFunction(
+    return _SearchSpace(
+        free=free,
+        box={name: box[name] for name in free},
+        log=[specs[name].log and box[name][0] > 0 for name in free],
+    )
+
+
+def _user_bounds(model, bounds) -> dict:
+    allowed = MODEL_PARAMETERS[model] + ("m",)
+    out = {}
+    for name, pair in (bounds or {}).items():
+        if name not in allowed:
+            raise ValueError(
+                f"`--bounds {name}`: unknown parameter for model {model!r}; allowed: "
+                f"{', '.join(allowed)}"
+            )
+        lo, hi = (float(check_finite(f"bounds {name}", x)) for x in pair)
+        if lo > hi:
+            raise ValueError(f"`--bounds {name}`: lower {lo!r} > upper {hi!r}")
+        out[name] = (lo, hi)
+    return out
+
+
+def _identification_cost(record, model, fixed, free, simulation) -> CostFunction:
+    return CostFunction(
         record,
         model,
         fixed=fixed,
         free=free,
-        substeps=substeps,
-        hold=hold,
-        lowpass=lowpass,
-        skip=skip,
+        **simulation.to_dict(),
     )
-    x0 = None
+
+
+def _initial_guess(init, space: _SearchSpace):
+    """The user's guess as one row of the initial population (None without one)."""
     if init is not None and not isinstance(init, dict) or isinstance(init, dict) and "c_m" in init:
         init = device_parameters(init)[0]  # a Harvester (or its parameters()) as the guess
-    if init:
-        x0 = [[np.clip(init.get(n, np.mean(box[n])), *box[n]) for n in free]]
-    user_callback = None
-    if callback is not None:
+    if not init:
+        return None
+    return [[np.clip(init.get(n, np.mean(space.box[n])), *space.box[n]) for n in space.free]]
 
-        def user_callback(gen, x, f):
-            return callback(gen, dict(zip(free, map(float, x), strict=True)), f)
 
-    start = time.perf_counter()
-    res = sade(
-        cost,
-        [box[n] for n in free],
-        log=log,
-        names=free,
-        popsize=popsize,
-        maxiter=maxiter,
-        seed=seed,
-        tol=tol,
-        patience=patience,
-        init=x0,
-        polish=polish,
-        callback=user_callback,
-        progress=progress,
-    )
-    elapsed = time.perf_counter() - start
-    parameters = {**dict(zip(free, map(float, res.x), strict=True)), **fixed}
-    order = ("m",) + MODEL_PARAMETERS[model]
-    parameters = {name: parameters[name] for name in order}
+def _named_callback(callback, free):
+    """SaDE's ``callback(gen, x, f)`` as the user's ``callback(gen, {name: value}, f)``."""
+    if callback is None:
+        return None
+
+    def named(gen, x, f):
+        return callback(gen, dict(zip(free, map(float, x), strict=True)), f)
+
+    return named
+
+
+def _identification_result(cost, space, res, elapsed, search, simulation):
+    parameters = {**dict(zip(space.free, map(float, res.x), strict=True)), **cost.fixed}
+    order = ("m",) + MODEL_PARAMETERS[cost.model]
+    seconds = cost.seconds
     return IdentificationResult(
-        model=model,
-        parameters=parameters,
-        free=free,
+        model=cost.model,
+        parameters={name: parameters[name] for name in order},
+        free=space.free,
         cost=float(res.fun),
-        bounds={n: tuple(map(float, box[n])) for n in free},
+        bounds={n: tuple(map(float, space.box[n])) for n in space.free},
         nfev=res.nfev,
         generations=res.nit,
         elapsed=elapsed,
-        simulations_per_second=cost.evaluations / cost.seconds if cost.seconds else float("nan"),
+        simulations_per_second=cost.evaluations / seconds if seconds else float("nan"),
         message=res.message + (" (polished)" if res.polished else ""),
         history={"best": res.history["best"], "nfev": res.history["nfev"]},
-        record=record.name,
+        record=cost.record.name,
         settings={
-            "substeps": substeps,
-            "hold": hold,
-            "lowpass": lowpass,
-            "skip": skip,
-            "popsize": popsize,
-            "maxiter": maxiter,
-            "seed": seed if isinstance(seed, int | None) else "generator",
+            **simulation.to_dict(),
+            "popsize": search.popsize,
+            "maxiter": search.maxiter,
+            "seed": search.seed if isinstance(search.seed, int | None) else "generator",
         },
     )
 
 
-# ----------------------------------------------------------------- predict/validate
+# ---------------------------------------------------------- predict_record/validate
 @dataclass(frozen=True, eq=False)
 class Prediction:
     """Simulated response of a parameter set to a record.
@@ -848,42 +982,49 @@ def _check_parameters(parameters, model):
     return {n: float(check_finite(n, parameters[n])) for n in names}
 
 
-def predict(
+def predict_record(
     parameters,
     model: str | None = None,
     record: Record | None = None,
     *,
     electrical=None,
-    substeps: int = 4,
-    hold: str = "linear",
-    lowpass: float | None = None,
-    skip: int = 0,
+    simulation: SimulationSettings | None = None,
+    **options,
 ) -> Prediction:
     """Simulate a record with given parameters and score it with J (Eq. 11).
 
-    Called as ``predict(parameters, model, record)`` with identified
-    parameters (total damping ``c``), or as ``predict(device, record)`` with a
-    :class:`~randvib.models.harvester.Harvester` (a preset included) or its
-    ``parameters()`` dict: the device's law names the model, c = c_m + c_e,
-    and its circuit, if any, gives the load voltage.
+    Called as ``predict_record(parameters, model, record)`` with identified
+    parameters (total damping ``c``), or as ``predict_record(device, record)``
+    with a :class:`~randvib.models.harvester.Harvester` (a preset included)
+    or its ``parameters()`` dict: the device's law names the model,
+    c = c_m + c_e, and its circuit, if any, gives the load voltage. (The
+    analytic power prediction is :func:`randvib.predict`.)
 
-    ``electrical`` (a :class:`randvib.ElectricalCoupling`) adds the coil's
-    damping c_e = alpha^2/(R_L + R_C) (Eq. 3) to the identified c and returns
-    the load voltage.
+    Parameters
+    ----------
+    parameters : dict or Harvester
+        ``m`` (kg), ``c`` (Ns/m), ``k`` (N/m), ``k3`` (N/m^3) and the model's
+        friction parameters; or a device.
+    model : str, optional
+        Identification model (see :data:`MODELS`); only with a parameter dict.
+    record : Record
+    electrical : ElectricalCoupling, optional
+        Adds the coil's damping c_e = alpha^2/(R_L + R_C) (Eq. 3) to the
+        identified c and gives the load voltage.
+    simulation : SimulationSettings, optional
+        Its fields may also be given as keywords (``substeps=``, ``hold=``,
+        ``lowpass=``, ``skip=``), which override it.
+
+    Returns
+    -------
+    Prediction
     """
+    (simulation,) = _settings("predict_record", options, simulation=simulation)
     parameters, model, record, circuit = _device_and_model(parameters, model, record)
     params = _check_parameters(parameters, model)
-    cost = CostFunction(
-        record,
-        model,
-        fixed=params,
-        free=(),
-        substeps=substeps,
-        hold=hold,
-        lowpass=lowpass,
-        skip=skip,
-    )
+    cost = CostFunction(record, model, fixed=params, free=(), **simulation.to_dict())
     z, v = cost.simulate(params, electrical)
+    skip = simulation.skip
     if np.all(np.isfinite(z)):
         j = float(normalised_cost(record.z[skip:], z[skip:]))
         rms = float(np.sqrt(np.mean((record.z[skip:] - z[skip:]) ** 2)))
@@ -894,6 +1035,17 @@ def predict(
     if circuit is not None:
         voltage = circuit.alpha * v * circuit.load_fraction
     return Prediction(record=record, z=z, v=v, cost=j, rms_error=rms, voltage=voltage)
+
+
+def predict(*args, **kwargs) -> Prediction:
+    """Deprecated name of :func:`predict_record` (``randvib.predict`` is the analytic power)."""
+    warnings.warn(
+        "randvib.identification.fitting.predict is deprecated; use predict_record "
+        "(randvib.predict is the analytic power prediction)",
+        DeprecationWarning,
+        stacklevel=2,
+    )
+    return predict_record(*args, **kwargs)
 
 
 @dataclass(frozen=True)
@@ -909,13 +1061,14 @@ def validate(parameters, model, records=None, **settings) -> list[ValidationRow]
     """J (Eq. 11) and RMS error of given parameters on each of several records.
 
     Called as ``validate(parameters, model, records)`` or
-    ``validate(device, records)`` with a Harvester (see :func:`predict`).
+    ``validate(device, records)`` with a Harvester; ``settings`` are those of
+    :func:`predict_record` (``simulation=`` or its fields as keywords).
     """
     if records is None:
         model, records = None, model
     parameters, model, _, _ = _device_and_model(parameters, model, records)
     rows = []
     for record in records:
-        pred = predict(parameters, model, record, **settings)
+        pred = predict_record(parameters, model, record, **settings)
         rows.append(ValidationRow(record.name, model, pred.cost, pred.rms_error, record.n))
     return rows

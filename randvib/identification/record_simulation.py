@@ -74,6 +74,7 @@ from randvib.models.friction import (
     FRICTION_MODELS,
     KERNEL_NONE,
     N_KERNEL_PARAMETERS,
+    STICK_SLIP_NONE,
     STICK_SLIP_SIGN,
     STICK_SLIP_TANH,
     FrictionModel,
@@ -105,10 +106,41 @@ SEARCH_SUBCYCLES = 32
 
 
 # --------------------------------------------------------------------- kernel
+# The compiled pieces hand each other small tuples instead of long argument
+# lists (numba passes them by value, so they cost nothing):
+#   dev   = (m, c, k, k3, gain)  one candidate's device; the input drives it
+#           with e(t) = gain * input(t), gain = -m for a base input, else 1
+#   law   = (kind, fn, p)        the friction law's kernel code, compiled
+#           callback and parameters, for :func:`evaluate_friction`
+#   layer = (tanh_mode, fc, beta, vb, fstick)  the friction as the stick-slip
+#           integrator sees it: ``Fc sgn v`` (vb = 0) or ``Fc tanh(beta v)``
+#           with the boundary layer |v| < vb; fstick is the largest friction
+#           force a stick holds
+#   slipping = (layer, sgn)      the friction while slipping in direction sgn = +-1
+#   seg   = (u0, du)             input over one sample interval, u0 + du * s
+#   st    = (z, v, mode, sgn)    the stick-slip integrator's state
 @numba.njit(cache=True, inline="always")
-def _slip_force(tanh_mode, fc, beta, vb, sgn, v):
+def _input(dev, seg, s):
+    # e at time s into the sample interval (first- or zero-order hold)
+    return dev[4] * (seg[0] + seg[1] * s)
+
+
+@numba.njit(cache=True, inline="always")
+def _free_force(dev, e, z, v):
+    # g = e - c z' - k z - k3 z^3: everything but friction (N)
+    return e - dev[1] * v - dev[2] * z - dev[3] * z * z * z
+
+
+@numba.njit(cache=True, inline="always")
+def _acceleration(dev, e, z, v, f):
+    return (_free_force(dev, e, z, v) - f) / dev[0]
+
+
+@numba.njit(cache=True, inline="always")
+def _slip_force(layer, sgn, v):
     # Friction while slipping in direction sgn, continued smoothly past the
     # boundary so that RK4 trial steps and the event interpolant are defined.
+    tanh_mode, fc, beta, vb, _ = layer
     if tanh_mode:
         w = sgn * v
         if w < vb:
@@ -118,64 +150,62 @@ def _slip_force(tanh_mode, fc, beta, vb, sgn, v):
 
 
 @numba.njit(cache=True, inline="always")
-def _slip_acc(m, c, k, k3, e, z, v, tanh_mode, fc, beta, vb, sgn):
-    return (e - c * v - k * z - k3 * z * z * z - _slip_force(tanh_mode, fc, beta, vb, sgn, v)) / m
-
-
-@numba.njit(cache=True)
-def _slip_rk4(m, c, k, k3, gain, u0, du, s, hh, z, v, tanh_mode, fc, beta, vb, sgn):
-    e0 = gain * (u0 + du * s)
-    e1 = gain * (u0 + du * (s + 0.5 * hh))
-    e2 = gain * (u0 + du * (s + hh))
-    a1 = _slip_acc(m, c, k, k3, e0, z, v, tanh_mode, fc, beta, vb, sgn)
-    z2 = z + 0.5 * hh * v
-    v2 = v + 0.5 * hh * a1
-    a2 = _slip_acc(m, c, k, k3, e1, z2, v2, tanh_mode, fc, beta, vb, sgn)
-    z3 = z + 0.5 * hh * v2
-    v3 = v + 0.5 * hh * a2
-    a3 = _slip_acc(m, c, k, k3, e1, z3, v3, tanh_mode, fc, beta, vb, sgn)
-    z4 = z + hh * v3
-    v4 = v + hh * a3
-    a4 = _slip_acc(m, c, k, k3, e2, z4, v4, tanh_mode, fc, beta, vb, sgn)
-    zn = z + hh / 6.0 * (v + 2.0 * v2 + 2.0 * v3 + v4)
-    vn = v + hh / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
-    return zn, vn, a1
+def _law_friction(law, v, th):
+    # (F, theta') of the law's own kernel: the smooth path
+    return evaluate_friction(law[0], law[1], law[2], v, th)
 
 
 @numba.njit(cache=True, inline="always")
-def _creep_velocity(tanh_mode, fc, beta, g):
-    # Quasi-static velocity inside the tanh boundary layer: Fc tanh(beta v) = g.
-    if not tanh_mode:
-        return 0.0
-    return math.atanh(g / fc) / beta
+def _slip_friction(slipping, v, th):
+    # (F, 0) while the stick-slip integrator slips
+    return _slip_force(slipping[0], slipping[1], v), 0.0
 
 
-@numba.njit(cache=True)
-def _smooth_rk4(kind, fn, p, m, c, k, k3, gain, u0, du, s, hh, z, v, th):
-    e0 = gain * (u0 + du * s)
-    e1 = gain * (u0 + du * (s + 0.5 * hh))
-    e2 = gain * (u0 + du * (s + hh))
-    f1, r1 = evaluate_friction(kind, fn, p, v, th)
-    a1 = (e0 - c * v - k * z - k3 * z * z * z - f1) / m
+@numba.njit(cache=True, inline="always")
+def _rk4(friction, fr, dev, seg, s, hh, z, v, th):
+    """Classical RK4 step of length hh from s on (z, z', theta).
+
+    ``friction(fr, v, theta) -> (F, theta')`` is :func:`_law_friction` (``fr`` =
+    ``law``) or :func:`_slip_friction` (``fr`` = ``slipping``), a compiled
+    function named where the step is used: inlined there, each use compiles
+    without the other's code (a run-time choice in every stage cost 12 % of
+    the Coulomb search, and a function passed at run time defeats caching).
+    Returns the state after the step and the acceleration at its start (the
+    slope that the event interpolant needs).
+    """
+    e0 = _input(dev, seg, s)
+    e1 = _input(dev, seg, s + 0.5 * hh)
+    e2 = _input(dev, seg, s + hh)
+    f1, r1 = friction(fr, v, th)
+    a1 = _acceleration(dev, e0, z, v, f1)
     z2 = z + 0.5 * hh * v
     v2 = v + 0.5 * hh * a1
     t2 = th + 0.5 * hh * r1
-    f2, r2 = evaluate_friction(kind, fn, p, v2, t2)
-    a2 = (e1 - c * v2 - k * z2 - k3 * z2 * z2 * z2 - f2) / m
+    f2, r2 = friction(fr, v2, t2)
+    a2 = _acceleration(dev, e1, z2, v2, f2)
     z3 = z + 0.5 * hh * v2
     v3 = v + 0.5 * hh * a2
     t3 = th + 0.5 * hh * r2
-    f3, r3 = evaluate_friction(kind, fn, p, v3, t3)
-    a3 = (e1 - c * v3 - k * z3 - k3 * z3 * z3 * z3 - f3) / m
+    f3, r3 = friction(fr, v3, t3)
+    a3 = _acceleration(dev, e1, z3, v3, f3)
     z4 = z + hh * v3
     v4 = v + hh * a3
     t4 = th + hh * r3
-    f4, r4 = evaluate_friction(kind, fn, p, v4, t4)
-    a4 = (e2 - c * v4 - k * z4 - k3 * z4 * z4 * z4 - f4) / m
+    f4, r4 = friction(fr, v4, t4)
+    a4 = _acceleration(dev, e2, z4, v4, f4)
     zn = z + hh / 6.0 * (v + 2.0 * v2 + 2.0 * v3 + v4)
     vn = v + hh / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
     tn = th + hh / 6.0 * (r1 + 2.0 * r2 + 2.0 * r3 + r4)
-    return zn, vn, tn
+    return zn, vn, tn, a1
+
+
+@numba.njit(cache=True, inline="always")
+def _creep_velocity(layer, g):
+    # Quasi-static velocity inside the tanh boundary layer: Fc tanh(beta v) = g.
+    tanh_mode, fc, beta, _, _ = layer
+    if not tanh_mode:
+        return 0.0
+    return math.atanh(g / fc) / beta
 
 
 @numba.njit(cache=True)
@@ -201,84 +231,175 @@ def _hermite_root(hh, q0, d0, q1, d1):
     return hi
 
 
+@numba.njit(cache=True, inline="always")
+def _stick_slip_layer(slip, p, m, h):
+    """(sticky, layer): whether the event-located integrator runs, and its friction.
+
+    The law declares how ``p`` reads (``stick_slip``). tanh friction takes
+    this path only when the step h exceeds twice its relaxation time
+    ``tau = m / (Fc beta)``; below that plain RK4 resolves it.
+    """
+    if slip == STICK_SLIP_SIGN and p[0] > 0.0:
+        return True, (False, p[0], 0.0, 0.0, p[0])
+    if slip == STICK_SLIP_TANH and p[0] > 0.0:
+        tau = m / (p[0] * p[1])
+        if h > 2.0 * tau:
+            xb = max(8.0, 0.5 * math.log(4.0 * h / tau))
+            return True, (True, p[0], p[1], xb / p[1], p[0] * math.tanh(xb))
+    return False, (False, 0.0, 0.0, 0.0, 0.0)
+
+
+@numba.njit(cache=True, inline="always")
+def _starting_state(dev, layer, e, z, v):
+    """(z, v, mode, sgn) at t = 0: stuck when at rest (or inside the layer) and
+    the non-friction force is held, else slipping in its direction."""
+    vb = layer[3]
+    if abs(v) <= vb or v == 0.0:
+        g = _free_force(dev, e, z, v)
+        if abs(g) <= layer[4]:
+            return z, _creep_velocity(layer, g), _STICK, 1.0
+        sgn = 1.0 if g > 0 else -1.0
+        return z, sgn * vb, _SLIP, sgn
+    return z, v, _SLIP, 1.0 if v > 0 else -1.0
+
+
+@numba.njit(cache=True, inline="always")
+def _stick(dev, layer, seg, s, b, st):
+    """Advance a stick from s: to b, or to breakaway. Returns (s, st).
+
+    With ``z`` frozen, g is linear in time (linear hold), so breakaway
+    ``|g| = fstick`` is found exactly. In tanh mode the mass creeps at the
+    quasi-static velocity instead of standing still.
+    """
+    z, v, mode, sgn = st
+    tanh_mode, _, _, vb, fstick = layer
+    ga = _free_force(dev, _input(dev, seg, s), z, 0.0)
+    gb = _free_force(dev, _input(dev, seg, b), z, 0.0)
+    if abs(ga) <= fstick and abs(gb) <= fstick:
+        if tanh_mode:
+            z += (b - s) * _creep_velocity(layer, 0.5 * (ga + gb))
+            v = _creep_velocity(layer, gb)
+        return b, (z, v, mode, sgn)
+    if abs(ga) > fstick:
+        s_new = s
+        sgn = 1.0 if ga > 0 else -1.0
+    else:
+        target = fstick if gb > 0 else -fstick
+        frac = (target - ga) / (gb - ga)
+        frac = min(max(frac, 0.0), 1.0)
+        s_new = s + frac * (b - s)
+        sgn = 1.0 if gb > 0 else -1.0
+    if tanh_mode:
+        # creep up to breakaway at the mean quasi-static velocity
+        z += (s_new - s) * _creep_velocity(layer, 0.5 * (ga + sgn * fstick))
+    return s_new, (z, sgn * vb, _SLIP, sgn)
+
+
+@numba.njit(cache=True, inline="always")
+def _slip(dev, layer, seg, s, b, st, accept):
+    """Slip from s: one RK4 step to b, or up to the velocity's return to the
+    layer (located on the step's cubic Hermite interpolant), where the
+    non-friction force decides between stick and slip. ``accept`` takes the
+    step to b whatever happens in it (the event budget is spent). Returns (s, st).
+    """
+    z, v, mode, sgn = st
+    vb = layer[3]
+    fr = (layer, sgn)
+    hh = b - s
+    z1, v1, _, a0 = _rk4(_slip_friction, fr, dev, seg, s, hh, z, v, 0.0)
+    if sgn * v1 > vb or accept:
+        return b, (z1, v1, mode, sgn)
+    # velocity reaches the boundary inside the step: locate, redo
+    a1 = _acceleration(dev, _input(dev, seg, b), z1, v1, _slip_force(layer, sgn, v1))
+    frac = _hermite_root(hh, sgn * v - vb, sgn * a0, sgn * v1 - vb, sgn * a1)
+    hs = frac * hh
+    z, v, _, a0 = _rk4(_slip_friction, fr, dev, seg, s, hs, z, v, 0.0)
+    s = min(s + hs, b)
+    v = sgn * vb
+    g = _free_force(dev, _input(dev, seg, s), z, v)
+    if abs(g) <= layer[4]:
+        return s, (z, _creep_velocity(layer, g), _STICK, sgn)
+    new = 1.0 if g > 0 else -1.0
+    if new != sgn:
+        sgn = new
+        v = sgn * vb  # cross the (zero-width or 1/beta) layer
+    return s, (z, v, _SLIP, sgn)
+
+
+@numba.njit(cache=True, inline="always")
+def _stick_slip_substep(dev, layer, seg, a, b, tiny, st):
+    """The event-located stick-slip integrator over one sub-step [a, b]."""
+    s = a
+    for it in range(_MAX_EVENTS):
+        if s >= b:
+            break
+        if st[2] == _STICK:
+            s, st = _stick(dev, layer, seg, s, b, st)
+        elif b - s <= tiny:
+            break
+        else:
+            s, st = _slip(dev, layer, seg, s, b, st, it == _MAX_EVENTS - 1)
+    return st
+
+
+@numba.njit(cache=True, inline="always")
+def _smooth_substep(dev, fr, seg, a, b, subcycling, z, v, th):
+    """RK4 over the sub-step [a, b], sub-cycled so that a law with memory
+    relaxes by less than one e-fold per step. Returns (ok, z, v, th); ok is
+    False when that needs more than the allowed sub-cycles."""
+    relax_rate, max_sub = subcycling
+    nc = 1
+    if relax_rate > 0.0:
+        nc = int(abs(v) * relax_rate * (b - a)) + 1
+        if nc > max_sub:
+            return False, z, v, th
+    hh = (b - a) / nc
+    for q in range(nc):
+        z, v, th, _ = _rk4(_law_friction, fr, dev, seg, a + q * hh, hh, z, v, th)
+    return True, z, v, th
+
+
+@numba.njit(cache=True, inline="always")
+def _diverged(out_z, out_v, store, first):
+    # A rejected candidate: NaN samples from ``first`` on, infinite cost.
+    if store:
+        for r in range(first, out_z.shape[0]):
+            out_z[r] = math.nan
+            out_v[r] = math.nan
+    return math.inf
+
+
 @numba.njit(cache=True)
-def _run_one(
-    par,
-    kind,
-    fn,
-    slip,
-    relax_rate,
-    base_input,
-    u,
-    dt,
-    nsub,
-    linear,
-    z0,
-    v0,
-    th0,
-    zref,
-    skip,
-    zlim,
-    max_sub,
-    out_z,
-    out_v,
-    store,
-):
+def _run_one(par, relax_rate, state0, friction, drive, scoring, out_z, out_v, store):
     """Simulate one parameter set; return the sum of squared errors against zref
-    over the samples from index ``skip`` on."""
+    over the samples from index ``skip`` on.
+
+    ``par`` is ``[m, c, k, k3, p...]``, ``state0`` ``[z0, v0, theta0]``;
+    ``friction = (kind, fn, stick_slip)``, ``drive = (u, dt, nsub, linear,
+    base_input)``, ``scoring = (zref, skip, zlim, max_subcycles)`` as built by
+    :func:`run_kernel`.
+    """
+    kind, fn, slip = friction
+    u, dt, nsub, linear, base_input = drive
+    zref, skip, zlim, max_sub = scoring
     m = par[0]
-    c = par[1]
-    k = par[2]
-    k3 = par[3]
     p = par[4:]
-    gain = -m if base_input else 1.0
+    dev = (m, par[1], par[2], par[3], -m if base_input else 1.0)
     h = dt / nsub
     n = u.shape[0]
     have_ref = zref.shape[0] == n
 
-    sticky = False
-    tanh_mode = False
-    fc = 0.0
-    beta = 0.0
-    vb = 0.0
-    fstick = 0.0
-    # The law declares how the stick-slip integrator reads p (``stick_slip``).
-    if slip == STICK_SLIP_SIGN and p[0] > 0.0:
-        sticky = True
-        fc = p[0]
-        fstick = fc
-    elif slip == STICK_SLIP_TANH and p[0] > 0.0:
-        tau = m / (p[0] * p[1])
-        if h > 2.0 * tau:
-            sticky = True
-            tanh_mode = True
-            fc = p[0]
-            beta = p[1]
-            xb = max(8.0, 0.5 * math.log(4.0 * h / tau))
-            vb = xb / beta
-            fstick = fc * math.tanh(xb)
-    if slip == STICK_SLIP_SIGN and not sticky:
-        kind = KERNEL_NONE  # Fc = 0
-    if slip == STICK_SLIP_TANH and p[0] == 0.0:
-        kind = KERNEL_NONE
-
-    z = z0
-    v = v0
-    th = th0
-    mode = _SLIP
-    sgn = 1.0
+    sticky, layer = _stick_slip_layer(slip, p, m, h)
+    if slip == STICK_SLIP_SIGN and not sticky or slip == STICK_SLIP_TANH and p[0] == 0.0:
+        kind = KERNEL_NONE  # Fc = 0: viscous only
+    law = (kind, fn, p)
+    z = state0[0]
+    v = state0[1]
+    th = state0[2]
+    st = (z, v, _SLIP, 1.0)
     if sticky:
-        e = gain * u[0]
-        if abs(v) <= vb or v == 0.0:
-            g = e - c * v - k * z - k3 * z * z * z
-            if abs(g) <= fstick:
-                mode = _STICK
-                v = _creep_velocity(tanh_mode, fc, beta, g)
-            else:
-                sgn = 1.0 if g > 0 else -1.0
-                v = sgn * vb
-        else:
-            sgn = 1.0 if v > 0 else -1.0
+        st = _starting_state(dev, layer, dev[4] * u[0], z, v)
+        v = st[1]
 
     sse = 0.0
     if have_ref and skip == 0:
@@ -287,98 +408,21 @@ def _run_one(
         out_z[0] = z
         out_v[0] = v
     for i in range(n - 1):
-        u0 = u[i]
-        du = (u[i + 1] - u[i]) / dt if linear else 0.0
+        seg = (u[i], (u[i + 1] - u[i]) / dt if linear else 0.0)
         for j in range(nsub):
             a = j * h
             b = dt if j == nsub - 1 else a + h
-            if not sticky:
-                nc = 1
-                if relax_rate > 0.0:
-                    nc = int(abs(v) * relax_rate * (b - a)) + 1
-                    if nc > max_sub:
-                        # bristles stiffer than the step resolves: rejected as diverged
-                        if store:
-                            for r in range(i + 1, n):
-                                out_z[r] = math.nan
-                                out_v[r] = math.nan
-                        return math.inf
-                hh = (b - a) / nc
-                for q in range(nc):
-                    z, v, th = _smooth_rk4(
-                        kind, fn, p, m, c, k, k3, gain, u0, du, a + q * hh, hh, z, v, th
-                    )
-                continue
-            s = a
-            for it in range(_MAX_EVENTS):
-                if s >= b:
-                    break
-                if mode == _STICK:
-                    ga = gain * (u0 + du * s) - k * z - k3 * z * z * z
-                    gb = gain * (u0 + du * b) - k * z - k3 * z * z * z
-                    if abs(ga) <= fstick and abs(gb) <= fstick:
-                        if tanh_mode:
-                            gm = 0.5 * (ga + gb)
-                            z += (b - s) * _creep_velocity(tanh_mode, fc, beta, gm)
-                            v = _creep_velocity(tanh_mode, fc, beta, gb)
-                        s = b
-                    else:
-                        if abs(ga) > fstick:
-                            s_new = s
-                            sgn = 1.0 if ga > 0 else -1.0
-                        else:
-                            target = fstick if gb > 0 else -fstick
-                            frac = (target - ga) / (gb - ga)
-                            frac = min(max(frac, 0.0), 1.0)
-                            s_new = s + frac * (b - s)
-                            sgn = 1.0 if gb > 0 else -1.0
-                        if tanh_mode:
-                            # creep up to breakaway at the mean quasi-static velocity
-                            gm = 0.5 * (ga + sgn * fstick)
-                            z += (s_new - s) * _creep_velocity(tanh_mode, fc, beta, gm)
-                        s = s_new
-                        mode = _SLIP
-                        v = sgn * vb
-                else:
-                    hh = b - s
-                    if hh <= 1e-14 * dt:
-                        s = b
-                        break
-                    z1, v1, a0 = _slip_rk4(
-                        m, c, k, k3, gain, u0, du, s, hh, z, v, tanh_mode, fc, beta, vb, sgn
-                    )
-                    if sgn * v1 > vb or it == _MAX_EVENTS - 1:
-                        z = z1
-                        v = v1
-                        s = b
-                        continue
-                    # velocity reaches the boundary inside the step: locate, redo
-                    e1 = gain * (u0 + du * b)
-                    a1 = _slip_acc(m, c, k, k3, e1, z1, v1, tanh_mode, fc, beta, vb, sgn)
-                    frac = _hermite_root(hh, sgn * v - vb, sgn * a0, sgn * v1 - vb, sgn * a1)
-                    hs = frac * hh
-                    z, v, a0 = _slip_rk4(
-                        m, c, k, k3, gain, u0, du, s, hs, z, v, tanh_mode, fc, beta, vb, sgn
-                    )
-                    s = s + hs
-                    if s > b:
-                        s = b
-                    v = sgn * vb
-                    g = gain * (u0 + du * s) - c * v - k * z - k3 * z * z * z
-                    if abs(g) <= fstick:
-                        mode = _STICK
-                        v = _creep_velocity(tanh_mode, fc, beta, g)
-                    else:
-                        new = 1.0 if g > 0 else -1.0
-                        if new != sgn:
-                            sgn = new
-                            v = sgn * vb  # cross the (zero-width or 1/beta) layer
+            if sticky:
+                st = _stick_slip_substep(dev, layer, seg, a, b, 1e-14 * dt, st)
+                z = st[0]
+                v = st[1]
+            else:
+                ok, z, v, th = _smooth_substep(dev, law, seg, a, b, (relax_rate, max_sub), z, v, th)
+                if not ok:
+                    # bristles stiffer than the step resolves: rejected as diverged
+                    return _diverged(out_z, out_v, store, i + 1)
         if not (abs(z) < zlim) or not (abs(v) < math.inf):
-            if store:
-                for r in range(i + 1, n):
-                    out_z[r] = math.nan
-                    out_v[r] = math.nan
-            return math.inf
+            return _diverged(out_z, out_v, store, i + 1)
         if have_ref and i + 1 >= skip:
             sse += (z - zref[i + 1]) ** 2
         if store:
@@ -388,41 +432,16 @@ def _run_one(
 
 
 @numba.njit(cache=True, parallel=True)
-def _run_batch(
-    params,
-    kind,
-    fn,
-    slip,
-    relax,
-    base_input,
-    u,
-    dt,
-    nsub,
-    linear,
-    z0,
-    v0,
-    th0,
-    zref,
-    skip,
-    zlim,
-    max_sub,
-    out_z,
-    out_v,
-    store,
-):
+def _run_batch(params, relax, state0, friction, drive, scoring, out_z, out_v, store):
+    # Without stored responses (store False) out_z, out_v are (1, 1), never written.
     n_pop = params.shape[0]
     sse = np.empty(n_pop)
     for i in numba.prange(n_pop):
-        if store:
-            sse[i] = _run_one(
-                params[i], kind, fn, slip, relax[i], base_input, u, dt, nsub, linear,
-                z0[i], v0[i], th0[i], zref, skip, zlim, max_sub, out_z[i], out_v[i], True,
-            )  # fmt: skip
-        else:
-            sse[i] = _run_one(
-                params[i], kind, fn, slip, relax[i], base_input, u, dt, nsub, linear,
-                z0[i], v0[i], th0[i], zref, skip, zlim, max_sub, out_z[0], out_v[0], False,
-            )  # fmt: skip
+        row = out_z[i] if store else out_z[0]
+        row_v = out_v[i] if store else out_v[0]
+        sse[i] = _run_one(
+            params[i], relax[i], state0[i], friction, drive, scoring, row, row_v, store
+        )
     return sse
 
 
@@ -630,35 +649,57 @@ def run_kernel(
     store=True,
     max_subcycles=4096,
 ):
-    """Low-level batched call; validated arguments. Returns (sse, z, v)."""
+    """Low-level batched call on validated arguments.
+
+    Parameters
+    ----------
+    matrix : ndarray, shape (n_pop, 4 + N_KERNEL_PARAMETERS)
+        Parameter rows from :func:`parameter_matrix`.
+    friction : str or FrictionModel subclass or None
+    drive, base_input
+        From :func:`driving_signal`.
+    dt : float
+        Sample interval (s).
+    reference : ndarray, optional
+        Measured z (m) to score the sum of squared errors against, from
+        sample ``skip`` on.
+    store : bool
+        Keep the responses (False during a search: only the errors are needed).
+    max_subcycles : int
+        Sub-cycles per sub-step a law with memory may take before the
+        candidate is rejected.
+
+    Returns
+    -------
+    sse : ndarray, shape (n_pop,)
+        Sums of squared errors (0 without a reference; inf when diverged).
+    z, v : ndarray, shape (n_pop, n), or None when not stored
+    """
     law = _law(friction)
     n_pop = matrix.shape[0]
     n = drive.shape[0]
-    z0 = np.broadcast_to(np.asarray(z0, dtype=float), (n_pop,)).copy()
-    v0 = np.broadcast_to(np.asarray(v0, dtype=float), (n_pop,)).copy()
-    th0 = np.broadcast_to(np.asarray(theta0, dtype=float), (n_pop,)).copy()
+    state0 = np.empty((n_pop, 3))
+    for j, value in enumerate((z0, v0, theta0)):
+        state0[:, j] = np.broadcast_to(np.asarray(value, dtype=float), (n_pop,))
     zref = np.empty(0) if reference is None else np.ascontiguousarray(reference, dtype=float)
     shape = (n_pop, n) if store else (1, 1)
     out_z = np.empty(shape)
     out_v = np.empty(shape)
-    sse = _run_batch(
-        np.ascontiguousarray(matrix),
+    kernel_friction = (
         KERNEL_NONE if law is None else law.kernel_code,
         kernel_callback(law),
-        0 if law is None else law.stick_slip,
-        np.zeros(n_pop) if law is None else law.kernel_relaxation_rate(matrix[:, 4:]),
-        bool(base_input),
-        drive,
-        float(dt),
-        int(substeps),
-        hold == "linear",
-        z0,
-        v0,
-        th0,
-        zref,
-        int(skip),
-        float(response_limit),
-        int(max_subcycles),
+        STICK_SLIP_NONE if law is None else law.stick_slip,
+    )
+    relax = np.zeros(n_pop) if law is None else law.kernel_relaxation_rate(matrix[:, 4:])
+    drive_args = (drive, float(dt), int(substeps), hold == "linear", bool(base_input))
+    scoring = (zref, int(skip), float(response_limit), int(max_subcycles))
+    sse = _run_batch(
+        np.ascontiguousarray(matrix),
+        np.ascontiguousarray(relax, dtype=float),
+        state0,
+        kernel_friction,
+        drive_args,
+        scoring,
         out_z,
         out_v,
         bool(store),
@@ -724,17 +765,7 @@ def simulate_record(
         # simulate_record(device, input_values, dt): the device names its law.
         friction, input_values, dt = None, friction, input_values
     parameters, friction = device_parameters(parameters, friction)
-    if input_values is None or dt is None:
-        raise ValueError("`input_values` and `dt` are required")
-    dt = float(check_positive("dt", dt, "s"))
-    substeps = check_int("substeps", substeps, minimum=1)
-    if hold not in HOLDS:
-        raise ValueError(f"`hold` must be one of {', '.join(HOLDS)}; got {hold!r}")
-    values = check_finite("input_values", input_values)
-    if values.ndim != 1 or values.shape[0] < 2:
-        raise ValueError(
-            f"`input_values` must be 1-D with at least 2 samples, got shape {values.shape}"
-        )
+    values, dt, substeps = _check_record_input(input_values, dt, substeps, hold)
     matrix = parameter_matrix(parameters, friction)
     drive, base_input = driving_signal(values, dt, input_kind, lowpass)
     _, z, v = run_kernel(
@@ -751,3 +782,19 @@ def simulate_record(
         response_limit=response_limit,
     )
     return BatchSimulation(time=np.arange(values.shape[0]) * dt, z=z, v=v)
+
+
+def _check_record_input(input_values, dt, substeps, hold):
+    """(values, dt, substeps) of :func:`simulate_record`, checked."""
+    if input_values is None or dt is None:
+        raise ValueError("`input_values` and `dt` are required")
+    dt = float(check_positive("dt", dt, "s"))
+    substeps = check_int("substeps", substeps, minimum=1)
+    if hold not in HOLDS:
+        raise ValueError(f"`hold` must be one of {', '.join(HOLDS)}; got {hold!r}")
+    values = check_finite("input_values", input_values)
+    if values.ndim != 1 or values.shape[0] < 2:
+        raise ValueError(
+            f"`input_values` must be 1-D with at least 2 samples, got shape {values.shape}"
+        )
+    return values, dt, substeps
