@@ -508,11 +508,9 @@ class CostFunction:
             out[name] = np.full(X.shape[0], float(value))
         return out
 
-    def __call__(self, X):
-        params = self.parameters(X)
-        matrix = parameter_matrix(params, self.friction)
-        start = time.perf_counter()
-        sse, _, _ = run_kernel(
+    def _run(self, matrix, **options):
+        """The compiled batch on this record's input, start and sub-steps."""
+        return run_kernel(
             matrix,
             self.friction,
             self.drive,
@@ -522,9 +520,18 @@ class CostFunction:
             hold=self.hold,
             z0=self.z0,
             v0=self.v0,
+            response_limit=self.limit,
+            **options,
+        )
+
+    def __call__(self, X):
+        params = self.parameters(X)
+        matrix = parameter_matrix(params, self.friction)
+        start = time.perf_counter()
+        sse, _, _ = self._run(
+            matrix,
             reference=self.record.z,
             skip=self.skip,
-            response_limit=self.limit,
             store=False,
             max_subcycles=SEARCH_SUBCYCLES,
         )
@@ -538,18 +545,7 @@ class CostFunction:
         if electrical is not None:
             params["c"] = params["c"] + electrical.electrical_damping
         matrix = parameter_matrix(params, self.friction)
-        _, z, v = run_kernel(
-            matrix,
-            self.friction,
-            self.drive,
-            self.base_input,
-            self.record.dt,
-            substeps=self.substeps,
-            hold=self.hold,
-            z0=self.z0,
-            v0=self.v0,
-            response_limit=self.limit,
-        )
+        _, z, v = self._run(matrix)
         return z[0], v[0]
 
 
