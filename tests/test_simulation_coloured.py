@@ -79,7 +79,7 @@ def case_coarse_discrete(scheme, excitation, seed):
     r = simulate(
         SLOW,
         excitation,
-        t_end=440.0,
+        t_end=480.0,
         dt=dt,
         n_paths=4000,
         burn_in=20.0,

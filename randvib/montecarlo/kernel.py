@@ -182,7 +182,7 @@ class Recording(NamedTuple):
 
 
 class Shaping(NamedTuple):
-    """The excitation's shaping filter, integrated with the device (``states`` 2), or none (0).
+    """The excitation's 2-state shaping filter, integrated with the device.
 
     White noise has no filter state: the velocity takes the noise increment
     (:func:`scheme_step`). A rational spectrum (band-pass, Kanai-Tajimi) is
@@ -192,7 +192,6 @@ class Shaping(NamedTuple):
     m z'' = ... - m y; :func:`filtered_step`).
     """
 
-    states: int  #: 0 (white noise) or 2
     coefficients: np.ndarray  #: float64[8]: A (row-major), G, C
     start: np.ndarray  #: float64[3]: (l11, l21, l22), Cholesky factor of the filter's covariance
 
@@ -380,8 +379,8 @@ def run_ensemble(
         Histograms and recorded histories.
     noise : Noise
         Given increments or the ziggurat tables.
-    shaping : Shaping
-        The excitation's filter states (none for white noise). With a random
+    shaping : Shaping or None
+        The excitation's filter; None for white noise. With a random
         start the filter starts from its own stationary law (two more draws
         per path, after the device's).
 
@@ -402,11 +401,13 @@ def run_ensemble(
     with_companion, comp_init_z, comp_init_v = companion
     hist_lo, hist_hi, hist_bins, n_record, record_every = recording
     dw, ki, wi, fi = noise
-    # Chosen once: white noise keeps the plain step (and its speed, bit for bit).
-    coloured = shaping.states > 0
-    sc = shaping.coefficients
-    filt = (sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7])
-    l11, l21, l22 = shaping.start[0], shaping.start[1], shaping.start[2]
+    # `shaping is None` is decided when compiling (numba prunes the dead branch
+    # for a None argument): white noise runs the plain loop, bit for bit and at
+    # its own speed; a filter compiles a second specialisation.
+    if shaping is not None:
+        sc = shaping.coefficients
+        filt = (sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7])
+        l11, l21, l22 = shaping.start[0], shaping.start[1], shaping.start[2]
     n_chunks = (n_paths + LANES - 1) // LANES
     acc = np.zeros((n_paths, N_ACC))
     failed = np.full(n_paths, -1, dtype=np.int64)
@@ -443,7 +444,7 @@ def run_ensemble(
                 v[j] = init_v * nv
                 zc[j] = comp_init_z * nz
                 vc[j] = comp_init_v * nv
-                if coloured:
+                if shaping is not None:
                     n1 = standard_normal(rng, j, ki, wi, fi)
                     n2 = standard_normal(rng, j, ki, wi, fi)
                     x1[j] = l11 * n1
@@ -468,7 +469,7 @@ def run_ensemble(
                 zj = z[j]
                 vj = v[j]
                 tj = th[j]
-                if coloured:
+                if shaping is not None:
                     zn, vn, tn, x1[j], x2[j], f1 = filtered_step(
                         zj,
                         vj,

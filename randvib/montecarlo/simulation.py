@@ -871,7 +871,7 @@ class _KernelSetup:
     initial: kernel.Start
     companion: kernel.Companion
     recording: kernel.Recording
-    shaping: kernel.Shaping
+    shaping: kernel.Shaping | None
 
     @classmethod
     def prepare(cls, run: _Run) -> _KernelSetup:
@@ -907,22 +907,22 @@ class _KernelSetup:
         )
 
 
-def _shaping(excitation: Excitation) -> kernel.Shaping:
-    """The kernel's filter group: none for white noise, else (A, G, C) and a start.
+def _shaping(excitation: Excitation) -> kernel.Shaping | None:
+    """The kernel's filter group: None for white noise, else (A, G, C) and a start.
 
     The filter's states start (with a random start) from their exact
     stationary law N(0, P), P from A P + P A^T + q G G^T = 0; the kernel
     draws them as the Cholesky factor of P times two standard normals.
     """
     if excitation.is_white:
-        return kernel.pack(kernel.Shaping, 0, np.zeros(8), np.zeros(3))
+        return None
     shaping = excitation.shaping_filter()
     system = shaping.system
     q = shaping.noise_intensity
     cov = linalg.solve_continuous_lyapunov(system.a, -q * np.outer(system.b, system.b))
     chol = np.linalg.cholesky(cov)
     coefficients = np.concatenate([system.a.ravel(), system.b, system.c[0]])
-    return kernel.pack(kernel.Shaping, 2, coefficients, [chol[0, 0], chol[1, 0], chol[1, 1]])
+    return kernel.pack(kernel.Shaping, coefficients, [chol[0, 0], chol[1, 0], chol[1, 1]])
 
 
 def _start_states(run: _Run) -> tuple[kernel.Start, kernel.Companion]:
