@@ -276,6 +276,7 @@ def as_excitation(value) -> Excitation:
 COLOURED_METHODS = (
     "statistical linearisation (randvib.statistical_linearisation, or "
     "predict/expected_power with method='linearisation')",
+    "Monte Carlo (randvib.simulate) for band-pass and Kanai-Tajimi spectra",
 )
 
 

@@ -181,6 +181,21 @@ class Recording(NamedTuple):
     every: int
 
 
+class Shaping(NamedTuple):
+    """The excitation's 2-state shaping filter, integrated with the device.
+
+    White noise has no filter state: the velocity takes the noise increment
+    (:func:`scheme_step`). A rational spectrum (band-pass, Kanai-Tajimi) is
+    the output y = C x of a 2-state filter x' = A x + G w of the same white
+    noise (:meth:`randvib.models.excitation.Excitation.shaping_filter`), and
+    the device's acceleration takes -y, its base acceleration (paper Eq. 18,
+    m z'' = ... - m y; :func:`filtered_step`).
+    """
+
+    coefficients: np.ndarray  #: float64[8]: A (row-major), G, C
+    start: np.ndarray  #: float64[3]: (l11, l21, l22), Cholesky factor of the filter's covariance
+
+
 class Noise(NamedTuple):
     """Where the Brownian increments come from.
 
@@ -277,8 +292,70 @@ def scheme_step(z, v, theta, dt, noise, weights, drift, kind, p, fn):
     )
 
 
+@numba.njit(cache=True, inline="always")
+def filtered_step(z, v, theta, x1, x2, dt, noise, weights, drift, kind, p, fn, shaping):
+    """:func:`scheme_step` for the device driven through a 2-state shaping filter.
+
+    The augmented state (z, v, theta, x1, x2) takes the same additive-noise
+    step: the noise increment enters the filter states (``G noise``), the
+    device's acceleration gets the base acceleration -C x of the filter. The
+    filter is linear, so the scheme's orders hold for the augmented system
+    and :meth:`Integrator.linear_recursion` gives its exact recursion on a
+    linear device.
+
+    Parameters
+    ----------
+    z, v, theta, dt, noise, weights, drift, kind, p, fn
+        As for :func:`scheme_step`; ``noise`` is sqrt(S/2) dW, S the filter's
+        input level.
+    x1, x2 : float
+        Filter states.
+    shaping : tuple of 8 floats
+        ``(a11, a12, a21, a22, g1, g2, c1, c2)`` of :class:`Shaping`.
+
+    Returns
+    -------
+    z, v, theta, x1, x2 : float
+        State after the step.
+    force : float
+        Friction force at the start of the step (N).
+    """
+    b1, b2 = weights
+    a11, a12, a21, a22, g1, g2, c1, c2 = shaping
+    acc1, rate1, force = _acceleration(z, v, theta, drift, kind, p, fn)
+    acc1 -= c1 * x1 + c2 * x2
+    d1 = a11 * x1 + a12 * x2
+    d2 = a21 * x1 + a22 * x2
+    if b2 == 0.0:
+        return (
+            z + b1 * v * dt,
+            v + b1 * acc1 * dt,
+            theta + b1 * rate1 * dt,
+            x1 + b1 * d1 * dt + g1 * noise,
+            x2 + b1 * d2 * dt + g2 * noise,
+            force,
+        )
+    zp = z + v * dt
+    vp = v + acc1 * dt
+    tp = theta + rate1 * dt
+    x1p = x1 + d1 * dt + g1 * noise
+    x2p = x2 + d2 * dt + g2 * noise
+    acc2, rate2, _ = _acceleration(zp, vp, tp, drift, kind, p, fn)
+    acc2 -= c1 * x1p + c2 * x2p
+    return (
+        z + (b1 * v + b2 * vp) * dt,
+        v + (b1 * acc1 + b2 * acc2) * dt,
+        theta + (b1 * rate1 + b2 * rate2) * dt,
+        x1 + (b1 * d1 + b2 * (a11 * x1p + a12 * x2p)) * dt + g1 * noise,
+        x2 + (b1 * d2 + b2 * (a21 * x1p + a22 * x2p)) * dt + g2 * noise,
+        force,
+    )
+
+
 @numba.njit(cache=True, parallel=True)
-def run_ensemble(scheme, device, friction, timing, paths, initial, companion, recording, noise):
+def run_ensemble(
+    scheme, device, friction, timing, paths, initial, companion, recording, noise, shaping
+):
     """Integrate ``paths.count`` paths and return per-path time averages.
 
     Parameters
@@ -302,6 +379,10 @@ def run_ensemble(scheme, device, friction, timing, paths, initial, companion, re
         Histograms and recorded histories.
     noise : Noise
         Given increments or the ziggurat tables.
+    shaping : Shaping or None
+        The excitation's filter; None for white noise. With a random
+        start the filter starts from its own stationary law (two more draws
+        per path, after the device's).
 
     Returns
     -------
@@ -320,6 +401,13 @@ def run_ensemble(scheme, device, friction, timing, paths, initial, companion, re
     with_companion, comp_init_z, comp_init_v = companion
     hist_lo, hist_hi, hist_bins, n_record, record_every = recording
     dw, ki, wi, fi = noise
+    # `shaping is None` is decided when compiling (numba prunes the dead branch
+    # for a None argument): white noise runs the plain loop, bit for bit and at
+    # its own speed; a filter compiles a second specialisation.
+    if shaping is not None:
+        sc = shaping.coefficients
+        filt = (sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7])
+        l11, l21, l22 = shaping.start[0], shaping.start[1], shaping.start[2]
     n_chunks = (n_paths + LANES - 1) // LANES
     acc = np.zeros((n_paths, N_ACC))
     failed = np.full(n_paths, -1, dtype=np.int64)
@@ -344,6 +432,8 @@ def run_ensemble(scheme, device, friction, timing, paths, initial, companion, re
         th = np.zeros(LANES)
         zc = np.zeros(LANES)
         vc = np.zeros(LANES)
+        x1 = np.zeros(LANES)
+        x2 = np.zeros(LANES)
         a = np.zeros((LANES, N_ACC))
         for j in range(lanes):
             seed_path_state(seed, first_path + start + j, rng, j)
@@ -354,6 +444,11 @@ def run_ensemble(scheme, device, friction, timing, paths, initial, companion, re
                 v[j] = init_v * nv
                 zc[j] = comp_init_z * nz
                 vc[j] = comp_init_v * nv
+                if shaping is not None:
+                    n1 = standard_normal(rng, j, ki, wi, fi)
+                    n2 = standard_normal(rng, j, ki, wi, fi)
+                    x1[j] = l11 * n1
+                    x2[j] = l21 * n1 + l22 * n2
             else:
                 z[j] = init_z
                 v[j] = init_v
@@ -374,9 +469,26 @@ def run_ensemble(scheme, device, friction, timing, paths, initial, companion, re
                 zj = z[j]
                 vj = v[j]
                 tj = th[j]
-                zn, vn, tn, f1 = scheme_step(
-                    zj, vj, tj, dt, noise, scheme, drift, fr_kind, fr_p, fr_fn
-                )
+                if shaping is not None:
+                    zn, vn, tn, x1[j], x2[j], f1 = filtered_step(
+                        zj,
+                        vj,
+                        tj,
+                        x1[j],
+                        x2[j],
+                        dt,
+                        noise,
+                        scheme,
+                        drift,
+                        fr_kind,
+                        fr_p,
+                        fr_fn,
+                        filt,
+                    )
+                else:
+                    zn, vn, tn, f1 = scheme_step(
+                        zj, vj, tj, dt, noise, scheme, drift, fr_kind, fr_p, fr_fn
+                    )
                 if in_window:
                     if n == n_burn:
                         a[j, ACC_H0] = 0.5 * m * vj * vj + 0.5 * k * zj * zj + 0.25 * k3 * zj**4

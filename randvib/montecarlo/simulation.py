@@ -1,4 +1,4 @@
-"""Monte Carlo simulation of the white-noise driven harvester: ``simulate``.
+"""Monte Carlo simulation of the harvester under white or rational noise: ``simulate``.
 
 The SDE (docs/conventions.md, paper Eq. 1 and 15-17) for the state (z, v = z') and,
 for LuGre friction, the bristle state theta:
@@ -6,6 +6,13 @@ for LuGre friction, the bristle state theta:
     dz = v dt
     dv = -(c v + k z + k3 z^3 + F(v, theta)) / m dt + sqrt(S/2) dW
     dtheta = theta'(v, theta) dt
+
+with sqrt(S/2) dW the paper's white base acceleration (Eq. 17). Under a
+rational spectrum (band-pass, Kanai-Tajimi) the base acceleration is instead
+the output y of the spectrum's 2-state shaping filter driven by that white
+noise, and dv gets -y dt in place of the noise (paper Eq. 18 with a
+coloured base); the filter states are integrated with the device by the same
+scheme (:func:`randvib.montecarlo.kernel.filtered_step`).
 
 Each path is an independent realisation; statistics are time averages over
 the window [burn_in, t_end) on each path, and their confidence intervals come
@@ -23,11 +30,13 @@ from dataclasses import dataclass, field
 
 import numba
 import numpy as np
-from scipy import special  # Student t quantile; lighter than scipy.stats
+from scipy import linalg, special  # Student t quantile; lighter than scipy.stats
 
 from randvib._validation import check_choice, check_int, check_positive
 from randvib.analytic import exact_solutions as exact
+from randvib.analytic.linear_response import mechanical_block
 from randvib.analytic.linearisation import equivalent_damping, linear_displacement_variance
+from randvib.models.excitation import Excitation, ShapingFilter, as_excitation
 from randvib.models.friction import kernel_arguments
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import integrators, kernel
@@ -182,6 +191,20 @@ class SimulationResult:
     histogram: Histogram | None = field(default=None, repr=False)
     histories: Histories | None = field(default=None, repr=False)
     wall_time: float = 0.0
+    #: The excitation simulated; None stands for white noise of level ``psd``.
+    excitation: Excitation | None = None
+
+    @property
+    def is_white(self) -> bool:
+        """True when the base acceleration was ideal white noise (level ``psd``)."""
+        return self.excitation is None or self.excitation.is_white
+
+    def _require_white(self, what: str) -> None:
+        if not self.is_white:
+            raise ValueError(
+                f"{what} rest on the white-noise energy balance (c E[v^2] + E[vF] = S m/4); "
+                f"this result was simulated under {self.excitation.name} excitation"
+            )
 
     @property
     def n_paths(self) -> int:
@@ -219,6 +242,7 @@ class SimulationResult:
           z^2 minus their exact values (S m / (4c), Gibbs E[z^2]): same noise,
           exactly known mean in continuous time (bias O(dt) at finite step).
         """
+        self._require_white("the control variates")
         h = self.harvester
         avg = self.averages
         cols = avg.energy_balance_controls(self.averaging_time)
@@ -267,7 +291,8 @@ class SimulationResult:
         return self.statistic(self.harvester.c_e * e.load_fraction * self.averages.v2)
 
     def energy_balance_residual(self) -> Statistic:
-        """c E[v^2] + E[v F] - S m / 4 (W): zero up to O(dt) and noise."""
+        """c E[v^2] + E[v F] - S m / 4 (W): zero up to O(dt) and noise (white noise only)."""
+        self._require_white("the energy-balance residual and its S m / 4")
         h = self.harvester
         return self.statistic(
             h.c * self.averages.v2 + self.averages.friction_power - self.psd * h.m / 4.0
@@ -298,6 +323,9 @@ class SimulationResult:
             control_variates=self.control_variates,
             wall_time=self.wall_time,
         )
+        # Added with coloured input (issue 10); `psd` stays the level S.
+        excitation = self.excitation or as_excitation(self.psd)
+        out["excitation"] = excitation.parameters()
         return out
 
 
@@ -321,8 +349,8 @@ def effective_linear_device(harvester: Harvester, psd: float) -> tuple[float, fl
     return float(h.k + 3.0 * h.k3 * z2), c_eff
 
 
-def step_bias(scheme: str, harvester: Harvester, psd: float, dt: float) -> float:
-    """Relative bias of the scheme's stationary E[v^2] on the linearised device.
+def step_bias(scheme: str, harvester: Harvester, psd, dt: float) -> float:
+    """Relative bias of the scheme's stationary variances on the linearised device.
 
     The scheme applied to ``m z'' + c_eff z' + k_eff z = m w`` is a linear
     Gaussian recursion whose stationary variance is exact
@@ -331,9 +359,19 @@ def step_bias(scheme: str, harvester: Harvester, psd: float, dt: float) -> float
     x / (1 - x) with x = k_eff dt / c_eff (energy gain per step against
     damping), so it needs far smaller steps than Heun on lightly damped
     devices. Returns inf where the recursion is unstable.
+
+    Under a rational spectrum (``psd`` a band-pass or Kanai-Tajimi
+    excitation) the recursion is that of the linearised device with the
+    filter's states (:func:`_augmented_bias`), and the bias is the largest
+    of those of E[y^2] (the filter's own), E[z^2] and E[v^2]; the linearised
+    device is the white-noise one at the excitation's level, as for white noise.
     """
-    k_eff, c_eff = effective_linear_device(harvester, psd)
-    return _scheme_bias(scheme, float(harvester.m), k_eff, c_eff, psd, dt)
+    excitation = as_excitation(psd)
+    k_eff, c_eff = effective_linear_device(harvester, excitation.level)
+    m = float(harvester.m)
+    if excitation.is_white:
+        return _scheme_bias(scheme, m, k_eff, c_eff, excitation.level, dt)
+    return _augmented_bias(scheme, m, k_eff, c_eff, excitation.shaping_filter(), dt)
 
 
 def _scheme_bias(scheme, m, k_eff, c_eff, psd, dt) -> float:
@@ -345,42 +383,95 @@ def _scheme_bias(scheme, m, k_eff, c_eff, psd, dt) -> float:
     return abs(cov[1, 1] / exact.linear_velocity_variance(m, c_eff, psd) - 1.0)
 
 
-def largest_step(
-    scheme: str, harvester: Harvester, psd: float, bias: float = MAX_STEP_BIAS
-) -> float:
+def _augmented_system(m, k_eff, c_eff, shaping: ShapingFilter):
+    """(F, G, C) of the linear device driven through ``shaping``: dx = F x dt + G dW.
+
+    States (filter, z, v); the rows of C pick y (the base acceleration), z, v.
+    """
+    system = mechanical_block(m, c_eff, k_eff).driven_by(shaping.system, "acceleration")
+    n_filter = shaping.system.n_states
+    pick = np.zeros((3, system.n_states))
+    pick[0, :n_filter] = shaping.system.c[0]
+    pick[1:, n_filter:] = np.eye(2)
+    g = np.sqrt(shaping.noise_intensity) * system.b[:, None]
+    return system.a, g, pick
+
+
+def _augmented_bias(scheme, m, k_eff, c_eff, shaping: ShapingFilter, dt) -> float:
+    """Largest relative bias of E[y^2], E[z^2], E[v^2] of the scheme on device + filter.
+
+    The scheme's exact recursion x_{n+1} = A x_n + B dW_n
+    (:meth:`Integrator.linear_recursion`) has the stationary covariance
+    P = A P A^T + dt B B^T, against the continuous Lyapunov F P + P F^T + G G^T = 0.
+    """
+    f, g, pick = _augmented_system(m, k_eff, c_eff, shaping)
+    a, b = integrators.integrator(scheme).linear_recursion(f, g, dt)
+    if max(abs(np.linalg.eigvals(a))) >= 1:
+        return float("inf")
+    discrete = np.diag(pick @ linalg.solve_discrete_lyapunov(a, dt * (b @ b.T)) @ pick.T)
+    continuous = np.diag(pick @ linalg.solve_continuous_lyapunov(f, -(g @ g.T)) @ pick.T)
+    return float(np.max(np.abs(discrete / continuous - 1.0)))
+
+
+def largest_step(scheme: str, harvester: Harvester, psd, bias: float = MAX_STEP_BIAS) -> float:
     """Largest dt (s) whose :func:`step_bias` stays below ``bias`` (bisection)."""
-    k_eff, c_eff = effective_linear_device(harvester, psd)  # once, not per bisection step
+    excitation = as_excitation(psd)
+    k_eff, c_eff = effective_linear_device(harvester, excitation.level)  # once, not per step
     m = float(harvester.m)
     lo, hi = 0.0, 2.0 / np.sqrt(k_eff / m)
+    if excitation.is_white:
+
+        def bias_at(dt):
+            return _scheme_bias(scheme, m, k_eff, c_eff, excitation.level, dt)
+
+    else:
+        shaping = excitation.shaping_filter()
+        hi = min(hi, 2.0 / max(abs(np.linalg.eigvals(shaping.system.a))))
+
+        def bias_at(dt):
+            return _augmented_bias(scheme, m, k_eff, c_eff, shaping, dt)
+
     for _ in range(60):
         mid = 0.5 * (lo + hi)
-        if _scheme_bias(scheme, m, k_eff, c_eff, psd, mid) <= bias:
+        if bias_at(mid) <= bias:
             lo = mid
         else:
             hi = mid
     return lo
 
 
-def _linearised_spread(harvester: Harvester, psd: float) -> tuple[float, float]:
-    """(std of z (m), std of v (m/s)) of the linearised stationary state (Eq. 20, 30)."""
-    c_eff = effective_linear_device(harvester, psd)[1]
+def _linearised_spread(harvester: Harvester, excitation: Excitation) -> tuple[float, float]:
+    """(std of z (m), std of v (m/s)) of the linearised stationary state.
+
+    White noise: Eq. 20 and 30. A rational spectrum: the Lyapunov covariance of
+    the same linearised device driven through the excitation's filter.
+    """
+    psd = excitation.level
+    k_eff, c_eff = effective_linear_device(harvester, psd)
+    if not excitation.is_white:
+        f, g, pick = _augmented_system(
+            float(harvester.m), k_eff, c_eff, excitation.shaping_filter()
+        )
+        cov = pick @ linalg.solve_continuous_lyapunov(f, -(g @ g.T)) @ pick.T
+        return float(np.sqrt(cov[1, 1])), float(np.sqrt(cov[2, 2]))
     vv = psd * harvester.m / (4.0 * c_eff)
     return float(np.sqrt(linear_displacement_variance(harvester, vv))), float(np.sqrt(vv))
 
 
-def _check_step(scheme, harvester, psd, dt):
-    bias = step_bias(scheme, harvester, psd, dt)
+def _check_step(scheme, harvester, excitation, dt):
+    bias = step_bias(scheme, harvester, excitation, dt)
+    resolves = "" if excitation.is_white else f" with the {excitation.name} filter's states"
     if bias > MAX_STEP_BIAS:
-        limit = largest_step(scheme, harvester, psd)
+        limit = largest_step(scheme, harvester, excitation)
         raise ValueError(
-            f"`dt` = {dt!r} s is too large for this device with {scheme}: on the linearised "
-            f"device its stationary variance is off by {bias:.3g} (allowed {MAX_STEP_BIAS:.0%}); "
-            f"use dt <= {limit:.3g} s"
+            f"`dt` = {dt!r} s is too large for this device{resolves} with {scheme}: on the "
+            f"linearised device its stationary variance is off by {bias:.3g} "
+            f"(allowed {MAX_STEP_BIAS:.0%}); use dt <= {limit:.3g} s"
         )
     if bias > WARN_STEP_BIAS:
         warnings.warn(
             f"dt = {dt!r} s gives {scheme} a stationary-variance bias of about {bias:.2%} "
-            "on the linearised device",
+            f"on the linearised device{resolves}",
             StepSizeWarning,
             stacklevel=3,
         )
@@ -514,6 +605,7 @@ class _Run:
 
     harvester: Harvester
     psd: float
+    excitation: Excitation
     scheme: Integrator
     grid: TimeGrid
     n_paths: int
@@ -528,7 +620,7 @@ class _Run:
 # ----------------------------------------------------------------- simulate
 def simulate(
     harvester: Harvester,
-    psd: float,
+    psd: float | Excitation,
     *,
     t_end: float,
     dt: float,
@@ -551,15 +643,23 @@ def simulate(
     check_step: bool = True,
     method: str | None = None,
 ) -> SimulationResult:
-    """Simulate an ensemble of the white-noise driven harvester.
+    """Simulate an ensemble of the harvester under white or rational base excitation.
 
     Parameters
     ----------
     harvester : Harvester
         Device with scalar parameters; any friction model.
-    psd : float
+    psd : float or Excitation
         One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0: the velocity
-        noise is sqrt(S/2) dW (paper Eq. 17).
+        noise is sqrt(S/2) dW (paper Eq. 17). Or an excitation
+        (:mod:`randvib.models.excitation`): ``White`` as a number;
+        ``BandPass`` and ``KanaiTajimi`` through their shaping filter's two
+        states, driven by sqrt(S/2) dW (S their ``level``) and integrated with
+        the device by the same scheme. Non-rational spectra (``BandLimited``,
+        ``Tabulated``, ``Measured``) are refused: use
+        :func:`randvib.statistical_linearisation`. Under coloured input the
+        companion and the control variates (white-noise energy balance) are
+        refused, and the step check covers the filter too.
     t_end : float
         Simulated time per path (s), burn-in included.
     dt : float
@@ -585,9 +685,10 @@ def simulate(
         first_path = n_paths continues the same ensemble.
     companion : bool
         Integrate the friction-free device with the same noise alongside
-        (control variates, :meth:`SimulationResult.controls`).
+        (control variates, :meth:`SimulationResult.controls`); white noise only.
     control_variates : bool
-        Report control-variate estimates (plain path means otherwise).
+        Report control-variate estimates (plain path means otherwise); white
+        noise only.
     histogram_bins, histogram_range
         Stationary histograms of z and v: number of bins and
         ((z_lo, z_hi), (v_lo, v_hi)) (default +-5 linearised std).
@@ -625,8 +726,9 @@ def simulate(
         companion=companion,
         record=(histogram_bins, histogram_range, record_paths, record_every),
     )
+    _check_coloured_options(run.excitation, run.companion, control_variates)
     if check_step:
-        _check_step(run.scheme.name, run.harvester, run.psd, run.grid.dt)
+        _check_step(run.scheme.name, run.harvester, run.excitation, run.grid.dt)
     setup = _KernelSetup.prepare(run)
     if threads is not None:
         threads = check_int("threads", threads, 1)
@@ -651,6 +753,7 @@ def simulate(
         histogram=_histogram(setup.recording, hist_total, run.n_paths * run.grid.window_steps),
         histories=_histories(records, run.record.record_every, run.grid.dt),
         wall_time=wall,
+        excitation=run.excitation,
     )
 
 
@@ -682,12 +785,13 @@ def _validated(
         if np.ndim(getattr(harvester, name)) != 0:
             raise ValueError(f"simulate needs scalar harvester parameters; `{name}` is an array")
     scheme = integrator(*scheme_argument)
-    psd = float(check_positive("psd", psd, "(m/s^2)^2/Hz"))
+    excitation = _simulated_excitation(psd)
     grid = TimeGrid.from_times(t_end, dt, burn_in)
     n_paths = check_int("n_paths", n_paths, 1)
     return _Run(
         harvester=harvester,
-        psd=psd,
+        psd=excitation.level,
+        excitation=excitation,
         scheme=scheme,
         grid=grid,
         n_paths=n_paths,
@@ -698,6 +802,43 @@ def _validated(
         dW=_checked_increments(dW, n_paths, grid.n_steps),
         companion=bool(companion),
     )
+
+
+def _simulated_excitation(psd) -> Excitation:
+    """``psd`` as an excitation that :func:`simulate` can integrate, or a clear refusal.
+
+    White noise and the rational spectra with a 2-state shaping filter
+    (band-pass, Kanai-Tajimi) are simulated; the others have no filter.
+    """
+    if not isinstance(psd, Excitation):
+        return as_excitation(float(check_positive("psd", psd, "(m/s^2)^2/Hz")))
+    shaping = psd.shaping_filter()
+    if psd.is_white:
+        return psd
+    if shaping is None or shaping.system.n_states != 2 or np.any(shaping.system.d != 0):
+        raise ValueError(
+            f"simulate integrates white noise and rational spectra (band-pass, kanai-tajimi) "
+            f"through their shaping filter; the {psd.name} excitation has none: use "
+            "randvib.statistical_linearisation, which accepts any spectrum"
+        )
+    return psd
+
+
+def _check_coloured_options(excitation: Excitation, companion: bool, control_variates: bool):
+    """Refuse the white-noise-only options under coloured input, saying why."""
+    if excitation.is_white:
+        return
+    if companion:
+        raise ValueError(
+            "`companion` needs white noise: the friction-free companion's exact moments "
+            f"(S m/(4c), Gibbs E[z^2]) do not hold under {excitation.name} excitation"
+        )
+    if control_variates:
+        raise ValueError(
+            "`control_variates` needs white noise: the controls come from the white-noise "
+            "energy balance (c E[v^2] + E[vF] = S m/4), which does not hold under "
+            f"{excitation.name} excitation; use control_variates=False"
+        )
 
 
 def _checked_increments(dW, n_paths, n_steps):
@@ -730,6 +871,7 @@ class _KernelSetup:
     initial: kernel.Start
     companion: kernel.Companion
     recording: kernel.Recording
+    shaping: kernel.Shaping | None
 
     @classmethod
     def prepare(cls, run: _Run) -> _KernelSetup:
@@ -744,6 +886,7 @@ class _KernelSetup:
             initial=initial,
             companion=companion,
             recording=_recording(run),
+            shaping=_shaping(run.excitation),
         )
 
     def arguments(self, run: _Run, lo: int, hi: int) -> dict:
@@ -760,14 +903,33 @@ class _KernelSetup:
             companion=self.companion,
             recording=self.recording._replace(n_record=n_record),
             noise=kernel.Noise(dw, ZIG_KI, ZIG_WI, ZIG_FI),
+            shaping=self.shaping,
         )
+
+
+def _shaping(excitation: Excitation) -> kernel.Shaping | None:
+    """The kernel's filter group: None for white noise, else (A, G, C) and a start.
+
+    The filter's states start (with a random start) from their exact
+    stationary law N(0, P), P from A P + P A^T + q G G^T = 0; the kernel
+    draws them as the Cholesky factor of P times two standard normals.
+    """
+    if excitation.is_white:
+        return None
+    shaping = excitation.shaping_filter()
+    system = shaping.system
+    q = shaping.noise_intensity
+    cov = linalg.solve_continuous_lyapunov(system.a, -q * np.outer(system.b, system.b))
+    chol = np.linalg.cholesky(cov)
+    coefficients = np.concatenate([system.a.ravel(), system.b, system.c[0]])
+    return kernel.pack(kernel.Shaping, coefficients, [chol[0, 0], chol[1, 0], chol[1, 1]])
 
 
 def _start_states(run: _Run) -> tuple[kernel.Start, kernel.Companion]:
     """Initial states of the device and of its friction-free companion."""
     h, psd = run.harvester, run.psd
     random = run.initial.kind == "stationary"
-    z, v = _linearised_spread(h, psd) if random else (run.initial.z, run.initial.v)
+    z, v = _linearised_spread(h, run.excitation) if random else (run.initial.z, run.initial.v)
     # The friction-free companion starts from its own stationary spread (exact
     # Gaussian velocity, Gibbs displacement variance), so its known moments
     # hold from t = 0 and its control mean is right without a long burn-in.
@@ -791,7 +953,7 @@ def _recording(run: _Run) -> kernel.Recording:
     else:
         ranges = run.record.histogram_range
         if ranges is None:
-            sz, sv = _linearised_spread(run.harvester, run.psd)
+            sz, sv = _linearised_spread(run.harvester, run.excitation)
             ranges = ((-5 * sz, 5 * sz), (-5 * sv, 5 * sv))
         arr = np.asarray(ranges, dtype=float)
         lo, hi = arr[:, 0], arr[:, 1]

@@ -1,0 +1,68 @@
+"""Seed calibration of the Monte Carlo assertions in tests/test_simulation_coloured.py.
+
+Run by hand (not collected by pytest), from the repository root:
+
+    NUMBA_NUM_THREADS=1 python tests/calibration/coloured.py [n_seeds] [name ...]
+
+For every exact comparison (``case_*`` in the test module: the coarse-step
+cases against the scheme's discrete Lyapunov covariance, the fine-step cases
+against the continuous one) it reruns the statistic over seeds 1000, 1001, ...
+and prints, per assertion, the number of seeds, the mean and standard
+deviation of the z-scores and the largest |z| (calibrated: mean near 0, SD
+near 1, no |z| above 4), plus the smallest power margin (detect * |reference|
+/ standard error, which must be >= 6). Names: the keys of COARSE (coarse-...)
+and FINE (fine-...) in the test module.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # this checkout's randvib
+
+import test_simulation_coloured as t  # noqa: E402
+from _stats import z_score  # noqa: E402
+
+CASES = {
+    **{
+        f"coarse-{name}": (lambda s, a=args: t.case_coarse_discrete(*a, s))
+        for name, args in t.COARSE.items()
+    },
+    **{
+        f"fine-{name}": (lambda s, e=ex: t.case_fine_continuous(e, s))
+        for name, ex in t.FINE.items()
+    },
+}
+
+
+def calibrate(name, case, seeds):
+    zs, margins = {}, {}
+    for seed in seeds:
+        for what, stat, ref, bias, detect in case(seed):
+            zs.setdefault(what, []).append(z_score(stat, ref, bias))
+            margins.setdefault(what, []).append(detect * abs(ref) / stat.std_error)
+    for what, z in zs.items():
+        z = np.array(z)
+        print(
+            f"{name:24s} {what:10s} seeds {z.size:4d}  mean z {z.mean():+.3f}  "
+            f"SD {z.std(ddof=1):.3f}  max|z| {np.abs(z).max():.2f}  "
+            f"min power margin {min(margins[what]):.2f} SE",
+            flush=True,
+        )
+
+
+def main():
+    n = int(sys.argv[1]) if len(sys.argv) > 1 else 40
+    only = sys.argv[2:] or None
+    for name, case in CASES.items():
+        if only and name not in only:
+            continue
+        calibrate(name, case, range(1000, 1000 + n))
+
+
+if __name__ == "__main__":
+    main()
