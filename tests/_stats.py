@@ -80,3 +80,30 @@ def assert_matches(
         f"threshold {n_sigma} sigma)"
     )
     return z
+
+
+def calibrate(name: str, case, seeds, widths=(24, 20)) -> dict:
+    """Rerun a test's statistic over ``seeds`` and print its z-scores' calibration.
+
+    ``case(seed)`` yields ``(what, stat, reference, known_bias, detect)`` rows, as the
+    tests' ``case_*`` functions do. Prints, per row name, the number of seeds, the mean,
+    standard deviation and largest |z| (calibrated: mean near 0, SD near 1) and the
+    smallest power margin ``detect * |reference| / SE`` (>= 6 for ``assert_matches``).
+    Used by the scripts in ``tests/calibration/``; returns the z-scores by row name.
+    """
+    import numpy as np
+
+    zs, margins = {}, {}
+    for seed in seeds:
+        for what, stat, ref, bias, detect in case(seed):
+            zs.setdefault(what, []).append(z_score(stat, ref, bias))
+            margins.setdefault(what, []).append(detect * abs(ref) / stat.std_error)
+    for what, z in zs.items():
+        z = np.array(z)
+        print(
+            f"{name:{widths[0]}s} {what:{widths[1]}s} seeds {z.size:4d}  mean z {z.mean():+.3f}  "
+            f"SD {z.std(ddof=1):.3f}  max|z| {np.abs(z).max():.2f}  "
+            f"min power margin {min(margins[what]):.2f} SE",
+            flush=True,
+        )
+    return zs

@@ -19,13 +19,11 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-import numpy as np
-
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # this checkout's randvib
 
 import test_simulation_coloured as t  # noqa: E402
-from _stats import z_score  # noqa: E402
+from _stats import calibrate as _calibrate  # noqa: E402
 
 CASES = {
     **{
@@ -40,19 +38,7 @@ CASES = {
 
 
 def calibrate(name, case, seeds):
-    zs, margins = {}, {}
-    for seed in seeds:
-        for what, stat, ref, bias, detect in case(seed):
-            zs.setdefault(what, []).append(z_score(stat, ref, bias))
-            margins.setdefault(what, []).append(detect * abs(ref) / stat.std_error)
-    for what, z in zs.items():
-        z = np.array(z)
-        print(
-            f"{name:24s} {what:10s} seeds {z.size:4d}  mean z {z.mean():+.3f}  "
-            f"SD {z.std(ddof=1):.3f}  max|z| {np.abs(z).max():.2f}  "
-            f"min power margin {min(margins[what]):.2f} SE",
-            flush=True,
-        )
+    return _calibrate(name, case, seeds, widths=(24, 10))
 
 
 def main():

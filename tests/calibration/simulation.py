@@ -29,7 +29,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import test_simulation as t  # noqa: E402
-from _stats import z_score  # noqa: E402
+from _stats import calibrate as _calibrate  # noqa: E402
 
 CASES = {
     "linear": (t.case_linear_continuous, 1.0),
@@ -43,19 +43,7 @@ CASES = {
 
 
 def calibrate(name, case, seeds):
-    zs, margins = {}, {}
-    for seed in seeds:
-        for what, stat, ref, bias, detect in case(seed):
-            zs.setdefault(what, []).append(z_score(stat, ref, bias))
-            margins.setdefault(what, []).append(detect * abs(ref) / stat.std_error)
-    for what, z in zs.items():
-        z = np.array(z)
-        print(
-            f"{name:12s} {what:20s} seeds {z.size:4d}  mean z {z.mean():+.3f}  "
-            f"SD {z.std(ddof=1):.3f}  max|z| {np.abs(z).max():.2f}  "
-            f"min power margin {min(margins[what]):.1f} SE",
-            flush=True,
-        )
+    return _calibrate(name, case, seeds, widths=(12, 20))
 
 
 def main():
