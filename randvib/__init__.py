@@ -52,6 +52,7 @@ _EXPORTS = {
         "SearchSettings",
         "SimulationSettings",
     ),
+    "randvib.identification.synthetic": ("synthetic_record",),
     "randvib.montecarlo.integrators": ("Integrator", "INTEGRATORS"),
     "randvib.analytic.linearisation": ("coulomb_equivalent_damping", "equivalent_damping"),
     "randvib.analytic.prediction": (

@@ -13,7 +13,7 @@ import importlib
 import sys
 
 #: Command modules under randvib.cli, in the order shown by --help.
-COMMANDS = ["power", "simulate", "study", "identify", "validate"]
+COMMANDS = ["power", "simulate", "study", "record", "identify", "validate"]
 
 
 class UserError(Exception):

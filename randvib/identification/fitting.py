@@ -269,12 +269,24 @@ class Record:
             data["voltage"] = self.voltage
         return pd.DataFrame(data)
 
-    def to_csv(self, path) -> None:
-        """Write the record as CSV (refuses to overwrite an existing file)."""
+    def to_csv(self, path, *, overwrite: bool = False, float_format: str | None = "%.10g") -> None:
+        """Write the record as the CSV :func:`read_record` reads.
+
+        Parameters
+        ----------
+        path : path-like
+        overwrite : bool
+            Replace an existing file (refused by default).
+        float_format : str or None
+            Number format; None writes every float exactly (shortest
+            round-trip representation), so the samples read back bit for bit.
+        """
         path = Path(path)
-        if path.exists():
-            raise FileExistsError(f"{str(path)!r} exists; records are never overwritten")
-        self.to_frame().to_csv(path, index=False, float_format="%.10g")
+        if path.exists() and not overwrite:
+            raise FileExistsError(
+                f"{str(path)!r} exists; records are not overwritten unless asked (overwrite=True)"
+            )
+        self.to_frame().to_csv(path, index=False, float_format=float_format)
 
 
 def _finite_column(name, values):

@@ -1,0 +1,74 @@
+"""``randvib record --out FILE``: a synthetic shaker record of a device, as ``identify`` reads it.
+
+The device options are those of ``simulate`` and ``power``; the excitation is
+the paper's band-limited shaker test (Sec. 3): ``--rms`` (m/s^2, scaled
+exactly) or ``--psd`` (flat level, (m/s^2)^2/Hz) between ``--f-lo`` and
+``--f-hi``. Sensor noise and offsets make it look like a measurement.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from randvib.cli._device import add_device_arguments, harvester_from_args
+from randvib.identification.synthetic import PAPER_BAND, SYNTHETIC_INPUTS, synthetic_record
+from randvib.models.excitation import BandLimited
+
+
+def register(sub) -> None:
+    p = sub.add_parser(
+        "record",
+        help="write a synthetic shaker record of a device (CSV for identify/validate)",
+        description="Simulate a device under band-limited base excitation and write the "
+        "record (time, input, relative_displacement) with optional sensor noise and offsets.",
+    )
+    add_device_arguments(p)  # also --psd: the flat level of the band
+    g = p.add_argument_group("excitation and record")
+    g.add_argument("--rms", type=float, help="RMS base acceleration (m/s^2), instead of --psd")
+    g.add_argument("--f-lo", type=float, default=PAPER_BAND[0], help="band start (Hz), default 4")
+    g.add_argument("--f-hi", type=float, default=PAPER_BAND[1], help="band end (Hz), default 20")
+    g.add_argument("--duration", type=float, default=10.0, help="record length (s), default 10")
+    g.add_argument("--sample-rate", type=float, default=1000.0, help="Hz, default 1000")
+    g.add_argument("--input", default="base_acceleration", help=", ".join(SYNTHETIC_INPUTS))
+    g.add_argument("--substeps", type=int, default=8, help="steps per sample (default 8)")
+    g.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    s = p.add_argument_group("sensors (measured = true + offset + noise)")
+    s.add_argument("--noise-z", type=float, default=0.0, help="RMS noise on z (m)")
+    s.add_argument("--noise-input", type=float, default=0.0, help="RMS noise on the input")
+    s.add_argument("--offset-z", type=float, default=0.0, help="offset on z (m)")
+    s.add_argument("--offset-input", type=float, default=0.0, help="offset on the input")
+    p.add_argument("--out", required=True, metavar="FILE.csv", help="output file (new)")
+    p.add_argument("--force", action="store_true", help="overwrite an existing --out")
+    p.set_defaults(handler=run)
+
+
+def run(args) -> int:
+    out = Path(args.out)
+    if out.exists() and not args.force:
+        raise FileExistsError(f"`--out` {str(out)!r} exists; choose a new name or give --force")
+    if (args.rms is None) == (args.psd is None):
+        raise ValueError("give exactly one of `--rms` (m/s^2) and `--psd` ((m/s^2)^2/Hz)")
+    if args.input not in SYNTHETIC_INPUTS:
+        raise ValueError(
+            f"`--input` must be one of {', '.join(SYNTHETIC_INPUTS)}; got {args.input!r}"
+        )
+    excitation = args.rms if args.psd is None else BandLimited(args.psd, args.f_lo, args.f_hi)
+    record = synthetic_record(
+        harvester_from_args(args),
+        excitation,
+        duration=args.duration,
+        sample_rate=args.sample_rate,
+        seed=args.seed,
+        input=args.input,
+        noise_z=args.noise_z,
+        noise_input=args.noise_input,
+        offset_z=args.offset_z,
+        offset_input=args.offset_input,
+        substeps=args.substeps,
+        band=(args.f_lo, args.f_hi),
+        name=out.stem,
+    )
+    # Full precision, so that identify reads back exactly the simulated samples.
+    record.to_csv(out, overwrite=args.force, float_format=None)
+    print(f"wrote {out} ({record.n} samples at {record.sample_rate:g} Hz, {args.input})")
+    return 0
