@@ -12,13 +12,38 @@ from randvib.models.presets import PRESETS, preset
 FRICTION_CHOICES = RegistryView(lambda law: law)
 
 
+def option_flag(dest: str) -> str:
+    """The command-line flag of an argparse ``dest`` (``f_lo`` -> ``--f-lo``)."""
+    return "--" + dest.replace("_", "-")
+
+
+def options_by_parameter(members: dict) -> dict[str, list]:
+    """Parameter name -> the members declaring it, from ``{member: parameter names}``.
+
+    Model families (friction laws, excitations) declare their parameters; the
+    CLI makes one option per parameter name and remembers who owns it.
+    """
+    out: dict[str, list] = {}
+    for member, names in members.items():
+        for name in names:
+            out.setdefault(name, []).append(member)
+    return out
+
+
+def refuse_foreign_options(given, own, owners: dict, describe: str, chosen: str) -> None:
+    """Refuse, rather than silently ignore, an option of another member of the family.
+
+    ``describe`` formats the owners' names, e.g. ``"{owners} friction"``.
+    """
+    for name in given:
+        if name not in own:
+            whose = describe.format(owners=", ".join(owners[name]))
+            raise ValueError(f"`{option_flag(name)}` applies to {whose}, not {chosen!r}")
+
+
 def _friction_options() -> dict[str, list]:
     """Parameter name -> the laws declaring it, over the registered laws."""
-    out: dict[str, list] = {}
-    for law in FRICTION_MODELS.values():
-        for name in law.parameter_names():
-            out.setdefault(name, []).append(law)
-    return out
+    return options_by_parameter({law: law.parameter_names() for law in FRICTION_MODELS.values()})
 
 
 def add_device_arguments(parser: argparse.ArgumentParser) -> None:
@@ -37,7 +62,7 @@ def add_device_arguments(parser: argparse.ArgumentParser) -> None:
     for name, laws in _friction_options().items():
         spec = laws[0].parameter_specs()[name]
         g.add_argument(
-            "--" + name.replace("_", "-"),
+            option_flag(name),
             type=float,
             help=f"{spec.description or name} ({spec.unit}); {', '.join(law.name for law in laws)}",
         )
@@ -74,7 +99,7 @@ def harvester_from_args(args) -> Harvester:
         if any(x is None for x in circuit):
             raise ValueError("`--alpha`, `--r-load` and `--r-coil` must be given together")
         for name in ("m", "c_m", "k"):
-            _need(values[name], "--" + name.replace("_", "-"), "the device")
+            _need(values[name], option_flag(name), "the device")
         return Harvester.from_electrical(
             m=values["m"],
             c_m=values["c_m"],
@@ -86,13 +111,14 @@ def harvester_from_args(args) -> Harvester:
             friction=friction,
         )
     for name in ("m", "c_m", "c_e", "k"):
-        _need(values[name], "--" + name.replace("_", "-"), "the device (or use --preset)")
+        _need(values[name], option_flag(name), "the device (or use --preset)")
     return Harvester(friction=friction, **values)
 
 
 def _friction_from_args(args, friction):
     """The friction law from ``--friction`` and its parameter options (over a preset's)."""
     options = _friction_options()
+    owners = {name: [law.name for law in laws] for name, laws in options.items()}
     given = {n: getattr(args, n) for n in options if getattr(args, n, None) is not None}
     if args.friction is not None:
         if args.friction not in FRICTION_CHOICES:
@@ -102,26 +128,24 @@ def _friction_from_args(args, friction):
         if args.friction == "none":
             return None
         law = FRICTION_MODELS[args.friction]
-        for name in given:  # refuse, rather than silently ignore, another law's option
-            if name not in law.parameter_names():
-                laws = ", ".join(other.name for other in options[name])
-                raise ValueError(f"`--{name}` applies to {laws} friction, not {law.name!r}")
+        refuse_foreign_options(given, law.parameter_names(), owners, "{owners} friction", law.name)
         # A parameter not given keeps the preset's value where its law has it.
         values = {n: given.get(n, getattr(friction, n, None)) for n in law.parameter_names()}
-        return law(**{n: _need(x, "--" + n, f"{law.name} friction") for n, x in values.items()})
+        return law(
+            **{n: _need(x, option_flag(n), f"{law.name} friction") for n, x in values.items()}
+        )
     if not given:
         return friction
     if friction is None:
-        flags = "/".join(f"`--{n}`" for n in given)
+        flags = "/".join(f"`{option_flag(n)}`" for n in given)
         laws = sorted({law.name for n in given for law in options[n]})
         verb = "needs" if len(given) == 1 else "need"
         raise ValueError(
             f"{flags} {verb} `--friction {'|'.join(laws)}` (or a preset with friction)"
         )
-    for name in given:
-        if name not in friction.parameter_names():
-            laws = ", ".join(law.name for law in options[name])
-            raise ValueError(f"`--{name}` applies to {laws} friction, not {friction.name!r}")
+    refuse_foreign_options(
+        given, friction.parameter_names(), owners, "{owners} friction", friction.name
+    )
     return type(friction)(**{**friction.parameters(), **given})
 
 

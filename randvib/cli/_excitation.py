@@ -14,7 +14,12 @@ import argparse
 from dataclasses import fields
 from pathlib import Path
 
-from randvib.cli._device import require_psd
+from randvib.cli._device import (
+    option_flag,
+    options_by_parameter,
+    refuse_foreign_options,
+    require_psd,
+)
 from randvib.models.excitation import EXCITATIONS
 
 #: File option (argparse dest) -> the registered excitation read from it (``from_csv``).
@@ -41,15 +46,7 @@ def _parameters(name: str) -> list[str]:
 
 def _parameter_options() -> dict[str, list[str]]:
     """Parameter name -> the excitations declaring it, over the ``--excitation`` choices."""
-    out: dict[str, list[str]] = {}
-    for name in excitation_choices():
-        for parameter in _parameters(name):
-            out.setdefault(parameter, []).append(name)
-    return out
-
-
-def _flag(dest: str) -> str:
-    return "--" + dest.replace("_", "-")
+    return options_by_parameter({name: _parameters(name) for name in excitation_choices()})
 
 
 def add_excitation_arguments(parser: argparse.ArgumentParser) -> None:
@@ -66,7 +63,11 @@ def add_excitation_arguments(parser: argparse.ArgumentParser) -> None:
     for name, owners in _parameter_options().items():
         metavar, text = _HELP.get(name, (name.upper(), name))
         g.add_argument(
-            _flag(name), dest=name, type=float, metavar=metavar, help=f"{text}; {', '.join(owners)}"
+            option_flag(name),
+            dest=name,
+            type=float,
+            metavar=metavar,
+            help=f"{text}; {', '.join(owners)}",
         )
     g.add_argument(
         "--psd-file",
@@ -104,35 +105,32 @@ def excitation_from_args(args):
         if len(files) > 1:
             raise ValueError("give one of `--psd-file` and `--record`, not both")
         ((dest, path),) = files.items()
-        extra = [_flag(name) for name in given]
+        extra = [option_flag(name) for name in given]
         extra += [flag for flag in ("--excitation", "--psd") if getattr(args, flag[2:]) is not None]
         if extra:
             flags = ", ".join(f"`{flag}`" for flag in extra)
-            raise ValueError(f"`{_flag(dest)}` gives the whole spectrum; drop {flags}")
-        return _read(_flag(dest), FILE_OPTIONS[dest], path)
+            raise ValueError(f"`{option_flag(dest)}` gives the whole spectrum; drop {flags}")
+        return _read(option_flag(dest), FILE_OPTIONS[dest], path)
 
     name = args.excitation or "white"
     own = _parameters(name)
-    for parameter in given:  # refuse, rather than silently ignore, another excitation's option
-        if parameter not in own:
-            owners = options[parameter]
-            if args.excitation is None:
-                raise ValueError(f"`{_flag(parameter)}` needs `--excitation {'|'.join(owners)}`")
-            raise ValueError(
-                f"`{_flag(parameter)}` applies to the {', '.join(owners)} excitation, not {name!r}"
-            )
+    foreign = [parameter for parameter in given if parameter not in own]
+    if foreign and args.excitation is None:
+        first = foreign[0]
+        raise ValueError(f"`{option_flag(first)}` needs `--excitation {'|'.join(options[first])}`")
+    refuse_foreign_options(given, own, options, "the {owners} excitation", name)
     level = require_psd(args)
     if EXCITATIONS[name].is_white:
         return level
     for parameter in own:
         if parameter not in given:
-            raise ValueError(f"`{_flag(parameter)}` is required for the {name} excitation")
+            raise ValueError(f"`{option_flag(parameter)}` is required for the {name} excitation")
     try:
         return EXCITATIONS[name](level, **given)
     except ValueError as exc:  # name the options, not the class's fields
         message = str(exc).replace("`level`", "`--psd`")
         for parameter in own:
-            message = message.replace(f"`{parameter}`", f"`{_flag(parameter)}`")
+            message = message.replace(f"`{parameter}`", f"`{option_flag(parameter)}`")
         raise ValueError(message) from None
 
 
