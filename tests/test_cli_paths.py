@@ -9,9 +9,9 @@ import json
 import matplotlib.image
 import numpy as np
 import pytest
+from _cli import one_line_error, run
 
 import randvib as rv
-from randvib.cli import main
 from randvib.identification.fitting import read_record
 from randvib.identification.fitting import validate as validate_api
 from randvib.montecarlo.simulation import simulate
@@ -19,19 +19,6 @@ from randvib.montecarlo.sweep import SweepSettings
 
 FIG9 = rv.preset("figure9")
 SIM = ["--paths", "16", "--t-end", "0.4", "--burn-in", "0.1", "--seed", "3"]
-
-
-def run(capsys, *argv):
-    code = main([str(a) for a in argv])
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
-def one_line_error(capsys, argv, fragment):
-    code, _, err = run(capsys, *argv)
-    assert code == 2, err
-    assert fragment in err, err
-    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
 
 
 def table_rows(out):

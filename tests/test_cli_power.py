@@ -3,15 +3,9 @@ import subprocess
 import sys
 
 import pytest
+from _cli import run
 
 import randvib as rv
-from randvib.cli import main
-
-
-def run(capsys, *argv):
-    code = main(list(argv))
-    out, err = capsys.readouterr()
-    return code, out, err
 
 
 def test_power_json_section5(capsys):

@@ -8,6 +8,7 @@ object; what Monte Carlo cannot take yet is refused with one line (exit 2).
 import json
 
 import pytest
+from _cli import one_line_error
 
 import randvib as rv
 from randvib.cli import main
@@ -67,8 +68,4 @@ def test_filtered_excitation_equals_the_python_api(capsys, argv, excitation):
     ],
 )
 def test_what_monte_carlo_cannot_take_is_one_line_exit_2(capsys, argv, fragment):
-    code = main(["simulate", *COMMON, "--psd", "1", *argv])
-    err = capsys.readouterr().err
-    assert code == 2, err
-    assert fragment in err, err
-    assert len(err.strip().splitlines()) == 1, err
+    one_line_error(capsys, ["simulate", *COMMON, "--psd", "1", *argv], fragment)

@@ -5,11 +5,11 @@ import json
 
 import numpy as np
 import pytest
+from _cli import one_line_error, run
 
 import randvib as rv
 from randvib.analytic.averaging import averaging_statistics, energy_density
 from randvib.analytic.fokker_planck import fast_fpk_statistics, fpk_statistics, solve_fpk
-from randvib.cli import main
 from randvib.cli._excitation import excitation_choices
 from randvib.models.excitation import (
     EXCITATIONS,
@@ -29,17 +29,9 @@ COLOURED = [
 ]
 
 
-def run(capsys, *argv):
-    code = main(list(argv))
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
-def one_line_error(capsys, argv, fragment):
-    code, out, err = run(capsys, "power", *argv)
-    assert code == 2, (out, err)
-    assert fragment in err, err
-    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+def power_error(capsys, argv, fragment):
+    """``randvib power ARGV`` is refused with one line naming ``fragment``."""
+    one_line_error(capsys, ["power", *argv], fragment)
 
 
 @pytest.fixture(scope="module")
@@ -276,7 +268,7 @@ def test_record_equals_the_api(tmp_path, capsys, harvester):
     ],
 )
 def test_refusals_and_bad_values(capsys, argv, fragment):
-    one_line_error(capsys, [*DEVICE, *argv], fragment)
+    power_error(capsys, [*DEVICE, *argv], fragment)
 
 
 @pytest.mark.parametrize(
@@ -293,8 +285,8 @@ def test_refusals_and_bad_values(capsys, argv, fragment):
 def test_bad_psd_file(tmp_path, capsys, content, fragment):
     file = tmp_path / "psd.csv"
     file.write_text(content)
-    one_line_error(capsys, [*DEVICE, "--psd-file", str(file)], f"`--psd-file` {file}: ")
-    one_line_error(capsys, [*DEVICE, "--psd-file", str(file)], fragment)
+    power_error(capsys, [*DEVICE, "--psd-file", str(file)], f"`--psd-file` {file}: ")
+    power_error(capsys, [*DEVICE, "--psd-file", str(file)], fragment)
 
 
 def test_bad_record(tmp_path, capsys):
@@ -303,42 +295,40 @@ def test_bad_record(tmp_path, capsys):
     with_nan = acceleration.copy()
     with_nan[10] = np.nan
     file = write_record(tmp_path / "nan.csv", time, with_nan)
-    one_line_error(capsys, [*DEVICE, "--record", file], "`base_acceleration` must be finite")
+    power_error(capsys, [*DEVICE, "--record", file], "`base_acceleration` must be finite")
     uneven = time.copy()
     uneven[100] += 0.004
     file = write_record(tmp_path / "uneven.csv", uneven, acceleration)
-    one_line_error(capsys, [*DEVICE, "--record", file], "`time` must be evenly spaced")
-    one_line_error(capsys, [*DEVICE, "--record", file], f"`--record` {file}: ")
+    power_error(capsys, [*DEVICE, "--record", file], "`time` must be evenly spaced")
+    power_error(capsys, [*DEVICE, "--record", file], f"`--record` {file}: ")
     nan_time = time.copy()
     nan_time[5] = np.nan
     file = write_record(tmp_path / "nan_time.csv", nan_time, acceleration)
-    one_line_error(capsys, [*DEVICE, "--record", file], "`time` must be finite")
+    power_error(capsys, [*DEVICE, "--record", file], "`time` must be finite")
 
 
 @pytest.mark.parametrize("option", ["--psd-file", "--record"])
 def test_missing_files_and_folders(tmp_path, capsys, option):
-    one_line_error(
-        capsys, [*DEVICE, option, str(tmp_path / "none.csv")], f"`{option}`: no such file"
-    )
-    one_line_error(
+    power_error(capsys, [*DEVICE, option, str(tmp_path / "none.csv")], f"`{option}`: no such file")
+    power_error(
         capsys, [*DEVICE, option, str(tmp_path)], f"`{option}` must be a CSV file, got the folder"
     )
 
 
 def test_file_options_exclude_the_others(tmp_path, capsys):
     file = write_table(tmp_path / "psd.csv", [0.0, 10.0, 20.0], [1.0, 1.0, 0.0])
-    one_line_error(
+    power_error(
         capsys,
         [*DEVICE, "--psd-file", file, "--psd", "1"],
         "`--psd-file` gives the whole spectrum; drop `--psd`",
     )
-    one_line_error(
+    power_error(
         capsys,
         [*DEVICE, "--psd-file", file, "--excitation", "band-pass", "--f0", "3"],
         "drop `--f0`, `--excitation`",
     )
-    one_line_error(capsys, [*DEVICE, "--psd-file", file, "--record", file], "not both")
-    one_line_error(
+    power_error(capsys, [*DEVICE, "--psd-file", file, "--record", file], "not both")
+    power_error(
         capsys,
         [*DEVICE, "--psd-file", file, "--method", "averaging"],
         "`--method averaging` assumes white noise",
