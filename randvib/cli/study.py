@@ -11,9 +11,7 @@ identification study).
 
 from __future__ import annotations
 
-import inspect
-
-from randvib.studies import STUDIES, load
+from randvib.studies import STUDIES, add_run_options, load, run_with_options
 
 
 def load_study(name: str):
@@ -30,43 +28,11 @@ def register(sub) -> None:
     )
     p.add_argument("name", help=f"study: {', '.join(STUDIES)}")
     p.add_argument("--out", required=True, help="output folder (created; never overwritten)")
-    p.add_argument("--quick", action="store_true", help="small, fast version (about a minute)")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    p.add_argument(
-        "--workers", type=int, default=None, help="local worker processes (default: all cores)"
-    )
-    p.add_argument(
-        "--threads",
-        type=int,
-        default=None,
-        help="numba threads of a study that simulates in-process (identification, "
-        "linearisation-vs-averaging; default: all cores)",
-    )
-    p.add_argument(
-        "--scheduler", default=None, help="Dask distributed scheduler ADDRESS to run the sweep on"
-    )
-    p.add_argument("--no-progress", action="store_true", help="no progress bars")
+    add_run_options(p)
     p.set_defaults(handler=run)
 
 
 def run(args) -> int:
-    study = load_study(args.name)
-    extra = {}
-    if args.threads is not None:
-        if "threads" not in inspect.signature(study).parameters:
-            raise ValueError(
-                f"study {args.name!r} has no `threads` option; its sweep runs on --workers "
-                "processes"
-            )
-        extra["threads"] = args.threads
-    report = study(
-        args.out,
-        quick=args.quick,
-        seed=args.seed,
-        workers=args.workers,
-        scheduler=args.scheduler,
-        progress=not args.no_progress,
-        **extra,
-    )
+    report = run_with_options(load_study(args.name), args.name, args.out, args)
     print(f"report: {report}")
     return 0

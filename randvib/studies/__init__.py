@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
+import inspect
 import sys
 from pathlib import Path
 
@@ -83,25 +84,60 @@ def load(name: str):
     return module
 
 
-def script_main(run_study, argv=None) -> int:
-    """``python studies/NAME.py OUT_DIR [--quick] [--seed N] [--workers N]``: run one study.
-
-    The same as ``randvib study NAME --out OUT_DIR ...``; for the ``__main__``
-    block of a study script.
-    """
-    parser = argparse.ArgumentParser(description=(run_study.__doc__ or "").splitlines()[0])
-    parser.add_argument("out", help="output folder (created; never overwritten)")
-    parser.add_argument("--quick", action="store_true", help="small, fast version")
+def add_run_options(parser: argparse.ArgumentParser) -> None:
+    """The options of a study run, shared by ``randvib study`` and the scripts' ``__main__``."""
+    parser.add_argument("--quick", action="store_true", help="small, fast version (about a minute)")
     parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    parser.add_argument("--workers", type=int, default=None, help="local worker processes")
+    parser.add_argument(
+        "--workers", type=int, default=None, help="local worker processes (default: all cores)"
+    )
+    parser.add_argument(
+        "--threads",
+        type=int,
+        default=None,
+        help="numba threads of a study that simulates in-process (identification, "
+        "linearisation-vs-averaging; default: all cores)",
+    )
+    parser.add_argument(
+        "--scheduler", default=None, help="Dask distributed scheduler ADDRESS to run the sweep on"
+    )
     parser.add_argument("--no-progress", action="store_true", help="no progress bars")
-    args = parser.parse_args(argv)
-    report = run_study(
-        args.out,
+
+
+def run_with_options(run_study, name: str, out, args) -> Path:
+    """Call a study's ``run_study`` with the options of :func:`add_run_options`.
+
+    ``--threads`` goes only to a study that takes it; elsewhere it is refused,
+    because those studies run their sweep on ``--workers`` processes.
+    """
+    extra = {}
+    if args.threads is not None:
+        if "threads" not in inspect.signature(run_study).parameters:
+            raise ValueError(
+                f"study {name!r} has no `threads` option; its sweep runs on --workers processes"
+            )
+        extra["threads"] = args.threads
+    return run_study(
+        out,
         quick=args.quick,
         seed=args.seed,
         workers=args.workers,
+        scheduler=args.scheduler,
         progress=not args.no_progress,
+        **extra,
     )
-    print(f"report: {report}")
+
+
+def script_main(run_study, argv=None) -> int:
+    """``python studies/NAME.py OUT_DIR [options]``: run one study.
+
+    The same as ``randvib study NAME --out OUT_DIR [options]`` (the same
+    options and the same call); for the ``__main__`` block of a study script.
+    """
+    parser = argparse.ArgumentParser(description=(run_study.__doc__ or "").splitlines()[0])
+    parser.add_argument("out", help="output folder (created; never overwritten)")
+    add_run_options(parser)
+    args = parser.parse_args(argv)
+    name = Path(sys.modules[run_study.__module__].__file__).stem.replace("_", "-")
+    print(f"report: {run_with_options(run_study, name, args.out, args)}")
     return 0
