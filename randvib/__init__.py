@@ -42,6 +42,7 @@ _EXPORTS = {
     "randvib.analytic.fokker_planck": ("fast_fpk_statistics", "fpk_statistics", "solve_fpk"),
     "randvib.models.friction": ("Coulomb", "FrictionModel", "LuGre", "Tanh"),
     "randvib.models.harvester": ("ElectricalCoupling", "Harvester"),
+    "randvib.models.coupling": ("Coupling", "COUPLINGS", "Inductive", "Piezo", "Resistive"),
     "randvib.identification.fitting": (
         "IdentificationResult",
         "identify",

@@ -62,6 +62,39 @@ def mechanical_block(m, c, k) -> StateSpace:
     return StateSpace(a, [0.0, -1.0], np.eye(2), [0.0, 0.0], ("z", "v"))
 
 
+def device_block(m, c, k, coupling=None) -> StateSpace:
+    """The linear device with its circuit state, when the coupling has one.
+
+    ``m z'' + c z' + k z + f x = -m a`` and ``x' = a_x x + b_x z'``
+    (:meth:`randvib.models.coupling.Coupling.circuit_equation`: a coil's
+    current, L i' + (R_L + R_C) i = alpha z', force alpha i; a piezo's voltage,
+    C_p V' + V / R_L = theta z', force theta V). Without a circuit state (no
+    coupling, or a static one whose c_e is in ``c``) it is
+    :func:`mechanical_block`.
+
+    Parameters
+    ----------
+    m, c, k : float
+        Mass (kg), viscous damping (Ns/m; c_eq when linearised, holding c_e for
+        a static coupling) and stiffness (N/m; k_eq when linearised).
+    coupling : Coupling or None
+        The electrical coupling.
+
+    Returns
+    -------
+    StateSpace
+        States and outputs ``z``, ``v`` and, with a circuit state,
+        ``coupling.state_name`` (``current`` in A or ``voltage`` in V); input
+        the base acceleration (m/s^2).
+    """
+    if coupling is None or not coupling.is_dynamic:
+        return mechanical_block(m, c, k)
+    a_x, b_x, f = (float(x) for x in coupling.circuit_equation())
+    a = [[0.0, 1.0, 0.0], [-k / m, -c / m, -f / m], [0.0, b_x, a_x]]
+    outputs = ("z", "v", coupling.state_name)
+    return StateSpace(a, [0.0, -1.0, 0.0], np.eye(3), np.zeros(3), outputs)
+
+
 def _require_stable(system: StateSpace):
     eig = np.linalg.eigvals(system.a)
     if np.any(eig.real >= 0):

@@ -17,6 +17,13 @@ Under white noise E[v^2] = S m / (4 c_eq) for any k_eq, so the fixed point
 is Eq. 19-20 and, for Coulomb friction, Eq. 30/32: the numbers of
 :func:`randvib.expected_power`. Under a coloured spectrum k_eq moves the
 resonance against the spectrum, and the spring matters.
+
+A coupling with a circuit state (coil inductance, piezo capacitance;
+:mod:`randvib.models.coupling`) stays a state of the linear system
+(:func:`randvib.analytic.linear_response.device_block`): c_eq then holds the
+mechanical and friction damping only, the circuit's mean square E[i^2] or
+E[V^2] comes from the same Lyapunov solution (or spectral integral), and the
+power from it. The circuit makes the spring matter under white noise too.
 """
 
 from __future__ import annotations
@@ -26,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize
 
-from randvib.analytic.linear_response import mechanical_block, output_variances, response_spectra
+from randvib.analytic.linear_response import device_block, output_variances, response_spectra
 from randvib.models.excitation import Excitation, as_excitation
 from randvib.models.harvester import Harvester
 
@@ -79,11 +86,14 @@ class LinearisationResult:
     velocity_variance, displacement_variance : float
         E[v^2] ((m/s)^2) and E[z^2] (m^2) of the linearised device.
     power_electrical : float
-        E[P_e] = c_e E[v^2] (W).
+        E[P_e] (W): c_e E[v^2], or from the circuit state ((R_L + R_C) E[i^2],
+        E[V^2] / R_L).
     power_load : float or None
         The share reaching R_L (W), when the harvester has a circuit.
     method : str
         How the variances were computed: ``lyapunov`` or ``spectral``.
+    circuit_variance : float or None
+        E[i^2] (A^2) or E[V^2] (V^2) of a circuit state; None without one.
     """
 
     harvester: Harvester
@@ -95,10 +105,12 @@ class LinearisationResult:
     power_electrical: float
     power_load: float | None
     method: str
+    circuit_variance: float | None = None
 
     def block(self):
-        """The linearised device as a :class:`~randvib.models.state_space.StateSpace`."""
-        return mechanical_block(self.harvester.m, self.c_eq, self.k_eq)
+        """The linearised device (with its circuit state) as a StateSpace."""
+        h = self.harvester
+        return device_block(h.m, self.c_eq, self.k_eq, h.electrical)
 
     def response_spectra(self, frequency) -> ResponseSpectra:
         """PSDs of z, v and the electrical power's distribution at ``frequency`` (Hz)."""
@@ -109,7 +121,7 @@ class LinearisationResult:
             excitation=self.excitation.psd(f),
             displacement=spectra["z"],
             velocity=spectra["v"],
-            power=self.harvester.c_e * spectra["v"],
+            power=_power(self.harvester, spectra["v"], _state(self.harvester, spectra))[0],
         )
 
     def to_dict(self) -> dict:
@@ -117,6 +129,8 @@ class LinearisationResult:
         keys = ("c_eq", "k_eq", "velocity_variance", "displacement_variance")
         out = {key: getattr(self, key) for key in keys}
         out.update(power_electrical=self.power_electrical, power_load=self.power_load)
+        if self.circuit_variance is not None:
+            out["circuit_variance"] = self.circuit_variance
         out.update(method=self.method, excitation=self.excitation.parameters())
         return out
 
@@ -179,8 +193,11 @@ def statistical_linearisation(
         )
         return c + increment, k + 3.0 * k3 * var_z
 
+    def variances(c_eq, k_eq):
+        return output_variances(device_block(m, c_eq, k_eq, harvester.electrical), excitation, used)
+
     def response(c_eq, k_eq):
-        out = output_variances(mechanical_block(m, c_eq, k_eq), excitation, used)
+        out = variances(c_eq, k_eq)
         return np.log([out["v"], out["z"]])
 
     def residual(x):
@@ -191,8 +208,8 @@ def statistical_linearisation(
     x = _solve(residual, response(c_start, k))
     c_eq, k_eq = equivalent(x)
     var_v, var_z = np.exp(x)
-    power = harvester.c_e * var_v
-    load = None if harvester.electrical is None else power * harvester.electrical.load_fraction
+    state = _state(harvester, variances(c_eq, k_eq))
+    power, load = _power(harvester, var_v, state)
     return LinearisationResult(
         harvester=harvester,
         excitation=excitation,
@@ -203,7 +220,24 @@ def statistical_linearisation(
         power_electrical=float(power),
         power_load=None if load is None else float(load),
         method=used,
+        circuit_variance=None if state is None else float(state),
     )
+
+
+def _state(harvester: Harvester, outputs: dict):
+    """The circuit state's entry of ``outputs`` (variance or PSD), or None without one."""
+    return outputs[harvester.electrical.state_name] if harvester.has_circuit else None
+
+
+def _power(harvester: Harvester, velocity, state):
+    """(electrical, load) power (W, or W/Hz for PSDs) from E[v^2] and the circuit's E[x^2]."""
+    coupling = harvester.electrical
+    if coupling is None:
+        return harvester.c_e * velocity, None
+    if not coupling.is_dynamic:  # the former c_e E[v^2], to the same bits
+        power = harvester.c_e * velocity
+        return power, power * coupling.load_fraction
+    return coupling.power_electrical(velocity, state), coupling.power_load(velocity, state)
 
 
 def _solve(residual, x0) -> np.ndarray:

@@ -15,47 +15,10 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from randvib._validation import check_nonnegative, check_positive, scalar_or_array
+from randvib.models.coupling import COUPLINGS, Coupling, ElectricalCoupling, Resistive
 from randvib.models.friction import FrictionModel
 
-
-@dataclass(frozen=True, eq=False)
-class ElectricalCoupling:
-    """Electromagnetic transducer and circuit (paper Eq. 3, Fig. 2b).
-
-    Parameters
-    ----------
-    alpha : float
-        Flux gradient (Wb/m = V s/m), > 0. The paper's device: 0.1992 Wb/m.
-    r_load : float
-        Load resistance R_L (ohm), > 0.
-    r_coil : float
-        Coil resistance R_C (ohm), >= 0. The paper's device: 0.48 ohm.
-    """
-
-    alpha: float
-    r_load: float
-    r_coil: float
-
-    def __post_init__(self):
-        object.__setattr__(
-            self, "alpha", scalar_or_array(check_positive("alpha", self.alpha, "Wb/m"))
-        )
-        object.__setattr__(
-            self, "r_load", scalar_or_array(check_positive("r_load", self.r_load, "ohm"))
-        )
-        object.__setattr__(
-            self, "r_coil", scalar_or_array(check_nonnegative("r_coil", self.r_coil, "ohm"))
-        )
-
-    @property
-    def electrical_damping(self):
-        """c_e = alpha^2 / (R_L + R_C) (Ns/m), paper Eq. 3."""
-        return self.alpha**2 / (self.r_load + self.r_coil)
-
-    @property
-    def load_fraction(self):
-        """R_L / (R_L + R_C): the share of the electrical power reaching the load."""
-        return self.r_load / (self.r_load + self.r_coil)
+__all__ = ["ElectricalCoupling", "Harvester"]  # ElectricalCoupling: re-exported, historical home
 
 
 @dataclass(frozen=True, eq=False)
@@ -81,9 +44,13 @@ class Harvester:
         Cubic (Duffing) stiffness (N/m^3), >= 0 (hardening, monostable).
     friction : FrictionModel or None, optional
         Friction model; ``None`` for none.
-    electrical : ElectricalCoupling or None, optional
-        Circuit data; when given, ``c_e`` must equal alpha^2 / (R_L + R_C)
-        (use :meth:`from_electrical`), and load voltage and power are defined.
+    electrical : Coupling or None, optional
+        The electrical coupling (:mod:`randvib.models.coupling`): resistive
+        (paper Eq. 3), inductive or piezo. A static one's ``c_e`` must equal
+        its electrical damping (alpha^2 / (R_L + R_C) for the resistive
+        circuit; use :meth:`from_electrical`); a dynamic one (inductance or
+        capacitance > 0) acts through its circuit state and needs ``c_e = 0``
+        (use :meth:`with_coupling`). With a coupling, load power is defined.
     """
 
     m: float
@@ -92,7 +59,7 @@ class Harvester:
     k: float
     k3: float = 0.0
     friction: FrictionModel | None = None
-    electrical: ElectricalCoupling | None = None
+    electrical: Coupling | None = None
 
     def __post_init__(self):
         for name, check, unit in (
@@ -109,17 +76,49 @@ class Harvester:
                 f"or None, got {self.friction!r}"
             )
         if self.electrical is not None:
-            expected = self.electrical.electrical_damping
-            if not np.allclose(self.c_e, expected, rtol=1e-12, atol=0):
-                raise ValueError(
-                    f"`c_e` = {self.c_e!r} Ns/m disagrees with alpha^2/(R_L+R_C) = "
-                    f"{expected!r} Ns/m from `electrical`; use Harvester.from_electrical"
-                )
-        if np.any(self.c_m + self.c_e <= 0) and self.friction is None:
+            self._check_coupling()
+        if np.any(self.c_m + self.c_e <= 0) and self.friction is None and not self.has_circuit:
             raise ValueError(
                 "total damping `c_m + c_e` must be > 0 without friction, got "
                 f"{self.c_m!r} + {self.c_e!r}; the undamped oscillator has no stationary state"
             )
+
+    def _check_coupling(self):
+        """The coupling is one of the family, and ``c_e`` agrees with it."""
+        if not isinstance(self.electrical, Coupling):
+            raise ValueError(
+                f"`electrical` must be a randvib coupling ({', '.join(COUPLINGS)}) or None, "
+                f"got {self.electrical!r}"
+            )
+        expected = self.electrical.electrical_damping
+        if not np.allclose(self.c_e, expected, rtol=1e-12, atol=0):
+            what = (
+                "a dynamic coupling acts through its circuit state, so c_e must be 0"
+                if self.electrical.is_dynamic
+                else "from `electrical`"
+            )
+            raise ValueError(
+                f"`c_e` = {self.c_e!r} Ns/m disagrees with {expected!r} Ns/m {what}; use "
+                "Harvester.from_electrical or Harvester.with_coupling"
+            )
+
+    @classmethod
+    def with_coupling(cls, m, c_m, k, coupling: Coupling, k3=0.0, friction=None):
+        """Build a harvester with any electrical coupling (:mod:`randvib.models.coupling`).
+
+        ``c_e`` follows from the coupling: its electrical damping when it is
+        static (resistive, Eq. 3; inductive with L = 0; piezo with C_p = 0),
+        0 when it carries a circuit state.
+        """
+        return cls(
+            m=m,
+            c_m=c_m,
+            c_e=coupling.electrical_damping,
+            k=k,
+            k3=k3,
+            friction=friction,
+            electrical=coupling,
+        )
 
     @classmethod
     def from_electrical(cls, m, c_m, k, alpha, r_load, r_coil, k3=0.0, friction=None):
@@ -135,15 +134,7 @@ class Harvester:
         Other parameters are as for :class:`Harvester`.
         """
         electrical = ElectricalCoupling(alpha, r_load, r_coil)
-        return cls(
-            m=m,
-            c_m=c_m,
-            c_e=electrical.electrical_damping,
-            k=k,
-            k3=k3,
-            friction=friction,
-            electrical=electrical,
-        )
+        return cls.with_coupling(m, c_m, k, electrical, k3=k3, friction=friction)
 
     # ----------------------------------------------------------------- derived
     @property
@@ -157,11 +148,30 @@ class Harvester:
         return np.sqrt(self.k / self.m)
 
     @property
+    def has_circuit(self) -> bool:
+        """True when the coupling carries a circuit state (inductance or capacitance > 0)."""
+        return self.electrical is not None and self.electrical.is_dynamic
+
+    @property
+    def coupling_name(self) -> str:
+        """``resistive`` (also for a bare c_e), ``inductive`` or ``piezo``."""
+        return "resistive" if self.electrical is None else self.electrical.name
+
+    def require_resistive(self, method: str, alternatives: str) -> None:
+        """Refuse a circuit state for a ``method`` that assumes a viscous electrical damper."""
+        if self.has_circuit:
+            raise ValueError(
+                f"{method} assumes resistive coupling (a viscous c_e); the "
+                f"{self.electrical.name} coupling's circuit state is handled by {alternatives}"
+            )
+
+    @property
     def friction_name(self) -> str:
         return "none" if self.friction is None else self.friction.name
 
     def electrical_power(self, velocity):
         """Instantaneous power into the electrical domain c_e z'^2 (W)."""
+        self.require_resistive("electrical_power(velocity)", "randvib.simulate")
         return self.c_e * np.asarray(velocity, dtype=float) ** 2
 
     def _require_electrical(self, what: str):
@@ -169,6 +179,12 @@ class Harvester:
             raise ValueError(
                 f"{what} needs the circuit: build the harvester with "
                 "Harvester.from_electrical(alpha=..., r_load=..., r_coil=...)"
+            )
+        if self.electrical.is_dynamic or not isinstance(self.electrical, Resistive):
+            raise ValueError(
+                f"{what} as a function of the velocity needs the resistive coupling; the "
+                f"{self.electrical.name} coupling's {self.electrical.state_name or 'output'} "
+                "depends on its history"
             )
         return self.electrical
 
@@ -195,7 +211,9 @@ class Harvester:
         if self.friction is not None:
             out.update(self.friction.parameters())
         if self.electrical is not None:
-            out.update({f.name: getattr(self.electrical, f.name) for f in fields(self.electrical)})
+            if not isinstance(self.electrical, Resistive):
+                out["coupling"] = self.electrical.name
+            out.update(self.electrical.parameters())
         return out
 
     def updated(self, **changes) -> Harvester:
@@ -223,9 +241,12 @@ class Harvester:
             if mine:
                 friction = dataclasses.replace(friction, **mine)
         electrical = self.electrical
-        circuit = {
-            key: changes.pop(key) for key in list(changes) if key in ("alpha", "r_load", "r_coil")
-        }
+        circuit_names = (
+            electrical.parameter_names()
+            if electrical is not None
+            else ("alpha", "r_load", "r_coil")
+        )
+        circuit = {key: changes.pop(key) for key in list(changes) if key in circuit_names}
         if circuit:
             if electrical is None:
                 raise ValueError(
@@ -238,7 +259,7 @@ class Harvester:
             electrical = None  # an explicit c_e overrides the circuit
         if changes:
             allowed = sorted(
-                {"m", "c", "c_m", "c_e", "k", "k3", "alpha", "r_load", "r_coil"}
+                {"m", "c", "c_m", "c_e", "k", "k3", *circuit_names}
                 | ({f.name for f in fields(friction)} if friction else set())
             )
             raise ValueError(

@@ -35,7 +35,8 @@ ACC_H0 = 5  # mechanical energy at the start of the window (J)
 ACC_H1 = 6  # mechanical energy at the end of the window (J)
 ACC_COMP_V2 = 7  # companion (same noise, no friction) mean v^2
 ACC_COMP_Z2 = 8  # companion mean z^2
-N_ACC = 9
+ACC_CIRCUIT2 = 9  # mean x^2 of the circuit state (A^2 or V^2); 0 without one
+N_ACC = 10
 
 
 class PathAverages:
@@ -94,6 +95,11 @@ class PathAverages:
     def companion_z2(self):
         """The friction-free companion's time average of z^2 (m^2); 0 without one."""
         return self._col(ACC_COMP_Z2)
+
+    @property
+    def circuit_square(self):
+        """Time average of the circuit state's square per path (i^2 in A^2, V^2 in V^2)."""
+        return self._col(ACC_CIRCUIT2)
 
     def energy_balance_controls(self, window):
         """The two zero-mean controls of the energy balance: Ito integral, energy change."""
@@ -181,19 +187,34 @@ class Recording(NamedTuple):
     every: int
 
 
-class Shaping(NamedTuple):
-    """The excitation's 2-state shaping filter, integrated with the device.
+class Auxiliary(NamedTuple):
+    """Linear auxiliary states integrated with the device: shaping filter and circuit.
 
-    White noise has no filter state: the velocity takes the noise increment
-    (:func:`scheme_step`). A rational spectrum (band-pass, Kanai-Tajimi) is
-    the output y = C x of a 2-state filter x' = A x + G w of the same white
-    noise (:meth:`randvib.models.excitation.Excitation.shaping_filter`), and
-    the device's acceleration takes -y, its base acceleration (paper Eq. 18,
-    m z'' = ... - m y; :func:`filtered_step`).
+    Up to :data:`N_AUX` states ``x`` with
+
+        dx = (A x + B v) dt + G sqrt(S/2) dW,    dv = (... - C x) dt + g_v sqrt(S/2) dW,
+
+    one block for every excitation x coupling combination
+    (:func:`auxiliary_step`). A rational spectrum's shaping filter
+    (band-pass, Kanai-Tajimi; :meth:`randvib.models.excitation.Excitation.shaping_filter`)
+    is driven by the noise (G) and puts its output, the base acceleration,
+    into the device's acceleration through C (paper Eq. 18, m z'' = ... - m y);
+    then g_v = 0. A dynamic circuit (:mod:`randvib.models.coupling`) is driven
+    by the velocity (B) and pushes back with f x / m through C; under white
+    noise g_v = 1. Unused states have zero rows and columns. White noise with
+    a resistive circuit has no block at all (``None``: :func:`scheme_step`).
     """
 
-    coefficients: np.ndarray  #: float64[8]: A (row-major), G, C
-    start: np.ndarray  #: float64[3]: (l11, l21, l22), Cholesky factor of the filter's covariance
+    n: int  #: number of states in use, 1 .. N_AUX (the random start draws n normals)
+    coefficients: np.ndarray  #: float64[N_AUX_COEFFICIENTS]: A (row-major), B, G, C, g_v
+    square: np.ndarray  #: float64[N_AUX]: row P; the kernel averages (P x)^2 (ACC_CIRCUIT2)
+    start: np.ndarray  #: float64[N_AUX, N_AUX]: Cholesky factor of the states' start covariance
+
+
+#: Largest number of auxiliary states (a 2-state filter and a 1-state circuit).
+N_AUX = 3
+#: Length of :attr:`Auxiliary.coefficients`: A (9), B (3), G (3), C (3), g_v (1).
+N_AUX_COEFFICIENTS = 19
 
 
 class Noise(NamedTuple):
@@ -293,68 +314,80 @@ def scheme_step(z, v, theta, dt, noise, weights, drift, kind, p, fn):
 
 
 @numba.njit(cache=True, inline="always")
-def filtered_step(z, v, theta, x1, x2, dt, noise, weights, drift, kind, p, fn, shaping):
-    """:func:`scheme_step` for the device driven through a 2-state shaping filter.
+def auxiliary_step(z, v, theta, x1, x2, x3, dt, noise, weights, drift, kind, p, fn, block):
+    """:func:`scheme_step` for the device with linear auxiliary states (filter, circuit).
 
-    The augmented state (z, v, theta, x1, x2) takes the same additive-noise
-    step: the noise increment enters the filter states (``G noise``), the
-    device's acceleration gets the base acceleration -C x of the filter. The
-    filter is linear, so the scheme's orders hold for the augmented system
-    and :meth:`Integrator.linear_recursion` gives its exact recursion on a
-    linear device.
+    The augmented state (z, v, theta, x1, x2, x3) takes the same additive-noise
+    step: the noise increment enters the velocity with the gain g_v and the
+    auxiliary states with G, the auxiliary states are driven by A x + B v,
+    and the device's acceleration gets -C x (:class:`Auxiliary`). The block is
+    linear, so the scheme's orders hold for the augmented system and
+    :meth:`Integrator.linear_recursion` gives its exact recursion on a linear
+    device. With a 2-state filter alone (third state, B and g_v zero) every
+    operation of the former filter-only step is done in the same order plus
+    exact zeros, so its results are bit for bit those of that step.
 
     Parameters
     ----------
     z, v, theta, dt, noise, weights, drift, kind, p, fn
-        As for :func:`scheme_step`; ``noise`` is sqrt(S/2) dW, S the filter's
-        input level.
-    x1, x2 : float
-        Filter states.
-    shaping : tuple of 8 floats
-        ``(a11, a12, a21, a22, g1, g2, c1, c2)`` of :class:`Shaping`.
+        As for :func:`scheme_step`; ``noise`` is sqrt(S/2) dW.
+    x1, x2, x3 : float
+        Auxiliary states (filter states, circuit current (A) or voltage (V)).
+    block : tuple of 19 floats
+        ``(a11, ..., a33, b1, b2, b3, g1, g2, g3, c1, c2, c3, g_v)`` of
+        :class:`Auxiliary`.
 
     Returns
     -------
-    z, v, theta, x1, x2 : float
+    z, v, theta, x1, x2, x3 : float
         State after the step.
     force : float
         Friction force at the start of the step (N).
     """
     b1, b2 = weights
-    a11, a12, a21, a22, g1, g2, c1, c2 = shaping
+    a11, a12, a13, a21, a22, a23, a31, a32, a33 = block[0:9]
+    bv1, bv2, bv3, g1, g2, g3, c1, c2, c3, gv = block[9:19]
     acc1, rate1, force = _acceleration(z, v, theta, drift, kind, p, fn)
-    acc1 -= c1 * x1 + c2 * x2
-    d1 = a11 * x1 + a12 * x2
-    d2 = a21 * x1 + a22 * x2
+    acc1 -= c1 * x1 + c2 * x2 + c3 * x3
+    d1 = a11 * x1 + a12 * x2 + a13 * x3 + bv1 * v
+    d2 = a21 * x1 + a22 * x2 + a23 * x3 + bv2 * v
+    d3 = a31 * x1 + a32 * x2 + a33 * x3 + bv3 * v
+    nv = gv * noise
     if b2 == 0.0:
         return (
             z + b1 * v * dt,
-            v + b1 * acc1 * dt,
+            v + b1 * acc1 * dt + nv,
             theta + b1 * rate1 * dt,
             x1 + b1 * d1 * dt + g1 * noise,
             x2 + b1 * d2 * dt + g2 * noise,
+            x3 + b1 * d3 * dt + g3 * noise,
             force,
         )
     zp = z + v * dt
-    vp = v + acc1 * dt
+    vp = v + acc1 * dt + nv
     tp = theta + rate1 * dt
     x1p = x1 + d1 * dt + g1 * noise
     x2p = x2 + d2 * dt + g2 * noise
+    x3p = x3 + d3 * dt + g3 * noise
     acc2, rate2, _ = _acceleration(zp, vp, tp, drift, kind, p, fn)
-    acc2 -= c1 * x1p + c2 * x2p
+    acc2 -= c1 * x1p + c2 * x2p + c3 * x3p
+    e1 = a11 * x1p + a12 * x2p + a13 * x3p + bv1 * vp
+    e2 = a21 * x1p + a22 * x2p + a23 * x3p + bv2 * vp
+    e3 = a31 * x1p + a32 * x2p + a33 * x3p + bv3 * vp
     return (
         z + (b1 * v + b2 * vp) * dt,
-        v + (b1 * acc1 + b2 * acc2) * dt,
+        v + (b1 * acc1 + b2 * acc2) * dt + nv,
         theta + (b1 * rate1 + b2 * rate2) * dt,
-        x1 + (b1 * d1 + b2 * (a11 * x1p + a12 * x2p)) * dt + g1 * noise,
-        x2 + (b1 * d2 + b2 * (a21 * x1p + a22 * x2p)) * dt + g2 * noise,
+        x1 + (b1 * d1 + b2 * e1) * dt + g1 * noise,
+        x2 + (b1 * d2 + b2 * e2) * dt + g2 * noise,
+        x3 + (b1 * d3 + b2 * e3) * dt + g3 * noise,
         force,
     )
 
 
 @numba.njit(cache=True, parallel=True)
 def run_ensemble(
-    scheme, device, friction, timing, paths, initial, companion, recording, noise, shaping
+    scheme, device, friction, timing, paths, initial, companion, recording, noise, auxiliary
 ):
     """Integrate ``paths.count`` paths and return per-path time averages.
 
@@ -379,9 +412,10 @@ def run_ensemble(
         Histograms and recorded histories.
     noise : Noise
         Given increments or the ziggurat tables.
-    shaping : Shaping or None
-        The excitation's filter; None for white noise. With a random
-        start the filter starts from its own stationary law (two more draws
+    auxiliary : Auxiliary or None
+        The linear auxiliary states (shaping filter and/or circuit); None for
+        white noise with a resistive circuit. With a random start they start
+        from N(0, L L^T), L = ``auxiliary.start`` (``auxiliary.n`` more draws
         per path, after the device's).
 
     Returns
@@ -401,13 +435,20 @@ def run_ensemble(
     with_companion, comp_init_z, comp_init_v = companion
     hist_lo, hist_hi, hist_bins, n_record, record_every = recording
     dw, ki, wi, fi = noise
-    # `shaping is None` is decided when compiling (numba prunes the dead branch
-    # for a None argument): white noise runs the plain loop, bit for bit and at
-    # its own speed; a filter compiles a second specialisation.
-    if shaping is not None:
-        sc = shaping.coefficients
-        filt = (sc[0], sc[1], sc[2], sc[3], sc[4], sc[5], sc[6], sc[7])
-        l11, l21, l22 = shaping.start[0], shaping.start[1], shaping.start[2]
+    # `auxiliary is None` is decided when compiling (numba prunes the dead
+    # branch for a None argument): white noise with a resistive circuit runs the
+    # plain loop, bit for bit and at its own speed; any filter or circuit
+    # compiles one second specialisation. The block's coefficients go to the
+    # step as a tuple of floats (an array would cost a reference count per step).
+    if auxiliary is not None:
+        n_aux = auxiliary.n
+        ac = auxiliary.coefficients
+        block = (
+            ac[0], ac[1], ac[2], ac[3], ac[4], ac[5], ac[6], ac[7], ac[8], ac[9],
+            ac[10], ac[11], ac[12], ac[13], ac[14], ac[15], ac[16], ac[17], ac[18],
+        )  # fmt: skip
+        p1, p2, p3 = auxiliary.square[0], auxiliary.square[1], auxiliary.square[2]
+        chol = auxiliary.start
     n_chunks = (n_paths + LANES - 1) // LANES
     acc = np.zeros((n_paths, N_ACC))
     failed = np.full(n_paths, -1, dtype=np.int64)
@@ -434,6 +475,7 @@ def run_ensemble(
         vc = np.zeros(LANES)
         x1 = np.zeros(LANES)
         x2 = np.zeros(LANES)
+        x3 = np.zeros(LANES)
         a = np.zeros((LANES, N_ACC))
         for j in range(lanes):
             seed_path_state(seed, first_path + start + j, rng, j)
@@ -444,11 +486,15 @@ def run_ensemble(
                 v[j] = init_v * nv
                 zc[j] = comp_init_z * nz
                 vc[j] = comp_init_v * nv
-                if shaping is not None:
+                if auxiliary is not None:
                     n1 = standard_normal(rng, j, ki, wi, fi)
-                    n2 = standard_normal(rng, j, ki, wi, fi)
-                    x1[j] = l11 * n1
-                    x2[j] = l21 * n1 + l22 * n2
+                    x1[j] = chol[0, 0] * n1
+                    if n_aux > 1:
+                        n2 = standard_normal(rng, j, ki, wi, fi)
+                        x2[j] = chol[1, 0] * n1 + chol[1, 1] * n2
+                        if n_aux > 2:
+                            n3 = standard_normal(rng, j, ki, wi, fi)
+                            x3[j] = chol[2, 0] * n1 + chol[2, 1] * n2 + chol[2, 2] * n3
             else:
                 z[j] = init_z
                 v[j] = init_v
@@ -469,13 +515,20 @@ def run_ensemble(
                 zj = z[j]
                 vj = v[j]
                 tj = th[j]
-                if shaping is not None:
-                    zn, vn, tn, x1[j], x2[j], f1 = filtered_step(
+                if auxiliary is not None:
+                    x1j = x1[j]
+                    x2j = x2[j]
+                    x3j = x3[j]
+                    if in_window:
+                        sq = p1 * x1j + p2 * x2j + p3 * x3j
+                        a[j, ACC_CIRCUIT2] += sq * sq
+                    zn, vn, tn, x1[j], x2[j], x3[j], f1 = auxiliary_step(
                         zj,
                         vj,
                         tj,
-                        x1[j],
-                        x2[j],
+                        x1j,
+                        x2j,
+                        x3j,
                         dt,
                         noise,
                         scheme,
@@ -483,7 +536,7 @@ def run_ensemble(
                         fr_kind,
                         fr_p,
                         fr_fn,
-                        filt,
+                        block,
                     )
                 else:
                     zn, vn, tn, f1 = scheme_step(

@@ -12,7 +12,12 @@ rational spectrum (band-pass, Kanai-Tajimi) the base acceleration is instead
 the output y of the spectrum's 2-state shaping filter driven by that white
 noise, and dv gets -y dt in place of the noise (paper Eq. 18 with a
 coloured base); the filter states are integrated with the device by the same
-scheme (:func:`randvib.montecarlo.kernel.filtered_step`).
+scheme (:func:`randvib.montecarlo.kernel.auxiliary_step`).
+
+A coupling with a circuit state (coil inductance, piezo capacitance;
+:mod:`randvib.models.coupling`) adds that state, ``x' = a x + b v``, with the
+force ``f x`` on the magnet, to the same linear auxiliary block; the kernel
+averages x^2 per path, so the circuit's power comes with its interval.
 
 Each path is an independent realisation; statistics are time averages over
 the window [burn_in, t_end) on each path, and their confidence intervals come
@@ -34,9 +39,10 @@ from scipy import linalg, special  # Student t quantile; lighter than scipy.stat
 
 from randvib._validation import check_choice, check_int, check_positive
 from randvib.analytic import exact_solutions as exact
-from randvib.analytic.linear_response import mechanical_block
+from randvib.analytic.linear_response import device_block
 from randvib.analytic.linearisation import equivalent_damping, linear_displacement_variance
-from randvib.models.excitation import Excitation, ShapingFilter, as_excitation
+from randvib.analytic.statistical_linearisation import statistical_linearisation
+from randvib.models.excitation import Excitation, as_excitation
 from randvib.models.friction import kernel_arguments
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import integrators, kernel
@@ -274,8 +280,23 @@ class SimulationResult:
 
     @property
     def power_electrical(self) -> Statistic:
-        """E[P_e] = c_e E[z'^2] (W) (paper Eq. 31)."""
-        return self.statistic(self.harvester.c_e * self.averages.v2)
+        """E[P_e] (W): c_e E[z'^2] (paper Eq. 31), or from the circuit state.
+
+        With a circuit state: (R_L + R_C) E[i^2] (inductive), E[V^2] / R_L (piezo).
+        """
+        return self.statistic(self._circuit_power("power_electrical"))
+
+    def _circuit_power(self, which: str) -> np.ndarray:
+        """Per-path electrical or load power of a circuit state (``which``: the method)."""
+        avg = self.averages
+        return getattr(self.harvester.electrical, which)(avg.v2, avg.circuit_square)
+
+    @property
+    def circuit_mean_square(self) -> Statistic | None:
+        """E[i^2] (A^2) or E[V^2] (V^2) of a circuit state; None without one."""
+        if not self.harvester.has_circuit:
+            return None
+        return self.statistic(self.averages.circuit_square)
 
     @property
     def friction_power(self) -> Statistic:
@@ -288,15 +309,23 @@ class SimulationResult:
         e = self.harvester.electrical
         if e is None:
             return None
+        if self.harvester.has_circuit:
+            return self.statistic(self._circuit_power("power_load"))
         return self.statistic(self.harvester.c_e * e.load_fraction * self.averages.v2)
 
     def energy_balance_residual(self) -> Statistic:
-        """c E[v^2] + E[v F] - S m / 4 (W): zero up to O(dt) and noise (white noise only)."""
+        """c E[v^2] + E[v F] + P_x - S m / 4 (W): zero up to O(dt) and noise (white only).
+
+        ``P_x`` is the power of a circuit state ((R_L + R_C) i^2 or V^2 / R_L;
+        docs/conventions.md: the coupling's force f x does the work
+        f x v = R x^2 + d/dt(stored energy)); without one, c holds c_e.
+        """
         self._require_white("the energy-balance residual and its S m / 4")
         h = self.harvester
-        return self.statistic(
-            h.c * self.averages.v2 + self.averages.friction_power - self.psd * h.m / 4.0
-        )
+        samples = h.c * self.averages.v2 + self.averages.friction_power - self.psd * h.m / 4.0
+        if h.has_circuit:
+            samples = samples + self._circuit_power("power_electrical")
+        return self.statistic(samples)
 
     def summary(self) -> dict:
         """Statistics as {name: {"mean", "ci95"}} plus run settings (JSON-ready)."""
@@ -312,6 +341,8 @@ class SimulationResult:
         }
         if self.power_load is not None:
             out["power_load"] = self.power_load.to_dict()
+        if self.harvester.has_circuit:
+            out["circuit_mean_square"] = self.circuit_mean_square.to_dict()
         out.update(
             n_paths=self.n_paths,
             dt=self.dt,
@@ -336,8 +367,15 @@ def effective_linear_device(harvester: Harvester, psd: float) -> tuple[float, fl
     k_eff = k + 3 k3 E[z^2] with E[z^2] from the exact friction-free density
     (friction only shrinks the motion, so this stiffness is an upper bound in
     the mean); c_eff = c_eq from equivalent linearisation, or c for LuGre.
+    With a circuit state, (k_eq, c_eq) of the statistical linearisation with
+    the circuit (a law with memory left out: it only adds damping).
     """
     h = harvester
+    if h.has_circuit:
+        if h.friction is not None and not h.friction.has_equivalent_damping:
+            h = h.updated(friction=None)
+        r = statistical_linearisation(h, psd)
+        return r.k_eq, r.c_eq
     c_eff = float(h.c)
     if h.friction is None or h.friction.has_equivalent_damping:
         c_eff = float(equivalent_damping(h, psd))
@@ -361,17 +399,20 @@ def step_bias(scheme: str, harvester: Harvester, psd, dt: float) -> float:
     devices. Returns inf where the recursion is unstable.
 
     Under a rational spectrum (``psd`` a band-pass or Kanai-Tajimi
-    excitation) the recursion is that of the linearised device with the
-    filter's states (:func:`_augmented_bias`), and the bias is the largest
-    of those of E[y^2] (the filter's own), E[z^2] and E[v^2]; the linearised
-    device is the white-noise one at the excitation's level, as for white noise.
+    excitation), or with a circuit state, the recursion is that of the
+    linearised device with the filter's and the circuit's states
+    (:func:`_augmented_bias`), and the bias is the largest of those of E[y^2]
+    (the filter's own), E[z^2], E[v^2] and the circuit's E[x^2]; the
+    linearised device is the white-noise one at the excitation's level, as for
+    white noise.
     """
     excitation = as_excitation(psd)
     k_eff, c_eff = effective_linear_device(harvester, excitation.level)
     m = float(harvester.m)
-    if excitation.is_white:
+    if excitation.is_white and not harvester.has_circuit:
         return _scheme_bias(scheme, m, k_eff, c_eff, excitation.level, dt)
-    return _augmented_bias(scheme, m, k_eff, c_eff, excitation.shaping_filter(), dt)
+    system = _augmented_system(m, k_eff, c_eff, excitation, harvester.electrical)
+    return _augmented_bias(scheme, *system, dt)
 
 
 def _scheme_bias(scheme, m, k_eff, c_eff, psd, dt) -> float:
@@ -383,28 +424,33 @@ def _scheme_bias(scheme, m, k_eff, c_eff, psd, dt) -> float:
     return abs(cov[1, 1] / exact.linear_velocity_variance(m, c_eff, psd) - 1.0)
 
 
-def _augmented_system(m, k_eff, c_eff, shaping: ShapingFilter):
-    """(F, G, C) of the linear device driven through ``shaping``: dx = F x dt + G dW.
+def _augmented_system(m, k_eff, c_eff, excitation: Excitation, coupling=None):
+    """(F, G, C) of the linear device (and circuit) driven through the excitation's filter.
 
-    States (filter, z, v); the rows of C pick y (the base acceleration), z, v.
+    dx = F x dt + G dW with the states (filter, z, v, circuit); the rows of C
+    pick y (the base acceleration; none under white noise), z, v and the
+    circuit state.
     """
-    system = mechanical_block(m, c_eff, k_eff).driven_by(shaping.system, "acceleration")
-    n_filter = shaping.system.n_states
-    pick = np.zeros((3, system.n_states))
-    pick[0, :n_filter] = shaping.system.c[0]
-    pick[1:, n_filter:] = np.eye(2)
-    g = np.sqrt(shaping.noise_intensity) * system.b[:, None]
+    block = device_block(m, c_eff, k_eff, coupling)
+    if excitation.is_white:
+        system, q, n_filter, rows = block, excitation.level / 2.0, 0, []
+    else:
+        shaping = excitation.shaping_filter()
+        system = block.driven_by(shaping.system, "acceleration")
+        q, n_filter = shaping.noise_intensity, shaping.system.n_states
+        rows = [np.concatenate([shaping.system.c[0], np.zeros(block.n_states)])]
+    pick = np.vstack(rows + [np.hstack([np.zeros((block.n_states, n_filter)), block.c])])
+    g = np.sqrt(q) * system.b[:, None]
     return system.a, g, pick
 
 
-def _augmented_bias(scheme, m, k_eff, c_eff, shaping: ShapingFilter, dt) -> float:
-    """Largest relative bias of E[y^2], E[z^2], E[v^2] of the scheme on device + filter.
+def _augmented_bias(scheme, f, g, pick, dt) -> float:
+    """Largest relative bias of the picked variances of the scheme on an augmented system.
 
     The scheme's exact recursion x_{n+1} = A x_n + B dW_n
     (:meth:`Integrator.linear_recursion`) has the stationary covariance
     P = A P A^T + dt B B^T, against the continuous Lyapunov F P + P F^T + G G^T = 0.
     """
-    f, g, pick = _augmented_system(m, k_eff, c_eff, shaping)
     a, b = integrators.integrator(scheme).linear_recursion(f, g, dt)
     if max(abs(np.linalg.eigvals(a))) >= 1:
         return float("inf")
@@ -419,17 +465,17 @@ def largest_step(scheme: str, harvester: Harvester, psd, bias: float = MAX_STEP_
     k_eff, c_eff = effective_linear_device(harvester, excitation.level)  # once, not per step
     m = float(harvester.m)
     lo, hi = 0.0, 2.0 / np.sqrt(k_eff / m)
-    if excitation.is_white:
+    if excitation.is_white and not harvester.has_circuit:
 
         def bias_at(dt):
             return _scheme_bias(scheme, m, k_eff, c_eff, excitation.level, dt)
 
     else:
-        shaping = excitation.shaping_filter()
-        hi = min(hi, 2.0 / max(abs(np.linalg.eigvals(shaping.system.a))))
+        system = _augmented_system(m, k_eff, c_eff, excitation, harvester.electrical)
+        hi = min(hi, 2.0 / max(abs(np.linalg.eigvals(system[0]))))
 
         def bias_at(dt):
-            return _augmented_bias(scheme, m, k_eff, c_eff, shaping, dt)
+            return _augmented_bias(scheme, *system, dt)
 
     for _ in range(60):
         mid = 0.5 * (lo + hi)
@@ -440,20 +486,28 @@ def largest_step(scheme: str, harvester: Harvester, psd, bias: float = MAX_STEP_
     return lo
 
 
+def _linearised_covariance(harvester: Harvester, excitation: Excitation) -> np.ndarray:
+    """Stationary covariance of (filter states, z, v, circuit) of the linearised device."""
+    k_eff, c_eff = effective_linear_device(harvester, excitation.level)
+    f, g, _ = _augmented_system(float(harvester.m), k_eff, c_eff, excitation, harvester.electrical)
+    return linalg.solve_continuous_lyapunov(f, -(g @ g.T))
+
+
 def _linearised_spread(harvester: Harvester, excitation: Excitation) -> tuple[float, float]:
     """(std of z (m), std of v (m/s)) of the linearised stationary state.
 
-    White noise: Eq. 20 and 30. A rational spectrum: the Lyapunov covariance of
-    the same linearised device driven through the excitation's filter.
+    White noise: Eq. 20 and 30. A rational spectrum or a circuit state: the
+    Lyapunov covariance of the same linearised device driven through the
+    excitation's filter, with the circuit.
     """
     psd = excitation.level
-    k_eff, c_eff = effective_linear_device(harvester, psd)
-    if not excitation.is_white:
-        f, g, pick = _augmented_system(
-            float(harvester.m), k_eff, c_eff, excitation.shaping_filter()
+    if not excitation.is_white or harvester.has_circuit:
+        cov = _linearised_covariance(harvester, excitation)
+        n_filter = 0 if excitation.is_white else excitation.shaping_filter().system.n_states
+        return float(np.sqrt(cov[n_filter, n_filter])), float(
+            np.sqrt(cov[n_filter + 1, n_filter + 1])
         )
-        cov = pick @ linalg.solve_continuous_lyapunov(f, -(g @ g.T)) @ pick.T
-        return float(np.sqrt(cov[1, 1])), float(np.sqrt(cov[2, 2]))
+    k_eff, c_eff = effective_linear_device(harvester, psd)
     vv = psd * harvester.m / (4.0 * c_eff)
     return float(np.sqrt(linear_displacement_variance(harvester, vv))), float(np.sqrt(vv))
 
@@ -727,6 +781,7 @@ def simulate(
         record=(histogram_bins, histogram_range, record_paths, record_every),
     )
     _check_coloured_options(run.excitation, run.companion, control_variates)
+    _check_circuit_options(run.harvester, run.companion, control_variates)
     if check_step:
         _check_step(run.scheme.name, run.harvester, run.excitation, run.grid.dt)
     setup = _KernelSetup.prepare(run)
@@ -841,6 +896,21 @@ def _check_coloured_options(excitation: Excitation, companion: bool, control_var
         )
 
 
+def _check_circuit_options(harvester: Harvester, companion: bool, control_variates: bool):
+    """Refuse the resistive-only options with a circuit state, saying why."""
+    if not harvester.has_circuit:
+        return
+    for name, given, why in (
+        ("companion", companion, "its exact moments (S m/(4c), Gibbs E[z^2])"),
+        ("control_variates", control_variates, "the controls' known means"),
+    ):
+        if given:
+            raise ValueError(
+                f"`{name}` needs a resistive coupling: {why} assume a viscous c_e, not the "
+                f"{harvester.electrical.name} coupling's circuit state; use {name}=False"
+            )
+
+
 def _checked_increments(dW, n_paths, n_steps):
     """Given Brownian increments as a contiguous (n_paths, n_steps) array, or None."""
     if dW is None:
@@ -871,7 +941,7 @@ class _KernelSetup:
     initial: kernel.Start
     companion: kernel.Companion
     recording: kernel.Recording
-    shaping: kernel.Shaping | None
+    auxiliary: kernel.Auxiliary | None
 
     @classmethod
     def prepare(cls, run: _Run) -> _KernelSetup:
@@ -886,7 +956,7 @@ class _KernelSetup:
             initial=initial,
             companion=companion,
             recording=_recording(run),
-            shaping=_shaping(run.excitation),
+            auxiliary=_auxiliary(run),
         )
 
     def arguments(self, run: _Run, lo: int, hi: int) -> dict:
@@ -903,26 +973,49 @@ class _KernelSetup:
             companion=self.companion,
             recording=self.recording._replace(n_record=n_record),
             noise=kernel.Noise(dw, ZIG_KI, ZIG_WI, ZIG_FI),
-            shaping=self.shaping,
+            auxiliary=self.auxiliary,
         )
 
 
-def _shaping(excitation: Excitation) -> kernel.Shaping | None:
-    """The kernel's filter group: None for white noise, else (A, G, C) and a start.
+def _auxiliary(run: _Run) -> kernel.Auxiliary | None:
+    """The kernel's linear auxiliary block: the excitation's filter and the circuit state.
 
-    The filter's states start (with a random start) from their exact
-    stationary law N(0, P), P from A P + P A^T + q G G^T = 0; the kernel
-    draws them as the Cholesky factor of P times two standard normals.
+    None for white noise with a resistive (or no) circuit. The filter's states
+    (A, G, C: :class:`randvib.models.excitation.ShapingFilter`) come first, the
+    circuit's (``x' = a x + b v``, acceleration ``-(f/m) x``) last. With a
+    random start the filter alone starts from its exact stationary law N(0, P),
+    A P + P A^T + q G G^T = 0; with a circuit the block starts from its
+    marginal law under the linearised device (:func:`_linearised_covariance`).
     """
-    if excitation.is_white:
+    h, excitation = run.harvester, run.excitation
+    if excitation.is_white and not h.has_circuit:
         return None
-    shaping = excitation.shaping_filter()
-    system = shaping.system
-    q = shaping.noise_intensity
-    cov = linalg.solve_continuous_lyapunov(system.a, -q * np.outer(system.b, system.b))
-    chol = np.linalg.cholesky(cov)
-    coefficients = np.concatenate([system.a.ravel(), system.b, system.c[0]])
-    return kernel.pack(kernel.Shaping, coefficients, [chol[0, 0], chol[1, 0], chol[1, 1]])
+    n = kernel.N_AUX
+    a, b, g, c, square = np.zeros((n, n)), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
+    n_filter = 0
+    if not excitation.is_white:
+        shaping = excitation.shaping_filter()
+        system = shaping.system
+        n_filter = system.n_states
+        a[:n_filter, :n_filter] = system.a
+        g[:n_filter] = system.b
+        c[:n_filter] = system.c[0]
+        q = shaping.noise_intensity
+        start = linalg.solve_continuous_lyapunov(system.a, -q * np.outer(system.b, system.b))
+    n_states = n_filter
+    if h.has_circuit:
+        a_x, b_x, f = h.electrical.circuit_equation()
+        a[n_filter, n_filter], b[n_filter], c[n_filter] = a_x, b_x, f / h.m
+        square[n_filter] = 1.0
+        n_states += 1
+        cov = _linearised_covariance(h, excitation)  # (filter, z, v, circuit)
+        keep = [*range(n_filter), cov.shape[0] - 1]
+        start = cov[np.ix_(keep, keep)]
+    chol = np.zeros((n, n))
+    chol[:n_states, :n_states] = np.linalg.cholesky(start)
+    gain = 1.0 if excitation.is_white else 0.0  # white noise drives the velocity itself
+    coefficients = np.concatenate([a.ravel(), b, g, c, [gain]])
+    return kernel.pack(kernel.Auxiliary, n_states, coefficients, square, chol)
 
 
 def _start_states(run: _Run) -> tuple[kernel.Start, kernel.Companion]:
