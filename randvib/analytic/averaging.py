@@ -331,14 +331,24 @@ def _moments_on_grid(x_max, gamma, omega, lam, fcm, beta, dd):
     return vv, abs_v, zz, fpow, z, ends[:, -1]
 
 
+#: Where a circuit state (coil inductance, piezo capacitance) is handled.
+CIRCUIT_METHODS = (
+    "equivalent linearisation (randvib.predict with method 'linearisation', "
+    "randvib.statistical_linearisation) and Monte Carlo (randvib.simulate)"
+)
+
+
 def memoryless_parameters(harvester: Harvester, psd, method: str = "stochastic averaging"):
     """Broadcast (m, c, k, k3, fc, beta, psd) for the semi-analytic methods.
 
     ``beta = inf`` marks Coulomb friction (or none, with ``fc = 0``). Methods
     that need a memoryless friction law (averaging, the FPK solvers) share
     this; the law declares (Fc, beta) through ``coulomb_tanh_form()``, and
-    ``method`` names the caller in the error raised for any other law (LuGre).
+    ``method`` names the caller in the error raised for any other law (LuGre)
+    and for a coupling with a circuit state: these methods reduce the device
+    to (z, v) with a viscous electrical damping c_e (resistive coupling).
     """
+    harvester.require_resistive(method, CIRCUIT_METHODS)
     friction = harvester.friction
     form = (0.0, np.inf) if friction is None else friction.coulomb_tanh_form()
     if form is None:

@@ -111,6 +111,9 @@ def equivalent_damping(harvester: Harvester, psd, expectation: str = "auto", *, 
         expectation = _renamed_method(expectation, method)
     psd = check_positive("psd", psd, "(m/s^2)^2/Hz")
     check_choice("expectation", expectation, EXPECTATIONS)
+    harvester.require_resistive(
+        "equivalent_damping (Eq. 19-30, a viscous c_e)", "randvib.statistical_linearisation"
+    )
     friction = harvester.friction
     c = np.asarray(harvester.c, dtype=float)
     m = np.asarray(harvester.m, dtype=float)

@@ -35,7 +35,7 @@ from randvib.analytic.averaging import averaging_statistics
 from randvib.analytic.fokker_planck import fast_fpk_statistics, fpk_statistics
 from randvib.analytic.linearisation import equivalent_damping, linear_displacement_variance
 from randvib.analytic.statistical_linearisation import statistical_linearisation
-from randvib.models.excitation import Excitation
+from randvib.models.excitation import Excitation, as_excitation
 from randvib.models.harvester import Harvester
 
 
@@ -60,6 +60,9 @@ class PowerPrediction:
         E[P_e] = c_e E[z'^2] (W) (paper Eq. 31-32).
     power_load : float, ndarray or None
         E[i^2 R_L] (W), when the harvester has a circuit.
+    circuit_mean_square : float or None
+        E[i^2] (A^2) or E[V^2] (V^2) of a circuit state (inductive or piezo
+        coupling); None without one (and left out of :meth:`to_dict`).
     """
 
     method: str
@@ -69,12 +72,14 @@ class PowerPrediction:
     mean_abs_velocity: object
     power_electrical: object
     power_load: object = None
+    circuit_mean_square: object = None
 
     def to_dict(self) -> dict:
         """Plain dict with floats or lists, ready for JSON."""
-        return {
-            k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()
-        }
+        out = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()}
+        if out["circuit_mean_square"] is None:
+            del out["circuit_mean_square"]
+        return out
 
 
 def _finish(
@@ -153,6 +158,7 @@ def _coloured_linearisation(harvester: Harvester, excitation: Excitation) -> Pow
         mean_abs_velocity=float(np.sqrt(2.0 / np.pi * r.velocity_variance)),  # Gaussian v
         power_electrical=r.power_electrical,
         power_load=r.power_load,
+        circuit_mean_square=r.circuit_variance,
     )
 
 
@@ -183,6 +189,21 @@ def _refuse_coloured(method: str, excitation: Excitation):
     )
 
 
+#: The methods of :data:`METHODS` that accept a coupling with a circuit state
+#: (coil inductance, piezo capacitance), under any excitation they accept:
+#: statistical linearisation with the circuit state in the linear system.
+CIRCUIT = {"linearisation": _coloured_linearisation}
+
+
+def _refuse_circuit(method: str, harvester: Harvester):
+    accepted = ", ".join(repr(name) for name in CIRCUIT)
+    raise ValueError(
+        f"method {method!r} assumes resistive coupling (a viscous c_e); the "
+        f"{harvester.electrical.name} coupling's circuit state is handled by method "
+        f"{accepted} (and randvib.simulate)"
+    )
+
+
 def predict(harvester: Harvester, psd, method: str = "linearisation") -> PowerPrediction:
     """Predict the stationary response and power under white noise or another excitation.
 
@@ -201,7 +222,9 @@ def predict(harvester: Harvester, psd, method: str = "linearisation") -> PowerPr
         ``"fpk-fast"`` (small corrected FPK grids; the power and its k3
         dependence to about 0.05 %, about 3 ms per point) or ``"fpk"`` (grid
         solution of the stationary FPK equation; reference, about 0.5 s per
-        point). Only ``"linearisation"`` accepts a non-white excitation.
+        point). Only ``"linearisation"`` accepts a non-white excitation or
+        a coupling with a circuit state (inductive, piezo: the circuit is a
+        state of the linearised system, scalar parameters).
 
     Raises
     ------
@@ -210,6 +233,12 @@ def predict(harvester: Harvester, psd, method: str = "linearisation") -> PowerPr
         a method that assumes white noise.
     """
     check_choice("method", method, tuple(METHODS))
+    if harvester.has_circuit:
+        if method not in CIRCUIT:
+            _refuse_circuit(method, harvester)
+        if not isinstance(psd, Excitation):
+            psd = as_excitation(float(check_positive("psd", psd, "(m/s^2)^2/Hz")))
+        return CIRCUIT[method](harvester, psd)
     if isinstance(psd, Excitation):
         if not psd.is_white:
             if method not in COLOURED:
@@ -266,9 +295,15 @@ def optimal_load_resistance(
 ):
     """Load resistance R_L (ohm) maximising expected load power (scalar inputs).
 
-    The harvester must have a circuit (``Harvester.from_electrical``); its
+    The harvester must have a coupling (``Harvester.from_electrical`` or
+    ``Harvester.with_coupling``: resistive, inductive or piezo); its
     ``r_load`` is the starting value and is replaced during the search. The
-    search is a bounded scalar minimisation over log R_L.
+    search is a bounded scalar minimisation over log R_L, with friction
+    through ``method`` (a circuit state: ``"linearisation"``). Without
+    friction, on the linear device under white noise, it finds the classical
+    optima (:meth:`randvib.models.coupling.Coupling.white_noise_optimal_load`:
+    sqrt(R_C^2 + R_C alpha^2/c_m) resistive, its inductive extension, and
+    sqrt(m / (C_p (C_p k + theta^2))) piezo).
 
     Returns
     -------
@@ -278,7 +313,10 @@ def optimal_load_resistance(
         Expected load power there (W).
     """
     if harvester.electrical is None:
-        raise ValueError("optimal_load_resistance needs Harvester.from_electrical(...)")
+        raise ValueError(
+            "optimal_load_resistance needs a coupling: Harvester.from_electrical(...) or "
+            "Harvester.with_coupling(...)"
+        )
     if not isinstance(psd, Excitation):
         psd = float(check_positive("psd", psd, "(m/s^2)^2/Hz"))
     lo, hi = (float(check_positive("bounds", b, "ohm")) for b in bounds)

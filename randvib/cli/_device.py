@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from randvib.models.coupling import COUPLINGS, coupling_class
 from randvib.models.friction import FRICTION_MODELS, RegistryView
 from randvib.models.harvester import Harvester
 from randvib.models.presets import PRESETS, preset
@@ -46,6 +47,11 @@ def _friction_options() -> dict[str, list]:
     return options_by_parameter({law: law.parameter_names() for law in FRICTION_MODELS.values()})
 
 
+def _coupling_options() -> dict[str, list]:
+    """Parameter name -> the couplings declaring it, over the registered couplings."""
+    return options_by_parameter({c: c.parameter_names() for c in COUPLINGS.values()})
+
+
 def add_device_arguments(parser: argparse.ArgumentParser) -> None:
     """Add --preset, the device parameters and --psd to ``parser``."""
     g = parser.add_argument_group("device (SI units; values override --preset)")
@@ -67,10 +73,18 @@ def add_device_arguments(parser: argparse.ArgumentParser) -> None:
             help=f"{spec.description or name} ({spec.unit}); {', '.join(law.name for law in laws)}",
         )
     g.add_argument(
-        "--alpha", type=float, help="flux gradient (Wb/m), with --r-load/--r-coil instead of --c-e"
+        "--coupling",
+        help=f"electrical coupling: {', '.join(COUPLINGS)} (default resistive when its options "
+        "are given; instead of --c-e)",
     )
-    g.add_argument("--r-load", type=float, help="load resistance (ohm)")
-    g.add_argument("--r-coil", type=float, help="coil resistance (ohm)")
+    # One option per coupling parameter, as the couplings declare them.
+    for name, couplings in _coupling_options().items():
+        spec = couplings[0].parameter_specs()[name]
+        g.add_argument(
+            option_flag(name),
+            type=float,
+            help=f"{spec.description} ({spec.unit}); {', '.join(c.name for c in couplings)}",
+        )
     g.add_argument(
         "--psd", type=float, default=None, help="one-sided base-acceleration PSD S ((m/s^2)^2/Hz)"
     )
@@ -92,27 +106,50 @@ def harvester_from_args(args) -> Harvester:
 
     friction = _friction_from_args(args, friction)
 
-    circuit = [args.alpha, args.r_load, args.r_coil]
-    if any(x is not None for x in circuit):
-        if args.c_e is not None:
-            raise ValueError("give either `--c-e` or `--alpha/--r-load/--r-coil`, not both")
-        if any(x is None for x in circuit):
-            raise ValueError("`--alpha`, `--r-load` and `--r-coil` must be given together")
+    coupling = _coupling_from_args(args)
+    if coupling is not None:
         for name in ("m", "c_m", "k"):
             _need(values[name], option_flag(name), "the device")
-        return Harvester.from_electrical(
-            m=values["m"],
-            c_m=values["c_m"],
-            k=values["k"],
-            k3=values["k3"],
-            alpha=args.alpha,
-            r_load=args.r_load,
-            r_coil=args.r_coil,
-            friction=friction,
+        return Harvester.with_coupling(
+            values["m"], values["c_m"], values["k"], coupling, k3=values["k3"], friction=friction
         )
     for name in ("m", "c_m", "c_e", "k"):
         _need(values[name], option_flag(name), "the device (or use --preset)")
     return Harvester(friction=friction, **values)
+
+
+def _coupling_from_args(args):
+    """The coupling from ``--coupling`` and its parameter options, or None (``--c-e``)."""
+    options = _coupling_options()
+    given = {n: getattr(args, n) for n in options if getattr(args, n, None) is not None}
+    if args.coupling is None and not given:
+        return None
+    if args.c_e is not None:
+        raise ValueError(
+            "give either `--c-e` or `--alpha/--r-load/--r-coil` (or another coupling's options), "
+            "not both"
+        )
+    if args.coupling is not None and args.coupling not in COUPLINGS:
+        raise ValueError(
+            f"`--coupling` must be one of {', '.join(COUPLINGS)}; got {args.coupling!r}"
+        )
+    cls = coupling_class(args.coupling or "resistive")
+    owners = {name: [c.name for c in couplings] for name, couplings in options.items()}
+    refuse_foreign_options(given, cls.parameter_names(), owners, "the {owners} coupling", cls.name)
+    missing = [n for n in cls.parameter_names() if n not in given]
+    if missing:
+        flags = ", ".join(f"`{option_flag(n)}`" for n in cls.parameter_names())
+        raise ValueError(
+            f"{flags} must be given together for the {cls.name} coupling "
+            f"(missing {', '.join(f'`{option_flag(n)}`' for n in missing)})"
+        )
+    try:
+        return cls(**given)
+    except ValueError as exc:  # name the flag, not the parameter
+        message = str(exc)
+        for name in given:
+            message = message.replace(f"`{name}`", f"`{option_flag(name)}`")
+        raise ValueError(message) from None
 
 
 def _friction_from_args(args, friction):

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import json
 
-from randvib.analytic.prediction import COLOURED, METHODS, predict
+from randvib.analytic.prediction import CIRCUIT, COLOURED, METHODS, predict
 from randvib.cli._device import add_device_arguments, harvester_from_args
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
 from randvib.cli._output import print_table
@@ -50,12 +50,19 @@ def run(args) -> int:
             f"`--method {args.method}` assumes white noise; the {psd.name} excitation needs "
             f"{accepted}"
         )
+    if harvester.has_circuit and args.method not in CIRCUIT:
+        accepted = ", ".join(f"`--method {name}`" for name in CIRCUIT)
+        raise ValueError(
+            f"`--method {args.method}` assumes the resistive coupling; the "
+            f"{harvester.coupling_name} coupling's circuit state needs {accepted}"
+        )
     result = predict(harvester, psd, method=args.method)
     out = {
         "method": result.method,
         # The level --psd; a tabulated or measured spectrum has none (null).
         "psd": getattr(psd, "level", None) if coloured else psd,
         "friction": harvester.friction_name,
+        "coupling": harvester.coupling_name,
         **result.to_dict(),
     }
     if result.power_load is None:
@@ -73,6 +80,7 @@ def run(args) -> int:
             "mean_abs_velocity": "m/s",
             "power_electrical": "W",
             "power_load": "W",
+            "circuit_mean_square": "A^2 or V^2",
             # the excitation's parameters
             "level": "(m/s^2)^2/Hz",
             "f0": "Hz",

@@ -53,6 +53,12 @@ def run(args) -> int:
             "`--control-variates` needs white noise: the energy-balance controls and the "
             f"friction-free companion's exact moments do not hold under {psd.name} excitation"
         )
+    if args.control_variates and harvester.has_circuit:
+        raise ValueError(
+            "`--control-variates` needs the resistive coupling: the energy-balance controls and "
+            f"the friction-free companion assume a viscous c_e, not the {harvester.coupling_name} "
+            "coupling's circuit state"
+        )
     if args.method not in INTEGRATORS:
         raise ValueError(f"`--method` must be one of {', '.join(INTEGRATORS)}; got {args.method!r}")
     result = simulate(
@@ -83,6 +89,7 @@ def run(args) -> int:
         "displacement_variance": "m^2",
         "mean_abs_velocity": "m/s",
         "friction_power": "W",
+        "circuit_mean_square": "A^2 or V^2",
     }
     for name, unit in units.items():
         if name not in summary:
