@@ -52,6 +52,7 @@ from scipy.sparse import linalg as sparse_linalg
 
 from randvib._validation import check_int, check_positive, scalar_or_array
 from randvib.analytic.averaging import (
+    CIRCUIT_METHODS,
     linear_psi_root,
     memoryless_parameters,
     turning_point_squared,
@@ -333,6 +334,7 @@ def fpk_statistics(harvester: Harvester, psd, n: int = 160):
     velocity_variance, displacement_variance, mean_abs_velocity : float or ndarray
     """
     n = check_int("n", n, 16)
+    harvester.require_resistive("the FPK solver", CIRCUIT_METHODS)
     psd = check_positive("psd", white_level(psd, "the FPK solver"), "(m/s^2)^2/Hz")
     friction = harvester.friction
     own = {name: getattr(harvester, name) for name in ("m", "c_m", "c_e", "k", "k3")}

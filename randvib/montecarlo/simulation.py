@@ -781,7 +781,7 @@ def simulate(
         record=(histogram_bins, histogram_range, record_paths, record_every),
     )
     _check_coloured_options(run.excitation, run.companion, control_variates)
-    _check_circuit_options(run.harvester, run.companion, control_variates)
+    _check_circuit_options(run.harvester, run.companion)
     if check_step:
         _check_step(run.scheme.name, run.harvester, run.excitation, run.grid.dt)
     setup = _KernelSetup.prepare(run)
@@ -896,19 +896,19 @@ def _check_coloured_options(excitation: Excitation, companion: bool, control_var
         )
 
 
-def _check_circuit_options(harvester: Harvester, companion: bool, control_variates: bool):
-    """Refuse the resistive-only options with a circuit state, saying why."""
-    if not harvester.has_circuit:
-        return
-    for name, given, why in (
-        ("companion", companion, "its exact moments (S m/(4c), Gibbs E[z^2])"),
-        ("control_variates", control_variates, "the controls' known means"),
-    ):
-        if given:
-            raise ValueError(
-                f"`{name}` needs a resistive coupling: {why} assume a viscous c_e, not the "
-                f"{harvester.electrical.name} coupling's circuit state; use {name}=False"
-            )
+def _check_circuit_options(harvester: Harvester, companion: bool):
+    """Refuse the friction-free companion with a circuit state, saying why.
+
+    The energy-balance controls (the Ito integral, mean exactly zero; the
+    change of mechanical energy, zero in the stationary state) hold for any
+    coupling, so ``control_variates`` stays available.
+    """
+    if harvester.has_circuit and companion:
+        raise ValueError(
+            "`companion` needs the resistive coupling: its exact moments (S m/(4c), Gibbs "
+            f"E[z^2]) assume a viscous c_e, not the {harvester.electrical.name} coupling's "
+            "circuit state; use companion=False"
+        )
 
 
 def _checked_increments(dW, n_paths, n_steps):
