@@ -11,6 +11,9 @@ Device: figure9 preset with k3 = 5e5 N/m^3 (Duffing + Coulomb), dt = 1e-4 s,
 * the same engine under band-pass input (issue 10): the kernel then
   integrates the shaping filter's 2 states with the device; the target is at
   most 1.5x the white-noise kernel per path-step (``filter_over_white``).
+* the same engine with a coil inductance (issue 11): the kernel integrates the
+  circuit's current as an auxiliary state (the same compiled block as the
+  filter's), reported as ``circuit_over_white`` per path-step.
 A module fixture prints ns per path-step and the ratios, and writes
 .benchmarks/engine_ratios.json. Set RANDVIB_BENCH_FULL_MEMORY=1 to also run the
 10^5 paths x 10^6 steps memory case (about 10 minutes on 2 cores).
@@ -38,11 +41,20 @@ WORK = N_PATHS * N_STEPS
 CORES = numba.config.NUMBA_NUM_THREADS
 #: Band-pass input centred at the device's linear resonance (8 Hz).
 BAND_PASS = BandPass(PSD, 8.0, 0.2)
+#: The same device with the paper's coil, load and a 1 mH inductance (L/R = 0.7 ms).
+COIL = rv.Harvester.with_coupling(
+    DEVICE.m,
+    DEVICE.c_m,
+    DEVICE.k,
+    rv.Inductive(alpha=0.1992, r_load=1.0, r_coil=0.48, inductance=1e-3),
+    k3=DEVICE.k3,
+    friction=DEVICE.friction,
+)
 
 
-def _run(method, excitation=PSD):
+def _run(method, excitation=PSD, device=DEVICE):
     return simulate(
-        DEVICE,
+        device,
         excitation,
         t_end=N_STEPS * DT,
         dt=DT,
@@ -81,13 +93,26 @@ def test_engine_filter_states(benchmark, method):
     record(benchmark, f"{method}-band-pass", WORK)
 
 
+@pytest.mark.parametrize("method", ["euler-maruyama", "heun"])
+def test_engine_circuit_state(benchmark, method):
+    """The same run with a coil inductance: the current integrated with the device."""
+    _run(method, PSD, COIL)  # compile / load cache
+    benchmark.pedantic(_run, args=(method, PSD, COIL), rounds=5, warmup_rounds=1)
+    record(benchmark, f"{method}-circuit", WORK)
+
+
+def _over_white(suffix):
+    """Kernel ``<scheme>-<suffix>`` over the white-noise kernel, per path-step."""
+    return {
+        m: TIMINGS[f"{m}-{suffix}"] / TIMINGS[m]
+        for m in ("euler-maruyama", "heun")
+        if m in TIMINGS and f"{m}-{suffix}" in TIMINGS
+    }
+
+
 def _filter_over_white():
     """Filter-state kernel over white-noise kernel, per path-step, for the schemes timed."""
-    return {
-        m: TIMINGS[f"{m}-band-pass"] / TIMINGS[m]
-        for m in ("euler-maruyama", "heun")
-        if m in TIMINGS and f"{m}-band-pass" in TIMINGS
-    }
+    return _over_white("band-pass")
 
 
 def test_sdeint_one_path(benchmark):
@@ -167,6 +192,8 @@ def ratios_and_memory():
     yield
     if _filter_over_white():
         print(f"\nfilter_over_white (target <= 1.5): {_filter_over_white()}")
+    if _over_white("circuit"):
+        print(f"\ncircuit_over_white: {_over_white('circuit')}")
     needed = {"floor", "euler-maruyama", "heun", "sdeint", "numpy"}
     if not needed <= TIMINGS.keys():
         return  # a subset was run: no ratios
@@ -183,6 +210,7 @@ def ratios_and_memory():
         "sdeint_over_euler_maruyama": ns["sdeint"] / ns["euler-maruyama"],
         "numpy_loop_over_euler_maruyama": ns["numpy"] / ns["euler-maruyama"],
         "filter_over_white": _filter_over_white(),
+        "circuit_over_white": _over_white("circuit"),
         # (RSS before the run, peak RSS during it) in MB; the difference is
         # what the simulation itself needs
         "rss_mb_baseline_and_peak": memory,
