@@ -323,6 +323,23 @@ MUTATIONS: tuple[Mutation, ...] = (
         why="Synthesised paths 1 % too large in amplitude (2 % in variance); the variance "
         "test is powered for 2 % (standard error 0.25 %).",
     ),
+    Mutation(
+        name="circuit-drive-in-kernel",
+        path="randvib/montecarlo/simulation.py",
+        edits=(
+            (
+                "a[n_filter, n_filter], b[n_filter], c[n_filter] = a_x, b_x, f / h.m",
+                "a[n_filter, n_filter], b[n_filter], c[n_filter] = a_x, 1.01 * b_x, f / h.m",
+            ),
+        ),
+        tests=(
+            "tests/test_coupling.py::test_coarse_step_exact_with_circuit_state"
+            "[heun-white-inductive]",
+        ),
+        why="The kernel's circuit state is driven 1 % too hard by the velocity (alpha/L "
+        "or theta/C_p), so E[i^2] is about 2 % too large; the coarse-step test compares "
+        "with the scheme's exact recursion on device + circuit, powered for 1 %.",
+    ),
 )
 
 

@@ -702,7 +702,12 @@ def simulate(
     Parameters
     ----------
     harvester : Harvester
-        Device with scalar parameters; any friction model.
+        Device with scalar parameters; any friction model; any coupling
+        (:mod:`randvib.models.coupling`): a coil's current or a piezo's
+        voltage is integrated as an auxiliary state with the device, under
+        white or rational input, and its mean square is averaged per path
+        (``circuit_mean_square``, the power from it); the companion then is
+        refused (it assumes a viscous c_e), the control variates are not.
     psd : float or Excitation
         One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0: the velocity
         noise is sqrt(S/2) dW (paper Eq. 17). Or an excitation

@@ -379,6 +379,8 @@ def run_sweep(
         Show a progress bar over points.
     """
     settings = settings or SweepSettings()
+    # the sweep's power columns are c_e E[v^2]; a circuit state has its own
+    base.require_resistive("run_sweep", "randvib.simulate, point by point")
     points = validate_points(base, points)
     rows: dict[int, dict] = {}
     per_path: dict[int, np.ndarray] = {}
