@@ -205,7 +205,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="load-power-share",
-        path="randvib/models/harvester.py",
+        path="randvib/models/coupling.py",
         edits=(
             (
                 "return self.r_load / (self.r_load + self.r_coil)",
