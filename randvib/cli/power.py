@@ -62,11 +62,12 @@ def run(args) -> int:
         # The level --psd; a tabulated or measured spectrum has none (null).
         "psd": getattr(psd, "level", None) if coloured else psd,
         "friction": harvester.friction_name,
-        "coupling": harvester.coupling_name,
         **result.to_dict(),
     }
     if result.power_load is None:
         out.pop("power_load")
+    if harvester.electrical is not None:  # added with the couplings (issue 11)
+        out["coupling"] = harvester.coupling_name
     if coloured:
         out["excitation"] = psd.parameters()
     if args.json:

@@ -284,7 +284,9 @@ class SimulationResult:
 
         With a circuit state: (R_L + R_C) E[i^2] (inductive), E[V^2] / R_L (piezo).
         """
-        return self.statistic(self._circuit_power("power_electrical"))
+        if self.harvester.has_circuit:
+            return self.statistic(self._circuit_power("power_electrical"))
+        return self.statistic(self.harvester.c_e * self.averages.v2)
 
     def _circuit_power(self, which: str) -> np.ndarray:
         """Per-path electrical or load power of a circuit state (``which``: the method)."""
