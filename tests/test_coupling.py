@@ -75,6 +75,25 @@ def test_lyapunov_matches_closed_forms_and_energy_balance():
 
 
 @pytest.mark.parametrize("coupling", [INDUCTIVE, PIEZO], ids=["inductive", "piezo"])
+def test_linearisation_with_friction_keeps_the_gaussian_energy_balance(coupling):
+    """c_m s^2 + Fc sqrt(2/pi) s + P_e = S m/4 at the fixed point (Coulomb, Duffing).
+
+    Statistical linearisation is the energy identity with the Gaussian closure
+    E|v| = sqrt(2/pi) s (docs/conventions.md); the circuit's power enters it as
+    in the exact identity. Array circuit parameters are refused.
+    """
+    fc, psd = 0.004, 0.5
+    r = rv.statistical_linearisation(linear(coupling, k3=2e5, friction=rv.Coulomb(fc)), psd)
+    s2 = r.velocity_variance
+    balance = C_M * s2 + fc * np.sqrt(2 / np.pi * s2) + r.power_electrical
+    assert balance == pytest.approx(psd * M / 4, rel=1e-8)
+    assert r.c_eq == pytest.approx(C_M + fc * np.sqrt(2 / np.pi / s2), rel=1e-8)
+    arrays = linear(rv.Piezo(theta=1e-3, capacitance=[1e-7, 2e-7], r_load=1e5))
+    with pytest.raises(ValueError, match="scalar"):
+        rv.statistical_linearisation(arrays, psd)
+
+
+@pytest.mark.parametrize("coupling", [INDUCTIVE, PIEZO], ids=["inductive", "piezo"])
 def test_spectral_integral_matches_lyapunov_with_the_circuit(coupling):
     block = device_block(M, C_M, K, coupling)
     exc = BandPass(0.5, 8.0, 0.3)

@@ -137,6 +137,8 @@ class LinearisationResult:
 
 def _check_harvester(harvester: Harvester):
     values = [harvester.m, harvester.c, harvester.k, harvester.k3]
+    if harvester.electrical is not None:
+        values += list(harvester.electrical.parameters().values())
     if any(np.ndim(v) != 0 for v in values):
         raise ValueError(
             "statistical_linearisation needs scalar harvester parameters; loop over a sweep"
