@@ -516,7 +516,12 @@ def _linearised_spread(harvester: Harvester, excitation: Excitation) -> tuple[fl
 
 def _check_step(scheme, harvester, excitation, dt):
     bias = step_bias(scheme, harvester, excitation, dt)
-    resolves = "" if excitation.is_white else f" with the {excitation.name} filter's states"
+    states = [] if excitation.is_white else [f"the {excitation.name} filter's states"]
+    if harvester.has_circuit:
+        states.append(
+            f"the {harvester.electrical.name} circuit's {harvester.electrical.state_name}"
+        )
+    resolves = f" with {' and '.join(states)}" if states else ""
     if bias > MAX_STEP_BIAS:
         limit = largest_step(scheme, harvester, excitation)
         raise ValueError(
