@@ -177,6 +177,9 @@ def test_methods_that_assume_a_viscous_damper_refuse_a_circuit_state():
         rv.equivalent_damping(h, 0.5)
     with pytest.raises(ValueError, match="companion"):
         simulate(h, 0.5, t_end=0.1, dt=1e-4, n_paths=2, companion=True)
+    stiff = linear(rv.Inductive(ALPHA, R_LOAD, R_COIL, 1e-6))  # L/R = 0.7 us
+    with pytest.raises(ValueError, match="with the inductive circuit's current.*use dt <="):
+        simulate(stiff, 0.5, t_end=0.1, dt=1e-4, n_paths=2)
     with pytest.raises(ValueError, match="c_e must be 0"):
         rv.Harvester(m=M, c_m=C_M, c_e=0.1, k=K, electrical=PIEZO)
     for bad in (dict(inductance=-1e-3), dict(r_load=0.0)):
