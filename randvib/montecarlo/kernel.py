@@ -8,6 +8,13 @@ in parallel (``numba.prange``). Every path draws from its own stream
 happen afterwards in path order, so results are bit-identical for any number
 of threads and any batching of paths.
 
+Two step functions: :func:`scheme_step` for the white-noise device with a
+resistive (viscous) circuit, the compile-time fast path, and
+:func:`auxiliary_step` for the device with up to :data:`N_AUX` linear
+auxiliary states (:class:`Auxiliary`: an excitation's shaping filter and/or a
+circuit's current or voltage), one compiled path for every excitation x
+coupling combination.
+
 Memory is O(n_paths): per-path running sums only, unless histograms or
 recorded histories are requested.
 """
