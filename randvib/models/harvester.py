@@ -14,8 +14,14 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from randvib._validation import check_nonnegative, check_positive, scalar_or_array
+from randvib._validation import check_finite, check_nonnegative, check_positive, scalar_or_array
 from randvib.models.friction import FrictionModel
+from randvib.models.potential import Potential
+
+
+def _check_real(name, value, unit):
+    """Any finite value: the potential's kind is the methods' business (issue 11)."""
+    return check_finite(name, value)
 
 
 @dataclass(frozen=True, eq=False)
@@ -76,14 +82,22 @@ class Harvester:
     c_e : float
         Electrical damping (Ns/m), >= 0; see :meth:`from_electrical` for Eq. 3.
     k : float
-        Linear stiffness (N/m), > 0.
+        Linear stiffness (N/m), any finite value: k > 0 monostable, k < 0
+        bistable (with k3 > 0), k = 0 pure cubic or, with k3 = 0, the free
+        mass (see :class:`~randvib.models.potential.Potential`).
     k3 : float, optional
-        Cubic (Duffing) stiffness (N/m^3), >= 0 (hardening, monostable).
+        Cubic (Duffing) stiffness (N/m^3), any finite value. A non-confining
+        potential (k3 < 0, or k < 0 with k3 = 0) can be built but every
+        stationary method refuses it.
     friction : FrictionModel or None, optional
         Friction model; ``None`` for none.
     electrical : ElectricalCoupling or None, optional
         Circuit data; when given, ``c_e`` must equal alpha^2 / (R_L + R_C)
         (use :meth:`from_electrical`), and load voltage and power are defined.
+    stroke : float or None, optional
+        Stroke limit (m), > 0: the largest |z| before the magnet meets its end
+        stops. It changes no dynamics; the methods report how often and how
+        soon |z| exceeds it (``stroke_exceedance``, first-passage time).
     """
 
     m: float
@@ -93,16 +107,22 @@ class Harvester:
     k3: float = 0.0
     friction: FrictionModel | None = None
     electrical: ElectricalCoupling | None = None
+    stroke: float | None = None
 
     def __post_init__(self):
         for name, check, unit in (
             ("m", check_positive, "kg"),
             ("c_m", check_nonnegative, "Ns/m"),
             ("c_e", check_nonnegative, "Ns/m"),
-            ("k", check_positive, "N/m"),
-            ("k3", check_nonnegative, "N/m^3"),
+            ("k", _check_real, "N/m"),
+            ("k3", _check_real, "N/m^3"),
         ):
             object.__setattr__(self, name, scalar_or_array(check(name, getattr(self, name), unit)))
+        if self.stroke is not None:
+            stroke = check_positive("stroke", self.stroke, "m")
+            if np.ndim(stroke):
+                raise ValueError(f"`stroke` must be one number (m), got {self.stroke!r}")
+            object.__setattr__(self, "stroke", float(stroke))
         if self.friction is not None and not isinstance(self.friction, FrictionModel):
             raise ValueError(
                 f"`friction` must be a randvib friction model (Coulomb, Tanh, LuGre) "
@@ -122,7 +142,7 @@ class Harvester:
             )
 
     @classmethod
-    def from_electrical(cls, m, c_m, k, alpha, r_load, r_coil, k3=0.0, friction=None):
+    def from_electrical(cls, m, c_m, k, alpha, r_load, r_coil, k3=0.0, friction=None, stroke=None):
         """Build a harvester whose c_e follows from the circuit (paper Eq. 3).
 
         Parameters
@@ -143,6 +163,7 @@ class Harvester:
             k3=k3,
             friction=friction,
             electrical=electrical,
+            stroke=stroke,
         )
 
     # ----------------------------------------------------------------- derived
@@ -153,8 +174,14 @@ class Harvester:
 
     @property
     def natural_frequency(self):
-        """Linear natural frequency omega_n = sqrt(k/m) (rad/s)."""
-        return np.sqrt(self.k / self.m)
+        """Linear natural frequency omega_n = sqrt(k/m) (rad/s); nan for k < 0."""
+        with np.errstate(invalid="ignore"):
+            return np.sqrt(self.k / self.m)
+
+    @property
+    def potential(self) -> Potential:
+        """The restoring potential k z^2/2 + k3 z^4/4 and what it allows."""
+        return Potential(self.k, self.k3)
 
     @property
     def friction_name(self) -> str:
@@ -196,19 +223,21 @@ class Harvester:
             out.update(self.friction.parameters())
         if self.electrical is not None:
             out.update({f.name: getattr(self.electrical, f.name) for f in fields(self.electrical)})
+        if self.stroke is not None:
+            out["stroke"] = self.stroke
         return out
 
     def updated(self, **changes) -> Harvester:
         """A copy with some parameters changed, friction and circuit ones included.
 
-        Keys may be any of ``m, c_m, c_e, k, k3``, the friction model's
+        Keys may be any of ``m, c_m, c_e, k, k3, stroke``, the friction model's
         parameters (``fc``, ``beta``, ...) or the circuit's (``alpha``,
         ``r_load``, ``r_coil``; c_e then follows Eq. 3). ``c`` sets the total
         damping, split in the current ratio of c_m to c_e.
         """
         own = {
             name: changes.pop(name)
-            for name in ("m", "c_m", "c_e", "k", "k3", "friction")
+            for name in ("m", "c_m", "c_e", "k", "k3", "friction", "stroke")
             if name in changes
         }
         if "c" in changes:
@@ -238,7 +267,7 @@ class Harvester:
             electrical = None  # an explicit c_e overrides the circuit
         if changes:
             allowed = sorted(
-                {"m", "c", "c_m", "c_e", "k", "k3", "alpha", "r_load", "r_coil"}
+                {"m", "c", "c_m", "c_e", "k", "k3", "stroke", "alpha", "r_load", "r_coil"}
                 | ({f.name for f in fields(friction)} if friction else set())
             )
             raise ValueError(
