@@ -29,6 +29,7 @@ from scipy import optimize
 from randvib.analytic.linear_response import mechanical_block, output_variances, response_spectra
 from randvib.models.excitation import Excitation, as_excitation
 from randvib.models.harvester import Harvester
+from randvib.models.potential import CONFINING
 
 #: Largest |log residual| accepted as converged.
 _TOLERANCE = 1e-10
@@ -133,6 +134,11 @@ def _check_harvester(harvester: Harvester):
             f"statistical linearisation needs a memoryless friction law; {friction.name!r} "
             "has internal state. Use randvib.simulate for it."
         )
+    # A spring is needed for a stationary z (the free mass has none; under white
+    # noise randvib.predict(method="linearisation") gives its velocity statistics).
+    harvester.potential.require(
+        "statistical_linearisation", CONFINING, "randvib.predict under white noise"
+    )
     return None if friction is None or friction.vanishes else friction
 
 
@@ -159,7 +165,10 @@ def statistical_linearisation(
     Raises
     ------
     ValueError
-        For a friction law with memory, array parameters or an unknown method.
+        For a friction law with memory, array parameters, an unknown method,
+        a potential that is not confining (the free mass included), or a
+        double well for which no zero-mean Gaussian solution with k_eq > 0
+        exists (a narrow band far above the wells' frequency).
     RuntimeError
         If the fixed point does not converge.
     """
@@ -177,7 +186,13 @@ def statistical_linearisation(
             if friction is None
             else float(friction.equivalent_damping_increment(np.sqrt(var_v)))
         )
-        return c + increment, k + 3.0 * k3 * var_z
+        k_eq = k + 3.0 * k3 * var_z
+        if k <= 0:
+            # A trial E[z^2] below -k/(3 k3) would make the linear device
+            # unstable: the floor keeps the solver's trial steps defined, and a
+            # "solution" on the floor is refused below.
+            k_eq = max(k_eq, 1e-6 * k_start)
+        return c + increment, k_eq
 
     def response(c_eq, k_eq):
         out = output_variances(mechanical_block(m, c_eq, k_eq), excitation, used)
@@ -187,10 +202,20 @@ def statistical_linearisation(
         return response(*equivalent(x)) - x
 
     # Start from the linear device; without viscous damping, from 5 % of critical.
-    c_start = c if c > 0 else 0.1 * np.sqrt(k * m)
-    x = _solve(residual, response(c_start, k))
+    # Without a positive k (double well, pure cubic) the linear device is
+    # unstable: start from the white-noise closure's k_eq at the level S instead.
+    k_start = k if k > 0 else _white_noise_k_eq(m, c, k, k3, _typical_level(excitation))
+    c_start = c if c > 0 else 0.1 * np.sqrt(k_start * m)
+    x = _solve(residual, response(c_start, k_start))
     c_eq, k_eq = equivalent(x)
     var_v, var_z = np.exp(x)
+    if k + 3.0 * k3 * var_z <= 0:
+        raise ValueError(
+            "statistical linearisation has no zero-mean Gaussian solution with k_eq > 0 for "
+            f"this {harvester.potential.kind} device under the {excitation.name} excitation "
+            "(the response is not a zero-mean Gaussian about the barrier): use Monte Carlo "
+            "(randvib.simulate)"
+        )
     power = harvester.c_e * var_v
     load = None if harvester.electrical is None else power * harvester.electrical.load_fraction
     return LinearisationResult(
@@ -204,6 +229,21 @@ def statistical_linearisation(
         power_load=None if load is None else float(load),
         method=used,
     )
+
+
+def _white_noise_k_eq(m, c, k, k3, level):
+    """k_eq = (k + sqrt(k^2 + 12 k3 m sigma_v^2))/2 with sigma_v^2 = S m/(4c) (N/m)."""
+    var_v = level * m / (4.0 * c) if c > 0 else level  # any positive scale will do
+    return 0.5 * (k + np.sqrt(k * k + 12.0 * k3 * m * var_v))
+
+
+def _typical_level(excitation) -> float:
+    """A PSD level ((m/s^2)^2/Hz) of the excitation: its ``level``, else variance / band."""
+    level = getattr(excitation, "level", None)
+    if level is None:
+        lo, hi = excitation.support
+        level = excitation.variance / (hi - lo)
+    return float(level)
 
 
 def _solve(residual, x0) -> np.ndarray:
