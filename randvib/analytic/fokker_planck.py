@@ -121,7 +121,7 @@ def _tail_mass(z, hz, mass, stroke):
             centre, face = x[cut[0]], x[cut[0]] + 0.5 * hz
             knots = np.array([stroke, max(stroke, centre), face])
             total += float(np.trapezoid(np.interp(knots, x, d), knots))
-    return total
+    return max(total, 0.0)  # central fluxes may undershoot in the far tails
 
 
 def _bernoulli(x):
@@ -609,9 +609,52 @@ def _half_moments_of_density(cells, p, point, stroke=None):
     beyond = np.nan
     if stroke is not None:
         marginal = (cell * p.sum(axis=0) + end * jump * at_zero) / mass
-        beyond = _tail_mass(z, hz, marginal, stroke)
+        beyond = _gibbs_weighted_tail(z, hz, marginal, stroke, point)
     ring = (p[-1].sum() + p[:-1, 0].sum() + p[:-1, -1].sum()) * cell / mass
     return np.array([vv, zz, abs_v, beyond]), ring
+
+
+def _gibbs_weighted_tail(z, hz, marginal, stroke, point):
+    """P(|z| > stroke) from a coarse z marginal, as Gibbs density times a smooth ratio.
+
+    The marginal is g(z) r(z) with g = exp(-(2 gamma/D)(G(z) - min G)) the
+    friction-free (Gibbs) shape, known exactly, and r a ratio that is
+    constant without friction (the fast solver is exact there) and smooth
+    with it. r is interpolated linearly between the cell centres (constant
+    beyond the outer ones) and g r integrated on a fine grid, so the tail
+    keeps the potential's exact decay where a sum over coarse cells would
+    not. Measured against the reference :func:`fpk_moments` (n = 200;
+    bistable with barrier T and 4 T, pure cubic; Fc = 0.005 and 0.02 N;
+    tests/test_potentials.py checks the first two ranges):
+    within 0.3 % for P >= 0.1; 0.2-1.5 % for P in 3e-3 .. 0.07 (10 % at
+    Fc = 0.02 N, barrier T, P = 6e-3); tens of percent or worse below 1e-3
+    with friction, where r's flat extrapolation beyond the fast box (density
+    exp(-13) of its peak) misses friction's thinning of the tails. Without
+    friction within 1e-5 down to P ~ 1e-2 and 4e-4 at P = 5e-4. For small
+    probabilities use the reference ``method="fpk"``. Without viscous
+    damping there is no Gibbs shape: :func:`_tail_mass` of the cells.
+    """
+    b = 2.0 * point.gamma / point.dd
+    if b == 0:
+        return _tail_mass(z, hz, marginal, stroke)
+    potential = Potential(point.k, point.k3)
+    low = potential.minimum
+
+    def shape(x):
+        return np.exp(-b * (potential.energy(x) - low) / point.m)
+
+    # Central fluxes undershoot slightly in the far tails: no negative ratio.
+    ratio = np.maximum(marginal / hz / shape(z), 0.0)
+
+    def integral(lo, hi):  # of g r over lo < |z| < hi, on a fine grid
+        x = np.linspace(lo, hi, 4001)
+        return np.trapezoid(shape(x) * (np.interp(x, z, ratio) + np.interp(-x, z, ratio)), x)
+
+    # Out to where g is exp(-60) of its peak.
+    z_far = float(potential.outer_turning_point(low + 60.0 * point.m / b))
+    if stroke >= z_far:
+        return 0.0
+    return float(integral(stroke, z_far) / integral(0.0, z_far))
 
 
 def fast_fpk_statistics(harvester: Harvester, psd, *, nz=FAST_NZ, nv=FAST_NV):

@@ -168,9 +168,16 @@ class Potential:
             reason = "is not confining (k3 < 0, or k < 0 with k3 = 0): no stationary state"
             tail = ""  # no stationary method treats it
         else:
-            reason = f"is {' / '.join(bad)}"
+            reason = "is " + " / ".join(_NAMES[name] for name in bad)
         raise ValueError(f"{method} needs {accepted}; the potential with {got} {reason}{tail}")
 
+
+_NAMES = {
+    "monostable": "monostable",
+    "bistable": "bistable",
+    "pure-cubic": "pure cubic",
+    "free": "the free mass (no spring: z is not stationary)",
+}
 
 _DESCRIPTIONS = {
     "monostable": "a monostable potential (k > 0, k3 >= 0)",

@@ -35,7 +35,9 @@ ACC_H0 = 5  # mechanical energy at the start of the window (J)
 ACC_H1 = 6  # mechanical energy at the end of the window (J)
 ACC_COMP_V2 = 7  # companion (same noise, no friction) mean v^2
 ACC_COMP_Z2 = 8  # companion mean z^2
-N_ACC = 9
+ACC_BEYOND = 9  # fraction of the window's steps with |z| > stroke
+ACC_FIRST_HIT = 10  # time (s) of the first state with |z| > stroke from t = 0; -1: none
+N_ACC = 11
 
 
 class PathAverages:
@@ -94,6 +96,16 @@ class PathAverages:
     def companion_z2(self):
         """The friction-free companion's time average of z^2 (m^2); 0 without one."""
         return self._col(ACC_COMP_Z2)
+
+    @property
+    def beyond_stroke(self):
+        """Fraction of the window's steps with |z| > stroke per path (0 without a stroke)."""
+        return self._col(ACC_BEYOND)
+
+    @property
+    def first_hit_time(self):
+        """Time (s) of the first state with |z| > stroke, from t = 0; -1 where none was."""
+        return self._col(ACC_FIRST_HIT)
 
     def energy_balance_controls(self, window):
         """The two zero-mean controls of the energy balance: Ito integral, energy change."""
@@ -171,7 +183,9 @@ class Recording(NamedTuple):
 
     Histograms of (z, v) over the window in ``hist_bins`` bins on
     [hist_lo, hist_hi) (``hist_bins`` 0: none); (z, v, theta) of the first
-    ``n_record`` paths every ``every`` steps, initial state included.
+    ``n_record`` paths every ``every`` steps, initial state included; the
+    stroke statistics (columns ``ACC_BEYOND``, ``ACC_FIRST_HIT``) against
+    ``stroke`` (m; inf: none).
     """
 
     hist_lo: np.ndarray  #: float64[2]
@@ -179,6 +193,7 @@ class Recording(NamedTuple):
     hist_bins: int
     n_record: int
     every: int
+    stroke: float
 
 
 class Shaping(NamedTuple):
@@ -399,7 +414,7 @@ def run_ensemble(
     seed, first_path, n_paths = paths
     init_random, init_z, init_v = initial
     with_companion, comp_init_z, comp_init_v = companion
-    hist_lo, hist_hi, hist_bins, n_record, record_every = recording
+    hist_lo, hist_hi, hist_bins, n_record, record_every, stroke = recording
     dw, ki, wi, fi = noise
     # `shaping is None` is decided when compiling (numba prunes the dead branch
     # for a None argument): white noise runs the plain loop, bit for bit and at
@@ -435,6 +450,7 @@ def run_ensemble(
         x1 = np.zeros(LANES)
         x2 = np.zeros(LANES)
         a = np.zeros((LANES, N_ACC))
+        a[:, ACC_FIRST_HIT] = -1.0
         for j in range(lanes):
             seed_path_state(seed, first_path + start + j, rng, j)
             if init_random:
@@ -489,6 +505,11 @@ def run_ensemble(
                     zn, vn, tn, f1 = scheme_step(
                         zj, vj, tj, dt, noise, scheme, drift, fr_kind, fr_p, fr_fn
                     )
+                if abs(zj) > stroke:
+                    if a[j, ACC_FIRST_HIT] < 0.0:
+                        a[j, ACC_FIRST_HIT] = n * dt
+                    if in_window:
+                        a[j, ACC_BEYOND] += 1.0
                 if in_window:
                     if n == n_burn:
                         a[j, ACC_H0] = 0.5 * m * vj * vj + 0.5 * k * zj * zj + 0.25 * k3 * zj**4
@@ -533,8 +554,10 @@ def run_ensemble(
             zj = z[j]
             vj = v[j]
             a[j, ACC_H1] = 0.5 * m * vj * vj + 0.5 * k * zj * zj + 0.25 * k3 * zj**4
+            if abs(zj) > stroke and a[j, ACC_FIRST_HIT] < 0.0:
+                a[j, ACC_FIRST_HIT] = n_steps * dt  # the final state
             for q in range(N_ACC):
-                if q == ACC_H0 or q == ACC_H1:
+                if q == ACC_H0 or q == ACC_H1 or q == ACC_FIRST_HIT:
                     acc[p, q] = a[j, q]
                 elif q == ACC_VDW:
                     acc[p, q] = a[j, q] / window

@@ -39,6 +39,7 @@ from randvib.analytic.linearisation import equivalent_damping, linear_displaceme
 from randvib.models.excitation import Excitation, ShapingFilter, as_excitation
 from randvib.models.friction import kernel_arguments
 from randvib.models.harvester import Harvester
+from randvib.models.potential import CONFINING
 from randvib.montecarlo import integrators, kernel
 from randvib.montecarlo.integrators import Integrator, integrator
 from randvib.montecarlo.rng import ZIG_FI, ZIG_KI, ZIG_WI
@@ -143,6 +144,65 @@ def estimate(samples, controls=None, folds: int = 4) -> Statistic:
     return Statistic(
         mean=mean, ci95=float(special.stdtrit(n - 1, 0.975) * se), std_error=float(se), n_paths=n
     )
+
+
+@dataclass(frozen=True)
+class FirstPassage:
+    """Time for |z| to first exceed the stroke, from each path's start state.
+
+    Paths that never reach the stroke within the run (``t_end``) are
+    *censored*: their first-passage time is only known to exceed ``t_end``.
+    The mean first-passage time is reported (``mean``, a t interval over
+    paths) only when every path reached the stroke; otherwise ``mean`` is
+    None and what the data do determine is given instead: how many paths
+    reached it, and the restricted mean E[min(tau, t_end)] (a plain mean
+    over paths, with its interval), a lower bound of the mean first-passage
+    time. With ``initial="stationary"`` the start is random and some paths
+    may start beyond the stroke (time 0); ``initial="rest"`` asks how soon
+    the magnet reaches its stops from rest.
+
+    Attributes
+    ----------
+    mean : Statistic or None
+        E[tau] (s), when every path reached the stroke.
+    restricted_mean : Statistic
+        E[min(tau, t_end)] (s), always defined.
+    paths_reached : int
+        Paths that reached the stroke within the run.
+    n_paths : int
+    horizon : float
+        t_end (s), the censoring time.
+    """
+
+    mean: Statistic | None
+    restricted_mean: Statistic
+    paths_reached: int
+    n_paths: int
+    horizon: float
+
+    @classmethod
+    def from_times(cls, times, horizon: float) -> FirstPassage:
+        """From per-path first times (s; negative: not reached within ``horizon``)."""
+        times = np.asarray(times, dtype=float)
+        reached = times >= 0
+        restricted = np.where(reached, times, horizon)
+        return cls(
+            mean=estimate(times) if np.all(reached) else None,
+            restricted_mean=estimate(restricted),
+            paths_reached=int(reached.sum()),
+            n_paths=int(times.size),
+            horizon=float(horizon),
+        )
+
+    def to_dict(self) -> dict:
+        return {
+            "mean": None if self.mean is None else self.mean.mean,
+            "ci95": None if self.mean is None else self.mean.ci95,
+            "paths_reached": self.paths_reached,
+            "n_paths": self.n_paths,
+            "horizon": self.horizon,
+            "restricted_mean": self.restricted_mean.to_dict(),
+        }
 
 
 @dataclass(frozen=True)
@@ -263,9 +323,29 @@ class SimulationResult:
         return self.statistic(self.averages.v2)
 
     @property
-    def displacement_variance(self) -> Statistic:
-        """E[z^2] (m^2)."""
+    def displacement_variance(self) -> Statistic | None:
+        """E[z^2] (m^2); None for the free mass (k = k3 = 0), whose z is not stationary."""
+        if self.harvester.potential.is_free:
+            return None
         return self.statistic(self.averages.z2)
+
+    @property
+    def stroke_exceedance(self) -> Statistic | None:
+        """Fraction of the window's time with |z| > stroke; None without a stroke.
+
+        For the free mass it is the fraction over this window (z is not
+        stationary, so it grows with the run), not a stationary probability.
+        """
+        if self.harvester.stroke is None:
+            return None
+        return self.statistic(self.averages.beyond_stroke)
+
+    @property
+    def stroke_first_passage(self) -> FirstPassage | None:
+        """First time |z| > stroke from the start (:class:`FirstPassage`); None without a stroke."""
+        if self.harvester.stroke is None:
+            return None
+        return FirstPassage.from_times(self.averages.first_hit_time, self.t_end)
 
     @property
     def mean_abs_velocity(self) -> Statistic:
@@ -305,13 +385,21 @@ class SimulationResult:
             for name in (
                 "power_electrical",
                 "velocity_variance",
-                "displacement_variance",
                 "mean_abs_velocity",
                 "friction_power",
             )
         }
+        # null for the free mass: its displacement has no stationary law
+        z2 = self.displacement_variance
+        out["displacement_variance"] = None if z2 is None else z2.to_dict()
         if self.power_load is not None:
             out["power_load"] = self.power_load.to_dict()
+        if self.harvester.stroke is not None:
+            out["stroke"] = self.harvester.stroke
+            out["stroke_exceedance"] = self.stroke_exceedance.to_dict()
+            first = self.stroke_first_passage
+            out["stroke_first_passage_time"] = None if first.mean is None else first.mean.to_dict()
+            out["stroke_first_passage"] = first.to_dict()
         out.update(
             n_paths=self.n_paths,
             dt=self.dt,
@@ -336,11 +424,15 @@ def effective_linear_device(harvester: Harvester, psd: float) -> tuple[float, fl
     k_eff = k + 3 k3 E[z^2] with E[z^2] from the exact friction-free density
     (friction only shrinks the motion, so this stiffness is an upper bound in
     the mean); c_eff = c_eq from equivalent linearisation, or c for LuGre.
+    Any confining potential: for a double well E[z^2] ~ z_w^2 at low noise,
+    so k_eff ~ -2 k, the wells' own stiffness; the free mass has k_eff = 0.
     """
     h = harvester
     c_eff = float(h.c)
     if h.friction is None or h.friction.has_equivalent_damping:
         c_eff = float(equivalent_damping(h, psd))
+    if h.potential.is_free:
+        return 0.0, c_eff
     if h.c > 0:
         z2 = exact.gibbs_displacement_moment(h.m, h.c, h.k, h.k3, psd)
     else:
@@ -375,7 +467,17 @@ def step_bias(scheme: str, harvester: Harvester, psd, dt: float) -> float:
 
 
 def _scheme_bias(scheme, m, k_eff, c_eff, psd, dt) -> float:
-    """:func:`step_bias` for an already linearised device (inf where unstable)."""
+    """:func:`step_bias` for an already linearised device (inf where unstable).
+
+    With k_eff = 0 (the free mass) only the velocity is stationary: the bias
+    of E[v^2] of the scheme's recursion on dv = -(c_eff/m) v dt + dW.
+    """
+    if k_eff == 0:
+        a, b = integrators.integrator(scheme).linear_recursion([[-c_eff / m]], [[1.0]], dt)
+        if abs(a[0, 0]) >= 1:
+            return float("inf")
+        discrete = dt * b[0, 0] ** 2 / (1.0 - a[0, 0] ** 2)
+        return abs(discrete * 2.0 * c_eff / m - 1.0)
     try:
         cov = integrators.scheme_stationary_covariance(scheme, m, c_eff, k_eff, psd, dt)
     except ValueError:
@@ -418,7 +520,8 @@ def largest_step(scheme: str, harvester: Harvester, psd, bias: float = MAX_STEP_
     excitation = as_excitation(psd)
     k_eff, c_eff = effective_linear_device(harvester, excitation.level)  # once, not per step
     m = float(harvester.m)
-    lo, hi = 0.0, 2.0 / np.sqrt(k_eff / m)
+    # The fastest linear time scale: the period over pi, or for the free mass m/c.
+    lo, hi = 0.0, 2.0 / np.sqrt(k_eff / m) if k_eff > 0 else 2.0 * m / c_eff
     if excitation.is_white:
 
         def bias_at(dt):
@@ -445,9 +548,15 @@ def _linearised_spread(harvester: Harvester, excitation: Excitation) -> tuple[fl
 
     White noise: Eq. 20 and 30. A rational spectrum: the Lyapunov covariance of
     the same linearised device driven through the excitation's filter.
+    Without a positive k (double well, pure cubic) the displacement's spread
+    is the exact friction-free (Gibbs) one, which sees both wells, where the
+    Gaussian closure would put a third of the wells' offset; the free mass
+    has no stationary spread in z (0: paths start at z = 0).
     """
     psd = excitation.level
     k_eff, c_eff = effective_linear_device(harvester, psd)
+    if harvester.potential.is_free:
+        return 0.0, float(np.sqrt(psd * harvester.m / (4.0 * c_eff)))
     if not excitation.is_white:
         f, g, pick = _augmented_system(
             float(harvester.m), k_eff, c_eff, excitation.shaping_filter()
@@ -455,6 +564,11 @@ def _linearised_spread(harvester: Harvester, excitation: Excitation) -> tuple[fl
         cov = pick @ linalg.solve_continuous_lyapunov(f, -(g @ g.T)) @ pick.T
         return float(np.sqrt(cov[1, 1])), float(np.sqrt(cov[2, 2]))
     vv = psd * harvester.m / (4.0 * c_eff)
+    h = harvester
+    if h.k <= 0 and h.c > 0:
+        return float(np.sqrt(exact.gibbs_displacement_moment(h.m, h.c, h.k, h.k3, psd))), float(
+            np.sqrt(vv)
+        )
     return float(np.sqrt(linear_displacement_variance(harvester, vv))), float(np.sqrt(vv))
 
 
@@ -784,6 +898,14 @@ def _validated(
     for name in ("m", "c_m", "c_e", "k", "k3"):
         if np.ndim(getattr(harvester, name)) != 0:
             raise ValueError(f"simulate needs scalar harvester parameters; `{name}` is an array")
+    # Statistics are time averages of a stationary state: a confining
+    # potential, or the free mass for its velocity.
+    harvester.potential.require("simulate", CONFINING + ("free",))
+    if companion and harvester.potential.is_free:
+        raise ValueError(
+            "`companion` needs a confining potential: the friction-free companion's exact "
+            "E[z^2] (Gibbs) does not exist for the free mass (k = k3 = 0)"
+        )
     scheme = integrator(*scheme_argument)
     excitation = _simulated_excitation(psd)
     grid = TimeGrid.from_times(t_end, dt, burn_in)
@@ -946,7 +1068,11 @@ def _start_states(run: _Run) -> tuple[kernel.Start, kernel.Companion]:
 
 
 def _recording(run: _Run) -> kernel.Recording:
-    """Histogram ranges and bins (default ranges +-5 linearised std); records per batch."""
+    """Histogram ranges and bins (default ranges +-5 linearised std); records per batch.
+
+    The free mass's z spreads like a random walk: its default range is
+    +-5 sqrt(2 sigma_v^2 (m/c_eff) t_end), five times the walk's spread at the end.
+    """
     bins = run.record.histogram_bins
     if bins == 0:
         lo, hi = np.zeros(2), np.ones(2)  # unused
@@ -954,10 +1080,14 @@ def _recording(run: _Run) -> kernel.Recording:
         ranges = run.record.histogram_range
         if ranges is None:
             sz, sv = _linearised_spread(run.harvester, run.excitation)
+            if run.harvester.potential.is_free:
+                _, c_eff = effective_linear_device(run.harvester, run.psd)
+                sz = sv * np.sqrt(2.0 * run.harvester.m / c_eff * run.grid.t_end)
             ranges = ((-5 * sz, 5 * sz), (-5 * sv, 5 * sv))
         arr = np.asarray(ranges, dtype=float)
         lo, hi = arr[:, 0], arr[:, 1]
-    return kernel.pack(kernel.Recording, lo, hi, bins, 0, run.record.record_every)
+    stroke = np.inf if run.harvester.stroke is None else run.harvester.stroke
+    return kernel.pack(kernel.Recording, lo, hi, bins, 0, run.record.record_every, stroke)
 
 
 # ----------------------------------------------------------------- compiled calls
