@@ -11,10 +11,12 @@ Monte Carlo z-scores were calibrated over seeds with
 each test's docstring).
 """
 
+import json
 import math
 
 import numpy as np
 import pytest
+from _cli import one_line_error, run
 from _stats import assert_matches
 from scipy import integrate, special
 
@@ -303,7 +305,9 @@ def _check(rows):
 def test_double_well_without_friction_matches_its_gibbs_density():
     """Monte Carlo E[v^2], E[z^2] and P(|z| > stroke) against the exact Gibbs density.
 
-    Calibration (``tests/calibration/potentials.py``): CALIBRATION_GIBBS.
+    Calibration (``NUMBA_NUM_THREADS=1 python tests/calibration/potentials.py 40``,
+    40 seeds): E[v^2] z mean -0.07, SD 1.03, max |z| 2.00; E[z^2] +0.12, 1.08, 2.54;
+    P(|z| > s) -0.12, 1.00, 2.39; power margins >= 6.9 SE.
     """
     assert step_bias("heun", device(KB), S, 5e-4) < 2e-3
     _check(case_double_well_gibbs(11))
@@ -312,7 +316,8 @@ def test_double_well_without_friction_matches_its_gibbs_density():
 def test_double_well_with_friction_stroke_exceedance_matches_fpk():
     """Monte Carlo P(|z| > stroke) and E[v^2] with Coulomb friction against the FPK reference.
 
-    Calibration: CALIBRATION_FRICTION.
+    Calibration (40 seeds): P(|z| > s) z mean +0.01, SD 0.93, max |z| 2.26; E[v^2]
+    -0.18, 1.17, 2.69; power margins >= 6.6 SE.
     """
     _check(case_double_well_friction(12))
 
@@ -320,7 +325,8 @@ def test_double_well_with_friction_stroke_exceedance_matches_fpk():
 def test_free_mass_with_coulomb_friction_matches_caughey_dienes():
     """The free mass's velocity against the Caughey-Dienes density; z not stationary.
 
-    Calibration: CALIBRATION_FREE.
+    Calibration (40 seeds): E[v^2] z mean -0.04, SD 0.89, max |z| 1.59; E|v| +0.00,
+    0.87, 1.87; power margins >= 6.5 SE.
     """
     _check(case_free_mass(13))
     h = device(0.0, 0.0, friction=rv.Coulomb(fc=0.005), stroke=0.01)
@@ -329,3 +335,65 @@ def test_free_mass_with_coulomb_friction_matches_caughey_dienes():
     summary = r.summary()
     assert summary["displacement_variance"] is None
     assert set(summary) >= {"stroke_exceedance", "stroke_first_passage_time"}
+
+
+# ---------------------------------------------------------------- command line
+DEVICE = ["--m", M, "--c-m", C / 2, "--c-e", C / 2, "--psd", S]
+
+
+@pytest.mark.parametrize("method", ["linearisation", "fpk-fast"])
+def test_cli_power_takes_negative_k_and_a_stroke(capsys, method):
+    argv = ["power", *DEVICE, "--k", KB, "--k3", "5e5", "--stroke", 1.2 * Z_WELL]
+    code, out, _ = run(capsys, *argv, "--method", method, "--json")
+    assert code == 0
+    got = json.loads(out)
+    expected = rv.predict(device(KB, stroke=1.2 * Z_WELL), S, method)
+    assert got["stroke_exceedance"] == expected.stroke_exceedance
+    assert got["power_electrical"] == expected.power_electrical and got["stroke"] == 1.2 * Z_WELL
+    code, out, _ = run(capsys, "power", *DEVICE, "--k", KB, "--k3", "5e5", "--json")
+    assert "stroke_exceedance" not in json.loads(out)
+
+
+def test_cli_free_mass_displacement_variance_is_null(capsys):
+    code, out, _ = run(capsys, "power", *DEVICE, "--k", 0, "--k3", 0, "--json")
+    got = json.loads(out)
+    assert code == 0 and got["displacement_variance"] is None
+    assert got["power_electrical"] == pytest.approx(C / 2 * S * M / (4 * C), rel=1e-14)
+    argv = ["simulate", *DEVICE, "--k", 0, "--k3", 0, "--stroke", 0.01, "--json"]
+    code, out, _ = run(capsys, *argv, "--paths", 8, "--t-end", 1, "--dt", 5e-4, "--burn-in", 0.5)
+    got = json.loads(out)
+    assert code == 0 and got["displacement_variance"] is None
+    assert {"stroke_exceedance", "stroke_first_passage_time"} <= set(got)
+
+
+def test_cli_simulate_reports_the_stroke_statistics_of_the_api(capsys):
+    argv = ["simulate", *DEVICE, "--k", KB, "--k3", "5e5", "--stroke", 1.2 * Z_WELL]
+    options = ["--paths", 16, "--t-end", 2, "--dt", 5e-4, "--burn-in", 0.5, "--seed", 3]
+    code, out, _ = run(capsys, *argv, *options, "--json")
+    got = json.loads(out)
+    r = rv.simulate(
+        device(KB, stroke=1.2 * Z_WELL), S, t_end=2, dt=5e-4, burn_in=0.5, n_paths=16, seed=3
+    )
+    assert got["stroke_exceedance"] == r.stroke_exceedance.to_dict()
+    first = r.stroke_first_passage
+    expected = None if first.mean is None else first.mean.to_dict()
+    assert got["stroke_first_passage_time"] == expected
+    assert got["stroke_first_passage"]["paths_reached"] == first.paths_reached
+
+
+@pytest.mark.parametrize(
+    "argv, fragment",
+    [
+        (["power", *DEVICE, "--k", 10, "--k3", "-5e5"], "is not confining"),
+        (["power", *DEVICE, "--k", -10, "--method", "fpk"], "needs a confining potential"),
+        (["power", *DEVICE, "--k", KB, "--k3", 5e5, "--method", "averaging"], "'fpk-fast'"),
+        (["power", *DEVICE, "--k", 25, "--stroke", -0.01], "`stroke` must be > 0"),
+        (
+            ["power", *DEVICE, "--k", 25, "--stroke", 0.01, "--method", "averaging"],
+            "`--stroke` needs `--method linearisation`",
+        ),
+        (["simulate", *DEVICE, "--k", -10, "--paths", 2], "is not confining"),
+    ],
+)
+def test_cli_refusals_are_one_line(capsys, argv, fragment):
+    one_line_error(capsys, argv, fragment)
