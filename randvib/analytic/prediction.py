@@ -83,9 +83,7 @@ class PowerPrediction:
 
     def to_dict(self) -> dict:
         """Plain dict with floats or lists, ready for JSON (``stroke_exceedance`` when given)."""
-        out = {
-            k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()
-        }
+        out = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()}
         if out["stroke_exceedance"] is None:
             del out["stroke_exceedance"]
         return out
