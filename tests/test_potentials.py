@@ -13,6 +13,7 @@ each test's docstring).
 
 import json
 import math
+from itertools import pairwise
 
 import numpy as np
 import pytest
@@ -272,11 +273,34 @@ def case_double_well_gibbs(seed):
     (step_bias), under the 1-2.5 % to detect.
     """
     h = device(KB, stroke=1.2 * Z_WELL)
-    r = rv.simulate(h, S, t_end=20.0, dt=5e-4, burn_in=2.0, n_paths=1024, seed=seed)
+    edges = np.linspace(-2 * Z_WELL, 2 * Z_WELL, 9)
+    r = rv.simulate(
+        h,
+        S,
+        t_end=20.0,
+        dt=5e-4,
+        burn_in=2.0,
+        n_paths=1024,
+        seed=seed,
+        histogram_bins=8,
+        histogram_range=((edges[0], edges[-1]), (-1.0, 1.0)),
+    )
     yield "E[v^2]", r.velocity_variance, S * M / (4 * C), 0.0, 0.025
     yield "E[z^2]", r.displacement_variance, gibbs_displacement_moment(M, C, KB, K3, S), 0.0, 0.01
     beyond = gibbs_exceedance(M, C, KB, K3, S, h.stroke)
     yield "P(|z|>s)", r.stroke_exceedance, beyond, 0.0, 0.015
+    # The histogram, bin by bin (intervals over the kernel's independent path groups).
+    exact = gibbs_bin_densities(edges)
+    for i, stat in enumerate(r.histogram.density_statistics("z")):
+        yield f"p(z) bin {i}", stat, exact[i], 0.0, 0.06
+
+
+def gibbs_bin_densities(edges):
+    """Bin averages of the exact Gibbs density of the double well KB (1/m), by quadrature."""
+    weight = lambda z: np.exp(-Potential(KB, K3).energy(z) / T)  # noqa: E731
+    norm = integrate.quad(weight, -np.inf, np.inf, points=None, epsabs=0, epsrel=1e-12)[0]
+    mass = [integrate.quad(weight, a, b, epsabs=0, epsrel=1e-12)[0] for a, b in pairwise(edges)]
+    return np.array(mass) / norm / np.diff(edges)
 
 
 def case_double_well_friction(seed):
@@ -303,7 +327,10 @@ def _check(rows):
 
 
 def test_double_well_without_friction_matches_its_gibbs_density():
-    """Monte Carlo E[v^2], E[z^2] and P(|z| > stroke) against the exact Gibbs density.
+    """Monte Carlo E[v^2], E[z^2], P(|z| > stroke) and the z histogram against Gibbs.
+
+    The histogram's 8 bins over +-2 z_w, each with its interval over the
+    kernel's 128 independent groups of 8 paths.
 
     Calibration (``NUMBA_NUM_THREADS=1 python tests/calibration/potentials.py 40``,
     40 seeds): E[v^2] z mean -0.07, SD 1.03, max |z| 2.00; E[z^2] +0.12, 1.08, 2.54;

@@ -215,6 +215,36 @@ class Histogram:
     v_density: np.ndarray
     #: Fraction of samples that fell outside the ranges.
     outside: tuple
+    #: Counts of z and v per group of paths (the kernel's chunks of up to
+    #: kernel.LANES independent paths), shape (n_groups, 2, bins), and the
+    #: paths in each group: the groups are independent, so they give intervals.
+    group_counts: np.ndarray | None = field(default=None, repr=False)
+    group_paths: np.ndarray | None = field(default=None, repr=False)
+    window_steps: int = 0
+
+    def density_statistics(self, variable: str = "z") -> list[Statistic]:
+        """The density (1/m or s/m) in each bin with its 95 % interval, over path groups.
+
+        Ratio estimator over the independent groups g with n_g paths:
+        mean = sum(counts) / (sum(n_g) T h) (= ``z_density``), standard error
+        from the groups' spread about it, weighted by n_g / sum(n_g).
+        """
+        row = check_choice("variable", variable, ("z", "v"))
+        edges = self.z_edges if row == "z" else self.v_edges
+        counts = self.group_counts[:, 0 if row == "z" else 1, :].astype(float)
+        n = self.group_paths.astype(float)
+        g = n.size
+        if g < 2:
+            raise ValueError(f"need at least 2 groups of paths for an interval, got {g}")
+        scale = self.window_steps * np.diff(edges)  # samples per path x bin width
+        per_group = counts / (n[:, None] * scale)
+        mean = counts.sum(axis=0) / (n.sum() * scale)
+        weight = (n / n.sum())[:, None]
+        se = np.sqrt(g / (g - 1) * np.sum(weight**2 * (per_group - mean) ** 2, axis=0))
+        t = float(special.stdtrit(g - 1, 0.975))
+        return [
+            Statistic(float(a), t * float(b), float(b), g) for a, b in zip(mean, se, strict=True)
+        ]
 
 
 @dataclass(frozen=True)
@@ -851,7 +881,7 @@ def simulate(
         progress = sys.stderr.isatty() and os.environ.get("CI") is None
     batches = _batches(n_paths, batch_paths, run.grid.n_steps, progress, run.record.record_paths)
     started = time.perf_counter()
-    per_path, hist_total, records = _run_batches(run, setup, batches, progress)
+    per_path, hist_groups, records = _run_batches(run, setup, batches, progress)
     wall = time.perf_counter() - started
     return SimulationResult(
         harvester=run.harvester,
@@ -864,7 +894,7 @@ def simulate(
         first_path=run.first_path,
         per_path=per_path,
         control_variates=control_variates,
-        histogram=_histogram(setup.recording, hist_total, run.n_paths * run.grid.window_steps),
+        histogram=_histogram(setup.recording, hist_groups, batches, run.grid.window_steps),
         histories=_histories(records, run.record.record_every, run.grid.dt),
         wall_time=wall,
         excitation=run.excitation,
@@ -1098,13 +1128,13 @@ def _run_batches(run: _Run, setup: _KernelSetup, batches, progress: bool):
     -------
     per_path : ndarray, shape (n_paths, N_ACC)
         Per-path time averages.
-    hist_total : ndarray of int64, shape (2, bins)
-        Histogram counts of z and v summed over paths.
+    hist_groups : ndarray of int64, shape (n_groups, 2, bins)
+        Histogram counts of z and v per chunk of paths, batches in order.
     records : ndarray or None
         Recorded histories of the first paths (from the first batch).
     """
     per_path = np.empty((run.n_paths, kernel.N_ACC))
-    hist_total = np.zeros((2, max(run.record.histogram_bins, 1)), dtype=np.int64)
+    hist_groups = []
     records = None
     bar = None
     if progress:
@@ -1117,7 +1147,7 @@ def _run_batches(run: _Run, setup: _KernelSetup, batches, progress: bool):
             _raise_if_diverged(run, lo, failed)
             per_path[lo:hi] = acc
             if run.record.histogram_bins > 0:
-                hist_total += hist.sum(axis=0)
+                hist_groups.append(hist)
             if lo == 0 and run.record.record_paths > 0:
                 records = rec
             if bar is not None:
@@ -1125,7 +1155,8 @@ def _run_batches(run: _Run, setup: _KernelSetup, batches, progress: bool):
     finally:
         if bar is not None:
             bar.close()
-    return per_path, hist_total, records
+    hist_groups = np.concatenate(hist_groups) if hist_groups else None
+    return per_path, hist_groups, records
 
 
 def _raise_if_diverged(run: _Run, lo: int, failed: np.ndarray) -> None:
@@ -1155,11 +1186,17 @@ def _batches(n_paths, batch_paths, n_steps, progress, record_paths):
 
 
 # ----------------------------------------------------------------- result assembly
-def _histogram(recording: kernel.Recording, counts, n_samples: int) -> Histogram | None:
-    """Densities of z and v from the summed counts over ``n_samples`` samples."""
+def _histogram(recording: kernel.Recording, groups, batches, window_steps: int):
+    """Densities of z and v from the per-chunk counts ``groups`` (or None without bins)."""
     bins = recording.hist_bins
     if bins == 0:
         return None
+    # The kernel's chunks: LANES paths each, the last of each batch possibly fewer.
+    sizes = [
+        min(kernel.LANES, hi - start) for lo, hi in batches for start in range(lo, hi, kernel.LANES)
+    ]
+    counts = groups.sum(axis=0)
+    n_samples = sum(sizes) * window_steps
     z_edges = np.linspace(recording.hist_lo[0], recording.hist_hi[0], bins + 1)
     v_edges = np.linspace(recording.hist_lo[1], recording.hist_hi[1], bins + 1)
     return Histogram(
@@ -1168,6 +1205,9 @@ def _histogram(recording: kernel.Recording, counts, n_samples: int) -> Histogram
         v_edges,
         counts[1] / (n_samples * np.diff(v_edges)),
         (1 - counts[0].sum() / n_samples, 1 - counts[1].sum() / n_samples),
+        group_counts=groups,
+        group_paths=np.array(sizes),
+        window_steps=window_steps,
     )
 
 
