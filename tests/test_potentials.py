@@ -30,7 +30,7 @@ from randvib.analytic.exact_solutions import (
 )
 from randvib.analytic.fokker_planck import fast_fpk_moments, fpk_moments, solve_fpk
 from randvib.models.potential import Potential
-from randvib.montecarlo.simulation import step_bias
+from randvib.montecarlo.simulation import largest_step, step_bias
 
 M, C, S = 0.0226, 0.2, 0.5  # kg, Ns/m (c_m = c_e = 0.1), (m/s^2)^2/Hz
 T = S * M * M / (4 * C)  # m sigma_v^2 (J), the Gibbs temperature
@@ -424,3 +424,28 @@ def test_cli_simulate_reports_the_stroke_statistics_of_the_api(capsys):
 )
 def test_cli_refusals_are_one_line(capsys, argv, fragment):
     one_line_error(capsys, argv, fragment)
+
+
+def test_histogram_groups_follow_the_batches():
+    """Per-group counts add up to the histogram whatever the batching (groups = kernel chunks)."""
+    kw = dict(t_end=0.2, dt=1e-3, n_paths=50, seed=4, histogram_bins=6)
+    one = rv.simulate(device(KB), S, **kw).histogram
+    split = rv.simulate(device(KB), S, batch_paths=20, **kw).histogram
+    assert np.array_equal(one.z_density, split.z_density)
+    assert split.group_paths.tolist() == [8, 8, 4, 8, 8, 4, 8, 2]
+    assert np.array_equal(split.group_counts.sum(axis=0), one.group_counts.sum(axis=0))
+    stats = split.density_statistics("z")
+    assert [s.mean for s in stats] == pytest.approx(split.z_density.tolist(), rel=1e-12)
+
+
+def test_free_mass_step_check_is_the_velocity_recursion():
+    """Euler-Maruyama on dv = -gamma v dt + dW: stationary variance 1/(gamma (2 - gamma dt))."""
+    h = device(0.0, 0.0)
+    gamma, dt = C / M, 1e-2
+    assert step_bias("euler-maruyama", h, S, dt) == pytest.approx(
+        gamma * dt / (2 - gamma * dt), rel=1e-12
+    )
+    limit = largest_step("heun", h, S)
+    assert 0 < limit < 2 * M / C and step_bias("heun", h, S, limit) == pytest.approx(0.1, rel=1e-6)
+    with pytest.raises(ValueError, match="`companion` needs a confining potential"):
+        rv.simulate(h, S, t_end=1.0, dt=1e-3, n_paths=2, companion=True)
