@@ -292,7 +292,7 @@ def case_double_well_gibbs(seed):
     # The histogram, bin by bin (intervals over the kernel's independent path groups).
     exact = gibbs_bin_densities(edges)
     for i, stat in enumerate(r.histogram.density_statistics("z")):
-        yield f"p(z) bin {i}", stat, exact[i], 0.0, 0.06
+        yield f"p(z) bin {i}", stat, exact[i], 0.0, 0.07
 
 
 def gibbs_bin_densities(edges):
@@ -334,7 +334,9 @@ def test_double_well_without_friction_matches_its_gibbs_density():
 
     Calibration (``NUMBA_NUM_THREADS=1 python tests/calibration/potentials.py 40``,
     40 seeds): E[v^2] z mean -0.07, SD 1.03, max |z| 2.00; E[z^2] +0.12, 1.08, 2.54;
-    P(|z| > s) -0.12, 1.00, 2.39; power margins >= 6.9 SE.
+    P(|z| > s) -0.12, 1.00, 2.39; power margins >= 6.9 SE. Histogram bins (detect
+    7 %): z means -0.22 .. +0.14, SDs 0.87-1.09, largest |z| 2.82; power margins
+    >= 6.4 SE.
     """
     assert step_bias("heun", device(KB), S, 5e-4) < 2e-3
     _check(case_double_well_gibbs(11))
