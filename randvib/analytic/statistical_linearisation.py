@@ -209,13 +209,7 @@ def statistical_linearisation(
     x = _solve(residual, response(c_start, k_start))
     c_eq, k_eq = equivalent(x)
     var_v, var_z = np.exp(x)
-    if k + 3.0 * k3 * var_z <= 0:
-        raise ValueError(
-            "statistical linearisation has no zero-mean Gaussian solution with k_eq > 0 for "
-            f"this {harvester.potential.kind} device under the {excitation.name} excitation "
-            "(the response is not a zero-mean Gaussian about the barrier): use Monte Carlo "
-            "(randvib.simulate)"
-        )
+    _require_positive_stiffness(harvester, excitation, k + 3.0 * k3 * var_z)
     power = harvester.c_e * var_v
     load = None if harvester.electrical is None else power * harvester.electrical.load_fraction
     return LinearisationResult(
@@ -229,6 +223,17 @@ def statistical_linearisation(
         power_load=None if load is None else float(load),
         method=used,
     )
+
+
+def _require_positive_stiffness(harvester, excitation, k_eq):
+    """Refuse a fixed point on the solver's stiffness floor: no zero-mean solution exists."""
+    if k_eq <= 0:
+        raise ValueError(
+            "statistical linearisation has no zero-mean Gaussian solution with k_eq > 0 for "
+            f"this {harvester.potential.kind} device under the {excitation.name} excitation "
+            "(the response is not a zero-mean Gaussian about the barrier): use Monte Carlo "
+            "(randvib.simulate)"
+        )
 
 
 def _white_noise_k_eq(m, c, k, k3, level):

@@ -263,7 +263,9 @@ class SimulationResult:
 
     The statistics (``power_electrical``, ``velocity_variance``,
     ``displacement_variance``, ``mean_abs_velocity``, ``friction_power``,
-    ``power_load``) are :class:`Statistic` objects; with
+    ``power_load``, ``stroke_exceedance``) are :class:`Statistic` objects
+    (``displacement_variance`` None for the free mass, the stroke ones None
+    without a stroke); ``stroke_first_passage`` is a :class:`FirstPassage`; with
     ``control_variates=True`` they use the zero-mean controls of
     :meth:`controls`, otherwise plain path means.
     """
@@ -792,7 +794,12 @@ def simulate(
     Parameters
     ----------
     harvester : Harvester
-        Device with scalar parameters; any friction model.
+        Device with scalar parameters; any friction model; any confining
+        potential (monostable, bistable, pure cubic) or the free mass
+        (k = k3 = 0: velocity statistics only, ``displacement_variance`` is
+        None); a non-confining one is refused. With a ``stroke`` the result
+        reports :attr:`SimulationResult.stroke_exceedance` and
+        :attr:`SimulationResult.stroke_first_passage`.
     psd : float or Excitation
         One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0: the velocity
         noise is sqrt(S/2) dW (paper Eq. 17). Or an excitation
