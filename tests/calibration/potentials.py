@@ -7,7 +7,7 @@ Run by hand (not collected by pytest), from the repository root:
 Reruns each ``case_*`` of the test module over seeds 1000, 1001, ... and
 prints, per assertion, the mean, standard deviation and largest |z| of the
 z-scores (calibrated: mean near 0, SD near 1, no |z| above 4) and the
-smallest power margin (>= 6). Names: gibbs, friction, free.
+smallest power margin (>= 6). Names: gibbs, cubic, friction, free.
 """
 
 from __future__ import annotations
@@ -23,6 +23,7 @@ from _stats import calibrate  # noqa: E402
 
 CASES = {
     "gibbs": t.case_double_well_gibbs,
+    "cubic": t.case_pure_cubic,
     "friction": t.case_double_well_friction,
     "free": t.case_free_mass,
 }
