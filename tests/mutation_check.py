@@ -307,13 +307,29 @@ MUTATIONS: tuple[Mutation, ...] = (
         path="randvib/analytic/statistical_linearisation.py",
         edits=(
             (
-                "return c + increment, k + 3.0 * k3 * var_z",
-                "return c + increment, k + 3.3 * k3 * var_z",
+                "k_eq = k + 3.0 * k3 * var_z",
+                "k_eq = k + 3.3 * k3 * var_z",
             ),
         ),
         tests=("tests/test_linear_response.py::test_white_noise_reduces_to_eq30_32",),
         why="k_eq = k + 3.3 k3 E[z^2] instead of 3 k3 E[z^2]; under white noise the "
         "displacement variance must equal Eq. 20's with the Gaussian-closure spring.",
+    ),
+    Mutation(
+        name="stroke-tail-cut",
+        path="randvib/analytic/fokker_planck.py",
+        edits=(
+            (
+                "return float(integral(stroke, z_far) / integral(0.0, z_far))",
+                "return float(integral(1.01 * stroke, z_far) / integral(0.0, z_far))",
+            ),
+        ),
+        tests=(
+            "tests/test_potentials.py::test_fpk_solvers_match_the_gibbs_density_of_any_confining_potential",
+        ),
+        why="fpk-fast's stroke exceedance integrates from 1 % beyond the stroke, so every "
+        "tail probability comes out low; checked against the exact Gibbs exceedance of "
+        "double wells and the pure cubic to 1e-4.",
     ),
     Mutation(
         name="synthesis-amplitude",

@@ -52,7 +52,8 @@ def test_updated_rejects_unknown_names():
         ({"m": -1.0}, "`m`"),
         ({"c_m": -0.1}, "`c_m`"),
         ({"k": float("nan")}, "`k`"),
-        ({"k3": -1.0}, "`k3`"),
+        ({"k3": float("inf")}, "`k3`"),  # any finite k3: non-confining ones are refused later
+        ({"stroke": 0.0}, "`stroke`"),
         ({"c_e": float("inf")}, "`c_e`"),
     ],
 )

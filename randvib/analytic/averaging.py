@@ -57,6 +57,16 @@ sign of that interaction but overstates its size 1.5-5x. For the k3 change
 use ``method="fpk-fast"`` (:func:`randvib.analytic.fokker_planck.fast_fpk_statistics`),
 which explains why a next-order averaging was not pursued.
 
+Potentials. Averaging is implemented for the monostable potential
+(k > 0, k3 >= 0) only and refuses the others with a message naming the
+methods that treat them (:data:`OTHER_POTENTIALS`). A double well would need
+orbits of two kinds, inside one well (energy below the barrier, two
+disjoint orbits) and around both (above it), with a period that diverges
+logarithmically at the barrier energy, and a matching condition for the
+energy density there; the free mass has no orbits at all. The FPK solvers
+treat every confining potential and the free mass; equivalent linearisation
+gets the power of any potential exactly without friction.
+
 Quadrature. On an orbit of amplitude A the substitution z = A sin(phi)
 removes the turning-point singularities: dz/v = dphi / (omega q(phi)) with
 ``q = sqrt(1 + mu (1 + sin^2 phi)/2)``, mu = (k3/k) A^2, omega^2 = k/m, so
@@ -90,6 +100,7 @@ from randvib.models.harvester import Harvester
 
 __all__ = [
     "AVERAGING_ZETA_LIMIT",
+    "OTHER_POTENTIALS",
     "AveragingResult",
     "AveragingValidityWarning",
     "OrbitAverages",
@@ -97,6 +108,12 @@ __all__ = [
     "energy_density",
     "orbit_averages",
 ]
+
+#: The methods named when averaging refuses a potential other than monostable.
+OTHER_POTENTIALS = (
+    "method 'fpk-fast' or 'fpk' (any confining potential, the free mass), 'linearisation' "
+    "(Gaussian closure) or randvib.simulate"
+)
 
 #: Friction damping ratio above which averaging is flagged as unreliable.
 #: Averaging is exact without friction, whatever the viscous damping (the
@@ -399,9 +416,11 @@ def averaging_statistics(harvester: Harvester, psd, *, warn: bool = True) -> Ave
     ------
     ValueError
         For bad ``psd``, for LuGre friction (it has memory, so the energy
-        drift is not a function of the energy alone), and for points with
-        neither damping nor friction.
+        drift is not a function of the energy alone), for points with
+        neither damping nor friction, and for a potential other than
+        monostable (the message names :data:`OTHER_POTENTIALS`).
     """
+    harvester.potential.require("stochastic averaging", ("monostable",), OTHER_POTENTIALS)
     m, c, k, k3, fc, beta, psd = memoryless_parameters(harvester, psd)
     shape = m.shape
     flat = [np.ravel(a) for a in (m, c, k, k3, fc, beta, psd)]
@@ -469,6 +488,7 @@ def orbit_averages(harvester: Harvester, energy) -> OrbitAverages:
     -------
     OrbitAverages
     """
+    harvester.potential.require("orbit_averages", ("monostable",), OTHER_POTENTIALS)
     energy = check_nonnegative("energy", energy, "J")
     m, k, k3, energy = np.broadcast_arrays(
         *(np.asarray(v, dtype=float) for v in (harvester.m, harvester.k, harvester.k3, energy))
@@ -504,6 +524,7 @@ def energy_density(harvester: Harvester, psd, energy):
     energy : array_like
         Energies E (J), >= 0.
     """
+    harvester.potential.require("stochastic averaging", ("monostable",), OTHER_POTENTIALS)
     m, c, k, k3, fc, beta, psd = (
         float(np.ravel(a)[0]) for a in memoryless_parameters(harvester, psd)
     )

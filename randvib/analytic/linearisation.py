@@ -19,6 +19,29 @@ velocity's distribution replaced by a Gaussian. For Coulomb friction it has
 the closed form of Eq. 30. The paper's Eq. 32 writes sigma_z^2 where the
 velocity variance is meant; we use the velocity variance.
 
+Potentials. c_eq and sigma_v^2 do not involve the spring, so under white
+noise with a resistive circuit the velocity variance and the power are the
+same for every potential (monostable, bistable, pure cubic, free mass).
+Without friction that is exact: the Gibbs density makes the velocity
+Gaussian with E[v^2] = S m/(4c) for any confining potential, and the free
+mass's velocity is an Ornstein-Uhlenbeck process. With friction it carries
+the Gaussian-velocity error of Eq. 30, whatever the potential.
+
+The displacement is where the Gaussian closure fails for a double well.
+k_eq = k + 3 k3 E[z^2] with E[z^2] = m sigma_v^2 / k_eq
+(:func:`linear_displacement_variance`) puts one Gaussian at z = 0, on the
+barrier, where the true density has two peaks at the wells +-z_w,
+z_w^2 = -k/k3. At low noise (barrier k^2/(4 k3) >> T = m sigma_v^2) the
+true E[z^2] -> z_w^2 but the closure gives k_eq -> 3 k3 T/|k| and
+E[z^2] -> z_w^2 / 3: three times too small, and its stroke exceedance
+erfc(s/sqrt(2 E[z^2])) is wrong accordingly (a stroke just outside the well
+is reached about half the time in truth, rarely by the Gaussian). At high
+noise (T >> barrier) the quartic dominates and the closure's error tends to
+the pure-cubic one, E[z^2] low by 15 % (exact Gamma(3/4)/Gamma(1/4)
+sqrt(4T/k3) against sqrt(T/(3 k3))). Both limits are tests
+(tests/test_potentials.py). Use the FPK solvers for the displacement and the
+stroke statistics of a double well.
+
 Units: S is the one-sided PSD of the base acceleration in (m/s^2)^2/Hz with
 E[w(t1) w(t2)] = (S/2) delta(t2 - t1) (Eq. 17).
 """
@@ -152,9 +175,13 @@ def linear_displacement_variance(harvester: Harvester, velocity_variance):
 
     Statistical linearisation of k z + k3 z^3 gives k_eq = k + 3 k3 sigma_z^2
     with sigma_z^2 = sigma_v^2 m / k_eq (linear oscillator), whose positive root
-    is k_eq = (k + sqrt(k^2 + 12 k3 m sigma_v^2)) / 2.
+    is k_eq = (k + sqrt(k^2 + 12 k3 m sigma_v^2)) / 2: positive for any
+    confining potential, k < 0 and k = 0 included (see the module docstring
+    for how far it is off for a double well). The free mass (k_eq = 0) has
+    no stationary displacement: inf.
     """
     k, k3, m = (np.asarray(x, dtype=float) for x in (harvester.k, harvester.k3, harvester.m))
     a = m * np.asarray(velocity_variance, dtype=float)
     k_eq = 0.5 * (k + np.sqrt(k**2 + 12.0 * k3 * a))
-    return a / k_eq
+    with np.errstate(divide="ignore"):
+        return a / k_eq

@@ -23,7 +23,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 import numpy as np
-from scipy import optimize
+from scipy import optimize, special
 
 from randvib._validation import (
     check_choice,
@@ -32,11 +32,12 @@ from randvib._validation import (
     scalar_or_array,
 )
 from randvib.analytic.averaging import averaging_statistics
-from randvib.analytic.fokker_planck import fast_fpk_statistics, fpk_statistics
+from randvib.analytic.fokker_planck import fast_fpk_moments, fpk_moments
 from randvib.analytic.linearisation import equivalent_damping, linear_displacement_variance
 from randvib.analytic.statistical_linearisation import statistical_linearisation
 from randvib.models.excitation import Excitation, as_excitation
 from randvib.models.harvester import Harvester
+from randvib.models.potential import CONFINING
 
 
 @dataclass(frozen=True)
@@ -63,6 +64,15 @@ class PowerPrediction:
     circuit_mean_square : float or None
         E[i^2] (A^2) or E[V^2] (V^2) of a circuit state (inductive or piezo
         coupling); None without one (and left out of :meth:`to_dict`).
+    stroke_exceedance : float, ndarray or None
+        P(|z| > stroke), the stationary fraction of time beyond the
+        harvester's stroke; None without a stroke, for the free mass and for
+        methods that do not give it (averaging). Linearisation's is the
+        Gaussian estimate erfc(stroke / sqrt(2 E[z^2])) (approximate; far off
+        for a double well, see :mod:`randvib.analytic.linearisation`).
+
+    ``displacement_variance`` is None for the free mass (k = k3 = 0): its
+    displacement has no stationary law.
     """
 
     method: str
@@ -73,12 +83,17 @@ class PowerPrediction:
     power_electrical: object
     power_load: object = None
     circuit_mean_square: object = None
+    stroke_exceedance: object = None
 
     def to_dict(self) -> dict:
-        """Plain dict with floats or lists, ready for JSON."""
+        """Plain dict with floats or lists, ready for JSON.
+
+        ``circuit_mean_square`` and ``stroke_exceedance`` only when given.
+        """
         out = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()}
-        if out["circuit_mean_square"] is None:
-            del out["circuit_mean_square"]
+        for optional in ("circuit_mean_square", "stroke_exceedance"):
+            if out[optional] is None:
+                del out[optional]
         return out
 
 
@@ -89,8 +104,12 @@ def _finish(
     displacement_variance,
     mean_abs_velocity,
     psd,
+    stroke_exceedance=None,
 ) -> PowerPrediction:
-    """Fill the derived fields common to every method."""
+    """Fill the derived fields common to every method.
+
+    The free mass's displacement statistics (not stationary) become None.
+    """
     vv = np.asarray(velocity_variance, dtype=float)
     c_eq = np.asarray(psd, dtype=float) * harvester.m / (4.0 * vv)
     power = harvester.c_e * vv
@@ -101,28 +120,41 @@ def _finish(
     def clean(x):
         return scalar_or_array(np.asarray(x, dtype=float))
 
+    free = harvester.potential.is_free
+    if free or harvester.stroke is None:
+        stroke_exceedance = None
     return PowerPrediction(
         method=method,
         c_eq=clean(c_eq),
         velocity_variance=clean(vv),
-        displacement_variance=clean(displacement_variance),
+        displacement_variance=None if free else clean(displacement_variance),
         mean_abs_velocity=clean(mean_abs_velocity),
         power_electrical=clean(power),
         power_load=None if power_load is None else clean(power_load),
+        stroke_exceedance=None if stroke_exceedance is None else clean(stroke_exceedance),
     )
 
 
 def _linearisation(harvester: Harvester, psd) -> PowerPrediction:
     c_eq = equivalent_damping(harvester, psd)
     vv = np.asarray(psd) * harvester.m / (4.0 * np.asarray(c_eq))  # Eq. 20
+    zz = None if harvester.potential.is_free else linear_displacement_variance(harvester, vv)
     return _finish(
         harvester,
         "linearisation",
         vv,
-        linear_displacement_variance(harvester, vv),
+        zz,
         np.sqrt(2.0 / np.pi * vv),
         psd,
+        None if zz is None else _gaussian_exceedance(harvester.stroke, zz),
     )
+
+
+def _gaussian_exceedance(stroke, displacement_variance):
+    """P(|z| > stroke) = erfc(stroke / sqrt(2 E[z^2])) of a zero-mean Gaussian z (or None)."""
+    if stroke is None:
+        return None
+    return special.erfc(stroke / np.sqrt(2.0 * np.asarray(displacement_variance, dtype=float)))
 
 
 def _averaging(harvester: Harvester, psd) -> PowerPrediction:
@@ -138,18 +170,19 @@ def _averaging(harvester: Harvester, psd) -> PowerPrediction:
 
 
 def _fpk(harvester: Harvester, psd) -> PowerPrediction:
-    vv, zz, av = fpk_statistics(harvester, psd)
-    return _finish(harvester, "fpk", vv, zz, av, psd)
+    vv, zz, av, beyond = fpk_moments(harvester, psd)
+    return _finish(harvester, "fpk", vv, zz, av, psd, beyond)
 
 
 def _fpk_fast(harvester: Harvester, psd) -> PowerPrediction:
-    vv, zz, av = fast_fpk_statistics(harvester, psd)
-    return _finish(harvester, "fpk-fast", vv, zz, av, psd)
+    vv, zz, av, beyond = fast_fpk_moments(harvester, psd)
+    return _finish(harvester, "fpk-fast", vv, zz, av, psd, beyond)
 
 
 def _coloured_linearisation(harvester: Harvester, excitation: Excitation) -> PowerPrediction:
     """Statistical linearisation under a non-white excitation (scalar parameters)."""
     r = statistical_linearisation(harvester, excitation)
+    beyond = _gaussian_exceedance(harvester.stroke, r.displacement_variance)
     return PowerPrediction(
         method="linearisation",
         c_eq=r.c_eq,
@@ -159,6 +192,7 @@ def _coloured_linearisation(harvester: Harvester, excitation: Excitation) -> Pow
         power_electrical=r.power_electrical,
         power_load=r.power_load,
         circuit_mean_square=r.circuit_variance,
+        stroke_exceedance=None if beyond is None else float(beyond),
     )
 
 
@@ -226,13 +260,23 @@ def predict(harvester: Harvester, psd, method: str = "linearisation") -> PowerPr
         a coupling with a circuit state (inductive, piezo: the circuit is a
         state of the linearised system, scalar parameters).
 
+    Potentials: every method refuses a non-confining potential (no
+    stationary state); ``"averaging"`` treats the monostable one only;
+    ``"fpk"``/``"fpk-fast"`` any confining potential and the free mass;
+    ``"linearisation"`` any confining potential and the free mass (exact
+    power without friction, Gaussian displacement; see
+    :mod:`randvib.analytic.linearisation`). For the free mass
+    ``displacement_variance`` and ``stroke_exceedance`` are None.
+
     Raises
     ------
     ValueError
-        For an unknown method, a bad ``psd``, or a non-white excitation with
-        a method that assumes white noise.
+        For an unknown method, a bad ``psd``, a non-white excitation with
+        a method that assumes white noise, or a potential the method cannot
+        treat (one line naming what it accepts).
     """
     check_choice("method", method, tuple(METHODS))
+    harvester.potential.require(f"method {method!r}", CONFINING + ("free",))
     if harvester.has_circuit:
         if method not in CIRCUIT:
             _refuse_circuit(method, harvester)

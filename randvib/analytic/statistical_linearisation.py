@@ -36,6 +36,7 @@ from scipy import optimize
 from randvib.analytic.linear_response import device_block, output_variances, response_spectra
 from randvib.models.excitation import Excitation, as_excitation
 from randvib.models.harvester import Harvester
+from randvib.models.potential import CONFINING
 
 #: Largest |log residual| accepted as converged.
 _TOLERANCE = 1e-10
@@ -149,6 +150,11 @@ def _check_harvester(harvester: Harvester):
             f"statistical linearisation needs a memoryless friction law; {friction.name!r} "
             "has internal state. Use randvib.simulate for it."
         )
+    # A spring is needed for a stationary z (the free mass has none; under white
+    # noise randvib.predict(method="linearisation") gives its velocity statistics).
+    harvester.potential.require(
+        "statistical_linearisation", CONFINING, "randvib.predict under white noise"
+    )
     return None if friction is None or friction.vanishes else friction
 
 
@@ -175,7 +181,10 @@ def statistical_linearisation(
     Raises
     ------
     ValueError
-        For a friction law with memory, array parameters or an unknown method.
+        For a friction law with memory, array parameters, an unknown method,
+        a potential that is not confining (the free mass included), or a
+        double well for which no zero-mean Gaussian solution with k_eq > 0
+        exists (a narrow band far above the wells' frequency).
     RuntimeError
         If the fixed point does not converge.
     """
@@ -193,7 +202,13 @@ def statistical_linearisation(
             if friction is None
             else float(friction.equivalent_damping_increment(np.sqrt(var_v)))
         )
-        return c + increment, k + 3.0 * k3 * var_z
+        k_eq = k + 3.0 * k3 * var_z
+        if k <= 0:
+            # A trial E[z^2] below -k/(3 k3) would make the linear device
+            # unstable: the floor keeps the solver's trial steps defined, and a
+            # "solution" on the floor is refused below.
+            k_eq = max(k_eq, 1e-6 * k_start)
+        return c + increment, k_eq
 
     def variances(c_eq, k_eq):
         return output_variances(device_block(m, c_eq, k_eq, harvester.electrical), excitation, used)
@@ -206,10 +221,14 @@ def statistical_linearisation(
         return response(*equivalent(x)) - x
 
     # Start from the linear device; without viscous damping, from 5 % of critical.
-    c_start = c if c > 0 else 0.1 * np.sqrt(k * m)
-    x = _solve(residual, response(c_start, k))
+    # Without a positive k (double well, pure cubic) the linear device is
+    # unstable: start from the white-noise closure's k_eq at the level S instead.
+    k_start = k if k > 0 else _white_noise_k_eq(m, c, k, k3, _typical_level(excitation))
+    c_start = c if c > 0 else 0.1 * np.sqrt(k_start * m)
+    x = _solve(residual, response(c_start, k_start))
     c_eq, k_eq = equivalent(x)
     var_v, var_z = np.exp(x)
+    _require_positive_stiffness(harvester, excitation, k + 3.0 * k3 * var_z)
     state = _state(harvester, variances(c_eq, k_eq))
     power, load = _power(harvester, var_v, state)
     return LinearisationResult(
@@ -240,6 +259,32 @@ def _power(harvester: Harvester, velocity, state):
         power = harvester.c_e * velocity
         return power, power * coupling.load_fraction
     return coupling.power_electrical(velocity, state), coupling.power_load(velocity, state)
+
+
+def _require_positive_stiffness(harvester, excitation, k_eq):
+    """Refuse a fixed point on the solver's stiffness floor: no zero-mean solution exists."""
+    if k_eq <= 0:
+        raise ValueError(
+            "statistical linearisation has no zero-mean Gaussian solution with k_eq > 0 for "
+            f"this {harvester.potential.kind} device under the {excitation.name} excitation "
+            "(the response is not a zero-mean Gaussian about the barrier): use Monte Carlo "
+            "(randvib.simulate)"
+        )
+
+
+def _white_noise_k_eq(m, c, k, k3, level):
+    """k_eq = (k + sqrt(k^2 + 12 k3 m sigma_v^2))/2 with sigma_v^2 = S m/(4c) (N/m)."""
+    var_v = level * m / (4.0 * c) if c > 0 else level  # any positive scale will do
+    return 0.5 * (k + np.sqrt(k * k + 12.0 * k3 * m * var_v))
+
+
+def _typical_level(excitation) -> float:
+    """A PSD level ((m/s^2)^2/Hz) of the excitation: its ``level``, else variance / band."""
+    level = getattr(excitation, "level", None)
+    if level is None:
+        lo, hi = excitation.support
+        level = excitation.variance / (hi - lo)
+    return float(level)
 
 
 def _solve(residual, x0) -> np.ndarray:

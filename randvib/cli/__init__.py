@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import re
 import sys
 
 #: Command modules under randvib.cli, in the order shown by --help.
@@ -20,7 +21,16 @@ class UserError(Exception):
     """An error caused by the user's input; printed as one line, exit 2."""
 
 
+#: What argparse takes for a negative number (not an option): its own pattern
+#: misses exponents, so `--k3 -5e5` would be read as a missing value.
+NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
+
+
 class _Parser(argparse.ArgumentParser):
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = NEGATIVE_NUMBER
+
     def error(self, message):  # one line, no usage dump, exit 2
         raise UserError(f"{self.prog}: {message}")
 

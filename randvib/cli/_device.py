@@ -61,8 +61,19 @@ def add_device_arguments(parser: argparse.ArgumentParser) -> None:
     g.add_argument("--m", type=float, help="mass (kg)")
     g.add_argument("--c-m", type=float, help="mechanical damping (Ns/m)")
     g.add_argument("--c-e", type=float, help="electrical damping (Ns/m)")
-    g.add_argument("--k", type=float, help="linear stiffness (N/m)")
+    g.add_argument(
+        "--k",
+        type=float,
+        help="linear stiffness (N/m); 0 or negative allowed: bistable with k < 0 < k3, "
+        "pure cubic with k = 0, free mass with k = k3 = 0",
+    )
     g.add_argument("--k3", type=float, help="cubic stiffness (N/m^3)")
+    g.add_argument(
+        "--stroke",
+        type=float,
+        help="stroke limit (m, > 0): report the time fraction with |z| beyond it "
+        "(and, from Monte Carlo, the mean first time to reach it)",
+    )
     g.add_argument("--friction", help=f"friction model: {', '.join(FRICTION_CHOICES)}")
     # One option per friction parameter, as the laws declare them.
     for name, laws in _friction_options().items():
@@ -111,11 +122,17 @@ def harvester_from_args(args) -> Harvester:
         for name in ("m", "c_m", "k"):
             _need(values[name], option_flag(name), "the device")
         return Harvester.with_coupling(
-            values["m"], values["c_m"], values["k"], coupling, k3=values["k3"], friction=friction
+            values["m"],
+            values["c_m"],
+            values["k"],
+            coupling,
+            k3=values["k3"],
+            friction=friction,
+            stroke=args.stroke,
         )
     for name in ("m", "c_m", "c_e", "k"):
         _need(values[name], option_flag(name), "the device (or use --preset)")
-    return Harvester(friction=friction, **values)
+    return Harvester(friction=friction, stroke=args.stroke, **values)
 
 
 def _coupling_from_args(args):

@@ -17,6 +17,9 @@ from randvib.cli._excitation import add_excitation_arguments, excitation_from_ar
 from randvib.cli._output import print_table
 from randvib.models.excitation import Excitation
 
+#: The methods that report the stationary probability beyond the stroke.
+STROKE_METHODS = ("linearisation", "fpk-fast", "fpk")
+
 
 def register(sub) -> None:
     p = sub.add_parser(
@@ -40,6 +43,11 @@ def register(sub) -> None:
     p.set_defaults(handler=run)
 
 
+# JSON: the keys of PowerPrediction.to_dict(); `displacement_variance` is null for
+# the free mass (k = k3 = 0); with --stroke, `stroke` and `stroke_exceedance`
+# (P(|z| > stroke): FPK's stationary probability, linearisation's Gaussian estimate).
+
+
 def run(args) -> int:
     harvester = harvester_from_args(args)
     psd = excitation_from_args(args)
@@ -56,6 +64,11 @@ def run(args) -> int:
             f"`--method {args.method}` assumes the resistive coupling; the "
             f"{harvester.coupling_name} coupling's circuit state needs {accepted}"
         )
+    if harvester.stroke is not None and args.method not in STROKE_METHODS:
+        allowed = " or ".join(f"`--method {name}`" for name in STROKE_METHODS)
+        raise ValueError(
+            f"`--stroke` needs {allowed}: `--method {args.method}` gives no stroke exceedance"
+        )
     result = predict(harvester, psd, method=args.method)
     out = {
         "method": result.method,
@@ -68,6 +81,10 @@ def run(args) -> int:
         out.pop("power_load")
     if harvester.electrical is not None:  # added with the couplings (issue 11)
         out["coupling"] = harvester.coupling_name
+    if harvester.stroke is not None:
+        out["stroke"] = harvester.stroke
+        # null where not stationary (the free mass)
+        out["stroke_exceedance"] = result.stroke_exceedance
     if coloured:
         out["excitation"] = psd.parameters()
     if args.json:
@@ -82,6 +99,7 @@ def run(args) -> int:
             "power_electrical": "W",
             "power_load": "W",
             "circuit_mean_square": "A^2 or V^2",
+            "stroke": "m",
             # the excitation's parameters
             "level": "(m/s^2)^2/Hz",
             "f0": "Hz",

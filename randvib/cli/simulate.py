@@ -76,7 +76,10 @@ def run(args) -> int:
         return 0
     analytic = None
     if harvester.friction is None or harvester.friction.has_equivalent_damping:
-        analytic = predict(harvester, psd)
+        try:
+            analytic = predict(harvester, psd)
+        except ValueError:  # e.g. no zero-mean Gaussian solution for this double well
+            analytic = None
     rows = []
     units = {
         "power_electrical": "W",
@@ -87,12 +90,25 @@ def run(args) -> int:
         "friction_power": "W",
         "circuit_mean_square": "A^2 or V^2",
     }
+    units.update(stroke_exceedance="", stroke_first_passage_time="s")
     for name, unit in units.items():
-        if name not in summary:
+        if summary.get(name) is None:
             continue
         s = summary[name]
         lin = getattr(analytic, name, None) if analytic is not None else None
         rows.append((name, s["mean"], s["ci95"], "" if lin is None else lin, unit))
+    first = summary.get("stroke_first_passage")
+    if first is not None and first["mean"] is None:
+        restricted = first["restricted_mean"]
+        rows.append(
+            (
+                f"E[min(first passage, {first['horizon']:g} s)]",
+                restricted["mean"],
+                restricted["ci95"],
+                f"{first['paths_reached']}/{first['n_paths']} paths reached the stroke",
+                "s",
+            )
+        )
     print_table(rows, ("statistic", "Monte Carlo", "± 95 %", "linearisation", "unit"))
     print(
         f"{result.n_paths} paths x {result.averaging_time:g} s averaged (dt {result.dt:g} s, "

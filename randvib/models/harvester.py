@@ -14,9 +14,16 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from randvib._validation import check_nonnegative, check_positive, scalar_or_array
+from randvib._validation import check_finite, check_nonnegative, check_positive, scalar_or_array
 from randvib.models.coupling import COUPLINGS, Coupling, ElectricalCoupling, Resistive
 from randvib.models.friction import FrictionModel
+from randvib.models.potential import Potential
+
+
+def _check_real(name, value, unit):
+    """Any finite value: the potential's kind is the methods' business (issue 11)."""
+    return check_finite(name, value)
+
 
 __all__ = ["ElectricalCoupling", "Harvester"]  # ElectricalCoupling: re-exported, historical home
 
@@ -39,9 +46,13 @@ class Harvester:
     c_e : float
         Electrical damping (Ns/m), >= 0; see :meth:`from_electrical` for Eq. 3.
     k : float
-        Linear stiffness (N/m), > 0.
+        Linear stiffness (N/m), any finite value: k > 0 monostable, k < 0
+        bistable (with k3 > 0), k = 0 pure cubic or, with k3 = 0, the free
+        mass (see :class:`~randvib.models.potential.Potential`).
     k3 : float, optional
-        Cubic (Duffing) stiffness (N/m^3), >= 0 (hardening, monostable).
+        Cubic (Duffing) stiffness (N/m^3), any finite value. A non-confining
+        potential (k3 < 0, or k < 0 with k3 = 0) can be built but every
+        stationary method refuses it.
     friction : FrictionModel or None, optional
         Friction model; ``None`` for none.
     electrical : Coupling or None, optional
@@ -51,6 +62,10 @@ class Harvester:
         circuit; use :meth:`from_electrical`); a dynamic one (inductance or
         capacitance > 0) acts through its circuit state and needs ``c_e = 0``
         (use :meth:`with_coupling`). With a coupling, load power is defined.
+    stroke : float or None, optional
+        Stroke limit (m), > 0: the largest |z| before the magnet meets its end
+        stops. It changes no dynamics; the methods report how often and how
+        soon |z| exceeds it (``stroke_exceedance``, first-passage time).
     """
 
     m: float
@@ -60,16 +75,22 @@ class Harvester:
     k3: float = 0.0
     friction: FrictionModel | None = None
     electrical: Coupling | None = None
+    stroke: float | None = None
 
     def __post_init__(self):
         for name, check, unit in (
             ("m", check_positive, "kg"),
             ("c_m", check_nonnegative, "Ns/m"),
             ("c_e", check_nonnegative, "Ns/m"),
-            ("k", check_positive, "N/m"),
-            ("k3", check_nonnegative, "N/m^3"),
+            ("k", _check_real, "N/m"),
+            ("k3", _check_real, "N/m^3"),
         ):
             object.__setattr__(self, name, scalar_or_array(check(name, getattr(self, name), unit)))
+        if self.stroke is not None:
+            stroke = check_positive("stroke", self.stroke, "m")
+            if np.ndim(stroke):
+                raise ValueError(f"`stroke` must be one number (m), got {self.stroke!r}")
+            object.__setattr__(self, "stroke", float(stroke))
         if self.friction is not None and not isinstance(self.friction, FrictionModel):
             raise ValueError(
                 f"`friction` must be a randvib friction model (Coulomb, Tanh, LuGre) "
@@ -103,7 +124,7 @@ class Harvester:
             )
 
     @classmethod
-    def with_coupling(cls, m, c_m, k, coupling: Coupling, k3=0.0, friction=None):
+    def with_coupling(cls, m, c_m, k, coupling: Coupling, k3=0.0, friction=None, stroke=None):
         """Build a harvester with any electrical coupling (:mod:`randvib.models.coupling`).
 
         ``c_e`` follows from the coupling: its electrical damping when it is
@@ -118,10 +139,11 @@ class Harvester:
             k3=k3,
             friction=friction,
             electrical=coupling,
+            stroke=stroke,
         )
 
     @classmethod
-    def from_electrical(cls, m, c_m, k, alpha, r_load, r_coil, k3=0.0, friction=None):
+    def from_electrical(cls, m, c_m, k, alpha, r_load, r_coil, k3=0.0, friction=None, stroke=None):
         """Build a harvester whose c_e follows from the circuit (paper Eq. 3).
 
         Parameters
@@ -134,7 +156,7 @@ class Harvester:
         Other parameters are as for :class:`Harvester`.
         """
         electrical = ElectricalCoupling(alpha, r_load, r_coil)
-        return cls.with_coupling(m, c_m, k, electrical, k3=k3, friction=friction)
+        return cls.with_coupling(m, c_m, k, electrical, k3=k3, friction=friction, stroke=stroke)
 
     # ----------------------------------------------------------------- derived
     @property
@@ -144,8 +166,14 @@ class Harvester:
 
     @property
     def natural_frequency(self):
-        """Linear natural frequency omega_n = sqrt(k/m) (rad/s)."""
-        return np.sqrt(self.k / self.m)
+        """Linear natural frequency omega_n = sqrt(k/m) (rad/s); nan for k < 0."""
+        with np.errstate(invalid="ignore"):
+            return np.sqrt(self.k / self.m)
+
+    @property
+    def potential(self) -> Potential:
+        """The restoring potential k z^2/2 + k3 z^4/4 and what it allows."""
+        return Potential(self.k, self.k3)
 
     @property
     def has_circuit(self) -> bool:
@@ -214,19 +242,21 @@ class Harvester:
             if not isinstance(self.electrical, Resistive):
                 out["coupling"] = self.electrical.name
             out.update(self.electrical.parameters())
+        if self.stroke is not None:
+            out["stroke"] = self.stroke
         return out
 
     def updated(self, **changes) -> Harvester:
         """A copy with some parameters changed, friction and circuit ones included.
 
-        Keys may be any of ``m, c_m, c_e, k, k3``, the friction model's
+        Keys may be any of ``m, c_m, c_e, k, k3, stroke``, the friction model's
         parameters (``fc``, ``beta``, ...) or the circuit's (``alpha``,
         ``r_load``, ``r_coil``; c_e then follows Eq. 3). ``c`` sets the total
         damping, split in the current ratio of c_m to c_e.
         """
         own = {
             name: changes.pop(name)
-            for name in ("m", "c_m", "c_e", "k", "k3", "friction")
+            for name in ("m", "c_m", "c_e", "k", "k3", "friction", "stroke")
             if name in changes
         }
         if "c" in changes:
@@ -259,7 +289,7 @@ class Harvester:
             electrical = None  # an explicit c_e overrides the circuit
         if changes:
             allowed = sorted(
-                {"m", "c", "c_m", "c_e", "k", "k3", *circuit_names}
+                {"m", "c", "c_m", "c_e", "k", "k3", "stroke", *circuit_names}
                 | ({f.name for f in fields(friction)} if friction else set())
             )
             raise ValueError(

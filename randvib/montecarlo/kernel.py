@@ -43,7 +43,9 @@ ACC_H1 = 6  # mechanical energy at the end of the window (J)
 ACC_COMP_V2 = 7  # companion (same noise, no friction) mean v^2
 ACC_COMP_Z2 = 8  # companion mean z^2
 ACC_CIRCUIT2 = 9  # mean x^2 of the circuit state (A^2 or V^2); 0 without one
-N_ACC = 10
+ACC_BEYOND = 10  # fraction of the window's steps with |z| > stroke
+ACC_FIRST_HIT = 11  # time (s) of the first state with |z| > stroke from t = 0; -1: none
+N_ACC = 12
 
 
 class PathAverages:
@@ -107,6 +109,16 @@ class PathAverages:
     def circuit_square(self):
         """Time average of the circuit state's square per path (i^2 in A^2, V^2 in V^2)."""
         return self._col(ACC_CIRCUIT2)
+
+    @property
+    def beyond_stroke(self):
+        """Fraction of the window's steps with |z| > stroke per path (0 without a stroke)."""
+        return self._col(ACC_BEYOND)
+
+    @property
+    def first_hit_time(self):
+        """Time (s) of the first state with |z| > stroke, from t = 0; -1 where none was."""
+        return self._col(ACC_FIRST_HIT)
 
     def energy_balance_controls(self, window):
         """The two zero-mean controls of the energy balance: Ito integral, energy change."""
@@ -184,7 +196,9 @@ class Recording(NamedTuple):
 
     Histograms of (z, v) over the window in ``hist_bins`` bins on
     [hist_lo, hist_hi) (``hist_bins`` 0: none); (z, v, theta) of the first
-    ``n_record`` paths every ``every`` steps, initial state included.
+    ``n_record`` paths every ``every`` steps, initial state included; the
+    stroke statistics (columns ``ACC_BEYOND``, ``ACC_FIRST_HIT``) against
+    ``stroke`` (m; inf: none).
     """
 
     hist_lo: np.ndarray  #: float64[2]
@@ -192,6 +206,7 @@ class Recording(NamedTuple):
     hist_bins: int
     n_record: int
     every: int
+    stroke: float
 
 
 class Auxiliary(NamedTuple):
@@ -440,7 +455,7 @@ def run_ensemble(
     seed, first_path, n_paths = paths
     init_random, init_z, init_v = initial
     with_companion, comp_init_z, comp_init_v = companion
-    hist_lo, hist_hi, hist_bins, n_record, record_every = recording
+    hist_lo, hist_hi, hist_bins, n_record, record_every, stroke = recording
     dw, ki, wi, fi = noise
     # `auxiliary is None` is decided when compiling (numba prunes the dead
     # branch for a None argument): white noise with a resistive circuit runs the
@@ -484,6 +499,7 @@ def run_ensemble(
         x2 = np.zeros(LANES)
         x3 = np.zeros(LANES)
         a = np.zeros((LANES, N_ACC))
+        a[:, ACC_FIRST_HIT] = -1.0
         for j in range(lanes):
             seed_path_state(seed, first_path + start + j, rng, j)
             if init_random:
@@ -549,6 +565,11 @@ def run_ensemble(
                     zn, vn, tn, f1 = scheme_step(
                         zj, vj, tj, dt, noise, scheme, drift, fr_kind, fr_p, fr_fn
                     )
+                if abs(zj) > stroke:
+                    if a[j, ACC_FIRST_HIT] < 0.0:
+                        a[j, ACC_FIRST_HIT] = n * dt
+                    if in_window:
+                        a[j, ACC_BEYOND] += 1.0
                 if in_window:
                     if n == n_burn:
                         a[j, ACC_H0] = 0.5 * m * vj * vj + 0.5 * k * zj * zj + 0.25 * k3 * zj**4
@@ -593,8 +614,10 @@ def run_ensemble(
             zj = z[j]
             vj = v[j]
             a[j, ACC_H1] = 0.5 * m * vj * vj + 0.5 * k * zj * zj + 0.25 * k3 * zj**4
+            if abs(zj) > stroke and a[j, ACC_FIRST_HIT] < 0.0:
+                a[j, ACC_FIRST_HIT] = n_steps * dt  # the final state
             for q in range(N_ACC):
-                if q == ACC_H0 or q == ACC_H1:
+                if q == ACC_H0 or q == ACC_H1 or q == ACC_FIRST_HIT:
                     acc[p, q] = a[j, q]
                 elif q == ACC_VDW:
                     acc[p, q] = a[j, q] / window

@@ -45,6 +45,7 @@ from randvib.analytic.statistical_linearisation import statistical_linearisation
 from randvib.models.excitation import Excitation, as_excitation
 from randvib.models.friction import kernel_arguments
 from randvib.models.harvester import Harvester
+from randvib.models.potential import CONFINING
 from randvib.montecarlo import integrators, kernel
 from randvib.montecarlo.integrators import Integrator, integrator
 from randvib.montecarlo.rng import ZIG_FI, ZIG_KI, ZIG_WI
@@ -152,6 +153,65 @@ def estimate(samples, controls=None, folds: int = 4) -> Statistic:
 
 
 @dataclass(frozen=True)
+class FirstPassage:
+    """Time for |z| to first exceed the stroke, from each path's start state.
+
+    Paths that never reach the stroke within the run (``t_end``) are
+    *censored*: their first-passage time is only known to exceed ``t_end``.
+    The mean first-passage time is reported (``mean``, a t interval over
+    paths) only when every path reached the stroke; otherwise ``mean`` is
+    None and what the data do determine is given instead: how many paths
+    reached it, and the restricted mean E[min(tau, t_end)] (a plain mean
+    over paths, with its interval), a lower bound of the mean first-passage
+    time. With ``initial="stationary"`` the start is random and some paths
+    may start beyond the stroke (time 0); ``initial="rest"`` asks how soon
+    the magnet reaches its stops from rest.
+
+    Attributes
+    ----------
+    mean : Statistic or None
+        E[tau] (s), when every path reached the stroke.
+    restricted_mean : Statistic
+        E[min(tau, t_end)] (s), always defined.
+    paths_reached : int
+        Paths that reached the stroke within the run.
+    n_paths : int
+    horizon : float
+        t_end (s), the censoring time.
+    """
+
+    mean: Statistic | None
+    restricted_mean: Statistic
+    paths_reached: int
+    n_paths: int
+    horizon: float
+
+    @classmethod
+    def from_times(cls, times, horizon: float) -> FirstPassage:
+        """From per-path first times (s; negative: not reached within ``horizon``)."""
+        times = np.asarray(times, dtype=float)
+        reached = times >= 0
+        restricted = np.where(reached, times, horizon)
+        return cls(
+            mean=estimate(times) if np.all(reached) else None,
+            restricted_mean=estimate(restricted),
+            paths_reached=int(reached.sum()),
+            n_paths=int(times.size),
+            horizon=float(horizon),
+        )
+
+    def to_dict(self) -> dict:
+        return {
+            "mean": None if self.mean is None else self.mean.mean,
+            "ci95": None if self.mean is None else self.mean.ci95,
+            "paths_reached": self.paths_reached,
+            "n_paths": self.n_paths,
+            "horizon": self.horizon,
+            "restricted_mean": self.restricted_mean.to_dict(),
+        }
+
+
+@dataclass(frozen=True)
 class Histogram:
     """Stationary histograms of displacement and velocity over the window."""
 
@@ -161,6 +221,36 @@ class Histogram:
     v_density: np.ndarray
     #: Fraction of samples that fell outside the ranges.
     outside: tuple
+    #: Counts of z and v per group of paths (the kernel's chunks of up to
+    #: kernel.LANES independent paths), shape (n_groups, 2, bins), and the
+    #: paths in each group: the groups are independent, so they give intervals.
+    group_counts: np.ndarray | None = field(default=None, repr=False)
+    group_paths: np.ndarray | None = field(default=None, repr=False)
+    window_steps: int = 0
+
+    def density_statistics(self, variable: str = "z") -> list[Statistic]:
+        """The density (1/m or s/m) in each bin with its 95 % interval, over path groups.
+
+        Ratio estimator over the independent groups g with n_g paths:
+        mean = sum(counts) / (sum(n_g) T h) (= ``z_density``), standard error
+        from the groups' spread about it, weighted by n_g / sum(n_g).
+        """
+        row = check_choice("variable", variable, ("z", "v"))
+        edges = self.z_edges if row == "z" else self.v_edges
+        counts = self.group_counts[:, 0 if row == "z" else 1, :].astype(float)
+        n = self.group_paths.astype(float)
+        g = n.size
+        if g < 2:
+            raise ValueError(f"need at least 2 groups of paths for an interval, got {g}")
+        scale = self.window_steps * np.diff(edges)  # samples per path x bin width
+        per_group = counts / (n[:, None] * scale)
+        mean = counts.sum(axis=0) / (n.sum() * scale)
+        weight = (n / n.sum())[:, None]
+        se = np.sqrt(g / (g - 1) * np.sum(weight**2 * (per_group - mean) ** 2, axis=0))
+        t = float(special.stdtrit(g - 1, 0.975))
+        return [
+            Statistic(float(a), t * float(b), float(b), g) for a, b in zip(mean, se, strict=True)
+        ]
 
 
 @dataclass(frozen=True)
@@ -179,7 +269,9 @@ class SimulationResult:
 
     The statistics (``power_electrical``, ``velocity_variance``,
     ``displacement_variance``, ``mean_abs_velocity``, ``friction_power``,
-    ``power_load``) are :class:`Statistic` objects; with
+    ``power_load``, ``stroke_exceedance``) are :class:`Statistic` objects
+    (``displacement_variance`` None for the free mass, the stroke ones None
+    without a stroke); ``stroke_first_passage`` is a :class:`FirstPassage`; with
     ``control_variates=True`` they use the zero-mean controls of
     :meth:`controls`, otherwise plain path means.
     """
@@ -269,9 +361,29 @@ class SimulationResult:
         return self.statistic(self.averages.v2)
 
     @property
-    def displacement_variance(self) -> Statistic:
-        """E[z^2] (m^2)."""
+    def displacement_variance(self) -> Statistic | None:
+        """E[z^2] (m^2); None for the free mass (k = k3 = 0), whose z is not stationary."""
+        if self.harvester.potential.is_free:
+            return None
         return self.statistic(self.averages.z2)
+
+    @property
+    def stroke_exceedance(self) -> Statistic | None:
+        """Fraction of the window's time with |z| > stroke; None without a stroke.
+
+        For the free mass it is the fraction over this window (z is not
+        stationary, so it grows with the run), not a stationary probability.
+        """
+        if self.harvester.stroke is None:
+            return None
+        return self.statistic(self.averages.beyond_stroke)
+
+    @property
+    def stroke_first_passage(self) -> FirstPassage | None:
+        """First time |z| > stroke from the start (:class:`FirstPassage`); None without a stroke."""
+        if self.harvester.stroke is None:
+            return None
+        return FirstPassage.from_times(self.averages.first_hit_time, self.t_end)
 
     @property
     def mean_abs_velocity(self) -> Statistic:
@@ -336,15 +448,23 @@ class SimulationResult:
             for name in (
                 "power_electrical",
                 "velocity_variance",
-                "displacement_variance",
                 "mean_abs_velocity",
                 "friction_power",
             )
         }
+        # null for the free mass: its displacement has no stationary law
+        z2 = self.displacement_variance
+        out["displacement_variance"] = None if z2 is None else z2.to_dict()
         if self.power_load is not None:
             out["power_load"] = self.power_load.to_dict()
         if self.harvester.has_circuit:
             out["circuit_mean_square"] = self.circuit_mean_square.to_dict()
+        if self.harvester.stroke is not None:
+            out["stroke"] = self.harvester.stroke
+            out["stroke_exceedance"] = self.stroke_exceedance.to_dict()
+            first = self.stroke_first_passage
+            out["stroke_first_passage_time"] = None if first.mean is None else first.mean.to_dict()
+            out["stroke_first_passage"] = first.to_dict()
         out.update(
             n_paths=self.n_paths,
             dt=self.dt,
@@ -371,6 +491,8 @@ def effective_linear_device(harvester: Harvester, psd: float) -> tuple[float, fl
     the mean); c_eff = c_eq from equivalent linearisation, or c for LuGre.
     With a circuit state, (k_eq, c_eq) of the statistical linearisation with
     the circuit (a law with memory left out: it only adds damping).
+    Any confining potential: for a double well E[z^2] ~ z_w^2 at low noise,
+    so k_eff ~ -2 k, the wells' own stiffness; the free mass has k_eff = 0.
     """
     h = harvester
     if h.has_circuit:
@@ -381,6 +503,8 @@ def effective_linear_device(harvester: Harvester, psd: float) -> tuple[float, fl
     c_eff = float(h.c)
     if h.friction is None or h.friction.has_equivalent_damping:
         c_eff = float(equivalent_damping(h, psd))
+    if h.potential.is_free:
+        return 0.0, c_eff
     if h.c > 0:
         z2 = exact.gibbs_displacement_moment(h.m, h.c, h.k, h.k3, psd)
     else:
@@ -418,7 +542,17 @@ def step_bias(scheme: str, harvester: Harvester, psd, dt: float) -> float:
 
 
 def _scheme_bias(scheme, m, k_eff, c_eff, psd, dt) -> float:
-    """:func:`step_bias` for an already linearised device (inf where unstable)."""
+    """:func:`step_bias` for an already linearised device (inf where unstable).
+
+    With k_eff = 0 (the free mass) only the velocity is stationary: the bias
+    of E[v^2] of the scheme's recursion on dv = -(c_eff/m) v dt + dW.
+    """
+    if k_eff == 0:
+        a, b = integrators.integrator(scheme).linear_recursion([[-c_eff / m]], [[1.0]], dt)
+        if abs(a[0, 0]) >= 1:
+            return float("inf")
+        discrete = dt * b[0, 0] ** 2 / (1.0 - a[0, 0] ** 2)
+        return abs(discrete * 2.0 * c_eff / m - 1.0)
     try:
         cov = integrators.scheme_stationary_covariance(scheme, m, c_eff, k_eff, psd, dt)
     except ValueError:
@@ -466,7 +600,12 @@ def largest_step(scheme: str, harvester: Harvester, psd, bias: float = MAX_STEP_
     excitation = as_excitation(psd)
     k_eff, c_eff = effective_linear_device(harvester, excitation.level)  # once, not per step
     m = float(harvester.m)
-    lo, hi = 0.0, 2.0 / np.sqrt(k_eff / m)
+    # The fastest linear time scale: the period over pi, or for the free mass m/c.
+    if k_eff > 0:
+        hi = 2.0 / np.sqrt(k_eff / m)
+    else:
+        hi = 2.0 * m / c_eff if c_eff > 0 else np.inf
+    lo = 0.0
     if excitation.is_white and not harvester.has_circuit:
 
         def bias_at(dt):
@@ -501,8 +640,17 @@ def _linearised_spread(harvester: Harvester, excitation: Excitation) -> tuple[fl
     White noise: Eq. 20 and 30. A rational spectrum or a circuit state: the
     Lyapunov covariance of the same linearised device driven through the
     excitation's filter, with the circuit.
+    Without a positive k (double well, pure cubic) the displacement's spread
+    under white noise is the exact friction-free (Gibbs) one, which sees both
+    wells, where the Gaussian closure would put a third of the wells' offset;
+    the free mass has no stationary spread in z (0: paths start at z = 0; its
+    velocity spread is the white-noise one at the excitation's level, a start
+    the burn-in corrects).
     """
     psd = excitation.level
+    if harvester.potential.is_free:
+        _, c_eff = effective_linear_device(harvester, psd)
+        return 0.0, float(np.sqrt(psd * harvester.m / (4.0 * c_eff)))
     if not excitation.is_white or harvester.has_circuit:
         cov = _linearised_covariance(harvester, excitation)
         n_filter = 0 if excitation.is_white else excitation.shaping_filter().system.n_states
@@ -511,6 +659,11 @@ def _linearised_spread(harvester: Harvester, excitation: Excitation) -> tuple[fl
         )
     k_eff, c_eff = effective_linear_device(harvester, psd)
     vv = psd * harvester.m / (4.0 * c_eff)
+    h = harvester
+    if h.k <= 0 and h.c > 0:
+        return float(np.sqrt(exact.gibbs_displacement_moment(h.m, h.c, h.k, h.k3, psd))), float(
+            np.sqrt(vv)
+        )
     return float(np.sqrt(linear_displacement_variance(harvester, vv))), float(np.sqrt(vv))
 
 
@@ -715,6 +868,12 @@ def simulate(
         white or rational input, and its mean square is averaged per path
         (``circuit_mean_square``, the power from it); the companion then is
         refused (it assumes a viscous c_e), the control variates are not.
+        Any confining potential (monostable, bistable, pure cubic) or the
+        free mass (k = k3 = 0: velocity statistics only,
+        ``displacement_variance`` is None); a non-confining one is refused.
+        With a ``stroke`` the result reports
+        :attr:`SimulationResult.stroke_exceedance` and
+        :attr:`SimulationResult.stroke_first_passage`.
     psd : float or Excitation
         One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0: the velocity
         noise is sqrt(S/2) dW (paper Eq. 17). Or an excitation
@@ -804,7 +963,7 @@ def simulate(
         progress = sys.stderr.isatty() and os.environ.get("CI") is None
     batches = _batches(n_paths, batch_paths, run.grid.n_steps, progress, run.record.record_paths)
     started = time.perf_counter()
-    per_path, hist_total, records = _run_batches(run, setup, batches, progress)
+    per_path, hist_groups, records = _run_batches(run, setup, batches, progress)
     wall = time.perf_counter() - started
     return SimulationResult(
         harvester=run.harvester,
@@ -817,7 +976,7 @@ def simulate(
         first_path=run.first_path,
         per_path=per_path,
         control_variates=control_variates,
-        histogram=_histogram(setup.recording, hist_total, run.n_paths * run.grid.window_steps),
+        histogram=_histogram(setup.recording, hist_groups, batches, run.grid.window_steps),
         histories=_histories(records, run.record.record_every, run.grid.dt),
         wall_time=wall,
         excitation=run.excitation,
@@ -851,6 +1010,14 @@ def _validated(
     for name in ("m", "c_m", "c_e", "k", "k3"):
         if np.ndim(getattr(harvester, name)) != 0:
             raise ValueError(f"simulate needs scalar harvester parameters; `{name}` is an array")
+    # Statistics are time averages of a stationary state: a confining
+    # potential, or the free mass for its velocity.
+    harvester.potential.require("simulate", CONFINING + ("free",))
+    if companion and harvester.potential.is_free:
+        raise ValueError(
+            "`companion` needs a confining potential: the friction-free companion's exact "
+            "E[z^2] (Gibbs) does not exist for the free mass (k = k3 = 0)"
+        )
     scheme = integrator(*scheme_argument)
     excitation = _simulated_excitation(psd)
     grid = TimeGrid.from_times(t_end, dt, burn_in)
@@ -1051,7 +1218,11 @@ def _start_states(run: _Run) -> tuple[kernel.Start, kernel.Companion]:
 
 
 def _recording(run: _Run) -> kernel.Recording:
-    """Histogram ranges and bins (default ranges +-5 linearised std); records per batch."""
+    """Histogram ranges and bins (default ranges +-5 linearised std); records per batch.
+
+    The free mass's z spreads like a random walk: its default range is
+    +-5 sqrt(2 sigma_v^2 (m/c_eff) t_end), five times the walk's spread at the end.
+    """
     bins = run.record.histogram_bins
     if bins == 0:
         lo, hi = np.zeros(2), np.ones(2)  # unused
@@ -1059,10 +1230,14 @@ def _recording(run: _Run) -> kernel.Recording:
         ranges = run.record.histogram_range
         if ranges is None:
             sz, sv = _linearised_spread(run.harvester, run.excitation)
+            if run.harvester.potential.is_free:
+                _, c_eff = effective_linear_device(run.harvester, run.psd)
+                sz = sv * np.sqrt(2.0 * run.harvester.m / c_eff * run.grid.t_end)
             ranges = ((-5 * sz, 5 * sz), (-5 * sv, 5 * sv))
         arr = np.asarray(ranges, dtype=float)
         lo, hi = arr[:, 0], arr[:, 1]
-    return kernel.pack(kernel.Recording, lo, hi, bins, 0, run.record.record_every)
+    stroke = np.inf if run.harvester.stroke is None else run.harvester.stroke
+    return kernel.pack(kernel.Recording, lo, hi, bins, 0, run.record.record_every, stroke)
 
 
 # ----------------------------------------------------------------- compiled calls
@@ -1073,13 +1248,13 @@ def _run_batches(run: _Run, setup: _KernelSetup, batches, progress: bool):
     -------
     per_path : ndarray, shape (n_paths, N_ACC)
         Per-path time averages.
-    hist_total : ndarray of int64, shape (2, bins)
-        Histogram counts of z and v summed over paths.
+    hist_groups : ndarray of int64, shape (n_groups, 2, bins)
+        Histogram counts of z and v per chunk of paths, batches in order.
     records : ndarray or None
         Recorded histories of the first paths (from the first batch).
     """
     per_path = np.empty((run.n_paths, kernel.N_ACC))
-    hist_total = np.zeros((2, max(run.record.histogram_bins, 1)), dtype=np.int64)
+    hist_groups = []
     records = None
     bar = None
     if progress:
@@ -1092,7 +1267,7 @@ def _run_batches(run: _Run, setup: _KernelSetup, batches, progress: bool):
             _raise_if_diverged(run, lo, failed)
             per_path[lo:hi] = acc
             if run.record.histogram_bins > 0:
-                hist_total += hist.sum(axis=0)
+                hist_groups.append(hist)
             if lo == 0 and run.record.record_paths > 0:
                 records = rec
             if bar is not None:
@@ -1100,7 +1275,8 @@ def _run_batches(run: _Run, setup: _KernelSetup, batches, progress: bool):
     finally:
         if bar is not None:
             bar.close()
-    return per_path, hist_total, records
+    hist_groups = np.concatenate(hist_groups) if hist_groups else None
+    return per_path, hist_groups, records
 
 
 def _raise_if_diverged(run: _Run, lo: int, failed: np.ndarray) -> None:
@@ -1130,11 +1306,17 @@ def _batches(n_paths, batch_paths, n_steps, progress, record_paths):
 
 
 # ----------------------------------------------------------------- result assembly
-def _histogram(recording: kernel.Recording, counts, n_samples: int) -> Histogram | None:
-    """Densities of z and v from the summed counts over ``n_samples`` samples."""
+def _histogram(recording: kernel.Recording, groups, batches, window_steps: int):
+    """Densities of z and v from the per-chunk counts ``groups`` (or None without bins)."""
     bins = recording.hist_bins
     if bins == 0:
         return None
+    # The kernel's chunks: LANES paths each, the last of each batch possibly fewer.
+    sizes = [
+        min(kernel.LANES, hi - start) for lo, hi in batches for start in range(lo, hi, kernel.LANES)
+    ]
+    counts = groups.sum(axis=0)
+    n_samples = sum(sizes) * window_steps
     z_edges = np.linspace(recording.hist_lo[0], recording.hist_hi[0], bins + 1)
     v_edges = np.linspace(recording.hist_lo[1], recording.hist_hi[1], bins + 1)
     return Histogram(
@@ -1143,6 +1325,9 @@ def _histogram(recording: kernel.Recording, counts, n_samples: int) -> Histogram
         v_edges,
         counts[1] / (n_samples * np.diff(v_edges)),
         (1 - counts[0].sum() / n_samples, 1 - counts[1].sum() / n_samples),
+        group_counts=groups,
+        group_paths=np.array(sizes),
+        window_steps=window_steps,
     )
 
 
