@@ -65,6 +65,7 @@ _EXPORTS = {
         "velocity_variance",
     ),
     "randvib.models.presets": ("MAGNET_MASS", "preset", "PRESETS"),
+    "randvib.montecarlo.on_record": ("RecordSimulation", "simulate_on_record"),
     "randvib.identification.sade": ("sade", "SADEResult"),
     "randvib.montecarlo.simulation": (
         "simulate",

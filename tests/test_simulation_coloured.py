@@ -26,14 +26,7 @@ from scipy import linalg
 
 import randvib as rv
 from randvib.analytic.linear_response import mechanical_block, stationary_covariance
-from randvib.models.excitation import (
-    BandLimited,
-    BandPass,
-    KanaiTajimi,
-    Measured,
-    Tabulated,
-    White,
-)
+from randvib.models.excitation import BandPass, KanaiTajimi, White
 from randvib.montecarlo import integrators
 from randvib.montecarlo.simulation import (
     StepSizeWarning,
@@ -254,20 +247,6 @@ def test_coloured_results_do_not_depend_on_batching_or_threads():
     np.testing.assert_array_equal(a.per_path, b.per_path)
     c = simulate(DUFFING_COULOMB, ex, seed=4, first_path=8, **{**KW, "n_paths": 8})
     np.testing.assert_array_equal(a.per_path[8:], c.per_path)
-
-
-@pytest.mark.parametrize(
-    "excitation",
-    [
-        BandLimited(1.0, 4.0, 20.0),
-        Tabulated(np.array([1.0, 10.0, 20.0]), np.array([1.0, 1.0, 0.5])),
-        Measured(np.arange(4096) * 1e-3, np.random.default_rng(0).standard_normal(4096)),
-    ],
-    ids=["band-limited", "tabulated", "measured"],
-)
-def test_non_rational_spectra_refused_naming_statistical_linearisation(excitation):
-    with pytest.raises(ValueError, match="randvib.statistical_linearisation"):
-        simulate(LINEAR, excitation, **KW)
 
 
 def test_white_noise_only_options_refused_under_coloured_input():

@@ -34,12 +34,13 @@ from scipy import linalg, special  # Student t quantile; lighter than scipy.stat
 
 from randvib._validation import check_choice, check_int, check_positive
 from randvib.analytic import exact_solutions as exact
-from randvib.analytic.linear_response import mechanical_block
+from randvib.analytic.linear_response import mechanical_block, output_variances
 from randvib.analytic.linearisation import equivalent_damping, linear_displacement_variance
+from randvib.analytic.statistical_linearisation import statistical_linearisation
 from randvib.models.excitation import Excitation, ShapingFilter, as_excitation
 from randvib.models.friction import kernel_arguments
 from randvib.models.harvester import Harvester
-from randvib.montecarlo import integrators, kernel
+from randvib.montecarlo import driven, integrators, kernel
 from randvib.montecarlo.integrators import Integrator, integrator
 from randvib.montecarlo.rng import ZIG_FI, ZIG_KI, ZIG_WI
 
@@ -367,11 +368,31 @@ def step_bias(scheme: str, harvester: Harvester, psd, dt: float) -> float:
     device is the white-noise one at the excitation's level, as for white noise.
     """
     excitation = as_excitation(psd)
-    k_eff, c_eff = effective_linear_device(harvester, excitation.level)
     m = float(harvester.m)
+    if excitation.shaping_filter() is None:  # synthesised or recorded input
+        k_eff, c_eff = _linearised_under(harvester, excitation)[:2]
+        return _scheme_bias(scheme, m, k_eff, c_eff, 1.0, dt)
+    k_eff, c_eff = effective_linear_device(harvester, excitation.level)
     if excitation.is_white:
         return _scheme_bias(scheme, m, k_eff, c_eff, excitation.level, dt)
     return _augmented_bias(scheme, m, k_eff, c_eff, excitation.shaping_filter(), dt)
+
+
+def _linearised_under(harvester: Harvester, excitation: Excitation) -> tuple:
+    """(k_eq, c_eq, E[z^2], E[v^2]) of the device linearised under a non-rational input.
+
+    Statistical linearisation (:func:`randvib.statistical_linearisation`) for
+    memoryless friction; with a friction state (LuGre) the viscous device
+    (k, c) and its spectral variances. Used for the step check and the
+    random start when the input is synthesised or recorded: there the scheme
+    integrates the device alone, the input's step integral being exact.
+    """
+    h = harvester
+    if h.friction is None or h.friction.has_equivalent_damping:
+        res = statistical_linearisation(h, excitation)
+        return res.k_eq, res.c_eq, res.displacement_variance, res.velocity_variance
+    var = output_variances(mechanical_block(float(h.m), float(h.c), float(h.k)), excitation)
+    return float(h.k), float(h.c), var["z"], var["v"]
 
 
 def _scheme_bias(scheme, m, k_eff, c_eff, psd, dt) -> float:
@@ -416,10 +437,18 @@ def _augmented_bias(scheme, m, k_eff, c_eff, shaping: ShapingFilter, dt) -> floa
 def largest_step(scheme: str, harvester: Harvester, psd, bias: float = MAX_STEP_BIAS) -> float:
     """Largest dt (s) whose :func:`step_bias` stays below ``bias`` (bisection)."""
     excitation = as_excitation(psd)
-    k_eff, c_eff = effective_linear_device(harvester, excitation.level)  # once, not per step
     m = float(harvester.m)
+    if excitation.shaping_filter() is None:
+        k_eff, c_eff = _linearised_under(harvester, excitation)[:2]
+    else:
+        k_eff, c_eff = effective_linear_device(harvester, excitation.level)  # once, not per step
     lo, hi = 0.0, 2.0 / np.sqrt(k_eff / m)
-    if excitation.is_white:
+    if excitation.shaping_filter() is None:
+
+        def bias_at(dt):
+            return _scheme_bias(scheme, m, k_eff, c_eff, 1.0, dt)
+
+    elif excitation.is_white:
 
         def bias_at(dt):
             return _scheme_bias(scheme, m, k_eff, c_eff, excitation.level, dt)
@@ -446,6 +475,9 @@ def _linearised_spread(harvester: Harvester, excitation: Excitation) -> tuple[fl
     White noise: Eq. 20 and 30. A rational spectrum: the Lyapunov covariance of
     the same linearised device driven through the excitation's filter.
     """
+    if excitation.shaping_filter() is None:
+        z2, v2 = _linearised_under(harvester, excitation)[2:]
+        return float(np.sqrt(z2)), float(np.sqrt(v2))
     psd = excitation.level
     k_eff, c_eff = effective_linear_device(harvester, psd)
     if not excitation.is_white:
@@ -460,7 +492,9 @@ def _linearised_spread(harvester: Harvester, excitation: Excitation) -> tuple[fl
 
 def _check_step(scheme, harvester, excitation, dt):
     bias = step_bias(scheme, harvester, excitation, dt)
-    resolves = "" if excitation.is_white else f" with the {excitation.name} filter's states"
+    resolves = ""
+    if excitation.shaping_filter() is not None and not excitation.is_white:
+        resolves = f" with the {excitation.name} filter's states"
     if bias > MAX_STEP_BIAS:
         limit = largest_step(scheme, harvester, excitation)
         raise ValueError(
@@ -615,6 +649,9 @@ class _Run:
     record: RecordOptions
     dW: np.ndarray | None
     companion: bool
+    #: Velocity increments of a given base acceleration, ``driver(first, count)``
+    #: -> (count, n_steps) (m/s): synthesised or recorded input (:mod:`randvib.montecarlo.driven`).
+    driver: object = None
 
 
 # ----------------------------------------------------------------- simulate
@@ -726,6 +763,18 @@ def simulate(
         companion=companion,
         record=(histogram_bins, histogram_range, record_paths, record_every),
     )
+    return execute(
+        run,
+        control_variates=control_variates,
+        check_step=check_step,
+        threads=threads,
+        batch_paths=batch_paths,
+        progress=progress,
+    )
+
+
+def execute(run: _Run, *, control_variates, check_step, threads, batch_paths, progress):
+    """Run a validated :class:`_Run` (see :func:`simulate` for the options)."""
     _check_coloured_options(run.excitation, run.companion, control_variates)
     if check_step:
         _check_step(run.scheme.name, run.harvester, run.excitation, run.grid.dt)
@@ -735,7 +784,11 @@ def simulate(
         numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
     if progress is None:
         progress = sys.stderr.isatty() and os.environ.get("CI") is None
-    batches = _batches(n_paths, batch_paths, run.grid.n_steps, progress, run.record.record_paths)
+    if batch_paths is None and run.driver is not None:  # the input's memory stays bounded
+        batch_paths = driven.batch_paths(run.grid.n_steps)
+    batches = _batches(
+        run.n_paths, batch_paths, run.grid.n_steps, progress, run.record.record_paths
+    )
     started = time.perf_counter()
     per_path, hist_total, records = _run_batches(run, setup, batches, progress)
     wall = time.perf_counter() - started
@@ -788,14 +841,24 @@ def _validated(
     excitation = _simulated_excitation(psd)
     grid = TimeGrid.from_times(t_end, dt, burn_in)
     n_paths = check_int("n_paths", n_paths, 1)
+    seed = check_int("seed", seed, 0)
+    driver = None
+    if excitation.shaping_filter() is None:  # synthesised input: the kernel takes its increments
+        if dW is not None:
+            raise ValueError(
+                f"`dW` drives white noise or a shaping filter; the {excitation.name} input is "
+                "synthesised from the seed (leave dW=None)"
+            )
+        driver = driven.SynthesisedInput(excitation, grid.n_steps, grid.dt, seed)
     return _Run(
         harvester=harvester,
-        psd=excitation.level,
+        psd=getattr(excitation, "level", None),
         excitation=excitation,
+        driver=driver,
         scheme=scheme,
         grid=grid,
         n_paths=n_paths,
-        seed=check_int("seed", seed, 0),
+        seed=seed,
         first_path=check_int("first_path", first_path, 0),
         initial=InitialState.from_argument(initial),
         record=RecordOptions.validated(*record),
@@ -805,21 +868,29 @@ def _validated(
 
 
 def _simulated_excitation(psd) -> Excitation:
-    """``psd`` as an excitation that :func:`simulate` can integrate, or a clear refusal.
+    """``psd`` as an excitation that :func:`simulate` can drive, or a clear refusal.
 
     White noise and the rational spectra with a 2-state shaping filter
-    (band-pass, Kanai-Tajimi) are simulated; the others have no filter.
+    (band-pass, Kanai-Tajimi) are integrated with the device; band-limited
+    and tabulated spectra are synthesised (:class:`driven.SynthesisedInput`);
+    a measured record is simulated on the record itself by
+    :func:`randvib.montecarlo.driven.simulate_on_record`.
     """
     if not isinstance(psd, Excitation):
         return as_excitation(float(check_positive("psd", psd, "(m/s^2)^2/Hz")))
-    shaping = psd.shaping_filter()
     if psd.is_white:
         return psd
-    if shaping is None or shaping.system.n_states != 2 or np.any(shaping.system.d != 0):
+    if psd.name == "measured":
         raise ValueError(
-            f"simulate integrates white noise and rational spectra (band-pass, kanai-tajimi) "
-            f"through their shaping filter; the {psd.name} excitation has none: use "
-            "randvib.statistical_linearisation, which accepts any spectrum"
+            "simulate draws its own paths; to simulate the device on the measured record "
+            "itself use randvib.simulate_on_record(harvester, record, ...), for Gaussian "
+            "paths with the record's Welch PSD pass record.spectrum"
+        )
+    shaping = psd.shaping_filter()
+    if shaping is not None and (shaping.system.n_states != 2 or np.any(shaping.system.d != 0)):
+        raise ValueError(
+            f"simulate integrates shaping filters of 2 states without feed-through; the "
+            f"{psd.name} filter has {shaping.system.n_states}"
         )
     return psd
 
@@ -876,7 +947,9 @@ class _KernelSetup:
     @classmethod
     def prepare(cls, run: _Run) -> _KernelSetup:
         h = run.harvester
-        device = (h.m, h.c, h.k, h.k3, np.sqrt(run.psd / 2.0))
+        # Given base-acceleration input arrives as velocity increments (m/s): amplitude 1.
+        amplitude = 1.0 if run.driver is not None else np.sqrt(run.psd / 2.0)
+        device = (h.m, h.c, h.k, h.k3, amplitude)
         initial, companion = _start_states(run)
         return cls(
             scheme=run.scheme.kernel_weights,
@@ -886,13 +959,16 @@ class _KernelSetup:
             initial=initial,
             companion=companion,
             recording=_recording(run),
-            shaping=_shaping(run.excitation),
+            shaping=None if run.driver is not None else _shaping(run.excitation),
         )
 
     def arguments(self, run: _Run, lo: int, hi: int) -> dict:
         """:func:`kernel.run_ensemble`'s keyword arguments for paths ``lo .. hi - 1``."""
         n_record = max(0, min(run.record.record_paths - lo, hi - lo))
-        dw = run.dW[lo:hi] if run.dW is not None else np.zeros((0, 0))
+        if run.driver is not None:
+            dw = run.driver(run.first_path + lo, hi - lo)
+        else:
+            dw = run.dW[lo:hi] if run.dW is not None else np.zeros((0, 0))
         return dict(
             scheme=self.scheme,
             device=self.device,
@@ -914,9 +990,9 @@ def _shaping(excitation: Excitation) -> kernel.Shaping | None:
     stationary law N(0, P), P from A P + P A^T + q G G^T = 0; the kernel
     draws them as the Cholesky factor of P times two standard normals.
     """
-    if excitation.is_white:
-        return None
     shaping = excitation.shaping_filter()
+    if excitation.is_white or shaping is None:
+        return None
     system = shaping.system
     q = shaping.noise_intensity
     cov = linalg.solve_continuous_lyapunov(system.a, -q * np.outer(system.b, system.b))
