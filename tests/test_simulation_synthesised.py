@@ -168,7 +168,9 @@ def test_device_on_a_sine_record_gives_the_harmonic_response():
     np.testing.assert_allclose(r.averages.v2, np.abs(response[1]) ** 2 / 2, rtol=1e-9)
     h = block.frequency_response(f0)
     assert abs(r.averages.v2[0] / (amp**2 * np.abs(h[1]) ** 2 / 2) - 1) < 5e-3
-    assert r.n_paths == 6 and r.psd is None and r.summary()["excitation"]["excitation"] == "measured"
+    assert (
+        r.n_paths == 6 and r.psd is None and r.summary()["excitation"]["excitation"] == "measured"
+    )
 
 
 def test_device_on_a_long_gaussian_record_matches_the_spectral_integral():

@@ -299,6 +299,12 @@ class SimulationResult:
             h.c * self.averages.v2 + self.averages.friction_power - self.psd * h.m / 4.0
         )
 
+    def response_spectra(self, segment_duration: float | None = None):
+        """Welch PSDs of z, v and c_e S_v from the recorded paths (:mod:`.spectra`)."""
+        from randvib.montecarlo.spectra import response_spectra
+
+        return response_spectra(self, segment_duration)
+
     def summary(self) -> dict:
         """Statistics as {name: {"mean", "ci95"}} plus run settings (JSON-ready)."""
         out = {
