@@ -13,7 +13,9 @@ subclassing :class:`Excitation`, that declares what every consumer needs
   whose output has exactly this PSD; None for the others;
 * ``sample(duration, dt, n_paths, seed)`` - for the non-rational ones
   (band-limited, tabulated, measured) a stationary Gaussian synthesis in the
-  frequency domain (:func:`synthesise`);
+  frequency domain (:func:`synthesise`; :func:`synthesised_increments` gives
+  its exact step integrals, one generator per path, for Monte Carlo), each
+  bin carrying the exact power of its cell (``cumulative_power``);
 * ``support``, ``features`` and ``breakpoints`` - where the spectrum lives,
   its peaks and its kinks, so that a quadrature over frequency can resolve
   them (:mod:`randvib.analytic.linear_response`).
@@ -290,7 +292,9 @@ def as_excitation(value) -> Excitation:
 COLOURED_METHODS = (
     "statistical linearisation (randvib.statistical_linearisation, or "
     "predict/expected_power with method='linearisation')",
-    "Monte Carlo (randvib.simulate) for band-pass and Kanai-Tajimi spectra",
+    "Monte Carlo (randvib.simulate: filter states for band-pass and Kanai-Tajimi, "
+    "spectral synthesis for band-limited and tabulated spectra; "
+    "randvib.simulate_on_record for a measured record)",
 )
 
 

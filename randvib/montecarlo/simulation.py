@@ -12,7 +12,10 @@ rational spectrum (band-pass, Kanai-Tajimi) the base acceleration is instead
 the output y of the spectrum's 2-state shaping filter driven by that white
 noise, and dv gets -y dt in place of the noise (paper Eq. 18 with a
 coloured base); the filter states are integrated with the device by the same
-scheme (:func:`randvib.montecarlo.kernel.filtered_step`).
+scheme (:func:`randvib.montecarlo.kernel.filtered_step`). Under a
+band-limited or tabulated spectrum y is synthesised per path and dv gets the
+exact step integral -int y dt through the kernel's given-increments path
+(:mod:`randvib.montecarlo.driven`).
 
 Each path is an independent realisation; statistics are time averages over
 the window [burn_in, t_end) on each path, and their confidence intervals come
@@ -686,7 +689,7 @@ def simulate(
     check_step: bool = True,
     method: str | None = None,
 ) -> SimulationResult:
-    """Simulate an ensemble of the harvester under white or rational base excitation.
+    """Simulate an ensemble of the harvester under white or coloured base excitation.
 
     Parameters
     ----------
@@ -698,11 +701,14 @@ def simulate(
         (:mod:`randvib.models.excitation`): ``White`` as a number;
         ``BandPass`` and ``KanaiTajimi`` through their shaping filter's two
         states, driven by sqrt(S/2) dW (S their ``level``) and integrated with
-        the device by the same scheme. Non-rational spectra (``BandLimited``,
-        ``Tabulated``, ``Measured``) are refused: use
-        :func:`randvib.statistical_linearisation`. Under coloured input the
-        companion and the control variates (white-noise energy balance) are
-        refused, and the step check covers the filter too.
+        the device by the same scheme. ``BandLimited`` and ``Tabulated`` by a
+        stationary Gaussian synthesis per path (:mod:`randvib.montecarlo.driven`:
+        path i's input from the stream (seed, i), the kernel taking its exact
+        step integrals; batches bound the memory). ``Measured`` is refused:
+        simulate on the record with :func:`randvib.simulate_on_record`.
+        Under coloured input the companion and the control variates
+        (white-noise energy balance) are refused, and the step check covers
+        the filter too.
     t_end : float
         Simulated time per path (s), burn-in included.
     dt : float
