@@ -11,6 +11,11 @@ Device: figure9 preset with k3 = 5e5 N/m^3 (Duffing + Coulomb), dt = 1e-4 s,
 * the same engine under band-pass input (issue 10): the kernel then
   integrates the shaping filter's 2 states with the device; the target is at
   most 1.5x the white-noise kernel per path-step (``filter_over_white``).
+* the same engine under band-limited input (4-20 Hz), synthesised per path
+  and fed to the kernel as given increments (``synthesised_over_white``, the
+  whole simulation), and the synthesis alone (``synthesis_over_white``: the
+  per-path spectral synthesis of the increments, per path-step, against the
+  white-noise kernel).
 A module fixture prints ns per path-step and the ratios, and writes
 .benchmarks/engine_ratios.json. Set RANDVIB_BENCH_FULL_MEMORY=1 to also run the
 10^5 paths x 10^6 steps memory case (about 10 minutes on 2 cores).
@@ -29,7 +34,8 @@ import sdeint
 from conftest import TIMINGS, record, write_report
 
 import randvib as rv
-from randvib.models.excitation import BandPass
+from randvib.models.excitation import BandLimited, BandPass
+from randvib.montecarlo.driven import SynthesisedInput
 from randvib.montecarlo.simulation import simulate
 
 DEVICE = rv.preset("figure9").updated(k3=5e5)
@@ -38,6 +44,8 @@ WORK = N_PATHS * N_STEPS
 CORES = numba.config.NUMBA_NUM_THREADS
 #: Band-pass input centred at the device's linear resonance (8 Hz).
 BAND_PASS = BandPass(PSD, 8.0, 0.2)
+#: The paper's shaker band, synthesised per path.
+BAND_LIMITED = BandLimited(PSD, 4.0, 20.0)
 
 
 def _run(method, excitation=PSD):
@@ -81,13 +89,43 @@ def test_engine_filter_states(benchmark, method):
     record(benchmark, f"{method}-band-pass", WORK)
 
 
+@pytest.mark.parametrize("method", ["euler-maruyama", "heun"])
+def test_engine_synthesised_input(benchmark, method):
+    """The same run under band-limited input: synthesis per path + the given-increments kernel."""
+    _run(method, BAND_LIMITED)  # compile / load cache
+    benchmark.pedantic(_run, args=(method, BAND_LIMITED), rounds=5, warmup_rounds=1)
+    record(benchmark, f"{method}-band-limited", WORK)
+
+
+def test_synthesis_alone(benchmark):
+    """The increments of all paths (one generator per path, FFT), without the kernel."""
+    source = SynthesisedInput(BAND_LIMITED, N_STEPS, DT, 1)
+    benchmark.pedantic(source, args=(0, N_PATHS), rounds=5, warmup_rounds=1)
+    record(benchmark, "synthesis", WORK)
+
+
+def _over_white(suffix):
+    """``{scheme}-{suffix}`` over the white-noise kernel, per path-step, for the schemes timed."""
+    return {
+        m: TIMINGS[f"{m}-{suffix}"] / TIMINGS[m]
+        for m in ("euler-maruyama", "heun")
+        if m in TIMINGS and f"{m}-{suffix}" in TIMINGS
+    }
+
+
 def _filter_over_white():
     """Filter-state kernel over white-noise kernel, per path-step, for the schemes timed."""
-    return {
-        m: TIMINGS[f"{m}-band-pass"] / TIMINGS[m]
-        for m in ("euler-maruyama", "heun")
-        if m in TIMINGS and f"{m}-band-pass" in TIMINGS
-    }
+    return _over_white("band-pass")
+
+
+def _synthesis_ratios():
+    """Synthesised input (whole run, and the synthesis alone) over the white kernel."""
+    out = {"synthesised_over_white": _over_white("band-limited")}
+    if "synthesis" in TIMINGS:
+        out["synthesis_over_white"] = {
+            m: TIMINGS["synthesis"] / TIMINGS[m] for m in ("euler-maruyama", "heun") if m in TIMINGS
+        }
+    return out
 
 
 def test_sdeint_one_path(benchmark):
@@ -167,6 +205,8 @@ def ratios_and_memory():
     yield
     if _filter_over_white():
         print(f"\nfilter_over_white (target <= 1.5): {_filter_over_white()}")
+    if any(_synthesis_ratios().values()):
+        print(f"\n{_synthesis_ratios()}")
     needed = {"floor", "euler-maruyama", "heun", "sdeint", "numpy"}
     if not needed <= TIMINGS.keys():
         return  # a subset was run: no ratios
@@ -183,6 +223,7 @@ def ratios_and_memory():
         "sdeint_over_euler_maruyama": ns["sdeint"] / ns["euler-maruyama"],
         "numpy_loop_over_euler_maruyama": ns["numpy"] / ns["euler-maruyama"],
         "filter_over_white": _filter_over_white(),
+        **_synthesis_ratios(),
         # (RSS before the run, peak RSS during it) in MB; the difference is
         # what the simulation itself needs
         "rss_mb_baseline_and_peak": memory,

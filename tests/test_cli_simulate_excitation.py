@@ -59,8 +59,8 @@ def test_filtered_excitation_equals_the_python_api(capsys, argv, excitation):
     ("argv", "fragment"),
     [
         (
-            ["--excitation", "band-pass", "--f0", "8", "--zeta", "0.3", "--control-variates"],
-            "control",
+            ["--excitation", "band-limited", "--f-lo", "4", "--f-hi", "20", "--control-variates"],
+            "`--control-variates` needs white noise or a filtered spectrum",
         ),
         (["--excitation", "band-pass", "--f0", "-8", "--zeta", "0.3"], "`--f0`"),
         (["--f0", "8"], "`--f0` needs `--excitation"),
@@ -127,3 +127,14 @@ def test_segments_without_record_one_line(capsys):
     one_line_error(
         capsys, ["simulate", *COMMON, "--psd", "1", "--segments", "3"], "needs `--record`"
     )
+
+
+def test_band_pass_control_variates_equal_the_python_api(capsys):
+    argv = ["--excitation", "band-pass", "--f0", "8", "--zeta", "0.3", "--control-variates"]
+    cli = _json(capsys, "--psd", "1", *argv)
+    api = rv.simulate(
+        rv.preset("figure9"), rv.BandPass(1.0, 8.0, 0.3), progress=False, control_variates=True,
+        **KW,
+    ).summary()  # fmt: skip
+    api.pop("wall_time")
+    assert cli == json.loads(json.dumps(api)) and cli["control_variates"] is True

@@ -253,13 +253,38 @@ def test_white_noise_only_options_refused_under_coloured_input():
     ex = BandPass(1.0, 8.0, 0.2)
     with pytest.raises(ValueError, match="`companion` needs white noise"):
         simulate(LINEAR, ex, companion=True, **KW)
-    with pytest.raises(ValueError, match="`control_variates` needs white noise"):
-        simulate(LINEAR, ex, control_variates=True, **KW)
     r = simulate(LINEAR, ex, **KW)
-    with pytest.raises(ValueError, match="white-noise energy balance"):
-        r.statistic(r.averages.v2, control_variates=True)
+    assert r.controls().shape == (KW["n_paths"], 2)  # Ito sum and energy change stay valid
     with pytest.raises(ValueError, match="white-noise energy balance"):
         r.energy_balance_residual()
+    synthesised = rv.BandLimited(1.0, 4.0, 20.0)
+    with pytest.raises(ValueError, match="`control_variates` needs Brownian increments"):
+        simulate(LINEAR, synthesised, control_variates=True, **KW)
+    r = simulate(LINEAR, synthesised, **KW)
+    with pytest.raises(ValueError, match="control variates need Brownian increments"):
+        r.statistic(r.averages.v2, control_variates=True)
+
+
+def test_control_variates_under_band_pass_match_the_continuous_lyapunov():
+    """Ito-sum and energy-change controls under a filter: exact zero means, 4-6x less variance.
+
+    The paper's linear device under BandPass(1, 8, 0.2), Heun dt = 1e-3 s:
+    the controlled E[v^2] against the continuous Lyapunov value with the
+    scheme's exact bias subtracted, with a quarter of the fine test's paths,
+    still powered for 1 %; the plain estimate on the same paths has the
+    larger standard error.
+    """
+    ex = BandPass(1.0, 8.0, 0.2)
+    dt = 1e-3
+    cont = continuous_covariance(LINEAR, ex)[1, 1]
+    disc = discrete_covariance("heun", LINEAR, ex, dt)[1, 1]
+    r = simulate(
+        LINEAR, ex, t_end=42.0, dt=dt, n_paths=1000, burn_in=1.0, seed=13,
+        control_variates=True, progress=False,
+    )  # fmt: skip
+    stat = r.velocity_variance
+    assert_matches(stat, cont, detect=DETECT, known_bias=disc - cont, what="controlled E[v^2]")
+    assert r.statistic(r.averages.v2, control_variates=False).std_error > 1.5 * stat.std_error
 
 
 def test_step_that_does_not_resolve_the_filter_is_refused():
