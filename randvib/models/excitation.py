@@ -542,8 +542,8 @@ class Tabulated(Excitation):
         if np.any(steps <= 0):
             i = int(np.argmax(steps <= 0))
             raise ValueError(
-                f"`frequency` must be strictly increasing, got {f[i + 1]!r} Hz after "
-                f"{f[i]!r} Hz (rows {i} and {i + 1})"
+                f"`frequency` must be strictly increasing, got {float(f[i + 1])!r} Hz after "
+                f"{float(f[i])!r} Hz (rows {i} and {i + 1})"
             )
         if not np.any(p > 0):
             raise ValueError("`psd` must be > 0 somewhere; the table has no power")
@@ -645,12 +645,12 @@ class Measured(Excitation):
             )
         dt = (t[-1] - t[0]) / (t.size - 1)
         if not dt > 0:
-            raise ValueError(f"`time` must increase, got {t[0]!r} s to {t[-1]!r} s")
+            raise ValueError(f"`time` must increase, got {float(t[0])!r} s to {float(t[-1])!r} s")
         off = np.abs(t - (t[0] + dt * np.arange(t.size)))
         if np.max(off) > 0.01 * dt:
             i = int(np.argmax(off))
             raise ValueError(
-                f"`time` must be evenly spaced: sample {i} is at {t[i]!r} s, {off[i]:.3g} s "
+                f"`time` must be evenly spaced: sample {i} is at {float(t[i])!r} s, {off[i]:.3g} s "
                 f"off the uniform grid of step {dt:.6g} s (allowed: 1 % of a step)"
             )
         length = (
