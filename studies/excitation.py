@@ -224,6 +224,7 @@ def verdicts(results: pd.DataFrame, inter: pd.DataFrame) -> dict:
                 }
                 for r in breaks.itertuples()
             ],  # fmt: skip
+            "by_k3": {f"{k3:g}": _range_of(sub) for k3, sub in band.groupby("k3")},
             "largest_relative_contrast": float(largest.relative_contrast),
             "largest_relative_ci95": float(largest.relative_ci95),
             "where_largest": f"{largest.centre}, zeta = {largest.zeta:g}, k3 = {largest.k3:g}",
@@ -233,6 +234,20 @@ def verdicts(results: pd.DataFrame, inter: pd.DataFrame) -> dict:
             },  # fmt: skip
             "no_interaction_holds_down_to_zeta": holds_down_to,
         },
+    }
+
+
+def _range_of(sub: pd.DataFrame) -> dict:
+    """Breaks, the contrast's range and where it is smallest in magnitude, for one k3."""
+    small = sub.loc[sub.relative_contrast.abs().idxmin()]
+    return {
+        "n_breaks": int(sub.breaks_no_interaction.sum()),
+        "n_points": int(len(sub)),
+        "min_relative_contrast": float(sub.relative_contrast.min()),
+        "max_relative_contrast": float(sub.relative_contrast.max()),
+        "smallest_abs": float(small.relative_contrast),
+        "smallest_abs_ci95": float(small.relative_ci95),
+        "smallest_abs_where": f"{small.centre}, zeta = {small.zeta:g}",
     }
 
 
@@ -380,22 +395,17 @@ def linearisation_section(results, v, figure) -> str:
 
 def interaction_section(inter, v, figure) -> str:
     it = v["interaction"]
-    if it["n_breaks"]:
-        listed = "; ".join(
-            f"{b['centre']} resonance, zeta = {b['zeta']:g}, k3 = {b['k3']:g}: "
-            f"{100 * b['relative_contrast']:+.1f} ± {100 * b['relative_ci95']:.1f} %"
-            for b in it["breaks"]
-        )
-        verdict = (
-            f'"No interaction" fails at {it["n_breaks"]} of {it["n_contrasts"]} band points '
-            f"(Holm-detectable and at least {100 * PRACTICAL:g} % of P(Fc, 0)): {listed}."
-        )
-    else:
-        verdict = (
-            f'"No interaction" holds at every band point: no contrast is both Holm-detectable '
-            f"and at least {100 * PRACTICAL:g} % of P(Fc, 0) ({it['n_detectable_holm']} of "
-            f"{it['n_contrasts']} Holm-detectable)."
-        )
+    per_k3 = "; ".join(
+        f"k3 = {k3}: {r['n_breaks']} of {r['n_points']}, contrast {100 * r['min_relative_contrast']:+.1f} "
+        f"to {100 * r['max_relative_contrast']:+.1f} %, smallest "
+        f"{100 * r['smallest_abs']:+.2f} ± {100 * r['smallest_abs_ci95']:.2f} % ({r['smallest_abs_where']})"
+        for k3, r in it["by_k3"].items()
+    )
+    verdict = (
+        f'"No interaction" fails at {it["n_breaks"]} of {it["n_contrasts"]} band points '
+        f"(Holm-detectable and at least {100 * PRACTICAL:g} % of P(Fc, 0); "
+        f"{it['n_detectable_holm']} Holm-detectable). By k3: {per_k3}."
+    )
     white = ", ".join(
         f"k3 = {k}: {100 * c:+.2f} ± {100 * h:.2f} %"
         for k, (c, h) in it["white_relative_contrasts"].items()
