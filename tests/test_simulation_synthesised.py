@@ -24,7 +24,7 @@ from randvib.analytic.linear_response import mechanical_block, output_variances
 from randvib.models.excitation import BandLimited, Measured, Tabulated, synthesis_power
 from randvib.models.excitation import synthesised_increments as increments
 from randvib.montecarlo import integrators
-from randvib.montecarlo.driven import path_generator
+from randvib.montecarlo.driven import path_amplitudes
 from randvib.montecarlo.simulation import estimate, simulate
 
 LINEAR = rv.Harvester(m=0.0226, c_m=0.1, c_e=0.1, k=57.4)
@@ -55,9 +55,10 @@ def test_increments_are_exact_step_integrals_of_the_synthesised_sum():
     """The step factor (e^{i w dt} - 1)/(i w) against the closed-form integral of each term."""
     ex = Tabulated([0.0, 3.0, 40.0, 60.0], [0.5, 2.0, 1.0, 0.0])
     n, dt = 256, 0.005
-    got = increments(ex, n, dt, [path_generator(3, 0)])[0]
+    normals = path_amplitudes(3, 0, 1, n)
+    got = increments(ex, n, dt, normals)[0]
     f, power = synthesis_power(ex, n, dt)
-    g = path_generator(3, 0).standard_normal((2, f.size))
+    g = normals.reshape(2, f.size)
     amp_a, amp_b = np.sqrt(power) * g[0], np.sqrt(power) * g[1]
     amp_b[0] = 0.0
     w, t0 = 2 * np.pi * f[1:], np.arange(n)[:, None] * dt
@@ -76,7 +77,7 @@ def test_increments_have_the_spectrum_variance_and_psd():
     """
     ex = BandLimited(0.5, 4.0, 20.0)
     n, dt = 20000, 0.005
-    y = increments(ex, n, dt, [path_generator(1, i) for i in range(100)]) / dt
+    y = increments(ex, n, dt, path_amplitudes(1, 0, 100, n)) / dt
     f, power = synthesis_power(ex, n, dt)
     expected = np.sum(power * np.sinc(f * dt) ** 2)
     assert ex.variance * np.sinc(20.0 * dt) ** 2 < expected < ex.variance

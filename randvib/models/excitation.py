@@ -803,8 +803,8 @@ def synthesise(excitation: Excitation, duration: float, dt: float, n_paths: int 
     return np.fft.irfft(scale * np.sqrt(power) * (g[0] - 1j * g[1]), n, axis=-1)
 
 
-def synthesised_increments(excitation: Excitation, n: int, dt: float, generators) -> np.ndarray:
-    """Step integrals of synthesised base-acceleration paths, one generator per path.
+def synthesised_increments(excitation: Excitation, n: int, dt: float, normals) -> np.ndarray:
+    """Step integrals of synthesised base-acceleration paths, from each path's own normals.
 
     For each path, the process of :func:`synthesise` (n samples of step dt,
     period n dt), y(t) = sum_k A_k cos(w_k t) + B_k sin(w_k t), integrated
@@ -822,15 +822,17 @@ def synthesised_increments(excitation: Excitation, n: int, dt: float, generators
         Steps per path (the period is n dt).
     dt : float
         Step (s).
-    generators : sequence of numpy.random.Generator
-        One per path: path i's amplitudes come from ``generators[i]`` alone,
-        so a path does not depend on which others are synthesised with it.
+    normals : ndarray, shape (n_paths, 2 (n // 2 + 1))
+        Standard normals, one row per path (A_k then B_k per bin, scaled by
+        sqrt(P_k)): a path's input depends on its own row only.
 
     Returns
     -------
-    ndarray, shape (len(generators), n)
+    ndarray, shape (n_paths, n)
         int y dt over each step (m/s).
     """
+    from scipy import fft
+
     f, power = synthesis_power(excitation, n, dt)
     scale = _irfft_scale(n, f.size)
     omega = 2.0 * np.pi * f
@@ -839,6 +841,6 @@ def synthesised_increments(excitation: Excitation, n: int, dt: float, generators
     if n % 2 == 0:
         step[-1] = 0.0  # the Nyquist cosine's step integral is exactly zero
     factor = scale * np.sqrt(power) * step
-    g = np.stack([gen.standard_normal((2, f.size)) for gen in generators], axis=1)
-    g[1][:, scale == n] = 0.0
-    return np.fft.irfft(factor * (g[0] - 1j * g[1]), n, axis=-1)
+    g = np.asarray(normals, dtype=float).reshape(-1, 2, f.size)
+    sine = np.where(scale == n, 0.0, g[:, 1])  # no sine at f = 0 and at the Nyquist bin
+    return fft.irfft(factor * (g[:, 0] - 1j * sine), n, axis=-1, workers=-1)

@@ -10,8 +10,11 @@ amplitude. Two sources provide those increments, path by path:
 * :class:`SynthesisedInput` - a stationary Gaussian process with a
   non-rational spectrum (band-limited, tabulated), synthesised in the
   frequency domain (:func:`randvib.models.excitation.synthesised_increments`)
-  with each path's amplitudes from its own stream, seeded by (seed, path):
-  results do not depend on batching or threads, and batches bound the memory;
+  with each path's amplitudes from its own compiled stream
+  (:func:`randvib.montecarlo.rng.path_normals`, keyed by (synthesis seed,
+  path), the synthesis seed derived from ``seed`` so that these streams are
+  not the kernel's): results do not depend on batching or threads, and
+  batches bound the memory;
 * :class:`RecordedInput` - a measured record, linearly interpolated between
   its samples, cut into segments that become the paths of
   :func:`randvib.montecarlo.on_record.simulate_on_record`.
@@ -25,6 +28,7 @@ import numpy as np
 
 from randvib.models.excitation import Excitation, Measured, synthesised_increments
 from randvib.montecarlo.kernel import LANES
+from randvib.montecarlo.rng import path_normals
 
 #: Spawn key that separates the synthesis streams from everything else seeded by ``seed``.
 SYNTHESIS_KEY = 0x53594E54  # "SYNT"
@@ -37,9 +41,19 @@ def batch_paths(n_steps: int) -> int:
     return max(LANES, MAX_INPUT_SAMPLES // max(n_steps, 1) // LANES * LANES)
 
 
-def path_generator(seed: int, path: int) -> np.random.Generator:
-    """The synthesis stream of path ``path``: a function of (seed, path) only."""
-    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(SYNTHESIS_KEY, path)))
+def synthesis_seed(seed: int) -> int:
+    """The seed of the synthesis streams: (seed, SYNTHESIS_KEY) hashed to 64 bits.
+
+    Path i's amplitudes are the normals of stream (synthesis_seed(seed), i),
+    distinct from the kernel's stream (seed, i) that draws its random start.
+    """
+    sequence = np.random.SeedSequence(seed, spawn_key=(SYNTHESIS_KEY,))
+    return int(sequence.generate_state(1, np.uint64)[0])
+
+
+def path_amplitudes(seed: int, first: int, count: int, n: int) -> np.ndarray:
+    """The standard normals behind the synthesised input of paths ``first .. first + count - 1``."""
+    return path_normals(synthesis_seed(seed), count, 2 * (n // 2 + 1), first)
 
 
 @dataclass(frozen=True)
@@ -56,7 +70,7 @@ class SynthesisedInput:
     dt : float
         Step (s).
     seed : int
-        Seed of the run; path i's input comes from :func:`path_generator` (seed, i).
+        Seed of the run; path i's input comes from :func:`path_amplitudes` (seed, i).
     """
 
     excitation: Excitation
@@ -66,8 +80,8 @@ class SynthesisedInput:
 
     def __call__(self, first: int, count: int) -> np.ndarray:
         """Increments of paths ``first .. first + count - 1``, shape (count, n_steps)."""
-        generators = [path_generator(self.seed, first + i) for i in range(count)]
-        return -synthesised_increments(self.excitation, self.n_steps, self.dt, generators)
+        normals = path_amplitudes(self.seed, first, count, self.n_steps)
+        return -synthesised_increments(self.excitation, self.n_steps, self.dt, normals)
 
 
 @dataclass(frozen=True)
