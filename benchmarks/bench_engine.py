@@ -14,6 +14,11 @@ Device: figure9 preset with k3 = 5e5 N/m^3 (Duffing + Coulomb), dt = 1e-4 s,
 * the same engine with a coil inductance (issue 11): the kernel integrates the
   circuit's current as an auxiliary state (the same compiled block as the
   filter's), reported as ``circuit_over_white`` per path-step.
+* the same engine under band-limited input (4-20 Hz), synthesised per path
+  and fed to the kernel as given increments (``synthesised_over_white``, the
+  whole simulation), and the synthesis alone (``synthesis_over_white``: the
+  per-path spectral synthesis of the increments, per path-step, against the
+  white-noise kernel).
 A module fixture prints ns per path-step and the ratios, and writes
 .benchmarks/engine_ratios.json. Set RANDVIB_BENCH_FULL_MEMORY=1 to also run the
 10^5 paths x 10^6 steps memory case (about 10 minutes on 2 cores).
@@ -32,7 +37,8 @@ import sdeint
 from conftest import TIMINGS, record, write_report
 
 import randvib as rv
-from randvib.models.excitation import BandPass
+from randvib.models.excitation import BandLimited, BandPass
+from randvib.montecarlo.driven import SynthesisedInput
 from randvib.montecarlo.simulation import simulate
 
 DEVICE = rv.preset("figure9").updated(k3=5e5)
@@ -50,6 +56,9 @@ COIL = rv.Harvester.with_coupling(
     k3=DEVICE.k3,
     friction=DEVICE.friction,
 )
+
+#: The paper's shaker band, synthesised per path.
+BAND_LIMITED = BandLimited(PSD, 4.0, 20.0)
 
 
 def _run(method, excitation=PSD, device=DEVICE):
@@ -101,8 +110,23 @@ def test_engine_circuit_state(benchmark, method):
     record(benchmark, f"{method}-circuit", WORK)
 
 
+@pytest.mark.parametrize("method", ["euler-maruyama", "heun"])
+def test_engine_synthesised_input(benchmark, method):
+    """The same run under band-limited input: synthesis per path + the given-increments kernel."""
+    _run(method, BAND_LIMITED)  # compile / load cache
+    benchmark.pedantic(_run, args=(method, BAND_LIMITED), rounds=5, warmup_rounds=1)
+    record(benchmark, f"{method}-band-limited", WORK)
+
+
+def test_synthesis_alone(benchmark):
+    """The increments of all paths (one generator per path, FFT), without the kernel."""
+    source = SynthesisedInput(BAND_LIMITED, N_STEPS, DT, 1)
+    benchmark.pedantic(source, args=(0, N_PATHS), rounds=5, warmup_rounds=1)
+    record(benchmark, "synthesis", WORK)
+
+
 def _over_white(suffix):
-    """Kernel ``<scheme>-<suffix>`` over the white-noise kernel, per path-step."""
+    """``{scheme}-{suffix}`` over the white-noise kernel, per path-step, for the schemes timed."""
     return {
         m: TIMINGS[f"{m}-{suffix}"] / TIMINGS[m]
         for m in ("euler-maruyama", "heun")
@@ -113,6 +137,16 @@ def _over_white(suffix):
 def _filter_over_white():
     """Filter-state kernel over white-noise kernel, per path-step, for the schemes timed."""
     return _over_white("band-pass")
+
+
+def _synthesis_ratios():
+    """Synthesised input (whole run, and the synthesis alone) over the white kernel."""
+    out = {"synthesised_over_white": _over_white("band-limited")}
+    if "synthesis" in TIMINGS:
+        out["synthesis_over_white"] = {
+            m: TIMINGS["synthesis"] / TIMINGS[m] for m in ("euler-maruyama", "heun") if m in TIMINGS
+        }
+    return out
 
 
 def test_sdeint_one_path(benchmark):
@@ -194,6 +228,8 @@ def ratios_and_memory():
         print(f"\nfilter_over_white (target <= 1.5): {_filter_over_white()}")
     if _over_white("circuit"):
         print(f"\ncircuit_over_white: {_over_white('circuit')}")
+    if any(_synthesis_ratios().values()):
+        print(f"\n{_synthesis_ratios()}")
     needed = {"floor", "euler-maruyama", "heun", "sdeint", "numpy"}
     if not needed <= TIMINGS.keys():
         return  # a subset was run: no ratios
@@ -211,6 +247,7 @@ def ratios_and_memory():
         "numpy_loop_over_euler_maruyama": ns["numpy"] / ns["euler-maruyama"],
         "filter_over_white": _filter_over_white(),
         "circuit_over_white": _over_white("circuit"),
+        **_synthesis_ratios(),
         # (RSS before the run, peak RSS during it) in MB; the difference is
         # what the simulation itself needs
         "rss_mb_baseline_and_peak": memory,

@@ -66,6 +66,9 @@ _EXPORTS = {
         "velocity_variance",
     ),
     "randvib.models.presets": ("MAGNET_MASS", "preset", "PRESETS"),
+    "randvib.montecarlo.on_record": ("RecordSimulation", "simulate_on_record"),
+    "randvib.montecarlo.spectra": ("SampledSpectra",),
+    "randvib.studies.spectra_figure": ("plot_response_spectra",),
     "randvib.identification.sade": ("sade", "SADEResult"),
     "randvib.montecarlo.simulation": (
         "simulate",

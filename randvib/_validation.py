@@ -24,7 +24,8 @@ def as_float_array(name: str, value) -> np.ndarray:
 
 
 def _first_bad(arr: np.ndarray, mask: np.ndarray):
-    return arr[mask].ravel()[0] if arr.ndim else arr.item()
+    # a Python float, so that messages read "got -1.0", not "got np.float64(-1.0)"
+    return arr[mask].ravel()[0].item() if arr.ndim else arr.item()
 
 
 def check_finite(name: str, value) -> np.ndarray:

@@ -26,14 +26,7 @@ from scipy import linalg
 
 import randvib as rv
 from randvib.analytic.linear_response import mechanical_block, stationary_covariance
-from randvib.models.excitation import (
-    BandLimited,
-    BandPass,
-    KanaiTajimi,
-    Measured,
-    Tabulated,
-    White,
-)
+from randvib.models.excitation import BandPass, KanaiTajimi, White
 from randvib.montecarlo import integrators
 from randvib.montecarlo.simulation import (
     StepSizeWarning,
@@ -158,10 +151,23 @@ def test_fine_step_continuous_lyapunov(name):
     (6.3), E[z^2] -0.54 / 1.04 / 2.5 (6.2); Kanai-Tajimi E[v^2] -0.50 / 1.07 /
     2.7 (7.4), E[z^2] -0.42 / 1.07 / 2.8 (8.3) (the two cases share their
     random numbers, so their z-scores are correlated). Seeds 2000-2029,
-    band-pass E[v^2]: -0.33 / 0.82 / 2.5. Over the 60 seeds the mean z is
-    -0.44 +- 0.13: a possible bias of about 0.07 % of E[v^2] (0.4 standard
-    errors), not explained yet (the start's transient, computed exactly, is
-    6e-7), far below the 1 % this test is powered to detect.
+    band-pass E[v^2]: -0.33 / 0.82 / 2.5. Over those 60 seeds the mean z was
+    -0.44 +- 0.13, a possible bias of 0.07 % of E[v^2]. Investigated (issue
+    10) and found to be a fluctuation, not a bias:
+
+    * every part of the estimator's expectation is exact: the kernel equals
+      the scheme's linear recursion on device + filter path by path (given
+      increments, 1.8e-15 relative); the discrete Lyapunov solution agrees
+      with a doubling iteration to 4e-16; the start (device and filter drawn
+      independently from their continuous laws) biases the window average by
+      -6.1e-7, computed by propagating the covariance step by step;
+    * the kernel's normals: 1e9 draws of streams (1000, 0..3999) have
+      variance 1 - 1.1e-5 +- 4.5e-5 and kurtosis 3.0000;
+    * fresh seeds: 3000-3029 give mean z -0.19, SD 0.84 (SE of the mean
+      0.15); seeds 5000-5019 pooled (80 000 paths) with the Ito-sum and
+      energy-change controls (exact zero means under a filter) give a
+      relative bias of -0.011 % +- 0.015 % (SE), which excludes -0.07 % at
+      4 standard errors (plain estimate on the same paths -0.045 % +- 0.034 %).
     """
     for what, stat, ref, bias, detect in case_fine_continuous(FINE[name], seed=12):
         assert_matches(stat, ref, detect=detect, known_bias=bias, what=f"{name} {what}")
@@ -256,31 +262,42 @@ def test_coloured_results_do_not_depend_on_batching_or_threads():
     np.testing.assert_array_equal(a.per_path[8:], c.per_path)
 
 
-@pytest.mark.parametrize(
-    "excitation",
-    [
-        BandLimited(1.0, 4.0, 20.0),
-        Tabulated(np.array([1.0, 10.0, 20.0]), np.array([1.0, 1.0, 0.5])),
-        Measured(np.arange(4096) * 1e-3, np.random.default_rng(0).standard_normal(4096)),
-    ],
-    ids=["band-limited", "tabulated", "measured"],
-)
-def test_non_rational_spectra_refused_naming_statistical_linearisation(excitation):
-    with pytest.raises(ValueError, match="randvib.statistical_linearisation"):
-        simulate(LINEAR, excitation, **KW)
-
-
 def test_white_noise_only_options_refused_under_coloured_input():
     ex = BandPass(1.0, 8.0, 0.2)
     with pytest.raises(ValueError, match="`companion` needs white noise"):
         simulate(LINEAR, ex, companion=True, **KW)
-    with pytest.raises(ValueError, match="`control_variates` needs white noise"):
-        simulate(LINEAR, ex, control_variates=True, **KW)
     r = simulate(LINEAR, ex, **KW)
-    with pytest.raises(ValueError, match="white-noise energy balance"):
-        r.statistic(r.averages.v2, control_variates=True)
+    assert r.controls().shape == (KW["n_paths"], 2)  # Ito sum and energy change stay valid
     with pytest.raises(ValueError, match="white-noise energy balance"):
         r.energy_balance_residual()
+    synthesised = rv.BandLimited(1.0, 4.0, 20.0)
+    with pytest.raises(ValueError, match="`control_variates` needs Brownian increments"):
+        simulate(LINEAR, synthesised, control_variates=True, **KW)
+    r = simulate(LINEAR, synthesised, **KW)
+    with pytest.raises(ValueError, match="control variates need Brownian increments"):
+        r.statistic(r.averages.v2, control_variates=True)
+
+
+def test_control_variates_under_band_pass_match_the_continuous_lyapunov():
+    """Ito-sum and energy-change controls under a filter: exact zero means, 4-6x less variance.
+
+    The paper's linear device under BandPass(1, 8, 0.2), Heun dt = 1e-3 s:
+    the controlled E[v^2] against the continuous Lyapunov value with the
+    scheme's exact bias subtracted, with a quarter of the fine test's paths,
+    still powered for 1 %; the plain estimate on the same paths has the
+    larger standard error.
+    """
+    ex = BandPass(1.0, 8.0, 0.2)
+    dt = 1e-3
+    cont = continuous_covariance(LINEAR, ex)[1, 1]
+    disc = discrete_covariance("heun", LINEAR, ex, dt)[1, 1]
+    r = simulate(
+        LINEAR, ex, t_end=42.0, dt=dt, n_paths=1000, burn_in=1.0, seed=13,
+        control_variates=True, progress=False,
+    )  # fmt: skip
+    stat = r.velocity_variance
+    assert_matches(stat, cont, detect=DETECT, known_bias=disc - cont, what="controlled E[v^2]")
+    assert r.statistic(r.averages.v2, control_variates=False).std_error > 1.5 * stat.std_error
 
 
 def test_step_that_does_not_resolve_the_filter_is_refused():

@@ -1,9 +1,11 @@
 """``randvib simulate``: Monte Carlo ensemble of the harvester under white or filtered noise.
 
 White noise as before; ``--excitation band-pass|kanai-tajimi`` integrates the
-shaping filter with the device (the options of :mod:`randvib.cli._excitation`,
-shared with ``randvib power``); spectra without a shaping filter are refused
-by :func:`randvib.simulate` with a message naming the method that takes them.
+shaping filter with the device, ``band-limited`` and ``--psd-file`` are
+synthesised path by path (the options of :mod:`randvib.cli._excitation`,
+shared with ``randvib power``); ``--record FILE`` simulates the device on the
+record itself (:func:`randvib.simulate_on_record`), ``--segments`` windows
+giving the interval.
 """
 
 from __future__ import annotations
@@ -20,16 +22,30 @@ from randvib.montecarlo.integrators import INTEGRATORS
 def register(sub) -> None:
     p = sub.add_parser(
         "simulate",
-        help="Monte Carlo simulation under white or filtered (band-pass, Kanai-Tajimi) noise",
-        description="Simulate an ensemble of the harvester under white-noise or filtered "
-        "base acceleration; statistics with 95 % confidence half-widths.",
+        help="Monte Carlo simulation under white, coloured or recorded base acceleration",
+        description="Simulate an ensemble of the harvester under white-noise, coloured "
+        "(filtered or synthesised) or recorded base acceleration; statistics with 95 % "
+        "confidence half-widths.",
     )
     add_device_arguments(p)
     add_excitation_arguments(p)
     g = p.add_argument_group("simulation")
-    g.add_argument("--paths", type=int, default=1000, help="number of paths (default 1000)")
-    g.add_argument("--t-end", type=float, default=20.0, help="time per path incl. burn-in (s)")
-    g.add_argument("--dt", type=float, default=1e-4, help="time step (s), default 1e-4")
+    g.add_argument("--paths", type=int, default=None, help="number of paths (default 1000)")
+    g.add_argument(
+        "--t-end", type=float, default=None, help="time per path incl. burn-in (s), default 20"
+    )
+    g.add_argument(
+        "--dt",
+        type=float,
+        default=None,
+        help="time step (s), default 1e-4; with --record the record's step or a divisor of it",
+    )
+    g.add_argument(
+        "--segments",
+        type=int,
+        default=None,
+        help="with --record: windows of the record that make the paths (default 10)",
+    )
     g.add_argument("--burn-in", type=float, default=2.0, help="discarded initial time (s)")
     g.add_argument("--method", default="heun", help=f"integrator: {', '.join(INTEGRATORS)}")
     g.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
@@ -37,7 +53,8 @@ def register(sub) -> None:
     g.add_argument(
         "--control-variates",
         action="store_true",
-        help="variance-reduced estimates (energy balance and friction-free companion)",
+        help="variance-reduced estimates (energy balance, and under white noise the "
+        "friction-free companion); white, band-pass and kanai-tajimi input",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(handler=run)
@@ -48,28 +65,36 @@ def run(args) -> int:
 
     harvester = harvester_from_args(args)
     psd = excitation_from_args(args)
-    if args.control_variates and not isinstance(psd, float | int):
+    white = isinstance(psd, float | int)
+    if args.control_variates and not white and psd.shaping_filter() is None:
         raise ValueError(
-            "`--control-variates` needs white noise: the energy-balance controls and the "
-            f"friction-free companion's exact moments do not hold under {psd.name} excitation"
+            "`--control-variates` needs white noise or a filtered spectrum (band-pass, "
+            f"kanai-tajimi): under the synthesised or recorded {psd.name} input no control "
+            "has a known mean"
         )
     if args.method not in INTEGRATORS:
         raise ValueError(f"`--method` must be one of {', '.join(INTEGRATORS)}; got {args.method!r}")
-    result = simulate(
-        harvester,
-        psd,
-        t_end=args.t_end,
-        dt=args.dt,
-        n_paths=args.paths,
-        burn_in=args.burn_in,
-        scheme=args.method,  # the CLI keeps its option name `--method`
-        seed=args.seed,
-        threads=args.threads,
-        # the companion's exact moments need the resistive coupling; the
-        # energy-balance controls hold for every coupling
-        companion=args.control_variates and not harvester.has_circuit,
-        control_variates=args.control_variates,
-    )
+    if args.record is not None:
+        result = _on_record(harvester, psd, args)
+    else:
+        if args.segments is not None:
+            raise ValueError("`--segments` cuts a record into paths; it needs `--record`")
+        result = simulate(
+            harvester,
+            psd,
+            t_end=20.0 if args.t_end is None else args.t_end,
+            dt=1e-4 if args.dt is None else args.dt,
+            n_paths=1000 if args.paths is None else args.paths,
+            burn_in=args.burn_in,
+            scheme=args.method,  # the CLI keeps its option name `--method`
+            seed=args.seed,
+            threads=args.threads,
+            # the friction-free companion's exact moments hold under white noise
+            # and the resistive coupling only; the energy-balance controls hold
+            # for every coupling
+            companion=args.control_variates and white and not harvester.has_circuit,
+            control_variates=args.control_variates,
+        )
     summary = result.summary()
     if args.json:
         print(json.dumps(summary))
@@ -110,8 +135,48 @@ def run(args) -> int:
             )
         )
     print_table(rows, ("statistic", "Monte Carlo", "± 95 %", "linearisation", "unit"))
+    if args.record is not None:
+        print(f"windows of the record as paths; lag-1 correlation {result.lag1_correlation:+.2f}")
     print(
         f"{result.n_paths} paths x {result.averaging_time:g} s averaged (dt {result.dt:g} s, "
         f"{result.scheme}, seed {result.seed}), {result.wall_time:.2f} s wall"
     )
     return 0
+
+
+def _on_record(harvester, record, args):
+    """``--record``: :func:`randvib.simulate_on_record`, the options checked one line each."""
+    from randvib.montecarlo.on_record import simulate_on_record
+
+    for flag in ("paths", "t_end"):
+        if getattr(args, flag) is not None:
+            option = "--" + flag.replace("_", "-")
+            raise ValueError(
+                f"`{option}` does not apply to `--record`: the record fixes the paths "
+                "(use `--segments`) and their length"
+            )
+    substeps = 1
+    if args.dt is not None:
+        if not args.dt > 0:
+            raise ValueError(f"`--dt` must be > 0 s, got {args.dt!r}")
+        ratio = record.dt / args.dt
+        substeps = round(ratio)
+        if substeps < 1 or abs(ratio - substeps) > 1e-6 * ratio:
+            raise ValueError(
+                f"`--dt` must divide the record's step {record.dt:.6g} s "
+                f"(record step / dt an integer), got {args.dt!r}"
+            )
+    try:
+        return simulate_on_record(
+            harvester,
+            record,
+            segments=10 if args.segments is None else args.segments,
+            burn_in=args.burn_in,
+            substeps=substeps,
+            scheme=args.method,
+            seed=args.seed,
+            threads=args.threads,
+        )
+    except ValueError as exc:  # name the options, not the function's arguments
+        message = str(exc).replace("`segments`", "`--segments`").replace("`burn_in`", "`--burn-in`")
+        raise ValueError(message) from None

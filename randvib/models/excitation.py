@@ -13,7 +13,9 @@ subclassing :class:`Excitation`, that declares what every consumer needs
   whose output has exactly this PSD; None for the others;
 * ``sample(duration, dt, n_paths, seed)`` - for the non-rational ones
   (band-limited, tabulated, measured) a stationary Gaussian synthesis in the
-  frequency domain (:func:`synthesise`);
+  frequency domain (:func:`synthesise`; :func:`synthesised_increments` gives
+  its exact step integrals, one generator per path, for Monte Carlo), each
+  bin carrying the exact power of its cell (``cumulative_power``);
 * ``support``, ``features`` and ``breakpoints`` - where the spectrum lives,
   its peaks and its kinks, so that a quadrature over frequency can resolve
   them (:mod:`randvib.analytic.linear_response`).
@@ -253,6 +255,20 @@ class Excitation:
         """The filter of white noise with this PSD (rational spectra), else None."""
         return None
 
+    def cumulative_power(self, frequency) -> np.ndarray:
+        """int_0^f S(f') df' ((m/s^2)^2) at ``frequency`` (Hz).
+
+        The synthesis (:func:`synthesis_power`) gives each frequency bin the
+        exact power of its cell, so a synthesised path's variance is the
+        spectrum's integral below the Nyquist frequency for any record length.
+        This default is the trapezoid rule on 2049 points up to each f;
+        the non-rational spectra integrate exactly.
+        """
+        f = np.asarray(frequency, dtype=float)
+        grid = np.linspace(0.0, 1.0, 2049)
+        values = [np.trapezoid(self.psd(x * grid), x * grid) for x in f.ravel()]
+        return np.reshape(values, f.shape)
+
     def sample(self, duration: float, dt: float, n_paths: int = 1, seed=None) -> np.ndarray:
         """Stationary Gaussian paths of the base acceleration (m/s^2), see :func:`synthesise`."""
         return synthesise(self, duration, dt, n_paths, seed)
@@ -276,7 +292,9 @@ def as_excitation(value) -> Excitation:
 COLOURED_METHODS = (
     "statistical linearisation (randvib.statistical_linearisation, or "
     "predict/expected_power with method='linearisation')",
-    "Monte Carlo (randvib.simulate) for band-pass and Kanai-Tajimi spectra",
+    "Monte Carlo (randvib.simulate: filter states for band-pass and Kanai-Tajimi, "
+    "spectral synthesis for band-limited and tabulated spectra; "
+    "randvib.simulate_on_record for a measured record)",
 )
 
 
@@ -484,6 +502,10 @@ class BandLimited(Excitation):
     def variance(self) -> float:
         return self.level * (self.f_hi - self.f_lo)
 
+    def cumulative_power(self, frequency):
+        f = np.asarray(frequency, dtype=float)
+        return self.level * np.clip(f - self.f_lo, 0.0, self.f_hi - self.f_lo)
+
     @property
     def support(self):
         return self.f_lo, self.f_hi
@@ -520,8 +542,8 @@ class Tabulated(Excitation):
         if np.any(steps <= 0):
             i = int(np.argmax(steps <= 0))
             raise ValueError(
-                f"`frequency` must be strictly increasing, got {f[i + 1]!r} Hz after "
-                f"{f[i]!r} Hz (rows {i} and {i + 1})"
+                f"`frequency` must be strictly increasing, got {float(f[i + 1])!r} Hz after "
+                f"{float(f[i])!r} Hz (rows {i} and {i + 1})"
             )
         if not np.any(p > 0):
             raise ValueError("`psd` must be > 0 somewhere; the table has no power")
@@ -541,6 +563,21 @@ class Tabulated(Excitation):
     def variance(self) -> float:
         """The exact integral of the interpolated table (trapezoid rule)."""
         return float(np.trapezoid(self.density, self.frequency))
+
+    def cumulative_power(self, frequency):
+        """Exact integral of the interpolated table from 0 to ``frequency`` (Hz)."""
+        f = np.clip(np.asarray(frequency, dtype=float), self.frequency[0], self.frequency[-1])
+        nodes = np.concatenate(
+            [
+                [0.0],
+                np.cumsum(np.diff(self.frequency) * 0.5 * (self.density[1:] + self.density[:-1])),
+            ]
+        )
+        i = np.clip(
+            np.searchsorted(self.frequency, f, side="right") - 1, 0, self.frequency.size - 2
+        )
+        partial = (f - self.frequency[i]) * 0.5 * (self.density[i] + self.psd(f))
+        return nodes[i] + partial
 
     @property
     def support(self):
@@ -608,12 +645,12 @@ class Measured(Excitation):
             )
         dt = (t[-1] - t[0]) / (t.size - 1)
         if not dt > 0:
-            raise ValueError(f"`time` must increase, got {t[0]!r} s to {t[-1]!r} s")
+            raise ValueError(f"`time` must increase, got {float(t[0])!r} s to {float(t[-1])!r} s")
         off = np.abs(t - (t[0] + dt * np.arange(t.size)))
         if np.max(off) > 0.01 * dt:
             i = int(np.argmax(off))
             raise ValueError(
-                f"`time` must be evenly spaced: sample {i} is at {t[i]!r} s, {off[i]:.3g} s "
+                f"`time` must be evenly spaced: sample {i} is at {float(t[i])!r} s, {off[i]:.3g} s "
                 f"off the uniform grid of step {dt:.6g} s (allowed: 1 % of a step)"
             )
         length = (
@@ -655,6 +692,9 @@ class Measured(Excitation):
         """Integral of the Welch PSD (close to the record's variance about its mean)."""
         return self.spectrum.variance
 
+    def cumulative_power(self, frequency):
+        return self.spectrum.cumulative_power(frequency)
+
     @property
     def support(self):
         return self.spectrum.support
@@ -685,15 +725,53 @@ def _read_columns(path, columns) -> dict:
     return {c: frame[c].to_numpy(dtype=float) for c in columns}
 
 
+def synthesis_power(excitation: Excitation, n: int, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """The bins of an n-sample synthesis and the power each one carries.
+
+    Bin k sits at f_k = k / (n dt), k = 0 .. n // 2, and carries the exact
+    power of its cell [f_k - 1/(2 n dt), f_k + 1/(2 n dt)] (clipped to
+    [0, 1/(2 dt)]), ``excitation.cumulative_power`` differenced; the powers
+    sum to the spectrum's integral up to the Nyquist frequency, so the
+    synthesised variance is exact for any record length.
+
+    Raises
+    ------
+    ValueError
+        If the spectrum has power above the Nyquist frequency 1/(2 dt).
+    """
+    top = excitation.support[1]
+    if top > 0.5 / dt * (1 + 1e-12):
+        raise ValueError(
+            f"`dt` = {dt} s resolves frequencies up to 1/(2 dt) = {0.5 / dt:.6g} Hz, but the "
+            f"{excitation.name} spectrum has power up to {top:.6g} Hz; choose `dt` <= "
+            f"{0.5 / top:.3g} s"
+        )
+    f = np.fft.rfftfreq(n, dt)
+    edges = np.clip(np.concatenate([f - 0.5 / (n * dt), [f[-1] + 0.5 / (n * dt)]]), 0, 0.5 / dt)
+    return f, np.maximum(np.diff(excitation.cumulative_power(edges)), 0.0)
+
+
+def _irfft_scale(n: int, size: int) -> np.ndarray:
+    """Factors turning amplitudes (A - iB) into irfft coefficients (see :func:`synthesise`)."""
+    # irfft(X)_j = (1/n) [X_0 + 2 Re sum_k X_k e^{2 pi i k j/n} + X_{n/2} (-1)^j]: the
+    # coefficient (n/2)(A - iB) gives A cos + B sin; DC and Nyquist are real, with n A.
+    scale = np.full(size, 0.5 * n)
+    scale[0] = n
+    if n % 2 == 0:
+        scale[-1] = n
+    return scale
+
+
 def synthesise(excitation: Excitation, duration: float, dt: float, n_paths: int = 1, seed=None):
     """Stationary Gaussian paths with the excitation's PSD, by frequency-domain synthesis.
 
     With n = duration/dt samples and the bins f_k = k / (n dt), each path is
     ``sum_k A_k cos(2 pi f_k t) + B_k sin(2 pi f_k t)`` with independent
-    A_k, B_k ~ N(0, S(f_k) w_k), w_k = 1/(n dt) (half at f = 0 and at the
-    Nyquist bin). The paths are exactly Gaussian and stationary (periodic
-    with period n dt); their variance is the trapezoid rule of int S df on
-    the bins, which tends to ``excitation.variance`` as the duration grows.
+    A_k, B_k ~ N(0, P_k), P_k the exact power of the bin's cell
+    (:func:`synthesis_power`; no sine at f = 0 and at the Nyquist bin). The
+    paths are exactly Gaussian and stationary (periodic with period n dt);
+    their variance is exactly ``excitation.variance`` (the integral of S
+    below the Nyquist frequency, where the spectrum must vanish).
 
     Parameters
     ----------
@@ -717,26 +795,52 @@ def synthesise(excitation: Excitation, duration: float, dt: float, n_paths: int 
     dt = float(check_positive("dt", dt, "s"))
     n_paths = check_int("n_paths", n_paths, minimum=1)
     n = check_int("number of samples (duration / dt)", round(duration / dt), minimum=8)
-    top = excitation.support[1]
-    if top > 0.5 / dt * (1 + 1e-12):
-        raise ValueError(
-            f"`dt` = {dt} s resolves frequencies up to 1/(2 dt) = {0.5 / dt:.6g} Hz, but the "
-            f"{excitation.name} spectrum has power up to {top:.6g} Hz; choose `dt` <= "
-            f"{0.5 / top:.3g} s"
-        )
-    f = np.fft.rfftfreq(n, dt)
-    weight = np.full(f.size, 1.0 / (n * dt))
-    weight[0] *= 0.5
-    if n % 2 == 0:
-        weight[-1] *= 0.5
-    std = np.sqrt(excitation.psd(f) * weight)
-    # irfft(X)_j = (1/n) [X_0 + 2 Re sum_k X_k e^{2 pi i k j/n} + X_{n/2} (-1)^j]: the
-    # coefficient (n/2)(A - iB) gives A cos + B sin; DC and Nyquist are real, with n A.
-    scale = np.full(f.size, 0.5 * n)
-    scale[0] = n
-    if n % 2 == 0:
-        scale[-1] = n
+    f, power = synthesis_power(excitation, n, dt)
+    scale = _irfft_scale(n, f.size)
     rng = np.random.default_rng(seed)
     g = rng.standard_normal((2, n_paths, f.size))
     g[1][:, scale == n] = 0.0
-    return np.fft.irfft(scale * std * (g[0] - 1j * g[1]), n, axis=-1)
+    return np.fft.irfft(scale * np.sqrt(power) * (g[0] - 1j * g[1]), n, axis=-1)
+
+
+def synthesised_increments(excitation: Excitation, n: int, dt: float, normals) -> np.ndarray:
+    """Step integrals of synthesised base-acceleration paths, from each path's own normals.
+
+    For each path, the process of :func:`synthesise` (n samples of step dt,
+    period n dt), y(t) = sum_k A_k cos(w_k t) + B_k sin(w_k t), integrated
+    exactly over every step: ``int_{j dt}^{(j+1) dt} y dt`` (m/s), the
+    coefficient of bin k multiplied by (e^{i w_k dt} - 1) / (i w_k) (dt at
+    w = 0; the Nyquist cosine integrates to zero over each step). These are
+    the velocity increments a simulation with additive input needs, with the
+    input's spectrum treated exactly rather than sampled.
+
+    Parameters
+    ----------
+    excitation : Excitation
+        Non-rational spectrum vanishing above 1/(2 dt).
+    n : int
+        Steps per path (the period is n dt).
+    dt : float
+        Step (s).
+    normals : ndarray, shape (n_paths, 2 (n // 2 + 1))
+        Standard normals, one row per path (A_k then B_k per bin, scaled by
+        sqrt(P_k)): a path's input depends on its own row only.
+
+    Returns
+    -------
+    ndarray, shape (n_paths, n)
+        int y dt over each step (m/s).
+    """
+    from scipy import fft
+
+    f, power = synthesis_power(excitation, n, dt)
+    scale = _irfft_scale(n, f.size)
+    omega = 2.0 * np.pi * f
+    with np.errstate(invalid="ignore", divide="ignore"):
+        step = np.where(omega > 0, np.expm1(1j * omega * dt) / (1j * omega), dt)
+    if n % 2 == 0:
+        step[-1] = 0.0  # the Nyquist cosine's step integral is exactly zero
+    factor = scale * np.sqrt(power) * step
+    g = np.asarray(normals, dtype=float).reshape(-1, 2, f.size)
+    sine = np.where(scale == n, 0.0, g[:, 1])  # no sine at f = 0 and at the Nyquist bin
+    return fft.irfft(factor * (g[:, 0] - 1j * sine), n, axis=-1, workers=-1)

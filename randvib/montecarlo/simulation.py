@@ -12,7 +12,10 @@ rational spectrum (band-pass, Kanai-Tajimi) the base acceleration is instead
 the output y of the spectrum's 2-state shaping filter driven by that white
 noise, and dv gets -y dt in place of the noise (paper Eq. 18 with a
 coloured base); the filter states are integrated with the device by the same
-scheme (:func:`randvib.montecarlo.kernel.auxiliary_step`).
+scheme (:func:`randvib.montecarlo.kernel.auxiliary_step`). Under a
+band-limited or tabulated spectrum y is synthesised per path and dv gets the
+exact step integral -int y dt through the kernel's given-increments path
+(:mod:`randvib.montecarlo.driven`).
 
 A coupling with a circuit state (coil inductance, piezo capacitance;
 :mod:`randvib.models.coupling`) adds that state, ``x' = a x + b v``, with the
@@ -39,14 +42,14 @@ from scipy import linalg, special  # Student t quantile; lighter than scipy.stat
 
 from randvib._validation import check_choice, check_int, check_positive
 from randvib.analytic import exact_solutions as exact
-from randvib.analytic.linear_response import device_block
+from randvib.analytic.linear_response import device_block, output_variances
 from randvib.analytic.linearisation import equivalent_damping, linear_displacement_variance
 from randvib.analytic.statistical_linearisation import statistical_linearisation
-from randvib.models.excitation import Excitation, as_excitation
+from randvib.models.excitation import Excitation, Tabulated, as_excitation
 from randvib.models.friction import kernel_arguments
 from randvib.models.harvester import Harvester
 from randvib.models.potential import CONFINING
-from randvib.montecarlo import integrators, kernel
+from randvib.montecarlo import driven, integrators, kernel
 from randvib.montecarlo.integrators import Integrator, integrator
 from randvib.montecarlo.rng import ZIG_FI, ZIG_KI, ZIG_WI
 
@@ -339,8 +342,22 @@ class SimulationResult:
         * with ``companion=True``, the friction-free companion's mean v^2 and
           z^2 minus their exact values (S m / (4c), Gibbs E[z^2]): same noise,
           exactly known mean in continuous time (bias O(dt) at finite step).
+
+        Under a rational spectrum (shaping filter) the first two stay valid:
+        v_n is adapted to the Brownian motion that drives the filter, so the
+        Ito sum still has mean exactly zero, and the energy change has zero
+        mean in any stationary state (measured: 4-6x less variance of E[P_e]
+        under band-pass input). Under synthesised or recorded input the
+        increments are the input's integrals, not Brownian, and the sum is
+        the input power: no control is valid there.
         """
-        self._require_white("the control variates")
+        if not self.is_white:
+            if self.excitation.shaping_filter() is None:
+                raise ValueError(
+                    "control variates need Brownian increments (white noise or a shaping "
+                    f"filter); the {self.excitation.name} input is synthesised or recorded"
+                )
+            return np.column_stack(self.averages.energy_balance_controls(self.averaging_time))
         h = self.harvester
         avg = self.averages
         cols = avg.energy_balance_controls(self.averaging_time)
@@ -441,6 +458,12 @@ class SimulationResult:
             samples = samples + self._circuit_power("power_electrical")
         return self.statistic(samples)
 
+    def response_spectra(self, segment_duration: float | None = None):
+        """Welch PSDs of z, v and c_e S_v from the recorded paths (:mod:`.spectra`)."""
+        from randvib.montecarlo.spectra import response_spectra
+
+        return response_spectra(self, segment_duration)
+
     def summary(self) -> dict:
         """Statistics as {name: {"mean", "ci95"}} plus run settings (JSON-ready)."""
         out = {
@@ -533,12 +556,38 @@ def step_bias(scheme: str, harvester: Harvester, psd, dt: float) -> float:
     white noise.
     """
     excitation = as_excitation(psd)
-    k_eff, c_eff = effective_linear_device(harvester, excitation.level)
     m = float(harvester.m)
+    if excitation.shaping_filter() is None:  # synthesised or recorded input
+        k_eff, c_eff = _linearised_under(harvester, excitation)[:2]
+        if not harvester.has_circuit:
+            return _scheme_bias(scheme, m, k_eff, c_eff, 1.0, dt)
+        # the input's step integrals drive the velocity as white noise does
+        system = _augmented_system(m, k_eff, c_eff, as_excitation(1.0), harvester.electrical)
+        return _augmented_bias(scheme, *system, dt)
+    k_eff, c_eff = effective_linear_device(harvester, excitation.level)
     if excitation.is_white and not harvester.has_circuit:
         return _scheme_bias(scheme, m, k_eff, c_eff, excitation.level, dt)
     system = _augmented_system(m, k_eff, c_eff, excitation, harvester.electrical)
     return _augmented_bias(scheme, *system, dt)
+
+
+def _linearised_under(harvester: Harvester, excitation: Excitation) -> tuple:
+    """(k_eq, c_eq, E[z^2], E[v^2]) of the device linearised under a non-rational input.
+
+    Statistical linearisation (:func:`randvib.statistical_linearisation`) for
+    memoryless friction; with a friction state (LuGre) the viscous device
+    (k, c) and its spectral variances. Used for the step check and the
+    random start when the input is synthesised or recorded: there the scheme
+    integrates the device alone, the input's step integral being exact.
+    """
+    h = harvester
+    excitation = _coarsened(excitation)
+    if h.friction is None or h.friction.has_equivalent_damping:
+        res = statistical_linearisation(h, excitation)
+        return res.k_eq, res.c_eq, res.displacement_variance, res.velocity_variance
+    block = device_block(float(h.m), float(h.c), float(h.k), h.electrical)
+    var = output_variances(block, excitation)
+    return float(h.k), float(h.c), var["z"], var["v"]
 
 
 def _scheme_bias(scheme, m, k_eff, c_eff, psd, dt) -> float:
@@ -595,24 +644,48 @@ def _augmented_bias(scheme, f, g, pick, dt) -> float:
     return float(np.max(np.abs(discrete / continuous - 1.0)))
 
 
+def _coarsened(excitation: Excitation, nodes: int = 1024) -> Excitation:
+    """A long table (a record's Welch PSD: tens of thousands of bins) as ``nodes`` cells.
+
+    Each cell keeps its exact power (``cumulative_power`` differenced), so the
+    variances the step check and the random start need are those of the
+    spectrum smoothed over cells of (support width / nodes), computed in a
+    fraction of the time of a quadrature over every bin.
+    """
+    if len(excitation.breakpoints()) <= 2 * nodes:
+        return excitation
+    lo, hi = excitation.support
+    edges = np.linspace(lo, hi, nodes + 1)
+    density = np.diff(excitation.cumulative_power(edges)) / np.diff(edges)
+    return Tabulated(np.concatenate([[lo], 0.5 * (edges[1:] + edges[:-1]), [hi]]),
+                     np.concatenate([[0.0], density, [0.0]]))  # fmt: skip
+
+
 def largest_step(scheme: str, harvester: Harvester, psd, bias: float = MAX_STEP_BIAS) -> float:
     """Largest dt (s) whose :func:`step_bias` stays below ``bias`` (bisection)."""
     excitation = as_excitation(psd)
-    k_eff, c_eff = effective_linear_device(harvester, excitation.level)  # once, not per step
     m = float(harvester.m)
+    driven_input = excitation.shaping_filter() is None  # synthesised or recorded
+    if driven_input:
+        k_eff, c_eff = _linearised_under(harvester, excitation)[:2]
+        level = 1.0  # the step check's linear device under unit white noise
+    else:
+        k_eff, c_eff = effective_linear_device(harvester, excitation.level)  # once, not per step
+        level = excitation.level
     # The fastest linear time scale: the period over pi, or for the free mass m/c.
     if k_eff > 0:
         hi = 2.0 / np.sqrt(k_eff / m)
     else:
         hi = 2.0 * m / c_eff if c_eff > 0 else np.inf
     lo = 0.0
-    if excitation.is_white and not harvester.has_circuit:
+    if (excitation.is_white or driven_input) and not harvester.has_circuit:
 
         def bias_at(dt):
-            return _scheme_bias(scheme, m, k_eff, c_eff, excitation.level, dt)
+            return _scheme_bias(scheme, m, k_eff, c_eff, level, dt)
 
     else:
-        system = _augmented_system(m, k_eff, c_eff, excitation, harvester.electrical)
+        linear_input = as_excitation(level) if driven_input else excitation
+        system = _augmented_system(m, k_eff, c_eff, linear_input, harvester.electrical)
         hi = min(hi, 2.0 / max(abs(np.linalg.eigvals(system[0]))))
 
         def bias_at(dt):
@@ -647,6 +720,9 @@ def _linearised_spread(harvester: Harvester, excitation: Excitation) -> tuple[fl
     velocity spread is the white-noise one at the excitation's level, a start
     the burn-in corrects).
     """
+    if excitation.shaping_filter() is None:
+        z2, v2 = _linearised_under(harvester, excitation)[2:]
+        return float(np.sqrt(z2)), float(np.sqrt(v2))
     psd = excitation.level
     if harvester.potential.is_free:
         _, c_eff = effective_linear_device(harvester, psd)
@@ -669,7 +745,9 @@ def _linearised_spread(harvester: Harvester, excitation: Excitation) -> tuple[fl
 
 def _check_step(scheme, harvester, excitation, dt):
     bias = step_bias(scheme, harvester, excitation, dt)
-    states = [] if excitation.is_white else [f"the {excitation.name} filter's states"]
+    states = []
+    if excitation.shaping_filter() is not None and not excitation.is_white:
+        states.append(f"the {excitation.name} filter's states")
     if harvester.has_circuit:
         states.append(
             f"the {harvester.electrical.name} circuit's {harvester.electrical.state_name}"
@@ -829,6 +907,9 @@ class _Run:
     record: RecordOptions
     dW: np.ndarray | None
     companion: bool
+    #: Velocity increments of a given base acceleration, ``driver(first, count)``
+    #: -> (count, n_steps) (m/s): synthesised or recorded input (:mod:`randvib.montecarlo.driven`).
+    driver: object = None
 
 
 # ----------------------------------------------------------------- simulate
@@ -857,7 +938,7 @@ def simulate(
     check_step: bool = True,
     method: str | None = None,
 ) -> SimulationResult:
-    """Simulate an ensemble of the harvester under white or rational base excitation.
+    """Simulate an ensemble of the harvester under white or coloured base excitation.
 
     Parameters
     ----------
@@ -880,11 +961,14 @@ def simulate(
         (:mod:`randvib.models.excitation`): ``White`` as a number;
         ``BandPass`` and ``KanaiTajimi`` through their shaping filter's two
         states, driven by sqrt(S/2) dW (S their ``level``) and integrated with
-        the device by the same scheme. Non-rational spectra (``BandLimited``,
-        ``Tabulated``, ``Measured``) are refused: use
-        :func:`randvib.statistical_linearisation`. Under coloured input the
-        companion and the control variates (white-noise energy balance) are
-        refused, and the step check covers the filter too.
+        the device by the same scheme. ``BandLimited`` and ``Tabulated`` by a
+        stationary Gaussian synthesis per path (:mod:`randvib.montecarlo.driven`:
+        path i's input from the stream (seed, i), the kernel taking its exact
+        step integrals; batches bound the memory). ``Measured`` is refused:
+        simulate on the record with :func:`randvib.simulate_on_record`.
+        Under coloured input the companion and the control variates
+        (white-noise energy balance) are refused, and the step check covers
+        the filter too.
     t_end : float
         Simulated time per path (s), burn-in included.
     dt : float
@@ -912,8 +996,9 @@ def simulate(
         Integrate the friction-free device with the same noise alongside
         (control variates, :meth:`SimulationResult.controls`); white noise only.
     control_variates : bool
-        Report control-variate estimates (plain path means otherwise); white
-        noise only.
+        Report control-variate estimates (plain path means otherwise): white
+        noise, and band-pass / Kanai-Tajimi input (the Ito-sum and
+        energy-change controls, :meth:`SimulationResult.controls`).
     histogram_bins, histogram_range
         Stationary histograms of z and v: number of bins and
         ((z_lo, z_hi), (v_lo, v_hi)) (default +-5 linearised std).
@@ -951,6 +1036,18 @@ def simulate(
         companion=companion,
         record=(histogram_bins, histogram_range, record_paths, record_every),
     )
+    return execute(
+        run,
+        control_variates=control_variates,
+        check_step=check_step,
+        threads=threads,
+        batch_paths=batch_paths,
+        progress=progress,
+    )
+
+
+def execute(run: _Run, *, control_variates, check_step, threads, batch_paths, progress):
+    """Run a validated :class:`_Run` (see :func:`simulate` for the options)."""
     _check_coloured_options(run.excitation, run.companion, control_variates)
     _check_circuit_options(run.harvester, run.companion)
     if check_step:
@@ -961,7 +1058,11 @@ def simulate(
         numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
     if progress is None:
         progress = sys.stderr.isatty() and os.environ.get("CI") is None
-    batches = _batches(n_paths, batch_paths, run.grid.n_steps, progress, run.record.record_paths)
+    if batch_paths is None and run.driver is not None:  # the input's memory stays bounded
+        batch_paths = driven.batch_paths(run.grid.n_steps)
+    batches = _batches(
+        run.n_paths, batch_paths, run.grid.n_steps, progress, run.record.record_paths
+    )
     started = time.perf_counter()
     per_path, hist_groups, records = _run_batches(run, setup, batches, progress)
     wall = time.perf_counter() - started
@@ -1022,14 +1123,24 @@ def _validated(
     excitation = _simulated_excitation(psd)
     grid = TimeGrid.from_times(t_end, dt, burn_in)
     n_paths = check_int("n_paths", n_paths, 1)
+    seed = check_int("seed", seed, 0)
+    driver = None
+    if excitation.shaping_filter() is None:  # synthesised input: the kernel takes its increments
+        if dW is not None:
+            raise ValueError(
+                f"`dW` drives white noise or a shaping filter; the {excitation.name} input is "
+                "synthesised from the seed (leave dW=None)"
+            )
+        driver = driven.SynthesisedInput(excitation, grid.n_steps, grid.dt, seed)
     return _Run(
         harvester=harvester,
-        psd=excitation.level,
+        psd=getattr(excitation, "level", None),
         excitation=excitation,
+        driver=driver,
         scheme=scheme,
         grid=grid,
         n_paths=n_paths,
-        seed=check_int("seed", seed, 0),
+        seed=seed,
         first_path=check_int("first_path", first_path, 0),
         initial=InitialState.from_argument(initial),
         record=RecordOptions.validated(*record),
@@ -1039,21 +1150,29 @@ def _validated(
 
 
 def _simulated_excitation(psd) -> Excitation:
-    """``psd`` as an excitation that :func:`simulate` can integrate, or a clear refusal.
+    """``psd`` as an excitation that :func:`simulate` can drive, or a clear refusal.
 
     White noise and the rational spectra with a 2-state shaping filter
-    (band-pass, Kanai-Tajimi) are simulated; the others have no filter.
+    (band-pass, Kanai-Tajimi) are integrated with the device; band-limited
+    and tabulated spectra are synthesised (:class:`driven.SynthesisedInput`);
+    a measured record is simulated on the record itself by
+    :func:`randvib.montecarlo.driven.simulate_on_record`.
     """
     if not isinstance(psd, Excitation):
         return as_excitation(float(check_positive("psd", psd, "(m/s^2)^2/Hz")))
-    shaping = psd.shaping_filter()
     if psd.is_white:
         return psd
-    if shaping is None or shaping.system.n_states != 2 or np.any(shaping.system.d != 0):
+    if psd.name == "measured":
         raise ValueError(
-            f"simulate integrates white noise and rational spectra (band-pass, kanai-tajimi) "
-            f"through their shaping filter; the {psd.name} excitation has none: use "
-            "randvib.statistical_linearisation, which accepts any spectrum"
+            "simulate draws its own paths; to simulate the device on the measured record "
+            "itself use randvib.simulate_on_record(harvester, record, ...), for Gaussian "
+            "paths with the record's Welch PSD pass record.spectrum"
+        )
+    shaping = psd.shaping_filter()
+    if shaping is not None and (shaping.system.n_states != 2 or np.any(shaping.system.d != 0)):
+        raise ValueError(
+            f"simulate integrates shaping filters of 2 states without feed-through; the "
+            f"{psd.name} filter has {shaping.system.n_states}"
         )
     return psd
 
@@ -1067,11 +1186,12 @@ def _check_coloured_options(excitation: Excitation, companion: bool, control_var
             "`companion` needs white noise: the friction-free companion's exact moments "
             f"(S m/(4c), Gibbs E[z^2]) do not hold under {excitation.name} excitation"
         )
-    if control_variates:
+    if control_variates and excitation.shaping_filter() is None:
         raise ValueError(
-            "`control_variates` needs white noise: the controls come from the white-noise "
-            "energy balance (c E[v^2] + E[vF] = S m/4), which does not hold under "
-            f"{excitation.name} excitation; use control_variates=False"
+            "`control_variates` needs Brownian increments (white noise, or band-pass and "
+            "Kanai-Tajimi through their filter): under the synthesised or recorded "
+            f"{excitation.name} input the Ito sum is the input power, not a zero-mean control; "
+            "use control_variates=False"
         )
 
 
@@ -1125,7 +1245,9 @@ class _KernelSetup:
     @classmethod
     def prepare(cls, run: _Run) -> _KernelSetup:
         h = run.harvester
-        device = (h.m, h.c, h.k, h.k3, np.sqrt(run.psd / 2.0))
+        # Given base-acceleration input arrives as velocity increments (m/s): amplitude 1.
+        amplitude = 1.0 if run.driver is not None else np.sqrt(run.psd / 2.0)
+        device = (h.m, h.c, h.k, h.k3, amplitude)
         initial, companion = _start_states(run)
         return cls(
             scheme=run.scheme.kernel_weights,
@@ -1141,7 +1263,10 @@ class _KernelSetup:
     def arguments(self, run: _Run, lo: int, hi: int) -> dict:
         """:func:`kernel.run_ensemble`'s keyword arguments for paths ``lo .. hi - 1``."""
         n_record = max(0, min(run.record.record_paths - lo, hi - lo))
-        dw = run.dW[lo:hi] if run.dW is not None else np.zeros((0, 0))
+        if run.driver is not None:
+            dw = run.driver(run.first_path + lo, hi - lo)
+        else:
+            dw = run.dW[lo:hi] if run.dW is not None else np.zeros((0, 0))
         return dict(
             scheme=self.scheme,
             device=self.device,
@@ -1165,14 +1290,18 @@ def _auxiliary(run: _Run) -> kernel.Auxiliary | None:
     random start the filter alone starts from its exact stationary law N(0, P),
     A P + P A^T + q G G^T = 0; with a circuit the block starts from its
     marginal law under the linearised device (:func:`_linearised_covariance`).
+    Synthesised or recorded input (``run.driver``) reaches the velocity as
+    given increments, like white noise: only a circuit needs the block, and it
+    starts from its statistical-linearisation variance under that input.
     """
     h, excitation = run.harvester, run.excitation
-    if excitation.is_white and not h.has_circuit:
+    driven_input = run.driver is not None
+    if (excitation.is_white or driven_input) and not h.has_circuit:
         return None
     n = kernel.N_AUX
     a, b, g, c, square = np.zeros((n, n)), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
     n_filter = 0
-    if not excitation.is_white:
+    if not (excitation.is_white or driven_input):
         shaping = excitation.shaping_filter()
         system = shaping.system
         n_filter = system.n_states
@@ -1187,14 +1316,31 @@ def _auxiliary(run: _Run) -> kernel.Auxiliary | None:
         a[n_filter, n_filter], b[n_filter], c[n_filter] = a_x, b_x, f / h.m
         square[n_filter] = 1.0
         n_states += 1
-        cov = _linearised_covariance(h, excitation)  # (filter, z, v, circuit)
-        keep = [*range(n_filter), cov.shape[0] - 1]
-        start = cov[np.ix_(keep, keep)]
+        if driven_input:
+            start = np.array([[_driven_circuit_variance(h, excitation)]])
+        else:
+            cov = _linearised_covariance(h, excitation)  # (filter, z, v, circuit)
+            keep = [*range(n_filter), cov.shape[0] - 1]
+            start = cov[np.ix_(keep, keep)]
     chol = np.zeros((n, n))
     chol[:n_states, :n_states] = np.linalg.cholesky(start)
-    gain = 1.0 if excitation.is_white else 0.0  # white noise drives the velocity itself
+    # white noise (or the given increments) drives the velocity itself
+    gain = 1.0 if excitation.is_white or driven_input else 0.0
     coefficients = np.concatenate([a.ravel(), b, g, c, [gain]])
     return kernel.pack(kernel.Auxiliary, n_states, coefficients, square, chol)
+
+
+def _driven_circuit_variance(harvester: Harvester, excitation: Excitation) -> float:
+    """E[x^2] of the circuit state under synthesised or recorded input, for the random start.
+
+    Statistical linearisation under the (coarsened) spectrum; a friction law
+    with memory is left out (it only adds damping, and the burn-in corrects
+    the start).
+    """
+    h = harvester
+    if h.friction is not None and not h.friction.has_equivalent_damping:
+        h = h.updated(friction=None)
+    return float(statistical_linearisation(h, _coarsened(excitation)).circuit_variance)
 
 
 def _start_states(run: _Run) -> tuple[kernel.Start, kernel.Companion]:

@@ -46,6 +46,7 @@ STUDIES = (
     "identification",
     "linearisation-vs-averaging",
     "silverbox",
+    "excitation",
 )
 
 

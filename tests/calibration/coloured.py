@@ -2,7 +2,7 @@
 
 Run by hand (not collected by pytest), from the repository root:
 
-    NUMBA_NUM_THREADS=1 python tests/calibration/coloured.py [n_seeds] [name ...]
+    NUMBA_NUM_THREADS=1 python tests/calibration/coloured.py [n_seeds] [--first=SEED] [name ...]
 
 For every exact comparison (``case_*`` in the test module: the coarse-step
 cases against the scheme's discrete Lyapunov covariance, the fine-step cases
@@ -42,12 +42,17 @@ def calibrate(name, case, seeds):
 
 
 def main():
-    n = int(sys.argv[1]) if len(sys.argv) > 1 else 40
-    only = sys.argv[2:] or None
+    args = sys.argv[1:]
+    first = 1000
+    for arg in [a for a in args if a.startswith("--first=")]:
+        first = int(arg.split("=", 1)[1])
+        args.remove(arg)
+    n = int(args[0]) if args else 40
+    only = args[1:] or None
     for name, case in CASES.items():
         if only and name not in only:
             continue
-        calibrate(name, case, range(1000, 1000 + n))
+        calibrate(name, case, range(first, first + n))
 
 
 if __name__ == "__main__":

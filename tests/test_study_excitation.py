@@ -1,0 +1,69 @@
+"""Study ``excitation`` (studies/excitation.py) at a tiny size, end to end through the CLI.
+
+The study's numbers are Monte Carlo; what is checked here is what must hold
+at any size: the response-matched levels make the linear device's power
+exactly the white-noise value (S = 1) in every band, Monte Carlo agrees with
+it within its interval, the paired contrast is the combination of the four
+devices' powers (same paths) and narrower than unpaired, the verdicts are
+recomputed from the CSVs, and a second run resumes without recomputing.
+"""
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+from _stats import assert_matches
+from study_checks import statistic
+
+import randvib as rv
+from randvib.cli import main
+from randvib.studies import load
+
+excitation = load("excitation")
+TINY = {"centres": ("at", "above"), "zetas": (0.5, 0.05), "k3s": (0.0, 5e7),
+        "mc": (160, 3.0, 2e-4, 0.5)}  # fmt: skip
+
+
+def _run(out, capsys):
+    argv = ["study", "excitation", "--quick", "--out", str(out), "--no-progress", "--threads", "1"]
+    assert main(argv) == 0
+    assert capsys.readouterr().out.strip() == f"report: {out / 'report.md'}"
+
+
+def test_excitation_study_end_to_end(tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr(excitation, "grid", lambda quick: TINY)
+    out = tmp_path / "exc"
+    _run(out, capsys)
+    results = pd.read_csv(out / "results.csv")
+    inter = pd.read_csv(out / "contrasts.csv")
+    assert len(results) == (2 * 2 + 1) * 4 and len(inter) == 5
+    base = rv.preset("figure9")
+    white = base.c_e * base.m / (4 * base.c)  # c_e S m / (4 c) at S = 1
+    linear = results[(results.fc == 0) & (results.k3 == 0)]
+    np.testing.assert_allclose(linear.power_linearisation, white, rtol=1e-9)
+    for r in linear.itertuples():
+        stat = statistic(r.power_mc, r.power_mc_ci95, r.n_paths)
+        assert_matches(stat, white, detect=0.3, what=f"linear device, {r.centre} {r.zeta}")
+    # the paired contrast is the four powers' combination, and pairing narrows it
+    for r in inter.itertuples():
+        p = results[(results.centre == r.centre) & (results.zeta == r.zeta)]
+        power = {(q.fc, q.k3): q for q in p.itertuples()}
+        four = [power[(excitation.FC, r.k3)], power[(excitation.FC, 0.0)],
+                power[(0.0, r.k3)], power[(0.0, 0.0)]]  # fmt: skip
+        combined = four[0].power_mc - four[1].power_mc - four[2].power_mc + four[3].power_mc
+        assert r.contrast == pytest.approx(combined, rel=1e-9, abs=1e-15)
+        assert r.contrast_ci95 < np.sqrt(sum(q.power_mc_ci95**2 for q in four))
+    assert not inter[inter.centre == "white"].detectable_holm.any()
+    # verdicts.json is what the tables say
+    verdict = json.loads((out / "verdicts.json").read_text())
+    assert verdict == json.loads(json.dumps(excitation.verdicts(results, inter)))
+    text = (out / "report.md").read_text()
+    largest = verdict["interaction"]["largest_relative_contrast"]
+    assert f"The largest contrast is {100 * largest:+.1f}" in text
+    for figure in ("interaction.png", "linearisation_error.png", "spectra.png"):
+        assert (out / figure).stat().st_size > 10_000
+    # a second run resumes from the tables
+    before = (out / "results.csv").stat().st_mtime_ns
+    _run(out, capsys)
+    assert (out / "results.csv").stat().st_mtime_ns == before
