@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from randvib._io import check_output_file
 from randvib.cli._device import add_device_arguments, harvester_from_args
 from randvib.identification.synthetic import PAPER_BAND, SYNTHETIC_INPUTS, synthetic_record
 from randvib.models.excitation import BandLimited
@@ -44,8 +45,9 @@ def register(sub) -> None:
 
 def run(args) -> int:
     out = Path(args.out)
-    if out.exists() and not args.force:
+    if out.exists() and not out.is_dir() and not args.force:
         raise FileExistsError(f"`--out` {str(out)!r} exists; choose a new name or give --force")
+    check_output_file(out, "--out", overwrite=args.force)
     if (args.rms is None) == (args.psd is None):
         raise ValueError("give exactly one of `--rms` (m/s^2) and `--psd` ((m/s^2)^2/Hz)")
     if args.input not in SYNTHETIC_INPUTS:
