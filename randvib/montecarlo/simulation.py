@@ -32,7 +32,8 @@ import numba
 import numpy as np
 from scipy import linalg, special  # Student t quantile; lighter than scipy.stats
 
-from randvib._validation import check_choice, check_int, check_positive
+from randvib._resources import announce_duration, check_memory
+from randvib._validation import MAX_SEED, check_choice, check_int, check_positive
 from randvib.analytic import exact_solutions as exact
 from randvib.analytic.linear_response import mechanical_block
 from randvib.analytic.linearisation import equivalent_damping, linear_displacement_variance
@@ -46,6 +47,10 @@ from randvib.montecarlo.rng import ZIG_FI, ZIG_KI, ZIG_WI
 #: Largest stationary-variance bias (relative) of the scheme on the linearised
 #: device for which a step is accepted; see :func:`step_bias`.
 MAX_STEP_BIAS = 0.10
+#: Most steps per path (int64 step counters, with room to spare).
+MAX_STEPS = 2**62
+#: Largest path index (streams are keyed by unsigned 64-bit integers).
+MAX_PATH_INDEX = 2**62
 #: Bias above which a warning is issued.
 WARN_STEP_BIAS = 0.01
 
@@ -458,11 +463,72 @@ def _linearised_spread(harvester: Harvester, excitation: Excitation) -> tuple[fl
     return float(np.sqrt(linear_displacement_variance(harvester, vv))), float(np.sqrt(vv))
 
 
+def _check_scales(run: _Run) -> None:
+    """Refuse parameters whose linearised scales are not finite float64 numbers.
+
+    Extreme values (m = 1e308, k3 = 1e308, S = 1e308) overflow the
+    step-size check and the stationary start; they are named here instead.
+    """
+    try:
+        with np.errstate(all="ignore"):
+            k_eff, c_eff = effective_linear_device(run.harvester, run.psd)
+            spread = _linearised_spread(run.harvester, run.excitation)
+    except (ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
+        problem = f"{type(exc).__name__}: {exc}"
+    else:
+        values = (k_eff, c_eff, *spread)
+        if all(np.isfinite(values)) and all(v > 0 for v in values):
+            return
+        problem = f"k_eff = {k_eff:.3g}, c_eff = {c_eff:.3g}, std z, v = {spread}"
+    raise ValueError(
+        f"the device's linearised scales are not finite positive float64 numbers ({problem}) "
+        f"at psd = {run.psd!r} and {run.harvester.parameters()}: the parameters are out of "
+        "range, or the device has neither damping nor friction"
+    )
+
+
+#: Rough speed of the compiled loop, path-steps per second per thread, for
+#: the duration estimate of long runs (Heun, Coulomb friction; measured on a
+#: laptop core, about 3e7).
+PATH_STEPS_PER_SECOND = 3e7
+
+
+def _check_resources(run: _Run, batch_paths, progress) -> None:
+    """Refuse a run whose arrays cannot fit in memory; announce a long one."""
+    n_steps, n_paths = run.grid.n_steps, run.n_paths
+    batch = n_paths if batch_paths is None else min(int(batch_paths), n_paths)
+    chunks = -(-batch // kernel.LANES)
+    rec = run.record
+    n_bytes = 8.0 * (
+        2 * n_paths * kernel.N_ACC  # per-path averages, and one batch's
+        + chunks * 2 * rec.histogram_bins  # histogram counts per chunk
+        + min(rec.record_paths, n_paths) * (n_steps // rec.record_every + 1) * 3
+    )
+    check_memory(
+        f"simulating {n_paths} paths of {n_steps} steps",
+        n_bytes,
+        "reduce `n_paths` (`--paths`), `histogram_bins` or `record_paths`, or run in parts "
+        "with `first_path`",
+    )
+    work = float(n_paths) * n_steps * (2 if run.companion else 1)
+    announce_duration(
+        f"simulating {n_paths} paths x {n_steps} steps",
+        work / (PATH_STEPS_PER_SECOND * numba.get_num_threads()),
+        stacklevel=4,
+    )
+
+
 def _check_step(scheme, harvester, excitation, dt):
     bias = step_bias(scheme, harvester, excitation, dt)
     resolves = "" if excitation.is_white else f" with the {excitation.name} filter's states"
     if bias > MAX_STEP_BIAS:
         limit = largest_step(scheme, harvester, excitation)
+        if not limit > 0:
+            raise ValueError(
+                f"`dt` = {dt!r} s is too large for this device{resolves} with {scheme}, and no "
+                f"representable step is small enough (its linearised stiffness and damping "
+                f"{effective_linear_device(harvester, excitation.level)} are out of range)"
+            )
         raise ValueError(
             f"`dt` = {dt!r} s is too large for this device{resolves} with {scheme}: on the "
             f"linearised device its stationary variance is off by {bias:.3g} "
@@ -505,6 +571,11 @@ class TimeGrid:
         if not (np.isfinite(burn_in) and 0.0 <= burn_in < t_end):
             raise ValueError(
                 f"`burn_in` must satisfy 0 <= burn_in < t_end = {t_end!r} s, got {burn_in!r}"
+            )
+        if not t_end / dt <= MAX_STEPS:
+            raise ValueError(
+                f"`t_end` / `dt` = {t_end:g} s / {dt:g} s = {t_end / dt:.3g} steps per path; "
+                f"at most {MAX_STEPS:.3g} can be counted: shorten `t_end` or enlarge `dt`"
             )
         grid = cls(dt, int(round(t_end / dt)), int(round(burn_in / dt)))
         if grid.window_steps < 1:
@@ -727,12 +798,15 @@ def simulate(
         record=(histogram_bins, histogram_range, record_paths, record_every),
     )
     _check_coloured_options(run.excitation, run.companion, control_variates)
+    if check_step or run.initial.kind == "stationary":
+        _check_scales(run)
     if check_step:
         _check_step(run.scheme.name, run.harvester, run.excitation, run.grid.dt)
     setup = _KernelSetup.prepare(run)
     if threads is not None:
         threads = check_int("threads", threads, 1)
         numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+    _check_resources(run, batch_paths, progress)
     if progress is None:
         progress = sys.stderr.isatty() and os.environ.get("CI") is None
     batches = _batches(n_paths, batch_paths, run.grid.n_steps, progress, run.record.record_paths)
@@ -795,8 +869,8 @@ def _validated(
         scheme=scheme,
         grid=grid,
         n_paths=n_paths,
-        seed=check_int("seed", seed, 0),
-        first_path=check_int("first_path", first_path, 0),
+        seed=check_int("seed", seed, 0, MAX_SEED),
+        first_path=check_int("first_path", first_path, 0, MAX_PATH_INDEX),
         initial=InitialState.from_argument(initial),
         record=RecordOptions.validated(*record),
         dW=_checked_increments(dW, n_paths, grid.n_steps),

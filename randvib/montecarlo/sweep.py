@@ -51,7 +51,7 @@ from randvib._io import (
     sha256,
     unlock_folder,
 )
-from randvib._validation import check_int, check_positive
+from randvib._validation import MAX_SEED, check_int, check_positive
 from randvib.analytic.prediction import METHODS, predict
 from randvib.models.harvester import Harvester
 from randvib.montecarlo.integrators import scheme_argument
@@ -123,7 +123,7 @@ class SweepSettings:
         check_int("min_paths", self.min_paths, 8)
         check_int("batch_paths", self.batch_paths, 1)
         check_int("max_paths", self.max_paths, self.min_paths)
-        check_int("seed", self.seed, 0)
+        check_int("seed", self.seed, 0, MAX_SEED)
 
     @property
     def method(self) -> str:
