@@ -70,8 +70,7 @@ def announce_duration(what: str, seconds: float, stacklevel: int = 3) -> None:
     """Warn (:class:`LongRunWarning`) when ``what`` is expected to take long."""
     if seconds > LONG_RUN_SECONDS:
         warnings.warn(
-            f"{what} will take about {duration_text(seconds)} (a rough estimate); "
-            "Ctrl-C stops it",
+            f"{what} will take about {duration_text(seconds)} (a rough estimate); Ctrl-C stops it",
             LongRunWarning,
             stacklevel=stacklevel,
         )

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import os
 import sys
+import threading
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -1057,7 +1058,9 @@ def _run_batches(run: _Run, setup: _KernelSetup, batches, progress: bool):
         bar = tqdm(total=run.n_paths, unit="path", desc="simulate", leave=False, delay=3.0)
     try:
         for lo, hi in batches:
-            acc, failed, hist, rec = kernel.run_ensemble(**setup.arguments(run, lo, hi))
+            acc, failed, hist, rec = interruptible(
+                kernel.run_ensemble, **setup.arguments(run, lo, hi)
+            )
             _raise_if_diverged(run, lo, failed)
             per_path[lo:hi] = acc
             if run.record.histogram_bins > 0:
@@ -1070,6 +1073,39 @@ def _run_batches(run: _Run, setup: _KernelSetup, batches, progress: bool):
         if bar is not None:
             bar.close()
     return per_path, hist_total, records
+
+
+def interruptible(compiled, **kwargs):
+    """Call a compiled (nogil) loop so that Ctrl-C stops it within a fraction of a second.
+
+    A compiled loop does not see signals, so it runs in a worker thread while
+    this (main) thread waits; on KeyboardInterrupt the shared ``stop`` flag is
+    set, the loop ends at its next check, and KeyboardInterrupt is raised
+    (finished batches, points and fits are kept by the callers).
+    """
+    stop = np.zeros(1, dtype=np.int64)
+    if threading.current_thread() is not threading.main_thread():
+        return compiled(stop=stop, **kwargs)  # signals only reach the main thread
+    outcome = {}
+
+    def target():
+        try:
+            outcome["value"] = compiled(stop=stop, **kwargs)
+        except BaseException as exc:  # handed to the caller's thread
+            outcome["error"] = exc
+
+    worker = threading.Thread(target=target, name="randvib-kernel", daemon=True)
+    worker.start()
+    try:
+        while worker.is_alive():
+            worker.join(0.05)
+    except KeyboardInterrupt:
+        stop[0] = 1
+        worker.join()
+        raise
+    if "error" in outcome:
+        raise outcome["error"]
+    return outcome["value"]
 
 
 def _raise_if_diverged(run: _Run, lo: int, failed: np.ndarray) -> None:

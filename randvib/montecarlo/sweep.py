@@ -251,6 +251,31 @@ def run_point(base: Harvester, point: Mapping, settings: SweepSettings, threads:
 
 
 # ------------------------------------------------------------------ executors
+#: Seconds to wait for a Dask scheduler to answer.
+SCHEDULER_TIMEOUT = 10
+
+
+def _worker_start(parent: int, initializer=None) -> None:
+    """In each local worker: end when the parent goes, then the user's initializer.
+
+    A sweep killed with SIGTERM or SIGKILL cannot shut its pool down; its
+    workers would live on (one numba-loaded interpreter each). A daemon
+    thread in every worker checks once a second that the parent is still
+    there and ends the worker when it is not.
+    """
+    import threading
+
+    def watch():
+        while True:
+            time.sleep(1.0)
+            if os.getppid() != parent:
+                os._exit(1)
+
+    threading.Thread(target=watch, name="randvib-parent-watch", daemon=True).start()
+    if initializer is not None:
+        initializer()
+
+
 def make_executor(workers: int | None = None, scheduler: str | None = None, initializer=None):
     """An executor and a closer: local processes, or a Dask cluster at ``scheduler``.
 
@@ -263,7 +288,14 @@ def make_executor(workers: int | None = None, scheduler: str | None = None, init
             raise ValueError(
                 "`scheduler` needs Dask distributed: pip install 'randvib[distributed]'"
             ) from None
-        client = Client(scheduler)
+        try:
+            # a short connect timeout: a wrong address fails in seconds, not after 30 s
+            client = Client(scheduler, timeout=SCHEDULER_TIMEOUT)
+        except (OSError, TimeoutError, ValueError, TypeError) as exc:
+            raise ValueError(
+                f"`scheduler` {scheduler!r}: cannot connect to a Dask scheduler there within "
+                f"{SCHEDULER_TIMEOUT} s ({type(exc).__name__}: {str(exc).splitlines()[0]})"
+            ) from None
         return client.get_executor(pure=False), client.close
     workers = os.cpu_count() or 1 if workers is None else check_int("workers", workers, 1)
     if workers == 1:
@@ -275,7 +307,7 @@ def make_executor(workers: int | None = None, scheduler: str | None = None, init
     pool = ProcessPoolExecutor(
         max_workers=workers,
         mp_context=multiprocessing.get_context("spawn"),
-        initializer=initializer,
+        initializer=functools.partial(_worker_start, os.getpid(), initializer),
     )
     return pool, lambda: pool.shutdown(cancel_futures=True)
 
