@@ -379,6 +379,8 @@ def _read_csv(path: Path):
     """The CSV as a DataFrame with string column names; parse errors as ValueError."""
     import pandas as pd
 
+    if path.is_dir():
+        raise IsADirectoryError(f"record file {str(path)!r} is a folder; give a CSV file")
     if not path.is_file():
         raise FileNotFoundError(f"record file {str(path)!r} does not exist")
     try:
@@ -846,6 +848,10 @@ def _search_space(record, model, fixed, bounds, skip) -> _SearchSpace:
         raise ValueError(
             f"record {record.name!r} has {record.n} samples; the {model} model with "
             f"{len(free)} free parameters needs at least {needed}"
+        )
+    if np.ptp(record.z[skip:]) == 0:
+        raise ValueError(
+            f"`{OUTPUT_COLUMN}` of record {record.name!r} is constant; J (Eq. 11) is undefined"
         )
     box = default_bounds(record, model, fixed.get("m"))
     box.update(_user_bounds(model, bounds))

@@ -47,6 +47,7 @@ from randvib._io import (
     atomic_write_bytes,
     atomic_write_text,
     dumps,
+    finite_json,
     prepare_output_dir,
     sha256,
     unlock_folder,
@@ -390,6 +391,10 @@ class _PointStore:
         values = [row.get(k) for k in (*STATISTICS, "n_paths")]
         if not all(isinstance(v, int | float) and math.isfinite(v) for v in values):
             raise _BadPoint(f"{row_file.name} lacks finite statistics")
+        if _row_checksum(row) != stored.get("row_sha256"):
+            raise _BadPoint(
+                f"{row_file.name}: the row does not match the checksum recorded with it"
+            )
         if sha256(data) != stored.get("sha256"):
             raise _BadPoint(f"{npy_file.name} does not match the checksum recorded with it")
         try:
@@ -407,10 +412,12 @@ class _PointStore:
         np.save(buffer, paths, allow_pickle=False)
         data = buffer.getvalue()
         atomic_write_bytes(self._paths(index), data)
+        row = finite_json(row, "not computable at this point")[0]
         stored = {
             "format": self.FORMAT,
             "point": _jsonable_point(point),
             "row": row,
+            "row_sha256": _row_checksum(row),
             "shape": list(paths.shape),
             "sha256": sha256(data),
         }
@@ -426,6 +433,11 @@ class _PointStore:
 
 class _BadPoint(Exception):
     """A stored sweep point that cannot be trusted (why in the message)."""
+
+
+def _row_checksum(row: dict) -> str:
+    """SHA-256 of a row's canonical JSON (what is stored is what is hashed)."""
+    return sha256(json.dumps(row, sort_keys=True, allow_nan=False).encode())
 
 
 def _jsonable_point(point: Mapping) -> dict:
