@@ -465,6 +465,19 @@ def test_work_that_cannot_fit_is_refused_with_the_estimate():
         simulate(BASE, 1.0, t_end=0.1, dt=1e-4, n_paths=8, histogram_bins=10**12)
 
 
+def test_population_that_cannot_fit_is_refused(capsys, record_csv):
+    one_line_error(capsys, _fit_args(record_csv[0], "--popsize", "100000000"), "of memory")
+
+
+def test_step_advice_never_says_dt_at_most_zero(monkeypatch):
+    from randvib.montecarlo import simulation
+
+    monkeypatch.setattr(simulation, "largest_step", lambda *a, **k: 0.0)
+    with pytest.raises(ValueError, match="too large") as info:
+        simulate(BASE, 1.0, t_end=10.0, dt=0.5, n_paths=2, progress=False)
+    assert "dt <= 0 s" not in str(info.value)
+
+
 def test_long_run_says_how_long(monkeypatch):
     from randvib._resources import LongRunWarning
     from randvib.montecarlo import simulation

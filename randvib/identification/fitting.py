@@ -816,6 +816,7 @@ def identify(
     fixed = _resolve_fixed(model, fixed, m, record)
     space = _search_space(record, model, fixed, bounds, simulation.skip)
     cost = _identification_cost(record, model, fixed, space.free, simulation)
+    _announce(record, search, simulation, len(space.free))
     start = time.perf_counter()
     res = sade(
         cost,
@@ -829,6 +830,29 @@ def identify(
     )
     elapsed = time.perf_counter() - start
     return _identification_result(cost, space, res, elapsed, search, simulation)
+
+
+def _announce(record: Record, search: SearchSettings, simulation: SimulationSettings, d) -> None:
+    """Refuse a population that cannot fit; say how long a long identification will take
+    (at most popsize x (maxiter + 1) simulations)."""
+    import numba
+
+    from randvib._resources import announce_duration
+    from randvib.identification.sade import check_population_memory
+
+    popsize, maxiter = check_int("popsize", search.popsize, 6), check_int("maxiter", search.maxiter)
+    check_population_memory(popsize, d)
+    steps = float(popsize) * (maxiter + 1) * record.n * simulation.substeps
+    announce_duration(
+        f"identification ({popsize} x {maxiter + 1} simulations of {record.n} samples)",
+        steps / (RECORD_STEPS_PER_SECOND * numba.get_num_threads()),
+        stacklevel=4,
+    )
+
+
+#: Rough speed of the compiled record simulation (sub-steps per second per
+#: thread), for the duration estimate of long identifications.
+RECORD_STEPS_PER_SECOND = 5e7
 
 
 @dataclass(frozen=True)

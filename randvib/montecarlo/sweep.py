@@ -310,7 +310,19 @@ def make_executor(workers: int | None = None, scheduler: str | None = None, init
         mp_context=multiprocessing.get_context("spawn"),
         initializer=functools.partial(_worker_start, os.getpid(), initializer),
     )
-    return pool, lambda: pool.shutdown(cancel_futures=True)
+    return pool, functools.partial(_close_pool, pool)
+
+
+def _close_pool(pool: ProcessPoolExecutor) -> None:
+    """Shut the pool down; after Ctrl-C (or any error) do not wait for running points."""
+    import sys
+
+    if sys.exc_info()[0] is not None:
+        # the points in flight are lost anyway: end their workers now
+        # (ProcessPoolExecutor has no public way to)
+        for process in list(getattr(pool, "_processes", {}).values()):
+            process.terminate()
+    pool.shutdown(cancel_futures=True)
 
 
 # ------------------------------------------------------------------ sweep

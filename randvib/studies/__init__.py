@@ -99,7 +99,10 @@ def add_run_options(parser: argparse.ArgumentParser) -> None:
         "linearisation-vs-averaging; default: all cores)",
     )
     parser.add_argument(
-        "--scheduler", default=None, help="Dask distributed scheduler ADDRESS to run the sweep on"
+        "--scheduler",
+        default=None,
+        help="Dask distributed scheduler ADDRESS to run the sweep on (it is sent pickled "
+        "Python objects: a cluster you trust only)",
     )
     parser.add_argument("--no-progress", action="store_true", help="no progress bars")
     parser.add_argument(
