@@ -573,3 +573,17 @@ def test_readme_sweep_example_has_the_main_guard():
     assert 'if __name__ == "__main__":' in block
     assert block.index("__main__") < block.index("run_sweep(")
     assert "trust" in readme[readme.index("scheduler=` (and `--scheduler`)") :][:300]
+
+
+def test_unreadable_stored_fit_is_named_and_fitted_again(tmp_path, record_csv):
+    from randvib.identification.fitting import read_record
+    from randvib.studies.campaign import identify_cached
+
+    path = tmp_path / "fit.json"
+    path.write_text("")  # a zero-byte file left by a crash
+    record = read_record(record_csv[0])
+    kwargs = dict(m=0.0226, popsize=8, maxiter=2, polish=False)
+    with pytest.warns(UserWarning, match="fit.json.* unusable"):
+        fit = identify_cached(path, record, "coulomb", **kwargs)
+    again = identify_cached(path, record, "coulomb", **kwargs)  # now loaded, not refitted
+    assert again.parameters == fit.parameters and json.loads(path.read_text())["model"] == "coulomb"
