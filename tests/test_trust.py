@@ -385,6 +385,8 @@ def test_identify_fixed_values_and_bounds_obey_parameter_rules(capsys, record_cs
         (["--k3", "1e308"], "no finite result"),
         (["--psd", "1e308", "--method", "fpk-fast"], "no finite result"),
         (["--m", "1e-300", "--method", "fpk-fast"], "no finite result"),
+        (["--excitation", "band-pass", "--f0", "1e308", "--zeta", "0.1"], "no finite result"),
+        (["--alpha", "1e308", "--r-load", "1", "--r-coil", "1"], "not a finite number"),
     ],
 )
 def test_power_never_prints_nan(capsys, device, fragment):
@@ -453,8 +455,9 @@ def test_unexpected_exception_is_one_line_exit_1(capsys, monkeypatch):
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
 
 
-def test_unreachable_scheduler_fails_fast_with_a_message():
+def test_unreachable_scheduler_fails_fast_with_a_message(monkeypatch):
     pytest.importorskip("distributed")
+    monkeypatch.setattr(sweep_module, "SCHEDULER_TIMEOUT", 2)
     with pytest.raises(ValueError, match="cannot connect to a Dask scheduler"):
         sweep_module.make_executor(scheduler="tcp://127.0.0.1:1")
 

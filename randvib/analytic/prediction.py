@@ -244,6 +244,11 @@ def _finite(method: str, harvester: Harvester, psd, solver) -> PowerPrediction:
         raise ValueError(
             _out_of_range(method, harvester, psd, f"{type(exc).__name__}: {exc}")
         ) from None
+    except ValueError as exc:
+        if "`" in str(exc):  # randvib's own messages name their argument in backticks
+            raise
+        # a library's (scipy: "array must not contain infs or NaNs") after an overflow
+        raise ValueError(_out_of_range(method, harvester, psd, f"ValueError: {exc}")) from None
     values = {
         "velocity_variance": result.velocity_variance,
         "displacement_variance": result.displacement_variance,
@@ -262,7 +267,7 @@ def _finite(method: str, harvester: Harvester, psd, solver) -> PowerPrediction:
 
 
 def _out_of_range(method, harvester, psd, what) -> str:
-    level = getattr(psd, "level", psd)
+    level = psd.parameters() if isinstance(psd, Excitation) else psd
     return (
         f"method {method!r} has no finite result at these values ({what}): psd = {level!r}, "
         f"{harvester.parameters()}; the parameters are outside the range float64 can "

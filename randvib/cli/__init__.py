@@ -53,6 +53,7 @@ def main(argv=None) -> int:
         # numpy's floating-point warnings at extreme values: every result is
         # checked for finiteness instead, and refused with a message naming it
         warnings.filterwarnings("ignore", category=RuntimeWarning, module=r"(numpy|scipy|randvib)")
+        warnings.filterwarnings("ignore", message=r"Matrix is exactly singular")
         return _main(argv)
 
 

@@ -100,16 +100,22 @@ def harvester_from_args(args) -> Harvester:
             raise ValueError("`--alpha`, `--r-load` and `--r-coil` must be given together")
         for name in ("m", "c_m", "k"):
             _need(values[name], option_flag(name), "the device")
-        return Harvester.from_electrical(
-            m=values["m"],
-            c_m=values["c_m"],
-            k=values["k"],
-            k3=values["k3"],
-            alpha=args.alpha,
-            r_load=args.r_load,
-            r_coil=args.r_coil,
-            friction=friction,
-        )
+        try:
+            return Harvester.from_electrical(
+                m=values["m"],
+                c_m=values["c_m"],
+                k=values["k"],
+                k3=values["k3"],
+                alpha=args.alpha,
+                r_load=args.r_load,
+                r_coil=args.r_coil,
+                friction=friction,
+            )
+        except (OverflowError, ZeroDivisionError):
+            raise ValueError(
+                f"`--alpha` {args.alpha!r}, `--r-load` {args.r_load!r}, `--r-coil` "
+                f"{args.r_coil!r}: c_e = alpha^2 / (r_load + r_coil) is not a finite number"
+            ) from None
     for name in ("m", "c_m", "c_e", "k"):
         _need(values[name], option_flag(name), "the device (or use --preset)")
     return Harvester(friction=friction, **values)

@@ -8,9 +8,11 @@ exactly) or ``--psd`` (flat level, (m/s^2)^2/Hz) between ``--f-lo`` and
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from randvib._io import check_output_file
+from randvib._resources import check_memory
 from randvib.cli._device import add_device_arguments, harvester_from_args
 from randvib.identification.synthetic import PAPER_BAND, SYNTHETIC_INPUTS, synthetic_record
 from randvib.models.excitation import BandLimited
@@ -54,6 +56,10 @@ def run(args) -> int:
         raise ValueError(
             f"`--input` must be one of {', '.join(SYNTHETIC_INPUTS)}; got {args.input!r}"
         )
+    samples = float(args.duration) * float(args.sample_rate)
+    if math.isfinite(samples):
+        # the excitation, its spectrum, the response and the CSV text, about 12 floats a sample
+        check_memory(f"a record of {samples:.3g} samples", 96.0 * samples, "shorten `--duration`")
     excitation = args.rms if args.psd is None else BandLimited(args.psd, args.f_lo, args.f_hi)
     record = synthetic_record(
         harvester_from_args(args),
