@@ -425,7 +425,7 @@ def test_simulate_extreme_values_one_line(capsys, argv, fragment):
     "extra, fragment",
     [
         (["--lowpass", "1e-308"], "`lowpass` must be at least"),
-        (["--seed", "-1"], "non-negative"),
+        (["--seed", "-1"], "`seed` must be an integer in 0 .."),
         (["--sample-rate", "1e-308", "--time-column", "none"], "search bounds of"),
     ],
 )
@@ -590,3 +590,9 @@ def test_unreadable_stored_fit_is_named_and_fitted_again(tmp_path, record_csv):
         fit = identify_cached(path, record, "coulomb", **kwargs)
     again = identify_cached(path, record, "coulomb", **kwargs)  # now loaded, not refitted
     assert again.parameters == fit.parameters and json.loads(path.read_text())["model"] == "coulomb"
+
+
+def test_record_seed_out_of_range_named(capsys, tmp_path):
+    argv = ["record", "--preset", "figure9", "--rms", "2", "--out", tmp_path / "x.csv"]
+    one_line_error(capsys, [*argv, "--seed", "-1"], "`--seed` must be an integer in 0 ..")
+    one_line_error(capsys, [*argv, "--duration", "1e23"], "of memory")

@@ -54,7 +54,13 @@ def main(argv=None) -> int:
         # checked for finiteness instead, and refused with a message naming it
         warnings.filterwarnings("ignore", category=RuntimeWarning, module=r"(numpy|scipy|randvib)")
         warnings.filterwarnings("ignore", message=r"Matrix is exactly singular")
+        warnings.showwarning = _show_warning
         return _main(argv)
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None):
+    """A warning as one line naming its kind (no source file, no code line)."""
+    print(f"randvib: warning ({category.__name__}): {message}", file=file or sys.stderr)
 
 
 def _main(argv) -> int:

@@ -13,6 +13,7 @@ from pathlib import Path
 
 from randvib._io import check_output_file
 from randvib._resources import check_memory
+from randvib._validation import MAX_SEED, check_int
 from randvib.cli._device import add_device_arguments, harvester_from_args
 from randvib.identification.synthetic import PAPER_BAND, SYNTHETIC_INPUTS, synthetic_record
 from randvib.models.excitation import BandLimited
@@ -50,6 +51,7 @@ def run(args) -> int:
     if out.exists() and not out.is_dir() and not args.force:
         raise FileExistsError(f"`--out` {str(out)!r} exists; choose a new name or give --force")
     check_output_file(out, "--out", overwrite=args.force)
+    check_int("--seed", args.seed, 0, MAX_SEED)
     if (args.rms is None) == (args.psd is None):
         raise ValueError("give exactly one of `--rms` (m/s^2) and `--psd` ((m/s^2)^2/Hz)")
     if args.input not in SYNTHETIC_INPUTS:

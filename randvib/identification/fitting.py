@@ -34,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from randvib._validation import check_int, check_nonnegative, check_positive
+from randvib._validation import MAX_SEED, check_int, check_nonnegative, check_positive
 from randvib.identification.record_simulation import (
     HOLDS,
     INPUT_KINDS,
@@ -157,6 +157,10 @@ class SearchSettings:
     tol: float = 1e-6
     patience: int | None = 40
     polish: bool = True
+
+    def __post_init__(self):
+        if isinstance(self.seed, int | np.integer) and not isinstance(self.seed, bool):
+            check_int("seed", self.seed, 0, MAX_SEED)
 
     def to_dict(self) -> dict:
         return _fields_of(self)
