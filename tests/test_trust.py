@@ -26,6 +26,7 @@ from _cli import one_line_error, run
 import randvib as rv
 import randvib.montecarlo.sweep as sweep_module
 from randvib import _io
+from randvib._resources import available_memory
 from randvib.montecarlo.simulation import simulate
 from randvib.montecarlo.sweep import SweepSettings, cartesian, run_sweep
 
@@ -139,6 +140,7 @@ def _holder_script(folder, seconds):
         f"""
         import sys, time
         from randvib import _io
+from randvib._resources import available_memory
         _io.lock_folder({str(folder)!r})
         print("locked", flush=True)
         time.sleep({seconds})
@@ -186,6 +188,7 @@ def test_simultaneous_runs_into_one_new_folder_one_wins(tmp_path):
         f"""
         import sys, time
         from randvib import _io
+from randvib._resources import available_memory
         time.sleep(max(0.0, float(sys.argv[2]) - time.time()))
         try:
             _io.prepare_output_dir({str(folder)!r}, {{"grid": int(sys.argv[1])}})
@@ -466,6 +469,10 @@ def test_unreachable_scheduler_fails_fast_with_a_message(monkeypatch):
 def test_work_that_cannot_fit_is_refused_with_the_estimate():
     with pytest.raises(ValueError, match="needs about .* of memory"):
         simulate(BASE, 1.0, t_end=0.1, dt=1e-4, n_paths=8, histogram_bins=10**12)
+    # the issue's case, killed at 24 GB: counts, their sum and densities exceed the memory
+    if available_memory() < 8 * 8 * 10**9:
+        with pytest.raises(ValueError, match="needs about .* of memory"):
+            simulate(BASE, 1.0, t_end=0.1, dt=1e-4, n_paths=8, histogram_bins=10**9)
 
 
 def test_population_that_cannot_fit_is_refused(capsys, record_csv):

@@ -502,7 +502,8 @@ def _check_resources(run: _Run, batch_paths, progress) -> None:
     rec = run.record
     n_bytes = 8.0 * (
         2 * n_paths * kernel.N_ACC  # per-path averages, and one batch's
-        + chunks * 2 * rec.histogram_bins  # histogram counts per chunk
+        # histogram counts per chunk, their sum, then densities and bin edges
+        + (chunks * 2 + 6) * rec.histogram_bins
         + min(rec.record_paths, n_paths) * (n_steps // rec.record_every + 1) * 3
     )
     check_memory(
