@@ -140,7 +140,6 @@ def _holder_script(folder, seconds):
         f"""
         import sys, time
         from randvib import _io
-from randvib._resources import available_memory
         _io.lock_folder({str(folder)!r})
         print("locked", flush=True)
         time.sleep({seconds})
@@ -188,7 +187,6 @@ def test_simultaneous_runs_into_one_new_folder_one_wins(tmp_path):
         f"""
         import sys, time
         from randvib import _io
-from randvib._resources import available_memory
         time.sleep(max(0.0, float(sys.argv[2]) - time.time()))
         try:
             _io.prepare_output_dir({str(folder)!r}, {{"grid": int(sys.argv[1])}})
