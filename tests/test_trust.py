@@ -601,3 +601,20 @@ def test_record_seed_out_of_range_named(capsys, tmp_path):
     argv = ["record", "--preset", "figure9", "--rms", "2", "--out", tmp_path / "x.csv"]
     one_line_error(capsys, [*argv, "--seed", "-1"], "`--seed` must be an integer in 0 ..")
     one_line_error(capsys, [*argv, "--duration", "1e23"], "of memory")
+
+
+def test_ctrl_c_in_a_study_exits_130_and_releases_its_folder(capsys, tmp_path, monkeypatch):
+    simulate(BASE, 1.0, t_end=0.01, dt=1e-4, n_paths=2, progress=False)
+
+    def long_study(out_dir, *, quick, seed, workers, scheduler, progress):
+        out = _io.prepare_output_dir(out_dir, {"study": "long"})
+        _io.write_tracked(out / "first.csv", "finished part\n")
+        simulate(BASE, 1.0, t_end=2000.0, dt=1e-4, n_paths=200, progress=False)
+
+    monkeypatch.setattr("randvib.cli.study.load_study", lambda name: long_study)
+    timer = _interrupt_after(1.0)
+    code, out, err = run(capsys, "study", "interaction", "--out", tmp_path / "s")
+    timer.cancel()
+    assert code == 130 and "Traceback" not in err
+    assert (tmp_path / "s" / "first.csv").read_text() == "finished part\n"  # kept
+    assert not (tmp_path / "s" / _io.LOCK_FILE).exists()
