@@ -4,16 +4,38 @@ A study or sweep writes into a folder together with ``metadata.json`` that
 describes what produced it (study name, grid, seeds, versions). Re-running
 into the same folder with the same description resumes; a different
 description is refused, naming the folder and the first differing key.
+
+While a run writes into a folder it holds the folder's lock
+(:data:`LOCK_FILE`: pid, host, start time); a second run is refused with the
+holder named, and the lock of a run that was killed (its pid gone on this
+host) is taken over. Files that a user may edit (reports, figures, tables)
+are written with :func:`write_tracked`, which records their checksums in
+:data:`WRITTEN_FILE` and refuses to replace a file changed since, unless
+:func:`overwrite_edited` allows it (``--force``). Output paths are checked
+before any computation (:func:`check_output_file`, :func:`check_output_folder`).
 """
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
+import hashlib
 import json
+import math
 import os
 import platform
+import tempfile
 from pathlib import Path
 
+# the folder locks, used here and re-exported for callers of this module
+from randvib._locks import LOCK_FILE as LOCK_FILE
+from randvib._locks import lock_folder as lock_folder
+from randvib._locks import release_all as release_all
+from randvib._locks import unlock_folder as unlock_folder
+
 METADATA_FILE = "metadata.json"
+#: Checksums (SHA-256) of the files written with :func:`write_tracked`.
+WRITTEN_FILE = ".randvib-written.json"
 
 
 def versions() -> dict:
@@ -60,18 +82,31 @@ def prepare_output_dir(out_dir, identity: dict, extra: dict | None = None) -> Pa
     Path
         The folder.
     """
-    out = Path(out_dir)
-    if out.exists() and not out.is_dir():
-        raise FileExistsError(f"`out` {str(out)!r} exists and is not a folder")
+    out = check_output_folder(out_dir, "out")
     identity = _jsonable(identity)
+    if out.exists() and not (out / METADATA_FILE).exists() and _foreign_entries(out):
+        raise FileExistsError(
+            f"`out` folder {str(out)!r} is not empty and has no randvib metadata; "
+            "choose an empty or new folder"
+        )
+    out.mkdir(parents=True, exist_ok=True)
+    lock_folder(out)
+    try:
+        return _open_locked(out, identity, extra)
+    except BaseException:
+        unlock_folder(out)
+        raise
+
+
+def _foreign_entries(out: Path) -> list:
+    return [p for p in out.iterdir() if p.name not in (LOCK_FILE, WRITTEN_FILE)]
+
+
+def _open_locked(out: Path, identity: dict, extra) -> Path:
+    """:func:`prepare_output_dir` once the folder's lock is held."""
     meta_path = out / METADATA_FILE
-    if meta_path.exists():
-        try:
-            old = json.loads(meta_path.read_text())["identity"]
-        except (ValueError, KeyError):
-            raise FileExistsError(
-                f"{str(meta_path)!r} is not a randvib metadata file; choose another `--out` folder"
-            ) from None
+    if meta_path.exists() or meta_path.is_symlink():
+        old = _read_identity(meta_path)
         if old != identity:
             keys = sorted(set(old) | set(identity))
             diff = next(k for k in keys if old.get(k) != identity.get(k))
@@ -81,12 +116,11 @@ def prepare_output_dir(out_dir, identity: dict, extra: dict | None = None) -> Pa
                 "choose another folder or delete it yourself"
             )
         return out
-    if out.exists() and any(out.iterdir()):
+    if _foreign_entries(out):  # filled by another run between our look and our lock
         raise FileExistsError(
             f"`out` folder {str(out)!r} is not empty and has no randvib metadata; "
             "choose an empty or new folder"
         )
-    out.mkdir(parents=True, exist_ok=True)
     atomic_write_text(
         meta_path,
         json.dumps(
@@ -96,9 +130,202 @@ def prepare_output_dir(out_dir, identity: dict, extra: dict | None = None) -> Pa
     return out
 
 
-def atomic_write_text(path, text: str) -> None:
-    """Write a file via a temporary name and rename, so a crash never leaves half a file."""
+def _read_identity(meta_path: Path) -> dict:
+    """The identity stored in ``metadata.json``, or a refusal naming the file."""
+    try:
+        old = json.loads(meta_path.read_text())["identity"]
+        if not isinstance(old, dict):
+            raise TypeError
+    except (OSError, ValueError, KeyError, TypeError, UnicodeDecodeError):
+        raise FileExistsError(
+            f"{str(meta_path)!r} is not a randvib metadata file (a JSON object with an "
+            "'identity'); choose another `--out` folder"
+        ) from None
+    return old
+
+
+# ------------------------------------------------------------------ output paths
+def check_output_file(path, option: str, *, overwrite: bool = False) -> Path:
+    """Check, before any computation, that ``path`` can be written as a new file.
+
+    Its folder must exist, be a folder and be writable; ``path`` must not be a
+    folder, nor (unless ``overwrite``) an existing file.
+
+    Raises
+    ------
+    FileExistsError, FileNotFoundError, PermissionError
+        Naming ``option`` and the path.
+    """
     path = Path(path)
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text)
-    os.replace(tmp, path)
+    parent = path.parent
+    if path.is_dir():
+        raise FileExistsError(f"`{option}` {str(path)!r} is a folder; give a file name")
+    if path.exists() and not overwrite:
+        raise FileExistsError(f"`{option}` {str(path)!r} exists; choose a new file name")
+    if not parent.exists():
+        raise FileNotFoundError(
+            f"`{option}` {str(path)!r}: folder {str(parent)!r} does not exist; create it first"
+        )
+    if not parent.is_dir():
+        raise FileExistsError(f"`{option}` {str(path)!r}: {str(parent)!r} is not a folder")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise PermissionError(f"`{option}` {str(path)!r}: folder {str(parent)!r} is not writable")
+    return path
+
+
+def check_output_folder(path, option: str) -> Path:
+    """Check that ``path`` is, or can be created as, a writable folder.
+
+    The nearest existing ancestor must be a writable folder (``path`` is
+    created with its missing parents when the run starts).
+    """
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise FileExistsError(f"`{option}` {str(path)!r} exists and is not a folder")
+    existing = path
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    if not existing.is_dir():
+        raise FileExistsError(
+            f"`{option}` {str(path)!r}: {str(existing)!r} is a file, not a folder"
+        )
+    if not os.access(existing, os.W_OK | os.X_OK):
+        raise PermissionError(f"`{option}` {str(path)!r}: {str(existing)!r} is not writable")
+    return path
+
+
+def write_or_keep(path, text: str, option: str) -> Path | None:
+    """Write ``text`` to the new file ``path``; if that fails, keep it beside, saying where.
+
+    For results of long runs: the path was checked before the run, but the
+    disk may have filled or the folder gone since. On failure the text goes to
+    a new file in the current folder (or, failing that, to stderr) and a note
+    says so; the returned path is where it is (None: printed).
+    """
+    import sys
+
+    try:
+        Path(path).write_text(text)
+        return Path(path)
+    except OSError as exc:
+        reason = exc.strerror or type(exc).__name__
+        fd, spare = tempfile.mkstemp(prefix="randvib-unsaved-", suffix=Path(path).suffix, dir=".")
+        try:
+            with os.fdopen(fd, "w") as f:
+                f.write(text)
+        except OSError:
+            print(f"randvib: could not write `{option}` {str(path)!r} ({reason}); the result:",
+                  file=sys.stderr)  # fmt: skip
+            print(text, file=sys.stderr)
+            return None
+        print(f"randvib: could not write `{option}` {str(path)!r} ({reason}); "
+              f"the result is kept in {spare!r}", file=sys.stderr)  # fmt: skip
+        return Path(spare)
+
+
+# ------------------------------------------------------------------ atomic writes
+def atomic_write_bytes(path, data: bytes) -> None:
+    """Write a file via a unique temporary name and rename, so a crash never leaves
+    half a file and two writers never share a temporary file."""
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+
+
+def atomic_write_text(path, text: str) -> None:
+    """Write a text file atomically (:func:`atomic_write_bytes`)."""
+    atomic_write_bytes(path, text.encode())
+
+
+def sha256(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
+
+
+# ------------------------------------------------------------------ edited files
+_OVERWRITE_EDITED = contextvars.ContextVar("overwrite_edited", default=False)
+
+
+@contextlib.contextmanager
+def overwrite_edited(allowed: bool = True):
+    """Within this block :func:`write_tracked` replaces files edited since written (--force)."""
+    token = _OVERWRITE_EDITED.set(bool(allowed))
+    try:
+        yield
+    finally:
+        _OVERWRITE_EDITED.reset(token)
+
+
+def _written(folder: Path) -> dict:
+    try:
+        data = json.loads((folder / WRITTEN_FILE).read_text())
+        return data if isinstance(data, dict) else {}
+    except (OSError, ValueError):
+        return {}
+
+
+def write_tracked(path, data: bytes | str) -> Path:
+    """Write ``path`` atomically unless the user changed it since randvib wrote it.
+
+    The SHA-256 of every file written here is kept in the folder's
+    :data:`WRITTEN_FILE`. An existing file whose content differs from the
+    recorded checksum (edited, or not written by randvib) is not replaced:
+    :class:`FileExistsError` names it, unless inside :func:`overwrite_edited`.
+    """
+    path = Path(path)
+    data = data.encode() if isinstance(data, str) else data
+    record = _written(path.parent)
+    if path.exists() and not _OVERWRITE_EDITED.get():
+        old = sha256(path.read_bytes())
+        if record.get(path.name) != old:
+            raise FileExistsError(
+                f"{str(path)!r} was changed since randvib wrote it (or randvib did not write "
+                "it); move it away, or give --force to overwrite it"
+            )
+    atomic_write_bytes(path, data)
+    record[path.name] = sha256(data)
+    atomic_write_text(path.parent / WRITTEN_FILE, json.dumps(record, indent=1, sort_keys=True))
+    return path
+
+
+# ------------------------------------------------------------------ JSON
+def finite_json(obj, reason: str = "not a finite number at these values"):
+    """``obj`` with every non-finite float replaced by None, and the reasons by key.
+
+    Returns
+    -------
+    clean : object
+        JSON-ready: NaN and infinities become None (JSON ``null``).
+    nulls : dict
+        Dotted key -> why that value is null.
+    """
+    nulls: dict = {}
+
+    def clean(value, key):
+        if isinstance(value, dict):
+            return {k: clean(v, f"{key}.{k}" if key else str(k)) for k, v in value.items()}
+        if isinstance(value, list | tuple):
+            return [clean(v, f"{key}[{i}]") for i, v in enumerate(value)]
+        if hasattr(value, "tolist") and not isinstance(value, str):
+            return clean(value.tolist(), key)
+        if isinstance(value, float) and not math.isfinite(value):
+            nulls[key] = f"{reason} ({value!r})"
+            return None
+        return value
+
+    return clean(obj, ""), nulls
+
+
+def dumps(obj, **kwargs) -> str:
+    """Valid JSON of ``obj`` (never NaN or Infinity): non-finite numbers become null,
+    and a top-level ``null_reasons`` object says why (when ``obj`` is a dict)."""
+    clean, nulls = finite_json(obj)
+    if nulls and isinstance(clean, dict):
+        clean["null_reasons"] = nulls
+    return json.dumps(clean, allow_nan=False, **kwargs)

@@ -63,12 +63,18 @@ def check_choice(name: str, value, allowed) -> str:
     return value
 
 
-def check_int(name: str, value, minimum: int = 0) -> int:
+def check_int(name: str, value, minimum: int = 0, maximum: int | None = None) -> int:
+    """An integer in ``[minimum, maximum]`` (no upper limit when ``maximum`` is None)."""
+    allowed = f">= {minimum}" if maximum is None else f"in {minimum} .. {maximum}"
     if isinstance(value, bool) or not isinstance(value, numbers.Integral):
-        raise ValueError(f"`{name}` must be an integer >= {minimum}, got {value!r}")
-    if value < minimum:
-        raise ValueError(f"`{name}` must be an integer >= {minimum}, got {value!r}")
+        raise ValueError(f"`{name}` must be an integer {allowed}, got {value!r}")
+    if value < minimum or (maximum is not None and value > maximum):
+        raise ValueError(f"`{name}` must be an integer {allowed}, got {value!r}")
     return int(value)
+
+
+#: Largest seed: the random streams are keyed by an unsigned 64-bit integer.
+MAX_SEED = 2**64 - 1
 
 
 def scalar_or_array(arr: np.ndarray):

@@ -24,7 +24,6 @@ viscous models identified on test 3.
 
 from __future__ import annotations
 
-import json
 import sys
 import time
 from pathlib import Path
@@ -33,6 +32,7 @@ import numpy as np
 import pandas as pd
 
 import randvib as rv
+from randvib._io import dumps, write_tracked
 from randvib.identification.plots import figure_costs, figure_fit
 from randvib.models.presets import ALPHA, R_COIL
 from randvib.studies import script_main
@@ -305,8 +305,9 @@ def run_study(
     tests = {n: make_test(n, **common)[0] for n in range(1, 10)}
     write_records(tests, out)
     fits = identify_all(tests, out, settings, seed, progress)
-    (out / "identified.json").write_text(
-        json.dumps({f"test{t}-{m}": r.to_dict() for (t, m), r in fits.items()}, indent=2)
+    write_tracked(
+        out / "identified.json",
+        dumps({f"test{t}-{m}": r.to_dict() for (t, m), r in fits.items()}, indent=2),
     )
     costs = cost_table(fits, tests, dict(enumerate(TEST_RMS, start=1)))
     exact = noise_free_fit(common, settings, seed, progress)

@@ -17,11 +17,11 @@ table ``results.csv`` and the fitted parameters as ``linear.json`` and
 
 from __future__ import annotations
 
-import json
 import sys
 
 import pandas as pd
 
+from randvib._io import dumps, write_tracked
 from randvib.datasets import silverbox
 from randvib.identification.fitting import identify, predict_record
 from randvib.studies import script_main
@@ -61,7 +61,7 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
     rows, params = [], {}
     for label, fixed in MODELS.items():
         res, fit_rows = fit_and_validate(estimation, validation, label, fixed, opt, seed, progress)
-        (out / f"{label.split()[0].lower()}.json").write_text(json.dumps(res.to_dict(), indent=2))
+        write_tracked(out / f"{label.split()[0].lower()}.json", dumps(res.to_dict(), indent=2))
         rows += fit_rows
         params[label] = res.parameters
     table = pd.DataFrame(rows)

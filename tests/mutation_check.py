@@ -373,6 +373,20 @@ MUTATIONS: tuple[Mutation, ...] = (
         "the exact step integral (1.6 % too much power at 20 Hz, a phase shift of half a "
         "step); the increments must equal the closed-form integrals to rounding.",
     ),
+    Mutation(
+        name="resume-trusts-stored-rows",
+        path="randvib/montecarlo/sweep.py",
+        edits=(
+            (
+                'if _row_checksum(row) != stored.get("row_sha256"):',
+                'if _row_checksum(row) == "trusted":',
+            ),
+        ),
+        tests=("tests/test_trust.py::test_corrupted_point_is_named_and_recomputed",),
+        why="A resumed sweep trusts each stored row without its checksum, so a stored power "
+        "changed on disk (doubled) flows into the table and the verdicts; the test doubles "
+        "one and requires it to be recomputed.",
+    ),
 )
 
 

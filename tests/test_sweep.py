@@ -270,7 +270,7 @@ def test_resume_interrupted_sweep_without_recomputing(tmp_path, monkeypatch):
         run_sweep(BASE, pts, FAST, out_dir=tmp_path / "s", workers=1, progress=False)
     saved = sorted((tmp_path / "s" / "points").glob("*.json"))
     assert len(saved) == 2
-    first = [json.loads(p.read_text()) for p in saved]
+    first = [json.loads(p.read_text())["row"] for p in saved]
 
     calls.clear()
 

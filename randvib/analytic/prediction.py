@@ -272,25 +272,86 @@ def predict(harvester: Harvester, psd, method: str = "linearisation") -> PowerPr
     ------
     ValueError
         For an unknown method, a bad ``psd``, a non-white excitation with
-        a method that assumes white noise, or a potential the method cannot
-        treat (one line naming what it accepts).
+        a method that assumes white noise, a potential the method cannot
+        treat (one line naming what it accepts), a device with neither
+        damping nor friction (no stationary state), or values at which the
+        method's result is not a finite float64 (overflow at extreme parameters).
     """
     check_choice("method", method, tuple(METHODS))
     harvester.potential.require(f"method {method!r}", CONFINING + ("free",))
+    _refuse_undamped(harvester)
     if harvester.has_circuit:
         if method not in CIRCUIT:
             _refuse_circuit(method, harvester)
         if not isinstance(psd, Excitation):
             psd = as_excitation(float(check_positive("psd", psd, "(m/s^2)^2/Hz")))
-        return CIRCUIT[method](harvester, psd)
+        return _finite(method, harvester, psd, CIRCUIT[method])
     if isinstance(psd, Excitation):
         if not psd.is_white:
             if method not in COLOURED:
                 _refuse_coloured(method, psd)
-            return COLOURED[method](harvester, psd)
+            return _finite(method, harvester, psd, COLOURED[method])
         psd = psd.level  # white: exactly the code of a plain number
     check_positive("psd", psd, "(m/s^2)^2/Hz")
-    return METHODS[method](harvester, psd)
+    return _finite(method, harvester, psd, METHODS[method])
+
+
+def _refuse_undamped(harvester: Harvester) -> None:
+    """No damping and no friction: the energy grows without bound, nothing is stationary.
+
+    A circuit state (inductive, piezo) dissipates in its resistance: it damps.
+    """
+    c = np.asarray(harvester.c_m + harvester.c_e, dtype=float)
+    friction = harvester.friction
+    if harvester.has_circuit:
+        return
+    if np.any(c == 0) and (friction is None or friction.vanishes):
+        raise ValueError(
+            "the device has no damping (c_m + c_e = 0) and no friction: under random "
+            "excitation its energy grows without bound and has no stationary power; "
+            "give `c_m` or `c_e` > 0"
+        )
+
+
+def _finite(method: str, harvester: Harvester, psd, solver) -> PowerPrediction:
+    """``solver(harvester, psd)``, refused where it is not a finite float64 (scalar case)."""
+    try:
+        with np.errstate(all="ignore"):
+            result = solver(harvester, psd)
+    except (ArithmeticError, RuntimeError) as exc:
+        raise ValueError(
+            _out_of_range(method, harvester, psd, f"{type(exc).__name__}: {exc}")
+        ) from None
+    except ValueError as exc:
+        if "`" in str(exc):  # randvib's own messages name their argument in backticks
+            raise
+        # a library's (scipy: "array must not contain infs or NaNs") after an overflow
+        raise ValueError(_out_of_range(method, harvester, psd, f"ValueError: {exc}")) from None
+    values = {
+        "velocity_variance": result.velocity_variance,
+        "displacement_variance": result.displacement_variance,  # None for the free mass
+        "power_electrical": result.power_electrical,  # zero without electrical damping
+    }
+    values = {name: value for name, value in values.items() if value is not None}
+    if any(np.ndim(v) for v in values.values()):
+        return result  # arrays: the caller's grid may hold points of any kind
+    bad = [
+        f"{name} = {value!r}"
+        for name, value in values.items()
+        if not np.isfinite(value) or (value <= 0 and name != "power_electrical")
+    ]
+    if bad:
+        raise ValueError(_out_of_range(method, harvester, psd, ", ".join(bad)))
+    return result
+
+
+def _out_of_range(method, harvester, psd, what) -> str:
+    level = psd.parameters() if isinstance(psd, Excitation) else psd
+    return (
+        f"method {method!r} has no finite result at these values ({what}): psd = {level!r}, "
+        f"{harvester.parameters()}; the parameters are outside the range float64 can "
+        "represent for this device"
+    )
 
 
 def expected_power(

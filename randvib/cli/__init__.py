@@ -2,16 +2,21 @@
 
 Each command lives in its own module exposing ``register(subparsers)`` which
 adds its parser and sets ``handler``; :data:`COMMANDS` lists the modules.
-Every user error (bad value, unknown name, unreadable file) ends with one
-line on stderr and exit status 2, never a traceback.
+Every user error (bad value, unknown name, unreadable or unwritable file)
+ends with one line on stderr and exit status 2, never a traceback; Ctrl-C
+ends with exit status 130 (what was finished is kept). Anything else that
+escapes a command is a bug: one line naming it, exit status 1, and the
+traceback only with ``RANDVIB_TRACEBACK=1``.
 """
 
 from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import re
 import sys
+import warnings
 
 #: Command modules under randvib.cli, in the order shown by --help.
 COMMANDS = ["power", "simulate", "study", "record", "identify", "validate"]
@@ -54,26 +59,44 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
+    with warnings.catch_warnings():
+        # numpy's floating-point warnings at extreme values: every result is
+        # checked for finiteness instead, and refused with a message naming it
+        warnings.filterwarnings("ignore", category=RuntimeWarning, module=r"(numpy|scipy|randvib)")
+        warnings.filterwarnings("ignore", message=r"Matrix is exactly singular")
+        warnings.showwarning = _show_warning
+        return _main(argv)
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None):
+    """A warning as one line naming its kind (no source file, no code line)."""
+    print(f"randvib: warning ({category.__name__}): {message}", file=file or sys.stderr)
+
+
+def _main(argv) -> int:
     try:
         parser = build_parser()
         args = parser.parse_args(argv)
         return int(args.handler(args) or 0)
-    except (
-        UserError,
-        ValueError,
-        FileNotFoundError,
-        FileExistsError,
-        PermissionError,
-        NotImplementedError,
-    ) as exc:
+    except (UserError, ValueError, OSError, NotImplementedError) as exc:
         message = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         if not message.startswith("randvib"):
             message = f"randvib: error: {message}"
         print(message, file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print("randvib: interrupted", file=sys.stderr)
+        print("randvib: interrupted; finished results were kept", file=sys.stderr)
         return 130
+    except Exception as exc:  # a bug: one line, not a traceback (unless asked for)
+        if os.environ.get("RANDVIB_TRACEBACK"):
+            raise
+        text = str(exc).strip().splitlines()
+        print(
+            f"randvib: internal error: {type(exc).__name__}: {text[0] if text else ''} "
+            "(please report it; RANDVIB_TRACEBACK=1 shows the traceback)",
+            file=sys.stderr,
+        )
+        return 1
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -121,15 +121,21 @@ def harvester_from_args(args) -> Harvester:
     if coupling is not None:
         for name in ("m", "c_m", "k"):
             _need(values[name], option_flag(name), "the device")
-        return Harvester.with_coupling(
-            values["m"],
-            values["c_m"],
-            values["k"],
-            coupling,
-            k3=values["k3"],
-            friction=friction,
-            stroke=args.stroke,
-        )
+        try:
+            return Harvester.with_coupling(
+                values["m"],
+                values["c_m"],
+                values["k"],
+                coupling,
+                k3=values["k3"],
+                friction=friction,
+                stroke=args.stroke,
+            )
+        except (OverflowError, ZeroDivisionError):
+            flags = ", ".join(f"`{option_flag(n)}`" for n in coupling.parameter_names())
+            raise ValueError(
+                f"{flags}: the {coupling.name} coupling's electrical damping is not a finite number"
+            ) from None
     for name in ("m", "c_m", "c_e", "k"):
         _need(values[name], option_flag(name), "the device (or use --preset)")
     return Harvester(friction=friction, stroke=args.stroke, **values)

@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-import json
+import sys
 from pathlib import Path
 
+from randvib._io import check_output_file, dumps, write_or_keep
 from randvib.cli._output import print_table
 from randvib.cli._records import (
     add_record_arguments,
@@ -54,12 +55,18 @@ def register(sub) -> None:
 
 
 def _new_file(path, option):
-    if path is None:
-        return None
-    path = Path(path)
-    if path.exists():
-        raise FileExistsError(f"`{option}` {str(path)!r} exists; choose a new file name")
-    return path
+    """Checked before the fit, so that a long fit is never thrown away at the end."""
+    return None if path is None else check_output_file(path, option)
+
+
+def _save_plot(result, record, plot: Path, title: str) -> None:
+    """The figure; if it cannot be written now, say so and keep going (the result is printed)."""
+    from randvib.identification.plots import figure_fit
+
+    try:
+        figure_fit(result.predict(record), plot, title=title)
+    except OSError as exc:
+        print(f"randvib: could not write `--plot` {str(plot)!r} ({exc})", file=sys.stderr)
 
 
 def run(args) -> int:
@@ -81,13 +88,11 @@ def run(args) -> int:
     )
     out = result.to_dict()
     if save is not None:
-        save.write_text(json.dumps(out, indent=2))
+        write_or_keep(save, dumps(out, indent=2), "--save")
     if plot is not None:
-        from randvib.identification.plots import figure_fit
-
-        figure_fit(result.predict(record), plot, title=f"{args.model} model on {record.name}")
+        _save_plot(result, record, plot, f"{args.model} model on {record.name}")
     if args.json:
-        print(json.dumps(out))
+        print(dumps(out))
         return 0
     rows = [
         [name, value, UNITS[name], "identified" if name in result.free else "fixed"]

@@ -9,8 +9,7 @@ do, and the JSON gains an ``excitation`` object describing it.
 
 from __future__ import annotations
 
-import json
-
+from randvib._io import dumps
 from randvib.analytic.prediction import CIRCUIT, COLOURED, METHODS, predict
 from randvib.cli._device import add_device_arguments, harvester_from_args
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
@@ -88,7 +87,7 @@ def run(args) -> int:
     if coloured:
         out["excitation"] = psd.parameters()
     if args.json:
-        print(json.dumps(out))
+        print(dumps(out))
     else:
         units = {
             "psd": "(m/s^2)^2/Hz",

@@ -8,8 +8,12 @@ exactly) or ``--psd`` (flat level, (m/s^2)^2/Hz) between ``--f-lo`` and
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
+from randvib._io import check_output_file
+from randvib._resources import check_memory
+from randvib._validation import MAX_SEED, check_int
 from randvib.cli._device import add_device_arguments, harvester_from_args
 from randvib.identification.synthetic import PAPER_BAND, SYNTHETIC_INPUTS, synthetic_record
 from randvib.models.excitation import BandLimited
@@ -44,14 +48,20 @@ def register(sub) -> None:
 
 def run(args) -> int:
     out = Path(args.out)
-    if out.exists() and not args.force:
+    if out.exists() and not out.is_dir() and not args.force:
         raise FileExistsError(f"`--out` {str(out)!r} exists; choose a new name or give --force")
+    check_output_file(out, "--out", overwrite=args.force)
+    check_int("--seed", args.seed, 0, MAX_SEED)
     if (args.rms is None) == (args.psd is None):
         raise ValueError("give exactly one of `--rms` (m/s^2) and `--psd` ((m/s^2)^2/Hz)")
     if args.input not in SYNTHETIC_INPUTS:
         raise ValueError(
             f"`--input` must be one of {', '.join(SYNTHETIC_INPUTS)}; got {args.input!r}"
         )
+    samples = float(args.duration) * float(args.sample_rate)
+    if math.isfinite(samples):
+        # the excitation, its spectrum, the response and the CSV text, about 12 floats a sample
+        check_memory(f"a record of {samples:.3g} samples", 96.0 * samples, "shorten `--duration`")
     excitation = args.rms if args.psd is None else BandLimited(args.psd, args.f_lo, args.f_hi)
     record = synthetic_record(
         harvester_from_args(args),

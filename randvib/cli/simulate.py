@@ -10,8 +10,7 @@ giving the interval.
 
 from __future__ import annotations
 
-import json
-
+from randvib._io import dumps
 from randvib.analytic.prediction import predict
 from randvib.cli._device import add_device_arguments, harvester_from_args
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
@@ -97,7 +96,7 @@ def run(args) -> int:
         )
     summary = result.summary()
     if args.json:
-        print(json.dumps(summary))
+        print(dumps(summary))
         return 0
     analytic = None
     if harvester.friction is None or harvester.friction.has_equivalent_damping:

@@ -27,7 +27,11 @@ def register(sub) -> None:
         "writes PNG figures, CSV tables and a Markdown report into --out.",
     )
     p.add_argument("name", help=f"study: {', '.join(STUDIES)}")
-    p.add_argument("--out", required=True, help="output folder (created; never overwritten)")
+    p.add_argument(
+        "--out",
+        required=True,
+        help="output folder (created; a rerun resumes; edited files kept unless --force)",
+    )
     add_run_options(p)
     p.set_defaults(handler=run)
 

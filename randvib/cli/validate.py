@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import argparse
 import json
 from pathlib import Path
 
+from randvib._io import check_output_folder, dumps
 from randvib.cli._output import print_table
 from randvib.cli._records import (
     add_record_arguments,
@@ -12,7 +14,9 @@ from randvib.cli._records import (
     record_from_args,
     simulation_settings,
 )
-from randvib.identification.fitting import MODELS, validate
+from randvib.identification.fitting import MODELS, SimulationSettings, check_parameter, validate
+
+SIMULATION_FIELDS = tuple(SimulationSettings().to_dict())
 
 
 def register(sub) -> None:
@@ -39,6 +43,8 @@ def register(sub) -> None:
 
 def _load_parameters(path):
     path = Path(path)
+    if path.is_dir():
+        raise IsADirectoryError(f"parameter file {str(path)!r} is a folder; give a JSON file")
     if not path.is_file():
         raise FileNotFoundError(f"parameter file {str(path)!r} does not exist")
     try:
@@ -49,18 +55,42 @@ def _load_parameters(path):
         raise ValueError(
             f"{str(path)!r} is not an identification result (JSON with 'model' and 'parameters')"
         ) from None
-    if model not in MODELS:
+    if not isinstance(model, str) or model not in MODELS:
         raise ValueError(f"{str(path)!r}: model {model!r} is not one of {', '.join(MODELS)}")
     return model, parameters, data.get("settings", {})
 
 
+def _settings(args, saved: dict, path):
+    """The simulation settings: the command line's over the file's, each checked as identify's."""
+    if not isinstance(saved, dict):
+        raise ValueError(f"{str(path)!r}: 'settings' must be a JSON object, got {saved!r}")
+    try:
+        simulation_settings(argparse.Namespace(**dict.fromkeys(SIMULATION_FIELDS)), saved)
+    except (ValueError, TypeError) as exc:
+        raise ValueError(f"{str(path)!r}: settings: {exc}") from None
+    return simulation_settings(args, saved)
+
+
+def _overrides(items, model: str) -> dict:
+    """``--set NAME=VALUE``: a parameter of ``model``, valued as the model allows."""
+    return {
+        name: check_parameter(model, name, value, f"--set {name}")
+        for name, value in parse_assignments(items, "--set").items()
+    }
+
+
 def run(args) -> int:
     model, parameters, saved = _load_parameters(args.params)
-    parameters.update(parse_assignments(args.set, "--set"))
-    settings = simulation_settings(args, saved)
+    for name, value in parameters.items():
+        try:
+            check_parameter(model, name, value)
+        except ValueError as exc:
+            raise ValueError(f"{str(args.params)!r}: {exc}") from None
+    parameters.update(_overrides(args.set, model))
+    settings = _settings(args, saved, args.params)
     plot_dir = None
     if args.plot is not None:
-        plot_dir = Path(args.plot)
+        plot_dir = check_output_folder(args.plot, "--plot")
         if plot_dir.exists() and any(plot_dir.iterdir()):
             raise FileExistsError(f"`--plot` folder {str(plot_dir)!r} is not empty")
         plot_dir.mkdir(parents=True, exist_ok=True)
@@ -77,7 +107,7 @@ def run(args) -> int:
             )
     if args.json:
         print(
-            json.dumps(
+            dumps(
                 {
                     "model": model,
                     "parameters": parameters,

@@ -34,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from randvib._validation import check_finite, check_int, check_positive
+from randvib._validation import MAX_SEED, check_int, check_nonnegative, check_positive
 from randvib.identification.record_simulation import (
     HOLDS,
     INPUT_KINDS,
@@ -157,6 +157,10 @@ class SearchSettings:
     tol: float = 1e-6
     patience: int | None = 40
     polish: bool = True
+
+    def __post_init__(self):
+        if isinstance(self.seed, int | np.integer) and not isinstance(self.seed, bool):
+            check_int("seed", self.seed, 0, MAX_SEED)
 
     def to_dict(self) -> dict:
         return _fields_of(self)
@@ -379,6 +383,8 @@ def _read_csv(path: Path):
     """The CSV as a DataFrame with string column names; parse errors as ValueError."""
     import pandas as pd
 
+    if path.is_dir():
+        raise IsADirectoryError(f"record file {str(path)!r} is a folder; give a CSV file")
     if not path.is_file():
         raise FileNotFoundError(f"record file {str(path)!r} does not exist")
     try:
@@ -500,9 +506,14 @@ class CostFunction:
         self.drive, self.base_input = driving_signal(
             record.input, record.dt, record.input_kind, lowpass
         )
+        if skip > record.n - 2:
+            raise ValueError(
+                f"`skip` = {skip} leaves fewer than 2 of the {record.n} samples of record "
+                f"{record.name!r} to score; use --skip <= {max(record.n - 2, 0)}"
+            )
         scored = record.z[skip:]
         self.variance = float(np.var(scored))
-        if self.variance == 0:
+        if self.variance == 0 or np.ptp(scored) == 0 or not np.isfinite(self.variance):
             raise ValueError(
                 f"`{OUTPUT_COLUMN}` of record {record.name!r} is constant; J (Eq. 11) is undefined"
             )
@@ -733,7 +744,7 @@ def _resolve_fixed(model, fixed, m, record):
                 f"`--fix {key}`: unknown parameter for model {model!r}; allowed: "
                 f"{', '.join(names + ('m',))}"
             )
-        fixed[key] = float(check_finite(f"--fix {key}", value))
+        fixed[key] = check_parameter(model, key, value, f"--fix {key}")
     if m is not None:
         if "m" in fixed and fixed["m"] != float(m):
             raise ValueError(f"`m` given twice with different values: {m} and --fix m={fixed['m']}")
@@ -809,6 +820,7 @@ def identify(
     fixed = _resolve_fixed(model, fixed, m, record)
     space = _search_space(record, model, fixed, bounds, simulation.skip)
     cost = _identification_cost(record, model, fixed, space.free, simulation)
+    _announce(record, search, simulation, len(space.free))
     start = time.perf_counter()
     res = sade(
         cost,
@@ -822,6 +834,29 @@ def identify(
     )
     elapsed = time.perf_counter() - start
     return _identification_result(cost, space, res, elapsed, search, simulation)
+
+
+def _announce(record: Record, search: SearchSettings, simulation: SimulationSettings, d) -> None:
+    """Refuse a population that cannot fit; say how long a long identification will take
+    (at most popsize x (maxiter + 1) simulations)."""
+    import numba
+
+    from randvib._resources import announce_duration
+    from randvib.identification.sade import check_population_memory
+
+    popsize, maxiter = check_int("popsize", search.popsize, 6), check_int("maxiter", search.maxiter)
+    check_population_memory(popsize, d)
+    steps = float(popsize) * (maxiter + 1) * record.n * simulation.substeps
+    announce_duration(
+        f"identification ({popsize} x {maxiter + 1} simulations of {record.n} samples)",
+        steps / (RECORD_STEPS_PER_SECOND * numba.get_num_threads()),
+        stacklevel=4,
+    )
+
+
+#: Rough speed of the compiled record simulation (sub-steps per second per
+#: thread), for the duration estimate of long identifications.
+RECORD_STEPS_PER_SECOND = 5e7
 
 
 @dataclass(frozen=True)
@@ -842,6 +877,10 @@ def _search_space(record, model, fixed, bounds, skip) -> _SearchSpace:
             f"record {record.name!r} has {record.n} samples; the {model} model with "
             f"{len(free)} free parameters needs at least {needed}"
         )
+    if np.ptp(record.z[skip:]) == 0:
+        raise ValueError(
+            f"`{OUTPUT_COLUMN}` of record {record.name!r} is constant; J (Eq. 11) is undefined"
+        )
     box = default_bounds(record, model, fixed.get("m"))
     box.update(_user_bounds(model, bounds))
     unbounded = [name for name in free if name not in box]
@@ -851,6 +890,15 @@ def _search_space(record, model, fixed, bounds, skip) -> _SearchSpace:
             "fix them (`--fix NAME=VALUE`) or bound them (`--bounds NAME=LO:HI`)"
         )
     specs = _specs(model)
+    for name in free:
+        lo, hi = box[name]
+        positive = specs[name].positive
+        if not (np.isfinite(lo) and np.isfinite(hi) and lo <= hi and (lo > 0 or not positive)):
+            raise ValueError(
+                f"the search bounds of `{name}` are ({lo!r}, {hi!r}), which model {model!r} "
+                f"cannot search: the record {record.name!r} (its sample rate and amplitudes) "
+                f"is outside the range of its default bounds; give `--bounds {name}=LO:HI`"
+            )
     return _SearchSpace(
         free=free,
         box={name: box[name] for name in free},
@@ -867,11 +915,30 @@ def _user_bounds(model, bounds) -> dict:
                 f"`--bounds {name}`: unknown parameter for model {model!r}; allowed: "
                 f"{', '.join(allowed)}"
             )
-        lo, hi = (float(check_finite(f"bounds {name}", x)) for x in pair)
+        lo, hi = (check_parameter(model, name, x, f"--bounds {name}") for x in pair)
         if lo > hi:
             raise ValueError(f"`--bounds {name}`: lower {lo!r} > upper {hi!r}")
         out[name] = (lo, hi)
     return out
+
+
+def check_parameter(model: str, name: str, value, label: str | None = None) -> float:
+    """``value`` of parameter ``name`` of ``model`` as a float, if the model allows it.
+
+    The rules are the declarations' (:data:`DEVICE_SPECS` and the friction
+    law's ``parameter(...)`` fields): finite, and > 0 for a positive
+    parameter (m, k, Fc, ...), >= 0 for the others (c, k3, ...). They hold
+    for fixed values, search bounds and validated parameters alike.
+    """
+    spec = _specs(model).get(name)
+    label = label or name
+    if spec is None:
+        raise ValueError(
+            f"`{label}`: unknown parameter for model {model!r}; allowed: "
+            f"{', '.join(('m',) + MODEL_PARAMETERS[model])}"
+        )
+    check = check_positive if spec.positive else check_nonnegative
+    return float(check(label, value, spec.unit))
 
 
 def _identification_cost(record, model, fixed, free, simulation) -> CostFunction:
@@ -905,6 +972,12 @@ def _named_callback(callback, free):
 
 
 def _identification_result(cost, space, res, elapsed, search, simulation):
+    if not np.isfinite(res.fun):
+        raise ValueError(
+            f"no candidate of the {cost.model} model could simulate record "
+            f"{cost.record.name!r} (best J = {res.fun!r}): every simulation diverged; check the "
+            f"fixed values {cost.fixed} and the bounds {space.box}"
+        )
     parameters = {**dict(zip(space.free, map(float, res.x), strict=True)), **cost.fixed}
     order = ("m",) + MODEL_PARAMETERS[cost.model]
     seconds = cost.seconds
@@ -987,7 +1060,7 @@ def _check_parameters(parameters, model):
         raise ValueError(
             f"parameters for model {model!r} lack {missing}; needed: {', '.join(names)}"
         )
-    return {n: float(check_finite(n, parameters[n])) for n in names}
+    return {n: check_parameter(model, n, parameters[n]) for n in names}
 
 
 def predict_record(

@@ -480,6 +480,12 @@ def lowpass_filter(x, dt, cutoff):
         raise ValueError(
             f"`lowpass` must be below the Nyquist frequency {nyquist:.6g} Hz, got {cutoff}"
         )
+    lowest = 1.0 / (max(len(x), 1) * dt)  # one cycle over the record
+    if cutoff < lowest:
+        raise ValueError(
+            f"`lowpass` must be at least {lowest:.6g} Hz (one cycle over the record's "
+            f"{len(x) * dt:.6g} s), got {cutoff!r}"
+        )
     sos = signal.butter(4, cutoff / nyquist, output="sos")
     return signal.sosfiltfilt(sos, x)
 

@@ -36,6 +36,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from randvib._resources import check_memory
 from randvib._validation import check_int
 
 STRATEGIES = ("rand/1/bin", "rand-to-best/2/bin", "rand/2/bin", "current-to-rand/1")
@@ -291,6 +292,7 @@ def sade(
         patience = check_int("patience", patience, minimum=1)
     rng = np.random.default_rng(seed)
     d = space.lo.size
+    check_population_memory(popsize, d)
     start = time.perf_counter()
     evaluate = _batched_cost(func, space)
 
@@ -351,6 +353,16 @@ def sade(
         costs=costs,
         elapsed=time.perf_counter() - start,
         polished=polished,
+    )
+
+
+def check_population_memory(popsize: int, d: int) -> None:
+    """Refuse a population that cannot fit in memory, with the estimate."""
+    # a dozen (popsize, d) float arrays and a few per-member vectors live at once
+    check_memory(
+        f"a SaDE population of {popsize} x {d}",
+        8.0 * popsize * (12 * d + 30),
+        "use a smaller `popsize` (`--popsize`)",
     )
 
 

@@ -407,9 +407,9 @@ def auxiliary_step(z, v, theta, x1, x2, x3, dt, noise, weights, drift, kind, p, 
     )
 
 
-@numba.njit(cache=True, parallel=True)
+@numba.njit(cache=True, parallel=True, nogil=True)
 def run_ensemble(
-    scheme, device, friction, timing, paths, initial, companion, recording, noise, auxiliary
+    scheme, device, friction, timing, paths, initial, companion, recording, noise, auxiliary, stop
 ):
     """Integrate ``paths.count`` paths and return per-path time averages.
 
@@ -439,6 +439,11 @@ def run_ensemble(
         white noise with a resistive circuit. With a random start they start
         from N(0, L L^T), L = ``auxiliary.start`` (``auxiliary.n`` more draws
         per path, after the device's).
+    stop : int64[1]
+        Set non-zero from another thread (Ctrl-C) to stop every path at its
+        next check (every CHECK_EVERY steps); the results are then partial
+        and the caller discards them. The loop releases the GIL (nogil) so
+        that the caller's thread can watch for the interrupt.
 
     Returns
     -------
@@ -607,7 +612,7 @@ def run_ensemble(
                     if not (np.isfinite(z[j]) and np.isfinite(v[j]) and np.isfinite(th[j])):
                         failed[start + j] = n + 1
                         stopped = True
-                if stopped:
+                if stopped or stop[0] != 0:
                     break
         for j in range(lanes):
             p = start + j

@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import os
 import sys
+import threading
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -40,7 +41,8 @@ import numba
 import numpy as np
 from scipy import linalg, special  # Student t quantile; lighter than scipy.stats
 
-from randvib._validation import check_choice, check_int, check_positive
+from randvib._resources import announce_duration, check_memory
+from randvib._validation import MAX_SEED, check_choice, check_int, check_positive
 from randvib.analytic import exact_solutions as exact
 from randvib.analytic.linear_response import device_block, output_variances
 from randvib.analytic.linearisation import equivalent_damping, linear_displacement_variance
@@ -56,6 +58,10 @@ from randvib.montecarlo.rng import ZIG_FI, ZIG_KI, ZIG_WI
 #: Largest stationary-variance bias (relative) of the scheme on the linearised
 #: device for which a step is accepted; see :func:`step_bias`.
 MAX_STEP_BIAS = 0.10
+#: Most steps per path (int64 step counters, with room to spare).
+MAX_STEPS = 2**62
+#: Largest path index (streams are keyed by unsigned 64-bit integers).
+MAX_PATH_INDEX = 2**62
 #: Bias above which a warning is issued.
 WARN_STEP_BIAS = 0.01
 
@@ -743,6 +749,68 @@ def _linearised_spread(harvester: Harvester, excitation: Excitation) -> tuple[fl
     return float(np.sqrt(linear_displacement_variance(harvester, vv))), float(np.sqrt(vv))
 
 
+def _check_scales(run: _Run) -> None:
+    """Refuse parameters whose linearised scales are not finite float64 numbers.
+
+    Extreme values (m = 1e308, k3 = 1e308, S = 1e308) overflow the
+    step-size check and the stationary start; they are named here instead.
+    """
+    h, excitation = run.harvester, run.excitation
+    try:
+        with np.errstate(all="ignore"):
+            if excitation.shaping_filter() is None:  # synthesised input
+                k_eff, c_eff = _linearised_under(h, excitation)[:2]
+            else:
+                k_eff, c_eff = effective_linear_device(h, excitation.level)
+            spread = _linearised_spread(h, excitation)
+    except (ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
+        problem = f"{type(exc).__name__}: {exc}"
+    else:
+        values = (k_eff, c_eff, *spread)
+        # the free mass has no stiffness and no stationary spread in z
+        positive = values[1:2] + values[3:] if h.potential.is_free else values
+        if all(np.isfinite(values)) and all(v > 0 for v in positive):
+            return
+        problem = f"k_eff = {k_eff:.3g}, c_eff = {c_eff:.3g}, std z, v = {spread}"
+    raise ValueError(
+        f"the device's linearised scales are not finite positive float64 numbers ({problem}) "
+        f"at psd = {run.psd!r} and {run.harvester.parameters()}: the parameters are out of "
+        "range, or the device has neither damping nor friction"
+    )
+
+
+#: Rough speed of the compiled loop, path-steps per second per thread, for
+#: the duration estimate of long runs (Heun, Coulomb friction; measured on a
+#: laptop core, about 3e7).
+PATH_STEPS_PER_SECOND = 3e7
+
+
+def _check_resources(run: _Run, batch_paths, progress) -> None:
+    """Refuse a run whose arrays cannot fit in memory; announce a long one."""
+    n_steps, n_paths = run.grid.n_steps, run.n_paths
+    batch = n_paths if batch_paths is None else min(int(batch_paths), n_paths)
+    chunks = -(-batch // kernel.LANES)
+    rec = run.record
+    n_bytes = 8.0 * (
+        2 * n_paths * kernel.N_ACC  # per-path averages, and one batch's
+        # histogram counts per chunk, their sum, then densities and bin edges
+        + (chunks * 2 + 6) * rec.histogram_bins
+        + min(rec.record_paths, n_paths) * (n_steps // rec.record_every + 1) * 3
+    )
+    check_memory(
+        f"simulating {n_paths} paths of {n_steps} steps",
+        n_bytes,
+        "reduce `n_paths` (`--paths`), `histogram_bins` or `record_paths`, or run in parts "
+        "with `first_path`",
+    )
+    work = float(n_paths) * n_steps * (2 if run.companion else 1)
+    announce_duration(
+        f"simulating {n_paths} paths x {n_steps} steps",
+        work / (PATH_STEPS_PER_SECOND * numba.get_num_threads()),
+        stacklevel=4,
+    )
+
+
 def _check_step(scheme, harvester, excitation, dt):
     bias = step_bias(scheme, harvester, excitation, dt)
     states = []
@@ -755,6 +823,12 @@ def _check_step(scheme, harvester, excitation, dt):
     resolves = f" with {' and '.join(states)}" if states else ""
     if bias > MAX_STEP_BIAS:
         limit = largest_step(scheme, harvester, excitation)
+        if not limit > 0:
+            raise ValueError(
+                f"`dt` = {dt!r} s is too large for this device{resolves} with {scheme}, and no "
+                f"representable step is small enough (its linearised stiffness and damping "
+                f"{effective_linear_device(harvester, excitation.level)} are out of range)"
+            )
         raise ValueError(
             f"`dt` = {dt!r} s is too large for this device{resolves} with {scheme}: on the "
             f"linearised device its stationary variance is off by {bias:.3g} "
@@ -797,6 +871,11 @@ class TimeGrid:
         if not (np.isfinite(burn_in) and 0.0 <= burn_in < t_end):
             raise ValueError(
                 f"`burn_in` must satisfy 0 <= burn_in < t_end = {t_end!r} s, got {burn_in!r}"
+            )
+        if not t_end / dt <= MAX_STEPS:
+            raise ValueError(
+                f"`t_end` / `dt` = {t_end:g} s / {dt:g} s = {t_end / dt:.3g} steps per path; "
+                f"at most {MAX_STEPS:.3g} can be counted: shorten `t_end` or enlarge `dt`"
             )
         grid = cls(dt, int(round(t_end / dt)), int(round(burn_in / dt)))
         if grid.window_steps < 1:
@@ -1050,12 +1129,15 @@ def execute(run: _Run, *, control_variates, check_step, threads, batch_paths, pr
     """Run a validated :class:`_Run` (see :func:`simulate` for the options)."""
     _check_coloured_options(run.excitation, run.companion, control_variates)
     _check_circuit_options(run.harvester, run.companion)
+    if check_step or run.initial.kind == "stationary":
+        _check_scales(run)
     if check_step:
         _check_step(run.scheme.name, run.harvester, run.excitation, run.grid.dt)
     setup = _KernelSetup.prepare(run)
     if threads is not None:
         threads = check_int("threads", threads, 1)
         numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+    _check_resources(run, batch_paths, progress)
     if progress is None:
         progress = sys.stderr.isatty() and os.environ.get("CI") is None
     if batch_paths is None and run.driver is not None:  # the input's memory stays bounded
@@ -1123,7 +1205,7 @@ def _validated(
     excitation = _simulated_excitation(psd)
     grid = TimeGrid.from_times(t_end, dt, burn_in)
     n_paths = check_int("n_paths", n_paths, 1)
-    seed = check_int("seed", seed, 0)
+    seed = check_int("seed", seed, 0, MAX_SEED)
     driver = None
     if excitation.shaping_filter() is None:  # synthesised input: the kernel takes its increments
         if dW is not None:
@@ -1141,7 +1223,7 @@ def _validated(
         grid=grid,
         n_paths=n_paths,
         seed=seed,
-        first_path=check_int("first_path", first_path, 0),
+        first_path=check_int("first_path", first_path, 0, MAX_PATH_INDEX),
         initial=InitialState.from_argument(initial),
         record=RecordOptions.validated(*record),
         dW=_checked_increments(dW, n_paths, grid.n_steps),
@@ -1409,7 +1491,9 @@ def _run_batches(run: _Run, setup: _KernelSetup, batches, progress: bool):
         bar = tqdm(total=run.n_paths, unit="path", desc="simulate", leave=False, delay=3.0)
     try:
         for lo, hi in batches:
-            acc, failed, hist, rec = kernel.run_ensemble(**setup.arguments(run, lo, hi))
+            acc, failed, hist, rec = interruptible(
+                kernel.run_ensemble, **setup.arguments(run, lo, hi)
+            )
             _raise_if_diverged(run, lo, failed)
             per_path[lo:hi] = acc
             if run.record.histogram_bins > 0:
@@ -1423,6 +1507,39 @@ def _run_batches(run: _Run, setup: _KernelSetup, batches, progress: bool):
             bar.close()
     hist_groups = np.concatenate(hist_groups) if hist_groups else None
     return per_path, hist_groups, records
+
+
+def interruptible(compiled, **kwargs):
+    """Call a compiled (nogil) loop so that Ctrl-C stops it within a fraction of a second.
+
+    A compiled loop does not see signals, so it runs in a worker thread while
+    this (main) thread waits; on KeyboardInterrupt the shared ``stop`` flag is
+    set, the loop ends at its next check, and KeyboardInterrupt is raised
+    (finished batches, points and fits are kept by the callers).
+    """
+    stop = np.zeros(1, dtype=np.int64)
+    if threading.current_thread() is not threading.main_thread():
+        return compiled(stop=stop, **kwargs)  # signals only reach the main thread
+    outcome = {}
+
+    def target():
+        try:
+            outcome["value"] = compiled(stop=stop, **kwargs)
+        except BaseException as exc:  # handed to the caller's thread
+            outcome["error"] = exc
+
+    worker = threading.Thread(target=target, name="randvib-kernel", daemon=True)
+    worker.start()
+    try:
+        while worker.is_alive():
+            worker.join(0.05)
+    except KeyboardInterrupt:
+        stop[0] = 1
+        worker.join()
+        raise
+    if "error" in outcome:
+        raise outcome["error"]
+    return outcome["value"]
 
 
 def _raise_if_diverged(run: _Run, lo: int, failed: np.ndarray) -> None:

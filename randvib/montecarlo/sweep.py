@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import io
 import itertools
 import json
 import math
@@ -42,8 +43,16 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from randvib._io import atomic_write_text, prepare_output_dir
-from randvib._validation import check_int, check_positive
+from randvib._io import (
+    atomic_write_bytes,
+    atomic_write_text,
+    dumps,
+    finite_json,
+    prepare_output_dir,
+    sha256,
+    unlock_folder,
+)
+from randvib._validation import MAX_SEED, check_int, check_positive
 from randvib.analytic.prediction import METHODS, predict
 from randvib.models.harvester import Harvester
 from randvib.montecarlo.integrators import scheme_argument
@@ -115,7 +124,7 @@ class SweepSettings:
         check_int("min_paths", self.min_paths, 8)
         check_int("batch_paths", self.batch_paths, 1)
         check_int("max_paths", self.max_paths, self.min_paths)
-        check_int("seed", self.seed, 0)
+        check_int("seed", self.seed, 0, MAX_SEED)
 
     @property
     def method(self) -> str:
@@ -243,6 +252,31 @@ def run_point(base: Harvester, point: Mapping, settings: SweepSettings, threads:
 
 
 # ------------------------------------------------------------------ executors
+#: Seconds to wait for a Dask scheduler to answer.
+SCHEDULER_TIMEOUT = 10
+
+
+def _worker_start(parent: int, initializer=None) -> None:
+    """In each local worker: end when the parent goes, then the user's initializer.
+
+    A sweep killed with SIGTERM or SIGKILL cannot shut its pool down; its
+    workers would live on (one numba-loaded interpreter each). A daemon
+    thread in every worker checks once a second that the parent is still
+    there and ends the worker when it is not.
+    """
+    import threading
+
+    def watch():
+        while True:
+            time.sleep(1.0)
+            if os.getppid() != parent:
+                os._exit(1)
+
+    threading.Thread(target=watch, name="randvib-parent-watch", daemon=True).start()
+    if initializer is not None:
+        initializer()
+
+
 def make_executor(workers: int | None = None, scheduler: str | None = None, initializer=None):
     """An executor and a closer: local processes, or a Dask cluster at ``scheduler``.
 
@@ -255,7 +289,14 @@ def make_executor(workers: int | None = None, scheduler: str | None = None, init
             raise ValueError(
                 "`scheduler` needs Dask distributed: pip install 'randvib[distributed]'"
             ) from None
-        client = Client(scheduler)
+        try:
+            # a short connect timeout: a wrong address fails in seconds, not after 30 s
+            client = Client(scheduler, timeout=SCHEDULER_TIMEOUT)
+        except (OSError, TimeoutError, ValueError, TypeError) as exc:
+            raise ValueError(
+                f"`scheduler` {scheduler!r}: cannot connect to a Dask scheduler there within "
+                f"{SCHEDULER_TIMEOUT} s ({type(exc).__name__}: {str(exc).splitlines()[0]})"
+            ) from None
         return client.get_executor(pure=False), client.close
     workers = os.cpu_count() or 1 if workers is None else check_int("workers", workers, 1)
     if workers == 1:
@@ -267,9 +308,21 @@ def make_executor(workers: int | None = None, scheduler: str | None = None, init
     pool = ProcessPoolExecutor(
         max_workers=workers,
         mp_context=multiprocessing.get_context("spawn"),
-        initializer=initializer,
+        initializer=functools.partial(_worker_start, os.getpid(), initializer),
     )
-    return pool, lambda: pool.shutdown(cancel_futures=True)
+    return pool, functools.partial(_close_pool, pool)
+
+
+def _close_pool(pool: ProcessPoolExecutor) -> None:
+    """Shut the pool down; after Ctrl-C (or any error) do not wait for running points."""
+    import sys
+
+    if sys.exc_info()[0] is not None:
+        # the points in flight are lost anyway: end their workers now
+        # (ProcessPoolExecutor has no public way to)
+        for process in list(getattr(pool, "_processes", {}).values()):
+            process.terminate()
+    pool.shutdown(cancel_futures=True)
 
 
 # ------------------------------------------------------------------ sweep
@@ -292,12 +345,18 @@ class SweepResult:
 class _PointStore:
     """A sweep's result folder: one JSON row and one ``.npy`` of per-path data per point.
 
-    Every finished point is written atomically (temporary name, then rename),
-    so an interrupted sweep resumes from the points already on disk;
-    ``results.csv`` is rewritten from the rows after each point. A folder
-    holding another sweep (different identity) is refused untouched by
-    :func:`randvib._io.prepare_output_dir`.
+    Every finished point is written atomically (unique temporary name, then
+    rename), so an interrupted sweep resumes from the points already on disk;
+    the JSON holds the point, its row, and the shape and SHA-256 of the
+    ``.npy``, and every stored point is checked when resumed (its grid point,
+    finite statistics, the array's checksum, shape and finite values); a bad
+    one is named in a warning and recomputed. ``results.csv`` is rebuilt from
+    the rows on every run and after each point. A folder holding another sweep
+    (different identity) is refused untouched, and the folder is locked while
+    the sweep writes (:func:`randvib._io.prepare_output_dir`).
     """
+
+    FORMAT = 2
 
     def __init__(self, out_dir, identity: dict):
         self.out = prepare_output_dir(out_dir, identity)
@@ -309,21 +368,92 @@ class _PointStore:
     def _row(self, index: int) -> Path:
         return self.out / "points" / f"{index:05d}.json"
 
-    def load_finished(self, n_points: int):
-        """Rows and per-path arrays of the points already on disk."""
+    def load_finished(self, points: list):
+        """Rows and per-path arrays of the good points already on disk."""
         rows, per_path = {}, {}
-        for i in range(n_points):
-            if self._row(i).exists() and self._paths(i).exists():
-                rows[i] = json.loads(self._row(i).read_text())
-                per_path[i] = np.load(self._paths(i))
+        for i, point in enumerate(points):
+            if not (self._row(i).exists() or self._paths(i).exists()):
+                continue
+            try:
+                rows[i], per_path[i] = self._load(i, point)
+            except _BadPoint as exc:
+                warnings.warn(
+                    f"sweep point {i} in {str(self.out / 'points')!r} is unusable ({exc}); "
+                    "recomputing it",
+                    stacklevel=3,
+                )
+        self.write_table(rows)
         return rows, per_path
 
-    def save(self, index: int, row: dict, paths: np.ndarray, rows: dict) -> None:
-        tmp = self._paths(index).with_suffix(".tmp.npy")
-        np.save(tmp, paths)
-        os.replace(tmp, self._paths(index))
-        atomic_write_text(self._row(index), json.dumps(row))
+    def _load(self, index: int, point: Mapping):
+        """One stored point, checked; :class:`_BadPoint` says what is wrong."""
+        from randvib.montecarlo.kernel import N_ACC
+
+        row_file, npy_file = self._row(index), self._paths(index)
+        try:
+            stored = json.loads(row_file.read_text())
+            data = npy_file.read_bytes()
+        except (OSError, ValueError, UnicodeDecodeError) as exc:
+            raise _BadPoint(f"cannot read {exc.__class__.__name__}: {exc}") from None
+        if not isinstance(stored, dict) or stored.get("format") != self.FORMAT:
+            raise _BadPoint(f"{row_file.name} is not a point record of this randvib version")
+        row, shape = stored.get("row"), stored.get("shape")
+        if stored.get("point") != _jsonable_point(point) or not isinstance(row, dict):
+            raise _BadPoint(f"{row_file.name} holds another grid point: {stored.get('point')}")
+        values = [row.get(k) for k in (*STATISTICS, "n_paths")]
+        if not all(isinstance(v, int | float) and math.isfinite(v) for v in values):
+            raise _BadPoint(f"{row_file.name} lacks finite statistics")
+        if _row_checksum(row) != stored.get("row_sha256"):
+            raise _BadPoint(
+                f"{row_file.name}: the row does not match the checksum recorded with it"
+            )
+        if sha256(data) != stored.get("sha256"):
+            raise _BadPoint(f"{npy_file.name} does not match the checksum recorded with it")
+        try:
+            paths = np.load(io.BytesIO(data), allow_pickle=False)
+        except (OSError, ValueError) as exc:
+            raise _BadPoint(f"{npy_file.name}: {exc}") from None
+        if list(paths.shape) != shape or shape != [row["n_paths"], N_ACC]:
+            raise _BadPoint(f"{npy_file.name} has shape {paths.shape}, expected {shape}")
+        if not np.all(np.isfinite(paths)):
+            raise _BadPoint(f"{npy_file.name} holds non-finite values")
+        return row, paths
+
+    def save(self, index: int, point: Mapping, row: dict, paths: np.ndarray, rows: dict) -> None:
+        buffer = io.BytesIO()
+        np.save(buffer, paths, allow_pickle=False)
+        data = buffer.getvalue()
+        atomic_write_bytes(self._paths(index), data)
+        row = finite_json(row, "not computable at this point")[0]
+        stored = {
+            "format": self.FORMAT,
+            "point": _jsonable_point(point),
+            "row": row,
+            "row_sha256": _row_checksum(row),
+            "shape": list(paths.shape),
+            "sha256": sha256(data),
+        }
+        atomic_write_text(self._row(index), dumps(stored))
+        self.write_table(rows)
+
+    def write_table(self, rows: dict) -> None:
         atomic_write_text(self.out / "results.csv", _table(rows).to_csv(index=False))
+
+    def close(self) -> None:
+        unlock_folder(self.out)
+
+
+class _BadPoint(Exception):
+    """A stored sweep point that cannot be trusted (why in the message)."""
+
+
+def _row_checksum(row: dict) -> str:
+    """SHA-256 of a row's canonical JSON (what is stored is what is hashed)."""
+    return sha256(json.dumps(row, sort_keys=True, allow_nan=False).encode())
+
+
+def _jsonable_point(point: Mapping) -> dict:
+    return json.loads(json.dumps({k: float(v) for k, v in point.items()}))
 
 
 def _table(rows: dict) -> pd.DataFrame:
@@ -393,17 +523,21 @@ def run_sweep(
             "settings": settings.to_dict(),
         }
         store = _PointStore(out_dir, identity)
-        rows, per_path = store.load_finished(len(points))
+        try:
+            rows, per_path = store.load_finished(points)
+        except BaseException:
+            store.close()
+            raise
     todo = [i for i in range(len(points)) if i not in rows]
     bar = _progress_bar(len(points), len(points) - len(todo), name) if progress and todo else None
     own_close = None
-    if executor is None and todo:
-        executor, own_close = make_executor(workers, scheduler)
     try:
+        if executor is None and todo:
+            executor, own_close = make_executor(workers, scheduler)
         for i, row, paths in _computed_points(base, points, settings, todo, executor):
             rows[i], per_path[i] = row, paths
             if store is not None:
-                store.save(i, row, paths, rows)
+                store.save(i, points[i], row, paths, rows)
             if bar is not None:
                 bar.update()
     finally:
@@ -411,6 +545,8 @@ def run_sweep(
             bar.close()
         if own_close is not None:
             own_close()
+        if store is not None:
+            store.close()
     return SweepResult(table=_table(rows), settings=settings, points=points, per_path=per_path)
 
 

@@ -100,17 +100,31 @@ def add_run_options(parser: argparse.ArgumentParser) -> None:
         "linearisation-vs-averaging; default: all cores)",
     )
     parser.add_argument(
-        "--scheduler", default=None, help="Dask distributed scheduler ADDRESS to run the sweep on"
+        "--scheduler",
+        default=None,
+        help="Dask distributed scheduler ADDRESS to run the sweep on (it is sent pickled "
+        "Python objects: a cluster you trust only)",
     )
     parser.add_argument("--no-progress", action="store_true", help="no progress bars")
+    parser.add_argument(
+        "--force",
+        action="store_true",
+        help="overwrite reports, tables and figures edited since the study wrote them",
+    )
 
 
 def run_with_options(run_study, name: str, out, args) -> Path:
     """Call a study's ``run_study`` with the options of :func:`add_run_options`.
 
     ``--threads`` goes only to a study that takes it; elsewhere it is refused,
-    because those studies run their sweep on ``--workers`` processes.
+    because those studies run their sweep on ``--workers`` processes. The
+    output folder is checked before anything runs; files the user edited since
+    the study wrote them are kept unless ``--force``; the folder locks taken by
+    the run are released when it ends.
     """
+    from randvib._io import check_output_folder, overwrite_edited, release_all
+
+    check_output_folder(out, "--out")
     extra = {}
     if args.threads is not None:
         if "threads" not in inspect.signature(run_study).parameters:
@@ -118,15 +132,19 @@ def run_with_options(run_study, name: str, out, args) -> Path:
                 f"study {name!r} has no `threads` option; its sweep runs on --workers processes"
             )
         extra["threads"] = args.threads
-    return run_study(
-        out,
-        quick=args.quick,
-        seed=args.seed,
-        workers=args.workers,
-        scheduler=args.scheduler,
-        progress=not args.no_progress,
-        **extra,
-    )
+    try:
+        with overwrite_edited(getattr(args, "force", False)):
+            return run_study(
+                out,
+                quick=args.quick,
+                seed=args.seed,
+                workers=args.workers,
+                scheduler=args.scheduler,
+                progress=not args.no_progress,
+                **extra,
+            )
+    finally:
+        release_all()
 
 
 def script_main(run_study, argv=None) -> int:
@@ -136,7 +154,9 @@ def script_main(run_study, argv=None) -> int:
     options and the same call); for the ``__main__`` block of a study script.
     """
     parser = argparse.ArgumentParser(description=(run_study.__doc__ or "").splitlines()[0])
-    parser.add_argument("out", help="output folder (created; never overwritten)")
+    parser.add_argument(
+        "out", help="output folder (created; a rerun resumes; edited files kept unless --force)"
+    )
     add_run_options(parser)
     args = parser.parse_args(argv)
     name = Path(sys.modules[run_study.__module__].__file__).stem.replace("_", "-")

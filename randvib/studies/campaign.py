@@ -12,12 +12,13 @@ Figure 7, Table 2, exact recovery).
 from __future__ import annotations
 
 import json
+import warnings
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from randvib._io import atomic_write_text
+from randvib._io import atomic_write_text, dumps
 from randvib.identification.fitting import MODEL_PARAMETERS, IdentificationResult, Record, identify
 from randvib.identification.record_simulation import simulate_record
 from randvib.models.excitation import band_limited_excitation
@@ -92,12 +93,20 @@ def identify_cached(path: Path, record: Record, model: str, **kwargs) -> Identif
     """:func:`randvib.identify` of ``model`` on ``record``, kept at ``path`` (JSON).
 
     A fit already at ``path`` is loaded instead of run again, so that an
-    interrupted campaign resumes where it stopped.
+    interrupted campaign resumes where it stopped; one that cannot be read
+    (truncated, edited into something else) is named in a warning and fitted
+    again.
     """
     if Path(path).exists():
-        return load_fit(path)
+        try:
+            return load_fit(path)
+        except (OSError, ValueError, KeyError, TypeError, UnicodeDecodeError) as exc:
+            warnings.warn(
+                f"stored fit {str(path)!r} is unusable ({type(exc).__name__}: {exc}); fitting again",
+                stacklevel=2,
+            )
     result = identify(record, model, **kwargs)
-    atomic_write_text(path, json.dumps(result.to_dict(), indent=2))
+    atomic_write_text(path, dumps(result.to_dict(), indent=2))
     return result
 
 

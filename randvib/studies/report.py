@@ -7,18 +7,20 @@ the numbers behind every sentence of the report, for tests and other
 programs), PNG figures (:func:`save_figure`) and ``report.md``
 (:func:`write_report`), whose tables come from :func:`markdown_table`, the
 one Markdown table writer of the package. Every write is atomic, so an
-interrupted study leaves no half-written file.
+interrupted study leaves no half-written file, and goes through
+:func:`randvib._io.write_tracked`: a rerun into the same folder refuses to
+replace a report, table or figure that the user edited since (``--force``
+allows it).
 """
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-from randvib._io import atomic_write_text, prepare_output_dir
+from randvib._io import dumps, prepare_output_dir, write_tracked
 
 __all__ = [
     "fc_levels",
@@ -61,16 +63,12 @@ def markdown_table(df: pd.DataFrame, floatfmt: str = ".4g", numparse: bool = Tru
 
 def write_table(out_dir: Path, name: str, df: pd.DataFrame) -> Path:
     """Write ``df`` as ``out_dir/name`` (CSV, no index)."""
-    path = Path(out_dir) / name
-    atomic_write_text(path, df.to_csv(index=False))
-    return path
+    return write_tracked(Path(out_dir) / name, df.to_csv(index=False))
 
 
 def write_verdicts(out_dir: Path, verdicts: dict) -> Path:
     """Write the numbers behind the report's verdicts as ``out_dir/verdicts.json``."""
-    path = Path(out_dir) / "verdicts.json"
-    atomic_write_text(path, json.dumps(verdicts, indent=2))
-    return path
+    return write_tracked(Path(out_dir) / "verdicts.json", dumps(verdicts, indent=2))
 
 
 def write_report(
@@ -83,18 +81,19 @@ def write_report(
         text += [intro.strip(), ""]
     for heading, body in sections:
         text += [f"## {heading}", "", body.strip(), ""]
-    path = Path(out_dir) / "report.md"
-    atomic_write_text(path, "\n".join(text))
-    return path
+    return write_tracked(Path(out_dir) / "report.md", "\n".join(text))
 
 
 def save_figure(fig, path: Path) -> Path:
-    """Save ``fig`` as a PNG (120 dpi) and close it."""
+    """Save ``fig`` as a PNG (120 dpi) and close it (refusing to replace an edited one)."""
+    import io
+
     import matplotlib.pyplot as plt
 
-    fig.savefig(path, dpi=120, bbox_inches="tight")
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=120, bbox_inches="tight")
     plt.close(fig)
-    return path
+    return write_tracked(path, buffer.getvalue())
 
 
 def sign_word(rows: pd.DataFrame, column: str = "relative_contrast") -> str:

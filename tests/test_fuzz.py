@@ -1,0 +1,173 @@
+"""Fuzzing the command line and the public functions (issue 13).
+
+Hypothesis draws arguments, ordinary and extreme (0, +-1e308, 1e-308, NaN,
+inf, huge integers), and each test asserts the contract: a command ends with
+exit 0 and finite numbers in valid JSON, or exit 2 with one line on stderr;
+never a traceback, an internal error (exit 1) or a non-finite number with
+exit 0. Sizes are bounded so that no legitimate run is long (a hang would
+show as the test's own timeout).
+"""
+
+import json
+import math
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import randvib as rv
+from randvib.cli import main
+
+EXTREMES = [0.0, -0.0, 1e-308, -1e-308, 1e308, -1e308, 1e-30, 1e30, math.nan, math.inf, -math.inf]
+#: Valid but extreme values, the ones that overflow float64 inside a method.
+HUGE_OR_TINY = [1e308, 1e300, 1e200, 1e-200, 1e-300, 1e-308]
+
+
+def numbers(lo, hi):
+    """Ordinary values in [lo, hi], negatives and the extremes."""
+    return st.one_of(
+        st.floats(lo, hi),
+        st.floats(-hi, -lo),
+        st.sampled_from(EXTREMES),
+    )
+
+
+def devices(**ranges):
+    """Parameter dicts: ordinary values, with one or two of them replaced by an extreme.
+
+    (Drawing every parameter from :func:`numbers` would almost never give a
+    device that is valid but for one extreme value, the case that overflows.)
+    """
+    ordinary = st.fixed_dictionaries({n: st.floats(lo, hi) for n, (lo, hi) in ranges.items()})
+    extreme = st.dictionaries(
+        st.sampled_from(sorted(ranges)),
+        st.one_of(st.sampled_from(EXTREMES), st.sampled_from(HUGE_OR_TINY)),
+        min_size=0,
+        max_size=2,
+    )
+    return st.builds(lambda a, b: {**a, **b}, ordinary, extreme)
+
+
+def _run(capsys, argv):
+    code = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def _check_contract(code, out, err, json_out: bool):
+    assert code in (0, 2), (code, err)
+    assert "Traceback" not in err
+    if code == 2:
+        assert len(err.strip().splitlines()) == 1, err
+        return
+    if json_out:
+        data = json.loads(out, parse_constant=lambda c: pytest.fail(f"{c} in JSON output"))
+        _assert_finite(data)
+    else:
+        for word in ("nan", "inf"):
+            assert word not in out.lower().replace("info", ""), out
+
+
+def _assert_finite(value):
+    if isinstance(value, dict):
+        for v in value.values():
+            _assert_finite(v)
+    elif isinstance(value, list):
+        for v in value:
+            _assert_finite(v)
+    elif isinstance(value, float):
+        assert math.isfinite(value)
+
+
+FUZZ = settings(
+    max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+
+
+@FUZZ
+@given(
+    p=devices(
+        m=(1e-3, 1.0), c_m=(0.0, 1.0), k=(1.0, 1e3), k3=(0.0, 1e6), fc=(0.0, 0.1), psd=(1e-3, 10.0)
+    ),  # fmt: skip
+    method=st.sampled_from(["linearisation", "averaging", "fpk-fast"]),
+    json_out=st.booleans(),
+)
+def test_power_cli_contract(capsys, p, method, json_out):
+    argv = ["power", "--preset", "figure9", "--method", method]
+    argv += [f"--{name.replace('_', '-')}={value}" for name, value in p.items()]
+    if json_out:
+        argv.append("--json")
+    _check_contract(*_run(capsys, argv), json_out)
+
+
+@settings(
+    max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(
+    p=devices(m=(1e-3, 1.0), k3=(0.0, 1e6), psd=(1e-3, 10.0), fc=(0.0, 0.1)),
+    dt=st.one_of(st.floats(2e-5, 1e-2), st.sampled_from([0.0, -1e-4, 1e308, math.nan])),
+    paths=st.one_of(st.integers(-2, 4), st.sampled_from([2**63, 10**30])),
+    seed=st.one_of(st.integers(-5, 5), st.sampled_from([2**64 - 1, 2**64, -(2**70)])),
+)
+def test_simulate_cli_contract(capsys, p, dt, paths, seed):
+    argv = ["simulate", "--preset", "figure9", f"--dt={dt}", f"--paths={paths}",
+            f"--seed={seed}", "--t-end=0.05", "--burn-in=0.01", "--json"]  # fmt: skip
+    argv += [f"--{name}={value}" for name, value in p.items()]
+    _check_contract(*_run(capsys, argv), True)
+
+
+@pytest.fixture(scope="module")
+def record_files(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("fuzz")
+    record = rv.synthetic_record(
+        rv.preset("coulomb-td1"), 2.0, duration=0.5, sample_rate=1000.0, seed=2
+    )
+    record.to_csv(folder / "rec.csv", float_format=None)
+    params = folder / "p.json"
+    params.write_text(
+        json.dumps(
+            {
+                "model": "coulomb",
+                "parameters": {"m": 0.0226, "c": 0.049, "k": 57.4, "k3": 70742.0, "fc": 0.0058},
+            }
+        )
+    )
+    return folder / "rec.csv", params
+
+
+@FUZZ
+@given(
+    skip=st.integers(-10, 1000),
+    substeps=st.integers(-3, 16),
+    name=st.sampled_from(["m", "c", "k", "k3", "fc", "beta", "bogus"]),
+    value=numbers(1e-3, 1e5),
+    lowpass=st.one_of(st.none(), numbers(1.0, 400.0)),
+)
+def test_validate_cli_contract(capsys, record_files, skip, substeps, name, value, lowpass):
+    rec, params = record_files
+    argv = ["validate", params, rec, f"--skip={skip}", f"--substeps={substeps}",
+            "--set", f"{name}={value}", "--json"]  # fmt: skip
+    if lowpass is not None:
+        argv.append(f"--lowpass={lowpass}")
+    _check_contract(*_run(capsys, argv), True)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    p=devices(
+        m=(1e-3, 1.0), c_m=(0.0, 1.0), k=(1.0, 1e3), k3=(0.0, 1e6), fc=(0.0, 0.1), psd=(1e-3, 10.0)
+    ),  # fmt: skip
+    method=st.sampled_from(["linearisation", "averaging", "fpk-fast"]),
+)
+def test_predict_refuses_or_is_finite(p, method):
+    p = dict(p)
+    try:
+        friction = rv.Coulomb(fc=p.pop("fc"))
+        psd = p.pop("psd")
+        device = rv.Harvester(c_e=0.1, friction=friction, **p)
+        result = rv.predict(device, psd, method)
+    except ValueError:
+        return  # refused with a message: allowed
+    for name in ("velocity_variance", "displacement_variance", "power_electrical"):
+        assert math.isfinite(getattr(result, name)), (name, result)
+    assert result.velocity_variance > 0 and result.displacement_variance > 0, result

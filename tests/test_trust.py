@@ -1,0 +1,620 @@
+"""Issue 13: nothing lost, nothing silently wrong, no traceback, interrupts that interrupt.
+
+Each test is one case of the issue (or a sibling found while fixing it) and
+fails on the code before the fix: output paths checked before computing,
+folder locks, checksummed resume, edited reports kept, parameter rules in
+identify/validate, valid JSON, one-line messages at extreme values, memory
+refused up front, Ctrl-C and killed parents.
+"""
+
+import _thread
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from _cli import one_line_error, run
+
+import randvib as rv
+import randvib.montecarlo.sweep as sweep_module
+from randvib import _io
+from randvib._resources import available_memory
+from randvib.montecarlo.simulation import simulate
+from randvib.montecarlo.sweep import SweepSettings, cartesian, run_sweep
+
+ROOT = Path(__file__).resolve().parents[1]
+BASE = rv.preset("figure9")
+TINY = SweepSettings(
+    dt=2e-4, window=0.2, burn_in=0.05, target_rel_ci=0.5, min_paths=8, batch_paths=8, max_paths=8
+)
+
+
+@pytest.fixture(scope="module")
+def record_csv(tmp_path_factory):
+    """A 2 s synthetic record of the Coulomb TD1 device, and its fitted-parameter file."""
+    folder = tmp_path_factory.mktemp("records")
+    path = folder / "rec.csv"
+    record = rv.synthetic_record(
+        rv.preset("coulomb-td1"), 2.0, duration=2.0, sample_rate=1000.0, seed=1
+    )
+    record.to_csv(path, float_format=None)
+    params = folder / "params.json"
+    params.write_text(
+        json.dumps(
+            {
+                "model": "coulomb",
+                "parameters": {"m": 0.0226, "c": 0.049, "k": 57.4, "k3": 70742.0, "fc": 0.0058},
+                "settings": {"substeps": 4},
+            }
+        )
+    )
+    return path, params
+
+
+def _fit_args(path, *extra):
+    return ["identify", path, "--model", "coulomb", "--m", "0.0226", "--popsize", "8",
+            "--generations", "2", "--no-progress", "--no-polish", *extra]  # fmt: skip
+
+
+# ------------------------------------------------------------------ work lost
+@pytest.mark.parametrize(
+    "option, target, fragment",
+    [
+        ("--save", "missing/x.json", "does not exist"),
+        ("--plot", "missing/x.png", "does not exist"),
+        ("--save", "a_file/x.json", "is not a folder"),
+        ("--plot", "a_file/x.png", "is not a folder"),
+        ("--save", "a_folder", "is a folder"),
+    ],
+)
+def test_identify_output_paths_checked_before_fitting(
+    capsys, tmp_path, monkeypatch, record_csv, option, target, fragment
+):
+    (tmp_path / "a_file").write_text("x")
+    (tmp_path / "a_folder").mkdir()
+    monkeypatch.chdir(tmp_path)
+    fitted = []
+    monkeypatch.setattr("randvib.cli.identify.identify", lambda *a, **k: fitted.append(1))
+    one_line_error(capsys, _fit_args(record_csv[0], option, target), fragment)
+    assert fitted == []  # refused before the fit
+
+
+@pytest.mark.parametrize(
+    "argv, fragment",
+    [
+        (["validate", "{params}", "{rec}", "--plot", "a_file/sub"], "is a file"),
+        (["record", "--preset", "figure9", "--rms", "2", "--out", "a_file/x.csv"], "not a folder"),
+        (["record", "--preset", "figure9", "--rms", "2", "--out", "a_folder"], "is a folder"),
+        (["study", "interaction", "--quick", "--out", "a_file/x"], "is a file"),
+    ],
+)
+def test_other_output_paths_under_a_file_or_a_folder(
+    capsys, tmp_path, monkeypatch, record_csv, argv, fragment
+):
+    (tmp_path / "a_file").write_text("x")
+    (tmp_path / "a_folder").mkdir()
+    monkeypatch.chdir(tmp_path)
+    argv = [a.format(params=record_csv[1], rec=record_csv[0]) for a in argv]
+    one_line_error(capsys, argv, fragment)
+
+
+def test_result_that_cannot_be_written_is_kept_beside(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    where = _io.write_or_keep(tmp_path / "gone" / "fit.json", '{"J": 1}', "--save")
+    assert where is not None and where.read_text() == '{"J": 1}'
+    assert where.parent == Path(".") or where.parent.resolve() == tmp_path
+    assert "could not write `--save`" in capsys.readouterr().err
+
+
+def test_identify_save_failing_after_the_fit_keeps_the_result(
+    capsys, tmp_path, monkeypatch, record_csv
+):
+    # The folder disappears during the fit: the result must still exist somewhere.
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "out").mkdir()
+    real = rv.identify
+
+    def fit_then_remove_folder(*args, **kwargs):
+        result = real(*args, **kwargs)
+        (tmp_path / "out").rmdir()
+        return result
+
+    monkeypatch.setattr("randvib.cli.identify.identify", fit_then_remove_folder)
+    code, out, err = run(capsys, *_fit_args(record_csv[0], "--save", "out/fit.json", "--json"))
+    assert code == 0
+    kept = list(tmp_path.glob("randvib-unsaved-*.json"))
+    assert len(kept) == 1 and json.loads(kept[0].read_text())["model"] == "coulomb"
+    assert str(kept[0].name) in err
+
+
+def _holder_script(folder, seconds):
+    return textwrap.dedent(
+        f"""
+        import sys, time
+        from randvib import _io
+        _io.lock_folder({str(folder)!r})
+        print("locked", flush=True)
+        time.sleep({seconds})
+        """
+    )
+
+
+def test_second_run_into_a_locked_folder_is_refused_naming_the_holder(tmp_path):
+    folder = tmp_path / "res"
+    folder.mkdir()
+    holder = subprocess.Popen(
+        [sys.executable, "-c", _holder_script(folder, 60)], stdout=subprocess.PIPE, text=True
+    )
+    try:
+        assert holder.stdout.readline().strip() == "locked"
+        with pytest.raises(FileExistsError, match=f"in use by another randvib run.*{holder.pid}"):
+            _io.prepare_output_dir(folder, {"grid": 1})
+        assert not (folder / _io.METADATA_FILE).exists()  # nothing written
+    finally:
+        holder.kill()
+        holder.wait()
+
+
+def test_stale_lock_of_a_killed_run_is_recovered(tmp_path):
+    folder = tmp_path / "res"
+    folder.mkdir()
+    holder = subprocess.Popen(
+        [sys.executable, "-c", _holder_script(folder, 60)], stdout=subprocess.PIPE, text=True
+    )
+    assert holder.stdout.readline().strip() == "locked"
+    holder.send_signal(signal.SIGKILL)  # no clean-up: the lock file stays
+    holder.wait()
+    assert (folder / _io.LOCK_FILE).exists()
+    out = _io.prepare_output_dir(folder, {"grid": 1})
+    assert json.loads((out / _io.LOCK_FILE).read_text())["pid"] == os.getpid()
+    _io.unlock_folder(out)
+    assert not (out / _io.LOCK_FILE).exists()
+
+
+def test_simultaneous_runs_into_one_new_folder_one_wins(tmp_path):
+    # Four runs of different grids start together into the same new folder:
+    # exactly one owns it; the others are refused, none exits quietly.
+    folder = tmp_path / "new"
+    script = textwrap.dedent(
+        f"""
+        import sys, time
+        from randvib import _io
+        time.sleep(max(0.0, float(sys.argv[2]) - time.time()))
+        try:
+            _io.prepare_output_dir({str(folder)!r}, {{"grid": int(sys.argv[1])}})
+        except FileExistsError as exc:
+            print("refused", exc)
+            sys.exit(3)
+        time.sleep(1.0)
+        print("owner")
+        """
+    )
+    start = time.time() + 4.0
+    procs = [
+        subprocess.Popen(
+            [sys.executable, "-c", script, str(i), str(start)], stdout=subprocess.PIPE, text=True
+        )
+        for i in range(4)
+    ]
+    outs = [p.communicate(timeout=120)[0] for p in procs]
+    codes = [p.returncode for p in procs]
+    assert sorted(codes) == [0, 3, 3, 3], outs
+    owner = codes.index(0)
+    assert json.loads((folder / _io.METADATA_FILE).read_text())["identity"] == {"grid": owner}
+
+
+def test_atomic_writes_from_many_writers_share_no_temporary_file(tmp_path):
+    target = tmp_path / "results.csv"
+    errors = []
+
+    def writer(i):
+        try:
+            for _ in range(50):
+                _io.atomic_write_text(target, f"writer {i}\n" * 100)
+        except Exception as exc:  # a shared temporary name crashes here
+            errors.append(exc)
+
+    threads = [threading.Thread(target=writer, args=(i,)) for i in range(8)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert errors == []
+    lines = set(target.read_text().splitlines())
+    assert len(lines) == 1  # one writer's whole file, never a mixture
+    assert list(tmp_path.iterdir()) == [target]  # no temporary left behind
+
+
+def test_edited_report_is_not_overwritten_without_force(tmp_path):
+    from randvib.studies.report import write_report
+
+    report = write_report(tmp_path, "T", [("A", "body")])
+    write_report(tmp_path, "T", [("A", "body")])  # a rerun may rewrite its own file
+    report.write_text(report.read_text() + "\nmy notes\n")
+    with pytest.raises(FileExistsError, match="changed since randvib wrote it"):
+        write_report(tmp_path, "T", [("A", "new body")])
+    assert "my notes" in report.read_text()
+    with _io.overwrite_edited():
+        write_report(tmp_path, "T", [("A", "new body")])
+    assert "new body" in report.read_text() and "my notes" not in report.read_text()
+
+
+def test_study_rerun_refuses_edited_figure_and_force_allows(capsys, tmp_path, monkeypatch):
+    from randvib.studies import report
+
+    def fake_study(out_dir, *, quick, seed, workers, scheduler, progress):
+        out = _io.prepare_output_dir(out_dir, {"study": "fake"})
+        import matplotlib.pyplot as plt
+
+        report.save_figure(plt.figure(), out / "figure.png")
+        return report.write_report(out, "fake", [])
+
+    monkeypatch.setattr("randvib.cli.study.load_study", lambda name: fake_study)
+    out = tmp_path / "study"
+    assert run(capsys, "study", "interaction", "--out", out)[0] == 0
+    (out / "figure.png").write_bytes(b"edited by hand")
+    one_line_error(capsys, ["study", "interaction", "--out", out], "--force")
+    assert (out / "figure.png").read_bytes() == b"edited by hand"
+    assert run(capsys, "study", "interaction", "--out", out, "--force")[0] == 0
+    assert (out / "figure.png").read_bytes().startswith(b"\x89PNG")
+    assert not (out / _io.LOCK_FILE).exists()  # released when the study ends
+
+
+@pytest.mark.parametrize("bad", ["list", "folder"])
+def test_metadata_that_is_a_list_or_a_folder_is_named(capsys, tmp_path, bad):
+    meta = tmp_path / _io.METADATA_FILE
+    if bad == "list":
+        meta.write_text("[1, 2]")
+    else:
+        meta.mkdir()
+    with pytest.raises(FileExistsError, match="not a randvib metadata file"):
+        _io.prepare_output_dir(tmp_path, {"grid": 1})
+
+
+# ------------------------------------------------------------------ silently wrong
+def _corrupt(points, how):
+    json0, npy0 = points / "00000.json", points / "00000.npy"
+    if how == "doubled power":
+        stored = json.loads(json0.read_text())
+        stored["row"]["power_electrical"] *= 2
+        json0.write_text(json.dumps(stored))
+    elif how == "empty object":
+        json0.write_text("{}")
+    elif how == "zero-byte json":
+        json0.write_bytes(b"")
+    elif how == "nan in npy":
+        arr = np.load(npy0)
+        arr[0, 0] = np.nan
+        np.save(npy0, arr)
+    elif how == "another point's arrays":
+        npy0.write_bytes((points / "00001.npy").read_bytes())
+    elif how == "truncated npy":
+        npy0.write_bytes(npy0.read_bytes()[:-40])
+    elif how == "npy missing":
+        npy0.unlink()
+
+
+@pytest.mark.parametrize(
+    "how",
+    [
+        "doubled power",
+        "empty object",
+        "zero-byte json",
+        "nan in npy",
+        "another point's arrays",
+        "truncated npy",
+        "npy missing",
+    ],
+)
+def test_corrupted_point_is_named_and_recomputed(tmp_path, monkeypatch, how):
+    pts = cartesian(psd=[1.0], fc=[0.0, 0.01])
+    first = run_sweep(BASE, pts, TINY, out_dir=tmp_path, workers=1, progress=False)
+    _corrupt(tmp_path / "points", how)
+    calls = []
+    real = sweep_module.run_point
+
+    def counting(base, point, settings, threads=1):
+        calls.append(point["fc"])
+        return real(base, point, settings, threads)
+
+    monkeypatch.setattr(sweep_module, "run_point", counting)
+    with pytest.warns(UserWarning, match="sweep point 0 .* unusable"):
+        again = run_sweep(BASE, pts, TINY, out_dir=tmp_path, workers=1, progress=False)
+    assert calls == [0.0]  # only the bad point was recomputed
+    cols = ["power_electrical", "velocity_variance", "n_paths"]
+    assert again.table[cols].equals(first.table[cols])  # same seed: the same numbers
+    assert np.array_equal(again.per_path[0], first.per_path[0])
+
+
+def test_results_csv_is_rebuilt_from_the_points(tmp_path):
+    pts = cartesian(psd=[1.0], fc=[0.0, 0.01])
+    run_sweep(BASE, pts, TINY, out_dir=tmp_path, workers=1, progress=False)
+    good = (tmp_path / "results.csv").read_text()
+    (tmp_path / "results.csv").write_text("point,power_electrical\n0,123\n")
+    run_sweep(BASE, pts, TINY, out_dir=tmp_path, workers=1, progress=False)
+    assert (tmp_path / "results.csv").read_text() == good
+
+
+def test_validate_settings_checked_as_identify_does(capsys, tmp_path, record_csv):
+    rec, params = record_csv
+    one_line_error(capsys, ["validate", params, rec, "--skip", "100000"], "`skip` = 100000")
+    one_line_error(capsys, ["validate", params, rec, "--substeps", "0"], "`substeps`")
+    one_line_error(capsys, ["validate", params, rec, "--set", "bogus=1"], "--set bogus")
+    one_line_error(capsys, ["validate", params, rec, "--set", "fc=-1"], "`--set fc` must be >= 0")
+    bad = tmp_path / "bad.json"
+    data = json.loads(params.read_text())
+    for settings, fragment in [
+        ({"substeps": 0}, "substeps"),
+        ({"hold": "bogus"}, "hold"),
+        ({"skip": -5}, "skip"),
+    ]:
+        bad.write_text(json.dumps({**data, "settings": settings}))
+        one_line_error(capsys, ["validate", bad, rec], f"{bad}")
+        one_line_error(capsys, ["validate", bad, rec], fragment)
+    bad.write_text(json.dumps({**data, "parameters": {**data["parameters"], "k": -1}}))
+    one_line_error(capsys, ["validate", bad, rec], "`k` must be > 0")
+
+
+@pytest.mark.parametrize(
+    "extra, fragment",
+    [
+        (["--fix", "fc=-1"], "`--fix fc` must be >= 0"),
+        (["--bounds", "k=-10:-1"], "`--bounds k` must be > 0"),
+        (["--fix", "k=0"], "`--fix k` must be > 0"),
+        (["--bounds", "c=0:inf"], "must be finite"),
+        (["--fix", "k3=1e308"], "every simulation diverged"),
+    ],
+)
+def test_identify_fixed_values_and_bounds_obey_parameter_rules(capsys, record_csv, extra, fragment):
+    one_line_error(capsys, _fit_args(record_csv[0], *extra), fragment)
+
+
+@pytest.mark.parametrize(
+    "device, fragment",
+    [
+        (["--m", "1e308"], "no finite result"),
+        (["--c-m", "0", "--c-e", "0", "--friction", "coulomb", "--fc", "0"], "no stationary"),
+        (["--c-m", "0", "--c-e", "0", "--friction", "none"], "no stationary"),
+        (["--k3", "1e308"], "no finite result"),
+        (["--psd", "1e308", "--method", "fpk-fast"], "no finite result"),
+        (["--m", "1e-300", "--method", "fpk-fast"], "no finite result"),
+        (["--excitation", "band-pass", "--f0", "1e308", "--zeta", "0.1"], "no finite result"),
+        (["--alpha", "1e308", "--r-load", "1", "--r-coil", "1"], "not a finite number"),
+    ],
+)
+def test_power_never_prints_nan(capsys, device, fragment):
+    argv = ["power", "--preset", "figure9", "--psd", "1", *device]
+    one_line_error(capsys, argv, fragment)
+    one_line_error(capsys, [*argv, "--json"], fragment)
+
+
+def test_json_output_is_always_valid_json():
+    text = _io.dumps({"a": float("nan"), "b": [1.0, float("inf")], "c": {"d": -math.inf}})
+    data = json.loads(text, parse_constant=lambda c: pytest.fail(f"{c} in JSON"))
+    assert data["a"] is None and data["b"] == [1.0, None] and data["c"]["d"] is None
+    assert set(data["null_reasons"]) == {"a", "b[1]", "c.d"}
+
+
+# ------------------------------------------------------------------ one-line messages
+@pytest.mark.parametrize(
+    "argv, fragment",
+    [
+        (["--seed", str(2**64)], "`seed` must be an integer in 0 .."),
+        (["--seed", "-1"], "`seed`"),
+        (["--m", "1e308"], "linearised scales"),
+        (["--k3", "1e308"], "linearised scales"),
+        (["--psd", "1e308"], "linearised scales"),
+        (["--t-end", "1e23"], "steps per path"),
+        (["--paths", str(10**23)], "of memory"),
+        (["--dt", "1e-300"], "steps per path"),
+    ],
+)
+def test_simulate_extreme_values_one_line(capsys, argv, fragment):
+    base = ["simulate", "--preset", "figure9", "--psd", "1", "--paths", "2"]
+    one_line_error(capsys, [*base, "--t-end", "0.1", "--burn-in", "0", *argv], fragment)
+
+
+@pytest.mark.parametrize(
+    "extra, fragment",
+    [
+        (["--lowpass", "1e-308"], "`lowpass` must be at least"),
+        (["--seed", "-1"], "`seed` must be an integer in 0 .."),
+        (["--sample-rate", "1e-308", "--time-column", "none"], "search bounds of"),
+    ],
+)
+def test_identify_extreme_settings_one_line(capsys, record_csv, extra, fragment):
+    one_line_error(capsys, _fit_args(record_csv[0], *extra), fragment)
+
+
+def test_record_folder_and_constant_column_named(capsys, tmp_path, record_csv):
+    one_line_error(capsys, _fit_args(tmp_path), "is a folder")
+    one_line_error(capsys, ["validate", tmp_path, record_csv[0]], "is a folder")
+    text = record_csv[0].read_text().splitlines()
+    const = tmp_path / "const.csv"
+    const.write_text(
+        "\n".join([text[0]] + [",".join(line.split(",")[:2] + ["0.001"]) for line in text[1:]])
+    )
+    one_line_error(capsys, _fit_args(const), "constant")
+
+
+def test_unexpected_exception_is_one_line_exit_1(capsys, monkeypatch):
+    def broken(args):
+        raise ZeroDivisionError("float division by zero")
+
+    monkeypatch.setattr("randvib.cli.power.run", broken)
+    monkeypatch.delenv("RANDVIB_TRACEBACK", raising=False)
+    code, out, err = run(capsys, "power", "--preset", "figure9", "--psd", "1")
+    assert code == 1 and "internal error: ZeroDivisionError" in err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+
+
+def test_unreachable_scheduler_fails_fast_with_a_message(monkeypatch):
+    pytest.importorskip("distributed")
+    monkeypatch.setattr(sweep_module, "SCHEDULER_TIMEOUT", 2)
+    with pytest.raises(ValueError, match="cannot connect to a Dask scheduler"):
+        sweep_module.make_executor(scheduler="tcp://127.0.0.1:1")
+
+
+# ------------------------------------------------------------------ resources, interrupts
+def test_work_that_cannot_fit_is_refused_with_the_estimate():
+    with pytest.raises(ValueError, match="needs about .* of memory"):
+        simulate(BASE, 1.0, t_end=0.1, dt=1e-4, n_paths=8, histogram_bins=10**12)
+    # the issue's case, killed at 24 GB: counts, their sum and densities exceed the memory
+    if available_memory() < 8 * 8 * 10**9:
+        with pytest.raises(ValueError, match="needs about .* of memory"):
+            simulate(BASE, 1.0, t_end=0.1, dt=1e-4, n_paths=8, histogram_bins=10**9)
+
+
+def test_population_that_cannot_fit_is_refused(capsys, record_csv):
+    one_line_error(capsys, _fit_args(record_csv[0], "--popsize", "100000000"), "of memory")
+
+
+def test_step_advice_never_says_dt_at_most_zero(monkeypatch):
+    from randvib.montecarlo import simulation
+
+    monkeypatch.setattr(simulation, "largest_step", lambda *a, **k: 0.0)
+    with pytest.raises(ValueError, match="too large") as info:
+        simulate(BASE, 1.0, t_end=10.0, dt=0.5, n_paths=2, progress=False)
+    assert "dt <= 0 s" not in str(info.value)
+
+
+def test_long_run_says_how_long(monkeypatch):
+    from randvib._resources import LongRunWarning
+    from randvib.montecarlo import simulation
+
+    monkeypatch.setattr(simulation, "PATH_STEPS_PER_SECOND", 1.0)  # pretend a slow machine
+    with pytest.warns(LongRunWarning, match="will take about"):
+        simulate(BASE, 1.0, t_end=0.05, dt=1e-4, n_paths=4, progress=False)
+
+
+def _interrupt_after(seconds):
+    timer = threading.Timer(seconds, _thread.interrupt_main)
+    timer.start()
+    return timer
+
+
+def test_ctrl_c_stops_a_running_simulation():
+    # compiled first, so that the interrupt lands inside the compiled loop
+    simulate(BASE, 1.0, t_end=0.01, dt=1e-4, n_paths=2, progress=False)
+    # 4e9 path-steps: minutes at the least on any machine; Ctrl-C after 1 s
+    kwargs = dict(t_end=2000.0, dt=1e-4, n_paths=200, progress=False)
+    timer = _interrupt_after(1.0)
+    started = time.perf_counter()
+    with pytest.raises(KeyboardInterrupt):
+        simulate(BASE, 1.0, **kwargs)
+    timer.cancel()
+    assert time.perf_counter() - started < 60  # stopped, not run to the end
+
+
+def test_ctrl_c_in_the_cli_exits_130(capsys):
+    simulate(BASE, 1.0, t_end=0.01, dt=1e-4, n_paths=2, progress=False)
+    timer = _interrupt_after(1.0)
+    code, out, err = run(capsys, "simulate", "--preset", "figure9", "--psd", "1",
+                         "--paths", "200", "--t-end", "2000", "--dt", "1e-4")  # fmt: skip
+    timer.cancel()
+    assert code == 130 and "interrupted" in err and "Traceback" not in err
+
+
+def test_sweep_workers_end_when_the_sweep_is_killed(tmp_path):
+    script = textwrap.dedent(
+        """
+        import os, sys, time
+        sys.path.insert(0, sys.argv[1])
+        from trust_worker import pid
+        from randvib.montecarlo.sweep import make_executor
+        if __name__ == "__main__":
+            pool, close = make_executor(workers=2)
+            print(" ".join(map(str, set(pool.map(pid, range(16))))), flush=True)
+            time.sleep(120)
+        """
+    )
+    (tmp_path / "trust_worker.py").write_text(
+        "import os, time\ndef pid(_):\n    time.sleep(0.2)\n    return os.getpid()\n"
+    )
+    (tmp_path / "main.py").write_text(script)
+    parent = subprocess.Popen(
+        [sys.executable, str(tmp_path / "main.py"), str(tmp_path)],
+        stdout=subprocess.PIPE,
+        text=True,
+        env={
+            **os.environ,
+            "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]),
+        },
+    )
+    workers = [int(p) for p in parent.stdout.readline().split()]
+    assert workers
+    parent.send_signal(signal.SIGKILL)
+    parent.wait()
+    deadline = time.monotonic() + 30
+    alive = workers
+    while alive and time.monotonic() < deadline:
+        time.sleep(0.2)
+        alive = [p for p in workers if _alive(p)]
+    assert alive == []
+
+
+def _alive(pid):
+    try:
+        os.waitpid(pid, os.WNOHANG)  # reap if it happens to be our child
+    except ChildProcessError:
+        pass
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    status = Path(f"/proc/{pid}/status")
+    return not (status.exists() and "zombie" in status.read_text())
+
+
+def test_readme_sweep_example_has_the_main_guard():
+    readme = (ROOT / "README.md").read_text()
+    block = readme[readme.index("from randvib.montecarlo.sweep import SweepSettings") :]
+    block = block[: block.index("```")]
+    assert 'if __name__ == "__main__":' in block
+    assert block.index("__main__") < block.index("run_sweep(")
+    assert "trust" in readme[readme.index("scheduler=` (and `--scheduler`)") :][:300]
+
+
+def test_unreadable_stored_fit_is_named_and_fitted_again(tmp_path, record_csv):
+    from randvib.identification.fitting import read_record
+    from randvib.studies.campaign import identify_cached
+
+    path = tmp_path / "fit.json"
+    path.write_text("")  # a zero-byte file left by a crash
+    record = read_record(record_csv[0])
+    kwargs = dict(m=0.0226, popsize=8, maxiter=2, polish=False)
+    with pytest.warns(UserWarning, match="fit.json.* unusable"):
+        fit = identify_cached(path, record, "coulomb", **kwargs)
+    again = identify_cached(path, record, "coulomb", **kwargs)  # now loaded, not refitted
+    assert again.parameters == fit.parameters and json.loads(path.read_text())["model"] == "coulomb"
+
+
+def test_record_seed_out_of_range_named(capsys, tmp_path):
+    argv = ["record", "--preset", "figure9", "--rms", "2", "--out", tmp_path / "x.csv"]
+    one_line_error(capsys, [*argv, "--seed", "-1"], "`--seed` must be an integer in 0 ..")
+    one_line_error(capsys, [*argv, "--duration", "1e23"], "of memory")
+
+
+def test_ctrl_c_in_a_study_exits_130_and_releases_its_folder(capsys, tmp_path, monkeypatch):
+    simulate(BASE, 1.0, t_end=0.01, dt=1e-4, n_paths=2, progress=False)
+
+    def long_study(out_dir, *, quick, seed, workers, scheduler, progress):
+        out = _io.prepare_output_dir(out_dir, {"study": "long"})
+        _io.write_tracked(out / "first.csv", "finished part\n")
+        simulate(BASE, 1.0, t_end=2000.0, dt=1e-4, n_paths=200, progress=False)
+
+    monkeypatch.setattr("randvib.cli.study.load_study", lambda name: long_study)
+    timer = _interrupt_after(1.0)
+    code, out, err = run(capsys, "study", "interaction", "--out", tmp_path / "s")
+    timer.cancel()
+    assert code == 130 and "Traceback" not in err
+    assert (tmp_path / "s" / "first.csv").read_text() == "finished part\n"  # kept
+    assert not (tmp_path / "s" / _io.LOCK_FILE).exists()
