@@ -317,6 +317,7 @@ def verdicts(results: pd.DataFrame, methods: pd.DataFrame) -> dict:
     return {
         "stroke": STROKE,
         "budget": BUDGET,
+        "n_levels": int(results.g.nunique()),
         "fixed_input": {
             name: _fixed_input(sub) for name, sub in results.groupby("input", sort=False)
         },
@@ -342,6 +343,17 @@ def _fixed_input(sub: pd.DataFrame) -> dict:
             "linear_exceedance_there": float(
                 sub[(sub.device == "linear") & (sub.g == best.g)].exceedance_mc.iloc[0]
             ),
+            "more_power_within_budget": [
+                {
+                    "g": float(r.g),
+                    "ratio": float(r.power_ratio_to_linear),
+                    "ratio_ci95": float(r.power_ratio_ci95),
+                    "exceedance": float(r.exceedance_mc),
+                    "exceedance_ci95": float(r.exceedance_mc_ci95),
+                }
+                for r in more.itertuples()
+                if r.exceedance_mc + r.exceedance_mc_ci95 <= BUDGET
+            ],  # fmt: skip
         }
     return out
 
@@ -367,7 +379,13 @@ def _method_accuracy(methods: pd.DataFrame) -> dict:
     """Per method and quantity: points compared, largest |error| and where, points within the MC interval."""
     out = {}
     for method, rows in methods.groupby("method", sort=False):
-        entry = {"refused": int((rows.refused.fillna("") != "").sum()), "points": int(len(rows))}
+        entry = {
+            "refused": int((rows.refused.fillna("") != "").sum()),
+            "points": int(len(rows)),
+            "negative_exceedance": int((rows.exceedance < 0).sum()),
+            "most_negative_exceedance": float(min(rows.exceedance.min(), 0.0))
+            if rows.exceedance.notna().any() else None,
+        }  # fmt: skip
         for q in ("power", "exceedance"):
             err = rows.dropna(subset=[f"{q}_rel_error"])
             if err.empty:
@@ -397,20 +415,44 @@ def answer(v: dict) -> str:
         b = devs["bistable"]
         at = v["at_budget"][name]["bistable"]
         more = ", ".join(f"{g:g}" for g in b["levels_more_power"]) or "none"
+        within = ", ".join(
+            f"g = {w['g']:g} ({w['ratio']:.3f} ± {w['ratio_ci95']:.3f} times, "
+            f"{100 * w['exceedance']:.2g} ± {100 * w['exceedance_ci95']:.2g} % beyond)"
+            for w in b["more_power_within_budget"]
+        )
         parts.append(
-            f"{name}: more power than the linear device (paired, 95 %) at g = {more}; largest "
+            f"{name}: more power than the linear device (paired, 95 %) at g = {more}; "
+            f"of these, within the budget (exceedance and its half-width at most "
+            f"{100 * v['budget']:g} %): {within or 'none'}; largest "
             f"ratio {b['largest_ratio']:.3f} ± {b['largest_ratio_ci95']:.3f} at g = "
             f"{b['largest_ratio_at_g']:g}, where it spends {100 * b['exceedance_there']:.2g} % of "
             f"the time beyond the gap (linear: {100 * b['linear_exceedance_there']:.2g} %); at the "
             f"{100 * v['budget']:g} % budget it delivers {_bound(at)}{at['ratio_to_linear']:.3g} "
             f"times the linear device's power ({'pays' if at['beats_linear'] else 'does not pay'})"
         )
+    paying = [
+        (name, w["g"]) for name, d in v["fixed_input"].items()
+        for w in d["bistable"]["more_power_within_budget"]
+    ]  # fmt: skip
+    total = sum(len(d["bistable"]["levels_more_power"]) + len(d["bistable"]["levels_less_power"])
+                for d in v["fixed_input"].values())  # fmt: skip
+    n_points = len(v["fixed_input"]) * v["n_levels"]
+    lead = (
+        f"At equal input, the bistable device delivers significantly more power than the linear "
+        f"one while within the {100 * v['budget']:g} % budget at {len(paying)} of {n_points} "
+        f"(input, level) points"
+        + (": " + ", ".join(f"{n} at g = {g:g}" for n, g in paying) if paying else "")
+        + f" (significantly different power at {total}). "
+    )
     hardening = ", ".join(
         f"{name} {_bound(d['hardening'])}{d['hardening']['ratio_to_linear']:.3g}"
         f"{' (pays)' * d['hardening']['beats_linear']}"
         for name, d in v["at_budget"].items()
     )
-    return "; ".join(parts) + f". For comparison, the hardening device at the budget: {hardening}."
+    return (
+        lead + "; ".join(parts) + ". For comparison, the hardening device at the budget: "
+        f"{hardening}."
+    )
 
 
 def _ratio_bound(device_where: str, linear_where: str) -> str:
@@ -484,7 +526,7 @@ def methods_figure(methods: pd.DataFrame, path: Path) -> Path:
 
 
 # ----------------------------------------------------------------- report
-def setup_section(axes, results, seed, quick, wall) -> str:
+def setup_section(axes, results, seed, quick, wall, resumed=False) -> str:
     n_paths, t_end, dt, burn = axes["mc"]
     rows = [{"device": name, "k (N/m)": d.k, "k3 (N/m^3)": d.k3, "start z0 (mm)": 1e3 * z0,
              "kind": d.potential.kind} for name, (d, (z0, _)) in devices().items()]  # fmt: skip
@@ -499,7 +541,8 @@ def setup_section(axes, results, seed, quick, wall) -> str:
         f"(damping ratio {BAND_ZETA:g}) have the peak level below. Monte Carlo: Heun, dt = {dt:g} s, "
         f"{n_paths} paths x {t_end - burn:g} s after {burn:g} s burn-in, from rest at a stable "
         f"equilibrium, one seed per input and level shared by the three devices (paired; seed "
-        f"{seed}). {'Quick mode. ' if quick else ''}Wall time {wall:.0f} s.\n\n"
+        f"{seed}). {'Quick mode. ' if quick else ''}Wall time {wall:.0f} s"
+        f"{' (tables resumed from an earlier run)' * resumed}.\n\n"
         + markdown_table(pd.DataFrame(rows), floatfmt=".4g") + "\n\n"
         + markdown_table(levels, floatfmt=".4g")
     )  # fmt: skip
@@ -560,6 +603,11 @@ def methods_section(methods, v, figure) -> str:
     lines = []
     for method, e in v["methods"].items():
         text = [f"**{method}**: refused at {e['refused']} of {e['points']} points"]
+        if e["negative_exceedance"]:
+            text.append(
+                f"a negative stroke exceedance (a probability below zero) at "
+                f"{e['negative_exceedance']} points, down to {e['most_negative_exceedance']:.2g}"
+            )
         for q in ("power", "exceedance"):
             a = e[q]
             if a is None:
@@ -617,6 +665,7 @@ def run_study(
     axes = grid(quick)
     out = prepare_output_dir(out_dir, {"study": NAME, "quick": quick, "seed": seed, **axes})
     started = time.perf_counter()
+    resumed = (out / "results.csv").exists() and (out / "methods.csv").exists()
     results, methods = tables_of(out, axes, seed, threads, progress)
     v = verdicts(results, methods)
     fig_trade = tradeoff_figure(results, out / "power_vs_exceedance.png")
@@ -628,7 +677,7 @@ def run_study(
         f"Study {NAME}: linear, hardening and bistable with friction and a stroke limit"
         f"{' (quick)' * quick}",
         [
-            ("Set-up", setup_section(axes, results, seed, quick, wall)),
+            ("Set-up", setup_section(axes, results, seed, quick, wall, resumed)),
             ("Power and stroke (Monte Carlo)", power_section(results, v, fig_trade)),
             ("Power at an exceedance budget", budget_section(results, v)),
             ("Which method predicts them", methods_section(methods, v, fig_methods)),
