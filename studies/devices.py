@@ -23,10 +23,10 @@ reference level).
 
 **Equal input power.** The input is scaled by a factor g (``levels``) of a
 reference. "Equal input power" means: *the same mean power injected by the
-base into the reference linear device without friction* (c E[z'^2], c = c_m +
-c_e), g m^2 S_ref / (4 c) ... i.e. g S_ref m / 4 W under white noise. Under
-white noise the injected power S m / 4 is the same for every device (the Ito
-term of the energy balance), so this is the level S = g S_ref. A band-pass
+base into the reference linear device without friction* (c E[z'^2] with
+c = c_m + c_e), set to g S_ref m / 4 (W). Under white noise the injected
+power S m / 4 is the same for every device (the Ito term of the energy
+balance), so this is the level S = g S_ref. A band-pass
 input's peak level is chosen so that the reference device receives the same
 power (equivalently: the same E[z'^2]). Equal base-acceleration variance is
 not used: white noise has none (infinite), and any cut-off frequency would

@@ -31,11 +31,11 @@ DT = 5e-4
 
 
 def case_band_limited_circuit(name, seed, n_paths=1024):
-    """Heun, 1024 paths x 12 s after 2 s burn-in: P_e (from the circuit state), E[v^2], E[z^2]."""
+    """Heun, 1024 paths x 14 s after 2 s burn-in: P_e (from the circuit state), E[v^2], E[z^2]."""
     h = rv.Harvester.with_coupling(M, C_M, K, COUPLINGS[name])
     assert step_bias("heun", h, BAND, DT) < 1e-3
     exact = rv.statistical_linearisation(h, BAND)
-    r = simulate(h, BAND, t_end=14.0, dt=DT, n_paths=n_paths, burn_in=2.0, seed=seed,
+    r = simulate(h, BAND, t_end=16.0, dt=DT, n_paths=n_paths, burn_in=2.0, seed=seed,
                  progress=False)  # fmt: skip
     return [
         ("P_e", r.power_electrical, exact.power_electrical, 0.0, 0.05),
