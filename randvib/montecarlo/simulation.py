@@ -757,7 +757,9 @@ def _check_scales(run: _Run) -> None:
     """
     h, excitation = run.harvester, run.excitation
     try:
-        with np.errstate(all="ignore"):
+        # quadrature warnings at such values would only precede the refusal
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore")
             if excitation.shaping_filter() is None:  # synthesised input
                 k_eff, c_eff = _linearised_under(h, excitation)[:2]
             else:

@@ -47,6 +47,7 @@ STUDIES = (
     "linearisation-vs-averaging",
     "silverbox",
     "excitation",
+    "devices",
 )
 
 
