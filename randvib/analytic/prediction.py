@@ -274,6 +274,15 @@ def predict(harvester: Harvester, psd, method: str = "linearisation") -> PowerPr
         For an unknown method, a bad ``psd``, a non-white excitation with
         a method that assumes white noise, or a potential the method cannot
         treat (one line naming what it accepts).
+
+    Examples
+    --------
+    >>> import randvib as rv
+    >>> result = rv.predict(rv.preset("figure9"), 1.0)
+    >>> print(f"{result.power_electrical:.4e} W, E[z'^2] = {result.velocity_variance:.4e} (m/s)^2")
+    2.4619e-03 W, E[z'^2] = 2.4619e-02 (m/s)^2
+    >>> print(f"{rv.predict(rv.preset('figure9'), 1.0, 'fpk-fast').power_electrical:.4e} W")
+    2.4642e-03 W
     """
     check_choice("method", method, tuple(METHODS))
     harvester.potential.require(f"method {method!r}", CONFINING + ("free",))
@@ -303,6 +312,18 @@ def expected_power(
     ``into="electrical"`` gives E[P_e] = c_e E[z'^2] (paper Eq. 32);
     ``into="load"`` gives the share dissipated in R_L (needs a circuit).
     Broadcasts over ``psd`` and array-valued harvester parameters.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import randvib as rv
+    >>> device = rv.preset("figure9")
+    >>> print(f"{rv.expected_power(device, 1.0):.4e} W")  # Eq. 32
+    2.4619e-03 W
+    >>> rv.expected_power(device, np.array([1.0, 0.5, 0.1])).round(6)  # broadcasts over S
+    array([0.002462, 0.001163, 0.000183])
+    >>> print(f"{rv.expected_power(device, rv.BandPass(1.0, 8.0, 0.1)):.4e} W")  # coloured input
+    1.1147e-03 W
     """
     check_choice("into", into, ("electrical", "load"))
     result = predict(harvester, psd, method)
@@ -355,6 +376,19 @@ def optimal_load_resistance(
         Optimal load resistance (ohm).
     power : float
         Expected load power there (W).
+
+    Examples
+    --------
+    >>> import randvib as rv
+    >>> wired = rv.Harvester.from_electrical(
+    ...     m=0.0226, c_m=0.049, k=57.4, alpha=0.1992, r_load=2.0, r_coil=0.48,
+    ...     friction=rv.Coulomb(0.0058),
+    ... )
+    >>> r_load, power = rv.optimal_load_resistance(wired, 1.0)
+    >>> print(f"R_L* = {r_load:.3f} ohm, P_L = {power:.4e} W")
+    R_L* = 0.745 ohm, P_L = 1.1025e-03 W
+    >>> print(f"{rv.optimal_load_resistance_linear(0.049, 0.1992, 0.48):.3f} ohm")  # Fc = 0
+    0.787 ohm
     """
     if harvester.electrical is None:
         raise ValueError(

@@ -187,6 +187,17 @@ def statistical_linearisation(
         exists (a narrow band far above the wells' frequency).
     RuntimeError
         If the fixed point does not converge.
+
+    Examples
+    --------
+    >>> import randvib as rv
+    >>> device = rv.preset("figure9")
+    >>> res = rv.statistical_linearisation(device, rv.BandPass(1.0, 8.0, 0.1))
+    >>> print(f"P_e = {res.power_electrical:.4e} W, c_eq = {res.c_eq:.4f} Ns/m, k_eq = {res.k_eq:.2f} N/m")
+    P_e = 1.1147e-03 W, c_eq = 0.2438 Ns/m, k_eq = 58.33 N/m
+    >>> white = rv.statistical_linearisation(device, rv.White(1.0))  # Eq. 32 exactly
+    >>> print(f"{white.power_electrical:.4e} W")
+    2.4619e-03 W
     """
     excitation = as_excitation(excitation)
     friction = _check_harvester(harvester)

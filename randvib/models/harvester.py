@@ -66,6 +66,20 @@ class Harvester:
         Stroke limit (m), > 0: the largest |z| before the magnet meets its end
         stops. It changes no dynamics; the methods report how often and how
         soon |z| exceeds it (``stroke_exceedance``, first-passage time).
+
+    Examples
+    --------
+    >>> import randvib as rv
+    >>> device = rv.Harvester(m=0.0226, c_m=0.1, c_e=0.1, k=57.4, k3=5e5, friction=rv.Coulomb(0.0058))
+    >>> device.c
+    0.2
+    >>> device.updated(fc=0.01).friction
+    Coulomb(fc=0.01)
+    >>> wired = rv.Harvester.from_electrical(
+    ...     m=0.0226, c_m=0.049, k=57.4, alpha=0.1992, r_load=2.0, r_coil=0.48
+    ... )
+    >>> print(f"c_e = {wired.c_e:.5f} Ns/m")  # alpha^2 / (R_L + R_C), Eq. 3
+    c_e = 0.01600 Ns/m
     """
 
     m: float

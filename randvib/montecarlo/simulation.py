@@ -935,6 +935,20 @@ def simulate(
     Returns
     -------
     SimulationResult
+
+    Examples
+    --------
+    A small ensemble (64 paths, 2 s) of the Section 5 device; the 95 %
+    half-width comes from the spread between paths:
+
+    >>> import randvib as rv
+    >>> result = rv.simulate(
+    ...     rv.preset("figure9"), 1.0, t_end=2.0, burn_in=0.5, dt=5e-4, n_paths=64,
+    ...     scheme="heun", seed=0, progress=False,
+    ... )
+    >>> power = result.power_electrical
+    >>> print(f"{power.mean:.3e} +- {power.ci95:.1e} W")
+    2.426e-03 +- 2.5e-04 W
     """
     run = _validated(
         harvester,
