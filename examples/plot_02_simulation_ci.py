@@ -43,6 +43,11 @@ cv = reduced.power_electrical
 print(f"with control variates: {1e3 * cv.mean:.4f} +- {1e3 * cv.ci95:.4f} mW (95 %)")
 
 # %%
+# In a notebook a result shows itself as a table (``_repr_html_``), and
+# ``to_frame()`` gives the statistics as a pandas DataFrame, one row each.
+reduced.to_frame()
+
+# %%
 # The interval is the estimate's statistical uncertainty only; the step size
 # adds a bias that ``simulate`` checks (a warning above 1 %, a refusal above
 # 10 %). Halving ``dt`` and comparing is the honest check of it.

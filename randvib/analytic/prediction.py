@@ -25,6 +25,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from scipy import optimize, special
 
+from randvib import _display
 from randvib._validation import (
     check_choice,
     check_nonnegative,
@@ -95,6 +96,53 @@ class PowerPrediction:
             if out[optional] is None:
                 del out[optional]
         return out
+
+    def _quantities(self) -> list[tuple[str, object, str]]:
+        """(name, value, unit) of every field with a value."""
+        out = [(name, getattr(self, name), unit) for name, unit in _UNITS.items()]
+        return [(name, value, unit) for name, value, unit in out if value is not None]
+
+    def to_frame(self):
+        """The prediction as a :class:`pandas.DataFrame`.
+
+        One row for scalar inputs; for a broadcast sweep one row per point
+        (the fields broadcast together and are flattened in C order, so row
+        ``i`` is ``numpy.unravel_index(i, shape)`` of the sweep's shape).
+        Columns are the fields (SI units, see the class) and ``method``.
+        """
+        pd = _display.pandas()
+        names = [name for name, _, _ in self._quantities()]
+        values = np.broadcast_arrays(
+            *(np.asarray(v, dtype=float) for _, v, _ in self._quantities())
+        )
+        frame = pd.DataFrame({n: v.ravel() for n, v in zip(names, values, strict=True)})
+        frame.insert(0, "method", self.method)
+        return frame
+
+    def _rows(self):
+        return [(name, _display.number(value), unit) for name, value, unit in self._quantities()]
+
+    def __repr__(self) -> str:
+        fields = ", ".join(
+            f"{name}={_display.number(value)}" for name, value, _ in self._quantities()
+        )
+        return f"PowerPrediction(method={self.method!r}, {fields})"
+
+    def _repr_html_(self) -> str:
+        return _display.html_table(f"Prediction ({self.method})", self._rows())
+
+
+#: Units of the fields of :class:`PowerPrediction`, in the order they are shown.
+_UNITS = {
+    "power_electrical": "W",
+    "power_load": "W",
+    "c_eq": "Ns/m",
+    "velocity_variance": "(m/s)^2",
+    "displacement_variance": "m^2",
+    "mean_abs_velocity": "m/s",
+    "circuit_mean_square": "A^2 or V^2",
+    "stroke_exceedance": "probability",
+}
 
 
 def _finish(
