@@ -53,11 +53,7 @@ numpydoc_validation_checks = set()
 intersphinx_mapping = {}
 
 # -- Markdown -----------------------------------------------------------------
-myst_enable_extensions = ["dollarmath"]
 myst_heading_anchors = 3
-# conventions.md and testing.md link to repository files outside docs/ (README,
-# tests); those links are for readers of the repository and are not site pages.
-suppress_warnings = ["myst.xref_missing"]
 
 # -- Gallery ------------------------------------------------------------------
 sphinx_gallery_conf = {
