@@ -52,9 +52,15 @@ def estimate(mean: float, ci95: float) -> str:
     if not (math.isfinite(mean) and math.isfinite(ci95)) or ci95 <= 0:
         return number(mean, 6)
     if mean == 0:
-        return f"0 ± {ci95:.2g}"
+        return f"0 ± {_figures(ci95, 2)}"
     figures = math.floor(math.log10(abs(mean))) - math.floor(math.log10(ci95)) + 2
-    return f"{mean:.{max(figures, 1)}g} ± {ci95:.2g}"
+    return f"{_figures(mean, max(figures, 1))} ± {_figures(ci95, 2)}"
+
+
+def _figures(x: float, n: int) -> str:
+    """``x`` to ``n`` significant figures, trailing zeros kept (0.00030, not 0.0003)."""
+    text = f"{x:#.{n}g}"
+    return text.replace(".e", "e").removesuffix(".")
 
 
 def text_table(title: str, rows, note: str = "") -> str:
