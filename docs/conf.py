@@ -89,8 +89,27 @@ def _escape_bars(line: str) -> str:
     return "".join(p if i % 2 else p.replace("|", r"\|") for i, p in enumerate(parts))
 
 
+def _indent(line: str) -> int:
+    return len(line) - len(line.lstrip())
+
+
 def _escape_docstring(app, what, name, obj, options, lines):
-    lines[:] = [_escape_bars(line) for line in lines]
+    """Escape the bars of prose lines; doctests and literal blocks stay verbatim."""
+    verbatim_above = None  # indentation of the line that opened a literal block
+    in_doctest = False
+    for i, line in enumerate(lines):
+        if not line.strip():
+            in_doctest = False
+            continue
+        if verbatim_above is not None and _indent(line) > verbatim_above:
+            continue
+        verbatim_above = None
+        in_doctest = in_doctest or line.lstrip().startswith(">>>")
+        if in_doctest:
+            continue
+        lines[i] = _escape_bars(line)
+        if line.rstrip().endswith("::"):
+            verbatim_above = _indent(line)
 
 
 def setup(app):
