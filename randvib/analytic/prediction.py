@@ -308,13 +308,9 @@ def predict(harvester: Harvester, psd, method: str = "linearisation") -> PowerPr
         a coupling with a circuit state (inductive, piezo: the circuit is a
         state of the linearised system, scalar parameters).
 
-    Potentials: every method refuses a non-confining potential (no
-    stationary state); ``"averaging"`` treats the monostable one only;
-    ``"fpk"``/``"fpk-fast"`` any confining potential and the free mass;
-    ``"linearisation"`` any confining potential and the free mass (exact
-    power without friction, Gaussian displacement; see
-    :mod:`randvib.analytic.linearisation`). For the free mass
-    ``displacement_variance`` and ``stroke_exceedance`` are None.
+    Returns
+    -------
+    PowerPrediction
 
     Raises
     ------
@@ -322,6 +318,16 @@ def predict(harvester: Harvester, psd, method: str = "linearisation") -> PowerPr
         For an unknown method, a bad ``psd``, a non-white excitation with
         a method that assumes white noise, or a potential the method cannot
         treat (one line naming what it accepts).
+
+    Notes
+    -----
+    Potentials: every method refuses a non-confining potential (no
+    stationary state); ``"averaging"`` treats the monostable one only;
+    ``"fpk"``/``"fpk-fast"`` any confining potential and the free mass;
+    ``"linearisation"`` any confining potential and the free mass (exact
+    power without friction, Gaussian displacement; see
+    :mod:`randvib.analytic.linearisation`). For the free mass
+    ``displacement_variance`` and ``stroke_exceedance`` are None.
 
     Examples
     --------

@@ -160,14 +160,14 @@ class Harvester:
     def from_electrical(cls, m, c_m, k, alpha, r_load, r_coil, k3=0.0, friction=None, stroke=None):
         """Build a harvester whose c_e follows from the circuit (paper Eq. 3).
 
+        The mechanical parameters are as for :class:`Harvester`.
+
         Parameters
         ----------
         alpha : float
             Flux gradient (Wb/m).
         r_load, r_coil : float
             Load and coil resistances (ohm).
-
-        Other parameters are as for :class:`Harvester`.
         """
         electrical = ElectricalCoupling(alpha, r_load, r_coil)
         return cls.with_coupling(m, c_m, k, electrical, k3=k3, friction=friction, stroke=stroke)
