@@ -41,7 +41,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGE = "randvib"
-COPIED = ("randvib", "tests", "studies", "pyproject.toml", "README.md", ".ci")
+# docs/ and examples/: tests/test_docs.py builds the site from them (``--full``)
+COPIED = ("randvib", "tests", "studies", "docs", "examples", "pyproject.toml", "README.md", ".ci")
 NUMBA_CACHE_SUFFIXES = (".nbi", ".nbc")
 
 
@@ -468,6 +469,7 @@ def copy_project(dest: Path, source: Path = ROOT) -> None:
 
     def ignore(directory, names):
         skip = {".hypothesis", ".pytest_cache", ".benchmarks", "calibration_output"}
+        skip |= {"_build", "generated", "auto_examples", "sg_execution_times.rst"}  # docs output
         return [n for n in names if n in skip or n.endswith(".pyc")]
 
     for name in COPIED:

@@ -129,6 +129,15 @@ def equivalent_damping(harvester: Harvester, psd, expectation: str = "auto", *, 
     -------
     float or ndarray
         c_eq, broadcast over ``psd`` and the harvester's parameters.
+
+    Examples
+    --------
+    >>> import randvib as rv
+    >>> print(f"{rv.equivalent_damping(rv.preset('figure9'), 1.0):.5f} Ns/m")  # Eq. 30
+    0.22949 Ns/m
+    >>> tanh = rv.preset("figure9").updated(friction=rv.Tanh(0.0058, 4.8e8))
+    >>> print(f"{rv.equivalent_damping(tanh, 1.0):.5f} Ns/m")  # Eq. 19-20, fixed point
+    0.22949 Ns/m
     """
     if method is not None:
         expectation = _renamed_method(expectation, method)

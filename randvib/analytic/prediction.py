@@ -25,6 +25,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from scipy import optimize, special
 
+from randvib import _display
 from randvib._validation import (
     check_choice,
     check_nonnegative,
@@ -95,6 +96,53 @@ class PowerPrediction:
             if out[optional] is None:
                 del out[optional]
         return out
+
+    def _quantities(self) -> list[tuple[str, object, str]]:
+        """(name, value, unit) of every field with a value."""
+        out = [(name, getattr(self, name), unit) for name, unit in _UNITS.items()]
+        return [(name, value, unit) for name, value, unit in out if value is not None]
+
+    def to_frame(self):
+        """The prediction as a :class:`pandas.DataFrame`.
+
+        One row for scalar inputs; for a broadcast sweep one row per point
+        (the fields broadcast together and are flattened in C order, so row
+        ``i`` is ``numpy.unravel_index(i, shape)`` of the sweep's shape).
+        Columns are the fields (SI units, see the class) and ``method``.
+        """
+        pd = _display.pandas()
+        names = [name for name, _, _ in self._quantities()]
+        values = np.broadcast_arrays(
+            *(np.asarray(v, dtype=float) for _, v, _ in self._quantities())
+        )
+        frame = pd.DataFrame({n: v.ravel() for n, v in zip(names, values, strict=True)})
+        frame.insert(0, "method", self.method)
+        return frame
+
+    def _rows(self):
+        return [(name, _display.number(value), unit) for name, value, unit in self._quantities()]
+
+    def __repr__(self) -> str:
+        fields = ", ".join(
+            f"{name}={_display.number(value)}" for name, value, _ in self._quantities()
+        )
+        return f"PowerPrediction(method={self.method!r}, {fields})"
+
+    def _repr_html_(self) -> str:
+        return _display.html_table(f"Prediction ({self.method})", self._rows())
+
+
+#: Units of the fields of :class:`PowerPrediction`, in the order they are shown.
+_UNITS = {
+    "power_electrical": "W",
+    "power_load": "W",
+    "c_eq": "Ns/m",
+    "velocity_variance": "(m/s)^2",
+    "displacement_variance": "m^2",
+    "mean_abs_velocity": "m/s",
+    "circuit_mean_square": "A^2 or V^2",
+    "stroke_exceedance": "probability",
+}
 
 
 def _finish(
@@ -260,13 +308,9 @@ def predict(harvester: Harvester, psd, method: str = "linearisation") -> PowerPr
         a coupling with a circuit state (inductive, piezo: the circuit is a
         state of the linearised system, scalar parameters).
 
-    Potentials: every method refuses a non-confining potential (no
-    stationary state); ``"averaging"`` treats the monostable one only;
-    ``"fpk"``/``"fpk-fast"`` any confining potential and the free mass;
-    ``"linearisation"`` any confining potential and the free mass (exact
-    power without friction, Gaussian displacement; see
-    :mod:`randvib.analytic.linearisation`). For the free mass
-    ``displacement_variance`` and ``stroke_exceedance`` are None.
+    Returns
+    -------
+    PowerPrediction
 
     Raises
     ------
@@ -276,6 +320,25 @@ def predict(harvester: Harvester, psd, method: str = "linearisation") -> PowerPr
         treat (one line naming what it accepts), a device with neither
         damping nor friction (no stationary state), or values at which the
         method's result is not a finite float64 (overflow at extreme parameters).
+
+    Notes
+    -----
+    Potentials: every method refuses a non-confining potential (no
+    stationary state); ``"averaging"`` treats the monostable one only;
+    ``"fpk"``/``"fpk-fast"`` any confining potential and the free mass;
+    ``"linearisation"`` any confining potential and the free mass (exact
+    power without friction, Gaussian displacement; see
+    :mod:`randvib.analytic.linearisation`). For the free mass
+    ``displacement_variance`` and ``stroke_exceedance`` are None.
+
+    Examples
+    --------
+    >>> import randvib as rv
+    >>> result = rv.predict(rv.preset("figure9"), 1.0)
+    >>> print(f"{result.power_electrical:.4e} W, E[z'^2] = {result.velocity_variance:.4e} (m/s)^2")
+    2.4619e-03 W, E[z'^2] = 2.4619e-02 (m/s)^2
+    >>> print(f"{rv.predict(rv.preset('figure9'), 1.0, 'fpk-fast').power_electrical:.4e} W")
+    2.4642e-03 W
     """
     check_choice("method", method, tuple(METHODS))
     harvester.potential.require(f"method {method!r}", CONFINING + ("free",))
@@ -364,6 +427,18 @@ def expected_power(
     ``into="electrical"`` gives E[P_e] = c_e E[z'^2] (paper Eq. 32);
     ``into="load"`` gives the share dissipated in R_L (needs a circuit).
     Broadcasts over ``psd`` and array-valued harvester parameters.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import randvib as rv
+    >>> device = rv.preset("figure9")
+    >>> print(f"{rv.expected_power(device, 1.0):.4e} W")  # Eq. 32
+    2.4619e-03 W
+    >>> rv.expected_power(device, np.array([1.0, 0.5, 0.1])).round(6)  # broadcasts over S
+    array([0.002462, 0.001163, 0.000183])
+    >>> print(f"{rv.expected_power(device, rv.BandPass(1.0, 8.0, 0.1)):.4e} W")  # coloured input
+    1.1147e-03 W
     """
     check_choice("into", into, ("electrical", "load"))
     result = predict(harvester, psd, method)
@@ -416,6 +491,19 @@ def optimal_load_resistance(
         Optimal load resistance (ohm).
     power : float
         Expected load power there (W).
+
+    Examples
+    --------
+    >>> import randvib as rv
+    >>> wired = rv.Harvester.from_electrical(
+    ...     m=0.0226, c_m=0.049, k=57.4, alpha=0.1992, r_load=2.0, r_coil=0.48,
+    ...     friction=rv.Coulomb(0.0058),
+    ... )
+    >>> r_load, power = rv.optimal_load_resistance(wired, 1.0)
+    >>> print(f"R_L* = {r_load:.3f} ohm, P_L = {power:.4e} W")
+    R_L* = 0.745 ohm, P_L = 1.1025e-03 W
+    >>> print(f"{rv.optimal_load_resistance_linear(0.049, 0.1992, 0.48):.3f} ohm")  # Fc = 0
+    0.787 ohm
     """
     if harvester.electrical is None:
         raise ValueError(

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize
 
+from randvib import _display
 from randvib.analytic.linear_response import device_block, output_variances, response_spectra
 from randvib.models.excitation import Excitation, as_excitation
 from randvib.models.harvester import Harvester
@@ -135,6 +136,45 @@ class LinearisationResult:
         out.update(method=self.method, excitation=self.excitation.parameters())
         return out
 
+    def _rows(self):
+        circuit_unit = "V^2" if self.harvester.coupling_name == "piezo" else "A^2"
+        named = (
+            ("power_electrical", "W"),
+            ("power_load", "W"),
+            ("c_eq", "Ns/m"),
+            ("k_eq", "N/m"),
+            ("velocity_variance", "(m/s)^2"),
+            ("displacement_variance", "m^2"),
+            ("circuit_variance", circuit_unit),
+        )
+        return [
+            (name, _display.number(getattr(self, name)), unit)
+            for name, unit in named
+            if getattr(self, name) is not None
+        ]
+
+    def to_frame(self):
+        """The numbers as a one-row :class:`pandas.DataFrame`.
+
+        Columns as in :meth:`to_dict`, the excitation's parameters flattened
+        to ``excitation_<name>`` columns.
+        """
+        pd = _display.pandas()
+        out = self.to_dict()
+        excitation = out.pop("excitation")
+        # the excitation's kind stays `excitation`; its parameters get the prefix
+        out["excitation"] = excitation.pop("excitation", None)
+        out.update({f"excitation_{key}": value for key, value in excitation.items()})
+        return pd.DataFrame([out])
+
+    def __repr__(self) -> str:
+        fields = ", ".join(f"{name}={value}" for name, value, _ in self._rows())
+        return f"LinearisationResult({self.excitation!r}, {self.method}; {fields})"
+
+    def _repr_html_(self) -> str:
+        title = f"Statistical linearisation ({self.method}) under {self.excitation!r}"
+        return _display.html_table(title, self._rows())
+
 
 def _check_harvester(harvester: Harvester):
     values = [harvester.m, harvester.c, harvester.k, harvester.k3]
@@ -187,6 +227,17 @@ def statistical_linearisation(
         exists (a narrow band far above the wells' frequency).
     RuntimeError
         If the fixed point does not converge.
+
+    Examples
+    --------
+    >>> import randvib as rv
+    >>> device = rv.preset("figure9")
+    >>> res = rv.statistical_linearisation(device, rv.BandPass(1.0, 8.0, 0.1))
+    >>> print(f"P_e = {res.power_electrical:.4e} W, c_eq = {res.c_eq:.4f} Ns/m, k_eq = {res.k_eq:.2f} N/m")
+    P_e = 1.1147e-03 W, c_eq = 0.2438 Ns/m, k_eq = 58.33 N/m
+    >>> white = rv.statistical_linearisation(device, rv.White(1.0))  # Eq. 32 exactly
+    >>> print(f"{white.power_electrical:.4e} W")
+    2.4619e-03 W
     """
     excitation = as_excitation(excitation)
     friction = _check_harvester(harvester)

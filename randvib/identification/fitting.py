@@ -34,6 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
+from randvib import _display
 from randvib._validation import MAX_SEED, check_int, check_nonnegative, check_positive
 from randvib.identification.record_simulation import (
     HOLDS,
@@ -705,6 +706,53 @@ class IdentificationResult:
             "message": self.message,
             "settings": self.settings,
         }
+
+    def to_frame(self):
+        """The parameters as a :class:`pandas.DataFrame`, one row per parameter.
+
+        Columns ``value``, ``unit``, ``free`` (identified, not fixed) and the
+        search bounds ``lower``, ``upper`` (NaN for a fixed parameter); the
+        cost and the search's summary are in :meth:`to_dict`.
+        """
+        pd = _display.pandas()
+        specs = _specs(self.model)
+        rows = {
+            name: {
+                "value": float(value),
+                "unit": specs[name].unit,
+                "free": name in self.free,
+                "lower": float(self.bounds[name][0]) if name in self.bounds else np.nan,
+                "upper": float(self.bounds[name][1]) if name in self.bounds else np.nan,
+            }
+            for name, value in self.parameters.items()
+        }
+        return pd.DataFrame.from_dict(rows, orient="index").rename_axis("parameter")
+
+    def _rows(self):
+        specs = _specs(self.model)
+        rows = [("cost J (Eq. 11)", _display.number(self.cost, 4), "")]
+        for name, value in self.parameters.items():
+            fixed = "" if name in self.free else " (fixed)"
+            rows.append((name + fixed, _display.number(value), specs[name].unit))
+        return rows
+
+    def _search_line(self) -> str:
+        record = f" on {self.record!r}" if self.record else ""
+        return (
+            f"{self.model}{record}: {self.nfev} simulations, {self.generations} generations, "
+            f"{self.elapsed:.3g} s; {self.message}"
+        )
+
+    def __repr__(self) -> str:
+        # compact: the per-generation history stays in .history, not on the screen
+        values = ", ".join(f"{name}={_display.number(v)}" for name, v in self.parameters.items())
+        return (
+            f"IdentificationResult(model={self.model!r}, cost={_display.number(self.cost, 4)}, "
+            f"{values}; {self.nfev} simulations, {self.generations} generations)"
+        )
+
+    def _repr_html_(self) -> str:
+        return _display.html_table("Identification", self._rows(), self._search_line())
 
     def predict(self, record: Record, electrical=None) -> Prediction:
         """Simulate ``record`` with these parameters (see :func:`predict_record`)."""

@@ -99,6 +99,18 @@ def synthetic_record(
     ------
     ValueError
         An argument out of range, named in the message.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import randvib as rv
+    >>> record = rv.synthetic_record(
+    ...     rv.preset("coulomb-td1"), 1.07, duration=1.0, sample_rate=500.0, seed=1
+    ... )
+    >>> record.n, record.dt, record.input_kind
+    (500, 0.002, 'base_acceleration')
+    >>> print(f"input RMS {np.sqrt(np.mean(record.input**2)):.2f} m/s^2")
+    input RMS 1.07 m/s^2
     """
     device = _device(device)
     duration = float(check_positive("duration", duration, "s"))

@@ -260,6 +260,16 @@ class Piezo(Coupling):
         Clamped capacitance C_p (F), >= 0.
     r_load : float
         Load resistance R_L (ohm), > 0.
+
+    Examples
+    --------
+    >>> import randvib as rv
+    >>> piezo = rv.Piezo(theta=1e-3, capacitance=1e-7, r_load=1e5)
+    >>> device = rv.Harvester.with_coupling(0.0226, 0.05, 57.4, piezo)
+    >>> print(f"P_L = {rv.expected_power(device, 0.5, into='load'):.4e} W")
+    P_L = 1.7016e-03 W
+    >>> print(f"R_L* = {piezo.white_noise_optimal_load(0.0226, 0.05, 57.4):.4g} ohm")
+    R_L* = 1.831e+05 ohm
     """
 
     theta: float = parameter("N/V", positive=True, description="piezo coupling theta")

@@ -418,6 +418,16 @@ class BandPass(_SecondOrder):
         Centre frequency (Hz), > 0.
     zeta : float
         Damping ratio of the filter, > 0 (narrow band: small zeta).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import randvib as rv
+    >>> excitation = rv.BandPass(1.0, 8.0, 0.1)  # peak S (m/s^2)^2/Hz at f0 = 8 Hz
+    >>> excitation.psd(np.array([4.0, 8.0, 16.0])).round(4)
+    array([0.0175, 1.    , 0.0175])
+    >>> excitation.is_white
+    False
     """
 
     name = "band-pass"

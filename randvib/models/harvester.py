@@ -66,6 +66,20 @@ class Harvester:
         Stroke limit (m), > 0: the largest |z| before the magnet meets its end
         stops. It changes no dynamics; the methods report how often and how
         soon |z| exceeds it (``stroke_exceedance``, first-passage time).
+
+    Examples
+    --------
+    >>> import randvib as rv
+    >>> device = rv.Harvester(m=0.0226, c_m=0.1, c_e=0.1, k=57.4, k3=5e5, friction=rv.Coulomb(0.0058))
+    >>> device.c
+    0.2
+    >>> device.updated(fc=0.01).friction
+    Coulomb(fc=0.01)
+    >>> wired = rv.Harvester.from_electrical(
+    ...     m=0.0226, c_m=0.049, k=57.4, alpha=0.1992, r_load=2.0, r_coil=0.48
+    ... )
+    >>> print(f"c_e = {wired.c_e:.5f} Ns/m")  # alpha^2 / (R_L + R_C), Eq. 3
+    c_e = 0.01600 Ns/m
     """
 
     m: float
@@ -146,14 +160,14 @@ class Harvester:
     def from_electrical(cls, m, c_m, k, alpha, r_load, r_coil, k3=0.0, friction=None, stroke=None):
         """Build a harvester whose c_e follows from the circuit (paper Eq. 3).
 
+        The mechanical parameters are as for :class:`Harvester`.
+
         Parameters
         ----------
         alpha : float
             Flux gradient (Wb/m).
         r_load, r_coil : float
             Load and coil resistances (ohm).
-
-        Other parameters are as for :class:`Harvester`.
         """
         electrical = ElectricalCoupling(alpha, r_load, r_coil)
         return cls.with_coupling(m, c_m, k, electrical, k3=k3, friction=friction, stroke=stroke)

@@ -70,6 +70,15 @@ def preset(name: str) -> Harvester:
     ------
     ValueError
         If ``name`` is not a preset; the message lists them.
+
+    Examples
+    --------
+    >>> import randvib as rv
+    >>> device = rv.preset("figure9")
+    >>> device
+    Harvester(m=0.0226, c_m=0.1, c_e=0.1, k=57.4, k3=70742.0, friction=Coulomb(fc=0.0058), electrical=None, stroke=None)
+    >>> print(f"{device.natural_frequency:.2f} rad/s")
+    50.40 rad/s
     """
     try:
         return PRESETS[name]

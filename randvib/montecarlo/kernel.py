@@ -164,7 +164,7 @@ class Timing(NamedTuple):
 
 
 class Paths(NamedTuple):
-    """Paths ``first .. first + count - 1``; path i draws from stream (seed, i)."""
+    """Paths ``first`` to ``first + count - 1``; path i draws from stream (seed, i)."""
 
     seed: np.uint64
     first: int

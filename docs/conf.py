@@ -1,0 +1,119 @@
+"""Sphinx configuration of randvib's documentation site.
+
+Build it with ``python -m sphinx -W --keep-going -b html docs docs/_build/html``
+(tests/test_docs.py runs the same build in CI, warnings as errors).
+"""
+
+import os
+import re
+import sys
+from pathlib import Path
+
+# the checkout; tests/test_docs.py builds a copy of docs/ elsewhere and names it
+ROOT = Path(os.environ.get("RANDVIB_CHECKOUT", Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(ROOT))
+# the gallery runs headless and on one numba thread (CI machines are small)
+os.environ.setdefault("MPLBACKEND", "Agg")
+os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+
+import randvib  # noqa: E402
+
+project = "randvib"
+author = "randvib authors"
+copyright = "randvib authors"
+release = randvib.__version__
+version = release
+
+extensions = [
+    "sphinx.ext.autodoc",
+    "sphinx.ext.autosummary",
+    "sphinx.ext.mathjax",
+    "sphinx.ext.intersphinx",
+    "numpydoc",
+    "myst_parser",  # docs/conventions.md and docs/testing.md stay Markdown: one source
+    "sphinx_gallery.gen_gallery",
+]
+
+source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
+exclude_patterns = ["_build", "Thumbs.db", ".DS_Store"]
+templates_path = ["_templates"]
+
+# -- API reference ------------------------------------------------------------
+autosummary_generate = True
+autosummary_imported_members = False
+autodoc_default_options = {"members": True, "inherited-members": False}
+autodoc_typehints = "none"  # numpydoc's Parameters sections carry the types
+numpydoc_show_class_members = False
+numpydoc_class_members_toctree = False
+numpydoc_xref_param_type = False
+# numpydoc validation is limited to format errors that change what the page
+# shows (a warning, hence an error, in the -W build): GL06 unknown section,
+# GL07 sections out of order, PR10 a parameter line without " : " (prose inside
+# a Parameters section becomes a parameter). Style checks (summary length,
+# every return described, ...) are left to review.
+numpydoc_validation_checks = {"GL06", "GL07", "PR10"}
+
+intersphinx_mapping = {}
+
+# -- Markdown -----------------------------------------------------------------
+myst_heading_anchors = 3
+
+# -- Gallery ------------------------------------------------------------------
+sphinx_gallery_conf = {
+    "examples_dirs": str(ROOT / "examples"),
+    "gallery_dirs": "auto_examples",
+    "filename_pattern": r"/plot_",  # every example runs: their output is the point
+    "download_all_examples": False,
+    "remove_config_comments": True,
+    "within_subsection_order": "FileNameSortKey",
+    "reset_modules": ("matplotlib",),
+    "plot_gallery": "True",
+}
+
+# -- HTML ---------------------------------------------------------------------
+html_theme = "furo"
+html_title = f"randvib {release}"
+html_static_path = []
+
+
+# -- Plain-text notation in docstrings ----------------------------------------
+# The docstrings are written for ``help()`` as much as for this site and use
+# absolute values such as |z| or E|v|; in reST a pair of bars is a substitution
+# reference. Escape bars outside inline literals and roles, leaving tables (a
+# bar at the start of a line) as they are.
+_LITERAL = re.compile(r"(``.*?``|`[^`]*`)")
+_TABLE_ROW = re.compile(r"^\s*(\+[-=+]+\+?\s*$|\|\s)")
+
+
+def _escape_bars(line: str) -> str:
+    if _TABLE_ROW.match(line):
+        return line
+    parts = _LITERAL.split(line)
+    return "".join(p if i % 2 else p.replace("|", r"\|") for i, p in enumerate(parts))
+
+
+def _indent(line: str) -> int:
+    return len(line) - len(line.lstrip())
+
+
+def _escape_docstring(app, what, name, obj, options, lines):
+    """Escape the bars of prose lines; doctests and literal blocks stay verbatim."""
+    verbatim_above = None  # indentation of the line that opened a literal block
+    in_doctest = False
+    for i, line in enumerate(lines):
+        if not line.strip():
+            in_doctest = False
+            continue
+        if verbatim_above is not None and _indent(line) > verbatim_above:
+            continue
+        verbatim_above = None
+        in_doctest = in_doctest or line.lstrip().startswith(">>>")
+        if in_doctest:
+            continue
+        lines[i] = _escape_bars(line)
+        if line.rstrip().endswith("::"):
+            verbatim_above = _indent(line)
+
+
+def setup(app):
+    app.connect("autodoc-process-docstring", _escape_docstring)

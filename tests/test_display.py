@@ -1,0 +1,97 @@
+"""Results in notebooks and pandas: compact reprs, HTML tables, to_frame/to_dict."""
+
+import numpy as np
+import pytest
+
+import randvib as rv
+from randvib import _display
+from randvib.identification.fitting import IdentificationResult
+
+
+@pytest.fixture(scope="module")
+def simulation():
+    return rv.simulate(
+        rv.preset("figure9"),
+        1.0,
+        t_end=1.0,
+        burn_in=0.2,
+        dt=5e-4,
+        n_paths=32,
+        seed=4,
+        progress=False,
+    )
+
+
+def test_estimate_shows_the_digits_its_interval_supports():
+    assert _display.estimate(0.0024646123, 5.4568e-7) == "0.00246461 ± 5.5e-07"
+    assert _display.estimate(12.3456, 0.25) == "12.35 ± 0.25"
+    assert _display.estimate(0.001346, 0.000295) == "0.00135 ± 0.00030"  # zeros kept
+    assert _display.estimate(134.55, 29.5) == "135 ± 30"
+    assert _display.estimate(1e-3, 0.0) == "0.001"  # no interval: six figures at most
+
+
+def test_simulation_frame_holds_the_statistics(simulation):
+    frame = simulation.to_frame()
+    for name in ("power_electrical", "velocity_variance", "friction_power"):
+        stat = getattr(simulation, name)
+        assert frame.loc[name, "mean"] == stat.mean
+        assert frame.loc[name, "ci95"] == stat.ci95
+        assert frame.loc[name, "n_paths"] == 32
+    assert frame.loc["power_electrical", "unit"] == "W"
+    assert "power_load" not in frame.index  # no circuit, no row
+    assert simulation.to_dict() == simulation.summary()
+
+
+def test_simulation_repr_is_one_compact_line(simulation):
+    text = repr(simulation)
+    assert "\n" not in text and len(text) < 250
+    assert "32 paths" in text and "power_electrical" in text
+    html = simulation._repr_html_()
+    assert html.startswith("<table>") and html.count("<tr>") == 1 + len(simulation.to_frame())
+    assert "friction_power" in str(simulation)
+
+
+def test_broadcast_prediction_flattens_to_one_row_per_point():
+    fc = np.linspace(0.0, 0.02, 3)
+    psd = np.array([[1.0], [0.5]])
+    prediction = rv.predict(rv.preset("figure9").updated(fc=fc), psd)
+    frame = prediction.to_frame()
+    assert len(frame) == 6
+    np.testing.assert_array_equal(frame["power_electrical"], prediction.power_electrical.ravel())
+    # row i is the point unravel_index(i, shape): here (1, 2), S = 0.5 and Fc = 0.02
+    single = rv.expected_power(rv.preset("figure9").updated(fc=0.02), 0.5)
+    assert frame["power_electrical"][5] == pytest.approx(single, rel=1e-12)
+    assert "array(2, 3)" in repr(prediction) and "\n" not in repr(prediction)
+
+
+def test_linearisation_frame_is_its_dict():
+    result = rv.statistical_linearisation(rv.preset("figure9"), rv.BandPass(1.0, 8.0, 0.1))
+    row = result.to_frame().iloc[0]
+    assert row["power_electrical"] == result.power_electrical
+    assert row["excitation"] == "band-pass" and row["excitation_f0"] == 8.0
+    assert "BandPass" in repr(result) and "harvester" not in repr(result)
+    assert "k_eq" in result._repr_html_()
+
+
+def test_identification_repr_leaves_the_history_out():
+    history = {"best": list(np.linspace(1.0, 0.01, 500)), "nfev": list(range(500))}
+    result = IdentificationResult(
+        model="coulomb",
+        parameters={"m": 0.0226, "c": 0.049, "k": 57.4, "k3": 7.07e4, "fc": 0.0058},
+        free=("c", "k", "k3", "fc"),
+        cost=0.0079,
+        bounds={"c": (1e-4, 1.0), "k": (5.0, 500.0), "k3": (0.0, 1e7), "fc": (0.0, 0.02)},
+        nfev=20000,
+        generations=500,
+        elapsed=12.0,
+        simulations_per_second=1.7e3,
+        message="converged",
+        history=history,
+    )
+    text = repr(result)
+    assert len(text) < 200 and "0.0079" in text and "fc=0.0058" in text
+    frame = result.to_frame()
+    assert frame.loc["k", "value"] == 57.4 and frame.loc["k", "unit"] == "N/m"
+    assert not frame.loc["m", "free"] and np.isnan(frame.loc["m", "lower"])
+    assert frame.loc["fc", "upper"] == 0.02
+    assert "(fixed)" in result._repr_html_()
