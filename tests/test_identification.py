@@ -116,9 +116,9 @@ def test_true_parameters_score_the_residual_of_the_initial_state(skip):
     r = (rec.z - zhat)[skip:]
     reference = 100 * np.mean(r**2) / np.var(rec.z[skip:])
     assert reference < 1e-6
-    assert predict_record(COULOMB, "coulomb", rec, skip=skip, initial_state="record").cost == pytest.approx(
-        reference, rel=1e-6
-    )
+    assert predict_record(
+        COULOMB, "coulomb", rec, skip=skip, initial_state="record"
+    ).cost == pytest.approx(reference, rel=1e-6)
     (row,) = validate(COULOMB, "coulomb", [rec], skip=skip, initial_state="record")
     assert row.cost == pytest.approx(reference, rel=1e-6)
 
@@ -241,7 +241,9 @@ def test_lugre_truth_scores_zero_and_the_fit_reaches_the_optimum():
 def test_viscous_model_cannot_match_a_friction_record(record):
     viscous = identify_classic(record, "viscous", m=COULOMB["m"], popsize=20, maxiter=40, seed=0)
     # without friction the record cannot be matched as well (paper Fig. 7)
-    assert viscous.cost > 10 * predict_record(COULOMB, "coulomb", record, initial_state="record").cost
+    assert (
+        viscous.cost > 10 * predict_record(COULOMB, "coulomb", record, initial_state="record").cost
+    )
     assert viscous.cost < 100
 
 
@@ -388,7 +390,8 @@ def test_bad_identify_arguments(record):
     with pytest.raises(ValueError, match="`--fix beta`: unknown parameter for model 'coulomb'"):
         identify(record, "coulomb", m=0.02, fixed={"beta": 1.0})
     with pytest.raises(
-        ValueError, match="has 30 samples; the lugre model with 9 free parameters needs at least 120"
+        ValueError,
+        match="has 30 samples; the lugre model with 9 free parameters needs at least 120",
     ):
         identify(record.rows(0, 30), "lugre", m=0.02)
 

@@ -931,7 +931,11 @@ def identify(
         with c = c_m + c_e) placed in the initial population.
     quadratic : bool
         Estimate a quadratic stiffness k2 (N/m^2): restoring force
-        ``k z + k2 z^2 + k3 z^3``.
+        ``k z + k2 z^2 + k3 z^3``; the input offset is then held at 0. With
+        k3 free the two describe the same family: a cubic force about an
+        origin shifted by s has the quadratic term 3 k3 s and a constant
+        force, which the input offset takes; ``quadratic`` reports the
+        asymmetry as k2 about the output sensor's origin instead.
     search : SearchSettings, optional
         SaDE and polish settings (popsize 30, maxiter 60, seed 0, tol 1e-6,
         patience 15, polish True).
