@@ -11,11 +11,10 @@ from __future__ import annotations
 import json
 
 import numpy as np
-import pytest
 from scipy import stats
 
 from randvib.cli import main
-from randvib.identification.fitting import Record, identify, predict_record, validate
+from randvib.identification.fitting import Record, identify, validate
 from randvib.identification.record_simulation import reconstruct_input, simulate_record
 from randvib.identification.synthetic import synthetic_record
 from randvib.models.friction import FRICTION_MODELS
@@ -139,7 +138,8 @@ def test_campaign_record_with_a_laser_offset_is_fitted_as_without():
     offset of 1 mm on the laser leaves the Coulomb estimate unchanged (to 5 % of
     its standard errors); the input offset is not estimated (it vanishes in the
     second derivative) and the result says so."""
-    from studies.identification import TRUTH as CAMPAIGN, make_test
+    from studies.identification import TRUTH as CAMPAIGN
+    from studies.identification import make_test
 
     rec, _ = make_test(3, duration=4.0, fs=500.0, seed=0)
     moved = Record(rec.dt, rec.input_kind, rec.input + 2e-3, rec.z + 1e-3, "moved")
