@@ -90,7 +90,7 @@ def test_95_percent_intervals_cover_the_truth():
     at level 0.01 / 4 per parameter (Bonferroni). With 60 seeds the region is
     [52, 60]; an interval that really covered 80 % (standard errors 1.6 times too
     small) falls below it with probability 0.7. Calibration over 400 seeds:
-    tests/calibration/coverage.py."""
+    tests/calibration/interval_coverage.py."""
     hits = coverage_counts(range(COVERAGE_SEEDS))
     lo, hi = binomial_region(COVERAGE_SEEDS, alpha=0.01 / len(FREE))
     assert all(lo <= h <= hi for h in hits.values()), (hits, (lo, hi))
