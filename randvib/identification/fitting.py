@@ -5,10 +5,17 @@ by minimising the normalised cost (paper Eq. 11)
 
     J(theta) = 100 / (N sigma_z^2) * sum_i (z_i - zhat_i(theta))^2
 
-with self-adaptive differential evolution (:func:`randvib.identification.sade.sade`); a
+with self-adaptive differential evolution (:func:`randvib.identification.sade.sade`),
+then a least-squares polish of the simulation error that also gives the
+parameters' standard errors (:mod:`randvib.identification.least_squares`); a
 model that predicts the mean scores 100 (Eq. 12), J < 5 is a good fit and
 J < 1 excellent. Every generation's population is simulated in one batched,
 compiled call (:mod:`randvib.identification.record_simulation`).
+
+Measurement model (measured = true + offset): constant offsets of the input
+and output channels, the input between samples (linear, cubic spline or
+band-limited reconstruction), the initial state, and an optional quadratic
+stiffness k2, estimated with the parameters (:func:`identify`).
 
 Models: ``viscous`` (c (Ns/m), k (N/m), k3 (N/m^3): the paper's "no
 friction") and one per registered friction law
@@ -19,9 +26,11 @@ the mass ``m`` (kg). With base excitation the mass cannot be identified
 (dividing Eq. 1 by m leaves c/m, k/m, k3/m, F/m), so it must be given; with a
 force input it may be left free and is identified.
 
-The simulation starts from the measured first displacement and a velocity
-estimated from the first five samples (fourth-order one-sided difference);
-LuGre's bristle state starts at zero.
+By default the initial state (z0, z'0) is estimated with the parameters;
+with ``initial_state='record'`` the simulation starts from the first sample
+(less the output offset) and a velocity estimated from the first five
+samples (fourth-order one-sided difference). LuGre's bristle state starts at
+zero.
 """
 
 from __future__ import annotations
