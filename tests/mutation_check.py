@@ -346,9 +346,7 @@ MUTATIONS: tuple[Mutation, ...] = (
                 "return z[:, self.cost.skip :] - matrix[:, -1:]",
             ),
         ),
-        tests=(
-            "tests/test_measurement_model.py::test_sensor_offsets_do_not_change_the_estimate",
-        ),
+        tests=("tests/test_measurement_model.py::test_sensor_offsets_do_not_change_the_estimate",),
         why="The output sensor's offset subtracted instead of added (measured = true + "
         "offset): the fit is unchanged but the reported offset has the wrong sign.",
     ),

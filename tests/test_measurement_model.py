@@ -138,12 +138,14 @@ def test_campaign_record_with_a_laser_offset_is_fitted_as_without():
     offset of 1 mm on the laser leaves the Coulomb estimate unchanged (to 5 % of
     its standard errors); the input offset is not estimated (it vanishes in the
     second derivative) and the result says so."""
-    from studies.identification import TRUTH as CAMPAIGN
-    from studies.identification import make_test
+    from randvib.studies import load
 
-    rec, _ = make_test(3, duration=4.0, fs=500.0, seed=0)
+    campaign = load("identification")  # the script studies/identification.py
+    rec, _ = campaign.make_test(3, duration=4.0, fs=500.0, seed=0)
     moved = Record(rec.dt, rec.input_kind, rec.input + 2e-3, rec.z + 1e-3, "moved")
-    fits = [identify(r, "coulomb", m=CAMPAIGN["m"], lowpass=50.0, seed=0) for r in (rec, moved)]
+    fits = [
+        identify(r, "coulomb", m=campaign.TRUTH["m"], lowpass=50.0, seed=0) for r in (rec, moved)
+    ]
     for name in FREE:
         se = fits[0].standard_errors[name]
         assert abs(fits[0].parameters[name] - fits[1].parameters[name]) <= 0.05 * se, name
