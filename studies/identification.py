@@ -200,8 +200,9 @@ def figure8_verdict(fig8: pd.DataFrame) -> str:
 def setup_text(settings, seed, quick, elapsed) -> str:
     return (
         f"Settings: {settings['duration']:g} s records at {settings['fs']:g} Hz, SaDE population "
-        f"{settings['popsize']} for up to {settings['generations']} generations, "
-        f"{settings['substeps']} sub-steps per sample, seed {seed}"
+        f"{settings['popsize']} for up to {settings['generations']} generations, then the "
+        "least-squares polish of the simulation error (output offset and initial state "
+        f"estimated), {settings['substeps']} sub-steps per sample, seed {seed}"
         + (" (quick run)" if quick else "")
         + f". Wall time {elapsed:.0f} s.\n\n"
         "Truth: paper Table 2, Coulomb model, training data 1 "

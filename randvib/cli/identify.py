@@ -16,6 +16,7 @@ from randvib.cli._records import (
 from randvib.identification.fitting import MODELS, UNITS, SearchSettings, identify
 
 DEFAULT = SearchSettings()
+INPUT_UNITS = {"base_acceleration": "m/s^2", "base_displacement": "m", "force": "N"}
 
 
 def register(sub) -> None:
@@ -112,7 +113,7 @@ def print_report(result, record) -> None:
             value,
             se.get(name, ""),
             "" if name not in ci else f"[{ci[name][0]:.6g}, {ci[name][1]:.6g}]",
-            UNITS[name],
+            INPUT_UNITS[record.input_kind] if name == "input_offset" else UNITS[name],
             "identified" if name in se or name in result.free else "fixed",
         ]
         for name, value in result.parameters.items()
