@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from randvib.identification.record_simulation import parameter_matrix
+from randvib.identification.record_simulation import SEARCH_SUBCYCLES, parameter_matrix
 
 #: Names of the initial-state coordinates in the least-squares vector.
 INITIAL_STATE = ("z0", "v0")
@@ -110,7 +110,9 @@ class SimulationError:
         named = self.named(thetas)
         z0, v0 = named.pop("z0"), named.pop("v0")
         matrix = parameter_matrix(named, self.cost.friction)
-        _, z, _ = self.cost.run(matrix, z0=z0, v0=v0)
+        # bristles stiffer than the search allows are rejected here too (NaN):
+        # otherwise one trial step can cost thousands of sub-cycles per step
+        _, z, _ = self.cost.run(matrix, z0=z0, v0=v0, max_subcycles=SEARCH_SUBCYCLES)
         self.simulations += matrix.shape[0]
         return z[:, self.cost.skip :] + matrix[:, -1:]
 
@@ -130,8 +132,18 @@ class SimulationError:
         rows[np.arange(d), np.arange(d)] = plus
         rows[d + np.arange(d), np.arange(d)] = minus
         z = self.responses(self.coordinates.to_theta(rows))
+        ok_plus = np.all(np.isfinite(z[:d]), axis=1)
+        ok_minus = np.all(np.isfinite(z[d:]), axis=1)
+        if not (ok_plus.all() and ok_minus.all()):
+            # a rejected side: one-sided difference from the centre instead
+            centre = self.responses(self.coordinates.to_theta(u[None, :]))[0]
+            z[:d][~ok_plus] = centre
+            z[d:][~ok_minus] = centre
+            plus = np.where(ok_plus, plus, u)
+            minus = np.where(ok_minus, minus, u)
+        width = np.where(plus > minus, plus - minus, 1.0)
         z = np.where(np.isfinite(z), z, 0.0)
-        return ((z[:d] - z[d:]) / (plus - minus)[:, None]).T
+        return ((z[:d] - z[d:]) / width[:, None]).T
 
 
 @dataclass(frozen=True)
