@@ -259,3 +259,15 @@ def test_cli_json_standard_errors_quadratic_and_fix(tmp_path, capsys):
     assert main([*base[:-1], "--no-progress"]) == 0
     text = capsys.readouterr().out
     assert "95 % interval" in text and "correlation matrix" in text
+
+
+def test_search_window_is_checked_and_the_polish_fits_the_whole_record():
+    rec = record(6)
+    import pytest
+
+    with pytest.raises(ValueError, match="`search_samples` must be an integer >= 20"):
+        identify(rec, "coulomb", m=TRUTH["m"], search_samples=3)
+    whole = identify(rec, "coulomb", m=TRUTH["m"], seed=0)
+    window = identify(rec, "coulomb", m=TRUTH["m"], seed=0, search_samples=300)
+    # the same optimum of the whole record's J, found from a search on 0.6 s
+    assert window.cost == pytest.approx(whole.cost, rel=1e-3)

@@ -51,6 +51,12 @@ def register(sub) -> None:
     p.add_argument("--popsize", type=int, default=DEFAULT.popsize, help="SaDE population")
     p.add_argument("--generations", type=int, default=DEFAULT.maxiter, help="SaDE generations")
     p.add_argument(
+        "--search-samples",
+        type=int,
+        metavar="N",
+        help="search on the record's first N samples only; the polish fits all of it",
+    )
+    p.add_argument(
         "--no-polish",
         action="store_true",
         help="skip the least-squares polish (and the standard errors it gives)",
@@ -77,7 +83,11 @@ def run(args) -> int:
     plot = _new_file(args.plot, "--plot")
     record = record_from_args(args.data, args)
     search = SearchSettings(
-        popsize=args.popsize, maxiter=args.generations, seed=args.seed, polish=not args.no_polish
+        popsize=args.popsize,
+        maxiter=args.generations,
+        seed=args.seed,
+        polish=not args.no_polish,
+        search_samples=args.search_samples,
     )
     result = identify(
         record,

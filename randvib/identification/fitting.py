@@ -984,6 +984,8 @@ def identify(
     space = _search_space(record, model, fixed, bounds, simulation.skip)
     cost = _identification_cost(record, model, fixed, space.free, simulation)
     searched = cost
+    if search.search_samples is not None:
+        check_int("search_samples", search.search_samples, minimum=SAMPLES_PER_PARAMETER * 2)
     if search.search_samples is not None and record.n > search.search_samples:
         window = record.rows(0, search.search_samples, name=record.name)
         searched = _identification_cost(window, model, fixed, space.free, simulation)
