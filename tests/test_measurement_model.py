@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 from scipy import stats
 
 from randvib.cli import main
@@ -263,8 +264,6 @@ def test_cli_json_standard_errors_quadratic_and_fix(tmp_path, capsys):
 
 def test_search_window_is_checked_and_the_polish_fits_the_whole_record():
     rec = record(6)
-    import pytest
-
     with pytest.raises(ValueError, match="`search_samples` must be an integer >= 20"):
         identify(rec, "coulomb", m=TRUTH["m"], search_samples=3)
     whole = identify(rec, "coulomb", m=TRUTH["m"], seed=0)
