@@ -3,8 +3,14 @@
 Run: ``python -m pytest benchmarks/bench_identification.py -s -p no:cacheprovider``
 (``-s`` prints the summaries; the numbers also land in ``extra_info``).
 
-1. Coulomb identification of a 10 s record sampled at 1 kHz, SaDE population 50
-   for 200 generations (10,050 simulations); target under 60 s on 2 cores.
+1. Coulomb identification of a 10 s record sampled at 1 kHz (target <= 10 s on
+   2 cores): the default method (SaDE 30 x 60 with patience 15, then the
+   least-squares polish of the simulation error, offsets and initial state
+   estimated) against the previous default measured in the same run (SaDE
+   50 x 200 with patience 40 and a Nelder-Mead polish, start from the
+   record, no offsets); the ratio of wall times and both parameter errors.
+4. The nine-test campaign (studies/identification.py, target <= 2 min):
+   only with ``--campaign`` (it takes minutes), new settings against the old.
 2. Simulations per second of the compiled batched kernel against a plain
    numpy implementation of the same event-driven stick-slip scheme
    (vectorised over the population), measured in the same run; the two
@@ -157,33 +163,104 @@ def simulate_coulomb_numpy(params, acc, dt, nsub, z0, v0):
 
 
 # --------------------------------------------------------------------- benchmarks
+FREE = ("c", "k", "k3", "fc")
+
+
+def previous_default(record, m, seed=0):
+    """The identification before the polish existed: SaDE 50 x 200 (patience 40)
+    and a Nelder-Mead polish, from the record's start, no offsets. Returns
+    (wall s, parameters, J)."""
+    cost = CostFunction(
+        record, "coulomb", fixed={"m": m, "k2": 0.0, "input_offset": 0.0}, free=FREE,
+        initial_state="record",
+    )  # fmt: skip
+    box = default_bounds(record, "coulomb", m)
+    start = time.perf_counter()
+    res = sade(
+        cost, [box[n] for n in FREE], log=[n != "k3" for n in FREE], names=FREE, popsize=50,
+        maxiter=200, seed=seed, tol=1e-6, patience=40, polish=True,
+    )  # fmt: skip
+    return time.perf_counter() - start, dict(zip(FREE, res.x, strict=True)), float(res.fun)
+
+
 def test_coulomb_identification_10s_1khz(benchmark):
     record = coulomb_record()
     # compile (or load the cache) outside the timing
-    identify(record.rows(0, 200), "coulomb", m=TRUE["m"], popsize=8, maxiter=1, polish=False)
+    identify(record.rows(0, 200), "coulomb", m=TRUE["m"], popsize=8, maxiter=1)
+    old_s, old_p, old_j = previous_default(record, TRUE["m"])
 
     def run():
-        return identify(
-            record, "coulomb", m=TRUE["m"], popsize=50, maxiter=200, seed=0, tol=0,
-            patience=None, polish=False,
-        )  # fmt: skip
+        return identify(record, "coulomb", m=TRUE["m"], seed=0)
 
     res = benchmark.pedantic(run, rounds=1, iterations=1)
-    errors = {n: res.parameters[n] / TRUE[n] - 1 for n in ("c", "k", "k3", "fc")}
+    errors = {n: res.parameters[n] / TRUE[n] - 1 for n in FREE}
+    old_errors = {n: old_p[n] / TRUE[n] - 1 for n in FREE}
+    worst, old_worst = (max(map(abs, e.values())) for e in (errors, old_errors))
     benchmark.extra_info.update(
         wall_s=res.elapsed,
+        previous_wall_s=old_s,
+        speedup=old_s / res.elapsed,
         simulations=res.nfev,
         kernel_sims_per_s=res.simulations_per_second,
         cost=res.cost,
-        max_relative_error=max(map(abs, errors.values())),
+        previous_cost=old_j,
+        max_relative_error=worst,
+        previous_max_relative_error=old_worst,
     )
     print(
-        f"\nCoulomb identification, 10 s at 1 kHz, pop 50 x 200 gen: {res.elapsed:.1f} s wall, "
-        f"{res.nfev} simulations, {res.nfev / res.elapsed:.0f} sims/s overall "
-        f"({res.simulations_per_second:.0f} sims/s in the kernel), J = {res.cost:.3g}, "
-        f"max parameter error {100 * max(map(abs, errors.values())):.2g} %"
+        f"\nCoulomb identification, 10 s at 1 kHz: SaDE 30 x 60 + least squares "
+        f"{res.elapsed:.1f} s wall ({res.nfev} simulations, J = {res.cost:.3g}, max parameter "
+        f"error {100 * worst:.2g} %); previous default (SaDE 50 x 200 + Nelder-Mead) "
+        f"{old_s:.1f} s (J = {old_j:.3g}, max error {100 * old_worst:.2g} %); "
+        f"ratio {old_s / res.elapsed:.1f}x"
     )
     assert res.cost < 1.0
+
+
+#: The last commit before the measurement model and the least-squares polish.
+BASELINE_COMMIT = "42e0b20"
+
+
+def _time_campaign(source_root, out):
+    """Wall time of ``python studies/identification.py OUT`` run from ``source_root``."""
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, PYTHONPATH=str(source_root))
+    start = time.perf_counter()
+    subprocess.run(
+        [sys.executable, "studies/identification.py", str(out), "--no-progress"],
+        cwd=source_root, env=env, check=True, capture_output=True,
+    )  # fmt: skip
+    return time.perf_counter() - start
+
+
+def test_campaign_against_the_previous_method(benchmark, request, tmp_path):
+    """The full nine-test campaign (studies/identification.py), this tree against
+    :data:`BASELINE_COMMIT` exported by ``git archive`` (minutes: only with
+    ``--campaign``). Each run compiles from its own cache first (a 1-sample
+    warm-up is not possible for a study), so both include compilation."""
+    import subprocess
+    from pathlib import Path
+
+    import pytest
+
+    if not request.config.getoption("--campaign"):
+        pytest.skip("the campaign benchmark runs only with --campaign")
+    root = Path(__file__).resolve().parents[1]
+    old_root = tmp_path / "baseline"
+    old_root.mkdir()
+    archive = subprocess.run(
+        ["git", "archive", BASELINE_COMMIT], cwd=root, check=True, capture_output=True
+    ).stdout
+    subprocess.run(["tar", "-x", "-C", str(old_root)], input=archive, check=True)
+    new_s = benchmark.pedantic(
+        lambda: _time_campaign(root, tmp_path / "new"), rounds=1, iterations=1
+    )
+    old_s = _time_campaign(old_root, tmp_path / "old")
+    benchmark.extra_info.update(wall_s=new_s, previous_wall_s=old_s, speedup=old_s / new_s)
+    print(f"\ncampaign: {new_s:.0f} s; at {BASELINE_COMMIT}: {old_s:.0f} s; {old_s / new_s:.1f}x")
 
 
 def test_kernel_vs_numpy_simulations_per_second(benchmark):

@@ -8,6 +8,15 @@ import pytest
 
 os.environ.setdefault("MPLBACKEND", "Agg")
 
+
+def pytest_addoption(parser):
+    parser.addoption(
+        "--campaign",
+        action="store_true",
+        help="also run the identification campaign benchmark (minutes)",
+    )
+
+
 #: Seconds per unit of work of each benchmark in this session, by name.
 TIMINGS: dict[str, float] = {}
 

@@ -197,8 +197,9 @@ def noisy_coulomb_z(noise_seed, lin=None):
     if lin is None:
         lin = Linearisation(COULOMB, "coulomb", clean, FREE, skip=NOISY["skip"])
     res = identify(
-        noisy, "coulomb", m=COULOMB["m"], popsize=30, maxiter=80, seed=1, skip=NOISY["skip"]
-    )
+        noisy, "coulomb", m=COULOMB["m"], popsize=30, maxiter=80, seed=1, skip=NOISY["skip"],
+        fixed={"input_offset": 0.0, "output_offset": 0.0}, initial_state="record",
+    )  # fmt: skip
     err = np.array([np.log(res.parameters[n] / COULOMB[n]) for n in FREE])
     se = lin.standard_errors(NOISY["sigma"])
     return res, (err - lin.bias - lin.initial_state_shift(noisy)) / se, se

@@ -250,7 +250,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     Mutation(
         name="initial-displacement-zeroed",
         path="randvib/identification/fitting.py",
-        edits=(("self.z0 = float(record.z[0])", "self.z0 = 0.0"),),
+        edits=(("self.z0 = float(record.z[0] - offset)", "self.z0 = float(0.0 - offset)"),),
         tests=(
             "tests/test_identification.py::test_true_parameters_score_the_residual_of_the_initial_state",
         ),
@@ -403,6 +403,33 @@ MUTATIONS: tuple[Mutation, ...] = (
         "instead of c = c_m + c_e: the band injects twice the white-noise power into the "
         "linear device, so the white/band comparison is not at equal input power; the "
         "injected power c E[v^2] must be g S m / 4 to 1e-9 (exact Lyapunov solution).",
+    ),
+    Mutation(
+        name="covariance-chain-rule-dropped",
+        path="randvib/identification/least_squares.py",
+        edits=(
+            (
+                "np.linalg.pinv(jacobian_u.T @ jacobian_u) * np.outer(dtheta_du, dtheta_du)",
+                "np.linalg.pinv(jacobian_u.T @ jacobian_u)",
+            ),
+        ),
+        tests=("tests/test_measurement_model.py::test_95_percent_intervals_cover_the_truth",),
+        why="Standard errors left in the optimiser's scaled variables (log or per-scale) "
+        "instead of the parameters' units: the 95 % intervals no longer cover the truth "
+        "about 95 % of the time.",
+    ),
+    Mutation(
+        name="output-offset-sign",
+        path="randvib/identification/least_squares.py",
+        edits=(
+            (
+                "return z[:, self.cost.skip :] + matrix[:, -1:]",
+                "return z[:, self.cost.skip :] - matrix[:, -1:]",
+            ),
+        ),
+        tests=("tests/test_measurement_model.py::test_sensor_offsets_do_not_change_the_estimate",),
+        why="The output sensor's offset subtracted instead of added (measured = true + "
+        "offset): the fit is unchanged but the reported offset has the wrong sign.",
     ),
 )
 

@@ -267,7 +267,7 @@ def test_diverging_candidate_is_flagged():
         (dict(friction="dry"), "`friction` must be one of"),
         (dict(dt=-1.0), "`dt` must be > 0"),
         (dict(substeps=0), "`substeps` must be an integer >= 1"),
-        (dict(hold="cubic"), "`hold` must be one of"),
+        (dict(hold="quintic"), "`hold` must be one of"),
         (dict(input_kind="velocity"), "`input_kind` must be one of"),
         (dict(input_values=[0.0, np.nan, 1.0]), "`input_values` must be finite"),
         (dict(parameters=dict(m=1.0, c=0.1, k=1.0)), r"missing parameter\(s\) \['k3'\]"),

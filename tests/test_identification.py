@@ -64,6 +64,20 @@ TOL = 1e-4
 Z0, V0 = 1e-3, 0.03
 
 
+#: The measurement model the error models of these tests (tests/_identification.py)
+#: are built on: the simulation starts from the record's first samples and the
+#: sensors have no offsets. The estimated start and offsets (the defaults) are
+#: tested in tests/test_measurement_model.py.
+NO_OFFSETS = {"input_offset": 0.0, "output_offset": 0.0}
+
+
+def identify_classic(rec, model, *, fixed=None, **kwargs):
+    """identify with the start taken from the record and no offsets estimated."""
+    return identify(
+        rec, model, fixed={**NO_OFFSETS, **(fixed or {})}, initial_state="record", **kwargs
+    )
+
+
 def assert_at_optimum(res, truth, lin, what):
     err = np.array([np.log(res.parameters[n] / truth[n]) for n in lin.free])
     off = err - lin.bias
@@ -102,10 +116,10 @@ def test_true_parameters_score_the_residual_of_the_initial_state(skip):
     r = (rec.z - zhat)[skip:]
     reference = 100 * np.mean(r**2) / np.var(rec.z[skip:])
     assert reference < 1e-6
-    assert predict_record(COULOMB, "coulomb", rec, skip=skip).cost == pytest.approx(
-        reference, rel=1e-6
-    )
-    (row,) = validate(COULOMB, "coulomb", [rec], skip=skip)
+    assert predict_record(
+        COULOMB, "coulomb", rec, skip=skip, initial_state="record"
+    ).cost == pytest.approx(reference, rel=1e-6)
+    (row,) = validate(COULOMB, "coulomb", [rec], skip=skip, initial_state="record")
     assert row.cost == pytest.approx(reference, rel=1e-6)
 
 
@@ -118,7 +132,7 @@ def test_noise_free_coulomb_not_at_rest_recovered_to_optimiser_precision():
     every parameter by 0.9 %; a zero initial state moves them by several %.
     """
     rec = not_at_rest("coulomb", COULOMB)
-    res = identify(rec, "coulomb", m=COULOMB["m"], popsize=30, maxiter=80, seed=1)
+    res = identify_classic(rec, "coulomb", m=COULOMB["m"], popsize=30, maxiter=80, seed=1)
     lin = H.Linearisation(COULOMB, "coulomb", rec, H.FREE)
     assert_at_optimum(res, COULOMB, lin, "coulomb")
     assert res.parameters["m"] == COULOMB["m"]  # the given mass, unchanged
@@ -131,8 +145,8 @@ def test_noise_free_coulomb_not_at_rest_recovered_to_optimiser_precision():
 def test_identified_forces_scale_exactly_with_the_given_mass():
     """Base excitation: Eq. 1 divided by m; doubling m doubles c, k, k3 and Fc, same J."""
     rec = not_at_rest("coulomb", COULOMB)
-    one = identify(rec, "coulomb", m=COULOMB["m"], popsize=30, maxiter=80, seed=1)
-    two = identify(rec, "coulomb", m=2 * COULOMB["m"], popsize=30, maxiter=80, seed=1)
+    one = identify_classic(rec, "coulomb", m=COULOMB["m"], popsize=30, maxiter=80, seed=1)
+    two = identify_classic(rec, "coulomb", m=2 * COULOMB["m"], popsize=30, maxiter=80, seed=1)
     for name in H.FREE:
         assert two.parameters[name] / one.parameters[name] == pytest.approx(2.0, rel=TOL), name
     assert two.cost == pytest.approx(one.cost, rel=1e-3)
@@ -165,7 +179,7 @@ def test_noisy_record_within_linearised_standard_errors():
     # J (Eq. 11) reported by identify is Eq. 11 over the scored samples
     skip = H.NOISY["skip"]
     _, noisy = H.noisy_coulomb_record(0)
-    pred = predict_record(res.parameters, "coulomb", noisy, skip=skip)
+    pred = predict_record(res.parameters, "coulomb", noisy, skip=skip, initial_state="record")
     assert res.cost == pytest.approx(pred.cost, rel=1e-9)
     # and sits at the noise floor: 100 sigma^2 / var(z) (fraction (N - d)/N of it)
     floor = 100 * H.NOISY["sigma"] ** 2 / np.var(noisy.z[skip:])
@@ -190,12 +204,12 @@ def test_tanh_base_displacement_not_at_rest_recovered_to_optimiser_precision():
     y, acc = H.tapered(ex)
     z = simulate_record(params, "tanh", acc, 1 / ex.fs, substeps=8, z0=Z0, v0=V0).z[0]
     rec = Record(1 / ex.fs, "base_displacement", y, z, "tanh")
-    res = identify(
+    res = identify_classic(
         rec, "tanh", m=COULOMB["m"], popsize=20, maxiter=60, seed=1, bounds={"beta": (10, 1e4)}
     )
     lin = H.Linearisation(params, "tanh", rec, H.FREE + ("beta",))
     assert_at_optimum(res, params, lin, "tanh")
-    assert res.cost <= predict_record(params, "tanh", rec).cost
+    assert res.cost <= predict_record(params, "tanh", rec, initial_state="record").cost
 
 
 LUGRE = dict(
@@ -215,19 +229,21 @@ def test_lugre_truth_scores_zero_and_the_fit_reaches_the_optimum():
     Stribeck parameters held the fit must reach the optimum to TOL.
     """
     rec = not_at_rest("lugre", LUGRE)
-    truth = predict_record(LUGRE, "lugre", rec).cost
+    truth = predict_record(LUGRE, "lugre", rec, initial_state="record").cost
     assert truth < 1e-6
     held = {n: LUGRE[n] for n in ("sigma0", "sigma1", "fs", "vs")}
-    res = identify(rec, "lugre", m=LUGRE["m"], fixed=held, popsize=16, maxiter=40, seed=1)
+    res = identify_classic(rec, "lugre", m=LUGRE["m"], fixed=held, popsize=16, maxiter=40, seed=1)
     assert res.free == H.FREE
     assert res.cost <= truth
     assert_at_optimum(res, LUGRE, H.Linearisation(LUGRE, "lugre", rec, H.FREE), "lugre")
 
 
 def test_viscous_model_cannot_match_a_friction_record(record):
-    viscous = identify(record, "viscous", m=COULOMB["m"], popsize=20, maxiter=40, seed=0)
+    viscous = identify_classic(record, "viscous", m=COULOMB["m"], popsize=20, maxiter=40, seed=0)
     # without friction the record cannot be matched as well (paper Fig. 7)
-    assert viscous.cost > 10 * predict_record(COULOMB, "coulomb", record).cost
+    assert (
+        viscous.cost > 10 * predict_record(COULOMB, "coulomb", record, initial_state="record").cost
+    )
     assert viscous.cost < 100
 
 
@@ -238,11 +254,11 @@ def test_force_input_identifies_the_mass():
     force = ex.acceleration
     z = simulate_record(params, "none", force, 1 / 400, input_kind="force", substeps=8).z[0]
     rec = Record(1 / 400, "force", force, z)
-    res = identify(rec, "viscous", popsize=30, maxiter=100, seed=0)
+    res = identify_classic(rec, "viscous", popsize=30, maxiter=100, seed=0)
     assert "m" in res.free
     lin = H.Linearisation(params, "viscous", rec, ("c", "k", "k3", "m"))
     assert_at_optimum(res, params, lin, "force")
-    lin = identify(rec, "viscous", fixed={"k3": 0}, popsize=20, maxiter=40, seed=0)
+    lin = identify_classic(rec, "viscous", fixed={"k3": 0}, popsize=20, maxiter=40, seed=0)
     assert lin.parameters["k3"] == 0.0 and "k3" not in lin.free
 
 
@@ -259,7 +275,7 @@ def test_default_bounds_contain_table2_values(record):
 
 def test_validate_scores_each_record(record):
     other = synthetic(seed=1, rms=1.5, kind="base_acceleration")
-    rows = validate(TRUE, "coulomb", [record, other])
+    rows = validate(TRUE, "coulomb", [record, other], initial_state="record")
     assert [r.record for r in rows] == ["test0", "test1"]
     assert all(r.cost < 1e-6 for r in rows)
 
@@ -286,8 +302,8 @@ def test_settings_objects_are_the_keywords(record):
     ).parameters == by_keyword.parameters  # fmt: skip
     with pytest.raises(TypeError, match="unexpected keyword argument\\(s\\) generations"):
         identify(short, "coulomb", m=TRUE["m"], generations=3)
-    with pytest.raises(ValueError, match="`hold` must be one of linear, zero"):
-        SimulationSettings(hold="cubic")
+    with pytest.raises(ValueError, match="`hold` must be one of linear, zero, cubic, bandlimited"):
+        SimulationSettings(hold="quintic")
 
 
 def test_predict_is_a_deprecated_alias_of_predict_record(record):
@@ -374,7 +390,8 @@ def test_bad_identify_arguments(record):
     with pytest.raises(ValueError, match="`--fix beta`: unknown parameter for model 'coulomb'"):
         identify(record, "coulomb", m=0.02, fixed={"beta": 1.0})
     with pytest.raises(
-        ValueError, match="has 30 samples; the lugre model with 8 free parameters needs at least 80"
+        ValueError,
+        match="has 30 samples; the lugre model with 9 free parameters needs at least 120",
     ):
         identify(record.rows(0, 30), "lugre", m=0.02)
 
@@ -389,7 +406,9 @@ def test_cli_identify_json_and_validate(tmp_path, capsys, record):
     ]  # fmt: skip
     assert main(argv) == 0
     out = json.loads(capsys.readouterr().out)
-    assert out["model"] == "coulomb" and set(out["parameters"]) == {"m", "c", "k", "k3", "fc"}
+    assert out["model"] == "coulomb"
+    # offsets are estimated by default and reported with the parameters
+    assert set(out["parameters"]) == {"m", "c", "k", "k3", "fc", "input_offset", "output_offset"}
     assert out["cost"] == pytest.approx(json.loads(params.read_text())["cost"])
     assert main(["validate", str(params), str(data), str(other), "--json"]) == 0
     scores = json.loads(capsys.readouterr().out)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 
 from randvib.identification.fitting import (
+    INITIAL_STATES,
     OUTPUT_COLUMN,
     TIME_COLUMN,
     SimulationSettings,
@@ -38,9 +39,21 @@ def add_record_arguments(parser: argparse.ArgumentParser) -> None:
     )
     s = parser.add_argument_group("simulation")
     s.add_argument("--substeps", type=int, default=None, help="integration steps per sample (4)")
-    s.add_argument("--hold", choices=HOLDS, default=None, help="input interpolation (linear)")
+    s.add_argument(
+        "--hold",
+        choices=HOLDS,
+        default=None,
+        help="input between samples (linear; bandlimited or cubic for a record sampled "
+        "not far above its bandwidth)",
+    )
     s.add_argument("--lowpass", type=float, metavar="HZ", help="low-pass the driving signal")
     s.add_argument("--skip", type=int, default=None, help="samples left out of J at the start (0)")
+    s.add_argument(
+        "--initial-state",
+        choices=INITIAL_STATES,
+        default=None,
+        help="estimate the initial state (default) or start from the record's first samples",
+    )
 
 
 def parse_rows(text):

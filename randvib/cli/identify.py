@@ -16,6 +16,9 @@ from randvib.cli._records import (
 )
 from randvib.identification.fitting import MODELS, UNITS, SearchSettings, identify
 
+DEFAULT = SearchSettings()
+INPUT_UNITS = {"base_acceleration": "m/s^2", "base_displacement": "m", "force": "N"}
+
 
 def register(sub) -> None:
     p = sub.add_parser(
@@ -43,9 +46,22 @@ def register(sub) -> None:
     p.add_argument(
         "--bounds", action="append", metavar="NAME=LO:HI", help="override a search range"
     )
-    p.add_argument("--popsize", type=int, default=50, help="SaDE population (default 50)")
-    p.add_argument("--generations", type=int, default=200, help="SaDE generations (default 200)")
-    p.add_argument("--no-polish", action="store_true", help="skip the final Nelder-Mead polish")
+    p.add_argument(
+        "--quadratic", action="store_true", help="also estimate k2: force k z + k2 z^2 + k3 z^3"
+    )
+    p.add_argument("--popsize", type=int, default=DEFAULT.popsize, help="SaDE population")
+    p.add_argument("--generations", type=int, default=DEFAULT.maxiter, help="SaDE generations")
+    p.add_argument(
+        "--search-samples",
+        type=int,
+        metavar="N",
+        help="search on the record's first N samples only; the polish fits all of it",
+    )
+    p.add_argument(
+        "--no-polish",
+        action="store_true",
+        help="skip the least-squares polish (and the standard errors it gives)",
+    )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--save", metavar="FILE.json", help="also write the JSON result (new file)")
     p.add_argument("--plot", metavar="FILE.png", help="measured vs simulated figure (new file)")
@@ -74,13 +90,18 @@ def run(args) -> int:
     plot = _new_file(args.plot, "--plot")
     record = record_from_args(args.data, args)
     search = SearchSettings(
-        popsize=args.popsize, maxiter=args.generations, seed=args.seed, polish=not args.no_polish
+        popsize=args.popsize,
+        maxiter=args.generations,
+        seed=args.seed,
+        polish=not args.no_polish,
+        search_samples=args.search_samples,
     )
     result = identify(
         record,
         args.model,
         m=args.m,
         fixed=parse_assignments(args.fix, "--fix"),
+        quadratic=args.quadratic,
         bounds=parse_bounds(args.bounds),
         search=search,
         simulation=simulation_settings(args),
@@ -94,14 +115,42 @@ def run(args) -> int:
     if args.json:
         print(dumps(out))
         return 0
+    print_report(result, record)
+    return 0
+
+
+def print_report(result, record) -> None:
+    """The parameters with standard errors and 95 % intervals, J, the correlations."""
+    se, ci = result.standard_errors, result.confidence_intervals
     rows = [
-        [name, value, UNITS[name], "identified" if name in result.free else "fixed"]
+        [
+            name,
+            value,
+            se.get(name, ""),
+            "" if name not in ci else f"[{ci[name][0]:.6g}, {ci[name][1]:.6g}]",
+            INPUT_UNITS[record.input_kind] if name == "input_offset" else UNITS[name],
+            "identified" if name in se or name in result.free else "fixed",
+        ]
         for name, value in result.parameters.items()
     ]
     print(f"model {result.model} on {record.name} ({record.n} samples, {record.input_kind} input)")
-    print_table(rows, ["parameter", "value", "unit", ""])
+    print_table(rows, ["parameter", "value", "std. error", "95 % interval", "unit", ""])
     print(
         f"J = {result.cost:.6g} (Eq. 11); {result.nfev} simulations in {result.elapsed:.1f} s "
         f"({result.simulations_per_second:.0f} sims/s); {result.message}"
     )
-    return 0
+    start = result.initial_state
+    print(f"initial state z0 = {start['z0']:.6g} m, v0 = {start['v0']:.6g} m/s")
+    for note in result.notes:
+        print(f"note: {note}")
+    unc = result.uncertainty
+    if unc is not None:
+        names = list(unc.names)
+        print(f"correlation matrix (residual noise s = {unc.noise_std:.4g}, {unc.dof} dof):")
+        print_table(
+            [
+                [n, *(f"{x:+.3f}" for x in row)]
+                for n, row in zip(names, unc.correlation, strict=True)
+            ],
+            ["", *names],
+        )

@@ -5,10 +5,17 @@ by minimising the normalised cost (paper Eq. 11)
 
     J(theta) = 100 / (N sigma_z^2) * sum_i (z_i - zhat_i(theta))^2
 
-with self-adaptive differential evolution (:func:`randvib.identification.sade.sade`); a
+with self-adaptive differential evolution (:func:`randvib.identification.sade.sade`),
+then a least-squares polish of the simulation error that also gives the
+parameters' standard errors (:mod:`randvib.identification.least_squares`); a
 model that predicts the mean scores 100 (Eq. 12), J < 5 is a good fit and
 J < 1 excellent. Every generation's population is simulated in one batched,
 compiled call (:mod:`randvib.identification.record_simulation`).
+
+Measurement model (measured = true + offset): constant offsets of the input
+and output channels, the input between samples (linear, cubic spline or
+band-limited reconstruction), the initial state, and an optional quadratic
+stiffness k2, estimated with the parameters (:func:`identify`).
 
 Models: ``viscous`` (c (Ns/m), k (N/m), k3 (N/m^3): the paper's "no
 friction") and one per registered friction law
@@ -19,9 +26,11 @@ the mass ``m`` (kg). With base excitation the mass cannot be identified
 (dividing Eq. 1 by m leaves c/m, k/m, k3/m, F/m), so it must be given; with a
 force input it may be left free and is identified.
 
-The simulation starts from the measured first displacement and a velocity
-estimated from the first five samples (fourth-order one-sided difference);
-LuGre's bristle state starts at zero.
+By default the initial state (z0, z'0) is estimated with the parameters;
+with ``initial_state='record'`` the simulation starts from the first sample
+(less the output offset) and a velocity estimated from the first five
+samples (fourth-order one-sided difference). LuGre's bristle state starts at
+zero.
 """
 
 from __future__ import annotations
@@ -35,14 +44,16 @@ from pathlib import Path
 import numpy as np
 
 from randvib import _display
-from randvib._validation import MAX_SEED, check_int, check_nonnegative, check_positive
+from randvib._validation import MAX_SEED, check_finite, check_int, check_nonnegative, check_positive
 from randvib.identification.record_simulation import (
+    EXTRA_PARAMETERS,
     HOLDS,
     INPUT_KINDS,
     SEARCH_SUBCYCLES,
     device_parameters,
     driving_signal,
     parameter_matrix,
+    reconstruct_input,
     run_kernel,
 )
 from randvib.identification.sade import sade
@@ -72,11 +83,19 @@ def _specs(model) -> dict[str, Parameter]:
     return {**DEVICE_SPECS, **({} if law is None else law.parameter_specs())}
 
 
+#: Units of the quadratic stiffness and the sensor offsets.
+EXTRA_UNITS = {"k2": "N/m^2", "input_offset": "input unit", "output_offset": "m"}
+
+
+def _unit(model, name):
+    return EXTRA_UNITS[name] if name in EXTRA_UNITS else _specs(model)[name].unit
+
+
 class _Units(Mapping):
     """Parameter name -> unit, from the device's and the laws' declarations."""
 
     def _table(self):
-        out = {name: spec.unit for name, spec in DEVICE_SPECS.items()}
+        out = {name: spec.unit for name, spec in DEVICE_SPECS.items()} | EXTRA_UNITS
         for law in FRICTION_MODELS.values():
             out.update({name: spec.unit for name, spec in law.parameter_specs().items()})
         return out
@@ -97,6 +116,8 @@ OUTPUT_COLUMN = "relative_displacement"
 TIME_COLUMN = "time"
 #: Fewest samples per free parameter that a record must have.
 SAMPLES_PER_PARAMETER = 10
+#: How the simulation's initial state is obtained (SimulationSettings.initial_state).
+INITIAL_STATES = ("estimate", "record")
 
 
 # ---------------------------------------------------------------------- settings
@@ -114,19 +135,32 @@ class SimulationSettings:
         Zero-phase low-pass cut-off (Hz) for the driving signal (useful for a
         base displacement differentiated twice).
     skip : int
-        Samples at the start left out of J (initial-condition transient).
+        Samples at the start left out of J.
+    initial_state : {'estimate', 'record'}
+        ``estimate`` (default): the initial displacement and velocity are
+        estimated with the parameters (by the least-squares polish in
+        :func:`identify`; by a two-parameter fit in :func:`predict_record`
+        and :func:`validate`), so a correct model is never penalised for its
+        start. ``record``: start from the first sample (less the output
+        offset) and the velocity of :func:`initial_velocity`.
     """
 
     substeps: int = 4
     hold: str = "linear"
     lowpass: float | None = None
     skip: int = 0
+    initial_state: str = "estimate"
 
     def __post_init__(self):
         object.__setattr__(self, "substeps", check_int("substeps", self.substeps, minimum=1))
         object.__setattr__(self, "skip", check_int("skip", self.skip, minimum=0))
         if self.hold not in HOLDS:
             raise ValueError(f"`hold` must be one of {', '.join(HOLDS)}; got {self.hold!r}")
+        if self.initial_state not in INITIAL_STATES:
+            raise ValueError(
+                f"`initial_state` must be one of {', '.join(INITIAL_STATES)}; "
+                f"got {self.initial_state!r}"
+            )
 
     def to_dict(self) -> dict:
         return _fields_of(self)
@@ -149,15 +183,27 @@ class SearchSettings:
     patience : int or None
         Stop after this many generations without improvement (None: never).
     polish : bool
-        Finish with a Nelder-Mead polish of the best candidate.
+        Finish with the least-squares polish of the simulation error
+        (:mod:`randvib.identification.least_squares`), which also estimates
+        the initial state and gives the parameters' uncertainty.
+    polish_maxfev : int
+        Most residual evaluations of the polish (each Jacobian costs 2 d
+        more simulations, run in one batch).
+    search_samples : int or None
+        Search on the record's first ``search_samples`` samples only (None:
+        all); the polish always fits the whole record. The search only has
+        to find the optimum's basin, so a window of a few periods of the
+        slowest dynamics is enough and makes it proportionally cheaper.
     """
 
-    popsize: int = 50
-    maxiter: int = 200
+    popsize: int = 30
+    maxiter: int = 60
     seed: int | np.random.Generator | None = 0
     tol: float = 1e-6
-    patience: int | None = 40
+    patience: int | None = 15
     polish: bool = True
+    polish_maxfev: int = 40
+    search_samples: int | None = None
 
     def __post_init__(self):
         if isinstance(self.seed, int | np.integer) and not isinstance(self.seed, bool):
@@ -165,6 +211,10 @@ class SearchSettings:
 
     def to_dict(self) -> dict:
         return _fields_of(self)
+
+
+#: SearchSettings fields that are not SaDE's.
+_NOT_SADE = ("polish", "polish_maxfev", "search_samples")
 
 
 def _fields_of(settings) -> dict:
@@ -482,6 +532,13 @@ class CostFunction:
     Calling it with an array ``X`` of shape (n, d), columns in the order of
     :attr:`free`, returns the n costs; every row is simulated in one
     parallel compiled call. Diverged candidates cost ``inf``.
+
+    With ``profile_offset`` the output offset is not a column of ``X``:
+    each candidate is scored with its best constant output offset (J
+    minimised over it in closed form), as the search does when the offset
+    is estimated. The simulation starts from ``z0`` (default: the first
+    sample less the output offset, fixed or guessed as the record's mean)
+    and ``v0`` (default: :func:`initial_velocity`).
     """
 
     def __init__(
@@ -495,6 +552,10 @@ class CostFunction:
         hold: str = "linear",
         lowpass: float | None = None,
         skip: int = 0,
+        initial_state: str = "record",
+        profile_offset: bool = False,
+        z0: float | None = None,
+        v0: float | None = None,
     ):
         self.record = record
         self.model = model
@@ -504,6 +565,7 @@ class CostFunction:
         self.substeps = substeps
         self.hold = hold
         self.skip = skip
+        self.profile_offset = bool(profile_offset)
         self.drive, self.base_input = driving_signal(
             record.input, record.dt, record.input_kind, lowpass
         )
@@ -512,6 +574,9 @@ class CostFunction:
                 f"`skip` = {skip} leaves fewer than 2 of the {record.n} samples of record "
                 f"{record.name!r} to score; use --skip <= {max(record.n - 2, 0)}"
             )
+        self.fine = (
+            None if hold == "zero" else reconstruct_input(self.drive, record.dt, substeps, hold)
+        )
         scored = record.z[skip:]
         self.variance = float(np.var(scored))
         if self.variance == 0 or np.ptp(scored) == 0 or not np.isfinite(self.variance):
@@ -519,9 +584,12 @@ class CostFunction:
                 f"`{OUTPUT_COLUMN}` of record {record.name!r} is constant; J (Eq. 11) is undefined"
             )
         self.n_scored = scored.size
-        self.z0 = float(record.z[0])
-        self.v0 = float(initial_velocity(record.z, record.dt))
-        self.limit = 100.0 * float(np.max(np.abs(record.z)))
+        offset = self.fixed.get(
+            "output_offset", float(np.mean(record.z)) if profile_offset else 0.0
+        )
+        self.z0 = float(record.z[0] - offset) if z0 is None else float(z0)
+        self.v0 = float(initial_velocity(record.z, record.dt)) if v0 is None else float(v0)
+        self.limit = 100.0 * float(np.max(np.abs(record.z - offset)))
         self.evaluations = 0
         self.seconds = 0.0
 
@@ -532,8 +600,10 @@ class CostFunction:
             out[name] = np.full(X.shape[0], float(value))
         return out
 
-    def _run(self, matrix, **options):
+    def run(self, matrix, **options):
         """The compiled batch on this record's input, start and sub-steps."""
+        options.setdefault("z0", self.z0)
+        options.setdefault("v0", self.v0)
         return run_kernel(
             matrix,
             self.friction,
@@ -542,34 +612,37 @@ class CostFunction:
             self.record.dt,
             substeps=self.substeps,
             hold=self.hold,
-            z0=self.z0,
-            v0=self.v0,
             response_limit=self.limit,
+            fine=self.fine,
             **options,
         )
+
+    _run = run
 
     def __call__(self, X):
         params = self.parameters(X)
         matrix = parameter_matrix(params, self.friction)
         start = time.perf_counter()
-        sse, _, _ = self._run(
+        sse, _, _ = self.run(
             matrix,
             reference=self.record.z,
             skip=self.skip,
             store=False,
             max_subcycles=SEARCH_SUBCYCLES,
+            profile_offset=self.profile_offset,
         )
         self.seconds += time.perf_counter() - start
         self.evaluations += matrix.shape[0]
         return 100.0 * sse / (self.n_scored * self.variance)
 
-    def simulate(self, parameters: dict, electrical=None):
+    def simulate(self, parameters: dict, electrical=None, z0=None, v0=None):
         """Responses (z, v) of one parameter set, c raised by c_e when a circuit is given."""
         params = {k: np.atleast_1d(np.asarray(v, dtype=float)) for k, v in parameters.items()}
         if electrical is not None:
             params["c"] = params["c"] + electrical.electrical_damping
         matrix = parameter_matrix(params, self.friction)
-        _, z, v = self._run(matrix)
+        start = {k: v for k, v in (("z0", z0), ("v0", v0)) if v is not None}
+        _, z, v = self.run(matrix, **start)
         return z[0], v[0]
 
 
@@ -673,6 +746,14 @@ class IdentificationResult:
         Name of the training record.
     settings : dict
         Simulation settings (substeps, hold, lowpass, skip, seed, ...).
+    uncertainty : Uncertainty or None
+        Standard errors, 95 % intervals and correlations of the estimated
+        quantities (:class:`randvib.identification.least_squares.Uncertainty`);
+        None without the polish.
+    initial_state : dict
+        ``z0`` (m) and ``v0`` (m/s) the simulation starts from.
+    notes : tuple of str
+        Why a measurement-model parameter was not estimated.
     """
 
     model: str
@@ -688,13 +769,31 @@ class IdentificationResult:
     history: dict = field(default_factory=dict)
     record: str = ""
     settings: dict = field(default_factory=dict)
+    uncertainty: object = None
+    initial_state: dict = field(default_factory=dict)
+    notes: tuple = ()
+
+    @property
+    def standard_errors(self) -> dict:
+        """Standard error of each estimated parameter (its unit); empty without the polish."""
+        if self.uncertainty is None:
+            return {}
+        se = self.uncertainty.standard_error
+        return {n: se[n] for n in self.parameters if n in se}
+
+    @property
+    def confidence_intervals(self) -> dict:
+        """95 % confidence interval of each estimated parameter."""
+        if self.uncertainty is None:
+            return {}
+        return {n: self.uncertainty.interval[n] for n in self.standard_errors}
 
     def to_dict(self) -> dict:
         """JSON-ready summary."""
         return {
             "model": self.model,
             "parameters": {k: float(v) for k, v in self.parameters.items()},
-            "units": {k: _specs(self.model)[k].unit for k in self.parameters},
+            "units": {k: _unit(self.model, k) for k in self.parameters},
             "cost": float(self.cost),
             "free": list(self.free),
             "bounds": {k: [float(a), float(b)] for k, (a, b) in self.bounds.items()},
@@ -705,6 +804,13 @@ class IdentificationResult:
             "simulations_per_second": float(self.simulations_per_second),
             "message": self.message,
             "settings": self.settings,
+            "initial_state": dict(self.initial_state),
+            "notes": list(self.notes),
+            **(
+                {}
+                if self.uncertainty is None
+                else {"uncertainty_of": "all estimated quantities", **self.uncertainty.to_dict()}
+            ),
         }
 
     def to_frame(self):
@@ -769,6 +875,11 @@ class IdentificationResult:
         from randvib.models.harvester import Harvester
 
         p = self.parameters
+        if p.get("k2", 0.0) != 0.0:
+            raise ValueError(
+                f"the identified k2 = {p['k2']:.6g} N/m^2 has no place in a Harvester "
+                "(restoring force k z + k3 z^3); identify without --quadratic"
+            )
         law = _check_model(self.model)
         friction = None if law is None else law(**{n: p[n] for n in law.parameter_names()})
         if electrical is None:
@@ -780,17 +891,19 @@ class IdentificationResult:
 
 
 def _sim_settings(settings):
-    return {k: settings[k] for k in ("substeps", "hold", "lowpass", "skip") if k in settings}
+    names = ("substeps", "hold", "lowpass", "skip", "initial_state")
+    return {k: settings[k] for k in names if k in settings}
 
 
 def _resolve_fixed(model, fixed, m, record):
     names = MODEL_PARAMETERS[model]
+    allowed = names + ("m",) + EXTRA_PARAMETERS
     fixed = dict(fixed or {})
     for key, value in fixed.items():
-        if key not in names and key != "m":
+        if key not in allowed:
             raise ValueError(
                 f"`--fix {key}`: unknown parameter for model {model!r}; allowed: "
-                f"{', '.join(names + ('m',))}"
+                f"{', '.join(allowed)}"
             )
         fixed[key] = check_parameter(model, key, value, f"--fix {key}")
     if m is not None:
@@ -807,6 +920,44 @@ def _resolve_fixed(model, fixed, m, record):
     return fixed
 
 
+def _measurement_model(record, fixed, quadratic) -> tuple[dict, tuple, tuple]:
+    """Which of k2 and the offsets are estimated: (fixed, reported, notes).
+
+    ``fixed`` gains k2 = 0 without ``quadratic`` and input_offset = 0 where a
+    constant input offset cannot be told apart from the rest of the model;
+    ``reported`` are the extra parameters the result lists (estimated or
+    fixed by the user); ``notes`` say why an offset is not estimated.
+    """
+    fixed = dict(fixed)
+    if quadratic and "k2" in fixed:
+        raise ValueError("`--quadratic` estimates k2; it cannot also be fixed (--fix k2=...)")
+    # reported: estimated, or held by the user at a nonzero value (validate needs it)
+    reported = tuple(
+        n
+        for n in EXTRA_PARAMETERS
+        if n == "k2" and quadratic or n != "k2" and n not in fixed or fixed.get(n, 0.0) != 0.0
+    )
+    notes = []
+    if not quadratic:
+        fixed.setdefault("k2", 0.0)
+    if "input_offset" not in fixed:
+        why = None
+        if record.input_kind == "base_displacement":
+            why = "a constant offset on a displacement vanishes in its second derivative"
+        elif quadratic:
+            why = (
+                "with k2 free a constant input only shifts the displacement's origin, which "
+                "k, k2 and the output offset absorb exactly"
+            )
+        elif fixed.get("k3") == 0.0 and fixed.get("k2") == 0.0:
+            why = "with a linear spring a constant input only shifts z, as the output offset does"
+        if why is not None:
+            fixed["input_offset"] = 0.0
+            reported = tuple(n for n in reported if n != "input_offset")
+            notes.append(f"input_offset fixed at 0: {why}")
+    return fixed, reported, tuple(notes)
+
+
 def identify(
     record: Record,
     model: str,
@@ -815,13 +966,27 @@ def identify(
     fixed: dict | None = None,
     bounds: dict | None = None,
     init=None,
+    quadratic: bool = False,
     search: SearchSettings | None = None,
     simulation: SimulationSettings | None = None,
     progress: bool = False,
     callback=None,
     **options,
 ) -> IdentificationResult:
-    """Fit a model to a record by minimising J (Eq. 11) with SaDE.
+    """Fit a model and its measurement model to a record: SaDE, then least squares.
+
+    The global search (self-adaptive DE, :func:`randvib.identification.sade.sade`)
+    minimises J (Eq. 11) with the output offset profiled out in closed form;
+    the local polish (:mod:`randvib.identification.least_squares`) then
+    minimises the simulation error over every estimated quantity (model
+    parameters, offsets, initial state) and gives their standard errors.
+    The reported cost is J.
+
+    The measurement model (measured = true + offset on each channel): a
+    constant output offset is estimated unless fixed; a constant input
+    offset is estimated for force and base-acceleration inputs when the
+    restoring force makes it identifiable (k3 free or nonzero and k2 not
+    free; see ``notes`` of the result otherwise).
 
     Parameters
     ----------
@@ -835,18 +1000,26 @@ def identify(
         with a force input.
     fixed : dict, optional
         Parameters held at given values, e.g. ``{"k3": 0.0}`` for a linear
-        spring.
+        spring, ``{"input_offset": 0.0, "output_offset": 0.0}`` for sensors
+        known to have none.
     bounds : dict, optional
-        ``name -> (lower, upper)`` overriding :func:`default_bounds`.
+        ``name -> (lower, upper)`` overriding :func:`default_bounds` (search box).
     init : dict or Harvester, optional
         A starting guess ``name -> value`` (or a device, a preset included,
         with c = c_m + c_e) placed in the initial population.
+    quadratic : bool
+        Estimate a quadratic stiffness k2 (N/m^2): restoring force
+        ``k z + k2 z^2 + k3 z^3``; the input offset is then held at 0. With
+        k3 free the two describe the same family: a cubic force about an
+        origin shifted by s has the quadratic term 3 k3 s and a constant
+        force, which the input offset takes; ``quadratic`` reports the
+        asymmetry as k2 about the output sensor's origin instead.
     search : SearchSettings, optional
-        SaDE settings (popsize 50, maxiter 200, seed 0, tol 1e-6, patience
-        40, polish True).
+        SaDE and polish settings (popsize 30, maxiter 60, seed 0, tol 1e-6,
+        patience 15, polish True).
     simulation : SimulationSettings, optional
         Record simulation settings (substeps 4, linear hold, no low-pass,
-        skip 0).
+        skip 0, initial state estimated).
     progress : bool
         Progress bar.
     callback : callable, optional
@@ -854,8 +1027,8 @@ def identify(
     **options
         Fields of either settings object as keywords (``popsize=``,
         ``maxiter=``, ``seed=``, ``tol=``, ``patience=``, ``polish=``;
-        ``substeps=``, ``hold=``, ``lowpass=``, ``skip=``); they override
-        ``search`` and ``simulation``.
+        ``substeps=``, ``hold=``, ``lowpass=``, ``skip=``,
+        ``initial_state=``); they override ``search`` and ``simulation``.
 
     Returns
     -------
@@ -866,22 +1039,34 @@ def identify(
         raise ValueError(f"`record` must be a randvib Record, got {type(record).__name__}")
     search, simulation = _settings("identify", options, search=search, simulation=simulation)
     fixed = _resolve_fixed(model, fixed, m, record)
+    fixed, reported, notes = _measurement_model(record, fixed, bool(quadratic))
     space = _search_space(record, model, fixed, bounds, simulation.skip)
     cost = _identification_cost(record, model, fixed, space.free, simulation)
     _announce(record, search, simulation, len(space.free))
+    searched = cost
+    if search.search_samples is not None:
+        check_int("search_samples", search.search_samples, minimum=SAMPLES_PER_PARAMETER * 2)
+    if search.search_samples is not None and record.n > search.search_samples:
+        window = record.rows(0, search.search_samples, name=record.name)
+        searched = _identification_cost(window, model, fixed, space.free, simulation)
     start = time.perf_counter()
     res = sade(
-        cost,
+        searched,
         [space.box[n] for n in space.free],
         log=space.log,
         names=space.free,
         init=_initial_guess(init, space),
         callback=_named_callback(callback, space.free),
         progress=progress,
-        **search.to_dict(),
+        **{k: v for k, v in search.to_dict().items() if k not in _NOT_SADE},
     )
+    cost.evaluations, cost.seconds = searched.evaluations, searched.seconds
+    found = dict(zip(space.free, map(float, res.x), strict=True))
+    refined = _polish(cost, space, found, simulation, search) if search.polish else None
     elapsed = time.perf_counter() - start
-    return _identification_result(cost, space, res, elapsed, search, simulation)
+    return _identification_result(
+        cost, space, res, refined, elapsed, search, simulation, reported, notes
+    )
 
 
 def _announce(record: Record, search: SearchSettings, simulation: SimulationSettings, d) -> None:
@@ -918,8 +1103,9 @@ class _SearchSpace:
 
 def _search_space(record, model, fixed, bounds, skip) -> _SearchSpace:
     """Free parameters and their bounds (declared defaults, then the user's)."""
-    free = tuple(n for n in MODEL_PARAMETERS[model] + ("m",) if n not in fixed)
-    needed = max(20, SAMPLES_PER_PARAMETER * len(free)) + skip
+    candidates = MODEL_PARAMETERS[model] + ("m", "k2", "input_offset")
+    free = tuple(n for n in candidates if n not in fixed)
+    needed = max(20, SAMPLES_PER_PARAMETER * (len(free) + 3)) + skip
     if record.n < needed:
         raise ValueError(
             f"record {record.name!r} has {record.n} samples; the {model} model with "
@@ -930,6 +1116,7 @@ def _search_space(record, model, fixed, bounds, skip) -> _SearchSpace:
             f"`{OUTPUT_COLUMN}` of record {record.name!r} is constant; J (Eq. 11) is undefined"
         )
     box = default_bounds(record, model, fixed.get("m"))
+    box.update(_extra_bounds(record, fixed.get("m")))
     box.update(_user_bounds(model, bounds))
     unbounded = [name for name in free if name not in box]
     if unbounded:
@@ -950,8 +1137,24 @@ def _search_space(record, model, fixed, bounds, skip) -> _SearchSpace:
     return _SearchSpace(
         free=free,
         box={name: box[name] for name in free},
-        log=[specs[name].log and box[name][0] > 0 for name in free],
+        log=[name in specs and specs[name].log and box[name][0] > 0 for name in free],
     )
+
+
+def _extra_bounds(record, m) -> dict:
+    """Search boxes of k2 and the input offset from the record's scales.
+
+    k2 within +-2 m w^2 / z_max (its force at z_max at most twice the
+    linear spring's); the input offset within the measured input's mean
+    +- half its standard deviation (the true input of a shaker test has no
+    mean, so the measured mean is the offset up to the record's finite
+    length).
+    """
+    omega, z_max, _, _, m_ref = _scales(record, m)
+    drive, _ = driving_signal(record.input, record.dt, record.input_kind)
+    k2 = 2 * m_ref * omega**2 / z_max
+    mean, half = float(np.mean(drive)), 0.5 * float(np.std(drive))
+    return {"k2": (-k2, k2), "input_offset": (mean - half, mean + half)}
 
 
 def _user_bounds(model, bounds) -> dict:
@@ -978,8 +1181,10 @@ def check_parameter(model: str, name: str, value, label: str | None = None) -> f
     parameter (m, k, Fc, ...), >= 0 for the others (c, k3, ...). They hold
     for fixed values, search bounds and validated parameters alike.
     """
-    spec = _specs(model).get(name)
     label = label or name
+    if name in EXTRA_PARAMETERS:  # k2 and the sensor offsets: any finite value
+        return float(check_finite(label, value))
+    spec = _specs(model).get(name)
     if spec is None:
         raise ValueError(
             f"`{label}`: unknown parameter for model {model!r}; allowed: "
@@ -995,7 +1200,88 @@ def _identification_cost(record, model, fixed, free, simulation) -> CostFunction
         model,
         fixed=fixed,
         free=free,
+        profile_offset="output_offset" not in fixed,
         **simulation.to_dict(),
+    )
+
+
+@dataclass(frozen=True)
+class _Polished:
+    """The least-squares polish's outcome."""
+
+    parameters: dict
+    initial_state: dict
+    cost: float
+    uncertainty: object
+    message: str
+    simulations: int
+
+
+def _polish(cost: CostFunction, space, found: dict, simulation, search) -> _Polished:
+    """Least squares of the simulation error from the search's best ``found``."""
+    from randvib.identification.least_squares import INITIAL_STATE, SimulationError, polish
+
+    names = list(space.free)
+    theta0 = [found[n] for n in names]
+    z0 = cost.z0
+    if cost.profile_offset:
+        # start from the offset the search profiled for this candidate
+        z = cost.simulate({**cost.fixed, **found})[0][cost.skip :]
+        offset = float(np.mean(cost.record.z[cost.skip :] - z))
+        names.append("output_offset")
+        theta0.append(offset)
+        z0 = float(cost.record.z[0]) - offset
+    if simulation.initial_state == "estimate":
+        names += list(INITIAL_STATE)
+        theta0 += [z0, cost.v0]
+    problem = SimulationError(cost, _coordinates(cost, space, names))
+    theta, residuals, unc, message = polish(
+        problem, np.array(theta0), max_nfev=search.polish_maxfev
+    )
+    values = dict(zip(names, map(float, theta), strict=True))
+    return _Polished(
+        parameters={n: v for n, v in values.items() if n not in INITIAL_STATE},
+        initial_state={n: values.get(n, getattr(cost, n)) for n in INITIAL_STATE},
+        cost=float(100.0 * (residuals @ residuals) / (cost.n_scored * cost.variance)),
+        uncertainty=unc,
+        message=str(message),
+        simulations=problem.simulations,
+    )
+
+
+def _coordinates(cost, space, names):
+    """Scales and bounds of the least-squares vector (the search box for model parameters)."""
+    from randvib.identification.least_squares import Coordinates
+
+    z_scale = float(np.std(cost.record.z))
+    scales = {
+        "output_offset": z_scale,
+        "z0": z_scale,
+        "v0": float(np.std(np.diff(cost.record.z))) / cost.record.dt,
+        "input_offset": max(float(np.std(cost.drive)), 1e-300),
+    }
+    log, scale, lower, upper = [], [], [], []
+    for name in names:
+        if name in space.free:
+            lo, hi = space.box[name]
+            is_log = space.log[space.free.index(name)]
+            log.append(is_log)
+            scale.append(max(abs(lo), abs(hi)) or 1.0)
+            # offsets and k2 are only searched in a box; the polish is free
+            bounded = name not in EXTRA_PARAMETERS
+            lower.append(lo if bounded else -np.inf)
+            upper.append(hi if bounded else np.inf)
+        else:
+            log.append(False)
+            scale.append(scales[name] or 1.0)
+            lower.append(-np.inf)
+            upper.append(np.inf)
+    return Coordinates(
+        names=tuple(names),
+        log=np.array(log, bool),
+        scale=np.array(scale, float),
+        lower=np.array(lower, float),
+        upper=np.array(upper, float),
     )
 
 
@@ -1019,27 +1305,43 @@ def _named_callback(callback, free):
     return named
 
 
-def _identification_result(cost, space, res, elapsed, search, simulation):
+def _identification_result(cost, space, res, refined, elapsed, search, simulation, reported, notes):
     if not np.isfinite(res.fun):
         raise ValueError(
             f"no candidate of the {cost.model} model could simulate record "
             f"{cost.record.name!r} (best J = {res.fun!r}): every simulation diverged; check the "
             f"fixed values {cost.fixed} and the bounds {space.box}"
         )
-    parameters = {**dict(zip(space.free, map(float, res.x), strict=True)), **cost.fixed}
-    order = ("m",) + MODEL_PARAMETERS[cost.model]
+    parameters = {**cost.fixed, **dict(zip(space.free, map(float, res.x), strict=True))}
+    j, message, unc, nfev = float(res.fun), res.message, None, res.nfev
+    start = {"z0": cost.z0, "v0": cost.v0}
+    if refined is not None:
+        parameters.update(refined.parameters)
+        j, unc = refined.cost, refined.uncertainty
+        start = refined.initial_state
+        message += f"; least-squares polish: {refined.message}"
+        nfev += refined.simulations
+    else:
+        # without the polish: the profiled offset, and J from the record's start
+        if cost.profile_offset:
+            z = cost.simulate(parameters)[0][cost.skip :]
+            parameters["output_offset"] = float(np.mean(cost.record.z[cost.skip :] - z))
+        simulation = replace(simulation, initial_state="record")
+        pred = predict_record(parameters, cost.model, cost.record, simulation=simulation)
+        j, start = pred.cost, pred.initial_state
+    order = ("m",) + MODEL_PARAMETERS[cost.model] + reported
     seconds = cost.seconds
     return IdentificationResult(
         model=cost.model,
-        parameters={name: parameters[name] for name in order},
-        free=space.free,
-        cost=float(res.fun),
+        parameters={name: float(parameters[name]) for name in order},
+        free=space.free + (("output_offset",) if cost.profile_offset else ()),
+        cost=j,
         bounds={n: tuple(map(float, space.box[n])) for n in space.free},
-        nfev=res.nfev,
+        nfev=nfev,
         generations=res.nit,
         elapsed=elapsed,
         simulations_per_second=cost.evaluations / seconds if seconds else float("nan"),
-        message=res.message + (" (polished)" if res.polished else ""),
+        message=message,
         history={"best": res.history["best"], "nfev": res.history["nfev"]},
         record=cost.record.name,
         settings={
@@ -1048,6 +1350,9 @@ def _identification_result(cost, space, res, elapsed, search, simulation):
             "maxiter": search.maxiter,
             "seed": search.seed if isinstance(search.seed, int | None) else "generator",
         },
+        uncertainty=unc,
+        initial_state={k: float(v) for k, v in start.items()},
+        notes=notes,
     )
 
 
@@ -1060,7 +1365,8 @@ class Prediction:
     ----------
     record : Record
     z, v : ndarray
-        Simulated relative displacement (m) and velocity (m/s).
+        Simulated relative displacement as the output sensor reads it
+        (true + ``output_offset``, m) and velocity (m/s).
     cost : float
         J (Eq. 11) against the record.
     rms_error : float
@@ -1068,6 +1374,9 @@ class Prediction:
     voltage : ndarray or None
         Simulated load voltage (V) when a circuit was given:
         ``V = alpha z' R_L / (R_L + R_C)``.
+    initial_state : dict
+        ``z0`` (m), ``v0`` (m/s) the simulation started from (estimated by
+        default, see :class:`SimulationSettings`).
     """
 
     record: Record
@@ -1076,6 +1385,7 @@ class Prediction:
     cost: float
     rms_error: float
     voltage: np.ndarray | None = None
+    initial_state: dict = field(default_factory=dict)
 
 
 def _device_and_model(parameters, model, record):
@@ -1108,7 +1418,34 @@ def _check_parameters(parameters, model):
         raise ValueError(
             f"parameters for model {model!r} lack {missing}; needed: {', '.join(names)}"
         )
+    names += tuple(n for n in EXTRA_PARAMETERS if n in parameters)
     return {n: check_parameter(model, n, parameters[n]) for n in names}
+
+
+def _start_estimate(cost: CostFunction):
+    """(z0, v0): the initial state that best explains the record, all else given.
+
+    A two-parameter least-squares fit of the simulation error (for a correct
+    model the error is then the noise alone, whatever the record's start).
+    """
+    from randvib.identification.least_squares import (
+        INITIAL_STATE,
+        Coordinates,
+        SimulationError,
+        polish,
+    )
+
+    z_scale = float(np.std(cost.record.z)) or 1.0
+    v_scale = float(np.std(np.diff(cost.record.z))) / cost.record.dt or 1.0
+    coords = Coordinates(
+        names=INITIAL_STATE,
+        log=np.zeros(2, bool),
+        scale=np.array([z_scale, v_scale]),
+        lower=np.full(2, -np.inf),
+        upper=np.full(2, np.inf),
+    )
+    theta, _, _, _ = polish(SimulationError(cost, coords), np.array([cost.z0, cost.v0]))
+    return float(theta[0]), float(theta[1])
 
 
 def predict_record(
@@ -1151,8 +1488,14 @@ def predict_record(
     (simulation,) = _settings("predict_record", options, simulation=simulation)
     parameters, model, record, circuit = _device_and_model(parameters, model, record)
     params = _check_parameters(parameters, model)
+    if electrical is not None:
+        params["c"] += electrical.electrical_damping
     cost = CostFunction(record, model, fixed=params, free=(), **simulation.to_dict())
-    z, v = cost.simulate(params, electrical)
+    start = {"z0": cost.z0, "v0": cost.v0}
+    if simulation.initial_state == "estimate":
+        start["z0"], start["v0"] = _start_estimate(cost)
+    z, v = cost.simulate(params, **start)
+    z = z + params.get("output_offset", 0.0)  # what the output sensor reads
     skip = simulation.skip
     if np.all(np.isfinite(z)):
         j = float(normalised_cost(record.z[skip:], z[skip:]))
@@ -1163,7 +1506,9 @@ def predict_record(
     circuit = electrical if electrical is not None else circuit
     if circuit is not None:
         voltage = circuit.alpha * v * circuit.load_fraction
-    return Prediction(record=record, z=z, v=v, cost=j, rms_error=rms, voltage=voltage)
+    return Prediction(
+        record=record, z=z, v=v, cost=j, rms_error=rms, voltage=voltage, initial_state=start
+    )
 
 
 def predict(*args, **kwargs) -> Prediction:

@@ -4,9 +4,17 @@
 
 with ``e(t) = -m y''(t)`` for base excitation and ``e(t) = u(t)`` for a force
 applied to the mass. The input is sampled on a uniform grid ``t_i = i dt``;
-between samples it is **linearly interpolated** (first-order hold; a
-zero-order hold is available), and each sample interval is split into
-``substeps`` equal steps.
+between samples it is reconstructed (:func:`reconstruct_input`: linear by
+default; cubic spline or band-limited (sinc) interpolation for records
+sampled not far above their bandwidth; a zero-order hold), and each sample
+interval is split into ``substeps`` equal steps. Each sub-step reads the
+reconstruction at its start, middle and end (RK4's stages) and uses the
+quadratic through them in between.
+
+The restoring force may have a quadratic term, ``k z + k2 z^2 + k3 z^3``,
+and the input channel a constant offset (the kernel is driven by
+``input - input_offset``); a constant output offset is added to z where it is
+scored (measured = true + offset).
 
 A recorded base displacement is turned into base acceleration by the
 fourth-order central difference
@@ -93,7 +101,18 @@ FRICTION_KINDS = RegistryView(lambda law: KERNEL_NONE if law is None else law.ke
 FRICTION_PARAMETERS = RegistryView(lambda law: () if law is None else law.parameter_names())
 #: Device parameters shared by every model.
 DEVICE_PARAMETERS = ("m", "c", "k", "k3")
-HOLDS = ("linear", "zero")
+#: Measurement-model and extra stiffness parameters every model may take
+#: (default 0): quadratic stiffness k2 (N/m^2), the input channel's offset
+#: (units of the driving signal: m/s^2 or N) and the output's (m).
+EXTRA_PARAMETERS = ("k2", "input_offset", "output_offset")
+#: Columns of a kernel parameter row: m, c, k, k3, the friction law's
+#: parameters (padded to N_KERNEL_PARAMETERS), then EXTRA_PARAMETERS.
+MATRIX_COLUMNS = 4 + N_KERNEL_PARAMETERS + len(EXTRA_PARAMETERS)
+_K2 = 4 + N_KERNEL_PARAMETERS
+_INPUT_OFFSET = _K2 + 1
+_OUTPUT_OFFSET = _K2 + 2
+#: Reconstructions of the input between samples (see :func:`reconstruct_input`).
+HOLDS = ("linear", "zero", "cubic", "bandlimited")
 
 _SLIP = 0
 _STICK = 1
@@ -108,8 +127,9 @@ SEARCH_SUBCYCLES = 32
 # --------------------------------------------------------------------- kernel
 # The compiled pieces hand each other small tuples instead of long argument
 # lists (numba passes them by value, so they cost nothing):
-#   dev   = (m, c, k, k3, gain)  one candidate's device; the input drives it
-#           with e(t) = gain * input(t), gain = -m for a base input, else 1
+#   dev   = (m, c, k, k3, gain, k2, u_off)  one candidate's device; the input
+#           drives it with e(t) = gain * (input(t) - u_off), gain = -m for a
+#           base input, else 1
 #   law   = (kind, fn, p)        the friction law's kernel code, compiled
 #           callback and parameters, for :func:`evaluate_friction`
 #   layer = (tanh_mode, fc, beta, vb, fstick)  the friction as the stick-slip
@@ -117,18 +137,22 @@ SEARCH_SUBCYCLES = 32
 #           with the boundary layer |v| < vb; fstick is the largest friction
 #           force a stick holds
 #   slipping = (layer, sgn)      the friction while slipping in direction sgn = +-1
-#   seg   = (u0, du)             input over one sample interval, u0 + du * s
+#   seg   = (a, u0, c1, c2)      input over one sub-step [a, b] of the sample
+#           interval, u0 + c1 (s - a) + c2 (s - a)^2 (c2 = 0: linear)
 #   st    = (z, v, mode, sgn)    the stick-slip integrator's state
 @numba.njit(cache=True, inline="always")
 def _input(dev, seg, s):
-    # e at time s into the sample interval (first- or zero-order hold)
-    return dev[4] * (seg[0] + seg[1] * s)
+    # e at time s into the sample interval: the sub-step's quadratic through
+    # the reconstructed input at its start, middle and end, less the input
+    # channel's offset (measured = true + offset)
+    r = s - seg[0]
+    return dev[4] * (seg[1] + r * (seg[2] + r * seg[3]) - dev[6])
 
 
 @numba.njit(cache=True, inline="always")
 def _free_force(dev, e, z, v):
-    # g = e - c z' - k z - k3 z^3: everything but friction (N)
-    return e - dev[1] * v - dev[2] * z - dev[3] * z * z * z
+    # g = e - c z' - k z - k2 z^2 - k3 z^3: everything but friction (N)
+    return e - dev[1] * v - z * (dev[2] + z * (dev[5] + z * dev[3]))
 
 
 @numba.njit(cache=True, inline="always")
@@ -264,11 +288,27 @@ def _starting_state(dev, layer, e, z, v):
 
 
 @numba.njit(cache=True, inline="always")
+def _breakaway_newton(dev, seg, z, target, s, b, guess):
+    # With a curved (quadratic) input sub-step g is quadratic in time: refine
+    # the chord's breakaway time by Newton steps on g(t) = target, kept in [s, b].
+    t = guess
+    for _ in range(4):
+        r = t - seg[0]
+        slope = dev[4] * (seg[2] + 2.0 * r * seg[3])
+        if slope == 0.0:
+            break
+        t -= (_free_force(dev, _input(dev, seg, t), z, 0.0) - target) / slope
+        t = min(max(t, s), b)
+    return t
+
+
+@numba.njit(cache=True, inline="always")
 def _stick(dev, layer, seg, s, b, st):
     """Advance a stick from s: to b, or to breakaway. Returns (s, st).
 
     With ``z`` frozen, g is linear in time (linear hold), so breakaway
-    ``|g| = fstick`` is found exactly. In tanh mode the mass creeps at the
+    ``|g| = fstick`` is found exactly (a curved sub-step refines the chord's
+    time by Newton steps). In tanh mode the mass creeps at the
     quasi-static velocity instead of standing still.
     """
     z, v, mode, sgn = st
@@ -288,6 +328,8 @@ def _stick(dev, layer, seg, s, b, st):
         frac = (target - ga) / (gb - ga)
         frac = min(max(frac, 0.0), 1.0)
         s_new = s + frac * (b - s)
+        if seg[3] != 0.0:
+            s_new = _breakaway_newton(dev, seg, z, target, s, b, s_new)
         sgn = 1.0 if gb > 0 else -1.0
     if tanh_mode:
         # creep up to breakaway at the mean quasi-static velocity
@@ -366,7 +408,27 @@ def _diverged(out_z, out_v, store, first):
         for r in range(first, out_z.shape[0]):
             out_z[r] = math.nan
             out_v[r] = math.nan
-    return math.inf
+    return math.inf, 0.0
+
+
+@numba.njit(cache=True, inline="always")
+def _segment(u, i, j, nsub, curved, a, b):
+    """(a, u0, c1, c2): the input over sub-step j = [a, b] of sample interval i.
+
+    ``u`` holds the reconstructed input at every half sub-step (2 nsub + 1
+    values per interval, shared ends) when ``curved``; the sub-step is then
+    the quadratic through its start, middle and end (exactly linear for a
+    linear reconstruction). Otherwise ``u`` holds the samples and the input
+    is held constant over the interval (zero-order hold).
+    """
+    if not curved:
+        return (a, u[i], 0.0, 0.0)
+    q = 2 * (i * nsub + j)
+    ua = u[q]
+    um = u[q + 1]
+    ub = u[q + 2]
+    hm = 0.5 * (b - a)
+    return (a, ua, (4.0 * um - 3.0 * ua - ub) / (2.0 * hm), (ua - 2.0 * um + ub) / (2.0 * hm * hm))
 
 
 @numba.njit(cache=True)
@@ -374,19 +436,21 @@ def _run_one(par, relax_rate, state0, friction, drive, scoring, out_z, out_v, st
     """Simulate one parameter set; return the sum of squared errors against zref
     over the samples from index ``skip`` on.
 
-    ``par`` is ``[m, c, k, k3, p...]``, ``state0`` ``[z0, v0, theta0]``;
-    ``friction = (kind, fn, stick_slip)``, ``drive = (u, dt, nsub, linear,
-    base_input)``, ``scoring = (zref, skip, zlim, max_subcycles)`` as built by
+    ``par`` is ``[m, c, k, k3, p..., k2, input offset, output offset]``
+    (:data:`MATRIX_COLUMNS`), ``state0`` ``[z0, v0, theta0]``; the error is
+    that of ``z + output offset``; ``friction = (kind, fn, stick_slip)``,
+    ``drive = (u, dt, nsub, curved, base_input)``, ``scoring = (zref, skip, zlim, max_subcycles)`` as built by
     :func:`run_kernel`.
     """
     kind, fn, slip = friction
-    u, dt, nsub, linear, base_input = drive
+    u, dt, nsub, curved, base_input = drive
     zref, skip, zlim, max_sub = scoring
     m = par[0]
-    p = par[4:]
-    dev = (m, par[1], par[2], par[3], -m if base_input else 1.0)
+    p = par[4 : 4 + N_KERNEL_PARAMETERS]
+    dev = (m, par[1], par[2], par[3], -m if base_input else 1.0, par[_K2], par[_INPUT_OFFSET])
+    z_off = par[_OUTPUT_OFFSET]
     h = dt / nsub
-    n = u.shape[0]
+    n = (u.shape[0] - 1) // (2 * nsub) + 1 if curved else u.shape[0]
     have_ref = zref.shape[0] == n
 
     sticky, layer = _stick_slip_layer(slip, p, m, h)
@@ -398,20 +462,22 @@ def _run_one(par, relax_rate, state0, friction, drive, scoring, out_z, out_v, st
     th = state0[2]
     st = (z, v, _SLIP, 1.0)
     if sticky:
-        st = _starting_state(dev, layer, dev[4] * u[0], z, v)
+        st = _starting_state(dev, layer, dev[4] * (u[0] - dev[6]), z, v)
         v = st[1]
 
     sse = 0.0
+    sres = 0.0  # sum of the errors, for a profiled output offset
     if have_ref and skip == 0:
-        sse = (z - zref[0]) ** 2
+        sse = (z + z_off - zref[0]) ** 2
+        sres = z + z_off - zref[0]
     if store:
         out_z[0] = z
         out_v[0] = v
     for i in range(n - 1):
-        seg = (u[i], (u[i + 1] - u[i]) / dt if linear else 0.0)
         for j in range(nsub):
             a = j * h
             b = dt if j == nsub - 1 else a + h
+            seg = _segment(u, i, j, nsub, curved, a, b)
             if sticky:
                 st = _stick_slip_substep(dev, layer, seg, a, b, 1e-14 * dt, st)
                 z = st[0]
@@ -424,25 +490,29 @@ def _run_one(par, relax_rate, state0, friction, drive, scoring, out_z, out_v, st
         if not (abs(z) < zlim) or not (abs(v) < math.inf):
             return _diverged(out_z, out_v, store, i + 1)
         if have_ref and i + 1 >= skip:
-            sse += (z - zref[i + 1]) ** 2
+            err = z + z_off - zref[i + 1]
+            sse += err * err
+            sres += err
         if store:
             out_z[i + 1] = z
             out_v[i + 1] = v
-    return sse
+    return sse, sres
 
 
 @numba.njit(cache=True, parallel=True)
 def _run_batch(params, relax, state0, friction, drive, scoring, out_z, out_v, store):
     # Without stored responses (store False) out_z, out_v are (1, 1), never written.
     n_pop = params.shape[0]
-    sse = np.empty(n_pop)
+    sums = np.empty((n_pop, 2))
     for i in numba.prange(n_pop):
         row = out_z[i] if store else out_z[0]
         row_v = out_v[i] if store else out_v[0]
-        sse[i] = _run_one(
+        sse, sres = _run_one(
             params[i], relax[i], state0[i], friction, drive, scoring, row, row_v, store
         )
-    return sse
+        sums[i, 0] = sse
+        sums[i, 1] = sres
+    return sums
 
 
 # ----------------------------------------------------------------- python API
@@ -520,6 +590,63 @@ def driving_signal(values, dt, input_kind, lowpass=None):
     if lowpass is not None:
         x = lowpass_filter(x, dt, lowpass)
     return np.ascontiguousarray(x), input_kind != "force"
+
+
+def reconstruct_input(samples, dt, substeps, hold="linear"):
+    """The input between samples, at every half sub-step (what the integrator reads).
+
+    Parameters
+    ----------
+    samples : ndarray, shape (n,)
+        The driving signal at ``t_i = i dt``.
+    dt : float
+        Sample interval (s).
+    substeps : int
+        Integration steps per sample interval.
+    hold : {'linear', 'cubic', 'bandlimited'}
+        ``linear``: straight lines between samples (first-order hold).
+        ``cubic``: the not-a-knot cubic spline through the samples (error
+        about (omega dt)^4 / 384 of the amplitude at angular frequency
+        omega). ``bandlimited``: the band-limited (sinc) interpolant,
+        computed by FFT zero-padding of the record's even (mirrored)
+        extension, which is continuous, so the ends do not ring as a
+        periodic extension would; exact for a signal with no power above
+        the Nyquist frequency that the mirror keeps smooth, the right
+        choice when the record is sampled not far above its bandwidth.
+
+    Returns
+    -------
+    ndarray, shape ((n - 1) * 2 substeps + 1,)
+        Values at ``t = q dt / (2 substeps)``.
+    """
+    x = np.asarray(samples, dtype=float)
+    n = x.shape[0]
+    up = 2 * int(substeps)
+    fine_t = np.arange((n - 1) * up + 1) / up  # in samples
+    if hold == "linear":
+        return np.ascontiguousarray(np.interp(fine_t, np.arange(n), x))
+    if hold == "cubic":
+        from scipy.interpolate import CubicSpline
+
+        return np.ascontiguousarray(CubicSpline(np.arange(n), x)(fine_t))
+    if hold == "bandlimited":
+        return np.ascontiguousarray(_sinc_interpolation(x, up)[: fine_t.size])
+    raise ValueError(
+        f"`hold` must be one of {', '.join(h for h in HOLDS if h != 'zero')}; got {hold!r}"
+    )
+
+
+def _sinc_interpolation(x, up):
+    """Band-limited interpolation of x by a factor ``up`` via its even periodic extension."""
+    n = x.shape[0]
+    ext = np.concatenate([x, x[-2:0:-1]])  # period 2n - 2, continuous
+    m = ext.shape[0]
+    spectrum = np.fft.rfft(ext)
+    if m % 2 == 0:
+        spectrum[-1] *= 0.5  # split the Nyquist bin between +-fs/2
+    padded = np.zeros(m * up // 2 + 1, dtype=complex)
+    padded[: spectrum.shape[0]] = spectrum
+    return np.fft.irfft(padded, m * up)[: (n - 1) * up + 1] * up
 
 
 @dataclass(frozen=True, eq=False)
@@ -602,13 +729,14 @@ _HARVESTER_ONLY = ("c_m", "c_e", "friction", "alpha", "r_load", "r_coil")
 
 
 def parameter_matrix(parameters: dict, friction) -> np.ndarray:
-    """Kernel parameter rows ``[m, c, k, k3, friction...]`` from named arrays.
+    """Kernel parameter rows ``[m, c, k, k3, friction..., k2, offsets]`` from named arrays.
 
     Parameters
     ----------
     parameters : dict
         ``m, c, k, k3`` and the friction parameters (see
-        :data:`FRICTION_PARAMETERS`); scalars or 1-D arrays of one length.
+        :data:`FRICTION_PARAMETERS`), optionally :data:`EXTRA_PARAMETERS`
+        (default 0); scalars or 1-D arrays of one length.
     friction : str or FrictionModel subclass
         One of :data:`FRICTION_KINDS`, or a law class.
     """
@@ -620,17 +748,23 @@ def parameter_matrix(parameters: dict, friction) -> np.ndarray:
         raise ValueError(
             f"missing parameter(s) {missing} for friction {friction!r}; needed: {', '.join(names)}"
         )
-    extra = sorted(set(parameters) - set(names))
+    extra = sorted(set(parameters) - set(names) - set(EXTRA_PARAMETERS))
     if extra:
         raise ValueError(
-            f"unknown parameter(s) {extra} for friction {friction!r}; allowed: {', '.join(names)}"
+            f"unknown parameter(s) {extra} for friction {friction!r}; allowed: "
+            f"{', '.join(names + EXTRA_PARAMETERS)}"
         )
-    columns = [np.atleast_1d(check_finite(name, parameters[name])) for name in names]
+    extras = [name for name in EXTRA_PARAMETERS if name in parameters]
+    columns = [
+        np.atleast_1d(check_finite(name, parameters[name])) for name in names + tuple(extras)
+    ]
+    where = list(range(len(names))) + [_K2 + EXTRA_PARAMETERS.index(name) for name in extras]
     n_pop = max(col.shape[0] for col in columns)
-    out = np.zeros((n_pop, 4 + N_KERNEL_PARAMETERS))
-    for j, col in enumerate(columns):
+    out = np.zeros((n_pop, MATRIX_COLUMNS))
+    for j, col in zip(where, columns, strict=True):
         if col.ndim != 1 or col.shape[0] not in (1, n_pop):
-            raise ValueError(f"parameter `{names[j]}` must be a scalar or a 1-D array of {n_pop}")
+            name = (names + tuple(extras))[where.index(j)]
+            raise ValueError(f"parameter `{name}` must be a scalar or a 1-D array of {n_pop}")
         out[:, j] = col
     if np.any(out[:, 0] <= 0):
         raise ValueError(f"`m` must be > 0 (kg), got {out[out[:, 0] <= 0, 0][0]!r}")
@@ -654,6 +788,8 @@ def run_kernel(
     response_limit=np.inf,
     store=True,
     max_subcycles=4096,
+    fine=None,
+    profile_offset=False,
 ):
     """Low-level batched call on validated arguments.
 
@@ -674,6 +810,12 @@ def run_kernel(
     max_subcycles : int
         Sub-cycles per sub-step a law with memory may take before the
         candidate is rejected.
+    fine : ndarray, optional
+        ``reconstruct_input(drive, dt, substeps, hold)`` computed once by a
+        caller that runs the kernel many times.
+    profile_offset : bool
+        Return the error sums minimised over a constant output offset
+        (added to the rows' own): ``sum e^2 - (sum e)^2 / N``.
 
     Returns
     -------
@@ -696,10 +838,16 @@ def run_kernel(
         kernel_callback(law),
         STICK_SLIP_NONE if law is None else law.stick_slip,
     )
-    relax = np.zeros(n_pop) if law is None else law.kernel_relaxation_rate(matrix[:, 4:])
-    drive_args = (drive, float(dt), int(substeps), hold == "linear", bool(base_input))
+    relax = np.zeros(n_pop) if law is None else law.kernel_relaxation_rate(matrix[:, 4:_K2])
+    if hold not in HOLDS:
+        raise ValueError(f"`hold` must be one of {', '.join(HOLDS)}; got {hold!r}")
+    if fine is not None and hold != "zero":
+        samples = fine  # the caller's reconstruct_input(drive, dt, substeps, hold), reused
+    else:
+        samples = drive if hold == "zero" else reconstruct_input(drive, dt, substeps, hold)
+    drive_args = (samples, float(dt), int(substeps), hold != "zero", bool(base_input))
     scoring = (zref, int(skip), float(response_limit), int(max_subcycles))
-    sse = _run_batch(
+    sums = _run_batch(
         np.ascontiguousarray(matrix),
         np.ascontiguousarray(relax, dtype=float),
         state0,
@@ -710,6 +858,10 @@ def run_kernel(
         out_v,
         bool(store),
     )
+    sse = sums[:, 0]
+    if profile_offset and zref.size:
+        # the best constant added to z: J's minimum over the output offset
+        sse = sse - sums[:, 1] ** 2 / (zref.size - int(skip))
     return sse, (out_z if store else None), (out_v if store else None)
 
 
@@ -754,8 +906,8 @@ def simulate_record(
     input_kind : {'base_displacement', 'base_acceleration', 'force'}
     substeps : int, optional
         Integration steps per sample interval (default 4).
-    hold : {'linear', 'zero'}
-        Interpolation of the input between samples.
+    hold : {'linear', 'zero', 'cubic', 'bandlimited'}
+        Reconstruction of the input between samples (:func:`reconstruct_input`).
     lowpass : float, optional
         Zero-phase low-pass cut-off (Hz) for the driving signal.
     z0, v0, theta0 : float or array_like

@@ -52,7 +52,7 @@ def synthesis_seed(seed: int) -> int:
 
 
 def path_amplitudes(seed: int, first: int, count: int, n: int) -> np.ndarray:
-    """The standard normals behind the synthesised input of paths ``first .. first + count - 1``."""
+    """The standard normals behind the synthesised input of paths ``first`` to ``first + count - 1``."""
     return path_normals(synthesis_seed(seed), count, 2 * (n // 2 + 1), first)
 
 
@@ -79,7 +79,7 @@ class SynthesisedInput:
     seed: int
 
     def __call__(self, first: int, count: int) -> np.ndarray:
-        """Increments of paths ``first .. first + count - 1``, shape (count, n_steps)."""
+        """Increments of paths ``first`` to ``first + count - 1``, shape (count, n_steps)."""
         normals = path_amplitudes(self.seed, first, count, self.n_steps)
         return -synthesised_increments(self.excitation, self.n_steps, self.dt, normals)
 
@@ -135,7 +135,7 @@ class RecordedInput:
         return (self.n_burn + self.window) * self.substeps
 
     def __call__(self, first: int, count: int) -> np.ndarray:
-        """Increments of segments ``first .. first + count - 1``, shape (count, n_steps)."""
+        """Increments of segments ``first`` to ``first + count - 1``, shape (count, n_steps)."""
         m = self.substeps
         fraction = (np.arange(m) + 0.5) / m  # midpoint of each sub-step: exact for a line
         out = np.empty((count, self.n_steps))

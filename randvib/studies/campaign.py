@@ -86,6 +86,8 @@ def load_fit(path: Path) -> IdentificationResult:
         message=d["message"],
         record=d["record"],
         settings=d["settings"],
+        initial_state=d.get("initial_state", {}),
+        notes=tuple(d.get("notes", ())),
     )
 
 
