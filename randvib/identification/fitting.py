@@ -1127,7 +1127,7 @@ def _search_space(record, model, fixed, bounds, skip) -> _SearchSpace:
     specs = _specs(model)
     for name in free:
         lo, hi = box[name]
-        positive = specs[name].positive
+        positive = name in specs and specs[name].positive  # k2, offsets: any sign
         if not (np.isfinite(lo) and np.isfinite(hi) and lo <= hi and (lo > 0 or not positive)):
             raise ValueError(
                 f"the search bounds of `{name}` are ({lo!r}, {hi!r}), which model {model!r} "
