@@ -36,27 +36,38 @@ def register(sub) -> None:
         type=float,
         help="mass (kg); required for base excitation, identified if omitted with a force input",
     )
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--seed", type=int, default=0, help="random seed")
     p.add_argument(
         "--fix", action="append", metavar="NAME=VALUE", help="hold a parameter, e.g. --fix k3=0"
     )
     p.add_argument(
         "--bounds", action="append", metavar="NAME=LO:HI", help="override a search range"
     )
-    p.add_argument("--popsize", type=int, default=50, help="SaDE population (default 50)")
-    p.add_argument("--generations", type=int, default=200, help="SaDE generations (default 200)")
+    p.add_argument("--popsize", type=int, default=50, help="SaDE population, popsize")
+    p.add_argument(
+        "--generations", type=int, default=200, help="SaDE generations, the API's maxiter"
+    )
     p.add_argument("--no-polish", action="store_true", help="skip the final Nelder-Mead polish")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--save", metavar="FILE.json", help="also write the JSON result (new file)")
-    p.add_argument("--plot", metavar="FILE.png", help="measured vs simulated figure (new file)")
+    p.add_argument(
+        "--save", metavar="FILE.json", help="also write the JSON result (a new file unless --force)"
+    )
+    p.add_argument(
+        "--plot",
+        metavar="FILE.png",
+        help="measured vs simulated figure (a new file unless --force)",
+    )
+    p.add_argument(
+        "--force", action="store_true", help="overwrite an existing --save or --plot file"
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     add_record_arguments(p)
     p.set_defaults(handler=run)
 
 
-def _new_file(path, option):
+def _new_file(path, option, overwrite=False):
     """Checked before the fit, so that a long fit is never thrown away at the end."""
-    return None if path is None else check_output_file(path, option)
+    return None if path is None else check_output_file(path, option, overwrite=overwrite)
 
 
 def _save_plot(result, record, plot: Path, title: str) -> None:
@@ -70,8 +81,8 @@ def _save_plot(result, record, plot: Path, title: str) -> None:
 
 
 def run(args) -> int:
-    save = _new_file(args.save, "--save")
-    plot = _new_file(args.plot, "--plot")
+    save = _new_file(args.save, "--save", args.force)
+    plot = _new_file(args.plot, "--plot", args.force)
     record = record_from_args(args.data, args)
     search = SearchSettings(
         popsize=args.popsize, maxiter=args.generations, seed=args.seed, polish=not args.no_polish

@@ -32,6 +32,8 @@ def register(sub) -> None:
     p.add_argument(
         "--method",
         default="linearisation",
+        choices=tuple(METHODS),
+        metavar="METHOD",
         help=f"analytic method: {', '.join(METHODS)} (default linearisation, paper Eq. 32; "
         "averaging: stochastic averaging, non-Gaussian velocity, 0.3 ms; "
         "fpk-fast: corrected small-grid FPK solution, resolves the k3 effect, 2 ms; "

@@ -29,9 +29,14 @@ def register(sub) -> None:
     add_device_arguments(p)
     add_excitation_arguments(p)
     g = p.add_argument_group("simulation")
-    g.add_argument("--paths", type=int, default=None, help="number of paths (default 1000)")
     g.add_argument(
-        "--t-end", type=float, default=None, help="time per path incl. burn-in (s), default 20"
+        "--paths", type=int, default=None, help="number of paths, n_paths (default: 1000)"
+    )
+    g.add_argument(
+        "--t-end",
+        type=float,
+        default=None,
+        help="time per path incl. burn-in (s) (default: 20; not with --record, whose length it is)",
     )
     g.add_argument(
         "--dt",
@@ -46,7 +51,13 @@ def register(sub) -> None:
         help="with --record: windows of the record that make the paths (default 10)",
     )
     g.add_argument("--burn-in", type=float, default=2.0, help="discarded initial time (s)")
-    g.add_argument("--method", default="heun", help=f"integrator: {', '.join(INTEGRATORS)}")
+    g.add_argument(
+        "--method",
+        default="heun",
+        choices=tuple(INTEGRATORS),
+        metavar="SCHEME",
+        help=f"integrator (the API's `scheme`): {', '.join(INTEGRATORS)}",
+    )
     g.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     g.add_argument("--threads", type=int, default=None, help="threads (default: all cores)")
     g.add_argument(
@@ -55,6 +66,7 @@ def register(sub) -> None:
         help="variance-reduced estimates (energy balance, and under white noise the "
         "friction-free companion); white, band-pass and kanai-tajimi input",
     )
+    g.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(handler=run)
 
@@ -71,8 +83,6 @@ def run(args) -> int:
             f"kanai-tajimi): under the synthesised or recorded {psd.name} input no control "
             "has a known mean"
         )
-    if args.method not in INTEGRATORS:
-        raise ValueError(f"`--method` must be one of {', '.join(INTEGRATORS)}; got {args.method!r}")
     if args.record is not None:
         result = _on_record(harvester, psd, args)
     else:
@@ -88,6 +98,7 @@ def run(args) -> int:
             scheme=args.method,  # the CLI keeps its option name `--method`
             seed=args.seed,
             threads=args.threads,
+            progress=False if args.no_progress or args.json else None,
             # the friction-free companion's exact moments hold under white noise
             # and the resistive coupling only; the energy-balance controls hold
             # for every coupling
@@ -175,6 +186,7 @@ def _on_record(harvester, record, args):
             scheme=args.method,
             seed=args.seed,
             threads=args.threads,
+            progress=False if args.no_progress or args.json else None,
         )
     except ValueError as exc:  # name the options, not the function's arguments
         message = str(exc).replace("`segments`", "`--segments`").replace("`burn_in`", "`--burn-in`")
