@@ -116,8 +116,19 @@ def _main_with_warnings(argv) -> int:
         # checked for finiteness instead, and refused with a message naming it
         warnings.filterwarnings("ignore", category=RuntimeWarning, module=r"(numpy|scipy|randvib)")
         warnings.filterwarnings("ignore", message=r"Matrix is exactly singular")
+        # ... but randvib's own advice, also RuntimeWarnings, is for the user
+        for advice in _advice_warnings():
+            warnings.filterwarnings("default", category=advice)
         warnings.showwarning = _show_warning
         return _main(argv)
+
+
+def _advice_warnings() -> tuple:
+    """randvib's warnings that say something about the user's run (a step size, a validity)."""
+    from randvib.analytic.averaging import AveragingValidityWarning
+    from randvib.montecarlo.simulation import StepSizeWarning
+
+    return (StepSizeWarning, AveragingValidityWarning)
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None):

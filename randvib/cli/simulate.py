@@ -14,7 +14,13 @@ from randvib._io import dumps
 from randvib.analytic.prediction import predict
 from randvib.cli._device import add_device_arguments, harvester_from_args
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
-from randvib.cli._output import print_table
+from randvib.cli._output import (
+    describe_device,
+    describe_excitation,
+    format_estimate,
+    format_value,
+    print_table,
+)
 from randvib.montecarlo.integrators import INTEGRATORS
 
 
@@ -131,19 +137,20 @@ def run(args) -> int:
             continue
         s = summary[name]
         lin = getattr(analytic, name, None) if analytic is not None else None
-        rows.append((name, s["mean"], s["ci95"], "" if lin is None else lin, unit))
+        rows.append((name, *format_estimate(s["mean"], s["ci95"]), format_value(lin), unit))
     first = summary.get("stroke_first_passage")
     if first is not None and first["mean"] is None:
         restricted = first["restricted_mean"]
         rows.append(
             (
                 f"E[min(first passage, {first['horizon']:g} s)]",
-                restricted["mean"],
-                restricted["ci95"],
+                *format_estimate(restricted["mean"], restricted["ci95"]),
                 f"{first['paths_reached']}/{first['n_paths']} paths reached the stroke",
                 "s",
             )
         )
+    print(describe_device(harvester))
+    print(describe_excitation(psd) if args.record is None else f"excitation: record {args.record}")
     print_table(rows, ("statistic", "Monte Carlo", "± 95 %", "linearisation", "unit"))
     if args.record is not None:
         print(f"windows of the record as paths; lag-1 correlation {result.lag1_correlation:+.2f}")

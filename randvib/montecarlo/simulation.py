@@ -906,9 +906,12 @@ def _check_step(scheme, harvester, excitation, dt):
             f"(allowed {MAX_STEP_BIAS:.0%}); use dt <= {limit:.3g} s"
         )
     if bias > WARN_STEP_BIAS:
+        # the step that keeps the warning away, so that the message says what to do
+        quiet = largest_step(scheme, harvester, excitation, bias=WARN_STEP_BIAS)
         warnings.warn(
             f"dt = {dt!r} s gives {scheme} a stationary-variance bias of about {bias:.2%} "
-            f"on the linearised device{resolves}",
+            f"on the linearised device{resolves}; use dt <= {quiet:.2g} s for less than "
+            f"{WARN_STEP_BIAS:.0%}",
             StepSizeWarning,
             stacklevel=3,
         )
