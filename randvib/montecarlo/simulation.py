@@ -1329,7 +1329,7 @@ def _simulated_excitation(psd) -> Excitation:
     :func:`randvib.montecarlo.driven.simulate_on_record`.
     """
     if not isinstance(psd, Excitation):
-        return as_excitation(float(check_positive("psd", psd, "(m/s^2)^2/Hz")))
+        return as_excitation(psd)  # one positive number (an array refused by name)
     if psd.is_white:
         return psd
     if psd.name == "measured":
