@@ -22,6 +22,21 @@ import warnings
 #: Command modules under randvib.cli, in the order shown by --help.
 COMMANDS = ["power", "simulate", "study", "record", "identify", "validate"]
 
+#: Options whose name differs from the Python API's argument (README's table).
+API_NAMES = {
+    "--paths": "n_paths (randvib.simulate)",
+    "--method (simulate)": "scheme (randvib.simulate)",
+    "--method (power)": "method (randvib.predict)",
+    "--generations": "SearchSettings.maxiter (randvib.identify)",
+    "--popsize": "SearchSettings.popsize (randvib.identify)",
+    "--no-polish": "SearchSettings.polish=False (randvib.identify)",
+    "--psd": "psd, or an excitation's level",
+    "--segments": "segments (randvib.simulate_on_record)",
+    "--dt (with --record)": "substeps = record step / dt (randvib.simulate_on_record)",
+    "--model": "model (randvib.identify)",
+    "--no-progress": "progress=False",
+}
+
 
 class UserError(Exception):
     """An error caused by the user's input; printed as one line, exit 2."""
@@ -98,7 +113,9 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv=None) -> int:
     try:
-        return _main_with_warnings(argv)
+        code = _main_with_warnings(argv)
+        sys.stdout.flush()  # a pipe's buffer is written here, where its closing is handled
+        return code
     except BrokenPipeError:
         # The reader (`head`, `less`) has gone: end quietly, as Unix tools do.
         # stdout is pointed at /dev/null so that the interpreter's final flush
