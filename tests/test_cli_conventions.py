@@ -160,6 +160,7 @@ def test_messages_name_commands_not_functions():
     assert cli_wording("use randvib.simulate for this") == "use `randvib simulate` for this"
     assert cli_wording("see `randvib.predict()`") == "see `randvib power`"
     assert cli_wording("randvib.Harvester stays") == "randvib.Harvester stays"
+    assert cli_wording("Use method='fpk-fast' there") == "Use `--method fpk-fast` there"
 
 
 def test_compile_notice_once_on_a_cache_miss(capsys):

@@ -163,6 +163,7 @@ _API_TO_COMMAND = {
     "validate": "randvib validate",
     "synthetic_record": "randvib record",
 }
+_KEYWORD_CHOICE = re.compile(r"\b(?P<name>method|friction|coupling)='(?P<value>[\w-]+)'")
 _API_NAME = re.compile(r"`?randvib\.(?P<name>[a-z_]+)(?:\(\))?`?")
 
 
@@ -177,7 +178,9 @@ def cli_wording(message: str) -> str:
         name = _API_TO_COMMAND.get(match["name"])
         return match[0] if name is None else f"`{name}`"
 
-    return _API_NAME.sub(command, message)
+    message = _API_NAME.sub(command, message)
+    # a keyword choice of the API (method='fpk-fast') is an option here
+    return _KEYWORD_CHOICE.sub(lambda m: f"`--{m['name']} {m['value']}`", message)
 
 
 #: What the compile notice says, once per run, on stderr.
