@@ -115,7 +115,8 @@ def check_scalar_device(harvester, function: str):
     for name, value in values.items():
         if not isinstance(value, str) and np.ndim(value) != 0:
             raise ValueError(
-                f"{function} needs one device: `{name}` is an array of shape "
+                f"{function} needs scalar harvester parameters (one device): `{name}` is an "
+                f"array of shape "
                 f"{np.shape(value)}; loop over its values (randvib.predict and "
                 "randvib.expected_power broadcast over arrays)"
             )

@@ -295,16 +295,24 @@ ARRAY = np.array([1.0, 0.1])
         (lambda: rv.simulate(FIG9, ARRAY, t_end=0.2, dt=1e-4, n_paths=2), "`psd` must be one"),
         (lambda: rv.statistical_linearisation(FIG9, ARRAY), "`psd` must be one number"),
         (lambda: BandLimited(ARRAY, 4, 20), "`level` must be one number"),
+        (
+            lambda: rv.simulate(FIG9.updated(fc=ARRAY), 1.0, t_end=0.2, dt=1e-4, n_paths=2),
+            "simulate needs scalar harvester parameters \\(one device\\): `fc`",
+        ),
+        (
+            lambda: rv.statistical_linearisation(FIG9.updated(fc=ARRAY), 1.0),
+            "statistical_linearisation needs scalar harvester parameters",
+        ),
         (lambda: BandLimited(1.0, 4, ARRAY * 30), "`f_hi` must be one number"),
         (
             lambda: rv.synthetic_record(
                 FIG9.updated(c_m=ARRAY), 1.0, duration=1.0, sample_rate=1000
             ),
-            "synthetic_record needs one device: `c_m`",
+            "synthetic_record needs scalar harvester parameters \\(one device\\): `c_m`",
         ),
         (
             lambda: rv.optimal_load_resistance(WIRED.updated(c_m=ARRAY), 1.0),
-            "optimal_load_resistance needs one device",
+            "optimal_load_resistance needs scalar harvester",
         ),
     ],
 )

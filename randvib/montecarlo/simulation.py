@@ -43,7 +43,13 @@ from scipy import linalg, special  # Student t quantile; lighter than scipy.stat
 
 from randvib import _display
 from randvib._resources import announce_duration, check_memory
-from randvib._validation import MAX_SEED, check_choice, check_int, check_positive
+from randvib._validation import (
+    MAX_SEED,
+    check_choice,
+    check_int,
+    check_positive,
+    check_scalar_device,
+)
 from randvib.analytic import exact_solutions as exact
 from randvib.analytic.linear_response import device_block, output_variances
 from randvib.analytic.linearisation import equivalent_damping, linear_displacement_variance
@@ -1278,9 +1284,7 @@ def _validated(
     """
     if not isinstance(harvester, Harvester):
         raise ValueError(f"`harvester` must be a randvib.Harvester, got {type(harvester).__name__}")
-    for name in ("m", "c_m", "c_e", "k", "k3"):
-        if np.ndim(getattr(harvester, name)) != 0:
-            raise ValueError(f"simulate needs scalar harvester parameters; `{name}` is an array")
+    check_scalar_device(harvester, "simulate")  # device, friction and coupling parameters
     # Statistics are time averages of a stationary state: a confining
     # potential, or the free mass for its velocity.
     harvester.potential.require("simulate", CONFINING + ("free",))
