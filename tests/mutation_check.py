@@ -404,6 +404,22 @@ MUTATIONS: tuple[Mutation, ...] = (
         "linear device, so the white/band comparison is not at equal input power; the "
         "injected power c E[v^2] must be g S m / 4 to 1e-9 (exact Lyapunov solution).",
     ),
+    Mutation(
+        name="power-mechanical-includes-electrical",
+        path="randvib/cli/power.py",
+        edits=(
+            (
+                'out["power_mechanical"] = (result.c_eq - harvester.c_e) * result.velocity_variance',
+                'out["power_mechanical"] = result.c_eq * result.velocity_variance',
+            ),
+        ),
+        tests=(
+            "tests/test_cli_conventions.py::test_power_mechanical_closes_the_energy_balance",
+        ),
+        why="`randvib power`'s mechanical dissipation counts the electrical power too: "
+        "mechanical + electrical must equal the injected m S / 4 to 1e-12 under white noise "
+        "(energy balance, c_eq = S m / (4 E[v^2])).",
+    ),
 )
 
 
