@@ -413,9 +413,7 @@ MUTATIONS: tuple[Mutation, ...] = (
                 'out["power_mechanical"] = result.c_eq * result.velocity_variance',
             ),
         ),
-        tests=(
-            "tests/test_cli_conventions.py::test_power_mechanical_closes_the_energy_balance",
-        ),
+        tests=("tests/test_cli_conventions.py::test_power_mechanical_closes_the_energy_balance",),
         why="`randvib power`'s mechanical dissipation counts the electrical power too: "
         "mechanical + electrical must equal the injected m S / 4 to 1e-12 under white noise "
         "(energy balance, c_eq = S m / (4 E[v^2])).",
