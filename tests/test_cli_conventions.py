@@ -56,7 +56,8 @@ def test_every_default_is_shown_in_help(name):
     parser = subcommands()[name]
     formatter = HelpFormatter(prog=parser.prog)
     for action in parser._actions:
-        if not action.option_strings or action.default in (None, False, argparse.SUPPRESS):
+        nothing = action.default is None or action.default is False
+        if not action.option_strings or nothing or action.default == argparse.SUPPRESS:
             continue
         text = formatter._expand_help(action)
         assert "default" in text, (name, action.option_strings, text)

@@ -63,7 +63,8 @@ class HelpFormatter(argparse.HelpFormatter):
 
     def _get_help_string(self, action):
         text = action.help or ""
-        shown = action.default not in (None, False, argparse.SUPPRESS)
+        # identity, not equality: a default of 0 or 0.0 is shown (0 == False)
+        shown = not any(action.default is nothing for nothing in (None, False, argparse.SUPPRESS))
         if shown and action.option_strings and "default" not in text:
             text += " (default: %(default)s)"
         return text
