@@ -39,6 +39,22 @@ def check_finite(name: str, value) -> np.ndarray:
     return arr
 
 
+def check_scalar(name: str, value, what: str, broadcast: str = "") -> float:
+    """One number, not an array: a clear refusal where a function takes a single value.
+
+    ``what`` says what the number is (``"a white-noise level S ((m/s^2)^2/Hz)"``);
+    ``broadcast`` names the functions that do take arrays, if any.
+    """
+    if np.ndim(value) != 0:
+        shape = np.shape(value)
+        hint = f"; {broadcast} broadcast over arrays" if broadcast else ""
+        raise ValueError(
+            f"`{name}` must be one number ({what}), got an array of shape {shape}: "
+            f"loop over its values{hint}"
+        )
+    return value
+
+
 def check_positive(name: str, value, unit: str = "") -> np.ndarray:
     """Finite and strictly greater than zero (scalar or array)."""
     arr = check_finite(name, value)
@@ -84,3 +100,24 @@ def scalar_or_array(arr: np.ndarray):
 
 def _unit(unit: str) -> str:
     return f" (in {unit})" if unit else ""
+
+
+def check_scalar_device(harvester, function: str):
+    """A harvester whose parameters are single numbers, for a function that runs one device.
+
+    Its own parameters (m, c_m, c_e, k, k3), its friction law's and its
+    coupling's are checked; an array is refused, naming it and ``function``.
+    """
+    values = {name: getattr(harvester, name) for name in ("m", "c_m", "c_e", "k", "k3")}
+    for part in (harvester.friction, harvester.electrical):
+        if part is not None:
+            values.update(part.parameters())
+    for name, value in values.items():
+        if not isinstance(value, str) and np.ndim(value) != 0:
+            raise ValueError(
+                f"{function} needs scalar harvester parameters (one device): `{name}` is an "
+                f"array of shape "
+                f"{np.shape(value)}; loop over its values (randvib.predict and "
+                "randvib.expected_power broadcast over arrays)"
+            )
+    return harvester

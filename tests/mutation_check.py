@@ -431,6 +431,20 @@ MUTATIONS: tuple[Mutation, ...] = (
         why="The output sensor's offset subtracted instead of added (measured = true + "
         "offset): the fit is unchanged but the reported offset has the wrong sign.",
     ),
+    Mutation(
+        name="power-mechanical-includes-electrical",
+        path="randvib/cli/power.py",
+        edits=(
+            (
+                'out["power_mechanical"] = (result.c_eq - harvester.c_e) * result.velocity_variance',
+                'out["power_mechanical"] = result.c_eq * result.velocity_variance',
+            ),
+        ),
+        tests=("tests/test_cli_conventions.py::test_power_mechanical_closes_the_energy_balance",),
+        why="`randvib power`'s mechanical dissipation counts the electrical power too: "
+        "mechanical + electrical must equal the injected m S / 4 to 1e-12 under white noise "
+        "(energy balance, c_eq = S m / (4 E[v^2])).",
+    ),
 )
 
 

@@ -78,7 +78,7 @@ def test_table_output(capsys):
     [
         (["--preset", "figure9", "--psd", "0"], "`psd` must be > 0"),
         (["--preset", "figure9", "--psd", "nan"], "finite"),
-        (["--preset", "nope", "--psd", "1"], "unknown preset 'nope'"),
+        (["--preset", "nope", "--psd", "1"], "`--preset` must be one of"),
         (
             ["--preset", "figure9", "--friction", "magic", "--psd", "1"],
             "`--friction` must be one of",

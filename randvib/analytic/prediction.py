@@ -30,13 +30,15 @@ from randvib._validation import (
     check_choice,
     check_nonnegative,
     check_positive,
+    check_scalar,
+    check_scalar_device,
     scalar_or_array,
 )
 from randvib.analytic.averaging import averaging_statistics
 from randvib.analytic.fokker_planck import fast_fpk_moments, fpk_moments
 from randvib.analytic.linearisation import equivalent_damping, linear_displacement_variance
 from randvib.analytic.statistical_linearisation import statistical_linearisation
-from randvib.models.excitation import Excitation, as_excitation
+from randvib.models.excitation import BROADCASTING, Excitation, as_excitation
 from randvib.models.harvester import Harvester
 from randvib.models.potential import CONFINING
 
@@ -510,7 +512,9 @@ def optimal_load_resistance(
             "optimal_load_resistance needs a coupling: Harvester.from_electrical(...) or "
             "Harvester.with_coupling(...)"
         )
+    check_scalar_device(harvester, "optimal_load_resistance")
     if not isinstance(psd, Excitation):
+        psd = check_scalar("psd", psd, "a white-noise level S in (m/s^2)^2/Hz", BROADCASTING)
         psd = float(check_positive("psd", psd, "(m/s^2)^2/Hz"))
     lo, hi = (float(check_positive("bounds", b, "ohm")) for b in bounds)
     if not lo < hi:

@@ -34,6 +34,7 @@ import numpy as np
 from scipy import optimize
 
 from randvib import _display
+from randvib._validation import check_scalar_device
 from randvib.analytic.linear_response import device_block, output_variances, response_spectra
 from randvib.models.excitation import Excitation, as_excitation
 from randvib.models.harvester import Harvester
@@ -177,13 +178,8 @@ class LinearisationResult:
 
 
 def _check_harvester(harvester: Harvester):
-    values = [harvester.m, harvester.c, harvester.k, harvester.k3]
-    if harvester.electrical is not None:
-        values += list(harvester.electrical.parameters().values())
-    if any(np.ndim(v) != 0 for v in values):
-        raise ValueError(
-            "statistical_linearisation needs scalar harvester parameters; loop over a sweep"
-        )
+    # scalar parameters (device, friction law, coupling), an array refused by name
+    check_scalar_device(harvester, "statistical_linearisation")
     friction = harvester.friction
     if friction is not None and not friction.has_equivalent_damping:
         raise ValueError(

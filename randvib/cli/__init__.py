@@ -12,6 +12,7 @@ traceback only with ``RANDVIB_TRACEBACK=1``.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
 import os
 import re
@@ -20,6 +21,21 @@ import warnings
 
 #: Command modules under randvib.cli, in the order shown by --help.
 COMMANDS = ["power", "simulate", "study", "record", "identify", "validate"]
+
+#: Options whose name differs from the Python API's argument (README's table).
+API_NAMES = {
+    "--paths": "n_paths (randvib.simulate)",
+    "--method (simulate)": "scheme (randvib.simulate)",
+    "--method (power)": "method (randvib.predict)",
+    "--generations": "SearchSettings.maxiter (randvib.identify)",
+    "--popsize": "SearchSettings.popsize (randvib.identify)",
+    "--no-polish": "SearchSettings.polish=False (randvib.identify)",
+    "--psd": "psd, or an excitation's level",
+    "--segments": "segments (randvib.simulate_on_record)",
+    "--dt (with --record)": "substeps = record step / dt (randvib.simulate_on_record)",
+    "--model": "model (randvib.identify)",
+    "--no-progress": "progress=False",
+}
 
 
 class UserError(Exception):
@@ -31,13 +47,51 @@ class UserError(Exception):
 NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
 
 
+#: argparse's refusal of a value outside ``choices`` (Python 3.11 and 3.12+ spellings).
+_INVALID_CHOICE = re.compile(
+    r"^argument (?P<flag>[^:]+): invalid choice: (?P<got>.+?) \(choose from (?P<allowed>.*)\)$"
+)
+
+
+class HelpFormatter(argparse.HelpFormatter):
+    """Every option's default in its help: ``(default: X)`` unless the text already says it.
+
+    Options whose default is None (not given) or False (a switch) have nothing
+    to show; an option whose effective default is decided later (``--paths``)
+    says it in its own text, which this formatter leaves alone.
+    """
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        # identity, not equality: a default of 0 or 0.0 is shown (0 == False)
+        shown = not any(action.default is nothing for nothing in (None, False, argparse.SUPPRESS))
+        if shown and action.option_strings and "default" not in text:
+            text += " (default: %(default)s)"
+        return text
+
+
+def one_line_choice_error(message: str) -> str:
+    """argparse's invalid-choice message in the project's words, else ``message`` itself.
+
+    ``argument --x: invalid choice: 'c' (choose from 'a', 'b')`` becomes
+    ``--x` must be one of a, b; got 'c'``, as the commands' own checks say it.
+    """
+    match = _INVALID_CHOICE.match(message)
+    if match is None:
+        return message
+    flag = match["flag"].split("/")[-1]
+    allowed = ", ".join(name.strip().strip("'") for name in match["allowed"].split(","))
+    return f"`{flag}` must be one of {allowed}; got {match['got']}"
+
+
 class _Parser(argparse.ArgumentParser):
     def __init__(self, *args, **kwargs):
+        kwargs.setdefault("formatter_class", HelpFormatter)
         super().__init__(*args, **kwargs)
         self._negative_number_matcher = NEGATIVE_NUMBER
 
     def error(self, message):  # one line, no usage dump, exit 2
-        raise UserError(f"{self.prog}: {message}")
+        raise UserError(f"{self.prog}: {one_line_choice_error(message)}")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -59,27 +113,121 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv=None) -> int:
+    try:
+        code = _main_with_warnings(argv)
+        sys.stdout.flush()  # a pipe's buffer is written here, where its closing is handled
+        return code
+    except BrokenPipeError:
+        # The reader (`head`, `less`) has gone: end quietly, as Unix tools do.
+        # stdout is pointed at /dev/null so that the interpreter's final flush
+        # does not raise the same error again at exit.
+        try:
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError):  # no real file descriptor (captured output)
+            pass
+        return 141  # 128 + SIGPIPE, what a shell reports for a tool ended by it
+
+
+def _main_with_warnings(argv) -> int:
     with warnings.catch_warnings():
         # numpy's floating-point warnings at extreme values: every result is
         # checked for finiteness instead, and refused with a message naming it
         warnings.filterwarnings("ignore", category=RuntimeWarning, module=r"(numpy|scipy|randvib)")
         warnings.filterwarnings("ignore", message=r"Matrix is exactly singular")
+        # ... but randvib's own advice, also RuntimeWarnings, is for the user
+        for advice in _advice_warnings():
+            warnings.filterwarnings("default", category=advice)
         warnings.showwarning = _show_warning
         return _main(argv)
 
 
+def _advice_warnings() -> tuple:
+    """randvib's warnings that say something about the user's run (a step size, a validity)."""
+    from randvib.analytic.averaging import AveragingValidityWarning
+    from randvib.montecarlo.simulation import StepSizeWarning
+
+    return (StepSizeWarning, AveragingValidityWarning)
+
+
 def _show_warning(message, category, filename, lineno, file=None, line=None):
-    """A warning as one line naming its kind (no source file, no code line)."""
-    print(f"randvib: warning ({category.__name__}): {message}", file=file or sys.stderr)
+    """A warning as one readable line (no kind, source file or code line)."""
+    text = cli_wording(str(message).strip().splitlines()[0] if str(message).strip() else "")
+    print(f"randvib: warning: {text}", file=file or sys.stderr)
+
+
+#: ``randvib.NAME(`` in the library's messages -> the command that does it here.
+_API_TO_COMMAND = {
+    "simulate": "randvib simulate",
+    "predict": "randvib power",
+    "expected_power": "randvib power",
+    "identify": "randvib identify",
+    "validate": "randvib validate",
+    "synthetic_record": "randvib record",
+}
+_KEYWORD_CHOICE = re.compile(r"\b(?P<name>method|friction|coupling)='(?P<value>[\w-]+)'")
+_API_NAME = re.compile(r"`?randvib\.(?P<name>[a-z_]+)(?:\(\))?`?")
+
+
+def cli_wording(message: str) -> str:
+    """A library message as the command line says it: ``randvib.simulate`` -> ``randvib simulate``.
+
+    Only the functions a command runs are translated; other names stay as
+    they are (they are the API the message is about).
+    """
+
+    def command(match):
+        name = _API_TO_COMMAND.get(match["name"])
+        return match[0] if name is None else f"`{name}`"
+
+    message = _API_NAME.sub(command, message)
+    # a keyword choice of the API (method='fpk-fast') is an option here
+    return _KEYWORD_CHOICE.sub(lambda m: f"`--{m['name']} {m['value']}`", message)
+
+
+#: What the compile notice says, once per run, on stderr.
+COMPILING = "randvib: compiling the numerical kernels (once; later runs load them from the cache)"
+
+
+@contextlib.contextmanager
+def compile_notice():
+    """Say on stderr, once, when numba compiles rather than loads from its cache.
+
+    numba fires its ``numba:compile`` event only on a cache miss (a kernel
+    loaded from the on-disk cache fires none), so a warm cache prints nothing
+    and the first run after an install or an upgrade explains its pause.
+    """
+    try:
+        from numba.core import event
+    except ImportError:  # pragma: no cover - numba is a dependency
+        yield
+        return
+
+    class Notice(event.Listener):
+        said = False
+
+        def on_start(self, data):
+            if not self.said:
+                self.said = True
+                print(COMPILING, file=sys.stderr, flush=True)
+
+        def on_end(self, data):
+            pass
+
+    with event.install_listener("numba:compile", Notice()):
+        yield
 
 
 def _main(argv) -> int:
     try:
         parser = build_parser()
         args = parser.parse_args(argv)
-        return int(args.handler(args) or 0)
+        with compile_notice():
+            return int(args.handler(args) or 0)
+    except BrokenPipeError:
+        raise  # handled in main: the reader went away, not a user error
     except (UserError, ValueError, OSError, NotImplementedError) as exc:
         message = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        message = cli_wording(message)
         if not message.startswith("randvib"):
             message = f"randvib: error: {message}"
         print(message, file=sys.stderr)

@@ -56,7 +56,10 @@ def add_device_arguments(parser: argparse.ArgumentParser) -> None:
     """Add --preset, the device parameters and --psd to ``parser``."""
     g = parser.add_argument_group("device (SI units; values override --preset)")
     g.add_argument(
-        "--preset", metavar="NAME", help=f"start from a paper preset: {', '.join(PRESETS)}"
+        "--preset",
+        metavar="NAME",
+        choices=tuple(PRESETS),
+        help=f"start from a paper preset: {', '.join(PRESETS)}",
     )
     g.add_argument("--m", type=float, help="mass (kg)")
     g.add_argument("--c-m", type=float, help="mechanical damping (Ns/m)")
@@ -74,7 +77,12 @@ def add_device_arguments(parser: argparse.ArgumentParser) -> None:
         help="stroke limit (m, > 0): report the time fraction with |z| beyond it "
         "(and, from Monte Carlo, the mean first time to reach it)",
     )
-    g.add_argument("--friction", help=f"friction model: {', '.join(FRICTION_CHOICES)}")
+    g.add_argument(
+        "--friction",
+        metavar="LAW",
+        choices=FRICTION_CHOICES,
+        help=f"friction model: {', '.join(FRICTION_CHOICES)}",
+    )
     # One option per friction parameter, as the laws declare them.
     for name, laws in _friction_options().items():
         spec = laws[0].parameter_specs()[name]
@@ -85,6 +93,8 @@ def add_device_arguments(parser: argparse.ArgumentParser) -> None:
         )
     g.add_argument(
         "--coupling",
+        metavar="NAME",
+        choices=tuple(COUPLINGS),
         help=f"electrical coupling: {', '.join(COUPLINGS)} (default resistive when its options "
         "are given; instead of --c-e)",
     )

@@ -1,4 +1,11 @@
-"""Human-readable output helpers for the CLI."""
+"""Human-readable output helpers for the CLI.
+
+Numbers are shown to the precision they have: an analytic value to
+:data:`ANALYTIC_DIGITS` significant digits, a Monte Carlo mean to the decimal
+of the second significant digit of its 95 % half-width (the half-width itself
+to two digits), so that no digit is printed that the ensemble does not
+support. JSON output is never rounded.
+"""
 
 from __future__ import annotations
 
@@ -6,14 +13,97 @@ import math
 
 from tabulate import tabulate
 
+#: Significant digits of an analytic (deterministic) value in a table.
+ANALYTIC_DIGITS = 6
 
-def _shown(value):
-    """A cell: non-finite numbers are shown as ``n/a``, never as nan or inf."""
+
+def _finite(value) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def format_value(value, digits: int = ANALYTIC_DIGITS) -> str:
+    """A cell: a number to ``digits`` significant digits, non-finite as ``n/a``."""
+    if value is None:
+        return ""
     if isinstance(value, float) and not math.isfinite(value):
         return "n/a"
-    return value
+    if _finite(value) and not isinstance(value, int):
+        return f"{value + 0.0:.{digits}g}"  # + 0.0: never "-0"
+    return str(value)
+
+
+def format_estimate(mean, half_width) -> tuple[str, str]:
+    """A Monte Carlo mean and its 95 % half-width, as the half-width allows.
+
+    The half-width is shown to two significant digits and the mean to the same
+    decimal place (``0.0024619 +- 0.00027`` -> ``0.00246``, ``0.00027``); a zero
+    or missing half-width leaves the mean at :data:`ANALYTIC_DIGITS` digits.
+
+    Examples
+    --------
+    >>> format_estimate(0.0024619412547950926, 0.000272784)
+    ('0.00246', '0.00027')
+    >>> format_estimate(12345.678, 140.0)
+    ('12350', '140')
+    """
+    if not (_finite(mean) and _finite(half_width) and half_width > 0):
+        return format_value(mean), format_value(half_width)
+    decimals = 1 - math.floor(math.log10(half_width))  # the 2nd significant digit's place
+    half = round(half_width, decimals)
+    if half > 0 and math.floor(math.log10(half)) > math.floor(math.log10(half_width)):
+        decimals -= 1  # 0.0996 rounded up to 0.10: two digits are now one place earlier
+    return _fixed(mean, decimals), _fixed(half_width, decimals)
+
+
+def _fixed(value: float, decimals: int) -> str:
+    """``value`` rounded to ``decimals`` places (negative: tens, hundreds...), in plain
+    notation where that stays short, else in exponent notation with the same digits."""
+    rounded = round(value, decimals) + 0.0  # + 0.0: never "-0"
+    if decimals >= 0 and (rounded == 0 or abs(rounded) >= 1e-4 or decimals <= 8):
+        return f"{rounded:.{decimals}f}"
+    if decimals < 0 and abs(rounded) < 1e9:
+        return f"{rounded:.0f}"
+    digits = max(1, math.floor(math.log10(abs(rounded))) + decimals + 1) if rounded else 1
+    return f"{rounded:.{digits - 1}e}"
 
 
 def print_table(rows, headers) -> None:
-    rows = [[_shown(v) for v in row] for row in rows]
-    print(tabulate(rows, headers=headers, floatfmt=".6g"))
+    """A plain table: numbers as :func:`format_value` (unless already text), right-aligned."""
+    rows = [[v if isinstance(v, str) else format_value(v) for v in row] for row in rows]
+    align = ["left"] + ["right"] * (len(headers) - 1)
+    if headers[-1] in ("unit", ""):  # text columns read better flush left
+        align[-1] = "left"
+    print(tabulate(rows, headers=headers, disable_numparse=True, colalign=tuple(align)))
+
+
+def _assignments(values: dict) -> str:
+    return ", ".join(f"{name} {format_value(value, 4)}" for name, value in values.items())
+
+
+def describe_device(harvester) -> str:
+    """One line: the device actually simulated or predicted (after preset and options)."""
+    parts = [
+        f"m {harvester.m:.4g} kg, c_m {harvester.c_m:.4g} Ns/m, c_e {harvester.c_e:.4g} Ns/m, "
+        f"k {harvester.k:.4g} N/m, k3 {harvester.k3:.4g} N/m^3"
+    ]
+    friction = harvester.friction
+    if friction is None:
+        parts.append("no friction")
+    else:
+        parts.append(f"{harvester.friction_name} friction ({_assignments(friction.parameters())})")
+    if harvester.electrical is not None:
+        electrical = harvester.electrical
+        parts.append(
+            f"{harvester.coupling_name} coupling ({_assignments(electrical.parameters())})"
+        )
+    if harvester.stroke is not None:
+        parts.append(f"stroke {harvester.stroke:.4g} m")
+    return "device: " + "; ".join(parts)
+
+
+def describe_excitation(psd) -> str:
+    """One line: the base excitation used (white level, or the excitation's parameters)."""
+    if isinstance(psd, int | float):
+        return f"excitation: white noise, S = {psd:.6g} (m/s^2)^2/Hz (one-sided)"
+    numbers = {k: v for k, v in psd.parameters().items() if not isinstance(v, str)}
+    return f"excitation: {psd.name} ({_assignments(numbers)})"

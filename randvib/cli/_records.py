@@ -24,7 +24,7 @@ def add_record_arguments(parser: argparse.ArgumentParser) -> None:
         "--output-column",
         metavar="NAME",
         default=OUTPUT_COLUMN,
-        help=f"relative-displacement column (default {OUTPUT_COLUMN})",
+        help="relative-displacement column",
     )
     g.add_argument(
         "--time-column", metavar="NAME", default=TIME_COLUMN, help="time column (s, uniform)"
@@ -38,16 +38,20 @@ def add_record_arguments(parser: argparse.ArgumentParser) -> None:
         help="use data rows START:STOP only (0-based, STOP excluded)",
     )
     s = parser.add_argument_group("simulation")
-    s.add_argument("--substeps", type=int, default=None, help="integration steps per sample (4)")
+    s.add_argument(
+        "--substeps", type=int, default=None, help="integration steps per sample (default: 4)"
+    )
     s.add_argument(
         "--hold",
         choices=HOLDS,
         default=None,
-        help="input between samples (linear; bandlimited or cubic for a record sampled "
-        "not far above its bandwidth)",
+        help="input between samples (default: linear; bandlimited or cubic for a record "
+        "sampled not far above its bandwidth)",
     )
     s.add_argument("--lowpass", type=float, metavar="HZ", help="low-pass the driving signal")
-    s.add_argument("--skip", type=int, default=None, help="samples left out of J at the start (0)")
+    s.add_argument(
+        "--skip", type=int, default=None, help="samples left out of J at the start (default: 0)"
+    )
     s.add_argument(
         "--initial-state",
         choices=INITIAL_STATES,

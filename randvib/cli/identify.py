@@ -39,7 +39,7 @@ def register(sub) -> None:
         type=float,
         help="mass (kg); required for base excitation, identified if omitted with a force input",
     )
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--seed", type=int, default=0, help="random seed")
     p.add_argument(
         "--fix", action="append", metavar="NAME=VALUE", help="hold a parameter, e.g. --fix k3=0"
     )
@@ -49,8 +49,13 @@ def register(sub) -> None:
     p.add_argument(
         "--quadratic", action="store_true", help="also estimate k2: force k z + k2 z^2 + k3 z^3"
     )
-    p.add_argument("--popsize", type=int, default=DEFAULT.popsize, help="SaDE population")
-    p.add_argument("--generations", type=int, default=DEFAULT.maxiter, help="SaDE generations")
+    p.add_argument("--popsize", type=int, default=DEFAULT.popsize, help="SaDE population, popsize")
+    p.add_argument(
+        "--generations",
+        type=int,
+        default=DEFAULT.maxiter,
+        help="SaDE generations, the API's maxiter",
+    )
     p.add_argument(
         "--search-samples",
         type=int,
@@ -63,16 +68,25 @@ def register(sub) -> None:
         help="skip the least-squares polish (and the standard errors it gives)",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--save", metavar="FILE.json", help="also write the JSON result (new file)")
-    p.add_argument("--plot", metavar="FILE.png", help="measured vs simulated figure (new file)")
+    p.add_argument(
+        "--save", metavar="FILE.json", help="also write the JSON result (a new file unless --force)"
+    )
+    p.add_argument(
+        "--plot",
+        metavar="FILE.png",
+        help="measured vs simulated figure (a new file unless --force)",
+    )
+    p.add_argument(
+        "--force", action="store_true", help="overwrite an existing --save or --plot file"
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     add_record_arguments(p)
     p.set_defaults(handler=run)
 
 
-def _new_file(path, option):
+def _new_file(path, option, overwrite=False):
     """Checked before the fit, so that a long fit is never thrown away at the end."""
-    return None if path is None else check_output_file(path, option)
+    return None if path is None else check_output_file(path, option, overwrite=overwrite)
 
 
 def _save_plot(result, record, plot: Path, title: str) -> None:
@@ -86,8 +100,8 @@ def _save_plot(result, record, plot: Path, title: str) -> None:
 
 
 def run(args) -> int:
-    save = _new_file(args.save, "--save")
-    plot = _new_file(args.plot, "--plot")
+    save = _new_file(args.save, "--save", args.force)
+    plot = _new_file(args.plot, "--plot", args.force)
     record = record_from_args(args.data, args)
     search = SearchSettings(
         popsize=args.popsize,

@@ -5,15 +5,40 @@ Under white noise (the default) every method of
 it was before excitations existed; under another excitation only the methods
 of :data:`~randvib.analytic.prediction.COLOURED` (statistical linearisation)
 do, and the JSON gains an ``excitation`` object describing it.
+
+Sweeps: every number of the device, its friction, coupling and excitation
+may be given several values (``--psd 1 0.5 0.1``) or a range
+``START:STOP:COUNT`` (``--fc 0:0.05:11``: 11 values from 0 to 0.05 N, both
+ends included, as :func:`numpy.linspace`); several swept options give every
+combination. A sweep prints one row per point (``--json``: a list of the
+single-point objects; ``--csv FILE``: all their keys, one row per point).
+``--optimal-load`` adds the load resistance that maximises the load power
+(:func:`randvib.optimal_load_resistance`) and that power.
 """
 
 from __future__ import annotations
 
-from randvib._io import dumps
-from randvib.analytic.prediction import CIRCUIT, COLOURED, METHODS, predict
-from randvib.cli._device import add_device_arguments, harvester_from_args
+import argparse
+import csv
+import itertools
+import math
+
+from randvib._io import check_output_file, dumps
+from randvib.analytic.prediction import (
+    CIRCUIT,
+    COLOURED,
+    METHODS,
+    optimal_load_resistance,
+    predict,
+)
+from randvib.cli._device import add_device_arguments, harvester_from_args, option_flag
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
-from randvib.cli._output import print_table
+from randvib.cli._output import (
+    describe_device,
+    describe_excitation,
+    format_value,
+    print_table,
+)
 from randvib.models.excitation import Excitation
 
 #: The methods that report the stationary probability beyond the stroke.
@@ -32,14 +57,80 @@ def register(sub) -> None:
     p.add_argument(
         "--method",
         default="linearisation",
+        choices=tuple(METHODS),
+        metavar="METHOD",
         help=f"analytic method: {', '.join(METHODS)} (default linearisation, paper Eq. 32; "
         "averaging: stochastic averaging, non-Gaussian velocity, 0.3 ms; "
         "fpk-fast: corrected small-grid FPK solution, resolves the k3 effect, 2 ms; "
         "fpk: fine-grid FPK solution, slow reference); a non-white excitation: "
         f"{', '.join(COLOURED)} only",
     )
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument(
+        "--optimal-load",
+        action="store_true",
+        help="also the load resistance R_L that maximises the load power, and that power "
+        "(needs a coupling: --alpha/--r-load/--r-coil or --coupling; its --r-load is the start)",
+    )
+    p.add_argument(
+        "--json", action="store_true", help="print one JSON object (a sweep: a list of them)"
+    )
+    p.add_argument(
+        "--csv", metavar="FILE", help="write the sweep's points to a CSV file (a new file)"
+    )
+    p.add_argument("--force", action="store_true", help="overwrite an existing --csv file")
+    _allow_sweeps(p)
     p.set_defaults(handler=run)
+
+
+#: The options that take a single value even in ``power`` (not physical numbers).
+NOT_SWEPT = ("psd_file", "record")
+
+
+def _allow_sweeps(parser) -> None:
+    """Let every numeric device/excitation option of ``power`` take several values."""
+    for action in parser._actions:
+        if action.type is float and action.option_strings and action.dest not in NOT_SWEPT:
+            action.nargs = "+"
+            action.type = sweep_values
+            action.help = (action.help or "") + "; several values or START:STOP:COUNT sweep"
+
+
+def sweep_values(text: str) -> list[float]:
+    """One command-line token of a swept option: a number, or ``START:STOP:COUNT``.
+
+    ``START:STOP:COUNT`` is ``COUNT`` evenly spaced values from START to STOP,
+    both included (:func:`numpy.linspace`); COUNT is an integer >= 2.
+    """
+    parts = text.split(":")
+    try:
+        if len(parts) == 1:
+            return [float(text)]
+        if len(parts) == 3:
+            start, stop, count = float(parts[0]), float(parts[1]), int(parts[2])
+            if count >= 2 and math.isfinite(start) and math.isfinite(stop):
+                return [start + (stop - start) * i / (count - 1) for i in range(count)]
+    except ValueError:
+        pass
+    raise argparse.ArgumentTypeError(
+        f"{text!r} is not a number nor START:STOP:COUNT (COUNT an integer >= 2)"
+    )
+
+
+def _sweep(args) -> tuple[list[str], list[argparse.Namespace]]:
+    """The swept options and one namespace per point (every combination), in order."""
+    given = {
+        dest: [x for token in value for x in token]
+        for dest, value in vars(args).items()
+        if isinstance(value, list) and value and isinstance(value[0], list)
+    }
+    swept = [dest for dest, values in given.items() if len(values) > 1]
+    points = []
+    for combination in itertools.product(*given.values()):
+        point = argparse.Namespace(**vars(args))
+        for dest, value in zip(given, combination, strict=True):
+            setattr(point, dest, value)
+        points.append(point)
+    return swept, points
 
 
 # JSON: the keys of PowerPrediction.to_dict(); `displacement_variance` is null for
@@ -48,25 +139,35 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
+    csv_file = (
+        None if args.csv is None else check_output_file(args.csv, "--csv", overwrite=args.force)
+    )
+    swept, points = _sweep(args)
+    results = [_point(point) for point in points]
+    if csv_file is not None:
+        _write_csv(csv_file, [out for out, _, _ in results])
+    if args.json:
+        outs = [out for out, _, _ in results]
+        print(dumps(outs[0] if len(outs) == 1 and not swept else outs))
+    elif swept:
+        _print_sweep(swept, points, results)
+    else:
+        _print_point(*results[0])
+    if csv_file is not None and not args.json:
+        print(f"wrote {csv_file} ({len(results)} points)")
+    return 0
+
+
+def _point(args) -> tuple[dict, object, object]:
+    """The JSON object of one point, with its harvester and excitation."""
     harvester = harvester_from_args(args)
     psd = excitation_from_args(args)
     coloured = isinstance(psd, Excitation)
-    if coloured and args.method not in COLOURED:
-        accepted = ", ".join(f"`--method {name}`" for name in COLOURED)
+    _check_method(args.method, harvester, psd, coloured)
+    if args.optimal_load and harvester.electrical is None:
         raise ValueError(
-            f"`--method {args.method}` assumes white noise; the {psd.name} excitation needs "
-            f"{accepted}"
-        )
-    if harvester.has_circuit and args.method not in CIRCUIT:
-        accepted = ", ".join(f"`--method {name}`" for name in CIRCUIT)
-        raise ValueError(
-            f"`--method {args.method}` assumes the resistive coupling; the "
-            f"{harvester.coupling_name} coupling's circuit state needs {accepted}"
-        )
-    if harvester.stroke is not None and args.method not in STROKE_METHODS:
-        allowed = " or ".join(f"`--method {name}`" for name in STROKE_METHODS)
-        raise ValueError(
-            f"`--stroke` needs {allowed}: `--method {args.method}` gives no stroke exceedance"
+            "`--optimal-load` needs a coupling: give `--alpha/--r-load/--r-coil` (resistive) "
+            "or `--coupling NAME` with its options, not `--c-e`"
         )
     result = predict(harvester, psd, method=args.method)
     out = {
@@ -80,36 +181,121 @@ def run(args) -> int:
         out.pop("power_load")
     if harvester.electrical is not None:  # added with the couplings (issue 11)
         out["coupling"] = harvester.coupling_name
+    else:
+        # what is not converted: c_m E[v^2] + friction power, c_eq E[v^2] being all
+        # that is dissipated (c_eq = S m / (4 E[v^2]) under white noise)
+        out["power_mechanical"] = (result.c_eq - harvester.c_e) * result.velocity_variance
     if harvester.stroke is not None:
         out["stroke"] = harvester.stroke
         # null where not stationary (the free mass)
         out["stroke_exceedance"] = result.stroke_exceedance
+    if args.optimal_load:
+        out["r_load_optimal"], out["power_load_optimal"] = optimal_load_resistance(
+            harvester, psd, method=args.method
+        )
     if coloured:
         out["excitation"] = psd.parameters()
-    if args.json:
-        print(dumps(out))
-    else:
-        units = {
-            "psd": "(m/s^2)^2/Hz",
-            "c_eq": "Ns/m",
-            "velocity_variance": "(m/s)^2",
-            "displacement_variance": "m^2",
-            "mean_abs_velocity": "m/s",
-            "power_electrical": "W",
-            "power_load": "W",
-            "circuit_mean_square": "A^2 or V^2",
-            "stroke": "m",
-            # the excitation's parameters
-            "level": "(m/s^2)^2/Hz",
-            "f0": "Hz",
-            "f_lo": "Hz",
-            "f_hi": "Hz",
-            "variance": "(m/s^2)^2",
-            "duration": "s",
-            "dt": "s",
-            "segment_length": "samples",
-        }
-        rows = [(k, v, units.get(k, "")) for k, v in out.items() if k != "excitation"]
-        rows += [(k, v, units.get(k, "")) for k, v in out.get("excitation", {}).items()]
-        print_table(rows, ("quantity", "value", "unit"))
-    return 0
+    return out, harvester, psd
+
+
+def _check_method(method: str, harvester, psd, coloured: bool) -> None:
+    """Refuse a method that does not apply to this excitation, coupling or stroke."""
+    if coloured and method not in COLOURED:
+        accepted = ", ".join(f"`--method {name}`" for name in COLOURED)
+        raise ValueError(
+            f"`--method {method}` assumes white noise; the {psd.name} excitation needs {accepted}"
+        )
+    if harvester.has_circuit and method not in CIRCUIT:
+        accepted = ", ".join(f"`--method {name}`" for name in CIRCUIT)
+        raise ValueError(
+            f"`--method {method}` assumes the resistive coupling; the "
+            f"{harvester.coupling_name} coupling's circuit state needs {accepted}"
+        )
+    if harvester.stroke is not None and method not in STROKE_METHODS:
+        allowed = " or ".join(f"`--method {name}`" for name in STROKE_METHODS)
+        raise ValueError(
+            f"`--stroke` needs {allowed}: `--method {method}` gives no stroke exceedance"
+        )
+
+
+UNITS = {
+    "psd": "(m/s^2)^2/Hz",
+    "c_eq": "Ns/m",
+    "velocity_variance": "(m/s)^2",
+    "displacement_variance": "m^2",
+    "mean_abs_velocity": "m/s",
+    "power_electrical": "W",
+    "power_load": "W",
+    "power_mechanical": "W",
+    "r_load_optimal": "ohm",
+    "power_load_optimal": "W",
+    "circuit_mean_square": "A^2 or V^2",
+    "stroke": "m",
+    # the excitation's parameters
+    "level": "(m/s^2)^2/Hz",
+    "f0": "Hz",
+    "f_lo": "Hz",
+    "f_hi": "Hz",
+    "variance": "(m/s^2)^2",
+    "duration": "s",
+    "dt": "s",
+    "segment_length": "samples",
+}
+
+
+def _print_point(out: dict, harvester, psd) -> None:
+    """One point: the device and excitation used, then quantity / value / unit."""
+    print(describe_device(harvester))
+    print(describe_excitation(psd))
+    rows = [(k, v, UNITS.get(k, "")) for k, v in out.items() if k != "excitation"]
+    rows += [(k, v, UNITS.get(k, "")) for k, v in out.get("excitation", {}).items()]
+    print_table(rows, ("quantity", "value", "unit"))
+    if harvester.electrical is None and harvester.c_e == 0:
+        print(
+            "note: this device has no electrical damping (c_e = 0, as the presets identified "
+            "without the coil), so the power it delivers is 0 W; give --alpha/--r-load/--r-coil "
+            f"or --c-e. It dissipates {format_value(out['power_mechanical'], 4)} W mechanically "
+            "(c_m E[v^2] + friction)."
+        )
+
+
+#: The columns of a sweep's table, after the swept options, where present.
+SWEEP_COLUMNS = (
+    "power_electrical",
+    "power_load",
+    "power_mechanical",
+    "r_load_optimal",
+    "power_load_optimal",
+    "c_eq",
+    "velocity_variance",
+    "stroke_exceedance",
+)
+
+
+def _print_sweep(swept: list[str], points, results) -> None:
+    """One row per point: the swept values, then the powers and main statistics."""
+    first = results[0][0]
+    columns = [c for c in SWEEP_COLUMNS if c in first]
+    print(f"method {first['method']}; swept {', '.join(option_flag(d) for d in swept)}")
+    rows = [
+        [getattr(point, dest) for dest in swept] + [out.get(c) for c in columns]
+        for point, (out, _, _) in zip(points, results, strict=True)
+    ]
+    headers = [option_flag(d) for d in swept] + [
+        f"{c} ({UNITS[c]})" if UNITS.get(c) else c for c in columns
+    ]
+    print_table(rows, headers)
+
+
+def _write_csv(path, outs: list[dict]) -> None:
+    """Every point's keys (the excitation's as ``excitation.NAME``), one row per point."""
+    rows = []
+    for out in outs:
+        row = {k: v for k, v in out.items() if k != "excitation"}
+        row.update({f"excitation.{k}": v for k, v in out.get("excitation", {}).items()})
+        rows.append(row)
+    names = list(dict.fromkeys(k for row in rows for k in row))
+    with open(path, "w", newline="") as file:
+        writer = csv.DictWriter(file, fieldnames=names)
+        writer.writeheader()
+        writer.writerows(rows)

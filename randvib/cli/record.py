@@ -33,7 +33,13 @@ def register(sub) -> None:
     g.add_argument("--f-hi", type=float, default=PAPER_BAND[1], help="band end (Hz), default 20")
     g.add_argument("--duration", type=float, default=10.0, help="record length (s), default 10")
     g.add_argument("--sample-rate", type=float, default=1000.0, help="Hz, default 1000")
-    g.add_argument("--input", default="base_acceleration", help=", ".join(SYNTHETIC_INPUTS))
+    g.add_argument(
+        "--input",
+        default="base_acceleration",
+        choices=tuple(SYNTHETIC_INPUTS),
+        metavar="KIND",
+        help=f"what the record's input column holds: {', '.join(SYNTHETIC_INPUTS)}",
+    )
     g.add_argument("--substeps", type=int, default=8, help="steps per sample (default 8)")
     g.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     s = p.add_argument_group("sensors (measured = true + offset + noise)")
@@ -54,10 +60,6 @@ def run(args) -> int:
     check_int("--seed", args.seed, 0, MAX_SEED)
     if (args.rms is None) == (args.psd is None):
         raise ValueError("give exactly one of `--rms` (m/s^2) and `--psd` ((m/s^2)^2/Hz)")
-    if args.input not in SYNTHETIC_INPUTS:
-        raise ValueError(
-            f"`--input` must be one of {', '.join(SYNTHETIC_INPUTS)}; got {args.input!r}"
-        )
     samples = float(args.duration) * float(args.sample_rate)
     if math.isfinite(samples):
         # the excitation, its spectrum, the response and the CSV text, about 12 floats a sample

@@ -14,7 +14,13 @@ from randvib._io import dumps
 from randvib.analytic.prediction import predict
 from randvib.cli._device import add_device_arguments, harvester_from_args
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
-from randvib.cli._output import print_table
+from randvib.cli._output import (
+    describe_device,
+    describe_excitation,
+    format_estimate,
+    format_value,
+    print_table,
+)
 from randvib.montecarlo.integrators import INTEGRATORS
 
 
@@ -29,9 +35,14 @@ def register(sub) -> None:
     add_device_arguments(p)
     add_excitation_arguments(p)
     g = p.add_argument_group("simulation")
-    g.add_argument("--paths", type=int, default=None, help="number of paths (default 1000)")
     g.add_argument(
-        "--t-end", type=float, default=None, help="time per path incl. burn-in (s), default 20"
+        "--paths", type=int, default=None, help="number of paths, n_paths (default: 1000)"
+    )
+    g.add_argument(
+        "--t-end",
+        type=float,
+        default=None,
+        help="time per path incl. burn-in (s) (default: 20; not with --record, whose length it is)",
     )
     g.add_argument(
         "--dt",
@@ -46,7 +57,13 @@ def register(sub) -> None:
         help="with --record: windows of the record that make the paths (default 10)",
     )
     g.add_argument("--burn-in", type=float, default=2.0, help="discarded initial time (s)")
-    g.add_argument("--method", default="heun", help=f"integrator: {', '.join(INTEGRATORS)}")
+    g.add_argument(
+        "--method",
+        default="heun",
+        choices=tuple(INTEGRATORS),
+        metavar="SCHEME",
+        help=f"integrator (the API's `scheme`): {', '.join(INTEGRATORS)}",
+    )
     g.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     g.add_argument("--threads", type=int, default=None, help="threads (default: all cores)")
     g.add_argument(
@@ -55,6 +72,7 @@ def register(sub) -> None:
         help="variance-reduced estimates (energy balance, and under white noise the "
         "friction-free companion); white, band-pass and kanai-tajimi input",
     )
+    g.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(handler=run)
 
@@ -71,8 +89,6 @@ def run(args) -> int:
             f"kanai-tajimi): under the synthesised or recorded {psd.name} input no control "
             "has a known mean"
         )
-    if args.method not in INTEGRATORS:
-        raise ValueError(f"`--method` must be one of {', '.join(INTEGRATORS)}; got {args.method!r}")
     if args.record is not None:
         result = _on_record(harvester, psd, args)
     else:
@@ -88,6 +104,7 @@ def run(args) -> int:
             scheme=args.method,  # the CLI keeps its option name `--method`
             seed=args.seed,
             threads=args.threads,
+            progress=False if args.no_progress or args.json else None,
             # the friction-free companion's exact moments hold under white noise
             # and the resistive coupling only; the energy-balance controls hold
             # for every coupling
@@ -120,19 +137,20 @@ def run(args) -> int:
             continue
         s = summary[name]
         lin = getattr(analytic, name, None) if analytic is not None else None
-        rows.append((name, s["mean"], s["ci95"], "" if lin is None else lin, unit))
+        rows.append((name, *format_estimate(s["mean"], s["ci95"]), format_value(lin), unit))
     first = summary.get("stroke_first_passage")
     if first is not None and first["mean"] is None:
         restricted = first["restricted_mean"]
         rows.append(
             (
                 f"E[min(first passage, {first['horizon']:g} s)]",
-                restricted["mean"],
-                restricted["ci95"],
+                *format_estimate(restricted["mean"], restricted["ci95"]),
                 f"{first['paths_reached']}/{first['n_paths']} paths reached the stroke",
                 "s",
             )
         )
+    print(describe_device(harvester))
+    print(describe_excitation(psd) if args.record is None else f"excitation: record {args.record}")
     print_table(rows, ("statistic", "Monte Carlo", "± 95 %", "linearisation", "unit"))
     if args.record is not None:
         print(f"windows of the record as paths; lag-1 correlation {result.lag1_correlation:+.2f}")
@@ -175,6 +193,7 @@ def _on_record(harvester, record, args):
             scheme=args.method,
             seed=args.seed,
             threads=args.threads,
+            progress=False if args.no_progress or args.json else None,
         )
     except ValueError as exc:  # name the options, not the function's arguments
         message = str(exc).replace("`segments`", "`--segments`").replace("`burn_in`", "`--burn-in`")

@@ -37,6 +37,9 @@ def register(sub) -> None:
     p.add_argument(
         "--plot", metavar="DIR", help="write one measured-vs-simulated PNG per record into DIR"
     )
+    p.add_argument(
+        "--force", action="store_true", help="write --plot into a folder that is not empty"
+    )
     add_record_arguments(p)
     p.set_defaults(handler=run)
 
@@ -91,8 +94,10 @@ def run(args) -> int:
     plot_dir = None
     if args.plot is not None:
         plot_dir = check_output_folder(args.plot, "--plot")
-        if plot_dir.exists() and any(plot_dir.iterdir()):
-            raise FileExistsError(f"`--plot` folder {str(plot_dir)!r} is not empty")
+        if plot_dir.exists() and any(plot_dir.iterdir()) and not args.force:
+            raise FileExistsError(
+                f"`--plot` folder {str(plot_dir)!r} is not empty; choose another or give --force"
+            )
         plot_dir.mkdir(parents=True, exist_ok=True)
     records = [record_from_args(path, args) for path in args.data]
     rows = validate(parameters, model, records, simulation=settings)

@@ -21,7 +21,13 @@ from numbers import Real
 
 import numpy as np
 
-from randvib._validation import check_finite, check_int, check_nonnegative, check_positive
+from randvib._validation import (
+    check_finite,
+    check_int,
+    check_nonnegative,
+    check_positive,
+    check_scalar_device,
+)
 from randvib.identification.fitting import Record
 from randvib.identification.record_simulation import simulate_record
 from randvib.models.excitation import BaseExcitation, Excitation, band_limited_excitation
@@ -153,7 +159,7 @@ def _device(device) -> Harvester:
         raise ValueError(
             f"`device` must be a Harvester or a preset name, got {type(device).__name__}"
         )
-    return device
+    return check_scalar_device(device, "synthetic_record")
 
 
 def _true_input(excitation, kind, duration, sample_rate, band, rng) -> np.ndarray:

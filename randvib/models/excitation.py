@@ -45,7 +45,13 @@ from dataclasses import dataclass, fields
 import numpy as np
 from scipy import signal
 
-from randvib._validation import check_finite, check_int, check_nonnegative, check_positive
+from randvib._validation import (
+    check_finite,
+    check_int,
+    check_nonnegative,
+    check_positive,
+    check_scalar,
+)
 from randvib.models.state_space import StateSpace
 
 
@@ -179,6 +185,9 @@ EXCITATIONS: dict[str, type] = {}
 
 _PSD_UNIT = "(m/s^2)^2/Hz"
 
+#: The functions that take an array of white-noise levels S (named in refusals).
+BROADCASTING = "randvib.predict, randvib.expected_power and randvib.equivalent_damping"
+
 
 @dataclass(frozen=True, eq=False)
 class ShapingFilter:
@@ -280,10 +289,18 @@ class Excitation:
         return out
 
 
+def _one(name: str, value):
+    """An excitation's parameter is one number; an array is refused by name."""
+    return check_scalar(name, value, "an excitation describes one spectrum; make one per value")
+
+
 def as_excitation(value) -> Excitation:
     """An :class:`Excitation` as is; a number S as white noise ``White(S)``."""
     if isinstance(value, Excitation):
         return value
+    # an array of levels is refused by name here (float() would fail with numpy's
+    # own words); predict, expected_power and equivalent_damping take arrays
+    value = check_scalar("psd", value, f"a white-noise level S in {_PSD_UNIT}", BROADCASTING)
     return White(float(check_positive("psd", value, _PSD_UNIT)))
 
 
@@ -353,7 +370,9 @@ class White(_Rational):
     is_white = True
 
     def __post_init__(self):
-        object.__setattr__(self, "level", float(check_positive("level", self.level, _PSD_UNIT)))
+        object.__setattr__(
+            self, "level", float(check_positive("level", _one("level", self.level), _PSD_UNIT))
+        )
 
     def psd(self, frequency):
         return np.full(np.shape(frequency), self.level)
@@ -382,9 +401,11 @@ class _SecondOrder(_Rational):
     zeta: float
 
     def __post_init__(self):
-        object.__setattr__(self, "level", float(check_positive("level", self.level, _PSD_UNIT)))
-        object.__setattr__(self, "f0", float(check_positive("f0", self.f0, "Hz")))
-        object.__setattr__(self, "zeta", float(check_positive("zeta", self.zeta)))
+        object.__setattr__(
+            self, "level", float(check_positive("level", _one("level", self.level), _PSD_UNIT))
+        )
+        object.__setattr__(self, "f0", float(check_positive("f0", _one("f0", self.f0), "Hz")))
+        object.__setattr__(self, "zeta", float(check_positive("zeta", _one("zeta", self.zeta))))
 
     def features(self):
         return ((self.f0, self.zeta * self.f0),)
@@ -498,9 +519,15 @@ class BandLimited(Excitation):
     name = "band-limited"
 
     def __post_init__(self):
-        object.__setattr__(self, "level", float(check_positive("level", self.level, _PSD_UNIT)))
-        object.__setattr__(self, "f_lo", float(check_nonnegative("f_lo", self.f_lo, "Hz")))
-        object.__setattr__(self, "f_hi", float(check_positive("f_hi", self.f_hi, "Hz")))
+        object.__setattr__(
+            self, "level", float(check_positive("level", _one("level", self.level), _PSD_UNIT))
+        )
+        object.__setattr__(
+            self, "f_lo", float(check_nonnegative("f_lo", _one("f_lo", self.f_lo), "Hz"))
+        )
+        object.__setattr__(
+            self, "f_hi", float(check_positive("f_hi", _one("f_hi", self.f_hi), "Hz"))
+        )
         if self.f_hi <= self.f_lo:
             raise ValueError(f"`f_hi` must be > `f_lo` = {self.f_lo} Hz, got {self.f_hi} Hz")
 

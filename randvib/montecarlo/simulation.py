@@ -43,7 +43,13 @@ from scipy import linalg, special  # Student t quantile; lighter than scipy.stat
 
 from randvib import _display
 from randvib._resources import announce_duration, check_memory
-from randvib._validation import MAX_SEED, check_choice, check_int, check_positive
+from randvib._validation import (
+    MAX_SEED,
+    check_choice,
+    check_int,
+    check_positive,
+    check_scalar_device,
+)
 from randvib.analytic import exact_solutions as exact
 from randvib.analytic.linear_response import device_block, output_variances
 from randvib.analytic.linearisation import equivalent_damping, linear_displacement_variance
@@ -906,9 +912,12 @@ def _check_step(scheme, harvester, excitation, dt):
             f"(allowed {MAX_STEP_BIAS:.0%}); use dt <= {limit:.3g} s"
         )
     if bias > WARN_STEP_BIAS:
+        # the step that keeps the warning away, so that the message says what to do
+        quiet = largest_step(scheme, harvester, excitation, bias=WARN_STEP_BIAS)
         warnings.warn(
             f"dt = {dt!r} s gives {scheme} a stationary-variance bias of about {bias:.2%} "
-            f"on the linearised device{resolves}",
+            f"on the linearised device{resolves}; use dt <= {quiet:.2g} s for less than "
+            f"{WARN_STEP_BIAS:.0%}",
             StepSizeWarning,
             stacklevel=3,
         )
@@ -1275,9 +1284,7 @@ def _validated(
     """
     if not isinstance(harvester, Harvester):
         raise ValueError(f"`harvester` must be a randvib.Harvester, got {type(harvester).__name__}")
-    for name in ("m", "c_m", "c_e", "k", "k3"):
-        if np.ndim(getattr(harvester, name)) != 0:
-            raise ValueError(f"simulate needs scalar harvester parameters; `{name}` is an array")
+    check_scalar_device(harvester, "simulate")  # device, friction and coupling parameters
     # Statistics are time averages of a stationary state: a confining
     # potential, or the free mass for its velocity.
     harvester.potential.require("simulate", CONFINING + ("free",))
@@ -1326,7 +1333,7 @@ def _simulated_excitation(psd) -> Excitation:
     :func:`randvib.montecarlo.driven.simulate_on_record`.
     """
     if not isinstance(psd, Excitation):
-        return as_excitation(float(check_positive("psd", psd, "(m/s^2)^2/Hz")))
+        return as_excitation(psd)  # one positive number (an array refused by name)
     if psd.is_white:
         return psd
     if psd.name == "measured":

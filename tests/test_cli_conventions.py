@@ -1,0 +1,336 @@
+"""One set of conventions for every command, and output for people (issue 12, command line).
+
+The parser walk below runs over every registered subcommand, so that a new
+command keeps the conventions: defaults shown in ``--help``, the shared flags
+present with one meaning, choices declared as choices.
+"""
+
+import argparse
+import csv
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numba
+import numpy as np
+import pytest
+
+import randvib as rv
+from randvib.cli import (
+    API_NAMES,
+    COMPILING,
+    HelpFormatter,
+    build_parser,
+    cli_wording,
+    compile_notice,
+    one_line_choice_error,
+)
+from randvib.cli._output import format_estimate
+from randvib.cli.power import sweep_values
+from randvib.models.excitation import BandLimited
+from tests._cli import one_line_error, run
+
+ROOT = Path(__file__).resolve().parents[1]
+FIG9 = rv.preset("figure9")
+WIRED = rv.Harvester.from_electrical(
+    m=0.0226, c_m=0.049, k=57.4, alpha=0.1992, r_load=2.0, r_coil=0.48, friction=rv.Coulomb(0.0058)
+)
+WIRED_ARGS = ["--m", "0.0226", "--c-m", "0.049", "--k", "57.4", "--alpha", "0.1992"]
+WIRED_ARGS += ["--r-load", "2", "--r-coil", "0.48", "--friction", "coulomb", "--fc", "0.0058"]
+
+
+def subcommands() -> dict[str, argparse.ArgumentParser]:
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    return dict(sub.choices)
+
+
+def options(parser) -> dict[str, argparse.Action]:
+    return {flag: a for a in parser._actions for flag in a.option_strings}
+
+
+# ------------------------------------------------------------- the parser walk
+@pytest.mark.parametrize("name", list(subcommands()))
+def test_every_default_is_shown_in_help(name):
+    parser = subcommands()[name]
+    formatter = HelpFormatter(prog=parser.prog)
+    for action in parser._actions:
+        nothing = action.default is None or action.default is False
+        if not action.option_strings or nothing or action.default == argparse.SUPPRESS:
+            continue
+        text = formatter._expand_help(action)
+        assert "default" in text, (name, action.option_strings, text)
+    # options whose default is decided later say it in their own text
+    if name == "simulate":
+        flags = options(parser)
+        for flag in ("--t-end", "--burn-in", "--paths", "--dt", "--method", "--seed"):
+            assert "default" in formatter._expand_help(flags[flag]), flag
+
+
+#: Shared flags: the commands that must have them, and what each must be.
+SHARED = {
+    "--json": ({"power", "simulate", "identify", "validate"}, dict(const=True, default=False)),
+    "--seed": ({"simulate", "record", "identify", "study"}, dict(type=int, default=0)),
+    "--no-progress": ({"simulate", "identify", "study"}, dict(const=True, default=False)),
+}
+
+
+@pytest.mark.parametrize("flag", list(SHARED))
+def test_shared_flags_have_one_meaning(flag):
+    commands, spec = SHARED[flag]
+    for name, parser in subcommands().items():
+        action = options(parser).get(flag)
+        if name in commands:
+            assert action is not None, (name, flag)
+        if action is not None:
+            for attribute, value in spec.items():
+                assert getattr(action, attribute) == value, (name, flag, attribute)
+
+
+def test_every_output_file_option_has_force():
+    """A command that writes a named file or folder overwrites it only with --force."""
+    writers = ("--out", "--save", "--csv", "--plot")
+    for name, parser in subcommands().items():
+        flags = options(parser)
+        if any(w in flags for w in writers):
+            assert "--force" in flags, name
+
+
+#: Option destinations that name one of a fixed set: declared as argparse choices.
+CHOICE_DESTS = ("method", "friction", "coupling", "preset", "excitation", "input", "model")
+CHOICE_DESTS += ("hold", "input_kind")
+
+
+def test_choices_are_declared():
+    seen = set()
+    for name, parser in subcommands().items():
+        for action in parser._actions:
+            if action.dest in CHOICE_DESTS and action.option_strings:
+                assert action.choices is not None, (name, action.dest)
+                seen.add(action.dest)
+    assert seen == set(CHOICE_DESTS)
+
+
+def test_readme_documents_every_renamed_option():
+    readme = (ROOT / "README.md").read_text()
+    for option, api in API_NAMES.items():
+        assert f"| `{option}` | {api} |" in readme, option
+
+
+# ------------------------------------------------------------- errors and pipes
+@pytest.mark.parametrize(
+    "argv, fragment",
+    [
+        (["power", "--preset", "figure9", "--psd", "1", "--method", "exact"], "`--method` must be"),
+        (["simulate", "--preset", "figure9", "--psd", "1", "--method", "rk4"], "got 'rk4'"),
+        (["power", "--preset", "figure9", "--psd", "1", "--coupling", "x"], "`--coupling` must"),
+        (["record", "--preset", "figure9", "--rms", "1", "--out", "x.csv", "--input", "f"], "KIND"),
+    ],
+)
+def test_choice_errors_are_one_line(capsys, argv, fragment):
+    one_line_error(capsys, argv, fragment if fragment != "KIND" else "`--input` must be one of")
+
+
+def test_argparse_choice_message_in_project_words():
+    text = "argument --x: invalid choice: 'c' (choose from 'a', 'b')"
+    assert one_line_choice_error(text) == "`--x` must be one of a, b; got 'c'"
+    assert one_line_choice_error("unrecognized arguments: --y") == "unrecognized arguments: --y"
+
+
+def test_closed_pipe_ends_quietly():
+    """``randvib power ... | head`` with the reader gone: no traceback, SIGPIPE's status."""
+    read_end, write_end = os.pipe()
+    os.close(read_end)
+    try:
+        done = subprocess.run(
+            [sys.executable, "-c", "import sys; from randvib.cli import main; sys.exit(main())"]
+            + ["power", "--preset", "figure9", "--psd", "0.1:1:40"],
+            stdout=write_end,
+            stderr=subprocess.PIPE,
+            text=True,
+            cwd=ROOT,
+            timeout=120,
+        )
+    finally:
+        os.close(write_end)
+    assert done.returncode == 141 and done.stderr == "", done.stderr
+
+
+def test_messages_name_commands_not_functions():
+    assert cli_wording("use randvib.simulate for this") == "use `randvib simulate` for this"
+    assert cli_wording("see `randvib.predict()`") == "see `randvib power`"
+    assert cli_wording("randvib.Harvester stays") == "randvib.Harvester stays"
+    assert cli_wording("Use method='fpk-fast' there") == "Use `--method fpk-fast` there"
+
+
+def test_compile_notice_once_on_a_cache_miss(capsys):
+    with compile_notice():
+        numba.njit(lambda x: x + 1)(1)  # a new function: compiled, never cached
+        numba.njit(lambda x: x + 2)(1)
+    assert capsys.readouterr().err.count(COMPILING) == 1
+    with compile_notice():
+        pass  # nothing compiled: nothing said
+    assert COMPILING not in capsys.readouterr().err
+
+
+def test_step_warning_is_one_readable_line(capsys):
+    code, out, err = run(
+        capsys,
+        "simulate",
+        "--preset",
+        "figure9",
+        "--psd",
+        "1",
+        "--paths",
+        "4",
+        "--t-end",
+        "0.3",
+        "--burn-in",
+        "0.1",
+        "--dt",
+        "2e-4",
+        "--method",
+        "euler-maruyama",
+    )
+    assert code == 0
+    (line,) = [text for text in err.splitlines() if "warning" in text]
+    assert line.startswith("randvib: warning: dt = 0.0002 s gives euler-maruyama")
+    assert "use dt <= " in line and ".py" not in line
+
+
+# ------------------------------------------------------------- output for people
+def test_estimate_shown_to_its_interval():
+    assert format_estimate(0.0024619412547950926, 0.000272784) == ("0.00246", "0.00027")
+    assert format_estimate(12345.678, 140.0) == ("12350", "140")
+    assert format_estimate(0.99, 0.0996) == ("0.99", "0.10")  # 0.0996 rounds up a place
+    assert format_estimate(-1e-9, 1e-3) == ("0.0000", "0.0010")  # never "-0"
+
+
+def test_simulate_prints_device_and_excitation(capsys):
+    argv = ["simulate", "--preset", "figure9", "--psd", "1", "--excitation", "band-pass"]
+    argv += ["--f0", "8", "--zeta", "0.2", "--paths", "4", "--t-end", "0.3", "--burn-in", "0.1"]
+    code, out, _ = run(capsys, *argv)
+    assert code == 0
+    assert "device: m 0.0226 kg" in out and "coulomb friction (fc 0.0058)" in out
+    assert "excitation: band-pass (level 1, f0 8, zeta 0.2)" in out
+
+
+def test_power_without_coil_says_why_and_reports_mechanical(capsys):
+    code, out, _ = run(capsys, "power", "--preset", "coulomb-td1", "--psd", "1")
+    assert code == 0 and "no electrical damping (c_e = 0" in out and "--c-e" in out
+    code, out, _ = run(capsys, "power", "--preset", "coulomb-td1", "--psd", "1", "--json")
+    data = json.loads(out)
+    assert data["power_electrical"] == 0
+    # under white noise all that is dissipated is m S / 4 (c_eq = S m / (4 E[v^2]))
+    assert data["power_mechanical"] == pytest.approx(0.0226 * 1.0 / 4, rel=1e-12)
+
+
+@pytest.mark.parametrize("method", ["linearisation", "averaging"])
+def test_power_mechanical_closes_the_energy_balance(capsys, method):
+    code, out, _ = run(
+        capsys, "power", "--preset", "figure9", "--psd", "0.5", "--json", "--method", method
+    )
+    data = json.loads(out)
+    total = data["power_mechanical"] + data["power_electrical"]
+    assert total == pytest.approx(FIG9.m * 0.5 / 4, rel=1e-12)
+    assert data["power_mechanical"] > data["power_electrical"]  # friction dissipates too
+
+
+# ------------------------------------------------------------- power sweeps
+def test_sweep_values():
+    assert sweep_values("0:0.05:11") == pytest.approx(np.linspace(0, 0.05, 11), abs=1e-15)
+    assert sweep_values("2.5") == [2.5]
+    for bad in ("0:1", "0:1:1", "0:1:x", "a", "0:inf:3"):
+        with pytest.raises(argparse.ArgumentTypeError):
+            sweep_values(bad)
+
+
+def test_power_sweep_json_is_the_single_points(capsys):
+    code, out, _ = run(
+        capsys, "power", "--preset", "figure9", "--psd", "1", "0.5", "--fc", "0:0.01:3", "--json"
+    )
+    points = json.loads(out)
+    assert code == 0 and len(points) == 6
+    for fc, psd, point in zip([0, 0, 0.005, 0.005, 0.01, 0.01], [1, 0.5] * 3, points, strict=True):
+        expected = rv.predict(FIG9.updated(fc=fc), psd)
+        assert point["psd"] == psd and point["power_electrical"] == expected.power_electrical
+
+
+def test_power_sweep_table_and_csv(capsys, tmp_path):
+    target = tmp_path / "sweep.csv"
+    argv = ["power", "--preset", "figure9", "--psd", "1", "0.5", "0.1", "--csv", target]
+    code, out, _ = run(capsys, *argv)
+    assert code == 0 and "swept --psd" in out and f"wrote {target} (3 points)" in out
+    with open(target, newline="") as file:
+        rows = list(csv.DictReader(file))
+    assert [float(r["psd"]) for r in rows] == [1, 0.5, 0.1]
+    for row in rows:
+        assert float(row["power_electrical"]) == rv.expected_power(FIG9, float(row["psd"]))
+    one_line_error(capsys, argv, "exists")  # a new file unless --force
+    assert run(capsys, *argv, "--force")[0] == 0
+
+
+def test_power_sweep_bad_range_is_one_line(capsys):
+    one_line_error(capsys, ["power", "--preset", "figure9", "--psd", "1:0.1"], "START:STOP:COUNT")
+
+
+def test_optimal_load(capsys):
+    code, out, _ = run(capsys, "power", *WIRED_ARGS, "--psd", "1", "--optimal-load", "--json")
+    data = json.loads(out)
+    r_load, power = rv.optimal_load_resistance(WIRED, 1.0)
+    assert data["r_load_optimal"] == r_load and data["power_load_optimal"] == power
+    one_line_error(
+        capsys, ["power", "--preset", "figure9", "--psd", "1", "--optimal-load"], "coupling"
+    )
+
+
+# ------------------------------------------------------------- arrays
+ARRAY = np.array([1.0, 0.1])
+
+
+@pytest.mark.parametrize(
+    "call, fragment",
+    [
+        (lambda: rv.optimal_load_resistance(WIRED, ARRAY), "`psd` must be one number"),
+        (lambda: rv.simulate(FIG9, ARRAY, t_end=0.2, dt=1e-4, n_paths=2), "`psd` must be one"),
+        (lambda: rv.statistical_linearisation(FIG9, ARRAY), "`psd` must be one number"),
+        (lambda: BandLimited(ARRAY, 4, 20), "`level` must be one number"),
+        (
+            lambda: rv.simulate(FIG9.updated(fc=ARRAY), 1.0, t_end=0.2, dt=1e-4, n_paths=2),
+            "simulate needs scalar harvester parameters \\(one device\\): `fc`",
+        ),
+        (
+            lambda: rv.statistical_linearisation(FIG9.updated(fc=ARRAY), 1.0),
+            "statistical_linearisation needs scalar harvester parameters",
+        ),
+        (lambda: BandLimited(1.0, 4, ARRAY * 30), "`f_hi` must be one number"),
+        (
+            lambda: rv.synthetic_record(
+                FIG9.updated(c_m=ARRAY), 1.0, duration=1.0, sample_rate=1000
+            ),
+            "synthetic_record needs scalar harvester parameters \\(one device\\): `c_m`",
+        ),
+        (
+            lambda: rv.optimal_load_resistance(WIRED.updated(c_m=ARRAY), 1.0),
+            "optimal_load_resistance needs scalar harvester",
+        ),
+    ],
+)
+def test_arrays_refused_by_name(call, fragment):
+    with pytest.raises(ValueError, match=fragment.replace("`", ".")):
+        call()
+
+
+@pytest.mark.parametrize("method", ["linearisation", "averaging", "fpk-fast"])
+def test_arrays_broadcast_where_documented(method):
+    both = rv.predict(FIG9, ARRAY, method=method)
+    for i, psd in enumerate(ARRAY):
+        one = rv.predict(FIG9, float(psd), method=method)
+        assert both.power_electrical[i] == pytest.approx(one.power_electrical, rel=1e-12)
+    assert rv.expected_power(FIG9, ARRAY)[1] == pytest.approx(
+        rv.expected_power(FIG9, 0.1), rel=1e-12
+    )
+    assert rv.equivalent_damping(FIG9, ARRAY)[0] == pytest.approx(
+        rv.equivalent_damping(FIG9, 1.0), rel=1e-12
+    )
