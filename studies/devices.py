@@ -74,10 +74,13 @@ from randvib.studies.report import (
     markdown_table,
     plus_minus,
     prepare_output_dir,
+    save_figure,
     write_report,
     write_table,
     write_verdicts,
 )
+from randvib.studies.style import colour as style_colour
+from randvib.studies.style import new_figure, panel_letters, styled
 
 NAME = "devices"
 FC = 0.0058  #: N, the paper's Coulomb level (Table 2, training data 1)
@@ -473,13 +476,11 @@ def _bound(entry: dict) -> str:
 
 
 # ----------------------------------------------------------------- figures
+@styled
 def tradeoff_figure(results: pd.DataFrame, path: Path) -> Path:
     """Power against stroke exceedance over the levels, a panel per input, a line per device."""
-    import matplotlib.pyplot as plt
-
     inputs = list(dict.fromkeys(results.input))
-    fig, axes = plt.subplots(1, len(inputs), figsize=(3.6 * len(inputs), 3.4), sharey=True,
-                             layout="constrained", squeeze=False)  # fmt: skip
+    fig, axes = new_figure(1, len(inputs), figsize=(3.6 * len(inputs), 3.4), sharey=True)
     for ax, name in zip(axes[0], inputs, strict=True):
         for dev in DEVICES:
             sub = results[(results.input == name) & (results.device == dev)].sort_values("g")
@@ -495,23 +496,21 @@ def tradeoff_figure(results: pd.DataFrame, path: Path) -> Path:
         ax.grid(alpha=0.3, lw=0.5)
     axes[0, 0].set_ylabel("E[P$_e$] (mW), Monte Carlo")
     axes[0, 0].legend(fontsize=7, title="levels g: markers", title_fontsize=7)
-    fig.savefig(path, dpi=150)
-    plt.close(fig)
-    return path
+    panel_letters(axes)
+    return save_figure(fig, path)
 
 
+@styled
 def methods_figure(methods: pd.DataFrame, path: Path) -> Path:
     """Relative errors of the methods against level, power and exceedance, a marker per device."""
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.4), layout="constrained")
+    fig, axes = new_figure(1, 2, figsize=(9, 3.6))
     markers = dict(zip(DEVICES, "osD", strict=True))
-    for ax, q in zip(axes, ("power", "exceedance"), strict=True):
+    for ax, q in zip(axes[0], ("power", "exceedance"), strict=True):
         for i, (method, rows) in enumerate(methods.groupby("method", sort=False)):
             for dev, sub in rows.dropna(subset=[f"{q}_rel_error"]).groupby("device"):
                 ax.errorbar(sub.g * (1.04**i), 100 * sub[f"{q}_rel_error"],
                             yerr=100 * sub[f"{q}_rel_error_ci95"], ls="none", marker=markers[dev],
-                            ms=3, capsize=1.5, color=f"C{i}",
+                            ms=3, capsize=1.5, color=style_colour(i),
                             label=f"{method}, {dev}")  # fmt: skip
         ax.axhline(0.0, color="0.5", lw=0.5)
         ax.set_xscale("log")
@@ -519,10 +518,9 @@ def methods_figure(methods: pd.DataFrame, path: Path) -> Path:
         ax.set_xlabel("level factor g (all inputs)")
         ax.set_ylabel(f"error in {q} vs Monte Carlo (%)")
         ax.grid(alpha=0.3, lw=0.5)
-    axes[1].legend(fontsize=6, ncol=2)
-    fig.savefig(path, dpi=150)
-    plt.close(fig)
-    return path
+    axes[0, 1].legend(fontsize=6, ncol=2)
+    panel_letters(axes)
+    return save_figure(fig, path)
 
 
 # ----------------------------------------------------------------- report

@@ -158,7 +158,7 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
     fig_main = figures.power_against_friction(table, base, PSDS, K3S, out / "figure9.png")
     fig_inter = figures.contrast_against_friction(
         inter,
-        "Duffing-Coulomb interaction at k3 = 5e5 N/m$^3$ (95 % CI, paired paths)",
+        "Duffing-Coulomb interaction at k$_3$ = 5 × 10$^5$ N/m$^3$",
         out / "interaction.png",
     )
 

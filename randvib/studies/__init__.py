@@ -161,5 +161,7 @@ def script_main(run_study, argv=None) -> int:
     add_run_options(parser)
     args = parser.parse_args(argv)
     name = Path(sys.modules[run_study.__module__].__file__).stem.replace("_", "-")
-    print(f"report: {run_with_options(run_study, name, args.out, args)}")
+    from randvib.studies.report import print_verdicts
+
+    print_verdicts(run_with_options(run_study, name, args.out, args))
     return 0

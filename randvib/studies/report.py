@@ -24,11 +24,15 @@ from randvib._io import dumps, prepare_output_dir, write_tracked
 
 __all__ = [
     "fc_levels",
+    "format_number",
+    "format_percent",
     "markdown_table",
     "plus_minus",
+    "print_verdicts",
     "prepare_output_dir",
     "save_figure",
     "sign_word",
+    "verdict_lines",
     "write_report",
     "write_table",
     "write_verdicts",
@@ -66,9 +70,83 @@ def write_table(out_dir: Path, name: str, df: pd.DataFrame) -> Path:
     return write_tracked(Path(out_dir) / name, df.to_csv(index=False))
 
 
-def write_verdicts(out_dir: Path, verdicts: dict) -> Path:
-    """Write the numbers behind the report's verdicts as ``out_dir/verdicts.json``."""
-    return write_tracked(Path(out_dir) / "verdicts.json", dumps(verdicts, indent=2))
+def write_verdicts(out_dir: Path, verdicts: dict, sentences=()) -> Path:
+    """Write the numbers behind the report's verdicts as ``out_dir/verdicts.json``.
+
+    ``sentences`` (the report's verdicts in words) are kept under the key
+    ``"verdicts"``; :func:`print_verdicts` shows them at the end of a run.
+    """
+    data = {**verdicts, "verdicts": [s for s in sentences if s]} if sentences else verdicts
+    return write_tracked(Path(out_dir) / "verdicts.json", dumps(data, indent=2))
+
+
+def verdict_lines(out_dir: Path, max_items: int = 40) -> list[str]:
+    """The verdicts of the study in ``out_dir`` as lines for the terminal.
+
+    The sentences of ``verdicts.json``'s ``"verdicts"`` first, then every
+    number and word of the file as ``key.sub: value`` (lists of records
+    counted, not listed), at most ``max_items`` of them.
+    """
+    import json
+
+    path = Path(out_dir) / "verdicts.json"
+    if not path.is_file():
+        return []
+    data = json.loads(path.read_text())
+    lines = [f"- {s}" for s in data.pop("verdicts", [])]
+    flat = []
+
+    def walk(prefix, value):
+        if isinstance(value, dict):
+            for key, sub in value.items():
+                walk(f"{prefix}.{key}" if prefix else str(key), sub)
+        elif isinstance(value, list) and any(isinstance(v, dict | list) for v in value):
+            flat.append(f"{prefix}: {len(value)} entries")
+        elif isinstance(value, float):
+            flat.append(f"{prefix}: {format_number(value)}")
+        else:
+            flat.append(f"{prefix}: {value}")
+
+    walk("", data)
+    if len(flat) > max_items:
+        flat = flat[:max_items] + [f"... ({len(flat) - max_items} more in {path})"]
+    return lines + [f"  {line}" for line in flat]
+
+
+def print_verdicts(report: Path) -> None:
+    """Print the report's path and the verdicts of its folder (the end of a study run)."""
+    report = Path(report)
+    print(f"report: {report}")
+    lines = verdict_lines(report.parent)
+    if lines:
+        print(f"verdicts ({report.parent / 'verdicts.json'}):")
+        print("\n".join(lines))
+
+
+def format_number(value, digits: int = 4) -> str:
+    """``value`` for a report: ``digits`` significant figures, 'n/a' for NaN or None, no '-0'."""
+    if value is None:
+        return "n/a"
+    value = float(value)
+    if value != value:
+        return "n/a"
+    if value == float("inf"):
+        return "∞"
+    if value == float("-inf"):
+        return "-∞"
+    text = f"{value:.{digits}g}"
+    # a negative value that rounds to zero is written as 0
+    return text[1:] if text.startswith("-") and float(text) == 0 else text
+
+
+def format_percent(fraction, digits: int = 2, sign: bool = False) -> str:
+    """A fraction written as a percentage ('1.23 %'), 'n/a' for NaN, no '-0.00 %'."""
+    if fraction is None or float(fraction) != float(fraction):
+        return "n/a"
+    text = f"{100 * float(fraction):{'+' if sign else ''}.{digits}f}"
+    if float(text) == 0:
+        text = f"{0:.{digits}f}"
+    return f"{text} %"
 
 
 def write_report(
@@ -85,13 +163,22 @@ def write_report(
 
 
 def save_figure(fig, path: Path) -> Path:
-    """Save ``fig`` as a PNG (120 dpi) and close it (refusing to replace an edited one)."""
+    """Save ``fig`` as a PNG (:data:`randvib.studies.style.DPI`) and close it.
+
+    Before saving, :func:`randvib.studies.style.check_layout` warns if the
+    figure lacks constrained layout or two of its texts overlap. An edited
+    PNG is not replaced (:func:`randvib._io.write_tracked`).
+    """
     import io
 
     import matplotlib.pyplot as plt
 
+    from randvib.studies.style import DPI, check_layout
+
+    path = Path(path)
+    check_layout(fig, path.name)
     buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=120, bbox_inches="tight")
+    fig.savefig(buffer, format="png", dpi=DPI)
     plt.close(fig)
     return write_tracked(path, buffer.getvalue())
 
