@@ -51,6 +51,7 @@ from randvib.studies.report import (
     markdown_table,
     plus_minus,
     prepare_output_dir,
+    readable_table,
     write_report,
     write_table,
     write_verdicts,
@@ -246,7 +247,7 @@ def step_section(check, check_data, settings, worst_bias) -> str:
         f"statistical error at {check_data['n_below']} of {len(check)} points"
         f"{check_data['sentence']}. "
         f"Linearised step bias at dt (randvib.montecarlo.simulation.step_bias) at most {worst_bias:.1e}.\n\n"
-        + markdown_table(check)
+        + markdown_table(readable_table(check))
     )
 
 

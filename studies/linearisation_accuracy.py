@@ -57,6 +57,7 @@ from randvib.studies.report import (
     markdown_table,
     plus_minus,
     prepare_output_dir,
+    readable_table,
     write_report,
     write_table,
     write_verdicts,
@@ -234,7 +235,8 @@ def step_section(check, settings, worst_bias) -> str:
         f"largest S) at dt/2 = {settings.dt / 2:g} s, independent noise. Time-step bias below "
         f"the statistical error at {int(check.bias_below_error.sum())} of {len(check)} points"
         f"{step_check_verdict(check)['sentence']}. "
-        f"Linearised step bias at dt at most {worst_bias:.1e}.\n\n" + markdown_table(check)
+        f"Linearised step bias at dt at most {worst_bias:.1e}.\n\n"
+        + markdown_table(readable_table(check))
     )
 
 

@@ -242,7 +242,9 @@ def error_against_friction_level(
         top.set_xlabel(f"Eq. 32 P / P(0) at that φ;  k$_3$ = {num_tex(k3)} N/m$^3$")
     axes[0, 0].set_ylabel("(P$_{method}$ − P$_{MC}$) / P$_{MC}$ (%), 95 % CI")
     handles, labels = axes[0, 0].get_legend_handles_labels()
-    for tol, alpha in sorted(bands):
+    for tol, _ in sorted(bands):
+        # the bands are nested: inside ±tol, every wider band's shade lies underneath too
+        alpha = 1.0 - float(np.prod([1.0 - a for t, a in bands if t >= tol]))
         handles.append(Patch(color=PALETTE_GREEN, alpha=alpha, lw=0))
         labels.append(f"|error| ≤ {100 * tol:g} %")
     fig.legend(handles, labels, loc="outside lower center", ncol=3)

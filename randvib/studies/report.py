@@ -29,6 +29,7 @@ __all__ = [
     "markdown_table",
     "plus_minus",
     "print_verdicts",
+    "readable_table",
     "prepare_output_dir",
     "save_figure",
     "sign_word",
@@ -50,11 +51,20 @@ def plus_minus(value, ci, scale: float = 100.0, fmt: str = "+.2f") -> list[str]:
 def markdown_table(df: pd.DataFrame, floatfmt: str = ".4g", numparse: bool = True) -> str:
     """``df`` as a GitHub-flavoured Markdown table, without the index.
 
-    ``numparse=False`` keeps text columns that look like numbers (e.g.
-    "1e+05") as written.
+    Numbers are written with ``floatfmt``; a NaN cell reads 'n/a' and a
+    negative number that rounds to zero reads 0 (no 'nan' or '-0' in a
+    report). ``numparse=False`` keeps text columns that look like numbers
+    (e.g. "1e+05") as written.
     """
     from tabulate import tabulate
 
+    df = df.copy()
+    for column in df.columns:
+        if pd.api.types.is_float_dtype(df[column]):
+            df[column] = [_float_cell(v, floatfmt) for v in df[column]]
+        elif df[column].dtype == object:
+            df[column] = [_float_cell(v, floatfmt) if isinstance(v, float) else v
+                          for v in df[column]]  # fmt: skip
     return tabulate(
         df,
         headers="keys",
@@ -63,6 +73,63 @@ def markdown_table(df: pd.DataFrame, floatfmt: str = ".4g", numparse: bool = Tru
         floatfmt=floatfmt,
         disable_numparse=not numparse,
     )
+
+
+def _float_cell(value: float, floatfmt: str) -> str:
+    """One number of a report table: 'n/a' for NaN, no '-0'."""
+    if value != value:
+        return "n/a"
+    text = format(value, floatfmt)
+    try:
+        zero = float(text) == 0
+    except ValueError:
+        return text
+    return text.lstrip("-") if zero else text
+
+
+#: Raw result columns and how a report shows them: (header with its unit, scale factor).
+READABLE_COLUMNS = {
+    "psd": ("S ((m/s²)²/Hz)", 1.0),
+    "k3": ("k3 (N/m³)", 1.0),
+    "fc": ("Fc (mN)", 1e3),
+    "phi": ("φ", 1.0),
+    "zeta": ("ζ", 1.0),
+    "linearisation_power": ("P Eq. 32 (mW)", 1e3),
+    "power_electrical": ("P Monte Carlo (mW)", 1e3),
+    "power_electrical_ci95": ("95 % half-width (mW)", 1e3),
+    "power_electrical_half": ("P at dt/2 (mW)", 1e3),
+    "power_electrical_ci95_half": ("95 % half-width at dt/2 (mW)", 1e3),
+    "difference": ("difference (mW)", 1e3),
+    "combined_ci95": ("combined 95 % half-width (mW)", 1e3),
+    "bias_below_error": ("bias below error", None),
+    "linearisation_rel_error": ("Eq. 32 error (%)", 100.0),
+    "linearisation_rel_error_ci95": ("Eq. 32 error 95 % half-width (%)", 100.0),
+    "linearisation_consistent": ("Eq. 32 inside the 95 % CI", None),
+    "contrast": ("contrast (µW)", 1e6),
+    "contrast_ci95": ("contrast 95 % half-width (µW)", 1e6),
+    "reference": ("P(Fc, 0) (mW)", 1e3),
+    "relative_contrast": ("contrast / P(Fc, 0) (%)", 100.0),
+    "relative_ci95": ("95 % half-width (%)", 100.0),
+    "p_value": ("p-value", 1.0),
+    "detectable": ("detectable (95 %)", None),
+    "detectable_holm": ("detectable (Holm)", None),
+    "n_paths": ("paths", 1.0),
+}
+
+
+def readable_table(df: pd.DataFrame) -> pd.DataFrame:
+    """``df`` for a report: known raw columns (:data:`READABLE_COLUMNS`) renamed with their
+    units and scaled (W to mW, fractions to %, N to mN), yes/no for booleans; others kept."""
+    out = {}
+    for column in df.columns:
+        header, scale = READABLE_COLUMNS.get(column, (column, 1.0))
+        values = df[column]
+        if scale is None or pd.api.types.is_bool_dtype(values):
+            values = values.map(lambda v: "yes" if bool(v) else "no")
+        elif scale != 1.0:
+            values = values * scale
+        out[header] = values.to_numpy()
+    return pd.DataFrame(out)
 
 
 def write_table(out_dir: Path, name: str, df: pd.DataFrame) -> Path:
