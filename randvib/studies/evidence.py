@@ -71,10 +71,11 @@ def independent_count(table: pd.DataFrame, value: str = "power_electrical") -> i
 
 
 def independence_note(n_rows: int, n_independent: int, what: str = "points") -> str:
-    """'' when every row is independent, else a clause saying how many pieces of evidence."""
+    """'' when every row is independent, else '; the k3 = 0 rows ... are N independent pieces
+    of evidence' (to close a parenthesis with)."""
     if n_independent == n_rows:
         return ""
     return (
-        f" (the k3 = 0 rows at different S are exact rescalings of the same noise paths, so "
-        f"these {n_rows} {what} are {n_independent} independent pieces of evidence)"
+        f"; the k3 = 0 rows at different S are exact rescalings of the same noise paths, so "
+        f"these {n_rows} {what} are {n_independent} independent pieces of evidence"
     )

@@ -176,12 +176,12 @@ def step_check_verdict(check: pd.DataFrame) -> dict:
     note = independence_note(len(check), n_independent)
     if n_below == len(check):
         data["sentence"] = (
-            f" (largest difference {worst:.2f} times the combined 95 % half-width){note}"
+            f" (largest difference {worst:.2f} times the combined 95 % half-width{note})"
         )
     else:
         data["sentence"] = (
             f"; at {len(check) - n_below} the half-step estimate differs by more than the "
             f"combined 95 % half-width (largest {worst:.2f} times it; "
-            f"{0.05 * n_independent:.1f} expected by chance){note}"
+            f"{0.05 * n_independent:.1f} expected by chance{note})"
         )
     return data

@@ -72,16 +72,17 @@ def linearisation_verdict(table: pd.DataFrame) -> tuple[dict, str]:
             if len(outside) == n_friction and (outside.fc > 0).all()
             else fc_levels(outside)
         )
-        independent = (
-            ""
-            if n_independent_friction == n_friction
-            else f", {data['n_outside_independent']} of {n_independent_friction} independent "
-            "ones: the k3 = 0 rows at different S are exact rescalings of the same noise paths"
-        )
+        if n_independent_friction == n_friction:
+            among = f"{chance} among the {n_friction} with friction"
+        else:
+            among = (
+                f"{data['n_outside_independent']} of the {n_independent_friction} independent "
+                f"points with friction, {chance}: the k3 = 0 rows at different S are exact "
+                "rescalings of the same noise paths and count once"
+            )
         sentence = (
             f"Eq. 32 is outside the Monte Carlo 95 % interval at {len(outside)} of {len(table)} "
-            f"points ({chance} among the {n_friction} with friction{independent}), {where} "
-            f"({levels}); {sign}."
+            f"points ({among}), {where} ({levels}); {sign}."
         )
         if over == 0 and len(outside) > data["expected_by_chance"]:
             sentence += (
