@@ -72,7 +72,7 @@ def power_against_friction(table: pd.DataFrame, base, psds, k3s, path: Path) -> 
                             color=c, mfc="none", lw=1,
                             label=f"averaging, k$_3$ = {num_tex(k3)} N/m$^3$")  # fmt: skip
         top.set_title(f"S = {psd:g} (m/s$^2$)$^2$/Hz")
-        bottom.axhline(0.0, color="k", lw=0.6)
+        bottom.axhline(0.0, color="k", lw=0.6, zorder=1)
         bottom.set_xlabel("Coulomb friction $F_c$ (mN)")
     axes[0, 0].set_ylabel("E[$P_e$] (mW)")
     axes[1, 0].set_ylabel("(P$_{method}$ − P$_{MC}$) / P$_{MC}$ (%)")
@@ -95,7 +95,7 @@ def contrast_against_friction(inter: pd.DataFrame, title: str, path: Path) -> Pa
         ax.errorbar(1e3 * sub.fc, 100 * sub.relative_contrast, yerr=100 * sub.relative_ci95,
                     fmt="os^D"[j % 4] + "-", color=colour(j),
                     label=f"S = {psd:g} (m/s$^2$)$^2$/Hz")  # fmt: skip
-    ax.axhline(0, color="k", lw=0.6)
+    ax.axhline(0, color="k", lw=0.6, zorder=1)
     ax.set_xlabel("Coulomb friction $F_c$ (mN)")
     ax.set_ylabel("interaction contrast / P($F_c$, 0) (%)")
     ax.set_title(title)
@@ -146,7 +146,7 @@ def contrast_bands(
                 ax.plot(np.r_[0.0, cur.fc] * 1e3,
                         100 * np.r_[0.0, cur.averaging_relative_contrast], "--",
                         color=colours[k3], lw=1)  # fmt: skip
-        ax.axhline(0.0, color="k", lw=0.6)
+        ax.axhline(0.0, color="k", lw=0.6, zorder=1)
         ax.set_title(f"S = {psd:g} (m/s$^2$)$^2$/Hz")
         ax.set_xlabel("Coulomb friction $F_c$ (mN)")
     axes[0, 0].set_ylabel("interaction contrast / P($F_c$, 0) (%)")
@@ -180,7 +180,7 @@ def linearisation_error_bands(table: pd.DataFrame, path: Path, labels: dict | No
                         yerr=100 * sub.linearisation_rel_error_ci95, fmt="os^Dv"[j % 5] + "-",
                         ms=3.5, color=colours[k3], mfc="none" if j % 2 else colours[k3],
                         label=_k3_label(k3, labels))  # fmt: skip
-        ax.axhline(0.0, color="k", lw=0.6)
+        ax.axhline(0.0, color="k", lw=0.6, zorder=1)
         ax.set_title(f"S = {psd:g} (m/s$^2$)$^2$/Hz")
         ax.set_xlabel("Coulomb friction $F_c$ (mN)")
     axes[0, 0].set_ylabel("Eq. 32 error (P$_{lin}$ − P$_{MC}$) / P$_{MC}$ (%)")
@@ -289,7 +289,7 @@ def method_errors_against_kappa(df: pd.DataFrame, labels: dict, path: Path) -> P
                         lw=1.4 - 0.2 * z, mfc="none" if z % 2 else c, zorder=2 + z)  # fmt: skip
         band = sub.groupby("kappa")["mc_rel_ci95"].max()
         ax.fill_between(band.index, -100 * band, 100 * band, color="0.8", zorder=0)
-        ax.axhline(0, color="k", lw=0.6)
+        ax.axhline(0, color="k", lw=0.6, zorder=1)
         ax.axhspan(-3, 3, color="0.94", zorder=-1)
         ax.set_title(f"S = {psd:g} (m/s$^2$)$^2$/Hz")
         ax.set_xlabel(r"friction level $\kappa = 4F_c^2/(\pi S m c)$")
@@ -324,7 +324,7 @@ def k3_change_against_kappa(df: pd.DataFrame, labels: dict, path: Path) -> Path:
                     label=labels[name], zorder=2 + z)  # fmt: skip
         ax.errorbar(s["kappa"], 100 * s["dk3_mc"], 100 * s["dk3_mc_ci95"], fmt="ko", ms=3.5,
                     label="Monte Carlo (paired), 95 % CI", zorder=10)  # fmt: skip
-        ax.axhline(0, color="k", lw=0.6)
+        ax.axhline(0, color="k", lw=0.6, zorder=1)
         ax.set_title(f"S = {psd:g} (m/s$^2$)$^2$/Hz")
         ax.set_xlabel(r"friction level $\kappa = 4F_c^2/(\pi S m c)$")
     axes[0, 0].set_ylabel(

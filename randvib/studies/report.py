@@ -62,8 +62,9 @@ def markdown_table(df: pd.DataFrame, floatfmt: str = ".4g", numparse: bool = Tru
     for column in df.columns:
         if pd.api.types.is_float_dtype(df[column]):
             df[column] = [_float_cell(v, floatfmt) for v in df[column]]
-        elif df[column].dtype == object:
-            df[column] = [_float_cell(v, floatfmt) if isinstance(v, float) else v
+        elif pd.api.types.is_object_dtype(df[column]) or pd.api.types.is_string_dtype(df[column]):
+            df[column] = [_float_cell(v, floatfmt) if isinstance(v, float)
+                          else _unsigned_zeros(v) if isinstance(v, str) else v
                           for v in df[column]]  # fmt: skip
     return tabulate(
         df,
@@ -73,6 +74,13 @@ def markdown_table(df: pd.DataFrame, floatfmt: str = ".4g", numparse: bool = Tru
         floatfmt=floatfmt,
         disable_numparse=not numparse,
     )
+
+
+def _unsigned_zeros(text: str) -> str:
+    """``text`` with every signed zero ('-0', '+0.000') written unsigned ('0', '0.000')."""
+    import re
+
+    return re.sub(r"(?<![\w.])[-+](0(?:\.0+)?)(?![\d.])", r"\1", text)
 
 
 def _float_cell(value: float, floatfmt: str) -> str:
@@ -150,9 +158,10 @@ def write_verdicts(out_dir: Path, verdicts: dict, sentences=()) -> Path:
 def verdict_lines(out_dir: Path, max_items: int = 40) -> list[str]:
     """The verdicts of the study in ``out_dir`` as lines for the terminal.
 
-    The sentences of ``verdicts.json``'s ``"verdicts"`` first, then every
-    number and word of the file as ``key.sub: value`` (lists of records
-    counted, not listed), at most ``max_items`` of them.
+    The sentences of ``verdicts.json`` first (its ``"verdicts"`` list and any
+    text longer than a line's worth), then every other number and word of the
+    file as ``key.sub: value`` (lists of records counted, not listed), at most
+    ``max_items`` of them.
     """
     import json
 
@@ -169,6 +178,9 @@ def verdict_lines(out_dir: Path, max_items: int = 40) -> list[str]:
                 walk(f"{prefix}.{key}" if prefix else str(key), sub)
         elif isinstance(value, list) and any(isinstance(v, dict | list) for v in value):
             flat.append(f"{prefix}: {len(value)} entries")
+        elif isinstance(value, str) and len(value) > 60:
+            # a verdict sentence stored beside its numbers: shown with the sentences
+            lines.append(f"- {value.strip()}")
         elif isinstance(value, float):
             flat.append(f"{prefix}: {format_number(value)}")
         else:
