@@ -169,7 +169,9 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
     inter_data, inter_sentence = interaction_verdict(inter, K3S[1])
     check_data = step_check_verdict(check)
     write_verdicts(
-        out, {"linearisation": lin_data, "interaction": inter_data, "step_check": check_data}
+        out,
+        {"linearisation": lin_data, "interaction": inter_data, "step_check": check_data},
+        [lin_sentence, "Interaction at the paper's k3: " + inter_sentence],
     )
     return write_report(
         out,

@@ -318,6 +318,7 @@ def run_study(
             "linearisation": lin_data,
             "step_check": check_data,
         },
+        [interaction_summary(inter, k3s, K3_LABELS)[0]],
     )
     return write_report(
         out,

@@ -99,7 +99,9 @@ def contrast_against_friction(inter: pd.DataFrame, title: str, path: Path) -> Pa
     ax.set_xlabel("Coulomb friction $F_c$ (mN)")
     ax.set_ylabel("interaction contrast / P($F_c$, 0) (%)")
     ax.set_title(title)
-    ax.legend(title="Monte Carlo, paired paths, 95 % CI")
+    # below the axes: inside, it would hide error bars
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center", ncol=3,
+               title="Monte Carlo, paired paths, 95 % CI")  # fmt: skip
     return save_figure(fig, path)
 
 
