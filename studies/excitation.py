@@ -341,9 +341,9 @@ def spectra_figure(base, axes, seed, threads, path: Path) -> Path:
                         seed=seed, threads=threads, record_paths=32, record_every=10,
                         progress=False)  # fmt: skip
         mc = r.response_spectra(segment_duration=min(4.0, (t_end - burn) / 2))
-        series[f"k3 = {k3:g}, Monte Carlo"] = mc
+        series[f"k$_3$ = {num_tex(k3)} N/m$^3$, Monte Carlo"] = mc
         lin = rv.statistical_linearisation(device, excitation).response_spectra(mc.frequency)
-        series[f"k3 = {k3:g}, linearisation"] = lin
+        series[f"k$_3$ = {num_tex(k3)} N/m$^3$, linearisation"] = lin
     return rv.plot_response_spectra(series, excitation=excitation, path=path)
 
 

@@ -138,11 +138,16 @@ def _texts(fig):
 
 def _drawn_ticklabels(ax, axis):
     """The tick labels of ``axis`` that are drawn: visible, with text, inside the view limits."""
-    lo, hi = sorted(axis.get_view_interval())
-    slack = 1e-9 * max(abs(lo), abs(hi), 1.0)
+    import numpy as np
+
+    # compare in the axis' scale (log10 on a log axis), where a relative slack is meaningful
+    scale = axis.get_transform()
+    lo, hi = sorted(np.ravel(scale.transform(np.reshape(axis.get_view_interval(), (-1, 1)))))
+    slack = 1e-9 * (hi - lo)
     out = []
     for tick in axis.get_major_ticks() + axis.get_minor_ticks():
-        if not lo - slack <= tick.get_loc() <= hi + slack:
+        loc = float(np.ravel(scale.transform([[tick.get_loc()]]))[0])
+        if not lo - slack <= loc <= hi + slack:
             continue
         for t in (tick.label1, tick.label2):
             if t.get_visible() and t.get_text():
