@@ -368,6 +368,8 @@ def setup_section(axes, results, seed, quick, wall) -> str:
 def linearisation_section(results, v, figure) -> str:
     lin = v["linearisation"]
     shown = results[["centre", "zeta", "fc", "k3"]].copy()
+    shown["fc"] = 1e3 * shown.fc
+    shown = shown.rename(columns={"fc": "Fc (mN)"})
     shown["P_MC (mW)"] = plus_minus(results.power_mc, results.power_mc_ci95, 1e3, ".4f")
     shown["P_lin (mW)"] = [f"{1e3 * p:.4f}" for p in results.power_linearisation]
     shown["lin. error (%)"] = plus_minus(

@@ -158,7 +158,7 @@ def setup_section(settings, axes, table, seed, quick) -> str:
 def contrasts_shown(inter: pd.DataFrame, has_avg: bool) -> pd.DataFrame:
     shown = inter[["psd", "k3", "fc", "phi"]].copy()
     shown["fc"] = 1e3 * shown.fc
-    shown = shown.rename(columns={"fc": "fc (mN)"})
+    shown = shown.rename(columns={"fc": "Fc (mN)"})
     shown["contrast / P(Fc,0) (%)"] = plus_minus(inter.relative_contrast, inter.relative_ci95)
     if has_avg:
         shown["averaging (%)"] = [f"{100 * x:+.2f}" for x in inter.averaging_relative_contrast]
@@ -210,7 +210,7 @@ def linearisation_section(lin, lin_data, has_avg, figure) -> str:
     by_k3 = lin.groupby("k3").linearisation_rel_error.agg(lambda e: e.abs().max())
     shown = lin[["psd", "k3", "fc", "phi"]].copy()
     shown["fc"] = 1e3 * shown.fc
-    shown = shown.rename(columns={"fc": "fc (mN)"})
+    shown = shown.rename(columns={"fc": "Fc (mN)"})
     shown["P_MC (mW)"] = plus_minus(lin.power_electrical, lin.power_electrical_ci95, 1e3, ".4f")
     shown["Eq. 32 error (%)"] = plus_minus(
         lin.linearisation_rel_error, lin.linearisation_rel_error_ci95

@@ -51,15 +51,18 @@ def plus_minus(value, ci, scale: float = 100.0, fmt: str = "+.2f") -> list[str]:
 def markdown_table(df: pd.DataFrame, floatfmt: str = ".4g", numparse: bool = True) -> str:
     """``df`` as a GitHub-flavoured Markdown table, without the index.
 
-    Numbers are written with ``floatfmt``; a NaN cell reads 'n/a' and a
+    Numbers are written with ``floatfmt``; a NaN cell reads 'n/a', a
     negative number that rounds to zero reads 0 (no 'nan' or '-0' in a
-    report). ``numparse=False`` keeps text columns that look like numbers
+    report), booleans read yes/no, and bare column names of stored
+    quantities (``psd``, ``k3``, ``phi``...) get their units. ``numparse=False`` keeps text columns that look like numbers
     (e.g. "1e+05") as written.
     """
     from tabulate import tabulate
 
-    df = df.copy()
+    df = df.rename(columns=_BARE_HEADERS)
     for column in df.columns:
+        if pd.api.types.is_bool_dtype(df[column]):
+            df[column] = df[column].map(lambda v: "yes" if v else "no")
         if pd.api.types.is_float_dtype(df[column]):
             df[column] = [_float_cell(v, floatfmt) for v in df[column]]
         elif pd.api.types.is_object_dtype(df[column]) or pd.api.types.is_string_dtype(df[column]):
@@ -74,6 +77,20 @@ def markdown_table(df: pd.DataFrame, floatfmt: str = ".4g", numparse: bool = Tru
         floatfmt=floatfmt,
         disable_numparse=not numparse,
     )
+
+
+#: Bare column names a report table may still carry, and their headers with units (the
+#: quantities are stored in these units; Fc is not here: stored in N, shown in mN).
+_BARE_HEADERS = {
+    "psd": "S ((m/s²)²/Hz)",
+    "k3": "k3 (N/m³)",
+    "phi": "φ",
+    "kappa": "κ",
+    "zeta": "ζ",
+    "f0": "f0 (Hz)",
+    "n_paths": "paths",
+    "p": "p-value",
+}
 
 
 def _unsigned_zeros(text: str) -> str:
