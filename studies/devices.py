@@ -502,23 +502,41 @@ def tradeoff_figure(results: pd.DataFrame, path: Path) -> Path:
 
 @styled
 def methods_figure(methods: pd.DataFrame, path: Path) -> Path:
-    """Relative errors of the methods against level, power and exceedance, a marker per device."""
-    fig, axes = new_figure(1, 2, figsize=(9, 3.6))
+    """Relative errors of the methods against level, power and exceedance, a marker per device.
+
+    A colour per method, a marker per device, 95 % bars; the error axis is
+    linear while every error is within ±10 %, symmetric-log beyond.
+    """
+    from matplotlib.ticker import FuncFormatter, NullFormatter
+
+    fig, axes = new_figure(1, 2, figsize=(9, 3.8))
     markers = dict(zip(DEVICES, "osD", strict=True))
+    levels = sorted(methods.g.unique())
     for ax, q in zip(axes[0], ("power", "exceedance"), strict=True):
         for i, (method, rows) in enumerate(methods.groupby("method", sort=False)):
             for dev, sub in rows.dropna(subset=[f"{q}_rel_error"]).groupby("device"):
                 ax.errorbar(sub.g * (1.04**i), 100 * sub[f"{q}_rel_error"],
                             yerr=100 * sub[f"{q}_rel_error_ci95"], ls="none", marker=markers[dev],
-                            ms=3, capsize=1.5, color=style_colour(i),
+                            ms=3.5, capsize=1.5, color=style_colour(i),
                             label=f"{method}, {dev}")  # fmt: skip
-        ax.axhline(0.0, color="0.5", lw=0.5)
+        ax.axhline(0.0, color="0.5", lw=0.5, zorder=1)
         ax.set_xscale("log")
-        ax.set_yscale("symlog", linthresh=10)
+        ax.set_xticks(levels, [f"{g:g}" for g in levels])
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        reach = (methods[f"{q}_rel_error"].abs() + methods[f"{q}_rel_error_ci95"]).max()
+        if 100 * reach > 10:
+            ax.set_yscale("symlog", linthresh=10)
+            ax.yaxis.set_major_formatter(FuncFormatter(lambda y, _: f"{y:g}"))
         ax.set_xlabel("level factor g (all inputs)")
-        ax.set_ylabel(f"error in {q} vs Monte Carlo (%)")
-        ax.grid(alpha=0.3, lw=0.5)
-    axes[0, 1].legend(fontsize=6, ncol=2)
+        ax.set_ylabel(f"error in {q} against Monte Carlo (%)")
+    handles, labels = {}, []
+    for ax in axes[0]:
+        for h, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            if label not in handles:
+                handles[label] = h
+                labels.append(label)
+    fig.legend([handles[k] for k in labels], labels, loc="outside lower center", ncol=4,
+               title="colour: method; marker: device; bars: 95 % CI")  # fmt: skip
     panel_letters(axes)
     return save_figure(fig, path)
 

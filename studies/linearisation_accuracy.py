@@ -215,7 +215,7 @@ def accuracy_section(table, methods, limits, spreads, figure, ref_zeta, phis) ->
 
 def points_shown(table, methods) -> pd.DataFrame:
     pts = table[["psd", "k3", "zeta", "phi"]].copy()
-    pts["fc (mN)"] = 1e3 * table.fc
+    pts["Fc (mN)"] = 1e3 * table.fc
     pts["P_MC (mW)"] = plus_minus(table.power_electrical, table.power_electrical_ci95, 1e3, ".4g")
     pts["Eq. 32 error (%)"] = plus_minus(
         table.linearisation_rel_error, table.linearisation_rel_error_ci95

@@ -159,9 +159,10 @@ def text_overlaps(fig) -> list[str]:
     """The pairs of texts of ``fig`` that overlap once drawn, as 'A' / 'B' descriptions.
 
     Checked: titles, axis labels, tick labels (major and minor), the
-    suptitle and legends, across all axes. Not counted: two tick labels of
-    the same axis (log-axis minor labels may touch), and a legend against the
-    tick labels of its own axes (it sits inside them).
+    suptitle and legends, across all axes, tick labels of one axis against
+    each other too (crowded log-axis labels). Not counted: a legend against
+    the tick labels of its own axes (it sits inside them), and boxes that
+    only touch (a pixel of slack).
     """
     fig.canvas.draw()
     renderer = fig.canvas.get_renderer()
@@ -172,8 +173,6 @@ def text_overlaps(fig) -> list[str]:
             boxes.append((owner, kind, artist, box))
     found = []
     for (o1, k1, a1, b1), (o2, k2, a2, b2) in combinations(boxes, 2):
-        if k1 == k2 and k1.startswith("tick") and o1 == o2:
-            continue
         if o1 == o2 and "legend" in (k1, k2) and (k1 + k2).count("tick"):
             continue
         # a strictly positive overlap area, with a pixel of slack for touching boxes
