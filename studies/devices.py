@@ -479,6 +479,8 @@ def _bound(entry: dict) -> str:
 @styled
 def tradeoff_figure(results: pd.DataFrame, path: Path) -> Path:
     """Power against stroke exceedance over the levels, a panel per input, a line per device."""
+    from matplotlib.ticker import LogLocator
+
     inputs = list(dict.fromkeys(results.input))
     fig, axes = new_figure(1, len(inputs), figsize=(3.6 * len(inputs), 3.4), sharey=True)
     for ax, name in zip(axes[0], inputs, strict=True):
@@ -491,6 +493,9 @@ def tradeoff_figure(results: pd.DataFrame, path: Path) -> Path:
         ax.axvline(BUDGET, color="k", ls=":", lw=1)
         ax.set_xscale("log")
         ax.set_yscale("log")
+        for axis in (ax.xaxis, ax.yaxis):
+            # minor ticks at 2 and 5 only: on a narrow range all eight minor labels collide
+            axis.set_minor_locator(LogLocator(subs=(2.0, 5.0)))
         ax.set_xlabel(f"fraction of time with |z| > {1e3 * STROKE:g} mm")
         ax.set_title(name, fontsize=9)
         ax.grid(alpha=0.3, lw=0.5)
