@@ -490,7 +490,7 @@ def tradeoff_figure(results: pd.DataFrame, path: Path) -> Path:
             ax.errorbar(sub.exceedance_mc[shown], 1e3 * sub.power_mc[shown],
                         xerr=sub.exceedance_mc_ci95[shown], yerr=1e3 * sub.power_mc_ci95[shown],
                         marker="o", ms=3, capsize=2, label=dev)  # fmt: skip
-        ax.axvline(BUDGET, color="k", ls=":", lw=1)
+        ax.axvline(BUDGET, color="k", ls=":", lw=1, label=f"budget: {100 * BUDGET:g} % of the time")
         ax.set_xscale("log")
         ax.set_yscale("log")
         for axis in (ax.xaxis, ax.yaxis):
@@ -500,7 +500,7 @@ def tradeoff_figure(results: pd.DataFrame, path: Path) -> Path:
         ax.set_title(name, fontsize=9)
         ax.grid(alpha=0.3, lw=0.5)
     axes[0, 0].set_ylabel("E[P$_e$] (mW), Monte Carlo")
-    axes[0, 0].legend(fontsize=7, title="levels g: markers", title_fontsize=7)
+    axes[0, 0].legend(fontsize=7, title="markers: levels g; bars: 95 % CI", title_fontsize=7)
     panel_letters(axes)
     return save_figure(fig, path)
 
