@@ -197,7 +197,7 @@ def verdict_lines(out_dir: Path, max_items: int = 40) -> list[str]:
             flat.append(f"{prefix}: {len(value)} entries")
         elif isinstance(value, str) and len(value) > 60:
             # a verdict sentence stored beside its numbers: shown with the sentences
-            lines.append(f"- {value.strip()}")
+            lines.append(f"- {prefix}: {value.strip().lstrip(';').strip()}")
         elif isinstance(value, float):
             flat.append(f"{prefix}: {format_number(value)}")
         else:
