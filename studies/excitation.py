@@ -57,10 +57,13 @@ from randvib.studies.report import (
     markdown_table,
     plus_minus,
     prepare_output_dir,
+    save_figure,
     write_report,
     write_table,
     write_verdicts,
 )
+from randvib.studies.style import colour as style_colour
+from randvib.studies.style import new_figure, num_tex, panel_letters, styled
 
 NAME = "excitation"
 FC = 0.0058  #: N, the paper's Coulomb level (Table 2, training data 1)
@@ -279,14 +282,12 @@ def _zeta_axis(ax, zetas) -> None:
     ax.grid(alpha=0.3, which="major", lw=0.5)
 
 
+@styled
 def linearisation_figure(results: pd.DataFrame, path: Path) -> Path:
     """Linearisation's relative error against zeta, one panel per k3 (Fc = FC), a line per centre."""
-    import matplotlib.pyplot as plt
-
     lin = results[results.fc > 0]
     k3s = sorted(lin.k3.unique())
-    fig, axes = plt.subplots(1, len(k3s), figsize=(3.2 * len(k3s), 3.4), sharey=True,
-                             layout="constrained", squeeze=False)  # fmt: skip
+    fig, axes = new_figure(1, len(k3s), figsize=(3.2 * len(k3s) + 0.4, 3.4), sharey=True)
     for ax, k3 in zip(axes[0], k3s, strict=True):
         for centre in CENTRES:
             sub = lin[(lin.centre == centre) & (lin.k3 == k3)].sort_values("zeta")
@@ -299,25 +300,22 @@ def linearisation_figure(results: pd.DataFrame, path: Path) -> Path:
                        label="white noise")  # fmt: skip
         ax.axhline(0.0, color="0.5", lw=0.5)
         _zeta_axis(ax, lin.zeta)
-        ax.set_title(f"F$_c$ = {1e3 * FC:g} mN, k$_3$ = {k3:g} N/m$^3$", fontsize=9)
+        ax.set_title(f"F$_c$ = {1e3 * FC:g} mN, k$_3$ = {num_tex(k3)} N/m$^3$", fontsize=9)
     axes[0, 0].set_ylabel("linearisation error in E[P$_e$] (%)")
     axes[0, 0].legend(fontsize=7)
-    fig.savefig(path, dpi=150)
-    plt.close(fig)
-    return path
+    panel_letters(axes)
+    return save_figure(fig, path)
 
 
+@styled
 def interaction_figure(inter: pd.DataFrame, path: Path) -> Path:
     """Relative interaction contrast against zeta, one panel per centre, a line per k3."""
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(1, len(CENTRES), figsize=(10, 3.4), sharey=True,
-                             layout="constrained")  # fmt: skip
-    for ax, centre in zip(axes, CENTRES, strict=True):
+    fig, axes = new_figure(1, len(CENTRES), figsize=(10, 3.6), sharey=True)
+    for ax, centre in zip(axes[0], CENTRES, strict=True):
         for i, k3 in enumerate(sorted(inter.k3.unique())):
-            colour = f"C{i}"
+            colour = style_colour(i)
             sub = inter[(inter.centre == centre) & (inter.k3 == k3)].sort_values("zeta")
-            label = f"k$_3$ = {k3:g} N/m$^3$ ({K3_LABELS.get(k3, '')})"
+            label = f"k$_3$ = {num_tex(k3)} N/m$^3$ ({K3_LABELS.get(k3, '')})"
             ax.errorbar(sub.zeta, 100 * sub.relative_contrast, yerr=100 * sub.relative_ci95,
                         marker="o", ms=4, capsize=2, color=colour, label=label)  # fmt: skip
             ax.plot(sub.zeta, 100 * sub.linearisation_relative_contrast, "--", color=colour,
@@ -325,12 +323,11 @@ def interaction_figure(inter: pd.DataFrame, path: Path) -> Path:
         ax.axhline(0.0, color="0.5", lw=0.5)
         _zeta_axis(ax, inter.zeta)
         ax.set_title(f"band centred {centre} the linear resonance", fontsize=9)
-    axes[0].set_ylabel("interaction contrast / P(F$_c$, 0) (%)")
-    axes[0].legend(fontsize=7, title="markers: Monte Carlo (95 %); dashed: linearisation",
+    axes[0, 0].set_ylabel("interaction contrast / P(F$_c$, 0) (%)")
+    axes[0, 0].legend(fontsize=7, title="markers: Monte Carlo (95 %); dashed: linearisation",
                    title_fontsize=7)  # fmt: skip
-    fig.savefig(path, dpi=150)
-    plt.close(fig)
-    return path
+    panel_letters(axes)
+    return save_figure(fig, path)
 
 
 def spectra_figure(base, axes, seed, threads, path: Path) -> Path:
@@ -344,9 +341,9 @@ def spectra_figure(base, axes, seed, threads, path: Path) -> Path:
                         seed=seed, threads=threads, record_paths=32, record_every=10,
                         progress=False)  # fmt: skip
         mc = r.response_spectra(segment_duration=min(4.0, (t_end - burn) / 2))
-        series[f"k3 = {k3:g}, Monte Carlo"] = mc
+        series[f"k$_3$ = {num_tex(k3)} N/m$^3$, Monte Carlo"] = mc
         lin = rv.statistical_linearisation(device, excitation).response_spectra(mc.frequency)
-        series[f"k3 = {k3:g}, linearisation"] = lin
+        series[f"k$_3$ = {num_tex(k3)} N/m$^3$, linearisation"] = lin
     return rv.plot_response_spectra(series, excitation=excitation, path=path)
 
 
@@ -371,6 +368,8 @@ def setup_section(axes, results, seed, quick, wall) -> str:
 def linearisation_section(results, v, figure) -> str:
     lin = v["linearisation"]
     shown = results[["centre", "zeta", "fc", "k3"]].copy()
+    shown["fc"] = 1e3 * shown.fc
+    shown = shown.rename(columns={"fc": "Fc (mN)"})
     shown["P_MC (mW)"] = plus_minus(results.power_mc, results.power_mc_ci95, 1e3, ".4f")
     shown["P_lin (mW)"] = [f"{1e3 * p:.4f}" for p in results.power_linearisation]
     shown["lin. error (%)"] = plus_minus(

@@ -28,6 +28,7 @@ from randvib.studies.grids import coulomb_grid, highest_friction_points
 from randvib.studies.report import (
     markdown_table,
     prepare_output_dir,
+    readable_table,
     write_report,
     write_table,
     write_verdicts,
@@ -87,7 +88,8 @@ def linearisation_section(table, settings, lin_data, lin_sentence) -> str:
         f"(S = {worst.psd:g}, k3 = {worst.k3:g}, Fc = {worst.fc:.4g} N). "
         f"Errors beyond 1 %: {int((err.abs() > 0.01).sum())} points; beyond 5 %: "
         f"{int((err.abs() > 0.05).sum())}.\n\n"
-        f"Verdict on the paper's first claim: {lin_sentence}\n\n" + markdown_table(table[columns])
+        f"Verdict on the paper's first claim: {lin_sentence}\n\n"
+        + markdown_table(readable_table(table[columns]))
     )
 
 
@@ -104,7 +106,7 @@ def interaction_section(inter, inter_data, inter_sentence, figure) -> str:
         f"numbers), so their verdicts are correlated; with Holm's correction for "
         f"{inter_data['n_contrasts']} tests at family level 5 %, {inter_data['n_holm']} remain.\n\n"
         f"Verdict on the paper's second claim at its own k3: {inter_sentence}\n\n"
-        + markdown_table(inter)
+        + markdown_table(readable_table(inter))
     )
 
 
@@ -113,7 +115,7 @@ def step_section(check, settings, check_data) -> str:
         f"Re-run of {len(check)} highest-friction points at dt/2 = {settings.dt / 2:g} s (independent "
         f"noise). Time-step bias below statistical error at {check_data['n_below']} of "
         f"{check_data['n_points']} points"
-        f"{check_data['sentence']}.\n\n" + markdown_table(check)
+        f"{check_data['sentence']}.\n\n" + markdown_table(readable_table(check))
     )
 
 
@@ -158,7 +160,7 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
     fig_main = figures.power_against_friction(table, base, PSDS, K3S, out / "figure9.png")
     fig_inter = figures.contrast_against_friction(
         inter,
-        "Duffing-Coulomb interaction at k3 = 5e5 N/m$^3$ (95 % CI, paired paths)",
+        "Duffing-Coulomb interaction at k$_3$ = 5 × 10$^5$ N/m$^3$",
         out / "interaction.png",
     )
 
@@ -167,7 +169,9 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
     inter_data, inter_sentence = interaction_verdict(inter, K3S[1])
     check_data = step_check_verdict(check)
     write_verdicts(
-        out, {"linearisation": lin_data, "interaction": inter_data, "step_check": check_data}
+        out,
+        {"linearisation": lin_data, "interaction": inter_data, "step_check": check_data},
+        [lin_sentence, "Interaction at the paper's k3: " + inter_sentence],
     )
     return write_report(
         out,

@@ -51,6 +51,7 @@ from randvib.studies.report import (
     markdown_table,
     plus_minus,
     prepare_output_dir,
+    readable_table,
     write_report,
     write_table,
     write_verdicts,
@@ -157,7 +158,7 @@ def setup_section(settings, axes, table, seed, quick) -> str:
 def contrasts_shown(inter: pd.DataFrame, has_avg: bool) -> pd.DataFrame:
     shown = inter[["psd", "k3", "fc", "phi"]].copy()
     shown["fc"] = 1e3 * shown.fc
-    shown = shown.rename(columns={"fc": "fc (mN)"})
+    shown = shown.rename(columns={"fc": "Fc (mN)"})
     shown["contrast / P(Fc,0) (%)"] = plus_minus(inter.relative_contrast, inter.relative_ci95)
     if has_avg:
         shown["averaging (%)"] = [f"{100 * x:+.2f}" for x in inter.averaging_relative_contrast]
@@ -209,7 +210,7 @@ def linearisation_section(lin, lin_data, has_avg, figure) -> str:
     by_k3 = lin.groupby("k3").linearisation_rel_error.agg(lambda e: e.abs().max())
     shown = lin[["psd", "k3", "fc", "phi"]].copy()
     shown["fc"] = 1e3 * shown.fc
-    shown = shown.rename(columns={"fc": "fc (mN)"})
+    shown = shown.rename(columns={"fc": "Fc (mN)"})
     shown["P_MC (mW)"] = plus_minus(lin.power_electrical, lin.power_electrical_ci95, 1e3, ".4f")
     shown["Eq. 32 error (%)"] = plus_minus(
         lin.linearisation_rel_error, lin.linearisation_rel_error_ci95
@@ -246,7 +247,7 @@ def step_section(check, check_data, settings, worst_bias) -> str:
         f"statistical error at {check_data['n_below']} of {len(check)} points"
         f"{check_data['sentence']}. "
         f"Linearised step bias at dt (randvib.montecarlo.simulation.step_bias) at most {worst_bias:.1e}.\n\n"
-        + markdown_table(check)
+        + markdown_table(readable_table(check))
     )
 
 
@@ -317,6 +318,7 @@ def run_study(
             "linearisation": lin_data,
             "step_check": check_data,
         },
+        [interaction_summary(inter, k3s, K3_LABELS)[0]],
     )
     return write_report(
         out,

@@ -57,6 +57,7 @@ from randvib.studies.report import (
     markdown_table,
     plus_minus,
     prepare_output_dir,
+    readable_table,
     write_report,
     write_table,
     write_verdicts,
@@ -214,7 +215,7 @@ def accuracy_section(table, methods, limits, spreads, figure, ref_zeta, phis) ->
 
 def points_shown(table, methods) -> pd.DataFrame:
     pts = table[["psd", "k3", "zeta", "phi"]].copy()
-    pts["fc (mN)"] = 1e3 * table.fc
+    pts["Fc (mN)"] = 1e3 * table.fc
     pts["P_MC (mW)"] = plus_minus(table.power_electrical, table.power_electrical_ci95, 1e3, ".4g")
     pts["Eq. 32 error (%)"] = plus_minus(
         table.linearisation_rel_error, table.linearisation_rel_error_ci95
@@ -234,7 +235,8 @@ def step_section(check, settings, worst_bias) -> str:
         f"largest S) at dt/2 = {settings.dt / 2:g} s, independent noise. Time-step bias below "
         f"the statistical error at {int(check.bias_below_error.sum())} of {len(check)} points"
         f"{step_check_verdict(check)['sentence']}. "
-        f"Linearised step bias at dt at most {worst_bias:.1e}.\n\n" + markdown_table(check)
+        f"Linearised step bias at dt at most {worst_bias:.1e}.\n\n"
+        + markdown_table(readable_table(check))
     )
 
 

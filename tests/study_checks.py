@@ -96,3 +96,37 @@ def step_zscores(check: pd.DataFrame) -> np.ndarray:
     """Half-step minus step estimate in combined standard errors (zero without a step bias)."""
     t = stats.t.ppf(0.975, 127)
     return (check.difference / (check.combined_ci95 / t)).to_numpy()
+
+
+# ----------------------------------------------------------------- what a study leaves
+#: Tokens a report for an outside reader must not contain: NaN, a negative zero, and
+#: references to the project's issue tracker.
+_UNCLEAN = {
+    "nan": r"(?i)\bnan\b",
+    "-0": r"(?<![\w.])-0(\.0+)?(?![\d.])",
+    "issue ": r"(?i)\bissue\s",
+}
+
+
+def unclean_tokens(text: str) -> dict:
+    """The forbidden tokens found in a report's ``text``, with a little context each."""
+    import re
+
+    found = {}
+    for name, pattern in _UNCLEAN.items():
+        hits = [text[max(m.start() - 30, 0) : m.end() + 30] for m in re.finditer(pattern, text)]
+        if hits:
+            found[name] = hits[:3]
+    return found
+
+
+def check_study_run(stdout: str, out) -> str:
+    """A study run's terminal output and report: the report's path, then its verdicts
+    (``verdicts.json`` shown), and a report without 'nan', '-0' or 'issue '. Returns
+    the report's text."""
+    lines = stdout.strip().splitlines()
+    assert lines[0] == f"report: {out / 'report.md'}"
+    assert lines[1] == f"verdicts ({out / 'verdicts.json'}):" and len(lines) > 2
+    text = (out / "report.md").read_text()
+    assert unclean_tokens(text) == {}
+    return text

@@ -10,6 +10,7 @@ import matplotlib.image
 import numpy as np
 import pytest
 from _cli import one_line_error, run
+from study_checks import check_study_run
 
 import randvib as rv
 from randvib.identification.fitting import read_record
@@ -221,7 +222,7 @@ def _study(capsys, name, out):
         capsys, "study", name, "--quick", "--out", out, "--workers", "1", "--no-progress"
     )
     assert code == 0, err
-    assert stdout.strip() == f"report: {out / 'report.md'}"
+    check_study_run(stdout, out)
     return (out / "report.md").read_text()
 
 

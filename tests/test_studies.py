@@ -14,7 +14,7 @@ import json
 import numpy as np
 import pandas as pd
 import pytest
-from study_checks import contrast_zscores
+from study_checks import check_study_run, contrast_zscores
 
 import randvib as rv
 from randvib.analytic.prediction import expected_power
@@ -133,7 +133,7 @@ def _cli_study(name, out, capsys):
     """``randvib study NAME --quick`` in-process; the quick grid is monkeypatched small."""
     argv = ["study", name, "--quick", "--out", str(out), "--workers", "1", "--no-progress"]
     assert main(argv) == 0
-    assert capsys.readouterr().out.strip() == f"report: {out / 'report.md'}"
+    check_study_run(capsys.readouterr().out, out)
     return out / "report.md"
 
 

@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 import pytest
 from _stats import assert_matches
-from study_checks import statistic
+from study_checks import check_study_run, statistic
 
 import randvib as rv
 from randvib.cli import main
@@ -31,7 +31,7 @@ TINY = {"inputs": ("white", "band at f_n"), "levels": (0.25, 1.0),
 def _run(out, capsys):
     argv = ["study", "devices", "--quick", "--out", str(out), "--no-progress", "--threads", "1"]
     assert main(argv) == 0
-    assert capsys.readouterr().out.strip() == f"report: {out / 'report.md'}"
+    check_study_run(capsys.readouterr().out, out)
 
 
 def test_equal_input_power_and_the_bistable_choice():

@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 import pytest
 from _stats import assert_matches
-from study_checks import statistic
+from study_checks import check_study_run, statistic
 
 import randvib as rv
 from randvib.cli import main
@@ -28,7 +28,7 @@ TINY = {"centres": ("at", "above"), "zetas": (0.5, 0.05), "k3s": (0.0, 5e7),
 def _run(out, capsys):
     argv = ["study", "excitation", "--quick", "--out", str(out), "--no-progress", "--threads", "1"]
     assert main(argv) == 0
-    assert capsys.readouterr().out.strip() == f"report: {out / 'report.md'}"
+    check_study_run(capsys.readouterr().out, out)
 
 
 def test_excitation_study_end_to_end(tmp_path, monkeypatch, capsys):

@@ -13,7 +13,7 @@ import numpy as np
 import pandas as pd
 import pytest
 from _stats import assert_matches
-from study_checks import contrast_zscores, power_zscores, step_zscores
+from study_checks import contrast_zscores, power_zscores, step_zscores, unclean_tokens
 
 from randvib.cli import main
 from randvib.studies.verdicts import interaction_verdict, linearisation_verdict
@@ -144,6 +144,28 @@ def _table(errors, consistent, fcs=(0.01, 0.02, 0.03, 0.04)):
             "linearisation_consistent": consistent,
         }
     )
+
+
+def test_figure9_report_is_clean_and_counts_rescaled_rows_once(figure9_quick):
+    out, _ = figure9_quick
+    report = (out / "report.md").read_text()
+    assert unclean_tokens(report) == {}
+    assert "Fc (mN)" in report and "P Monte Carlo (mW)" in report
+    # the k3 = 0 rows at the three S repeat the same paths rescaled: one piece of evidence
+    # per Fc level, which the verdict counts
+    table = pd.read_csv(out / "results.csv")
+    lin = json.loads((out / "verdicts.json").read_text())["linearisation"]
+    k3_free = table[(table.k3 == 0) & (table.fc > 0)]
+    n_other = int(((table.k3 != 0) & (table.fc > 0)).sum())
+    n_psd = table.psd.nunique()
+    assert lin["n_independent_friction_points"] == len(k3_free) // n_psd + n_other
+    # the rescaling itself: the same relative error at every S (to rounding)
+    spread = k3_free.groupby(
+        (k3_free.fc / np.sqrt(k3_free.psd)).round(12)
+    ).linearisation_rel_error.agg(np.ptp)
+    assert len(spread) == len(k3_free) // n_psd and (spread < 1e-9).all()
+    check = json.loads((out / "verdicts.json").read_text())["step_check"]
+    assert check["n_independent_points"] < check["n_points"]
 
 
 def test_linearisation_verdict_follows_the_data():

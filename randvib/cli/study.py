@@ -37,6 +37,7 @@ def register(sub) -> None:
 
 
 def run(args) -> int:
-    report = run_with_options(load_study(args.name), args.name, args.out, args)
-    print(f"report: {report}")
+    from randvib.studies.report import print_verdicts
+
+    print_verdicts(run_with_options(load_study(args.name), args.name, args.out, args))
     return 0

@@ -16,7 +16,9 @@ such scripts share lives here:
   runs, and the accuracy criteria for a fast method;
 - :mod:`~randvib.studies.stepcheck`: the sweep with its half-step re-run, and its verdict;
 - :mod:`~randvib.studies.verdicts`: the verdict sentences, built from the numbers;
+- :mod:`~randvib.studies.evidence`: rows that repeat one experiment (exact rescalings);
 - :mod:`~randvib.studies.figures`: figures of power and contrasts against Fc;
+- :mod:`~randvib.studies.style`: one figure style, panel letters, the layout check;
 - :mod:`~randvib.studies.report`: CSV, ``verdicts.json``, Markdown tables, ``report.md``.
 
 Every script defines ``run_study(out_dir, *, quick=False, seed=0,
@@ -161,5 +163,7 @@ def script_main(run_study, argv=None) -> int:
     add_run_options(parser)
     args = parser.parse_args(argv)
     name = Path(sys.modules[run_study.__module__].__file__).stem.replace("_", "-")
-    print(f"report: {run_with_options(run_study, name, args.out, args)}")
+    from randvib.studies.report import print_verdicts
+
+    print_verdicts(run_with_options(run_study, name, args.out, args))
     return 0

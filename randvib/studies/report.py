@@ -24,11 +24,16 @@ from randvib._io import dumps, prepare_output_dir, write_tracked
 
 __all__ = [
     "fc_levels",
+    "format_number",
+    "format_percent",
     "markdown_table",
     "plus_minus",
+    "print_verdicts",
+    "readable_table",
     "prepare_output_dir",
     "save_figure",
     "sign_word",
+    "verdict_lines",
     "write_report",
     "write_table",
     "write_verdicts",
@@ -46,11 +51,24 @@ def plus_minus(value, ci, scale: float = 100.0, fmt: str = "+.2f") -> list[str]:
 def markdown_table(df: pd.DataFrame, floatfmt: str = ".4g", numparse: bool = True) -> str:
     """``df`` as a GitHub-flavoured Markdown table, without the index.
 
-    ``numparse=False`` keeps text columns that look like numbers (e.g.
-    "1e+05") as written.
+    Numbers are written with ``floatfmt``; a NaN cell reads 'n/a', a
+    negative number that rounds to zero reads 0 (no 'nan' or '-0' in a
+    report), booleans read yes/no, and bare column names of stored
+    quantities (``psd``, ``k3``, ``phi``...) get their units. ``numparse=False`` keeps text columns that look like numbers
+    (e.g. "1e+05") as written.
     """
     from tabulate import tabulate
 
+    df = df.rename(columns=_BARE_HEADERS)
+    for column in df.columns:
+        if pd.api.types.is_bool_dtype(df[column]):
+            df[column] = df[column].map(lambda v: "yes" if v else "no")
+        if pd.api.types.is_float_dtype(df[column]):
+            df[column] = [_float_cell(v, floatfmt) for v in df[column]]
+        elif pd.api.types.is_object_dtype(df[column]) or pd.api.types.is_string_dtype(df[column]):
+            df[column] = [_float_cell(v, floatfmt) if isinstance(v, float)
+                          else _unsigned_zeros(v) if isinstance(v, str) else v
+                          for v in df[column]]  # fmt: skip
     return tabulate(
         df,
         headers="keys",
@@ -61,14 +79,170 @@ def markdown_table(df: pd.DataFrame, floatfmt: str = ".4g", numparse: bool = Tru
     )
 
 
+#: Bare column names a report table may still carry, and their headers with units (the
+#: quantities are stored in these units; Fc is not here: stored in N, shown in mN).
+_BARE_HEADERS = {
+    "psd": "S ((m/s²)²/Hz)",
+    "k3": "k3 (N/m³)",
+    "phi": "φ",
+    "kappa": "κ",
+    "zeta": "ζ",
+    "f0": "f0 (Hz)",
+    "n_paths": "paths",
+    "p": "p-value",
+}
+
+
+def _unsigned_zeros(text: str) -> str:
+    """``text`` with every signed zero ('-0', '+0.000') written unsigned ('0', '0.000')."""
+    import re
+
+    return re.sub(r"(?<![\w.])[-+](0(?:\.0+)?)(?![\d.])", r"\1", text)
+
+
+def _float_cell(value: float, floatfmt: str) -> str:
+    """One number of a report table: 'n/a' for NaN, no '-0'."""
+    if value != value:
+        return "n/a"
+    text = format(value, floatfmt)
+    try:
+        zero = float(text) == 0
+    except ValueError:
+        return text
+    return text.lstrip("-") if zero else text
+
+
+#: Raw result columns and how a report shows them: (header with its unit, scale factor).
+READABLE_COLUMNS = {
+    "psd": ("S ((m/s²)²/Hz)", 1.0),
+    "k3": ("k3 (N/m³)", 1.0),
+    "fc": ("Fc (mN)", 1e3),
+    "phi": ("φ", 1.0),
+    "zeta": ("ζ", 1.0),
+    "linearisation_power": ("P Eq. 32 (mW)", 1e3),
+    "power_electrical": ("P Monte Carlo (mW)", 1e3),
+    "power_electrical_ci95": ("95 % half-width (mW)", 1e3),
+    "power_electrical_half": ("P at dt/2 (mW)", 1e3),
+    "power_electrical_ci95_half": ("95 % half-width at dt/2 (mW)", 1e3),
+    "difference": ("difference (mW)", 1e3),
+    "combined_ci95": ("combined 95 % half-width (mW)", 1e3),
+    "bias_below_error": ("bias below error", None),
+    "linearisation_rel_error": ("Eq. 32 error (%)", 100.0),
+    "linearisation_rel_error_ci95": ("Eq. 32 error 95 % half-width (%)", 100.0),
+    "linearisation_consistent": ("Eq. 32 inside the 95 % CI", None),
+    "contrast": ("contrast (µW)", 1e6),
+    "contrast_ci95": ("contrast 95 % half-width (µW)", 1e6),
+    "reference": ("P(Fc, 0) (mW)", 1e3),
+    "relative_contrast": ("contrast / P(Fc, 0) (%)", 100.0),
+    "relative_ci95": ("95 % half-width (%)", 100.0),
+    "p_value": ("p-value", 1.0),
+    "detectable": ("detectable (95 %)", None),
+    "detectable_holm": ("detectable (Holm)", None),
+    "n_paths": ("paths", 1.0),
+}
+
+
+def readable_table(df: pd.DataFrame) -> pd.DataFrame:
+    """``df`` for a report: known raw columns (:data:`READABLE_COLUMNS`) renamed with their
+    units and scaled (W to mW, fractions to %, N to mN), yes/no for booleans; others kept."""
+    out = {}
+    for column in df.columns:
+        header, scale = READABLE_COLUMNS.get(column, (column, 1.0))
+        values = df[column]
+        if scale is None or pd.api.types.is_bool_dtype(values):
+            values = values.map(lambda v: "yes" if bool(v) else "no")
+        elif scale != 1.0:
+            values = values * scale
+        out[header] = values.to_numpy()
+    return pd.DataFrame(out)
+
+
 def write_table(out_dir: Path, name: str, df: pd.DataFrame) -> Path:
     """Write ``df`` as ``out_dir/name`` (CSV, no index)."""
     return write_tracked(Path(out_dir) / name, df.to_csv(index=False))
 
 
-def write_verdicts(out_dir: Path, verdicts: dict) -> Path:
-    """Write the numbers behind the report's verdicts as ``out_dir/verdicts.json``."""
-    return write_tracked(Path(out_dir) / "verdicts.json", dumps(verdicts, indent=2))
+def write_verdicts(out_dir: Path, verdicts: dict, sentences=()) -> Path:
+    """Write the numbers behind the report's verdicts as ``out_dir/verdicts.json``.
+
+    ``sentences`` (the report's verdicts in words) are kept under the key
+    ``"verdicts"``; :func:`print_verdicts` shows them at the end of a run.
+    """
+    data = {**verdicts, "verdicts": [s for s in sentences if s]} if sentences else verdicts
+    return write_tracked(Path(out_dir) / "verdicts.json", dumps(data, indent=2))
+
+
+def verdict_lines(out_dir: Path, max_items: int = 40) -> list[str]:
+    """The verdicts of the study in ``out_dir`` as lines for the terminal.
+
+    The sentences of ``verdicts.json`` first (its ``"verdicts"`` list and any
+    text longer than a line's worth), then every other number and word of the
+    file as ``key.sub: value`` (lists of records counted, not listed), at most
+    ``max_items`` of them.
+    """
+    import json
+
+    path = Path(out_dir) / "verdicts.json"
+    if not path.is_file():
+        return []
+    data = json.loads(path.read_text())
+    lines = [f"- {s}" for s in data.pop("verdicts", [])]
+    flat = []
+
+    def walk(prefix, value):
+        if isinstance(value, dict):
+            for key, sub in value.items():
+                walk(f"{prefix}.{key}" if prefix else str(key), sub)
+        elif isinstance(value, list) and any(isinstance(v, dict | list) for v in value):
+            flat.append(f"{prefix}: {len(value)} entries")
+        elif isinstance(value, str) and len(value) > 60:
+            # a verdict sentence stored beside its numbers: shown with the sentences
+            lines.append(f"- {prefix}: {value.strip().lstrip(';').strip()}")
+        elif isinstance(value, float):
+            flat.append(f"{prefix}: {format_number(value)}")
+        else:
+            flat.append(f"{prefix}: {value}")
+
+    walk("", data)
+    if len(flat) > max_items:
+        flat = flat[:max_items] + [f"... ({len(flat) - max_items} more in {path})"]
+    return lines + [f"  {line}" for line in flat]
+
+
+def print_verdicts(report: Path) -> None:
+    """Print the report's path and the verdicts of its folder (the end of a study run)."""
+    report = Path(report)
+    print(f"report: {report}")
+    lines = verdict_lines(report.parent)
+    if lines:
+        print(f"verdicts ({report.parent / 'verdicts.json'}):")
+        print("\n".join(lines))
+
+
+def format_number(value, digits: int = 4) -> str:
+    """``value`` for a report: ``digits`` significant figures, 'n/a' for NaN or None, no '-0'."""
+    if value is None:
+        return "n/a"
+    value = float(value)
+    if value != value:
+        return "n/a"
+    if value == float("inf"):
+        return "∞"
+    if value == float("-inf"):
+        return "-∞"
+    text = f"{value:.{digits}g}"
+    # a negative value that rounds to zero is written as 0
+    return text[1:] if text.startswith("-") and float(text) == 0 else text
+
+
+def format_percent(fraction, digits: int = 2, sign: bool = False) -> str:
+    """A fraction written as a percentage ('1.23 %'), 'n/a' for NaN, no '-0.00 %'."""
+    if fraction is None or float(fraction) != float(fraction):
+        return "n/a"
+    text = f"{100 * float(fraction):{'+' if sign else ''}.{digits}f}"
+    if float(text) == 0:
+        text = f"{0:.{digits}f}"
+    return f"{text} %"
 
 
 def write_report(
@@ -85,13 +259,22 @@ def write_report(
 
 
 def save_figure(fig, path: Path) -> Path:
-    """Save ``fig`` as a PNG (120 dpi) and close it (refusing to replace an edited one)."""
+    """Save ``fig`` as a PNG (:data:`randvib.studies.style.DPI`) and close it.
+
+    Before saving, :func:`randvib.studies.style.check_layout` warns if the
+    figure lacks constrained layout or two of its texts overlap. An edited
+    PNG is not replaced (:func:`randvib._io.write_tracked`).
+    """
     import io
 
     import matplotlib.pyplot as plt
 
+    from randvib.studies.style import DPI, check_layout
+
+    path = Path(path)
+    check_layout(fig, path.name)
     buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=120, bbox_inches="tight")
+    fig.savefig(buffer, format="png", dpi=DPI)
     plt.close(fig)
     return write_tracked(path, buffer.getvalue())
 

@@ -16,6 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
+from randvib.studies.style import DPI, PALETTE, check_layout, new_figure, panel_letters, styled
+
 _PANELS = (
     ("displacement", "$S_z$ (m$^2$/Hz)"),
     ("velocity", "$S_v$ ((m/s)$^2$/Hz)"),
@@ -23,6 +25,7 @@ _PANELS = (
 )
 
 
+@styled
 def plot_response_spectra(
     series: dict, *, excitation=None, f_max: float | None = None, path: str | Path | None = None
 ):
@@ -41,7 +44,8 @@ def plot_response_spectra(
         the first series' power peak (room for a third harmonic), at most the
         highest frequency given.
     path : str or Path, optional
-        Save the figure there (PNG, 150 dpi) and close it.
+        Save the figure there (PNG, :data:`randvib.studies.style.DPI` dpi) and close it;
+        a :class:`randvib.studies.style.FigureLayoutWarning` first if texts overlap.
 
     Returns
     -------
@@ -50,8 +54,9 @@ def plot_response_spectra(
     """
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(3, 1, figsize=(6.5, 8.0), sharex=True, layout="constrained")
-    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    fig, axes = new_figure(3, 1, figsize=(6.5, 8.0), sharex=True)
+    axes = axes[:, 0]
+    colours = PALETTE
     top, peak = 0.0, None
     for i, (label, spectra) in enumerate(series.items()):
         colour = colours[i % len(colours)]
@@ -84,9 +89,11 @@ def plot_response_spectra(
                    title_fontsize=7)  # fmt: skip
     axes[-1].set_xlabel("frequency (Hz)")
     axes[-1].set_xlim(0.0, f_max)
+    panel_letters(axes)
     if path is None:
         return fig
     path = Path(path)
-    fig.savefig(path, dpi=150)
+    check_layout(fig, path.name)
+    fig.savefig(path, dpi=DPI)
     plt.close(fig)
     return path

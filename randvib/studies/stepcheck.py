@@ -162,19 +162,26 @@ def sweep_with_step_check(
 
 def step_check_verdict(check: pd.DataFrame) -> dict:
     """Half-step re-run: how many points agree within the combined 95 % half-width."""
+    from randvib.studies.evidence import independence_note, independent_count
+
     n_below = int(check.bias_below_error.sum())
     worst = (check.difference.abs() / check.combined_ci95).max()
+    n_independent = independent_count(check)
     data = {
         "n_points": len(check),
+        "n_independent_points": n_independent,
         "n_below": n_below,
         "largest_difference_over_ci95": float(worst),
     }
+    note = independence_note(len(check), n_independent)
     if n_below == len(check):
-        data["sentence"] = f" (largest difference {worst:.2f} times the combined 95 % half-width)"
+        data["sentence"] = (
+            f" (largest difference {worst:.2f} times the combined 95 % half-width{note})"
+        )
     else:
         data["sentence"] = (
             f"; at {len(check) - n_below} the half-step estimate differs by more than the "
             f"combined 95 % half-width (largest {worst:.2f} times it; "
-            f"{0.05 * len(check):.1f} expected by chance)"
+            f"{0.05 * n_independent:.1f} expected by chance{note})"
         )
     return data

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from randvib.studies.evidence import rescaling_groups
 from randvib.studies.report import fc_levels, plus_minus, sign_word
 
 
@@ -29,6 +30,8 @@ def linearisation_verdict(table: pd.DataFrame) -> tuple[dict, str]:
     rel_level = table.fc / fc_max
     outside = table[~table.linearisation_consistent.astype(bool)]
     n_friction = int((table.fc > 0).sum())
+    groups = pd.Series(rescaling_groups(table), index=table.index)
+    n_independent_friction = groups[table.fc > 0].nunique()
     under = int((outside.linearisation_rel_error < 0).sum())
     over = int((outside.linearisation_rel_error > 0).sum())
     high = int((rel_level[outside.index] > 0.5).sum())
@@ -36,7 +39,10 @@ def linearisation_verdict(table: pd.DataFrame) -> tuple[dict, str]:
         "n_points": len(table),
         "n_friction_points": n_friction,
         "n_outside": len(outside),
-        "expected_by_chance": 0.05 * n_friction,
+        "n_independent_points": int(groups.nunique()),
+        "n_independent_friction_points": int(n_independent_friction),
+        "n_outside_independent": int(groups[outside.index].nunique()),
+        "expected_by_chance": 0.05 * n_independent_friction,
         "n_under": under,
         "n_over": over,
         "n_outside_high_friction": high,
@@ -66,10 +72,17 @@ def linearisation_verdict(table: pd.DataFrame) -> tuple[dict, str]:
             if len(outside) == n_friction and (outside.fc > 0).all()
             else fc_levels(outside)
         )
+        if n_independent_friction == n_friction:
+            among = f"{chance} among the {n_friction} with friction"
+        else:
+            among = (
+                f"{data['n_outside_independent']} of the {n_independent_friction} independent "
+                f"points with friction, {chance}: the k3 = 0 rows at different S are exact "
+                "rescalings of the same noise paths and count once"
+            )
         sentence = (
             f"Eq. 32 is outside the Monte Carlo 95 % interval at {len(outside)} of {len(table)} "
-            f"points ({chance} among the {n_friction} with friction), {where} "
-            f"({levels}); {sign}."
+            f"points ({among}), {where} ({levels}); {sign}."
         )
         if over == 0 and len(outside) > data["expected_by_chance"]:
             sentence += (
