@@ -189,8 +189,9 @@ MUTATIONS: tuple[Mutation, ...] = (
                 "return 101.0 * sse / (self.n_scored * self.variance)",
             ),
         ),
-        tests=("tests/test_identification.py::test_cli_identify_json_and_validate",),
-        why="The compiled-batch cost used by the search is 1 % off Eq. 11.",
+        tests=("tests/test_identification.py::test_search_cost_is_eq11_of_predict_record",),
+        why="The compiled-batch cost used by the search is 1 % off Eq. 11 (the reported J is "
+        "recomputed, so only the search's own cost and its history show it).",
     ),
     Mutation(
         name="fpk-richardson-weight",
