@@ -618,3 +618,111 @@ def test_ctrl_c_in_a_study_exits_130_and_releases_its_folder(capsys, tmp_path, m
     assert code == 130 and "Traceback" not in err
     assert (tmp_path / "s" / "first.csv").read_text() == "finished part\n"  # kept
     assert not (tmp_path / "s" / _io.LOCK_FILE).exists()
+
+
+# ------------------------------------------------------------------ SIGTERM, Ctrl-C on a pool
+def _subprocess_env():
+    return {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]),
+        "NUMBA_NUM_THREADS": "1",
+    }
+
+
+def test_sigterm_stops_simulate_and_exits_143():
+    simulate(BASE, 1.0, t_end=0.01, dt=1e-4, n_paths=2, progress=False)  # numba cache warm
+    # 4e10 path-steps: its LongRunWarning is printed once the run starts
+    child = subprocess.Popen(
+        [sys.executable, "-m", "randvib", "simulate", "--preset", "figure9", "--psd", "1",
+         "--paths", "200", "--t-end", "20000", "--dt", "1e-4"],  # fmt: skip
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=_subprocess_env(),
+    )
+    assert "will take about" in child.stderr.readline()
+    time.sleep(0.5)
+    child.send_signal(signal.SIGTERM)
+    out, err = child.communicate(timeout=60)
+    assert child.returncode == 143, err
+    assert "terminated" in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+SWEEP_STUDY = """
+import sys
+import randvib as rv
+import randvib.cli.study
+from randvib.cli import main
+from randvib.montecarlo.sweep import SweepSettings, cartesian, run_sweep
+
+
+def sweep_study(out_dir, *, quick, seed, workers, scheduler, progress):
+    # 2000 small points on 2 worker processes: minutes, far longer than the test waits
+    settings = SweepSettings(dt=2e-4, window=1.0, burn_in=0.05, target_rel_ci=0.5,
+                             min_paths=8, batch_paths=8, max_paths=8)
+    points = cartesian(psd=[1.0 + i / 1000 for i in range(2000)])
+    run_sweep(rv.preset("figure9"), points, settings, out_dir=out_dir, workers=workers,
+              progress=False)
+
+
+if __name__ == "__main__":
+    randvib.cli.study.load_study = lambda name: sweep_study
+    sys.exit(main(["study", "interaction", "--out", sys.argv[1], "--workers", "2"]))
+"""
+
+
+def _children(pid):
+    """Process ids whose parent is ``pid`` (Linux /proc)."""
+    found = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid:
+            found.append(int(stat.parent.name))
+    return found
+
+
+@pytest.mark.parametrize(
+    "how, code",
+    [("ctrl-c", 130), ("sigterm", 143)],
+)
+def test_interrupted_process_pool_sweep_keeps_points_and_ends_workers(tmp_path, how, code):
+    """Ctrl-C (SIGINT to the whole process group, as a terminal sends it) or
+    SIGTERM (to the parent only) on a sweep over 2 worker processes: exit
+    130 / 143, no worker left, the finished points kept and valid, the lock gone."""
+    simulate(BASE, 1.0, t_end=0.01, dt=2e-4, n_paths=2, progress=False)  # numba cache warm
+    script, out = tmp_path / "sweep_study.py", tmp_path / "out"
+    script.write_text(SWEEP_STUDY)
+    child = subprocess.Popen(
+        [sys.executable, str(script), str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=_subprocess_env(),
+        start_new_session=True,  # its own process group, as a shell job
+    )
+    deadline = time.monotonic() + 120
+    while not list(out.glob("points/*.json")) and time.monotonic() < deadline:
+        assert child.poll() is None, child.communicate()
+        time.sleep(0.1)
+    workers = _children(child.pid)
+    assert len(workers) >= 2  # the two workers (and spawn's resource tracker)
+    if how == "ctrl-c":
+        os.killpg(child.pid, signal.SIGINT)
+    else:
+        child.send_signal(signal.SIGTERM)
+    _, err = child.communicate(timeout=60)
+    assert child.returncode == code, err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+    deadline = time.monotonic() + 30
+    while any(_alive(p) for p in workers) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not [p for p in workers if _alive(p)]
+    assert not (out / _io.LOCK_FILE).exists()
+    points = sorted(out.glob("points/*.json"))
+    assert 1 <= len(points) < 2000
+    for p in points:
+        stored = json.loads(p.read_text())
+        assert math.isfinite(stored["row"]["power_electrical"])

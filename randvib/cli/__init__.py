@@ -4,7 +4,9 @@ Each command lives in its own module exposing ``register(subparsers)`` which
 adds its parser and sets ``handler``; :data:`COMMANDS` lists the modules.
 Every user error (bad value, unknown name, unreadable or unwritable file)
 ends with one line on stderr and exit status 2, never a traceback; Ctrl-C
-ends with exit status 130 (what was finished is kept). Anything else that
+ends with exit status 130 and SIGTERM with 143 (128 + 15), both keeping
+what was finished, releasing folder locks and ending worker processes.
+Anything else that
 escapes a command is a bug: one line naming it, exit status 1, and the
 traceback only with ``RANDVIB_TRACEBACK=1``.
 """
@@ -15,6 +17,7 @@ import argparse
 import importlib
 import os
 import re
+import signal
 import sys
 import warnings
 
@@ -24,6 +27,28 @@ COMMANDS = ["power", "simulate", "study", "record", "identify", "validate"]
 
 class UserError(Exception):
     """An error caused by the user's input; printed as one line, exit 2."""
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM received: raised in the main thread so that a run stops as on Ctrl-C.
+
+    A subclass of KeyboardInterrupt, so every path that stops on Ctrl-C
+    (compiled loops, sweeps, studies, fits) stops on SIGTERM the same way:
+    finished points kept, folder locks released, workers ended.
+    """
+
+
+def _raise_terminated(signum, frame):
+    raise Terminated()
+
+
+def _on_sigterm():
+    """Install the SIGTERM handler (main thread only); return the handler it replaces."""
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return None
+    return signal.signal(signal.SIGTERM, _raise_terminated)
 
 
 #: What argparse takes for a negative number (not an option): its own pattern
@@ -65,7 +90,12 @@ def main(argv=None) -> int:
         warnings.filterwarnings("ignore", category=RuntimeWarning, module=r"(numpy|scipy|randvib)")
         warnings.filterwarnings("ignore", message=r"Matrix is exactly singular")
         warnings.showwarning = _show_warning
-        return _main(argv)
+        previous = _on_sigterm()
+        try:
+            return _main(argv)
+        finally:
+            if previous is not None:
+                signal.signal(signal.SIGTERM, previous)
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None):
@@ -84,6 +114,9 @@ def _main(argv) -> int:
             message = f"randvib: error: {message}"
         print(message, file=sys.stderr)
         return 2
+    except Terminated:
+        print("randvib: terminated (SIGTERM); finished results were kept", file=sys.stderr)
+        return 128 + signal.SIGTERM
     except KeyboardInterrupt:
         print("randvib: interrupted; finished results were kept", file=sys.stderr)
         return 130
