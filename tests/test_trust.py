@@ -370,11 +370,35 @@ def test_validate_settings_checked_as_identify_does(capsys, tmp_path, record_csv
         (["--bounds", "k=-10:-1"], "`--bounds k` must be > 0"),
         (["--fix", "k=0"], "`--fix k` must be > 0"),
         (["--bounds", "c=0:inf"], "must be finite"),
-        (["--fix", "k3=1e308"], "every simulation diverged"),
     ],
 )
 def test_identify_fixed_values_and_bounds_obey_parameter_rules(capsys, record_csv, extra, fragment):
     one_line_error(capsys, _fit_args(record_csv[0], *extra), fragment)
+
+
+@pytest.mark.parametrize(
+    "extra",
+    [["--fix", "k3=1e308"], ["--bounds", "k=1e300:1e308"], ["--bounds", "c=1e300:1e308"]],
+)
+def test_identify_unsimulable_fixed_values_refused_before_searching(
+    capsys, monkeypatch, record_csv, extra
+):
+    """A fixed value or bound at which the model cannot be simulated is refused
+    after one batched probe of the bounds' corners, before the search runs."""
+
+    def no_search(*args, **kwargs):
+        raise AssertionError("the search ran")
+
+    monkeypatch.setattr("randvib.identification.fitting.sade", no_search)
+    one_line_error(capsys, _fit_args(record_csv[0], *extra), "nothing was searched")
+
+
+def test_identify_probe_refuses_nothing_a_search_can_fit(record_csv):
+    from randvib.identification.fitting import identify, read_record
+
+    fit = identify(read_record(record_csv[0]), "coulomb", m=0.0226, popsize=8, maxiter=2,
+                   polish=False, fixed={"k3": 70742.0})  # fmt: skip
+    assert math.isfinite(fit.cost)
 
 
 @pytest.mark.parametrize(
@@ -726,3 +750,38 @@ def test_interrupted_process_pool_sweep_keeps_points_and_ends_workers(tmp_path, 
     for p in points:
         stored = json.loads(p.read_text())
         assert math.isfinite(stored["row"]["power_electrical"])
+
+
+def test_record_extreme_excitation_names_the_excitation(capsys, tmp_path):
+    argv = ["record", "--preset", "figure9", "--out", tmp_path / "x.csv"]
+    for extra in (["--rms", "1e308"], ["--psd", "1e308"]):
+        one_line_error(capsys, [*argv, *extra], "`excitation`")
+    code, _, err = run(capsys, *argv, "--rms", "1e308")
+    assert "input_values" not in err
+
+
+INTEGER_OPTIONS = [
+    (["simulate", "--preset", "figure9", "--psd", "1"], "--paths", 1),
+    (["simulate", "--preset", "figure9", "--psd", "1"], "--threads", 1),
+    (["simulate", "--preset", "figure9", "--psd", "1"], "--seed", 0),
+    (["simulate", "--preset", "figure9"], "--segments", 2),
+    (["record", "--preset", "figure9", "--rms", "1", "--out", "x.csv"], "--substeps", 1),
+    (["identify", "rec.csv", "--model", "coulomb"], "--popsize", 6),
+    (["identify", "rec.csv", "--model", "coulomb"], "--generations", 0),
+    (["validate", "p.json", "rec.csv"], "--skip", 0),
+    (["validate", "p.json", "rec.csv"], "--substeps", 1),
+    (["study", "figure9", "--out", "o"], "--workers", 1),
+]
+
+
+@pytest.mark.parametrize("argv, option, minimum", INTEGER_OPTIONS)
+def test_integer_options_named_and_accept_float_notation(capsys, argv, option, minimum):
+    """Every integer option: a non-integer, 'nan', a value below its minimum or
+    beyond any count is refused naming the option (never 'invalid int value' or
+    a library argument); float notation of an integer (1e1) is parsed."""
+    from randvib._validation import integer_option
+
+    for bad in ("0.5", "nan", "1e999999999", "abc", str(minimum - 1)):
+        one_line_error(capsys, [*argv, f"{option}={bad}"], f"argument {option}: must be an integer")
+    parse = integer_option(minimum)
+    assert parse("1e1") == 10 and parse(f"{minimum}.0") == minimum and parse("1e23") == 10**23

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from randvib._validation import integer_option
 from randvib.identification.fitting import (
     OUTPUT_COLUMN,
     TIME_COLUMN,
@@ -37,10 +38,17 @@ def add_record_arguments(parser: argparse.ArgumentParser) -> None:
         help="use data rows START:STOP only (0-based, STOP excluded)",
     )
     s = parser.add_argument_group("simulation")
-    s.add_argument("--substeps", type=int, default=None, help="integration steps per sample (4)")
+    s.add_argument(
+        "--substeps", type=integer_option(1), default=None, help="integration steps per sample (4)"
+    )
     s.add_argument("--hold", choices=HOLDS, default=None, help="input interpolation (linear)")
     s.add_argument("--lowpass", type=float, metavar="HZ", help="low-pass the driving signal")
-    s.add_argument("--skip", type=int, default=None, help="samples left out of J at the start (0)")
+    s.add_argument(
+        "--skip",
+        type=integer_option(0),
+        default=None,
+        help="samples left out of J at the start (0)",
+    )
 
 
 def parse_rows(text):

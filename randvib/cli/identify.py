@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 from randvib._io import check_output_file, dumps, write_or_keep
+from randvib._validation import MAX_SEED, integer_option
 from randvib.cli._output import print_table
 from randvib.cli._records import (
     add_record_arguments,
@@ -36,15 +37,21 @@ def register(sub) -> None:
         type=float,
         help="mass (kg); required for base excitation, identified if omitted with a force input",
     )
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument(
+        "--seed", type=integer_option(0, MAX_SEED), default=0, help="random seed (default 0)"
+    )
     p.add_argument(
         "--fix", action="append", metavar="NAME=VALUE", help="hold a parameter, e.g. --fix k3=0"
     )
     p.add_argument(
         "--bounds", action="append", metavar="NAME=LO:HI", help="override a search range"
     )
-    p.add_argument("--popsize", type=int, default=50, help="SaDE population (default 50)")
-    p.add_argument("--generations", type=int, default=200, help="SaDE generations (default 200)")
+    p.add_argument(
+        "--popsize", type=integer_option(6), default=50, help="SaDE population (default 50)"
+    )
+    p.add_argument(
+        "--generations", type=integer_option(0), default=200, help="SaDE generations (default 200)"
+    )
     p.add_argument("--no-polish", action="store_true", help="skip the final Nelder-Mead polish")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--save", metavar="FILE.json", help="also write the JSON result (new file)")

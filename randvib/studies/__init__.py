@@ -34,6 +34,8 @@ import inspect
 import sys
 from pathlib import Path
 
+from randvib._validation import MAX_SEED, integer_option
+
 #: Where the study scripts are: ``studies/`` beside the package in a checkout.
 STUDIES_DIR = Path(__file__).resolve().parents[2] / "studies"
 
@@ -89,13 +91,18 @@ def load(name: str):
 def add_run_options(parser: argparse.ArgumentParser) -> None:
     """The options of a study run, shared by ``randvib study`` and the scripts' ``__main__``."""
     parser.add_argument("--quick", action="store_true", help="small, fast version (about a minute)")
-    parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     parser.add_argument(
-        "--workers", type=int, default=None, help="local worker processes (default: all cores)"
+        "--seed", type=integer_option(0, MAX_SEED), default=0, help="random seed (default 0)"
+    )
+    parser.add_argument(
+        "--workers",
+        type=integer_option(1),
+        default=None,
+        help="local worker processes (default: all cores)",
     )
     parser.add_argument(
         "--threads",
-        type=int,
+        type=integer_option(1),
         default=None,
         help="numba threads of a study that simulates in-process (identification, "
         "linearisation-vs-averaging; default: all cores)",
