@@ -656,9 +656,10 @@ def _subprocess_env():
 def test_sigterm_stops_simulate_and_exits_143():
     simulate(BASE, 1.0, t_end=0.01, dt=1e-4, n_paths=2, progress=False)  # numba cache warm
     # 4e10 path-steps: its LongRunWarning is printed once the run starts
+    argv = ["simulate", "--preset", "figure9", "--psd", "1", "--paths", "200",
+            "--t-end", "20000", "--dt", "1e-4"]  # fmt: skip
     child = subprocess.Popen(
-        [sys.executable, "-m", "randvib", "simulate", "--preset", "figure9", "--psd", "1",
-         "--paths", "200", "--t-end", "20000", "--dt", "1e-4"],  # fmt: skip
+        [sys.executable, "-m", "randvib", *argv],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
