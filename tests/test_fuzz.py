@@ -171,3 +171,132 @@ def test_predict_refuses_or_is_finite(p, method):
     for name in ("velocity_variance", "displacement_variance", "power_electrical"):
         assert math.isfinite(getattr(result, name)), (name, result)
     assert result.velocity_variance > 0 and result.displacement_variance > 0, result
+
+
+# ------------------------------------------------------------------ issues 10 and 11 options
+#: Each excitation with the options it takes, and the ordinary range of each.
+EXCITATION_OPTIONS = {
+    "white": {},
+    "band-pass": {"f0": (1.0, 100.0), "zeta": (0.01, 1.0)},
+    "kanai-tajimi": {"f0": (1.0, 100.0), "zeta": (0.01, 1.0)},
+    "band-limited": {"f_lo": (0.0, 10.0), "f_hi": (20.0, 200.0)},
+}
+#: Each coupling with the options it takes, and the ordinary range of each.
+COUPLING_OPTIONS = {
+    None: {},
+    "resistive": {"alpha": (1.0, 50.0), "r_load": (10.0, 1e3), "r_coil": (1.0, 100.0)},
+    "inductive": {
+        "alpha": (1.0, 50.0), "r_load": (10.0, 1e3), "r_coil": (1.0, 100.0),
+        "inductance": (1e-4, 1.0),
+    },  # fmt: skip
+    "piezo": {"theta": (1e-4, 1e-2), "capacitance": (1e-9, 1e-6), "r_load": (1e3, 1e6)},
+}
+#: Extreme values of the new options (zero, negative, overflow, underflow).
+NEW_EXTREMES = [0.0, -1.0, -1e308, 1e308, 1e-308, -1e-308, math.nan, math.inf]
+
+
+def _option_values(ranges: dict):
+    """Ordinary values of the given options, up to two replaced by an extreme."""
+    if not ranges:
+        return st.just({})
+    ordinary = st.fixed_dictionaries({n: st.floats(lo, hi) for n, (lo, hi) in ranges.items()})
+    extreme = st.dictionaries(
+        st.sampled_from(sorted(ranges)), st.sampled_from(NEW_EXTREMES), max_size=2
+    )
+    return st.builds(lambda a, b: {**a, **b}, ordinary, extreme)
+
+
+@st.composite
+def excitation_and_coupling(draw):
+    """argv fragments: an excitation, a coupling, k (negative: bistable), k3, stroke."""
+    argv = []
+    excitation = draw(st.sampled_from(sorted(EXCITATION_OPTIONS)))
+    argv += ["--excitation", excitation]
+    for name, value in draw(_option_values(EXCITATION_OPTIONS[excitation])).items():
+        argv.append(f"--{name.replace('_', '-')}={value}")
+    coupling = draw(st.sampled_from(list(COUPLING_OPTIONS)))
+    if coupling is not None:
+        argv += ["--coupling", coupling]
+        for name, value in draw(_option_values(COUPLING_OPTIONS[coupling])).items():
+            argv.append(f"--{name.replace('_', '-')}={value}")
+    device = draw(
+        _option_values({"k": (-200.0, 200.0), "k3": (0.0, 1e7), "stroke": (1e-3, 0.1)})
+    )
+    argv += [f"--{name}={value}" for name, value in device.items()]
+    return argv
+
+
+@FUZZ
+@given(extra=excitation_and_coupling(), json_out=st.booleans())
+def test_power_cli_contract_new_options(capsys, extra, json_out):
+    argv = ["power", "--preset", "figure9", "--psd=1.0", *extra] + (["--json"] if json_out else [])
+    _check_contract(*_run(capsys, argv), json_out)
+
+
+@settings(
+    max_examples=20, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(extra=excitation_and_coupling())
+def test_simulate_cli_contract_new_options(capsys, extra):
+    argv = ["simulate", "--preset", "figure9", "--psd=1.0", "--paths=2", "--dt=2e-4",
+            "--t-end=0.05", "--burn-in=0.01", "--json", *extra]  # fmt: skip
+    _check_contract(*_run(capsys, argv), True)
+
+
+BAD_TABLES = {
+    "empty.csv": "",
+    "header_only.csv": "frequency,psd\n",
+    "one_row.csv": "frequency,psd\n10,1\n",
+    "negative.csv": "frequency,psd\n1,1\n10,-1\n20,1\n",
+    "nan.csv": "frequency,psd\n1,1\n10,nan\n20,1\n",
+    "huge.csv": "frequency,psd\n1,1e308\n10,1e308\n20,1e308\n",
+    "unsorted.csv": "frequency,psd\n20,1\n1,1\n10,1\n",
+    "duplicate.csv": "frequency,psd\n1,1\n1,2\n20,1\n",
+    "zero.csv": "frequency,psd\n1,0\n10,0\n20,0\n",
+    "text.csv": "frequency,psd\n1,a\n10,b\n",
+    "wrong_columns.csv": "f,S\n1,1\n10,1\n",
+    "binary.csv": "\x00\x01\x02",
+}
+BAD_RECORDS = {
+    "empty.csv": "",
+    "header_only.csv": "time,base_acceleration\n",
+    "short.csv": "time,base_acceleration\n0,1\n0.001,2\n",
+    "uneven.csv": "time,base_acceleration\n" + "".join(f"{t**2 / 1e3},{math.sin(t)}\n" for t in range(50)),
+    "constant.csv": "time,base_acceleration\n" + "".join(f"{t / 1e3},1\n" for t in range(200)),
+    "huge.csv": "time,base_acceleration\n" + "".join(f"{t / 1e3},{1e300 * (-1) ** t}\n" for t in range(200)),
+    "nan.csv": "time,base_acceleration\n" + "".join(f"{t / 1e3},nan\n" for t in range(200)),
+    "backwards.csv": "time,base_acceleration\n" + "".join(f"{-t / 1e3},{t % 3}\n" for t in range(200)),
+    "wrong_columns.csv": "t,a\n0,1\n0.001,2\n",
+}  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def bad_files(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("bad_inputs")
+    made = {}
+    for kind, table in (("psd-file", BAD_TABLES), ("record", BAD_RECORDS)):
+        (folder / kind).mkdir()
+        for name, text in table.items():
+            (folder / kind / name).write_text(text)
+        made[kind] = [folder / kind / name for name in table]
+        made[kind] += [folder / kind, folder / kind / "missing.csv"]  # a folder, no file
+    return made
+
+
+@settings(
+    max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(
+    command=st.sampled_from(["power", "simulate"]),
+    kind=st.sampled_from(["psd-file", "record"]),
+    index=st.integers(0, 100),
+)
+def test_bad_psd_files_and_records_are_named(capsys, bad_files, command, kind, index):
+    path = bad_files[kind][index % len(bad_files[kind])]
+    argv = [command, "--preset", "figure9", f"--{kind}", path, "--json"]
+    if command == "simulate":
+        argv += ["--paths=2", "--t-end=0.05", "--burn-in=0.01"]
+    code, out, err = _run(capsys, argv)
+    _check_contract(code, out, err, True)
+    if code == 2 and path.exists() and path.is_file():
+        assert path.name in err or "psd" in err or "record" in err, err

@@ -786,3 +786,12 @@ def test_integer_options_named_and_accept_float_notation(capsys, argv, option, m
         one_line_error(capsys, [*argv, f"{option}={bad}"], f"argument {option}: must be an integer")
     parse = integer_option(minimum)
     assert parse("1e1") == 10 and parse(f"{minimum}.0") == minimum and parse("1e23") == 10**23
+
+
+def test_own_refusal_is_not_called_a_float64_overflow(capsys):
+    """Found by the fuzz test over the new options: a free mass (k = k3 = 0) under a
+    band-pass input was refused with "outside the range float64 can represent"
+    appended to the real reason."""
+    code, _, err = run(capsys, "power", "--preset", "figure9", "--psd", "1", "--excitation",
+                       "band-pass", "--f0", "1", "--zeta", "0.1", "--k", "0", "--k3", "0")  # fmt: skip
+    assert code == 2 and "confining potential" in err and "float64" not in err
