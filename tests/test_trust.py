@@ -346,7 +346,7 @@ def test_results_csv_is_rebuilt_from_the_points(tmp_path):
 def test_validate_settings_checked_as_identify_does(capsys, tmp_path, record_csv):
     rec, params = record_csv
     one_line_error(capsys, ["validate", params, rec, "--skip", "100000"], "`skip` = 100000")
-    one_line_error(capsys, ["validate", params, rec, "--substeps", "0"], "`substeps`")
+    one_line_error(capsys, ["validate", params, rec, "--substeps", "0"], "argument --substeps")
     one_line_error(capsys, ["validate", params, rec, "--set", "bogus=1"], "--set bogus")
     one_line_error(capsys, ["validate", params, rec, "--set", "fc=-1"], "`--set fc` must be >= 0")
     bad = tmp_path / "bad.json"
@@ -431,8 +431,8 @@ def test_json_output_is_always_valid_json():
 @pytest.mark.parametrize(
     "argv, fragment",
     [
-        (["--seed", str(2**64)], "`seed` must be an integer in 0 .."),
-        (["--seed", "-1"], "`seed`"),
+        (["--seed", str(2**64)], "argument --seed: must be an integer in 0 .."),
+        (["--seed", "-1"], "argument --seed"),
         (["--m", "1e308"], "linearised scales"),
         (["--k3", "1e308"], "linearised scales"),
         (["--psd", "1e308"], "linearised scales"),
@@ -450,7 +450,7 @@ def test_simulate_extreme_values_one_line(capsys, argv, fragment):
     "extra, fragment",
     [
         (["--lowpass", "1e-308"], "`lowpass` must be at least"),
-        (["--seed", "-1"], "`seed` must be an integer in 0 .."),
+        (["--seed", "-1"], "argument --seed: must be an integer in 0 .."),
         (["--sample-rate", "1e-308", "--time-column", "none"], "search bounds of"),
     ],
 )
@@ -623,7 +623,7 @@ def test_unreadable_stored_fit_is_named_and_fitted_again(tmp_path, record_csv):
 
 def test_record_seed_out_of_range_named(capsys, tmp_path):
     argv = ["record", "--preset", "figure9", "--rms", "2", "--out", tmp_path / "x.csv"]
-    one_line_error(capsys, [*argv, "--seed", "-1"], "`--seed` must be an integer in 0 ..")
+    one_line_error(capsys, [*argv, "--seed", "-1"], "argument --seed: must be an integer in 0 ..")
     one_line_error(capsys, [*argv, "--duration", "1e23"], "of memory")
 
 
