@@ -11,6 +11,7 @@ show as the test's own timeout).
 import json
 import math
 
+import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -186,7 +187,9 @@ COUPLING_OPTIONS = {
     None: {},
     "resistive": {"alpha": (1.0, 50.0), "r_load": (10.0, 1e3), "r_coil": (1.0, 100.0)},
     "inductive": {
-        "alpha": (1.0, 50.0), "r_load": (10.0, 1e3), "r_coil": (1.0, 100.0),
+        "alpha": (1.0, 50.0),
+        "r_load": (10.0, 1e3),
+        "r_coil": (1.0, 100.0),
         "inductance": (1e-4, 1.0),
     },  # fmt: skip
     "piezo": {"theta": (1e-4, 1e-2), "capacitance": (1e-9, 1e-6), "r_load": (1e3, 1e6)},
@@ -219,9 +222,7 @@ def excitation_and_coupling(draw):
         argv += ["--coupling", coupling]
         for name, value in draw(_option_values(COUPLING_OPTIONS[coupling])).items():
             argv.append(f"--{name.replace('_', '-')}={value}")
-    device = draw(
-        _option_values({"k": (-200.0, 200.0), "k3": (0.0, 1e7), "stroke": (1e-3, 0.1)})
-    )
+    device = draw(_option_values({"k": (-200.0, 200.0), "k3": (0.0, 1e7), "stroke": (1e-3, 0.1)}))
     argv += [f"--{name}={value}" for name, value in device.items()]
     return argv
 
@@ -300,3 +301,108 @@ def test_bad_psd_files_and_records_are_named(capsys, bad_files, command, kind, i
     _check_contract(code, out, err, True)
     if code == 2 and path.exists() and path.is_file():
         assert path.name in err or "psd" in err or "record" in err, err
+
+
+# ------------------------------------------------------------------ new public functions
+def _couplings():
+    from randvib.models.coupling import Inductive, Piezo, Resistive
+
+    return st.one_of(
+        st.builds(lambda p: Resistive(**p), _option_values(COUPLING_OPTIONS["resistive"])),
+        st.builds(lambda p: Inductive(**p), _option_values(COUPLING_OPTIONS["inductive"])),
+        st.builds(lambda p: Piezo(**p), _option_values(COUPLING_OPTIONS["piezo"])),
+    )
+
+
+def _excitations():
+    return st.one_of(
+        st.builds(lambda p: rv.BandPass(level=1.0, **p), _option_values(EXCITATION_OPTIONS["band-pass"])),
+        st.builds(lambda p: rv.KanaiTajimi(level=1.0, **p), _option_values(EXCITATION_OPTIONS["kanai-tajimi"])),
+        st.builds(lambda p: rv.BandLimited(level=1.0, **p), _option_values(EXCITATION_OPTIONS["band-limited"])),
+        st.sampled_from([1.0, 1e-300, 1e300]),
+    )  # fmt: skip
+
+
+def _refused(build):
+    """``build()``, or None when it is refused with a ValueError, or with the
+    RuntimeError that says statistical linearisation did not converge (both allowed)."""
+    try:
+        return build()
+    except ValueError:
+        return None
+    except RuntimeError as exc:
+        if "did not converge" not in str(exc):
+            raise
+        return None
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    p=_option_values({"m": (1e-3, 1.0), "c_m": (0.0, 1.0), "k": (-200.0, 200.0), "k3": (0.0, 1e7)}),
+    coupling=st.data(),
+    excitation=st.data(),
+)
+def test_coupled_linearisation_and_optimal_load_refuse_or_are_finite(p, coupling, excitation):
+    """Harvester.with_coupling, statistical_linearisation and optimal_load_resistance
+    with couplings: a ValueError naming the problem, or finite positive results."""
+    c = _refused(lambda: coupling.draw(_couplings()))
+    if c is None:
+        return
+    device = _refused(lambda: rv.Harvester.with_coupling(coupling=c, **p))
+    if device is None:
+        return
+    psd = _refused(lambda: excitation.draw(_excitations()))
+    if psd is None:
+        return
+    with np.errstate(all="ignore"):
+        result = _refused(lambda: rv.statistical_linearisation(device, psd))
+        if result is not None:
+            for name in ("velocity_variance", "displacement_variance", "power_electrical"):
+                value = getattr(result, name)
+                assert math.isfinite(value) and value >= 0, (name, result)
+        best = _refused(lambda: rv.optimal_load_resistance(device, psd))
+    if best is not None:
+        assert all(math.isfinite(x) and x > 0 for x in best), best
+
+
+@settings(max_examples=200, deadline=None)
+@given(k=numbers(1e-3, 1e4), k3=numbers(1e-3, 1e8))
+def test_potential_refuses_or_is_finite(k, k3):
+    from randvib.models.potential import Potential
+
+    potential = _refused(lambda: Potential(k, k3))
+    if potential is None:
+        return
+    with np.errstate(all="ignore"):
+        for name in ("wells", "minimum", "barrier_height"):
+            value = _refused(lambda name=name: getattr(potential, name))
+            if value is not None:
+                assert np.all(np.isfinite(np.asarray(value, dtype=float))), (name, value)
+
+
+@pytest.fixture(scope="module")
+def short_record():
+    t = np.arange(2000) * 1e-3
+    rng = np.random.default_rng(0)
+    return t, rng.standard_normal(t.size)
+
+
+@settings(max_examples=12, deadline=None)
+@given(
+    p=_option_values({"m": (1e-3, 1.0), "k": (1.0, 200.0), "k3": (0.0, 1e6)}),
+    scale=st.sampled_from([1.0, 1e-300, 1e150, 1e300]),
+    segments=st.sampled_from([2, 4, 1, 0]),
+)
+def test_simulate_on_record_refuses_or_is_finite(short_record, p, scale, segments):
+    t, a = short_record
+    record = _refused(lambda: rv.Measured(t, a * scale))
+    device = _refused(lambda: rv.preset("figure9").updated(**p))
+    if record is None or device is None:
+        return
+    with np.errstate(all="ignore"):
+        result = _refused(
+            lambda: rv.simulate_on_record(device, record, segments=segments, burn_in=0.2)
+        )
+    if result is not None:
+        for name in ("power_electrical", "velocity_variance", "displacement_variance"):
+            assert math.isfinite(getattr(result, name).mean), (name, result)

@@ -795,3 +795,11 @@ def test_own_refusal_is_not_called_a_float64_overflow(capsys):
     code, _, err = run(capsys, "power", "--preset", "figure9", "--psd", "1", "--excitation",
                        "band-pass", "--f0", "1", "--zeta", "0.1", "--k", "0", "--k3", "0")  # fmt: skip
     assert code == 2 and "confining potential" in err and "float64" not in err
+
+
+def test_coupling_overflow_is_a_value_error():
+    """Found by the fuzz test: alpha = 1e308 raised OverflowError from alpha**2."""
+    from randvib.models.coupling import Resistive
+
+    with pytest.raises(ValueError, match="overflows float64"):
+        rv.Harvester.with_coupling(0.02, 0.1, 50.0, Resistive(1e308, 100.0, 10.0))

@@ -145,10 +145,20 @@ class Harvester:
         static (resistive, Eq. 3; inductive with L = 0; piezo with C_p = 0),
         0 when it carries a circuit state.
         """
+        try:
+            with np.errstate(all="ignore"):
+                c_e = coupling.electrical_damping
+        except OverflowError:  # Python floats: alpha**2 beyond float64
+            c_e = np.inf
+        if not np.all(np.isfinite(c_e)):
+            raise ValueError(
+                f"the electrical damping c_e of {coupling!r} overflows float64; "
+                "give coupling parameters of a physical size"
+            )
         return cls(
             m=m,
             c_m=c_m,
-            c_e=coupling.electrical_damping,
+            c_e=c_e,
             k=k,
             k3=k3,
             friction=friction,
