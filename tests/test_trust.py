@@ -803,3 +803,25 @@ def test_coupling_overflow_is_a_value_error():
 
     with pytest.raises(ValueError, match="overflows float64"):
         rv.Harvester.with_coupling(0.02, 0.1, 50.0, Resistive(1e308, 100.0, 10.0))
+
+
+@pytest.mark.parametrize(
+    "stop, code",
+    [(KeyboardInterrupt, 130), ("sigterm", 143)],
+)
+def test_study_script_main_stops_with_one_line(capsys, tmp_path, stop, code):
+    """``python studies/NAME.py OUT``: Ctrl-C and SIGTERM end with 130 / 143 and
+    one line (they printed a KeyboardInterrupt traceback)."""
+    from randvib.studies import script_main
+
+    def run_study(out_dir, *, quick, seed, workers, scheduler, progress):
+        """A study stopped while it runs."""
+        if stop == "sigterm":
+            os.kill(os.getpid(), signal.SIGTERM)  # handled: raises Terminated here
+            time.sleep(5)
+        raise stop()
+
+    run_study.__module__ = __name__
+    assert script_main(run_study, [str(tmp_path / "o")]) == code
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err

@@ -17,9 +17,10 @@ import argparse
 import importlib
 import os
 import re
-import signal
 import sys
 import warnings
+
+from randvib._interrupts import interrupted_exit, sigterm_stops
 
 #: Command modules under randvib.cli, in the order shown by --help.
 COMMANDS = ["power", "simulate", "study", "record", "identify", "validate"]
@@ -27,28 +28,6 @@ COMMANDS = ["power", "simulate", "study", "record", "identify", "validate"]
 
 class UserError(Exception):
     """An error caused by the user's input; printed as one line, exit 2."""
-
-
-class Terminated(KeyboardInterrupt):
-    """SIGTERM received: raised in the main thread so that a run stops as on Ctrl-C.
-
-    A subclass of KeyboardInterrupt, so every path that stops on Ctrl-C
-    (compiled loops, sweeps, studies, fits) stops on SIGTERM the same way:
-    finished points kept, folder locks released, workers ended.
-    """
-
-
-def _raise_terminated(signum, frame):
-    raise Terminated()
-
-
-def _on_sigterm():
-    """Install the SIGTERM handler (main thread only); return the handler it replaces."""
-    import threading
-
-    if threading.current_thread() is not threading.main_thread():
-        return None
-    return signal.signal(signal.SIGTERM, _raise_terminated)
 
 
 #: What argparse takes for a negative number (not an option): its own pattern
@@ -90,12 +69,8 @@ def main(argv=None) -> int:
         warnings.filterwarnings("ignore", category=RuntimeWarning, module=r"(numpy|scipy|randvib)")
         warnings.filterwarnings("ignore", message=r"Matrix is exactly singular")
         warnings.showwarning = _show_warning
-        previous = _on_sigterm()
-        try:
+        with sigterm_stops():
             return _main(argv)
-        finally:
-            if previous is not None:
-                signal.signal(signal.SIGTERM, previous)
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None):
@@ -114,12 +89,10 @@ def _main(argv) -> int:
             message = f"randvib: error: {message}"
         print(message, file=sys.stderr)
         return 2
-    except Terminated:
-        print("randvib: terminated (SIGTERM); finished results were kept", file=sys.stderr)
-        return 128 + signal.SIGTERM
-    except KeyboardInterrupt:
-        print("randvib: interrupted; finished results were kept", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (Terminated)
+        code, line = interrupted_exit(exc)
+        print(line, file=sys.stderr)
+        return code
     except Exception as exc:  # a bug: one line, not a traceback (unless asked for)
         if os.environ.get("RANDVIB_TRACEBACK"):
             raise

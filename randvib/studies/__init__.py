@@ -34,6 +34,7 @@ import inspect
 import sys
 from pathlib import Path
 
+from randvib._interrupts import interrupted_exit, sigterm_stops
 from randvib._validation import MAX_SEED, integer_option
 
 #: Where the study scripts are: ``studies/`` beside the package in a checkout.
@@ -168,5 +169,11 @@ def script_main(run_study, argv=None) -> int:
     add_run_options(parser)
     args = parser.parse_args(argv)
     name = Path(sys.modules[run_study.__module__].__file__).stem.replace("_", "-")
-    print(f"report: {run_with_options(run_study, name, args.out, args)}")
+    try:
+        with sigterm_stops():  # SIGTERM stops the study as Ctrl-C does
+            print(f"report: {run_with_options(run_study, name, args.out, args)}")
+    except KeyboardInterrupt as exc:  # finished points and files are kept
+        code, line = interrupted_exit(exc)
+        print(line, file=sys.stderr)
+        return code
     return 0
