@@ -28,6 +28,10 @@ def _check_real(name, value, unit):
 __all__ = ["ElectricalCoupling", "Harvester"]  # ElectricalCoupling: re-exported, historical home
 
 
+class ElectricalDampingOverflow(ValueError):
+    """A coupling's electrical damping c_e overflows float64 (e.g. alpha = 1e308)."""
+
+
 @dataclass(frozen=True, eq=False)
 class Harvester:
     """Single-degree-of-freedom electromagnetic harvester (paper Eq. 1).
@@ -151,9 +155,9 @@ class Harvester:
         except OverflowError:  # Python floats: alpha**2 beyond float64
             c_e = np.inf
         if not np.all(np.isfinite(c_e)):
-            raise ValueError(
-                f"the electrical damping c_e of {coupling!r} overflows float64; "
-                "give coupling parameters of a physical size"
+            raise ElectricalDampingOverflow(
+                f"the electrical damping c_e of {coupling!r} is not a finite number "
+                "(it overflows float64); give coupling parameters of a physical size"
             )
         return cls(
             m=m,
