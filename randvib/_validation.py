@@ -93,6 +93,37 @@ def check_int(name: str, value, minimum: int = 0, maximum: int | None = None) ->
 MAX_SEED = 2**64 - 1
 
 
+def integer_option(minimum: int = 0, maximum: int | None = None):
+    """An argparse ``type`` for an integer count or seed in ``[minimum, maximum]``.
+
+    It takes an integer written as one (``200``) or in float notation when
+    that is exactly an integer (``1e5``, ``2.0``), and refuses anything else
+    with a message that argparse prefixes with the option's name
+    (``argument --paths: must be an integer >= 1, got '0.5'``), instead of
+    "invalid int value" or the library argument's name.
+    """
+    import argparse
+    from decimal import Decimal, InvalidOperation
+
+    allowed = f">= {minimum}" if maximum is None else f"in {minimum} .. {maximum}"
+
+    def parse(text: str) -> int:
+        try:
+            number = Decimal(text.strip())
+        except InvalidOperation:
+            number = None
+        # 40 digits is beyond every count and seed; int() of 1e999999999 would not end
+        ok = number is not None and number.is_finite() and number.adjusted() < 40
+        if ok and number == number.to_integral_value():
+            value = int(number)
+            if value >= minimum and (maximum is None or value <= maximum):
+                return value
+        raise argparse.ArgumentTypeError(f"must be an integer {allowed}, got {text!r}")
+
+    parse.__name__ = "integer"
+    return parse
+
+
 def scalar_or_array(arr: np.ndarray):
     """Return a Python float for 0-d arrays, the array otherwise."""
     return float(arr) if np.ndim(arr) == 0 else arr

@@ -84,10 +84,10 @@ def test_simulate_control_variates_reach_the_simulation(capsys):
 @pytest.mark.parametrize(
     ("argv", "fragment"),
     [
-        (["--paths", "0"], "`n_paths`"),
+        (["--paths", "0"], "argument --paths"),
         (["--dt", "0"], "`dt`"),
         (["--t-end", "1", "--burn-in", "1"], "`burn_in`"),
-        (["--threads", "0"], "`threads`"),
+        (["--threads", "0"], "argument --threads"),
     ],
 )
 def test_simulate_bad_options(capsys, argv, fragment):

@@ -110,7 +110,7 @@ def test_record_equals_simulate_on_record(capsys, tmp_path):
         (["--paths", "10"], None, "`--paths` does not apply to `--record`"),
         (["--t-end", "3"], None, "`--t-end` does not apply"),
         (["--dt", "3e-4"], None, "`--dt` must divide the record's step"),
-        (["--segments", "1"], None, "`--segments` must be"),
+        (["--segments", "1"], None, "argument --segments: must be"),
         (["--burn-in", "100"], None, "hold no window"),
         ([], "nan", "`--record`"),
         ([], "uneven", "evenly spaced"),

@@ -11,6 +11,7 @@ show as the test's own timeout).
 import json
 import math
 
+import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -176,3 +177,237 @@ def test_predict_refuses_or_is_finite(p, method):
     for name in ("velocity_variance", "power_electrical"):
         assert math.isfinite(getattr(result, name)), (name, result)
     assert result.velocity_variance > 0, result
+
+
+# ------------------------------------------------------------------ issues 10 and 11 options
+#: Each excitation with the options it takes, and the ordinary range of each.
+EXCITATION_OPTIONS = {
+    "white": {},
+    "band-pass": {"f0": (1.0, 100.0), "zeta": (0.01, 1.0)},
+    "kanai-tajimi": {"f0": (1.0, 100.0), "zeta": (0.01, 1.0)},
+    "band-limited": {"f_lo": (0.0, 10.0), "f_hi": (20.0, 200.0)},
+}
+#: Each coupling with the options it takes, and the ordinary range of each.
+COUPLING_OPTIONS = {
+    None: {},
+    "resistive": {"alpha": (1.0, 50.0), "r_load": (10.0, 1e3), "r_coil": (1.0, 100.0)},
+    "inductive": {
+        "alpha": (1.0, 50.0),
+        "r_load": (10.0, 1e3),
+        "r_coil": (1.0, 100.0),
+        "inductance": (1e-4, 1.0),
+    },  # fmt: skip
+    "piezo": {"theta": (1e-4, 1e-2), "capacitance": (1e-9, 1e-6), "r_load": (1e3, 1e6)},
+}
+#: Extreme values of the new options (zero, negative, overflow, underflow).
+NEW_EXTREMES = [0.0, -1.0, -1e308, 1e308, 1e-308, -1e-308, math.nan, math.inf]
+
+
+def _option_values(ranges: dict):
+    """Ordinary values of the given options, up to two replaced by an extreme."""
+    if not ranges:
+        return st.just({})
+    ordinary = st.fixed_dictionaries({n: st.floats(lo, hi) for n, (lo, hi) in ranges.items()})
+    extreme = st.dictionaries(
+        st.sampled_from(sorted(ranges)), st.sampled_from(NEW_EXTREMES), max_size=2
+    )
+    return st.builds(lambda a, b: {**a, **b}, ordinary, extreme)
+
+
+@st.composite
+def excitation_and_coupling(draw):
+    """argv fragments: an excitation, a coupling, k (negative: bistable), k3, stroke."""
+    argv = []
+    excitation = draw(st.sampled_from(sorted(EXCITATION_OPTIONS)))
+    argv += ["--excitation", excitation]
+    for name, value in draw(_option_values(EXCITATION_OPTIONS[excitation])).items():
+        argv.append(f"--{name.replace('_', '-')}={value}")
+    coupling = draw(st.sampled_from(list(COUPLING_OPTIONS)))
+    if coupling is not None:
+        argv += ["--coupling", coupling]
+        for name, value in draw(_option_values(COUPLING_OPTIONS[coupling])).items():
+            argv.append(f"--{name.replace('_', '-')}={value}")
+    device = draw(_option_values({"k": (-200.0, 200.0), "k3": (0.0, 1e7), "stroke": (1e-3, 0.1)}))
+    argv += [f"--{name}={value}" for name, value in device.items()]
+    return argv
+
+
+@FUZZ
+@given(extra=excitation_and_coupling(), json_out=st.booleans())
+def test_power_cli_contract_new_options(capsys, extra, json_out):
+    argv = ["power", "--preset", "figure9", "--psd=1.0", *extra] + (["--json"] if json_out else [])
+    _check_contract(*_run(capsys, argv), json_out)
+
+
+@settings(
+    max_examples=8, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(extra=excitation_and_coupling())
+def test_simulate_cli_contract_new_options(capsys, extra):
+    argv = ["simulate", "--preset", "figure9", "--psd=1.0", "--paths=2", "--dt=2e-4",
+            "--t-end=0.05", "--burn-in=0.01", "--json", *extra]  # fmt: skip
+    _check_contract(*_run(capsys, argv), True)
+
+
+BAD_TABLES = {
+    "empty.csv": "",
+    "header_only.csv": "frequency,psd\n",
+    "one_row.csv": "frequency,psd\n10,1\n",
+    "negative.csv": "frequency,psd\n1,1\n10,-1\n20,1\n",
+    "nan.csv": "frequency,psd\n1,1\n10,nan\n20,1\n",
+    "huge.csv": "frequency,psd\n1,1e308\n10,1e308\n20,1e308\n",
+    "unsorted.csv": "frequency,psd\n20,1\n1,1\n10,1\n",
+    "duplicate.csv": "frequency,psd\n1,1\n1,2\n20,1\n",
+    "zero.csv": "frequency,psd\n1,0\n10,0\n20,0\n",
+    "text.csv": "frequency,psd\n1,a\n10,b\n",
+    "wrong_columns.csv": "f,S\n1,1\n10,1\n",
+    "binary.csv": "\x00\x01\x02",
+}
+BAD_RECORDS = {
+    "empty.csv": "",
+    "header_only.csv": "time,base_acceleration\n",
+    "short.csv": "time,base_acceleration\n0,1\n0.001,2\n",
+    "uneven.csv": "time,base_acceleration\n" + "".join(f"{t**2 / 1e3},{math.sin(t)}\n" for t in range(50)),
+    "constant.csv": "time,base_acceleration\n" + "".join(f"{t / 1e3},1\n" for t in range(200)),
+    "huge.csv": "time,base_acceleration\n" + "".join(f"{t / 1e3},{1e300 * (-1) ** t}\n" for t in range(200)),
+    "nan.csv": "time,base_acceleration\n" + "".join(f"{t / 1e3},nan\n" for t in range(200)),
+    "backwards.csv": "time,base_acceleration\n" + "".join(f"{-t / 1e3},{t % 3}\n" for t in range(200)),
+    "wrong_columns.csv": "t,a\n0,1\n0.001,2\n",
+}  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def bad_files(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("bad_inputs")
+    made = {}
+    for kind, table in (("psd-file", BAD_TABLES), ("record", BAD_RECORDS)):
+        (folder / kind).mkdir()
+        for name, text in table.items():
+            (folder / kind / name).write_text(text)
+        made[kind] = [folder / kind / name for name in table]
+        made[kind] += [folder / kind, folder / kind / "missing.csv"]  # a folder, no file
+    return made
+
+
+@settings(
+    max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(
+    command=st.sampled_from(["power", "simulate"]),
+    kind=st.sampled_from(["psd-file", "record"]),
+    index=st.integers(0, 100),
+)
+def test_bad_psd_files_and_records_are_named(capsys, bad_files, command, kind, index):
+    path = bad_files[kind][index % len(bad_files[kind])]
+    argv = [command, "--preset", "figure9", f"--{kind}", path, "--json"]
+    if command == "simulate":
+        argv += ["--paths=2", "--t-end=0.05", "--burn-in=0.01"]
+    code, out, err = _run(capsys, argv)
+    _check_contract(code, out, err, True)
+    if code == 2 and path.exists() and path.is_file():
+        assert path.name in err or "psd" in err or "record" in err, err
+
+
+# ------------------------------------------------------------------ new public functions
+def _couplings():
+    from randvib.models.coupling import Inductive, Piezo, Resistive
+
+    return st.one_of(
+        st.builds(lambda p: Resistive(**p), _option_values(COUPLING_OPTIONS["resistive"])),
+        st.builds(lambda p: Inductive(**p), _option_values(COUPLING_OPTIONS["inductive"])),
+        st.builds(lambda p: Piezo(**p), _option_values(COUPLING_OPTIONS["piezo"])),
+    )
+
+
+def _excitations():
+    return st.one_of(
+        st.builds(lambda p: rv.BandPass(level=1.0, **p), _option_values(EXCITATION_OPTIONS["band-pass"])),
+        st.builds(lambda p: rv.KanaiTajimi(level=1.0, **p), _option_values(EXCITATION_OPTIONS["kanai-tajimi"])),
+        st.builds(lambda p: rv.BandLimited(level=1.0, **p), _option_values(EXCITATION_OPTIONS["band-limited"])),
+        st.sampled_from([1.0, 1e-300, 1e300]),
+    )  # fmt: skip
+
+
+def _refused(build):
+    """``build()``, or None when it is refused with a ValueError, or with the
+    RuntimeError that says statistical linearisation did not converge (both allowed)."""
+    try:
+        return build()
+    except ValueError:
+        return None
+    except RuntimeError as exc:
+        if "did not converge" not in str(exc):
+            raise
+        return None
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    p=_option_values({"m": (1e-3, 1.0), "c_m": (0.0, 1.0), "k": (-200.0, 200.0), "k3": (0.0, 1e7)}),
+    coupling=st.data(),
+    excitation=st.data(),
+)
+def test_coupled_linearisation_and_optimal_load_refuse_or_are_finite(p, coupling, excitation):
+    """Harvester.with_coupling, statistical_linearisation and optimal_load_resistance
+    with couplings: a ValueError naming the problem, or finite positive results."""
+    c = _refused(lambda: coupling.draw(_couplings()))
+    if c is None:
+        return
+    device = _refused(lambda: rv.Harvester.with_coupling(coupling=c, **p))
+    if device is None:
+        return
+    psd = _refused(lambda: excitation.draw(_excitations()))
+    if psd is None:
+        return
+    with np.errstate(all="ignore"):
+        result = _refused(lambda: rv.statistical_linearisation(device, psd))
+        if result is not None:
+            for name in ("velocity_variance", "displacement_variance", "power_electrical"):
+                value = getattr(result, name)
+                assert math.isfinite(value) and value >= 0, (name, result)
+        best = _refused(lambda: rv.optimal_load_resistance(device, psd))
+    if best is not None:
+        assert all(math.isfinite(x) and x > 0 for x in best), best
+
+
+@settings(max_examples=200, deadline=None)
+@given(k=numbers(1e-3, 1e4), k3=numbers(1e-3, 1e8))
+def test_potential_refuses_or_is_finite(k, k3):
+    from randvib.models.potential import Potential
+
+    potential = _refused(lambda: Potential(k, k3))
+    if potential is None:
+        return
+    with np.errstate(all="ignore"):
+        for name in ("wells", "minimum", "barrier_height"):
+            value = _refused(lambda name=name: getattr(potential, name))
+            if value is not None:
+                assert np.all(np.isfinite(np.asarray(value, dtype=float))), (name, value)
+
+
+@pytest.fixture(scope="module")
+def short_record():
+    t = np.arange(2000) * 1e-3
+    rng = np.random.default_rng(0)
+    return t, rng.standard_normal(t.size)
+
+
+@settings(max_examples=12, deadline=None)
+@given(
+    p=_option_values({"m": (1e-3, 1.0), "k": (1.0, 200.0), "k3": (0.0, 1e6)}),
+    scale=st.sampled_from([1.0, 1e-300, 1e150, 1e300]),
+    segments=st.sampled_from([2, 4, 1, 0]),
+)
+def test_simulate_on_record_refuses_or_is_finite(short_record, p, scale, segments):
+    t, a = short_record
+    record = _refused(lambda: rv.Measured(t, a * scale))
+    device = _refused(lambda: rv.preset("figure9").updated(**p))
+    if record is None or device is None:
+        return
+    with np.errstate(all="ignore"):
+        result = _refused(
+            lambda: rv.simulate_on_record(device, record, segments=segments, burn_in=0.2)
+        )
+    if result is not None:
+        for name in ("power_electrical", "velocity_variance", "displacement_variance"):
+            assert math.isfinite(getattr(result, name).mean), (name, result)

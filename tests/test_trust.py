@@ -346,7 +346,7 @@ def test_results_csv_is_rebuilt_from_the_points(tmp_path):
 def test_validate_settings_checked_as_identify_does(capsys, tmp_path, record_csv):
     rec, params = record_csv
     one_line_error(capsys, ["validate", params, rec, "--skip", "100000"], "`skip` = 100000")
-    one_line_error(capsys, ["validate", params, rec, "--substeps", "0"], "`substeps`")
+    one_line_error(capsys, ["validate", params, rec, "--substeps", "0"], "argument --substeps")
     one_line_error(capsys, ["validate", params, rec, "--set", "bogus=1"], "--set bogus")
     one_line_error(capsys, ["validate", params, rec, "--set", "fc=-1"], "`--set fc` must be >= 0")
     bad = tmp_path / "bad.json"
@@ -370,11 +370,35 @@ def test_validate_settings_checked_as_identify_does(capsys, tmp_path, record_csv
         (["--bounds", "k=-10:-1"], "`--bounds k` must be > 0"),
         (["--fix", "k=0"], "`--fix k` must be > 0"),
         (["--bounds", "c=0:inf"], "must be finite"),
-        (["--fix", "k3=1e308"], "every simulation diverged"),
     ],
 )
 def test_identify_fixed_values_and_bounds_obey_parameter_rules(capsys, record_csv, extra, fragment):
     one_line_error(capsys, _fit_args(record_csv[0], *extra), fragment)
+
+
+@pytest.mark.parametrize(
+    "extra",
+    [["--fix", "k3=1e308"], ["--bounds", "k=1e300:1e308"], ["--bounds", "c=1e300:1e308"]],
+)
+def test_identify_unsimulable_fixed_values_refused_before_searching(
+    capsys, monkeypatch, record_csv, extra
+):
+    """A fixed value or bound at which the model cannot be simulated is refused
+    after one batched probe of the bounds' corners, before the search runs."""
+
+    def no_search(*args, **kwargs):
+        raise AssertionError("the search ran")
+
+    monkeypatch.setattr("randvib.identification.fitting.sade", no_search)
+    one_line_error(capsys, _fit_args(record_csv[0], *extra), "nothing was searched")
+
+
+def test_identify_probe_refuses_nothing_a_search_can_fit(record_csv):
+    from randvib.identification.fitting import identify, read_record
+
+    fit = identify(read_record(record_csv[0]), "coulomb", m=0.0226, popsize=8, maxiter=2,
+                   polish=False, fixed={"k3": 70742.0})  # fmt: skip
+    assert math.isfinite(fit.cost)
 
 
 @pytest.mark.parametrize(
@@ -407,8 +431,8 @@ def test_json_output_is_always_valid_json():
 @pytest.mark.parametrize(
     "argv, fragment",
     [
-        (["--seed", str(2**64)], "`seed` must be an integer in 0 .."),
-        (["--seed", "-1"], "`seed`"),
+        (["--seed", str(2**64)], "argument --seed: must be an integer in 0 .."),
+        (["--seed", "-1"], "argument --seed"),
         (["--m", "1e308"], "linearised scales"),
         (["--k3", "1e308"], "linearised scales"),
         (["--psd", "1e308"], "linearised scales"),
@@ -426,7 +450,7 @@ def test_simulate_extreme_values_one_line(capsys, argv, fragment):
     "extra, fragment",
     [
         (["--lowpass", "1e-308"], "`lowpass` must be at least"),
-        (["--seed", "-1"], "`seed` must be an integer in 0 .."),
+        (["--seed", "-1"], "argument --seed: must be an integer in 0 .."),
         (["--sample-rate", "1e-308", "--time-column", "none"], "search bounds of"),
     ],
 )
@@ -599,7 +623,7 @@ def test_unreadable_stored_fit_is_named_and_fitted_again(tmp_path, record_csv):
 
 def test_record_seed_out_of_range_named(capsys, tmp_path):
     argv = ["record", "--preset", "figure9", "--rms", "2", "--out", tmp_path / "x.csv"]
-    one_line_error(capsys, [*argv, "--seed", "-1"], "`--seed` must be an integer in 0 ..")
+    one_line_error(capsys, [*argv, "--seed", "-1"], "argument --seed: must be an integer in 0 ..")
     one_line_error(capsys, [*argv, "--duration", "1e23"], "of memory")
 
 
@@ -618,3 +642,186 @@ def test_ctrl_c_in_a_study_exits_130_and_releases_its_folder(capsys, tmp_path, m
     assert code == 130 and "Traceback" not in err
     assert (tmp_path / "s" / "first.csv").read_text() == "finished part\n"  # kept
     assert not (tmp_path / "s" / _io.LOCK_FILE).exists()
+
+
+# ------------------------------------------------------------------ SIGTERM, Ctrl-C on a pool
+def _subprocess_env():
+    return {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]),
+        "NUMBA_NUM_THREADS": "1",
+    }
+
+
+def test_sigterm_stops_simulate_and_exits_143():
+    simulate(BASE, 1.0, t_end=0.01, dt=1e-4, n_paths=2, progress=False)  # numba cache warm
+    # 4e10 path-steps: its LongRunWarning is printed once the run starts
+    argv = ["simulate", "--preset", "figure9", "--psd", "1", "--paths", "200",
+            "--t-end", "20000", "--dt", "1e-4"]  # fmt: skip
+    child = subprocess.Popen(
+        [sys.executable, "-m", "randvib", *argv],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=_subprocess_env(),
+    )
+    assert "will take about" in child.stderr.readline()
+    time.sleep(0.5)
+    child.send_signal(signal.SIGTERM)
+    out, err = child.communicate(timeout=60)
+    assert child.returncode == 143, err
+    assert "terminated" in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+SWEEP_STUDY = """
+import sys
+import randvib as rv
+import randvib.cli.study
+from randvib.cli import main
+from randvib.montecarlo.sweep import SweepSettings, cartesian, run_sweep
+
+
+def sweep_study(out_dir, *, quick, seed, workers, scheduler, progress):
+    # 2000 small points on 2 worker processes: minutes, far longer than the test waits
+    settings = SweepSettings(dt=2e-4, window=1.0, burn_in=0.05, target_rel_ci=0.5,
+                             min_paths=8, batch_paths=8, max_paths=8)
+    points = cartesian(psd=[1.0 + i / 1000 for i in range(2000)])
+    run_sweep(rv.preset("figure9"), points, settings, out_dir=out_dir, workers=workers,
+              progress=False)
+
+
+if __name__ == "__main__":
+    randvib.cli.study.load_study = lambda name: sweep_study
+    sys.exit(main(["study", "interaction", "--out", sys.argv[1], "--workers", "2"]))
+"""
+
+
+def _children(pid):
+    """Process ids whose parent is ``pid`` (Linux /proc)."""
+    found = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid:
+            found.append(int(stat.parent.name))
+    return found
+
+
+@pytest.mark.parametrize(
+    "how, code",
+    [("ctrl-c", 130), ("sigterm", 143)],
+)
+def test_interrupted_process_pool_sweep_keeps_points_and_ends_workers(tmp_path, how, code):
+    """Ctrl-C (SIGINT to the whole process group, as a terminal sends it) or
+    SIGTERM (to the parent only) on a sweep over 2 worker processes: exit
+    130 / 143, no worker left, the finished points kept and valid, the lock gone."""
+    simulate(BASE, 1.0, t_end=0.01, dt=2e-4, n_paths=2, progress=False)  # numba cache warm
+    script, out = tmp_path / "sweep_study.py", tmp_path / "out"
+    script.write_text(SWEEP_STUDY)
+    child = subprocess.Popen(
+        [sys.executable, str(script), str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=_subprocess_env(),
+        start_new_session=True,  # its own process group, as a shell job
+    )
+    deadline = time.monotonic() + 120
+    while not list(out.glob("points/*.json")) and time.monotonic() < deadline:
+        assert child.poll() is None, child.communicate()
+        time.sleep(0.1)
+    workers = _children(child.pid)
+    assert len(workers) >= 2  # the two workers (and spawn's resource tracker)
+    if how == "ctrl-c":
+        os.killpg(child.pid, signal.SIGINT)
+    else:
+        child.send_signal(signal.SIGTERM)
+    _, err = child.communicate(timeout=60)
+    assert child.returncode == code, err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+    deadline = time.monotonic() + 30
+    while any(_alive(p) for p in workers) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not [p for p in workers if _alive(p)]
+    assert not (out / _io.LOCK_FILE).exists()
+    points = sorted(out.glob("points/*.json"))
+    assert 1 <= len(points) < 2000
+    for p in points:
+        stored = json.loads(p.read_text())
+        assert math.isfinite(stored["row"]["power_electrical"])
+
+
+def test_record_extreme_excitation_names_the_excitation(capsys, tmp_path):
+    argv = ["record", "--preset", "figure9", "--out", tmp_path / "x.csv"]
+    for extra in (["--rms", "1e308"], ["--psd", "1e308"]):
+        one_line_error(capsys, [*argv, *extra], "`excitation`")
+    code, _, err = run(capsys, *argv, "--rms", "1e308")
+    assert "input_values" not in err
+
+
+INTEGER_OPTIONS = [
+    (["simulate", "--preset", "figure9", "--psd", "1"], "--paths", 1),
+    (["simulate", "--preset", "figure9", "--psd", "1"], "--threads", 1),
+    (["simulate", "--preset", "figure9", "--psd", "1"], "--seed", 0),
+    (["simulate", "--preset", "figure9"], "--segments", 2),
+    (["record", "--preset", "figure9", "--rms", "1", "--out", "x.csv"], "--substeps", 1),
+    (["identify", "rec.csv", "--model", "coulomb"], "--popsize", 6),
+    (["identify", "rec.csv", "--model", "coulomb"], "--generations", 0),
+    (["validate", "p.json", "rec.csv"], "--skip", 0),
+    (["validate", "p.json", "rec.csv"], "--substeps", 1),
+    (["study", "figure9", "--out", "o"], "--workers", 1),
+]
+
+
+@pytest.mark.parametrize("argv, option, minimum", INTEGER_OPTIONS)
+def test_integer_options_named_and_accept_float_notation(capsys, argv, option, minimum):
+    """Every integer option: a non-integer, 'nan', a value below its minimum or
+    beyond any count is refused naming the option (never 'invalid int value' or
+    a library argument); float notation of an integer (1e1) is parsed."""
+    from randvib._validation import integer_option
+
+    for bad in ("0.5", "nan", "1e999999999", "abc", str(minimum - 1)):
+        one_line_error(capsys, [*argv, f"{option}={bad}"], f"argument {option}: must be an integer")
+    parse = integer_option(minimum)
+    assert parse("1e1") == 10 and parse(f"{minimum}.0") == minimum and parse("1e23") == 10**23
+
+
+def test_own_refusal_is_not_called_a_float64_overflow(capsys):
+    """Found by the fuzz test over the new options: a free mass (k = k3 = 0) under a
+    band-pass input was refused with "outside the range float64 can represent"
+    appended to the real reason."""
+    code, _, err = run(capsys, "power", "--preset", "figure9", "--psd", "1", "--excitation",
+                       "band-pass", "--f0", "1", "--zeta", "0.1", "--k", "0", "--k3", "0")  # fmt: skip
+    assert code == 2 and "confining potential" in err and "float64" not in err
+
+
+def test_coupling_overflow_is_a_value_error():
+    """Found by the fuzz test: alpha = 1e308 raised OverflowError from alpha**2."""
+    from randvib.models.coupling import Resistive
+
+    with pytest.raises(ValueError, match="overflows float64"):
+        rv.Harvester.with_coupling(0.02, 0.1, 50.0, Resistive(1e308, 100.0, 10.0))
+
+
+@pytest.mark.parametrize(
+    "stop, code",
+    [(KeyboardInterrupt, 130), ("sigterm", 143)],
+)
+def test_study_script_main_stops_with_one_line(capsys, tmp_path, stop, code):
+    """``python studies/NAME.py OUT``: Ctrl-C and SIGTERM end with 130 / 143 and
+    one line (they printed a KeyboardInterrupt traceback)."""
+    from randvib.studies import script_main
+
+    def run_study(out_dir, *, quick, seed, workers, scheduler, progress):
+        """A study stopped while it runs."""
+        if stop == "sigterm":
+            os.kill(os.getpid(), signal.SIGTERM)  # handled: raises Terminated here
+            time.sleep(5)
+        raise stop()
+
+    run_study.__module__ = __name__
+    assert script_main(run_study, [str(tmp_path / "o")]) == code
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err

@@ -383,15 +383,14 @@ def _finite(method: str, harvester: Harvester, psd, solver) -> PowerPrediction:
     try:
         with np.errstate(all="ignore"):
             result = solver(harvester, psd)
-    except (ArithmeticError, RuntimeError) as exc:
-        raise ValueError(
-            _out_of_range(method, harvester, psd, f"{type(exc).__name__}: {exc}")
-        ) from None
-    except ValueError as exc:
-        if "`" in str(exc):  # randvib's own messages name their argument in backticks
-            raise
-        # a library's (scipy: "array must not contain infs or NaNs") after an overflow
-        raise ValueError(_out_of_range(method, harvester, psd, f"ValueError: {exc}")) from None
+    except (ArithmeticError, RuntimeError, ValueError) as exc:
+        own = _raised_by_randvib(exc) and not isinstance(exc, ArithmeticError)
+        if own and isinstance(exc, ValueError):
+            raise  # randvib's own explanation (no stationary response, a potential it cannot treat)
+        # a library's (scipy: "array must not contain infs or NaNs") after an
+        # overflow; randvib's own RuntimeError (no convergence) is not one
+        what = f"{type(exc).__name__}: {exc}"
+        raise ValueError(_out_of_range(method, harvester, psd, what, overflow=not own)) from None
     values = {
         "velocity_variance": result.velocity_variance,
         "displacement_variance": result.displacement_variance,  # None for the free mass
@@ -410,11 +409,26 @@ def _finite(method: str, harvester: Harvester, psd, solver) -> PowerPrediction:
     return result
 
 
-def _out_of_range(method, harvester, psd, what) -> str:
+def _raised_by_randvib(exc: BaseException) -> bool:
+    """Whether ``exc`` was raised in randvib's own code (not in numpy or scipy)."""
+    from pathlib import Path
+
+    tb = exc.__traceback__
+    if tb is None:
+        return False
+    while tb.tb_next is not None:
+        tb = tb.tb_next
+    package = Path(__file__).resolve().parents[1]
+    return Path(tb.tb_frame.f_code.co_filename).resolve().is_relative_to(package)
+
+
+def _out_of_range(method, harvester, psd, what, overflow: bool = True) -> str:
     level = psd.parameters() if isinstance(psd, Excitation) else psd
+    text = f"method {method!r} has no finite result at these values ({what}): psd = {level!r}, "
+    if not overflow:
+        return text + str(harvester.parameters())
     return (
-        f"method {method!r} has no finite result at these values ({what}): psd = {level!r}, "
-        f"{harvester.parameters()}; the parameters are outside the range float64 can "
+        text + f"{harvester.parameters()}; the parameters are outside the range float64 can "
         "represent for this device"
     )
 

@@ -334,6 +334,15 @@ def _typical_level(excitation) -> float:
     return float(level)
 
 
+class LinearisationDidNotConverge(ValueError, RuntimeError):
+    """No fixed point of the statistical linearisation was found.
+
+    A ValueError (the device and excitation admit no Gaussian linearisation
+    the solver can find: callers report it as a refusal, one line), and a
+    RuntimeError as before.
+    """
+
+
 def _solve(residual, x0) -> np.ndarray:
     """Root of ``residual`` (log variances) by Powell's hybrid method.
 
@@ -347,7 +356,7 @@ def _solve(residual, x0) -> np.ndarray:
             return solution.x
         for _ in range(50):
             x = x + 0.5 * residual(x)
-    raise RuntimeError(
+    raise LinearisationDidNotConverge(
         "statistical linearisation did not converge (largest log-variance residual "
         f"{np.max(np.abs(residual(solution.x))):.3g}); a narrow-band excitation near the "
         "resonance can admit several solutions: use Monte Carlo (randvib.simulate)"

@@ -4,7 +4,9 @@ Each command lives in its own module exposing ``register(subparsers)`` which
 adds its parser and sets ``handler``; :data:`COMMANDS` lists the modules.
 Every user error (bad value, unknown name, unreadable or unwritable file)
 ends with one line on stderr and exit status 2, never a traceback; Ctrl-C
-ends with exit status 130 (what was finished is kept). Anything else that
+ends with exit status 130 and SIGTERM with 143 (128 + 15), both keeping
+what was finished, releasing folder locks and ending worker processes.
+Anything else that
 escapes a command is a bug: one line naming it, exit status 1, and the
 traceback only with ``RANDVIB_TRACEBACK=1``.
 """
@@ -18,6 +20,8 @@ import os
 import re
 import sys
 import warnings
+
+from randvib._interrupts import interrupted_exit, sigterm_stops
 
 #: Command modules under randvib.cli, in the order shown by --help.
 COMMANDS = ["power", "simulate", "study", "record", "identify", "validate"]
@@ -138,7 +142,8 @@ def _main_with_warnings(argv) -> int:
         for advice in _advice_warnings():
             warnings.filterwarnings("default", category=advice)
         warnings.showwarning = _show_warning
-        return _main(argv)
+        with sigterm_stops():
+            return _main(argv)
 
 
 def _advice_warnings() -> tuple:
@@ -232,9 +237,10 @@ def _main(argv) -> int:
             message = f"randvib: error: {message}"
         print(message, file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("randvib: interrupted; finished results were kept", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (Terminated)
+        code, line = interrupted_exit(exc)
+        print(line, file=sys.stderr)
+        return code
     except Exception as exc:  # a bug: one line, not a traceback (unless asked for)
         if os.environ.get("RANDVIB_TRACEBACK"):
             raise

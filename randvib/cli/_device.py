@@ -6,7 +6,7 @@ import argparse
 
 from randvib.models.coupling import COUPLINGS, coupling_class
 from randvib.models.friction import FRICTION_MODELS, RegistryView
-from randvib.models.harvester import Harvester
+from randvib.models.harvester import ElectricalDampingOverflow, Harvester
 from randvib.models.presets import PRESETS, preset
 
 #: ``--friction`` choices: ``none`` and every registered law (live view).
@@ -141,7 +141,7 @@ def harvester_from_args(args) -> Harvester:
                 friction=friction,
                 stroke=args.stroke,
             )
-        except (OverflowError, ZeroDivisionError):
+        except (OverflowError, ZeroDivisionError, ElectricalDampingOverflow):
             flags = ", ".join(f"`{option_flag(n)}`" for n in coupling.parameter_names())
             raise ValueError(
                 f"{flags}: the {coupling.name} coupling's electrical damping is not a finite number"

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 
+from randvib._validation import integer_option
 from randvib.identification.fitting import (
     INITIAL_STATES,
     OUTPUT_COLUMN,
@@ -39,7 +40,10 @@ def add_record_arguments(parser: argparse.ArgumentParser) -> None:
     )
     s = parser.add_argument_group("simulation")
     s.add_argument(
-        "--substeps", type=int, default=None, help="integration steps per sample (default: 4)"
+        "--substeps",
+        type=integer_option(1),
+        default=None,
+        help="integration steps per sample (default: 4)",
     )
     s.add_argument(
         "--hold",
@@ -50,7 +54,10 @@ def add_record_arguments(parser: argparse.ArgumentParser) -> None:
     )
     s.add_argument("--lowpass", type=float, metavar="HZ", help="low-pass the driving signal")
     s.add_argument(
-        "--skip", type=int, default=None, help="samples left out of J at the start (default: 0)"
+        "--skip",
+        type=integer_option(0),
+        default=None,
+        help="samples left out of J at the start (default: 0)",
     )
     s.add_argument(
         "--initial-state",

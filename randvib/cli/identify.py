@@ -6,6 +6,7 @@ import sys
 from pathlib import Path
 
 from randvib._io import check_output_file, dumps, write_or_keep
+from randvib._validation import MAX_SEED, integer_option
 from randvib.cli._output import print_table
 from randvib.cli._records import (
     add_record_arguments,
@@ -39,7 +40,7 @@ def register(sub) -> None:
         type=float,
         help="mass (kg); required for base excitation, identified if omitted with a force input",
     )
-    p.add_argument("--seed", type=int, default=0, help="random seed")
+    p.add_argument("--seed", type=integer_option(0, MAX_SEED), default=0, help="random seed")
     p.add_argument(
         "--fix", action="append", metavar="NAME=VALUE", help="hold a parameter, e.g. --fix k3=0"
     )
@@ -49,16 +50,21 @@ def register(sub) -> None:
     p.add_argument(
         "--quadratic", action="store_true", help="also estimate k2: force k z + k2 z^2 + k3 z^3"
     )
-    p.add_argument("--popsize", type=int, default=DEFAULT.popsize, help="SaDE population, popsize")
+    p.add_argument(
+        "--popsize",
+        type=integer_option(6),
+        default=DEFAULT.popsize,
+        help="SaDE population, popsize",
+    )
     p.add_argument(
         "--generations",
-        type=int,
+        type=integer_option(0),
         default=DEFAULT.maxiter,
         help="SaDE generations, the API's maxiter",
     )
     p.add_argument(
         "--search-samples",
-        type=int,
+        type=integer_option(1),
         metavar="N",
         help="search on the record's first N samples only; the polish fits all of it",
     )

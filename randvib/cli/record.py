@@ -13,7 +13,7 @@ from pathlib import Path
 
 from randvib._io import check_output_file
 from randvib._resources import check_memory
-from randvib._validation import MAX_SEED, check_int
+from randvib._validation import MAX_SEED, check_int, integer_option
 from randvib.cli._device import add_device_arguments, harvester_from_args
 from randvib.identification.synthetic import PAPER_BAND, SYNTHETIC_INPUTS, synthetic_record
 from randvib.models.excitation import BandLimited
@@ -40,8 +40,12 @@ def register(sub) -> None:
         metavar="KIND",
         help=f"what the record's input column holds: {', '.join(SYNTHETIC_INPUTS)}",
     )
-    g.add_argument("--substeps", type=int, default=8, help="steps per sample (default 8)")
-    g.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    g.add_argument(
+        "--substeps", type=integer_option(1), default=8, help="steps per sample (default 8)"
+    )
+    g.add_argument(
+        "--seed", type=integer_option(0, MAX_SEED), default=0, help="random seed (default 0)"
+    )
     s = p.add_argument_group("sensors (measured = true + offset + noise)")
     s.add_argument("--noise-z", type=float, default=0.0, help="RMS noise on z (m)")
     s.add_argument("--noise-input", type=float, default=0.0, help="RMS noise on the input")

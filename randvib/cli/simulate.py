@@ -11,6 +11,7 @@ giving the interval.
 from __future__ import annotations
 
 from randvib._io import dumps
+from randvib._validation import MAX_SEED, integer_option
 from randvib.analytic.prediction import predict
 from randvib.cli._device import add_device_arguments, harvester_from_args
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
@@ -36,7 +37,10 @@ def register(sub) -> None:
     add_excitation_arguments(p)
     g = p.add_argument_group("simulation")
     g.add_argument(
-        "--paths", type=int, default=None, help="number of paths, n_paths (default: 1000)"
+        "--paths",
+        type=integer_option(1),
+        default=None,
+        help="number of paths, n_paths (default: 1000)",
     )
     g.add_argument(
         "--t-end",
@@ -52,7 +56,7 @@ def register(sub) -> None:
     )
     g.add_argument(
         "--segments",
-        type=int,
+        type=integer_option(2),
         default=None,
         help="with --record: windows of the record that make the paths (default 10)",
     )
@@ -64,8 +68,12 @@ def register(sub) -> None:
         metavar="SCHEME",
         help=f"integrator (the API's `scheme`): {', '.join(INTEGRATORS)}",
     )
-    g.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    g.add_argument("--threads", type=int, default=None, help="threads (default: all cores)")
+    g.add_argument(
+        "--seed", type=integer_option(0, MAX_SEED), default=0, help="random seed (default 0)"
+    )
+    g.add_argument(
+        "--threads", type=integer_option(1), default=None, help="threads (default: all cores)"
+    )
     g.add_argument(
         "--control-variates",
         action="store_true",

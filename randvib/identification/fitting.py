@@ -1043,6 +1043,7 @@ def identify(
     space = _search_space(record, model, fixed, bounds, simulation.skip)
     cost = _identification_cost(record, model, fixed, space.free, simulation)
     _announce(record, search, simulation, len(space.free))
+    _refuse_unsimulable(cost, space)
     searched = cost
     if search.search_samples is not None:
         check_int("search_samples", search.search_samples, minimum=SAMPLES_PER_PARAMETER * 2)
@@ -1283,6 +1284,46 @@ def _coordinates(cost, space, names):
         lower=np.array(lower, float),
         upper=np.array(upper, float),
     )
+
+
+#: At most this many corners of the search box are probed before a search.
+PROBE_CORNERS = 64
+
+
+def _probe_points(space: _SearchSpace) -> np.ndarray:
+    """The box's corners (a seeded sample of 64 of them in more than 6 dimensions)
+    and its centre (arithmetic, and geometric on log-scaled axes), one per row."""
+    lo = np.array([space.box[n][0] for n in space.free], dtype=float)
+    hi = np.array([space.box[n][1] for n in space.free], dtype=float)
+    d = lo.size
+    if 2**d <= PROBE_CORNERS:
+        bits = (np.arange(2**d)[:, None] >> np.arange(d)) & 1
+    else:
+        bits = np.random.default_rng(0).integers(0, 2, size=(PROBE_CORNERS, d))
+    centre = lo / 2 + hi / 2  # (lo + hi) / 2 overflows at 1e308
+    geometric = np.where(space.log, np.sqrt(np.abs(lo)) * np.sqrt(np.abs(hi)), centre)
+    return np.vstack([np.where(bits == 1, hi, lo), centre, geometric])
+
+
+def _refuse_unsimulable(cost: CostFunction, space: _SearchSpace) -> None:
+    """Refuse before searching when the model cannot simulate the record anywhere probed.
+
+    A fixed value or bound at which the model diverges or overflows (``--fix
+    k3=1e308``, ``--bounds k=1e300:1e308``) would make every candidate of the
+    search diverge; one batched simulation at the box's corners and centre
+    finds it first. Some probes diverging is normal (wide default bounds);
+    all of them diverging is refused.
+    """
+    probes = _probe_points(space)
+    with np.errstate(all="ignore"):
+        costs = cost(probes)
+    if not np.any(np.isfinite(costs)):
+        raise ValueError(
+            f"the {cost.model} model cannot simulate record {cost.record.name!r} with the "
+            f"fixed values {cost.fixed} anywhere in the bounds {space.box}: all {len(probes)} "
+            "probes (the corners and centre of the bounds) diverged; check `--fix` and "
+            "`--bounds` (nothing was searched)"
+        )
 
 
 def _initial_guess(init, space: _SearchSpace):

@@ -131,11 +131,20 @@ def synthetic_record(
     }
     substeps = check_int("substeps", substeps, minimum=1)
     excitation_rng, noise_rng = np.random.default_rng(seed).spawn(2)
-    true_input = _true_input(excitation, input, duration, sample_rate, band, excitation_rng)
+    with np.errstate(all="ignore"):
+        true_input = _true_input(excitation, input, duration, sample_rate, band, excitation_rng)
+    if not np.all(np.isfinite(true_input)):
+        raise ValueError(
+            f"`excitation` {_excitation_text(excitation)} overflows float64 in the {input} "
+            "signal; lower it (`--rms` / `--psd`)"
+        )
     dt = 1.0 / sample_rate
     z = simulate_record(device, true_input, dt, input_kind=input, substeps=substeps).z[0]
     if not np.all(np.isfinite(z)):
-        raise ValueError("the simulated response diverged; lower the excitation or `substeps` dt")
+        raise ValueError(
+            f"the simulated response to `excitation` {_excitation_text(excitation)} diverged; "
+            "lower the excitation (`--rms` / `--psd`) or raise `substeps`"
+        )
     # Independent draws per channel, always drawn so that one channel's noise
     # does not depend on whether the other has any.
     eps_input, eps_z = noise_rng.standard_normal((2, z.size))
@@ -146,6 +155,12 @@ def synthetic_record(
         z + sensor["offset_z"] + sensor["noise_z"] * eps_z,
         name,
     )
+
+
+def _excitation_text(excitation) -> str:
+    if isinstance(excitation, Real):
+        return f"{excitation!r} m/s^2 RMS"
+    return repr(excitation) if not isinstance(excitation, BaseExcitation) else "(given signal)"
 
 
 def _device(device) -> Harvester:

@@ -28,6 +28,10 @@ def _check_real(name, value, unit):
 __all__ = ["ElectricalCoupling", "Harvester"]  # ElectricalCoupling: re-exported, historical home
 
 
+class ElectricalDampingOverflow(ValueError):
+    """A coupling's electrical damping c_e overflows float64 (e.g. alpha = 1e308)."""
+
+
 @dataclass(frozen=True, eq=False)
 class Harvester:
     """Single-degree-of-freedom electromagnetic harvester (paper Eq. 1).
@@ -145,10 +149,20 @@ class Harvester:
         static (resistive, Eq. 3; inductive with L = 0; piezo with C_p = 0),
         0 when it carries a circuit state.
         """
+        try:
+            with np.errstate(all="ignore"):
+                c_e = coupling.electrical_damping
+        except OverflowError:  # Python floats: alpha**2 beyond float64
+            c_e = np.inf
+        if not np.all(np.isfinite(c_e)):
+            raise ElectricalDampingOverflow(
+                f"the electrical damping c_e of {coupling!r} is not a finite number "
+                "(it overflows float64); give coupling parameters of a physical size"
+            )
         return cls(
             m=m,
             c_m=c_m,
-            c_e=coupling.electrical_damping,
+            c_e=c_e,
             k=k,
             k3=k3,
             friction=friction,

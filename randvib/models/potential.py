@@ -110,7 +110,13 @@ class Potential:
         k, k3 = float(self.k), float(self.k3)
         if k >= 0:
             return (0.0,)
-        z_w = np.sqrt(-k / k3)
+        with np.errstate(all="ignore"):
+            z_w = np.sqrt(-k / k3)
+        if not np.isfinite(z_w):
+            raise ValueError(
+                f"the wells of the bistable potential k = {k!r} N/m, k3 = {k3!r} N/m^3 lie "
+                "beyond float64 (sqrt(-k/k3) overflows)"
+            )
         return (-float(z_w), float(z_w))
 
     @property
@@ -119,6 +125,11 @@ class Potential:
         k, k3 = np.broadcast_arrays(np.asarray(self.k, float), np.asarray(self.k3, float))
         with np.errstate(divide="ignore", invalid="ignore"):
             low = np.where((k < 0) & (k3 > 0), -(k * k) / (4.0 * np.where(k3 > 0, k3, 1.0)), 0.0)
+        if low.ndim == 0 and not np.isfinite(low):  # a grid keeps its points, -inf included
+            raise ValueError(
+                f"min U = -k^2/(4 k3) of the bistable potential k = {float(k)!r} N/m, "
+                f"k3 = {float(k3)!r} N/m^3 overflows float64"
+            )
         return scalar_or_array(low)
 
     @property

@@ -262,9 +262,15 @@ def _worker_start(parent: int, initializer=None) -> None:
     A sweep killed with SIGTERM or SIGKILL cannot shut its pool down; its
     workers would live on (one numba-loaded interpreter each). A daemon
     thread in every worker checks once a second that the parent is still
-    there and ends the worker when it is not.
+    there and ends the worker when it is not. A worker ignores SIGINT: a
+    terminal's Ctrl-C reaches the whole process group, and the parent alone
+    stops the sweep (keeping the finished points) and ends its workers, so
+    the user sees one line, not a traceback per worker.
     """
+    import signal
     import threading
+
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
     def watch():
         while True:

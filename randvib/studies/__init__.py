@@ -36,6 +36,9 @@ import inspect
 import sys
 from pathlib import Path
 
+from randvib._interrupts import interrupted_exit, sigterm_stops
+from randvib._validation import MAX_SEED, integer_option
+
 #: Where the study scripts are: ``studies/`` beside the package in a checkout.
 STUDIES_DIR = Path(__file__).resolve().parents[2] / "studies"
 
@@ -91,13 +94,18 @@ def load(name: str):
 def add_run_options(parser: argparse.ArgumentParser) -> None:
     """The options of a study run, shared by ``randvib study`` and the scripts' ``__main__``."""
     parser.add_argument("--quick", action="store_true", help="small, fast version (about a minute)")
-    parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     parser.add_argument(
-        "--workers", type=int, default=None, help="local worker processes (default: all cores)"
+        "--seed", type=integer_option(0, MAX_SEED), default=0, help="random seed (default 0)"
+    )
+    parser.add_argument(
+        "--workers",
+        type=integer_option(1),
+        default=None,
+        help="local worker processes (default: all cores)",
     )
     parser.add_argument(
         "--threads",
-        type=int,
+        type=integer_option(1),
         default=None,
         help="numba threads of a study that simulates in-process (identification, "
         "linearisation-vs-averaging; default: all cores)",
@@ -165,5 +173,11 @@ def script_main(run_study, argv=None) -> int:
     name = Path(sys.modules[run_study.__module__].__file__).stem.replace("_", "-")
     from randvib.studies.report import print_verdicts
 
-    print_verdicts(run_with_options(run_study, name, args.out, args))
+    try:
+        with sigterm_stops():  # SIGTERM stops the study as Ctrl-C does
+            print_verdicts(run_with_options(run_study, name, args.out, args))
+    except KeyboardInterrupt as exc:  # finished points and files are kept
+        code, line = interrupted_exit(exc)
+        print(line, file=sys.stderr)
+        return code
     return 0
