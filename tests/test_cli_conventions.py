@@ -71,7 +71,7 @@ def test_every_default_is_shown_in_help(name):
 #: Shared flags: the commands that must have them, and what each must be.
 SHARED = {
     "--json": ({"power", "simulate", "identify", "validate"}, dict(const=True, default=False)),
-    "--seed": ({"simulate", "record", "identify", "study"}, dict(type=int, default=0)),
+    "--seed": ({"simulate", "record", "identify", "study"}, dict(default=0)),
     "--no-progress": ({"simulate", "identify", "study"}, dict(const=True, default=False)),
 }
 
@@ -86,6 +86,12 @@ def test_shared_flags_have_one_meaning(flag):
         if action is not None:
             for attribute, value in spec.items():
                 assert getattr(action, attribute) == value, (name, flag, attribute)
+            if flag == "--seed":  # one integer type: 0 .. 2^64 - 1, float notation of an integer
+                assert action.type("12") == 12 and action.type("1e3") == 1000, name
+                assert action.type(str(2**64 - 1)) == 2**64 - 1, name
+                for bad in ("-1", str(2**64), "0.5"):
+                    with pytest.raises(argparse.ArgumentTypeError):
+                        action.type(bad)
 
 
 def test_every_output_file_option_has_force():
