@@ -407,6 +407,47 @@ def auxiliary_step(z, v, theta, x1, x2, x3, dt, noise, weights, drift, kind, p, 
     )
 
 
+@numba.njit(cache=True, inline="always")
+def filter_step(z, v, theta, x1, x2, dt, noise, weights, drift, kind, p, fn, block):
+    """:func:`auxiliary_step` for a 2-state shaping filter alone (no circuit, g_v = 0).
+
+    The same operations in the same order without the third state's and the
+    velocity drive's exact zeros, so the results are those of
+    :func:`auxiliary_step` bit for bit, at the cost of a 2-state filter.
+    """
+    b1, b2 = weights
+    a11, a12, a21, a22 = block[0], block[1], block[3], block[4]
+    g1, g2, c1, c2 = block[12], block[13], block[15], block[16]
+    acc1, rate1, force = _acceleration(z, v, theta, drift, kind, p, fn)
+    acc1 -= c1 * x1 + c2 * x2
+    d1 = a11 * x1 + a12 * x2
+    d2 = a21 * x1 + a22 * x2
+    if b2 == 0.0:
+        return (
+            z + b1 * v * dt,
+            v + b1 * acc1 * dt,
+            theta + b1 * rate1 * dt,
+            x1 + b1 * d1 * dt + g1 * noise,
+            x2 + b1 * d2 * dt + g2 * noise,
+            force,
+        )
+    zp = z + v * dt
+    vp = v + acc1 * dt
+    tp = theta + rate1 * dt
+    x1p = x1 + d1 * dt + g1 * noise
+    x2p = x2 + d2 * dt + g2 * noise
+    acc2, rate2, _ = _acceleration(zp, vp, tp, drift, kind, p, fn)
+    acc2 -= c1 * x1p + c2 * x2p
+    return (
+        z + (b1 * v + b2 * vp) * dt,
+        v + (b1 * acc1 + b2 * acc2) * dt,
+        theta + (b1 * rate1 + b2 * rate2) * dt,
+        x1 + (b1 * d1 + b2 * (a11 * x1p + a12 * x2p)) * dt + g1 * noise,
+        x2 + (b1 * d2 + b2 * (a21 * x1p + a22 * x2p)) * dt + g2 * noise,
+        force,
+    )
+
+
 @numba.njit(cache=True, parallel=True, nogil=True)
 def run_ensemble(
     scheme, device, friction, timing, paths, initial, companion, recording, noise, auxiliary, stop
@@ -467,6 +508,7 @@ def run_ensemble(
     # plain loop, bit for bit and at its own speed; any filter or circuit
     # compiles one second specialisation. The block's coefficients go to the
     # step as a tuple of floats (an array would cost a reference count per step).
+    filter_only = False
     if auxiliary is not None:
         n_aux = auxiliary.n
         ac = auxiliary.coefficients
@@ -475,6 +517,16 @@ def run_ensemble(
             ac[10], ac[11], ac[12], ac[13], ac[14], ac[15], ac[16], ac[17], ac[18],
         )  # fmt: skip
         p1, p2, p3 = auxiliary.square[0], auxiliary.square[1], auxiliary.square[2]
+        # a 2-state filter alone (no circuit: no square, no velocity drive, g_v = 0)
+        filter_only = (
+            n_aux == 2
+            and p1 == 0.0
+            and p2 == 0.0
+            and p3 == 0.0
+            and ac[9] == 0.0
+            and ac[10] == 0.0
+            and ac[18] == 0.0
+        )
         chol = auxiliary.start
     n_chunks = (n_paths + LANES - 1) // LANES
     acc = np.zeros((n_paths, N_ACC))
@@ -543,7 +595,23 @@ def run_ensemble(
                 zj = z[j]
                 vj = v[j]
                 tj = th[j]
-                if auxiliary is not None:
+                if auxiliary is not None and filter_only:
+                    zn, vn, tn, x1[j], x2[j], f1 = filter_step(
+                        zj,
+                        vj,
+                        tj,
+                        x1[j],
+                        x2[j],
+                        dt,
+                        noise,
+                        scheme,
+                        drift,
+                        fr_kind,
+                        fr_p,
+                        fr_fn,
+                        block,
+                    )
+                elif auxiliary is not None:
                     x1j = x1[j]
                     x2j = x2[j]
                     x3j = x3[j]
