@@ -89,7 +89,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     Mutation(
         name="filter-damping-in-kernel",
         path="randvib/montecarlo/kernel.py",
-        edits=(("d2 = a21 * x1 + a22 * x2", "d2 = a21 * x1 + 1.05 * a22 * x2"),),
+        edits=(("r2 = a21 * x1 + a22 * x2", "r2 = a21 * x1 + 1.05 * a22 * x2"),),
         tests=("tests/test_simulation_coloured.py::test_coarse_step_exact",),
         why="The shaping filter's damping term is 5 % too large in the first stage of the "
         "filter-state step (the whole of Euler-Maruyama's, half of Heun's), so the base "

@@ -420,30 +420,30 @@ def filter_step(z, v, theta, x1, x2, dt, noise, weights, drift, kind, p, fn, blo
     g1, g2, c1, c2 = block[12], block[13], block[15], block[16]
     acc1, rate1, force = _acceleration(z, v, theta, drift, kind, p, fn)
     acc1 -= c1 * x1 + c2 * x2
-    d1 = a11 * x1 + a12 * x2
-    d2 = a21 * x1 + a22 * x2
+    r1 = a11 * x1 + a12 * x2
+    r2 = a21 * x1 + a22 * x2
     if b2 == 0.0:
         return (
             z + b1 * v * dt,
             v + b1 * acc1 * dt,
             theta + b1 * rate1 * dt,
-            x1 + b1 * d1 * dt + g1 * noise,
-            x2 + b1 * d2 * dt + g2 * noise,
+            x1 + b1 * r1 * dt + g1 * noise,
+            x2 + b1 * r2 * dt + g2 * noise,
             force,
         )
     zp = z + v * dt
     vp = v + acc1 * dt
     tp = theta + rate1 * dt
-    x1p = x1 + d1 * dt + g1 * noise
-    x2p = x2 + d2 * dt + g2 * noise
+    x1p = x1 + r1 * dt + g1 * noise
+    x2p = x2 + r2 * dt + g2 * noise
     acc2, rate2, _ = _acceleration(zp, vp, tp, drift, kind, p, fn)
     acc2 -= c1 * x1p + c2 * x2p
     return (
         z + (b1 * v + b2 * vp) * dt,
         v + (b1 * acc1 + b2 * acc2) * dt,
         theta + (b1 * rate1 + b2 * rate2) * dt,
-        x1 + (b1 * d1 + b2 * (a11 * x1p + a12 * x2p)) * dt + g1 * noise,
-        x2 + (b1 * d2 + b2 * (a21 * x1p + a22 * x2p)) * dt + g2 * noise,
+        x1 + (b1 * r1 + b2 * (a11 * x1p + a12 * x2p)) * dt + g1 * noise,
+        x2 + (b1 * r2 + b2 * (a21 * x1p + a22 * x2p)) * dt + g2 * noise,
         force,
     )
 
