@@ -41,14 +41,13 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from randvib._validation import check_nonnegative, check_positive, scalar_or_array
-from randvib.models.friction import Parameter, parameter
+from randvib.models.friction import DeclaredParameters, parameter
 
 #: Registered couplings by name (``resistive``, ``inductive``, ``piezo``).
 COUPLINGS: dict[str, type] = {}
 
 
-class Coupling:
+class Coupling(DeclaredParameters):
     """Base class of the electrical couplings: the declaration every consumer reads.
 
     Subclasses are frozen dataclasses whose fields are made with
@@ -66,24 +65,6 @@ class Coupling:
         super().__init_subclass__(**kwargs)
         if "name" in cls.__dict__:
             COUPLINGS[cls.name] = cls
-
-    @classmethod
-    def parameter_specs(cls) -> dict[str, Parameter]:
-        """Declared parameters by name."""
-        return {f.name: f.metadata["parameter"] for f in fields(cls)}
-
-    @classmethod
-    def parameter_names(cls) -> tuple[str, ...]:
-        return tuple(f.name for f in fields(cls))
-
-    def __post_init__(self):
-        # One validation from the declarations: the message names the
-        # parameter, its value, the allowed range and the unit.
-        for name, spec in self.parameter_specs().items():
-            check = check_positive if spec.positive else check_nonnegative
-            object.__setattr__(
-                self, name, scalar_or_array(check(name, getattr(self, name), spec.unit))
-            )
 
     def parameters(self) -> dict:
         """The coupling's parameters by name (SI units)."""

@@ -159,7 +159,36 @@ def _no_generic_kernel(p, v, theta):
 _COMPILED_KERNELS: dict[type, object] = {}
 
 
-class FrictionModel:
+class DeclaredParameters:
+    """What every model family declared with :func:`parameter` fields shares.
+
+    The family's base class (friction laws, couplings) inherits it: the
+    declarations by name, in field order (the kernel's order for friction
+    laws), and one validation from them, so a bad value is named the same
+    way in every family.
+    """
+
+    @classmethod
+    def parameter_specs(cls) -> dict[str, Parameter]:
+        """Declared parameters by name, in field order."""
+        return {f.name: f.metadata["parameter"] for f in fields(cls)}
+
+    @classmethod
+    def parameter_names(cls) -> tuple[str, ...]:
+        """Parameter names in field order."""
+        return tuple(f.name for f in fields(cls))
+
+    def __post_init__(self):
+        # One validation from the declarations: a message names the
+        # parameter, its value, the allowed range and the unit.
+        for name, spec in self.parameter_specs().items():
+            check = check_positive if spec.positive else check_nonnegative
+            object.__setattr__(
+                self, name, scalar_or_array(check(name, getattr(self, name), spec.unit))
+            )
+
+
+class FrictionModel(DeclaredParameters):
     """Base class of the friction laws: the declaration every consumer reads.
 
     Subclasses are frozen dataclasses whose fields are made with
@@ -196,25 +225,6 @@ class FrictionModel:
         FRICTION_MODELS[cls.name] = cls
 
     # ------------------------------------------------------------ parameters
-    @classmethod
-    def parameter_specs(cls) -> dict[str, Parameter]:
-        """Declared parameters by name, in kernel order."""
-        return {f.name: f.metadata["parameter"] for f in fields(cls)}
-
-    @classmethod
-    def parameter_names(cls) -> tuple[str, ...]:
-        """Parameter names in kernel order."""
-        return tuple(f.name for f in fields(cls))
-
-    def __post_init__(self):
-        # One validation for every law, from the declarations: a message names
-        # the parameter, its value, the allowed range and the unit.
-        for name, spec in self.parameter_specs().items():
-            check = check_positive if spec.positive else check_nonnegative
-            object.__setattr__(
-                self, name, scalar_or_array(check(name, getattr(self, name), spec.unit))
-            )
-
     def parameters(self) -> dict:
         """The law's parameters by name (SI units)."""
         return {f.name: scalar_or_array(np.asarray(getattr(self, f.name))) for f in fields(self)}
