@@ -67,6 +67,7 @@ import numpy as np
 import pandas as pd
 
 import randvib as rv
+from randvib._progress import progress_bar
 from randvib.analytic.linear_response import mechanical_block, output_variances
 from randvib.montecarlo.simulation import estimate
 from randvib.studies import script_main
@@ -250,9 +251,7 @@ def compute(axes, seed, threads, progress) -> tuple[pd.DataFrame, pd.DataFrame]:
     points = [(name, g) for name in axes["inputs"] for g in axes["levels"]]
     bar = None
     if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=len(points), desc=NAME, unit="point", disable=None)
+        bar = progress_bar(len(points), desc=NAME, unit="point")
     results, methods = [], []
     for i, (name, g) in enumerate(points):
         r, m = compute_point(name, g, axes, seed * 1000 + i, threads)

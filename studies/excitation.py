@@ -49,6 +49,7 @@ import pandas as pd
 from scipy import special
 
 import randvib as rv
+from randvib._progress import progress_bar
 from randvib.analytic.linear_response import mechanical_block, output_variances
 from randvib.montecarlo.simulation import estimate
 from randvib.montecarlo.sweep import holm_significant, two_sided_p_value
@@ -154,9 +155,7 @@ def compute(base, axes, seed, threads, progress) -> tuple[pd.DataFrame, pd.DataF
     cases = _cases(base, axes)
     bar = None
     if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=len(cases), desc=NAME, unit="band", disable=None)
+        bar = progress_bar(len(cases), desc=NAME, unit="band")
     results, contrasts = [], []
     for i, (centre, zeta, excitation) in enumerate(cases):
         head = {"centre": centre, "f0": getattr(excitation, "f0", np.nan), "zeta": zeta,

@@ -38,6 +38,7 @@ import numpy as np
 import pandas as pd
 
 import randvib as rv
+from randvib._progress import progress_bar
 from randvib.studies import figures, script_main
 from randvib.studies.methods import (
     ANALYTIC,
@@ -86,9 +87,7 @@ def compute_table(quick: bool, seed: int, threads, progress: bool) -> pd.DataFra
     columns = [(psd, kappa) for psd in psds for kappa in kappas]
     bar = None
     if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=len(columns), desc=NAME, unit="column", disable=None)  # terminals only
+        bar = progress_bar(len(columns), desc=NAME, unit="column")
     rows = []
     for i, (psd, kappa) in enumerate(columns):
         # A fresh seed per (S, kappa) column; shared within it (paired k3).

@@ -106,13 +106,14 @@ def test_every_output_file_option_has_force():
 #: Option destinations that name one of a fixed set: declared as argparse choices.
 CHOICE_DESTS = ("method", "friction", "coupling", "preset", "excitation", "input", "model")
 CHOICE_DESTS += ("hold", "input_kind")
+CHOICE_DESTS += ("name",)  # randvib study NAME
 
 
 def test_choices_are_declared():
     seen = set()
     for name, parser in subcommands().items():
         for action in parser._actions:
-            if action.dest in CHOICE_DESTS and action.option_strings:
+            if action.dest in CHOICE_DESTS:
                 assert action.choices is not None, (name, action.dest)
                 seen.add(action.dest)
     assert seen == set(CHOICE_DESTS)

@@ -210,4 +210,6 @@ def test_interaction_verdict_follows_the_data():
 
 def test_unknown_study(capsys, tmp_path):
     assert main(["study", "nope", "--out", str(tmp_path / "x")]) == 2
-    assert "unknown study 'nope'" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "`NAME` must be one of figure9, interaction" in err and "got 'nope'" in err
+    assert not (tmp_path / "x").exists()

@@ -26,7 +26,7 @@ def register(sub) -> None:
         description="Run one of the study scripts of the checkout's studies/ folder; "
         "writes PNG figures, CSV tables and a Markdown report into --out.",
     )
-    p.add_argument("name", help=f"study: {', '.join(STUDIES)}")
+    p.add_argument("name", choices=STUDIES, metavar="NAME", help=f"study: {', '.join(STUDIES)}")
     p.add_argument(
         "--out",
         required=True,

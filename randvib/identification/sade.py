@@ -36,6 +36,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from randvib._progress import progress_bar
 from randvib._resources import check_memory
 from randvib._validation import check_int
 
@@ -278,7 +279,7 @@ def sade(
     callback : callable, optional
         ``callback(generation, best_x, best_cost)``; returning True stops.
     progress : bool
-        Show a tqdm progress bar with the best cost.
+        Show a progress bar (terminal or notebook) with the best cost.
 
     Returns
     -------
@@ -305,7 +306,7 @@ def sade(
     best = int(np.argmin(costs))
     stall = 0
     message = f"maximum number of generations ({maxiter}) reached"
-    bar = _progress_bar(maxiter) if progress else None
+    bar = progress_bar(maxiter, desc="SaDE", unit="gen", transient=True) if progress else None
     nit = 0
     try:
         for gen in range(maxiter):
@@ -407,12 +408,6 @@ def _batched_cost(func, space):
         return np.where(np.isfinite(costs), costs, np.inf)
 
     return evaluate
-
-
-def _progress_bar(maxiter):
-    from tqdm.auto import tqdm
-
-    return tqdm(total=maxiter, desc="SaDE", unit="gen", leave=False, disable=None)  # terminals only
 
 
 def _polish(evaluate, pop, costs, best, maxfev):

@@ -30,8 +30,6 @@ depend on any assumption about correlation times.
 
 from __future__ import annotations
 
-import os
-import sys
 import threading
 import time
 import warnings
@@ -42,6 +40,7 @@ import numpy as np
 from scipy import linalg, special  # Student t quantile; lighter than scipy.stats
 
 from randvib import _display
+from randvib._progress import progress_bar, progress_wanted
 from randvib._resources import announce_duration, check_memory
 from randvib._validation import (
     MAX_SEED,
@@ -1170,7 +1169,8 @@ def simulate(
         Paths per compiled call (default: all, or chunks of about a second when
         a progress bar is shown). Results do not depend on it.
     progress : bool, optional
-        Progress bar (default: on when stderr is a terminal).
+        Progress bar (default: on in a notebook or when stderr is a terminal,
+        off in CI and in logs).
     check_step : bool
         Refuse steps that are too large (default True).
     method : str, optional
@@ -1233,7 +1233,7 @@ def execute(run: _Run, *, control_variates, check_step, threads, batch_paths, pr
         numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
     _check_resources(run, batch_paths, progress)
     if progress is None:
-        progress = sys.stderr.isatty() and os.environ.get("CI") is None
+        progress = progress_wanted()
     if batch_paths is None and run.driver is not None:  # the input's memory stays bounded
         batch_paths = driven.batch_paths(run.grid.n_steps)
     batches = _batches(
@@ -1578,9 +1578,7 @@ def _run_batches(run: _Run, setup: _KernelSetup, batches, progress: bool):
     records = None
     bar = None
     if progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=run.n_paths, unit="path", desc="simulate", leave=False, delay=3.0)
+        bar = progress_bar(run.n_paths, desc="simulate", unit="path", transient=True)
     try:
         for lo, hi in batches:
             acc, failed, hist, rec = interruptible(

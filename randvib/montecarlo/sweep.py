@@ -52,6 +52,7 @@ from randvib._io import (
     sha256,
     unlock_folder,
 )
+from randvib._progress import progress_bar
 from randvib._validation import MAX_SEED, check_int, check_positive
 from randvib.analytic.prediction import METHODS, predict
 from randvib.models.harvester import Harvester
@@ -466,13 +467,6 @@ def _table(rows: dict) -> pd.DataFrame:
     return pd.DataFrame([{"point": i, **rows[i]} for i in sorted(rows)])
 
 
-def _progress_bar(total: int, done: int, name: str):
-    from tqdm import tqdm
-
-    # disable=None: shown on terminals only, not in logs or CI
-    return tqdm(total=total, initial=done, unit="point", desc=name, disable=None)
-
-
 def _computed_points(base, points, settings, todo, executor):
     """Yield ``(index, row, per_path)`` for each point in ``todo`` as it finishes."""
     if executor is None:
@@ -535,7 +529,9 @@ def run_sweep(
             store.close()
             raise
     todo = [i for i in range(len(points)) if i not in rows]
-    bar = _progress_bar(len(points), len(points) - len(todo), name) if progress and todo else None
+    bar = None
+    if progress and todo:
+        bar = progress_bar(len(points), initial=len(points) - len(todo), desc=name, unit="point")
     own_close = None
     try:
         if executor is None and todo:
