@@ -219,8 +219,8 @@ def test_simulate_prints_device_and_excitation(capsys):
     argv += ["--f0", "8", "--zeta", "0.2", "--paths", "4", "--t-end", "0.3", "--burn-in", "0.1"]
     code, out, _ = run(capsys, *argv)
     assert code == 0
-    assert "device: m 0.0226 kg" in out and "coulomb friction (fc 0.0058)" in out
-    assert "excitation: band-pass (level 1, f0 8, zeta 0.2)" in out
+    assert "device: m 0.0226 kg" in out and "coulomb friction (fc 0.0058 N)" in out
+    assert "excitation: band-pass (level 1 (m/s^2)^2/Hz, f0 8 Hz, zeta 0.2)" in out
 
 
 def test_power_without_coil_says_why_and_reports_mechanical(capsys):
@@ -341,3 +341,13 @@ def test_arrays_broadcast_where_documented(method):
     assert rv.equivalent_damping(FIG9, ARRAY)[0] == pytest.approx(
         rv.equivalent_damping(FIG9, 1.0), rel=1e-12
     )
+
+
+def test_every_error_line_names_its_command(capsys):
+    """Parser and command errors read alike: ``randvib COMMAND: error: ...``."""
+    one_line_error(
+        capsys, ["power", "--psd", "1", "--nosuch"], "randvib power: error: unrecognized"
+    )
+    one_line_error(capsys, ["power", "--friction", "x"], "randvib power: error: `--friction`")
+    one_line_error(capsys, ["power", "--friction", "lugre", "--psd", "1"], "randvib power: error:")
+    one_line_error(capsys, ["bogus"], "randvib: error: `COMMAND` must be one of power")

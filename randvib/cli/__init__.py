@@ -95,7 +95,7 @@ class _Parser(argparse.ArgumentParser):
         self._negative_number_matcher = NEGATIVE_NUMBER
 
     def error(self, message):  # one line, no usage dump, exit 2
-        raise UserError(f"{self.prog}: {one_line_choice_error(message)}")
+        raise UserError(f"{self.prog}: error: {one_line_choice_error(message)}")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -223,9 +223,15 @@ def compile_notice():
 
 
 def _main(argv) -> int:
+    prog = "randvib"  # "randvib COMMAND" once the command is known, as argparse names it
     try:
         parser = build_parser()
-        args = parser.parse_args(argv)
+        args, unknown = parser.parse_known_args(argv)
+        prog = f"randvib {args.command}"
+        if unknown:  # named by the command, with where to look (argparse names only "randvib")
+            raise UserError(
+                f"{prog}: error: unrecognized arguments: {' '.join(unknown)} (see `{prog} --help`)"
+            )
         with compile_notice():
             return int(args.handler(args) or 0)
     except BrokenPipeError:
@@ -234,7 +240,7 @@ def _main(argv) -> int:
         message = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         message = cli_wording(message)
         if not message.startswith("randvib"):
-            message = f"randvib: error: {message}"
+            message = f"{prog}: error: {message}"
         print(message, file=sys.stderr)
         return 2
     except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (Terminated)

@@ -13,6 +13,8 @@ import math
 
 from tabulate import tabulate
 
+from randvib.models.excitation import PARAMETER_UNITS
+
 #: Significant digits of an analytic (deterministic) value in a table.
 ANALYTIC_DIGITS = 6
 
@@ -76,8 +78,16 @@ def print_table(rows, headers) -> None:
     print(tabulate(rows, headers=headers, disable_numparse=True, colalign=tuple(align)))
 
 
-def _assignments(values: dict) -> str:
-    return ", ".join(f"{name} {format_value(value, 4)}" for name, value in values.items())
+def _assignments(values: dict, units: dict) -> str:
+    """``name value unit, ...`` with four significant digits."""
+    return ", ".join(
+        f"{name} {format_value(value, 4)} {units.get(name, '')}".rstrip()
+        for name, value in values.items()
+    )
+
+
+def _units(model) -> dict:
+    return {name: spec.unit for name, spec in type(model).parameter_specs().items()}
 
 
 def describe_device(harvester) -> str:
@@ -90,11 +100,15 @@ def describe_device(harvester) -> str:
     if friction is None:
         parts.append("no friction")
     else:
-        parts.append(f"{harvester.friction_name} friction ({_assignments(friction.parameters())})")
+        parts.append(
+            f"{harvester.friction_name} friction "
+            f"({_assignments(friction.parameters(), _units(friction))})"
+        )
     if harvester.electrical is not None:
         electrical = harvester.electrical
         parts.append(
-            f"{harvester.coupling_name} coupling ({_assignments(electrical.parameters())})"
+            f"{harvester.coupling_name} coupling "
+            f"({_assignments(electrical.parameters(), _units(electrical))})"
         )
     if harvester.stroke is not None:
         parts.append(f"stroke {harvester.stroke:.4g} m")
@@ -106,4 +120,4 @@ def describe_excitation(psd) -> str:
     if isinstance(psd, int | float):
         return f"excitation: white noise, S = {psd:.6g} (m/s^2)^2/Hz (one-sided)"
     numbers = {k: v for k, v in psd.parameters().items() if not isinstance(v, str)}
-    return f"excitation: {psd.name} ({_assignments(numbers)})"
+    return f"excitation: {psd.name} ({_assignments(numbers, PARAMETER_UNITS)})"

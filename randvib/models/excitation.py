@@ -289,6 +289,20 @@ class Excitation:
         return out
 
 
+#: SI units of the numbers :meth:`Excitation.parameters` reports, for tables and messages.
+PARAMETER_UNITS = {
+    "level": "(m/s^2)^2/Hz",
+    "f0": "Hz",
+    "zeta": "",
+    "f_lo": "Hz",
+    "f_hi": "Hz",
+    "variance": "(m/s^2)^2",
+    "duration": "s",
+    "dt": "s",
+    "segment_length": "samples",
+}
+
+
 def _one(name: str, value):
     """An excitation's parameter is one number; an array is refused by name."""
     return check_scalar(name, value, "an excitation describes one spectrum; make one per value")
