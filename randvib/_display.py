@@ -46,21 +46,70 @@ def estimate(mean: float, ci95: float) -> str:
     """``mean ± ci95`` with the mean to the precision its interval supports.
 
     The half-width keeps two significant figures and the mean is written to
-    the same decimal place (``0.00246461 ± 5.5e-07``): the last digit shown is
-    the interval's second.
+    the same decimal place (``0.00246461 ± 0.00000055``): the last digit shown is
+    the interval's second. See :func:`estimate_parts`.
     """
-    if not (math.isfinite(mean) and math.isfinite(ci95)) or ci95 <= 0:
+    if not (_finite(mean) and _finite(ci95)) or ci95 <= 0:
         return number(mean, 6)
-    if mean == 0:
-        return f"0 ± {_figures(ci95, 2)}"
-    figures = math.floor(math.log10(abs(mean))) - math.floor(math.log10(ci95)) + 2
-    return f"{_figures(mean, max(figures, 1))} ± {_figures(ci95, 2)}"
+    return " ± ".join(estimate_parts(mean, ci95))
 
 
-def _figures(x: float, n: int) -> str:
-    """``x`` to ``n`` significant figures, trailing zeros kept (0.00030, not 0.0003)."""
-    text = f"{x:#.{n}g}"
-    return text.replace(".e", "e").removesuffix(".")
+#: Below this magnitude the leading zeros hide the digits: 9.29e-06, not 0.00000929.
+PLAIN_BELOW = 1e-4
+
+
+def estimate_parts(mean, half_width) -> tuple[str, str]:
+    """A Monte Carlo mean and its 95 % half-width, as the half-width allows.
+
+    The half-width is shown to two significant digits and the mean to the same
+    decimal place (``0.0024619 +- 0.00027`` -> ``0.00246``, ``0.00027``), both
+    in one notation, chosen by the mean's size. A zero or missing half-width
+    leaves the mean at six significant digits; non-finite values are ``n/a``.
+    One rule for the terminal tables, the reprs and the notebook.
+
+    Examples
+    --------
+    >>> estimate_parts(0.0024619412547950926, 0.000272784)
+    ('0.00246', '0.00027')
+    >>> estimate_parts(12345.678, 140.0)
+    ('12350', '140')
+    >>> estimate_parts(9.2912e-06, 9.81e-07)
+    ('9.29e-06', '9.8e-07')
+    """
+    if not (_finite(mean) and _finite(half_width) and half_width > 0):
+        return _cell(mean), _cell(half_width)
+    decimals = 1 - math.floor(math.log10(half_width))  # the 2nd significant digit's place
+    half = round(half_width, decimals)
+    if half > 0 and math.floor(math.log10(half)) > math.floor(math.log10(half_width)):
+        decimals -= 1  # 0.0996 rounded up to 0.10: two digits are now one place earlier
+    # the pair in one notation, chosen by the mean: 0.000722 and 0.000042
+    plain = round(mean, decimals) == 0 or abs(mean) >= PLAIN_BELOW
+    return _fixed(mean, decimals, plain), _fixed(half_width, decimals, plain)
+
+
+def _finite(value) -> bool:
+    return isinstance(value, int | float | np.floating) and math.isfinite(value)
+
+
+def _cell(value) -> str:
+    """A value without an interval: six significant digits, ``n/a`` if not a number."""
+    if value is None:
+        return ""
+    if isinstance(value, float | np.floating) and not math.isfinite(value):
+        return "n/a"
+    return f"{value + 0.0:.6g}" if _finite(value) else str(value)
+
+
+def _fixed(value: float, decimals: int, plain: bool) -> str:
+    """``value`` rounded to ``decimals`` places (negative: tens, hundreds...), in plain
+    notation if ``plain``, else in exponent notation with the same digits."""
+    rounded = round(value, decimals) + 0.0  # + 0.0: never "-0"
+    if decimals >= 0 and plain:
+        return f"{rounded:.{decimals}f}"
+    if decimals < 0 and abs(rounded) < 1e9:
+        return f"{rounded:.0f}"
+    digits = max(1, math.floor(math.log10(abs(rounded))) + decimals + 1) if rounded else 1
+    return f"{rounded:.{digits - 1}e}"
 
 
 def text_table(title: str, rows, note: str = "") -> str:

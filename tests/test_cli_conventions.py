@@ -18,6 +18,7 @@ import numpy as np
 import pytest
 
 import randvib as rv
+from randvib._display import estimate_parts as format_estimate
 from randvib.cli import (
     API_NAMES,
     COMPILING,
@@ -27,7 +28,6 @@ from randvib.cli import (
     compile_notice,
     one_line_choice_error,
 )
-from randvib.cli._output import format_estimate
 from randvib.cli.power import sweep_values
 from randvib.models.excitation import BandLimited
 from tests._cli import one_line_error, run

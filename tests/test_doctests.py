@@ -18,7 +18,7 @@ MODULES = (
     "randvib.analytic.linearisation",
     "randvib.analytic.prediction",
     "randvib.analytic.statistical_linearisation",
-    "randvib.cli._output",
+    "randvib._display",
     "randvib.identification.synthetic",
     "randvib.models.coupling",
     "randvib.models.excitation",

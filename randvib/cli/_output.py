@@ -34,41 +34,6 @@ def format_value(value, digits: int = ANALYTIC_DIGITS) -> str:
     return str(value)
 
 
-def format_estimate(mean, half_width) -> tuple[str, str]:
-    """A Monte Carlo mean and its 95 % half-width, as the half-width allows.
-
-    The half-width is shown to two significant digits and the mean to the same
-    decimal place (``0.0024619 +- 0.00027`` -> ``0.00246``, ``0.00027``); a zero
-    or missing half-width leaves the mean at :data:`ANALYTIC_DIGITS` digits.
-
-    Examples
-    --------
-    >>> format_estimate(0.0024619412547950926, 0.000272784)
-    ('0.00246', '0.00027')
-    >>> format_estimate(12345.678, 140.0)
-    ('12350', '140')
-    """
-    if not (_finite(mean) and _finite(half_width) and half_width > 0):
-        return format_value(mean), format_value(half_width)
-    decimals = 1 - math.floor(math.log10(half_width))  # the 2nd significant digit's place
-    half = round(half_width, decimals)
-    if half > 0 and math.floor(math.log10(half)) > math.floor(math.log10(half_width)):
-        decimals -= 1  # 0.0996 rounded up to 0.10: two digits are now one place earlier
-    return _fixed(mean, decimals), _fixed(half_width, decimals)
-
-
-def _fixed(value: float, decimals: int) -> str:
-    """``value`` rounded to ``decimals`` places (negative: tens, hundreds...), in plain
-    notation where that stays short, else in exponent notation with the same digits."""
-    rounded = round(value, decimals) + 0.0  # + 0.0: never "-0"
-    if decimals >= 0 and (rounded == 0 or abs(rounded) >= 1e-4 or decimals <= 8):
-        return f"{rounded:.{decimals}f}"
-    if decimals < 0 and abs(rounded) < 1e9:
-        return f"{rounded:.0f}"
-    digits = max(1, math.floor(math.log10(abs(rounded))) + decimals + 1) if rounded else 1
-    return f"{rounded:.{digits - 1}e}"
-
-
 def print_table(rows, headers) -> None:
     """A plain table: numbers as :func:`format_value` (unless already text), right-aligned."""
     rows = [[v if isinstance(v, str) else format_value(v) for v in row] for row in rows]

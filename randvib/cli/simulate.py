@@ -10,6 +10,7 @@ giving the interval.
 
 from __future__ import annotations
 
+from randvib._display import estimate_parts
 from randvib._io import dumps
 from randvib._validation import MAX_SEED, integer_option
 from randvib.analytic.prediction import predict
@@ -18,7 +19,6 @@ from randvib.cli._excitation import add_excitation_arguments, excitation_from_ar
 from randvib.cli._output import (
     describe_device,
     describe_excitation,
-    format_estimate,
     format_value,
     print_table,
 )
@@ -145,14 +145,14 @@ def run(args) -> int:
             continue
         s = summary[name]
         lin = getattr(analytic, name, None) if analytic is not None else None
-        rows.append((name, *format_estimate(s["mean"], s["ci95"]), format_value(lin), unit))
+        rows.append((name, *estimate_parts(s["mean"], s["ci95"]), format_value(lin), unit))
     first = summary.get("stroke_first_passage")
     if first is not None and first["mean"] is None:
         restricted = first["restricted_mean"]
         rows.append(
             (
                 f"E[min(first passage, {first['horizon']:g} s)]",
-                *format_estimate(restricted["mean"], restricted["ci95"]),
+                *estimate_parts(restricted["mean"], restricted["ci95"]),
                 f"{first['paths_reached']}/{first['n_paths']} paths reached the stroke",
                 "s",
             )
