@@ -351,3 +351,18 @@ def test_every_error_line_names_its_command(capsys):
     one_line_error(capsys, ["power", "--friction", "x"], "randvib power: error: `--friction`")
     one_line_error(capsys, ["power", "--friction", "lugre", "--psd", "1"], "randvib power: error:")
     one_line_error(capsys, ["bogus"], "randvib: error: `COMMAND` must be one of power")
+
+
+def test_table_columns_of_words_are_flush_left_and_named(capsys):
+    from randvib.cli._output import print_table
+
+    print_table(
+        [["c", 0.049, 1e-3, "Ns/m", "identified"], ["m", 0.0226, None, "kg", "fixed"]],
+        ["parameter", "value", "std. error", "unit", "status"],
+    )
+    header, rule, first, second = capsys.readouterr().out.splitlines()
+    assert header.split() == ["parameter", "value", "std.", "error", "unit", "status"]
+    # words start where their header starts; numbers end where theirs ends
+    assert first.index("Ns/m") == header.index("unit") == second.index("kg")
+    assert first.index("identified") == header.index("status") == second.index("fixed")
+    assert first.index("0.049") + len("0.049") == header.index("value") + len("value")

@@ -34,12 +34,15 @@ def format_value(value, digits: int = ANALYTIC_DIGITS) -> str:
     return str(value)
 
 
+#: Table columns that hold words, not numbers.
+TEXT_COLUMNS = ("unit", "status", "")
+
+
 def print_table(rows, headers) -> None:
     """A plain table: numbers as :func:`format_value` (unless already text), right-aligned."""
     rows = [[v if isinstance(v, str) else format_value(v) for v in row] for row in rows]
-    align = ["left"] + ["right"] * (len(headers) - 1)
-    if headers[-1] in ("unit", ""):  # text columns read better flush left
-        align[-1] = "left"
+    # numbers flush right; the first column and text columns flush left
+    align = ["left"] + ["left" if h in TEXT_COLUMNS else "right" for h in headers[1:]]
     print(tabulate(rows, headers=headers, disable_numparse=True, colalign=tuple(align)))
 
 

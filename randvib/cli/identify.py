@@ -154,7 +154,7 @@ def print_report(result, record) -> None:
         for name, value in result.parameters.items()
     ]
     print(f"model {result.model} on {record.name} ({record.n} samples, {record.input_kind} input)")
-    print_table(rows, ["parameter", "value", "std. error", "95 % interval", "unit", ""])
+    print_table(rows, ["parameter", "value", "std. error", "95 % interval", "unit", "status"])
     print(
         f"J = {result.cost:.6g} (Eq. 11); {result.nfev} simulations in {result.elapsed:.1f} s "
         f"({result.simulations_per_second:.0f} sims/s); {result.message}"
