@@ -97,3 +97,18 @@ def test_identification_repr_leaves_the_history_out():
     assert not frame.loc["m", "free"] and np.isnan(frame.loc["m", "lower"])
     assert frame.loc["fc", "upper"] == 0.02
     assert "(fixed)" in result._repr_html_()
+
+
+def test_results_under_a_table_or_a_record_show_themselves():
+    """psd is None there (no single level): repr, str and HTML name the input instead."""
+    table = rv.Tabulated(np.array([1.0, 5.0, 20.0, 30.0]), np.array([0.0, 1.0, 1.0, 0.0]))
+    device = rv.preset("figure9")
+    result = rv.simulate(device, table, t_end=0.3, burn_in=0.1, dt=1e-3, n_paths=4, progress=False)
+    assert result.psd is None
+    for text in (repr(result), str(result), result._repr_html_()):
+        assert "tabulated" in text and "S = " not in text
+    record = rv.Measured(np.arange(4000) * 1e-3, table.sample(4.0, 1e-3, seed=1)[0])
+    on_record = rv.simulate_on_record(device, record, segments=2, burn_in=0.5, progress=False)
+    assert on_record.psd is None
+    assert repr(on_record).startswith("RecordSimulation(") and "measured" in repr(on_record)
+    assert "array" not in repr(on_record)  # not the record's samples

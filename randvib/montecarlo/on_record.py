@@ -119,7 +119,8 @@ def simulate_on_record(
     return RecordSimulation(**{f.name: getattr(result, f.name) for f in dataclasses.fields(result)})
 
 
-@dataclasses.dataclass(frozen=True)
+# repr=False: keep SimulationResult's compact repr (a generated one would print the record's arrays)
+@dataclasses.dataclass(frozen=True, repr=False)
 class RecordSimulation(SimulationResult):
     """:class:`SimulationResult` of :func:`simulate_on_record`: paths are successive windows."""
 

@@ -292,7 +292,9 @@ class SimulationResult:
     """
 
     harvester: Harvester
-    psd: float
+    #: White-noise level S, or the excitation's level ((m/s^2)^2/Hz); None
+    #: where no single level describes the input (a table, a measured record).
+    psd: float | None
     scheme: str
     dt: float
     t_end: float
@@ -537,12 +539,15 @@ class SimulationResult:
         return [(name, stat, unit) for name, stat, unit in out if stat is not None]
 
     def _settings_line(self) -> str:
-        excitation = "white" if self.is_white else repr(self.excitation)
+        if self.is_white:
+            excitation = f"white, S = {self.psd:g}"
+        else:  # the name and level, not the repr (a table's or record's arrays)
+            level = "" if self.psd is None else f", S = {self.psd:g}"
+            excitation = f"{self.excitation.name}{level}"
         cv = ", control variates" if self.control_variates else ""
         return (
             f"{self.n_paths} paths x {_display.number(self.averaging_time, 4)} s averaged, "
-            f"dt {self.dt:g} s, {self.scheme}, seed {self.seed}, S = {self.psd:g}, "
-            f"{excitation}{cv}"
+            f"dt {self.dt:g} s, {self.scheme}, seed {self.seed}, {excitation}{cv}"
         )
 
     def to_frame(self):
@@ -570,7 +575,7 @@ class SimulationResult:
     def __repr__(self) -> str:
         power = self.power_electrical
         return (
-            f"SimulationResult({self._settings_line()}; power_electrical = "
+            f"{type(self).__name__}({self._settings_line()}; power_electrical = "
             f"{_display.estimate(power.mean, power.ci95)} W)"
         )
 
