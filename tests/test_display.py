@@ -112,3 +112,29 @@ def test_results_under_a_table_or_a_record_show_themselves():
     assert on_record.psd is None
     assert repr(on_record).startswith("RecordSimulation(") and "measured" in repr(on_record)
     assert "array" not in repr(on_record)  # not the record's samples
+
+
+def test_tables_records_and_spectra_have_compact_reprs(simulation):
+    """Objects holding long arrays show their size and range, never the arrays."""
+    table = rv.Tabulated(np.array([1.0, 5.0, 20.0, 30.0]), np.array([0.0, 1.0, 1.0, 0.0]))
+    # variance: the trapezoid's exact integral, 2 + 15 + 5 = 22 (m/s^2)^2
+    assert repr(table) == "Tabulated(4 points, 1-30 Hz, variance 22 (m/s^2)^2)"
+    record = rv.Measured(np.arange(4000) * 1e-3, np.random.default_rng(0).normal(size=4000))
+    assert repr(record).startswith("Measured(4000 samples at 1000 Hz, 4 s, variance ")
+    statistical = rv.statistical_linearisation(rv.preset("figure9"), table)
+    assert "array" not in repr(statistical) and "array" not in statistical._repr_html_()
+    spectra = rv.simulate(
+        rv.preset("figure9"),
+        1.0,
+        t_end=1.0,
+        burn_in=0.1,
+        dt=1e-3,
+        n_paths=2,
+        record_paths=2,
+        progress=False,
+    ).response_spectra()
+    text = repr(spectra)
+    assert text.startswith(
+        f"SampledSpectra({spectra.frequency.size} frequencies, 0-500 Hz, 2 paths"
+    )
+    assert len(text) < 200

@@ -644,6 +644,13 @@ class Tabulated(Excitation):
         lo, hi = self.support
         return {"excitation": self.name, "f_lo": lo, "f_hi": hi, "variance": self.variance}
 
+    def __repr__(self) -> str:  # the size and range, not the arrays
+        lo, hi = self.support
+        return (
+            f"Tabulated({self.frequency.size} points, {lo:g}-{hi:g} Hz, "
+            f"variance {self.variance:.4g} (m/s^2)^2)"
+        )
+
 
 def welch_segment_length(n_samples: int) -> int:
     """Welch segment length (samples) for a record of ``n_samples``.
@@ -761,6 +768,13 @@ class Measured(Excitation):
             "segment_length": self.segment_length,
             "variance": self.variance,
         }
+
+    def __repr__(self) -> str:  # the record's size, not its samples
+        duration = float(self.time[-1] - self.time[0] + self.dt)
+        return (
+            f"Measured({self.time.size} samples at {1.0 / self.dt:.6g} Hz, {duration:.6g} s, "
+            f"variance {self.variance:.4g} (m/s^2)^2)"
+        )
 
 
 def _read_columns(path, columns) -> dict:

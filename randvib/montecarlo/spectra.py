@@ -57,6 +57,14 @@ class SampledSpectra:
     n_paths: int
     segment_duration: float
 
+    def __repr__(self) -> str:  # the grid and the evidence, not the arrays
+        peak = float(self.frequency[int(np.argmax(self.power))]) if self.power.size else np.nan
+        return (
+            f"SampledSpectra({self.frequency.size} frequencies, 0-{self.frequency[-1]:g} Hz, "
+            f"{self.n_paths} paths, segments of {self.segment_duration:g} s; "
+            f"power density peaks at {peak:g} Hz)"
+        )
+
     def to_frame(self):
         """The spectra as a :class:`pandas.DataFrame`, one row per frequency."""
         import pandas as pd
