@@ -39,7 +39,7 @@ from randvib.cli._output import (
     format_value,
     print_table,
 )
-from randvib.models.excitation import Excitation
+from randvib.models.excitation import PARAMETER_UNITS, Excitation
 
 #: The methods that report the stationary probability beyond the stroke.
 STROKE_METHODS = ("linearisation", "fpk-fast", "fpk")
@@ -231,15 +231,7 @@ UNITS = {
     "power_load_optimal": "W",
     "circuit_mean_square": "A^2 or V^2",
     "stroke": "m",
-    # the excitation's parameters
-    "level": "(m/s^2)^2/Hz",
-    "f0": "Hz",
-    "f_lo": "Hz",
-    "f_hi": "Hz",
-    "variance": "(m/s^2)^2",
-    "duration": "s",
-    "dt": "s",
-    "segment_length": "samples",
+    **PARAMETER_UNITS,  # the excitation's parameters
 }
 
 
