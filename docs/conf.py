@@ -32,6 +32,7 @@ extensions = [
     "numpydoc",
     "myst_parser",  # docs/conventions.md and docs/testing.md stay Markdown: one source
     "sphinx_gallery.gen_gallery",
+    "sphinxarg.ext",  # docs/cli.rst: the command line reference, generated from the parsers
 ]
 
 source_suffix = {".rst": "restructuredtext", ".md": "markdown"}

@@ -6,6 +6,7 @@ or a broken cross-reference fails here. It builds a copy of ``docs/`` so that
 the generated pages never land in the checkout.
 """
 
+import html as html_module
 import os
 import re
 import shutil
@@ -21,6 +22,9 @@ pytest.importorskip("sphinx", reason="the docs extra (pip install -e '.[docs]') 
 pytest.importorskip("numpydoc")
 pytest.importorskip("sphinx_gallery")
 pytest.importorskip("myst_parser")
+pytest.importorskip("sphinxarg")
+
+from randvib.cli import build_parser
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = sorted(p.stem for p in (ROOT / "examples").glob("plot_*.py"))
@@ -53,7 +57,8 @@ def test_site_builds_without_warnings(site):
     html, done = site
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-6000:]
     assert "WARNING" not in done.stderr and "ERROR" not in done.stderr, done.stderr[-6000:]
-    for page in ("index", "conventions", "testing", "quickstart", "api", "auto_examples/index"):
+    pages = ("index", "conventions", "testing", "quickstart", "cli", "api", "auto_examples/index")
+    for page in pages:
         assert (html / f"{page}.html").is_file(), page
 
 
@@ -64,6 +69,18 @@ def test_every_example_ran_and_printed(site):
         page = (html / "auto_examples" / f"{stem}.html").read_text()
         # sphinx-gallery shows what the script printed under "Out:" blocks
         assert "sphx-glr-script-out" in page, f"{stem} printed nothing"
+
+
+def test_cli_page_documents_every_command_and_option(site):
+    """docs/cli.rst is generated from the parsers: every flag of every command is on it."""
+    html, _ = site
+    text = html_module.unescape(re.sub(r"<[^>]+>", "", (html / "cli.html").read_text()))
+    commands = next(a for a in build_parser()._actions if a.dest == "command").choices
+    for name, parser in commands.items():
+        assert f"randvib {name} [-h]" in text, name
+        for action in parser._actions:
+            for flag in action.option_strings:
+                assert flag in text, (name, flag)
 
 
 def test_api_reference_lists_every_public_name():

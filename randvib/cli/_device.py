@@ -74,7 +74,7 @@ def add_device_arguments(parser: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--stroke",
         type=float,
-        help="stroke limit (m, > 0): report the time fraction with |z| beyond it "
+        help="stroke limit (m, > 0): report the time fraction with abs(z) beyond it "
         "(and, from Monte Carlo, the mean first time to reach it)",
     )
     g.add_argument(
