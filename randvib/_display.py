@@ -57,13 +57,18 @@ def estimate(mean: float, ci95: float) -> str:
 #: Below this magnitude the leading zeros hide the digits: 9.29e-06, not 0.00000929.
 PLAIN_BELOW = 1e-4
 
+#: Most significant digits shown of an estimate (a noise-free fit's interval
+#: may support more; eight say all a reader can use).
+MAX_FIGURES = 8
+
 
 def estimate_parts(mean, half_width) -> tuple[str, str]:
     """A Monte Carlo mean and its 95 % half-width, as the half-width allows.
 
     The half-width is shown to two significant digits and the mean to the same
     decimal place (``0.0024619 +- 0.00027`` -> ``0.00246``, ``0.00027``), both
-    in one notation, chosen by the mean's size. A zero or missing half-width
+    in one notation, chosen by the mean's size; a mean known to more than
+    :data:`MAX_FIGURES` digits is shown to that many. A zero or missing half-width
     leaves the mean at six significant digits; non-finite values are ``n/a``.
     One rule for the terminal tables, the reprs and the notebook.
 
@@ -75,6 +80,8 @@ def estimate_parts(mean, half_width) -> tuple[str, str]:
     ('12350', '140')
     >>> estimate_parts(9.2912e-06, 9.81e-07)
     ('9.29e-06', '9.8e-07')
+    >>> estimate_parts(0.0490000000112, 2.09e-12)
+    ('0.049000000', '2.1e-12')
     """
     if not (_finite(mean) and _finite(half_width) and half_width > 0):
         return _cell(mean), _cell(half_width)
@@ -82,9 +89,13 @@ def estimate_parts(mean, half_width) -> tuple[str, str]:
     half = round(half_width, decimals)
     if half > 0 and math.floor(math.log10(half)) > math.floor(math.log10(half_width)):
         decimals -= 1  # 0.0996 rounded up to 0.10: two digits are now one place earlier
-    # the pair in one notation, chosen by the mean: 0.000722 and 0.000042
-    plain = round(mean, decimals) == 0 or abs(mean) >= PLAIN_BELOW
-    return _fixed(mean, decimals, plain), _fixed(half_width, decimals, plain)
+    shown = decimals
+    if mean != 0:  # no more than MAX_FIGURES digits, however small the interval
+        shown = min(decimals, MAX_FIGURES - 1 - math.floor(math.log10(abs(mean))))
+    # the pair in one notation, chosen by the mean: 0.000722 and 0.000042;
+    # a half-width past the eighth decimal in exponent notation (2.1e-12)
+    plain = round(mean, shown) == 0 or abs(mean) >= PLAIN_BELOW
+    return _fixed(mean, shown, plain), _fixed(half_width, decimals, plain and decimals <= 8)
 
 
 def _finite(value) -> bool:

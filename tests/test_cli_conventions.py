@@ -366,3 +366,13 @@ def test_table_columns_of_words_are_flush_left_and_named(capsys):
     assert first.index("Ns/m") == header.index("unit") == second.index("kg")
     assert first.index("identified") == header.index("status") == second.index("fixed")
     assert first.index("0.049") + len("0.049") == header.index("value") + len("value")
+
+
+def test_identify_table_shows_the_digits_the_standard_error_supports():
+    from randvib.cli.identify import _with_precision
+
+    row = _with_precision(57.4001412, 0.00014079, (57.3998653, 57.4004171))
+    assert row == ["57.40014", "0.00014", "[57.39987, 57.40042]"]
+    # a noise-free fit: eight significant digits, the tiny error in exponent form
+    assert _with_precision(0.0490000000112, 2.09e-12, None) == ["0.049000000", "2.1e-12", ""]
+    assert _with_precision(0.0226, None, None) == [0.0226, "", ""]  # a fixed parameter

@@ -5,6 +5,9 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
+import numpy as np
+
+from randvib._display import estimate_parts
 from randvib._io import check_output_file, dumps, write_or_keep
 from randvib._validation import MAX_SEED, integer_option
 from randvib.cli._output import print_table
@@ -139,15 +142,30 @@ def run(args) -> int:
     return 0
 
 
+def _with_precision(value, se, interval) -> list:
+    """Value, standard error and interval to the digits the standard error supports.
+
+    The standard error keeps two significant digits and the value and the
+    interval's ends are written to its decimal place, as Monte Carlo means are
+    (:func:`randvib._display.estimate_parts`); without a standard error the
+    value keeps six digits.
+    """
+    if se is None or not np.isfinite(se) or se <= 0:
+        return [value, "" if se is None else se, ""]
+    shown, se_shown = estimate_parts(value, se)
+    if interval is None:
+        return [shown, se_shown, ""]
+    lo, hi = (estimate_parts(end, se)[0] for end in interval)
+    return [shown, se_shown, f"[{lo}, {hi}]"]
+
+
 def print_report(result, record) -> None:
     """The parameters with standard errors and 95 % intervals, J, the correlations."""
     se, ci = result.standard_errors, result.confidence_intervals
     rows = [
         [
             name,
-            value,
-            se.get(name, ""),
-            "" if name not in ci else f"[{ci[name][0]:.6g}, {ci[name][1]:.6g}]",
+            *_with_precision(value, se.get(name), ci.get(name)),
             INPUT_UNITS[record.input_kind] if name == "input_offset" else UNITS[name],
             "identified" if name in se or name in result.free else "fixed",
         ]
