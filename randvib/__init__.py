@@ -75,8 +75,8 @@ _EXPORTS = {
         "SimulationDivergedError",
         "SimulationResult",
         "Statistic",
-        "StepSizeWarning",
     ),
+    "randvib.montecarlo.step_check": ("StepSizeWarning",),
 }
 _WHERE = {name: module for module, names in _EXPORTS.items() for name in names}
 

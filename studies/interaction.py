@@ -246,7 +246,7 @@ def step_section(check, check_data, settings, worst_bias) -> str:
         + f") at dt/2 = {settings.dt / 2:g} s, independent noise. Time-step bias below the "
         f"statistical error at {check_data['n_below']} of {len(check)} points"
         f"{check_data['sentence']}. "
-        f"Linearised step bias at dt (randvib.montecarlo.simulation.step_bias) at most {worst_bias:.1e}.\n\n"
+        f"Linearised step bias at dt (randvib.montecarlo.step_check.step_bias) at most {worst_bias:.1e}.\n\n"
         + markdown_table(readable_table(check))
     )
 

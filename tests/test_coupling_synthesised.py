@@ -21,7 +21,8 @@ import pytest
 from _stats import assert_matches
 
 import randvib as rv
-from randvib.montecarlo.simulation import simulate, step_bias
+from randvib.montecarlo.simulation import simulate
+from randvib.montecarlo.step_check import step_bias
 
 M, C_M, K = 0.0226, 0.05, 57.4
 COUPLINGS = {

@@ -30,7 +30,7 @@ from randvib.analytic.exact_solutions import (
 )
 from randvib.analytic.fokker_planck import fast_fpk_moments, fpk_moments, solve_fpk
 from randvib.models.potential import Potential
-from randvib.montecarlo.simulation import largest_step, step_bias
+from randvib.montecarlo.step_check import largest_step, step_bias
 
 M, C, S = 0.0226, 0.2, 0.5  # kg, Ns/m (c_m = c_e = 0.1), (m/s^2)^2/Hz
 T = S * M * M / (4 * C)  # m sigma_v^2 (J), the Gibbs temperature

@@ -32,12 +32,8 @@ import randvib as rv
 from randvib.analytic import exact_solutions as exact
 from randvib.montecarlo import integrators
 from randvib.montecarlo.integrators import INTEGRATORS
-from randvib.montecarlo.simulation import (
-    SimulationDivergedError,
-    StepSizeWarning,
-    estimate,
-    simulate,
-)
+from randvib.montecarlo.simulation import SimulationDivergedError, estimate, simulate
+from randvib.montecarlo.step_check import StepSizeWarning
 
 LINEAR = rv.Harvester(m=0.0226, c_m=0.1, c_e=0.1, k=57.4)
 DUFFING_COULOMB = rv.preset("figure9").updated(k3=5e5)
@@ -470,7 +466,7 @@ def _sde_functions(device, psd):
 
 
 @pytest.mark.filterwarnings(
-    "ignore::randvib.montecarlo.simulation.StepSizeWarning"
+    "ignore::randvib.montecarlo.step_check.StepSizeWarning"
 )  # EM at 1e-4 on purpose
 @pytest.mark.parametrize(
     ("method", "reference"), [("euler-maruyama", sdeint.itoEuler), ("heun", sdeint.stratHeun)]

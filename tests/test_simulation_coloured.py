@@ -28,13 +28,8 @@ import randvib as rv
 from randvib.analytic.linear_response import mechanical_block, stationary_covariance
 from randvib.models.excitation import BandPass, KanaiTajimi, White
 from randvib.montecarlo import integrators
-from randvib.montecarlo.simulation import (
-    StepSizeWarning,
-    estimate,
-    largest_step,
-    simulate,
-    step_bias,
-)
+from randvib.montecarlo.simulation import estimate, simulate
+from randvib.montecarlo.step_check import StepSizeWarning, largest_step, step_bias
 
 DETECT = 0.01
 #: A well-damped linear device at 0.32 Hz and a filter near it, for coarse steps.

@@ -106,7 +106,7 @@ def test_figure9_half_step_bias_below_statistical_error(figure9_quick):
     """Half-step re-run of the 6 highest-friction points: differences within 4 combined SE.
 
     The linearised Heun bias at dt = 1e-4 s is below 1e-4 relative
-    (randvib.montecarlo.simulation.step_bias), far below the combined standard error
+    (randvib.montecarlo.step_check.step_bias), far below the combined standard error
     (about 0.3 %), so the difference must be consistent with zero.
     Calibration (seeds 0-19, 120 z-scores): mean -0.24, SD 0.86, largest
     |z| 1.89.

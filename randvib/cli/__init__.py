@@ -149,7 +149,7 @@ def _main_with_warnings(argv) -> int:
 def _advice_warnings() -> tuple:
     """randvib's warnings that say something about the user's run (a step size, a validity)."""
     from randvib.analytic.averaging import AveragingValidityWarning
-    from randvib.montecarlo.simulation import StepSizeWarning
+    from randvib.montecarlo.step_check import StepSizeWarning
 
     return (StepSizeWarning, AveragingValidityWarning)
 

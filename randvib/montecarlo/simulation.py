@@ -30,6 +30,7 @@ depend on any assumption about correlation times.
 
 from __future__ import annotations
 
+import functools
 import threading
 import time
 import warnings
@@ -50,34 +51,27 @@ from randvib._validation import (
     check_scalar_device,
 )
 from randvib.analytic import exact_solutions as exact
-from randvib.analytic.linear_response import device_block, output_variances
-from randvib.analytic.linearisation import equivalent_damping, linear_displacement_variance
 from randvib.analytic.statistical_linearisation import statistical_linearisation
-from randvib.models.excitation import Excitation, Tabulated, as_excitation
+from randvib.models.excitation import Excitation, as_excitation
 from randvib.models.friction import kernel_arguments
 from randvib.models.harvester import Harvester
 from randvib.models.potential import CONFINING
 from randvib.montecarlo import driven, integrators, kernel
 from randvib.montecarlo.integrators import Integrator, integrator
 from randvib.montecarlo.rng import ZIG_FI, ZIG_KI, ZIG_WI
+from randvib.montecarlo.step_check import (
+    LinearTestSystem,
+    coarsened,
+)
 
-#: Largest stationary-variance bias (relative) of the scheme on the linearised
-#: device for which a step is accepted; see :func:`step_bias`.
-MAX_STEP_BIAS = 0.10
 #: Most steps per path (int64 step counters, with room to spare).
 MAX_STEPS = 2**62
 #: Largest path index (streams are keyed by unsigned 64-bit integers).
 MAX_PATH_INDEX = 2**62
-#: Bias above which a warning is issued.
-WARN_STEP_BIAS = 0.01
 
 
 class SimulationDivergedError(ValueError):
     """The state became non-finite during a simulation."""
-
-
-class StepSizeWarning(RuntimeWarning):
-    """The time step gives a noticeable discretisation bias."""
 
 
 @dataclass(frozen=True)
@@ -590,260 +584,21 @@ class SimulationResult:
         )
 
 
-# ----------------------------------------------------------------- step size
-def effective_linear_device(harvester: Harvester, psd: float) -> tuple[float, float]:
-    """(k_eff, c_eff) of the linearised device, for step-size checks.
-
-    k_eff = k + 3 k3 E[z^2] with E[z^2] from the exact friction-free density
-    (friction only shrinks the motion, so this stiffness is an upper bound in
-    the mean); c_eff = c_eq from equivalent linearisation, or c for LuGre.
-    With a circuit state, (k_eq, c_eq) of the statistical linearisation with
-    the circuit (a law with memory left out: it only adds damping).
-    Any confining potential: for a double well E[z^2] ~ z_w^2 at low noise,
-    so k_eff ~ -2 k, the wells' own stiffness; the free mass has k_eff = 0.
-    """
-    h = harvester
-    if h.has_circuit:
-        if h.friction is not None and not h.friction.has_equivalent_damping:
-            h = h.updated(friction=None)
-        r = statistical_linearisation(h, psd)
-        return r.k_eq, r.c_eq
-    c_eff = float(h.c)
-    if h.friction is None or h.friction.has_equivalent_damping:
-        c_eff = float(equivalent_damping(h, psd))
-    if h.potential.is_free:
-        return 0.0, c_eff
-    if h.c > 0:
-        z2 = exact.gibbs_displacement_moment(h.m, h.c, h.k, h.k3, psd)
-    else:
-        vv = psd * h.m / (4.0 * c_eff)
-        z2 = float(linear_displacement_variance(h, vv))
-    return float(h.k + 3.0 * h.k3 * z2), c_eff
-
-
-def step_bias(scheme: str, harvester: Harvester, psd, dt: float) -> float:
-    """Relative bias of the scheme's stationary variances on the linearised device.
-
-    The scheme applied to ``m z'' + c_eff z' + k_eff z = m w`` is a linear
-    Gaussian recursion whose stationary variance is exact
-    (:func:`randvib.montecarlo.integrators.scheme_stationary_covariance`); its departure from
-    S m / (4 c_eff) measures the time-step bias. Euler-Maruyama's bias is about
-    x / (1 - x) with x = k_eff dt / c_eff (energy gain per step against
-    damping), so it needs far smaller steps than Heun on lightly damped
-    devices. Returns inf where the recursion is unstable.
-
-    Under a rational spectrum (``psd`` a band-pass or Kanai-Tajimi
-    excitation), or with a circuit state, the recursion is that of the
-    linearised device with the filter's and the circuit's states
-    (:func:`_augmented_bias`), and the bias is the largest of those of E[y^2]
-    (the filter's own), E[z^2], E[v^2] and the circuit's E[x^2]; the
-    linearised device is the white-noise one at the excitation's level, as for
-    white noise.
-    """
-    excitation = as_excitation(psd)
-    m = float(harvester.m)
-    if excitation.shaping_filter() is None:  # synthesised or recorded input
-        k_eff, c_eff = _linearised_under(harvester, excitation)[:2]
-        if not harvester.has_circuit:
-            return _scheme_bias(scheme, m, k_eff, c_eff, 1.0, dt)
-        # the input's step integrals drive the velocity as white noise does
-        system = _augmented_system(m, k_eff, c_eff, as_excitation(1.0), harvester.electrical)
-        return _augmented_bias(scheme, *system, dt)
-    k_eff, c_eff = effective_linear_device(harvester, excitation.level)
-    if excitation.is_white and not harvester.has_circuit:
-        return _scheme_bias(scheme, m, k_eff, c_eff, excitation.level, dt)
-    system = _augmented_system(m, k_eff, c_eff, excitation, harvester.electrical)
-    return _augmented_bias(scheme, *system, dt)
-
-
-def _linearised_under(harvester: Harvester, excitation: Excitation) -> tuple:
-    """(k_eq, c_eq, E[z^2], E[v^2]) of the device linearised under a non-rational input.
-
-    Statistical linearisation (:func:`randvib.statistical_linearisation`) for
-    memoryless friction; with a friction state (LuGre) the viscous device
-    (k, c) and its spectral variances. Used for the step check and the
-    random start when the input is synthesised or recorded: there the scheme
-    integrates the device alone, the input's step integral being exact.
-    """
-    h = harvester
-    excitation = _coarsened(excitation)
-    if h.friction is None or h.friction.has_equivalent_damping:
-        res = statistical_linearisation(h, excitation)
-        return res.k_eq, res.c_eq, res.displacement_variance, res.velocity_variance
-    block = device_block(float(h.m), float(h.c), float(h.k), h.electrical)
-    var = output_variances(block, excitation)
-    return float(h.k), float(h.c), var["z"], var["v"]
-
-
-def _scheme_bias(scheme, m, k_eff, c_eff, psd, dt) -> float:
-    """:func:`step_bias` for an already linearised device (inf where unstable).
-
-    With k_eff = 0 (the free mass) only the velocity is stationary: the bias
-    of E[v^2] of the scheme's recursion on dv = -(c_eff/m) v dt + dW.
-    """
-    if k_eff == 0:
-        a, b = integrators.integrator(scheme).linear_recursion([[-c_eff / m]], [[1.0]], dt)
-        if abs(a[0, 0]) >= 1:
-            return float("inf")
-        discrete = dt * b[0, 0] ** 2 / (1.0 - a[0, 0] ** 2)
-        return abs(discrete * 2.0 * c_eff / m - 1.0)
-    try:
-        cov = integrators.scheme_stationary_covariance(scheme, m, c_eff, k_eff, psd, dt)
-    except ValueError:
-        return float("inf")
-    return abs(cov[1, 1] / exact.linear_velocity_variance(m, c_eff, psd) - 1.0)
-
-
-def _augmented_system(m, k_eff, c_eff, excitation: Excitation, coupling=None):
-    """(F, G, C) of the linear device (and circuit) driven through the excitation's filter.
-
-    dx = F x dt + G dW with the states (filter, z, v, circuit); the rows of C
-    pick y (the base acceleration; none under white noise), z, v and the
-    circuit state.
-    """
-    block = device_block(m, c_eff, k_eff, coupling)
-    if excitation.is_white:
-        system, q, n_filter, rows = block, excitation.level / 2.0, 0, []
-    else:
-        shaping = excitation.shaping_filter()
-        system = block.driven_by(shaping.system, "acceleration")
-        q, n_filter = shaping.noise_intensity, shaping.system.n_states
-        rows = [np.concatenate([shaping.system.c[0], np.zeros(block.n_states)])]
-    pick = np.vstack(rows + [np.hstack([np.zeros((block.n_states, n_filter)), block.c])])
-    g = np.sqrt(q) * system.b[:, None]
-    return system.a, g, pick
-
-
-def _augmented_bias(scheme, f, g, pick, dt) -> float:
-    """Largest relative bias of the picked variances of the scheme on an augmented system.
-
-    The scheme's exact recursion x_{n+1} = A x_n + B dW_n
-    (:meth:`Integrator.linear_recursion`) has the stationary covariance
-    P = A P A^T + dt B B^T, against the continuous Lyapunov F P + P F^T + G G^T = 0.
-    """
-    a, b = integrators.integrator(scheme).linear_recursion(f, g, dt)
-    if max(abs(np.linalg.eigvals(a))) >= 1:
-        return float("inf")
-    discrete = np.diag(pick @ linalg.solve_discrete_lyapunov(a, dt * (b @ b.T)) @ pick.T)
-    continuous = np.diag(pick @ linalg.solve_continuous_lyapunov(f, -(g @ g.T)) @ pick.T)
-    return float(np.max(np.abs(discrete / continuous - 1.0)))
-
-
-def _coarsened(excitation: Excitation, nodes: int = 1024) -> Excitation:
-    """A long table (a record's Welch PSD: tens of thousands of bins) as ``nodes`` cells.
-
-    Each cell keeps its exact power (``cumulative_power`` differenced), so the
-    variances the step check and the random start need are those of the
-    spectrum smoothed over cells of (support width / nodes), computed in a
-    fraction of the time of a quadrature over every bin.
-    """
-    if len(excitation.breakpoints()) <= 2 * nodes:
-        return excitation
-    lo, hi = excitation.support
-    edges = np.linspace(lo, hi, nodes + 1)
-    density = np.diff(excitation.cumulative_power(edges)) / np.diff(edges)
-    return Tabulated(np.concatenate([[lo], 0.5 * (edges[1:] + edges[:-1]), [hi]]),
-                     np.concatenate([[0.0], density, [0.0]]))  # fmt: skip
-
-
-def largest_step(scheme: str, harvester: Harvester, psd, bias: float = MAX_STEP_BIAS) -> float:
-    """Largest dt (s) whose :func:`step_bias` stays below ``bias`` (bisection)."""
-    excitation = as_excitation(psd)
-    m = float(harvester.m)
-    driven_input = excitation.shaping_filter() is None  # synthesised or recorded
-    if driven_input:
-        k_eff, c_eff = _linearised_under(harvester, excitation)[:2]
-        level = 1.0  # the step check's linear device under unit white noise
-    else:
-        k_eff, c_eff = effective_linear_device(harvester, excitation.level)  # once, not per step
-        level = excitation.level
-    # The fastest linear time scale: the period over pi, or for the free mass m/c.
-    if k_eff > 0:
-        hi = 2.0 / np.sqrt(k_eff / m)
-    else:
-        hi = 2.0 * m / c_eff if c_eff > 0 else np.inf
-    lo = 0.0
-    if (excitation.is_white or driven_input) and not harvester.has_circuit:
-
-        def bias_at(dt):
-            return _scheme_bias(scheme, m, k_eff, c_eff, level, dt)
-
-    else:
-        linear_input = as_excitation(level) if driven_input else excitation
-        system = _augmented_system(m, k_eff, c_eff, linear_input, harvester.electrical)
-        hi = min(hi, 2.0 / max(abs(np.linalg.eigvals(system[0]))))
-
-        def bias_at(dt):
-            return _augmented_bias(scheme, *system, dt)
-
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        if bias_at(mid) <= bias:
-            lo = mid
-        else:
-            hi = mid
-    return lo
-
-
-def _linearised_covariance(harvester: Harvester, excitation: Excitation) -> np.ndarray:
-    """Stationary covariance of (filter states, z, v, circuit) of the linearised device."""
-    k_eff, c_eff = effective_linear_device(harvester, excitation.level)
-    f, g, _ = _augmented_system(float(harvester.m), k_eff, c_eff, excitation, harvester.electrical)
-    return linalg.solve_continuous_lyapunov(f, -(g @ g.T))
-
-
-def _linearised_spread(harvester: Harvester, excitation: Excitation) -> tuple[float, float]:
-    """(std of z (m), std of v (m/s)) of the linearised stationary state.
-
-    White noise: Eq. 20 and 30. A rational spectrum or a circuit state: the
-    Lyapunov covariance of the same linearised device driven through the
-    excitation's filter, with the circuit.
-    Without a positive k (double well, pure cubic) the displacement's spread
-    under white noise is the exact friction-free (Gibbs) one, which sees both
-    wells, where the Gaussian closure would put a third of the wells' offset;
-    the free mass has no stationary spread in z (0: paths start at z = 0; its
-    velocity spread is the white-noise one at the excitation's level, a start
-    the burn-in corrects).
-    """
-    if excitation.shaping_filter() is None:
-        z2, v2 = _linearised_under(harvester, excitation)[2:]
-        return float(np.sqrt(z2)), float(np.sqrt(v2))
-    psd = excitation.level
-    if harvester.potential.is_free:
-        _, c_eff = effective_linear_device(harvester, psd)
-        return 0.0, float(np.sqrt(psd * harvester.m / (4.0 * c_eff)))
-    if not excitation.is_white or harvester.has_circuit:
-        cov = _linearised_covariance(harvester, excitation)
-        n_filter = 0 if excitation.is_white else excitation.shaping_filter().system.n_states
-        return float(np.sqrt(cov[n_filter, n_filter])), float(
-            np.sqrt(cov[n_filter + 1, n_filter + 1])
-        )
-    k_eff, c_eff = effective_linear_device(harvester, psd)
-    vv = psd * harvester.m / (4.0 * c_eff)
-    h = harvester
-    if h.k <= 0 and h.c > 0:
-        return float(np.sqrt(exact.gibbs_displacement_moment(h.m, h.c, h.k, h.k3, psd))), float(
-            np.sqrt(vv)
-        )
-    return float(np.sqrt(linear_displacement_variance(harvester, vv))), float(np.sqrt(vv))
-
-
-def _check_scales(run: _Run) -> None:
+def _check_scales(run: _Run, linear) -> None:
     """Refuse parameters whose linearised scales are not finite float64 numbers.
 
     Extreme values (m = 1e308, k3 = 1e308, S = 1e308) overflow the
     step-size check and the stationary start; they are named here instead.
+    ``linear`` gives the run's :class:`LinearTestSystem` (built on first use).
     """
-    h, excitation = run.harvester, run.excitation
+    h = run.harvester
     try:
         # quadrature warnings at such values would only precede the refusal
         with np.errstate(all="ignore"), warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            if excitation.shaping_filter() is None:  # synthesised input
-                k_eff, c_eff = _linearised_under(h, excitation)[:2]
-            else:
-                k_eff, c_eff = effective_linear_device(h, excitation.level)
-            spread = _linearised_spread(h, excitation)
+            system = linear()
+            k_eff, c_eff = system.k_eff, system.c_eff
+            spread = system.spread()
     except (ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
         problem = f"{type(exc).__name__}: {exc}"
     else:
@@ -890,41 +645,6 @@ def _check_resources(run: _Run, batch_paths, progress) -> None:
         work / (PATH_STEPS_PER_SECOND * numba.get_num_threads()),
         stacklevel=4,
     )
-
-
-def _check_step(scheme, harvester, excitation, dt):
-    bias = step_bias(scheme, harvester, excitation, dt)
-    states = []
-    if excitation.shaping_filter() is not None and not excitation.is_white:
-        states.append(f"the {excitation.name} filter's states")
-    if harvester.has_circuit:
-        states.append(
-            f"the {harvester.electrical.name} circuit's {harvester.electrical.state_name}"
-        )
-    resolves = f" with {' and '.join(states)}" if states else ""
-    if bias > MAX_STEP_BIAS:
-        limit = largest_step(scheme, harvester, excitation)
-        if not limit > 0:
-            raise ValueError(
-                f"`dt` = {dt!r} s is too large for this device{resolves} with {scheme}, and no "
-                f"representable step is small enough (its linearised stiffness and damping "
-                f"{effective_linear_device(harvester, excitation.level)} are out of range)"
-            )
-        raise ValueError(
-            f"`dt` = {dt!r} s is too large for this device{resolves} with {scheme}: on the "
-            f"linearised device its stationary variance is off by {bias:.3g} "
-            f"(allowed {MAX_STEP_BIAS:.0%}); use dt <= {limit:.3g} s"
-        )
-    if bias > WARN_STEP_BIAS:
-        # the step that keeps the warning away, so that the message says what to do
-        quiet = largest_step(scheme, harvester, excitation, bias=WARN_STEP_BIAS)
-        warnings.warn(
-            f"dt = {dt!r} s gives {scheme} a stationary-variance bias of about {bias:.2%} "
-            f"on the linearised device{resolves}; use dt <= {quiet:.2g} s for less than "
-            f"{WARN_STEP_BIAS:.0%}",
-            StepSizeWarning,
-            stacklevel=3,
-        )
 
 
 # ----------------------------------------------------------------- options
@@ -1136,7 +856,8 @@ def simulate(
         Simulated time per path (s), burn-in included.
     dt : float
         Time step (s). Steps whose scheme bias on the linearised device exceeds
-        :data:`MAX_STEP_BIAS` are refused (see :func:`step_bias`).
+        :data:`~randvib.montecarlo.step_check.MAX_STEP_BIAS` are refused (see
+        :func:`~randvib.montecarlo.step_check.step_bias`).
     n_paths : int
         Number of independent paths (>= 2 for confidence intervals).
     burn_in : float
@@ -1228,11 +949,15 @@ def execute(run: _Run, *, control_variates, check_step, threads, batch_paths, pr
     """Run a validated :class:`_Run` (see :func:`simulate` for the options)."""
     _check_coloured_options(run.excitation, run.companion, control_variates)
     _check_circuit_options(run.harvester, run.companion)
+    # One linear test system per run, built when first needed (a fixed start
+    # without a step check may need none): the step check, the random start,
+    # the default histogram ranges and the circuit's start all use it.
+    linear = functools.cache(lambda: LinearTestSystem.of(run.harvester, run.excitation))
     if check_step or run.initial.kind == "stationary":
-        _check_scales(run)
+        _check_scales(run, linear)
     if check_step:
-        _check_step(run.scheme.name, run.harvester, run.excitation, run.grid.dt)
-    setup = _KernelSetup.prepare(run)
+        linear().check_step(run.scheme.name, run.grid.dt)
+    setup = _KernelSetup.prepare(run, linear)
     if threads is not None:
         threads = check_int("threads", threads, 1)
         numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
@@ -1422,12 +1147,13 @@ class _KernelSetup:
     auxiliary: kernel.Auxiliary | None
 
     @classmethod
-    def prepare(cls, run: _Run) -> _KernelSetup:
+    def prepare(cls, run: _Run, linear) -> _KernelSetup:
+        """The argument groups; ``linear()`` gives the run's :class:`LinearTestSystem`."""
         h = run.harvester
         # Given base-acceleration input arrives as velocity increments (m/s): amplitude 1.
         amplitude = 1.0 if run.driver is not None else np.sqrt(run.psd / 2.0)
         device = (h.m, h.c, h.k, h.k3, amplitude)
-        initial, companion = _start_states(run)
+        initial, companion = _start_states(run, linear)
         return cls(
             scheme=run.scheme.kernel_weights,
             device=kernel.pack(kernel.Device, *device),
@@ -1435,8 +1161,8 @@ class _KernelSetup:
             timing=kernel.pack(kernel.Timing, run.grid.dt, run.grid.n_steps, run.grid.n_burn),
             initial=initial,
             companion=companion,
-            recording=_recording(run),
-            auxiliary=_auxiliary(run),
+            recording=_recording(run, linear),
+            auxiliary=_auxiliary(run, linear),
         )
 
     def arguments(self, run: _Run, lo: int, hi: int) -> dict:
@@ -1460,7 +1186,7 @@ class _KernelSetup:
         )
 
 
-def _auxiliary(run: _Run) -> kernel.Auxiliary | None:
+def _auxiliary(run: _Run, linear) -> kernel.Auxiliary | None:
     """The kernel's linear auxiliary block: the excitation's filter and the circuit state.
 
     None for white noise with a resistive (or no) circuit. The filter's states
@@ -1468,7 +1194,7 @@ def _auxiliary(run: _Run) -> kernel.Auxiliary | None:
     circuit's (``x' = a x + b v``, acceleration ``-(f/m) x``) last. With a
     random start the filter alone starts from its exact stationary law N(0, P),
     A P + P A^T + q G G^T = 0; with a circuit the block starts from its
-    marginal law under the linearised device (:func:`_linearised_covariance`).
+    marginal law under the linearised device (:meth:`LinearTestSystem.covariance`).
     Synthesised or recorded input (``run.driver``) reaches the velocity as
     given increments, like white noise: only a circuit needs the block, and it
     starts from its statistical-linearisation variance under that input.
@@ -1498,7 +1224,7 @@ def _auxiliary(run: _Run) -> kernel.Auxiliary | None:
         if driven_input:
             start = np.array([[_driven_circuit_variance(h, excitation)]])
         else:
-            cov = _linearised_covariance(h, excitation)  # (filter, z, v, circuit)
+            cov = linear().covariance()  # (filter, z, v, circuit)
             keep = [*range(n_filter), cov.shape[0] - 1]
             start = cov[np.ix_(keep, keep)]
     chol = np.zeros((n, n))
@@ -1519,14 +1245,14 @@ def _driven_circuit_variance(harvester: Harvester, excitation: Excitation) -> fl
     h = harvester
     if h.friction is not None and not h.friction.has_equivalent_damping:
         h = h.updated(friction=None)
-    return float(statistical_linearisation(h, _coarsened(excitation)).circuit_variance)
+    return float(statistical_linearisation(h, coarsened(excitation)).circuit_variance)
 
 
-def _start_states(run: _Run) -> tuple[kernel.Start, kernel.Companion]:
+def _start_states(run: _Run, linear) -> tuple[kernel.Start, kernel.Companion]:
     """Initial states of the device and of its friction-free companion."""
     h, psd = run.harvester, run.psd
     random = run.initial.kind == "stationary"
-    z, v = _linearised_spread(h, run.excitation) if random else (run.initial.z, run.initial.v)
+    z, v = linear().spread() if random else (run.initial.z, run.initial.v)
     # The friction-free companion starts from its own stationary spread (exact
     # Gaussian velocity, Gibbs displacement variance), so its known moments
     # hold from t = 0 and its control mean is right without a long burn-in.
@@ -1542,7 +1268,7 @@ def _start_states(run: _Run) -> tuple[kernel.Start, kernel.Companion]:
     )
 
 
-def _recording(run: _Run) -> kernel.Recording:
+def _recording(run: _Run, linear) -> kernel.Recording:
     """Histogram ranges and bins (default ranges +-5 linearised std); records per batch.
 
     The free mass's z spreads like a random walk: its default range is
@@ -1554,9 +1280,9 @@ def _recording(run: _Run) -> kernel.Recording:
     else:
         ranges = run.record.histogram_range
         if ranges is None:
-            sz, sv = _linearised_spread(run.harvester, run.excitation)
+            sz, sv = linear().spread()
             if run.harvester.potential.is_free:
-                _, c_eff = effective_linear_device(run.harvester, run.psd)
+                c_eff = linear().c_eff
                 sz = sv * np.sqrt(2.0 * run.harvester.m / c_eff * run.grid.t_end)
             ranges = ((-5 * sz, 5 * sz), (-5 * sv, 5 * sv))
         arr = np.asarray(ranges, dtype=float)

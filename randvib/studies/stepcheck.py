@@ -96,10 +96,10 @@ def study_executor(workers=None, scheduler=None):
 def check_step_bias(base: Harvester, points: list, settings: SweepSettings) -> float:
     """The largest linearised step bias over ``points``; refuse it above the warning level.
 
-    Uses :func:`randvib.montecarlo.simulation.step_bias` (the scheme's exact stationary
+    Uses :func:`randvib.montecarlo.step_check.step_bias` (the scheme's exact stationary
     bias on each point's linearised device).
     """
-    from randvib.montecarlo.simulation import WARN_STEP_BIAS, step_bias
+    from randvib.montecarlo.step_check import WARN_STEP_BIAS, step_bias
 
     worst = max(
         step_bias(settings.scheme, point_device(base, p), p["psd"], settings.dt) for p in points
