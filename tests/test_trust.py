@@ -825,3 +825,53 @@ def test_study_script_main_stops_with_one_line(capsys, tmp_path, stop, code):
     assert script_main(run_study, [str(tmp_path / "o")]) == code
     err = capsys.readouterr().err
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+
+
+NARROW_BAND = ["--preset", "figure9", "--psd", "1", "--excitation", "band-pass", "--f0", "1",
+               "--zeta", "0.01"]  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    "device",
+    [
+        # a soft device with a coil at the band's centre: the search's trial c_eq overflows
+        [
+            "--coupling",
+            "inductive",
+            "--alpha",
+            "1",
+            "--r-load",
+            "10",
+            "--r-coil",
+            "1",
+            "--inductance",
+            "1e-4",
+            "--k",
+            "1",
+            "--k3",
+            "10",
+        ],  # fmt: skip
+        # a double well: a trial k_eq on the solver's floor (an eigenvalue rounding to 0)
+        ["--k", "-1", "--k3", "1"],
+    ],
+    ids=["soft-coil", "double-well"],
+)
+def test_linearisation_without_a_fixed_point_says_so(capsys, device):
+    """At ordinary values these were refused as "outside the range float64 can represent"
+    (soft coil) or as the device having "an eigenvalue with non-negative real part
+    (0+0j)" (double well): both were the solver's trial steps, not the device."""
+    code, _, err = run(capsys, "power", *NARROW_BAND, *device)
+    assert code == 2 and len(err.strip().splitlines()) == 1
+    assert "statistical linearisation found no fixed point" in err
+    assert "`randvib simulate`" in err and "float64" not in err and "0+0j" not in err
+
+
+def test_float64_is_blamed_only_for_extreme_values():
+    from randvib.analytic.prediction import _out_of_range
+
+    ordinary = _out_of_range("fpk", rv.preset("figure9"), 1.0, "LinAlgError: x")
+    assert "float64" not in ordinary
+    extreme = _out_of_range("fpk", rv.preset("figure9").updated(k3=1e250), 1.0, "LinAlgError: x")
+    assert "k3 = 1e+250 is beyond the range this method can compute in float64" in extreme
+    tiny = _out_of_range("fpk", rv.preset("figure9"), 1e-300, "LinAlgError: x")
+    assert "psd = 1e-300 is beyond" in tiny

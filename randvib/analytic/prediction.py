@@ -422,14 +422,34 @@ def _raised_by_randvib(exc: BaseException) -> bool:
     return Path(tb.tb_frame.f_code.co_filename).resolve().is_relative_to(package)
 
 
+#: Magnitudes beyond which a parameter's products and powers leave float64 in
+#: the analytic methods (k3 E[z^2]^2, S m / c, ...): 1e100 squared is 1e200.
+EXTREME_MAGNITUDE = 1e100
+
+
+def _extreme_values(harvester: Harvester, psd) -> list[str]:
+    """``name = value`` of the parameters (and PSD numbers) of extreme magnitude."""
+    level = psd.parameters() if isinstance(psd, Excitation) else {"psd": psd}
+    values = {**harvester.parameters(), **level}
+    return [
+        f"{name} = {value:g}"
+        for name, value in values.items()
+        if isinstance(value, int | float)
+        and value != 0
+        and not 1.0 / EXTREME_MAGNITUDE <= abs(value) <= EXTREME_MAGNITUDE
+    ]
+
+
 def _out_of_range(method, harvester, psd, what, overflow: bool = True) -> str:
+    """The refusal of a non-finite result; float64's range is blamed only when it is the cause."""
     level = psd.parameters() if isinstance(psd, Excitation) else psd
     text = f"method {method!r} has no finite result at these values ({what}): psd = {level!r}, "
-    if not overflow:
+    extreme = _extreme_values(harvester, psd) if overflow else []
+    if not extreme:
         return text + str(harvester.parameters())
     return (
-        text + f"{harvester.parameters()}; the parameters are outside the range float64 can "
-        "represent for this device"
+        text + f"{harvester.parameters()}; {', '.join(extreme)} is beyond the range this "
+        "method can compute in float64 (|x| within 1e-100 .. 1e100)"
     )
 
 

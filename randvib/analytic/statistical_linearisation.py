@@ -265,7 +265,23 @@ def statistical_linearisation(
         return np.log([out["v"], out["z"]])
 
     def residual(x):
-        return response(*equivalent(x)) - x
+        # The solver's trial steps may leave the region where the linearised
+        # device is stable and its variances finite (a narrow band near the
+        # resonance of a soft or double-well device): that is the solver's
+        # failure to find a fixed point, reported as such by _solve, not a
+        # property of the user's device.
+        with np.errstate(all="ignore"):
+            c_eq, k_eq = equivalent(x)
+            trial = _TrialUndefined(f"c_eq = {c_eq:.3g} Ns/m, k_eq = {k_eq:.3g} N/m")
+            if not (np.isfinite(c_eq) and np.isfinite(k_eq)):
+                raise trial
+            try:
+                out = response(c_eq, k_eq) - x
+            except (ValueError, np.linalg.LinAlgError):
+                raise trial from None  # unstable, or a stiffness on the floor (rounds to 0)
+        if not np.all(np.isfinite(out)):
+            raise trial
+        return out
 
     # Start from the linear device; without viscous damping, from 5 % of critical.
     # Without a positive k (double well, pure cubic) the linear device is
@@ -343,19 +359,33 @@ class LinearisationDidNotConverge(ValueError, RuntimeError):
     """
 
 
+class _TrialUndefined(ArithmeticError):
+    """A trial step of the solver left the region where the linearised device has a response."""
+
+
 def _solve(residual, x0) -> np.ndarray:
     """Root of ``residual`` (log variances) by Powell's hybrid method.
 
     If it stalls (a coloured spectrum can make the map stiff), damped
     fixed-point steps x <- x + r(x)/2 bring it closer and it is tried again.
+    A trial step with no finite stable response ends the search: no fixed
+    point was found (:class:`LinearisationDidNotConverge`).
     """
     x = np.asarray(x0, dtype=float)
-    for _ in range(3):
-        solution = optimize.root(residual, x, method="hybr", options={"xtol": 1e-14})
-        if np.max(np.abs(residual(solution.x))) <= _TOLERANCE:
-            return solution.x
-        for _ in range(50):
-            x = x + 0.5 * residual(x)
+    try:
+        for _ in range(3):
+            solution = optimize.root(residual, x, method="hybr", options={"xtol": 1e-14})
+            if np.max(np.abs(residual(solution.x))) <= _TOLERANCE:
+                return solution.x
+            for _ in range(50):
+                x = x + 0.5 * residual(x)
+    except _TrialUndefined as trial:
+        raise LinearisationDidNotConverge(
+            "statistical linearisation found no fixed point: the search reached a linearised "
+            f"device ({trial}) with no finite stationary response; a narrow-band excitation near the "
+            "resonance of a soft or double-well device can leave the Gaussian closure without "
+            "a solution: use Monte Carlo (randvib.simulate)"
+        ) from None
     raise LinearisationDidNotConverge(
         "statistical linearisation did not converge (largest log-variance residual "
         f"{np.max(np.abs(residual(solution.x))):.3g}); a narrow-band excitation near the "

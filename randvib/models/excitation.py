@@ -598,6 +598,14 @@ class Tabulated(Excitation):
             )
         if not np.any(p > 0):
             raise ValueError("`psd` must be > 0 somewhere; the table has no power")
+        with np.errstate(all="ignore"):
+            power = float(np.trapezoid(p, f))
+        if not np.isfinite(power):
+            raise ValueError(
+                f"the table's total power (the variance, integral of `psd` over `frequency`) "
+                f"overflows float64, with `psd` up to {float(p.max()):.3g} {_PSD_UNIT} over "
+                f"{float(f[0]):g}-{float(f[-1]):g} Hz; give the PSD in {_PSD_UNIT}"
+            )
         object.__setattr__(self, "frequency", f)
         object.__setattr__(self, "density", p)
 
