@@ -202,8 +202,8 @@ def test_step_warning_is_one_readable_line(capsys):
     )
     assert code == 0
     (line,) = [text for text in err.splitlines() if "warning" in text]
-    assert line.startswith("randvib: warning: dt = 0.0002 s gives euler-maruyama")
-    assert "use dt <= " in line and ".py" not in line
+    assert line.startswith("randvib simulate: warning: --dt = 0.0002 s gives euler-maruyama")
+    assert "use --dt <= " in line and ".py" not in line
 
 
 # ------------------------------------------------------------- output for people

@@ -85,8 +85,8 @@ def test_simulate_control_variates_reach_the_simulation(capsys):
     ("argv", "fragment"),
     [
         (["--paths", "0"], "argument --paths"),
-        (["--dt", "0"], "`dt`"),
-        (["--t-end", "1", "--burn-in", "1"], "`burn_in`"),
+        (["--dt", "0"], "`--dt`"),
+        (["--t-end", "1", "--burn-in", "1"], "`--burn-in`"),
         (["--threads", "0"], "argument --threads"),
     ],
 )
@@ -271,7 +271,7 @@ def test_study_linearisation_vs_averaging_cli(tmp_path, capsys, monkeypatch):
             "--scheduler",
             "tcp://h:1",
         ],
-        "`scheduler` is not supported",
+        "`--scheduler` is not supported",
     )
 
 

@@ -76,7 +76,7 @@ def test_table_output(capsys):
 @pytest.mark.parametrize(
     ("argv", "fragment"),
     [
-        (["--preset", "figure9", "--psd", "0"], "`psd` must be > 0"),
+        (["--preset", "figure9", "--psd", "0"], "`--psd` must be > 0"),
         (["--preset", "figure9", "--psd", "nan"], "finite"),
         (["--preset", "nope", "--psd", "1"], "`--preset` must be one of"),
         (
@@ -85,10 +85,10 @@ def test_table_output(capsys):
         ),
         (
             ["--m", "-1", "--c-m", "0.1", "--c-e", "0.1", "--k", "57", "--psd", "1"],
-            "`m` must be > 0",
+            "`--m` must be > 0",
         ),
-        (["--preset", "figure9", "--c-m", "-0.1", "--psd", "1"], "`c_m` must be >= 0"),
-        (["--preset", "figure9", "--fc", "-1", "--psd", "1"], "`fc` must be >= 0"),
+        (["--preset", "figure9", "--c-m", "-0.1", "--psd", "1"], "`--c-m` must be >= 0"),
+        (["--preset", "figure9", "--fc", "-1", "--psd", "1"], "`--fc` must be >= 0"),
         (["--preset", "figure9"], "`--psd` is required"),
         (["--preset", "figure9", "--psd", "1", "--bogus"], "unrecognized arguments"),
     ],

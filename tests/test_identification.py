@@ -385,10 +385,18 @@ def test_read_record_round_trip_and_mapping(tmp_path, record):
             {},
             "column `time` is not uniformly sampled",
         ),
-        (lambda f: f.drop(columns="time"), {}, "no `time` column; give the sample rate"),
+        (
+            lambda f: f.drop(columns="time"),
+            {},
+            "no 'time' column \\(`time_column`\\); give the sample rate",
+        ),
         (lambda f: f, dict(sample_rate=1000), "`sample_rate` = 1000 Hz disagrees"),
         (lambda f: f.iloc[:3], {}, "at least 5"),
-        (lambda f: f, dict(input_column="acc"), "input column `acc` not found"),
+        (
+            lambda f: f,
+            dict(input_column="acc"),
+            "input column 'acc' \\(`input_column`\\) not found",
+        ),
     ],
 )
 def test_bad_records(tmp_path, record, mutate, kwargs, match):
@@ -438,7 +446,7 @@ def test_cli_identify_json_and_validate(tmp_path, capsys, record):
     "extra, message",
     [
         (["--model", "dry", "--m", "1"], "`--model` must be one of"),
-        (["--model", "coulomb"], "`m` (kg) is required"),
+        (["--model", "coulomb"], "`--m` (kg) is required"),
         (["--model", "coulomb", "--m", "0.02", "--fix", "k3"], "`--fix` expects NAME=VALUE"),
         (
             ["--model", "coulomb", "--m", "0.02", "--bounds", "k=1"],

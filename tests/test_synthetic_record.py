@@ -146,8 +146,8 @@ def test_cli_writes_a_record_identify_reads_and_refuses_to_overwrite(tmp_path, c
         ([], "give exactly one of `--rms`"),
         (["--rms", "1", "--psd", "0.1"], "give exactly one of `--rms`"),
         (["--rms", "1", "--input", "force"], "`--input` must be one of"),
-        (["--rms", "1", "--f-lo", "30"], "`f_hi` must be > `f_lo`"),
-        (["--rms", "1", "--noise-z", "-1"], "`noise_z` must be >= 0"),
+        (["--rms", "1", "--f-lo", "30"], "`--f-hi` must be > `--f-lo`"),
+        (["--rms", "1", "--noise-z", "-1"], "`--noise-z` must be >= 0"),
     ],
 )
 def test_cli_errors_are_one_line(tmp_path, capsys, extra, message):

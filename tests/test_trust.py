@@ -345,7 +345,7 @@ def test_results_csv_is_rebuilt_from_the_points(tmp_path):
 
 def test_validate_settings_checked_as_identify_does(capsys, tmp_path, record_csv):
     rec, params = record_csv
-    one_line_error(capsys, ["validate", params, rec, "--skip", "100000"], "`skip` = 100000")
+    one_line_error(capsys, ["validate", params, rec, "--skip", "100000"], "`--skip` = 100000")
     one_line_error(capsys, ["validate", params, rec, "--substeps", "0"], "argument --substeps")
     one_line_error(capsys, ["validate", params, rec, "--set", "bogus=1"], "--set bogus")
     one_line_error(capsys, ["validate", params, rec, "--set", "fc=-1"], "`--set fc` must be >= 0")
@@ -449,7 +449,7 @@ def test_simulate_extreme_values_one_line(capsys, argv, fragment):
 @pytest.mark.parametrize(
     "extra, fragment",
     [
-        (["--lowpass", "1e-308"], "`lowpass` must be at least"),
+        (["--lowpass", "1e-308"], "`--lowpass` must be at least"),
         (["--seed", "-1"], "argument --seed: must be an integer in 0 .."),
         (["--sample-rate", "1e-308", "--time-column", "none"], "search bounds of"),
     ],
@@ -875,3 +875,48 @@ def test_float64_is_blamed_only_for_extreme_values():
     assert "k3 = 1e+250 is beyond the range this method can compute in float64" in extreme
     tiny = _out_of_range("fpk", rv.preset("figure9"), 1e-300, "LinAlgError: x")
     assert "psd = 1e-300 is beyond" in tiny
+
+
+def _value_options(command: str):
+    """(flag, dest) of every option of ``command`` that takes a value (not a choice or a switch)."""
+    from randvib.cli import build_parser
+
+    parser = next(a for a in build_parser()._actions if a.dest == "command").choices[command]
+    for action in parser._actions:
+        longs = [o for o in action.option_strings if o.startswith("--")]
+        if longs and action.nargs != 0 and action.choices is None and action.dest != "help":
+            yield longs[0], action.dest
+
+
+def _base_argv(command, record_csv, tmp_path):
+    path, params = (str(p) for p in record_csv)
+    return {
+        "power": ["power", "--preset", "figure9", "--psd", "1"],
+        "simulate": ["simulate", "--preset", "figure9", "--psd", "1", "--paths", "4",
+                     "--t-end", "0.2", "--burn-in", "0.05"],
+        "record": ["record", "--preset", "figure9", "--rms", "1", "--duration", "1",
+                   "--out", str(tmp_path / "r.csv"), "--force"],
+        "identify": _fit_args(path),
+        "validate": ["validate", params, path],
+    }[command]  # fmt: skip
+
+
+@pytest.mark.parametrize("command", ["power", "simulate", "record", "identify", "validate"])
+def test_messages_name_the_flag_the_user_typed(capsys, record_csv, tmp_path, command):
+    """Every value option of every command, given a bad value: the refusal names the
+    flag (`--burn-in`), never the API argument behind it (`burn_in`, `dt`, `k`)."""
+    checked = 0
+    for flag, dest in _value_options(command):
+        for bad in ("-1", "nan", "0"):
+            code, _, err = run(capsys, *_base_argv(command, record_csv, tmp_path), flag, bad)
+            if code == 2:
+                break
+        if code != 2:
+            continue  # every value of the option is allowed (a seed, a column name...)
+        checked += 1
+        if dest != flag.removeprefix("--"):  # the API's spelling differs from the flag's
+            assert f"`{dest}`" not in err and f" {dest} " not in err, (flag, err)
+        if f"`{flag}`" not in err and f"argument {flag}" not in err:
+            # the few refusals that explain the device (not confining) name its parameters
+            assert "not confining" in err, (flag, err)
+    assert checked >= 3

@@ -142,8 +142,12 @@ def _main_with_warnings(argv) -> int:
         for advice in _advice_warnings():
             warnings.filterwarnings("default", category=advice)
         warnings.showwarning = _show_warning
-        with sigterm_stops():
-            return _main(argv)
+        try:
+            with sigterm_stops():
+                return _main(argv)
+        finally:
+            # in-process callers (tests, notebooks) get the API's words back
+            _Running.prog, _Running.flags = "randvib", {}
 
 
 def _advice_warnings() -> tuple:
@@ -157,7 +161,7 @@ def _advice_warnings() -> tuple:
 def _show_warning(message, category, filename, lineno, file=None, line=None):
     """A warning as one readable line (no kind, source file or code line)."""
     text = cli_wording(str(message).strip().splitlines()[0] if str(message).strip() else "")
-    print(f"randvib: warning: {text}", file=file or sys.stderr)
+    print(f"{_Running.prog}: warning: {text}", file=file or sys.stderr)
 
 
 #: ``randvib.NAME(`` in the library's messages -> the command that does it here.
@@ -173,11 +177,14 @@ _KEYWORD_CHOICE = re.compile(r"\b(?P<name>method|friction|coupling)='(?P<value>[
 _API_NAME = re.compile(r"`?randvib\.(?P<name>[a-z_]+)(?:\(\))?`?")
 
 
-def cli_wording(message: str) -> str:
+def cli_wording(message: str, flags: dict | None = None) -> str:
     """A library message as the command line says it: ``randvib.simulate`` -> ``randvib simulate``.
 
     Only the functions a command runs are translated; other names stay as
-    they are (they are the API the message is about).
+    they are (they are the API the message is about). With ``flags`` (API
+    argument -> the flag that sets it, :func:`api_flags`), the arguments the
+    message names become the flags the user typed: `` `burn_in` must satisfy
+    0 <= burn_in < t_end`` -> `` `--burn-in` must satisfy 0 <= --burn-in < --t-end``.
     """
 
     def command(match):
@@ -186,7 +193,43 @@ def cli_wording(message: str) -> str:
 
     message = _API_NAME.sub(command, message)
     # a keyword choice of the API (method='fpk-fast') is an option here
-    return _KEYWORD_CHOICE.sub(lambda m: f"`--{m['name']} {m['value']}`", message)
+    message = _KEYWORD_CHOICE.sub(lambda m: f"`--{m['name']} {m['value']}`", message)
+    flags = _Running.flags if flags is None else flags
+    if flags:
+        message = _QUOTED_NAME.sub(lambda m: f"`{flags.get(m[1], m[1])}`", message)
+        # bare names with an underscore in formulas and advice (dt is one too)
+        message = _BARE_NAME.sub(lambda m: flags.get(m[1], m[1]), message)
+    return message
+
+
+class _Running:
+    """The command being run: its name and API-argument -> flag map (errors and warnings)."""
+
+    prog = "randvib"
+    flags: dict = {}
+
+
+#: API arguments whose flag is named differently (README's table of renamed options).
+_RENAMED = {"n_paths": "--paths", "scheme": "--method", "maxiter": "--generations"}
+
+_QUOTED_NAME = re.compile(r"`([A-Za-z_][\w ()-]*)`")
+_BARE_NAME = re.compile(r"(?<![\w`./-])([a-z][a-z0-9]*(?:_[a-z0-9]+)+|dt)(?![\w`/(-])")
+
+
+def api_flags(parser: argparse.ArgumentParser) -> dict:
+    """API argument name -> the flag that sets it, for one command's parser.
+
+    An option's ``dest`` is the API argument's name (``--burn-in`` sets
+    ``burn_in``); a command may add names of its own with
+    ``set_defaults(api_flags={...})`` (``record --rms`` sets the excitation).
+    """
+    flags = dict(_RENAMED)
+    for action in parser._actions:
+        longs = [o for o in action.option_strings if o.startswith("--")]
+        if longs and action.dest != "help":
+            flags[action.dest] = longs[0]
+    flags.update(parser.get_default("api_flags") or {})
+    return flags
 
 
 #: What the compile notice says, once per run, on stderr.
@@ -222,12 +265,17 @@ def compile_notice():
         yield
 
 
+def _command_parser(parser, command: str) -> argparse.ArgumentParser:
+    return next(a for a in parser._actions if a.dest == "command").choices[command]
+
+
 def _main(argv) -> int:
     prog = "randvib"  # "randvib COMMAND" once the command is known, as argparse names it
     try:
         parser = build_parser()
         args, unknown = parser.parse_known_args(argv)
         prog = f"randvib {args.command}"
+        _Running.prog, _Running.flags = prog, api_flags(_command_parser(parser, args.command))
         if unknown:  # named by the command, with where to look (argparse names only "randvib")
             raise UserError(
                 f"{prog}: error: unrecognized arguments: {' '.join(unknown)} (see `{prog} --help`)"

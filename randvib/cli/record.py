@@ -53,7 +53,7 @@ def register(sub) -> None:
     s.add_argument("--offset-input", type=float, default=0.0, help="offset on the input")
     p.add_argument("--out", required=True, metavar="FILE.csv", help="output file (new)")
     p.add_argument("--force", action="store_true", help="overwrite an existing --out")
-    p.set_defaults(handler=run)
+    p.set_defaults(handler=run, api_flags={"excitation (RMS base acceleration)": "--rms"})
 
 
 def run(args) -> int:

@@ -38,9 +38,9 @@ def register(sub) -> None:
     g = p.add_argument_group("simulation")
     g.add_argument(
         "--paths",
-        type=integer_option(1),
+        type=integer_option(2),  # the table's intervals need two paths
         default=None,
-        help="number of paths, n_paths (default: 1000)",
+        help="number of paths, n_paths, >= 2 for the confidence intervals (default: 1000)",
     )
     g.add_argument(
         "--t-end",

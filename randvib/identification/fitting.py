@@ -464,22 +464,23 @@ def _input_column(path: Path, columns, input_column, input_kind) -> tuple[str, s
         if not present:
             raise ValueError(
                 f"{path.name}: no input column; expected one of {', '.join(INPUT_KINDS)} "
-                f"(or name it with `--input-column`); columns are {columns}"
+                f"(or name it with `input_column`); columns are {columns}"
             )
         if len(present) > 1:
             raise ValueError(
-                f"{path.name}: several input columns {present}; choose one with `--input-kind`"
+                f"{path.name}: several input columns {present}; choose one with `input_kind`"
             )
         input_column = present[0]
     if input_column not in columns:
         raise ValueError(
-            f"{path.name}: input column `{input_column}` not found; columns are {columns}"
+            f"{path.name}: input column {input_column!r} (`input_column`) not found; "
+            f"columns are {columns}"
         )
     if input_kind is None:
         if input_column not in INPUT_KINDS:
             raise ValueError(
                 f"input column `{input_column}` is not one of {', '.join(INPUT_KINDS)}; "
-                "say what it holds with `--input-kind`"
+                "say what it holds with `input_kind`"
             )
         input_kind = input_column
     return input_column, input_kind
@@ -491,7 +492,8 @@ def _sample_interval(path: Path, frame, time_column, sample_rate) -> float:
     if time_column not in frame.columns:
         if sample_rate is None:
             raise ValueError(
-                f"{path.name}: no `{time_column}` column; give the sample rate with `--sample-rate`"
+                f"{path.name}: no {time_column!r} column (`time_column`); give the sample rate "
+                "with `sample_rate`"
             )
         return 1.0 / float(check_positive("sample_rate", sample_rate, "Hz"))
     t = _finite_column(time_column, frame[time_column])
