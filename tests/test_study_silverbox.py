@@ -5,6 +5,8 @@ only (SaDE 12 x 10, then the least-squares polish) and is scored on the
 held-out multisine test and the full arrow-head, which nothing was tuned on.
 """
 
+import json
+
 import pandas as pd
 
 from randvib.studies import load
@@ -21,3 +23,24 @@ def test_quick_study_meets_the_arrow_head_target(tmp_path):
     assert rms["arrow-head"] <= 0.5
     assert rms["multisine test"] <= 0.5
     assert "Beintema" in (tmp_path / "sb" / "report.md").read_text()
+    verdicts = json.loads((tmp_path / "sb" / "verdicts.json").read_text())
+    assert verdicts["arrow_head_rms_mV"] == rms["arrow-head"]
+    assert verdicts["best_model"] == "Duffing" and len(verdicts["verdicts"]) == 1
+
+
+def test_verdicts_follow_from_the_tables():
+    rows = [
+        ("linear (k3 = 0)", "arrow-head", 8.0), ("linear (k3 = 0)", "multisine test", 4.0),
+        ("Duffing", "arrow-head", 0.4), ("Duffing", "multisine test", 0.3),
+    ]  # fmt: skip
+    table = pd.DataFrame(rows, columns=["model", "record", "RMS error (mV)"])
+    ablation = pd.DataFrame({"arrow-head RMS (mV)": [2.0, 1.0, 0.4]})
+    data, sentences = study.silverbox_verdicts(table, ablation, "multisine test", "arrow-head")
+    assert data["best_model"] == "Duffing" and data["duffing_over_linear_arrow_head"] == 20.0
+    assert "3.5 times smaller than the 1.4 mV" in sentences[0]  # 1.4 / 0.4
+    assert "1.2 times smaller than its 0.36 mV" in sentences[0]  # 0.36 / 0.3
+    assert "20 times the Duffing model's" in sentences[1]
+    assert "divides the Duffing model's arrow-head error by 5 (2 -> 0.4 mV)" in sentences[2]
+    worse = table.assign(**{"RMS error (mV)": [8.0, 4.0, 2.8, 0.72]})
+    _, sentences = study.silverbox_verdicts(worse, pd.DataFrame(), "multisine test", "arrow-head")
+    assert "2 times larger than the 1.4 mV" in sentences[0] and len(sentences) == 2
