@@ -69,19 +69,18 @@ import pandas as pd
 import randvib as rv
 from randvib._progress import progress_bar
 from randvib.analytic.linear_response import mechanical_block, output_variances
+from randvib.figure_style import colour as style_colour
+from randvib.figure_style import new_figure, panel_letters, save_figure, styled
 from randvib.montecarlo.simulation import estimate
 from randvib.studies import script_main
 from randvib.studies.report import (
     markdown_table,
     plus_minus,
     prepare_output_dir,
-    save_figure,
     write_report,
     write_table,
     write_verdicts,
 )
-from randvib.studies.style import colour as style_colour
-from randvib.studies.style import new_figure, panel_letters, styled
 
 NAME = "devices"
 FC = 0.0058  #: N, the paper's Coulomb level (Table 2, training data 1)

@@ -1,7 +1,7 @@
 """The studies' shared figure style, layout check, report formatting and evidence counting.
 
 Every study figure of the tests' tiny runs goes through
-:func:`randvib.studies.report.save_figure`, whose layout check is an error
+:func:`randvib.figure_style.save_figure`, whose layout check is an error
 in the tests (``filterwarnings`` in pyproject.toml); these tests show the
 check itself catches what it must.
 """
@@ -15,22 +15,22 @@ import pandas as pd  # noqa: E402
 import pytest  # noqa: E402
 from study_checks import unclean_tokens  # noqa: E402
 
+from randvib.figure_style import (  # noqa: E402
+    FigureLayoutWarning,
+    new_figure,
+    num_tex,
+    panel_letters,
+    save_figure,
+    text_overlaps,
+)
 from randvib.studies.evidence import independent_count, rescaling_groups  # noqa: E402
 from randvib.studies.report import (  # noqa: E402
     format_number,
     format_percent,
     markdown_table,
     readable_table,
-    save_figure,
     verdict_lines,
     write_verdicts,
-)
-from randvib.studies.style import (  # noqa: E402
-    FigureLayoutWarning,
-    new_figure,
-    num_tex,
-    panel_letters,
-    text_overlaps,
 )
 
 

@@ -252,9 +252,9 @@ def test_study_rerun_refuses_edited_figure_and_force_allows(capsys, tmp_path, mo
 
     def fake_study(out_dir, *, quick, seed, workers, scheduler, progress):
         out = _io.prepare_output_dir(out_dir, {"study": "fake"})
-        from randvib.studies.style import new_figure
+        from randvib.figure_style import new_figure, save_figure
 
-        report.save_figure(new_figure()[0], out / "figure.png")  # a study's figure style
+        save_figure(new_figure()[0], out / "figure.png")  # a study's figure style
         return report.write_report(out, "fake", [])
 
     monkeypatch.setattr("randvib.cli.study.load_study", lambda name: fake_study)

@@ -18,8 +18,10 @@ such scripts share lives here:
 - :mod:`~randvib.studies.verdicts`: the verdict sentences, built from the numbers;
 - :mod:`~randvib.studies.evidence`: rows that repeat one experiment (exact rescalings);
 - :mod:`~randvib.studies.figures`: figures of power and contrasts against Fc;
-- :mod:`~randvib.studies.style`: one figure style, panel letters, the layout check;
 - :mod:`~randvib.studies.report`: CSV, ``verdicts.json``, Markdown tables, ``report.md``.
+
+Every figure is drawn in :mod:`randvib.figure_style` (shared with the
+identification plots).
 
 Every script defines ``run_study(out_dir, *, quick=False, seed=0,
 workers=None, scheduler=None, progress=True) -> Path`` (the report it wrote);

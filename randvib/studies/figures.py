@@ -1,7 +1,7 @@
 """Figures the studies share: power and contrasts against the Coulomb level.
 
 Each function draws from a study's table, saves one PNG at ``path``
-(:func:`randvib.studies.report.save_figure`) and returns the path; nothing
+(:func:`randvib.figure_style.save_figure`) and returns the path; nothing
 is computed here except the analytic curves drawn for comparison.
 """
 
@@ -13,8 +13,7 @@ import numpy as np
 import pandas as pd
 
 from randvib.analytic.prediction import METHODS, expected_power
-from randvib.studies.report import save_figure
-from randvib.studies.style import colour, new_figure, num_tex, panel_letters, styled
+from randvib.figure_style import colour, new_figure, num_tex, panel_letters, save_figure, styled
 
 
 def _averaging_power(device, psd):

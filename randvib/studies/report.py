@@ -4,7 +4,7 @@ A study writes into one folder (made by :func:`prepare_output_dir`, which refuse
 another run's folder and lets the same run resume):
 CSV tables (:func:`write_table`), ``verdicts.json`` (:func:`write_verdicts`:
 the numbers behind every sentence of the report, for tests and other
-programs), PNG figures (:func:`save_figure`) and ``report.md``
+programs), PNG figures (:func:`randvib.figure_style.save_figure`) and ``report.md``
 (:func:`write_report`), whose tables come from :func:`markdown_table`, the
 one Markdown table writer of the package. Every write is atomic, so an
 interrupted study leaves no half-written file, and goes through
@@ -31,7 +31,6 @@ __all__ = [
     "print_verdicts",
     "readable_table",
     "prepare_output_dir",
-    "save_figure",
     "sign_word",
     "verdict_lines",
     "write_report",
@@ -256,27 +255,6 @@ def write_report(
     for heading, body in sections:
         text += [f"## {heading}", "", body.strip(), ""]
     return write_tracked(Path(out_dir) / "report.md", "\n".join(text))
-
-
-def save_figure(fig, path: Path) -> Path:
-    """Save ``fig`` as a PNG (:data:`randvib.studies.style.DPI`) and close it.
-
-    Before saving, :func:`randvib.studies.style.check_layout` warns if the
-    figure lacks constrained layout or two of its texts overlap. An edited
-    PNG is not replaced (:func:`randvib._io.write_tracked`).
-    """
-    import io
-
-    import matplotlib.pyplot as plt
-
-    from randvib.studies.style import DPI, check_layout
-
-    path = Path(path)
-    check_layout(fig, path.name)
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=DPI)
-    plt.close(fig)
-    return write_tracked(path, buffer.getvalue())
 
 
 def sign_word(rows: pd.DataFrame, column: str = "relative_contrast") -> str:

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from randvib.studies.style import DPI, PALETTE, check_layout, new_figure, panel_letters, styled
+from randvib.figure_style import DPI, PALETTE, check_layout, new_figure, panel_letters, styled
 
 _PANELS = (
     ("displacement", "$S_z$ (m$^2$/Hz)"),
@@ -44,8 +44,8 @@ def plot_response_spectra(
         the first series' power peak (room for a third harmonic), at most the
         highest frequency given.
     path : str or Path, optional
-        Save the figure there (PNG, :data:`randvib.studies.style.DPI` dpi) and close it;
-        a :class:`randvib.studies.style.FigureLayoutWarning` first if texts overlap.
+        Save the figure there (PNG, :data:`randvib.figure_style.DPI` dpi) and close it;
+        a :class:`randvib.figure_style.FigureLayoutWarning` first if texts overlap.
 
     Returns
     -------

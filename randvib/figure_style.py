@@ -1,12 +1,13 @@
-"""One look for every figure of the studies: style, layout, panel letters, and a layout check.
+"""One look for every figure randvib draws: style, layout, panel letters, and a layout check.
 
+Studies, the identification plots and the response-spectra figure all draw
+with it; it imports nothing of randvib's layers, so every layer may use it.
 :func:`new_figure` makes a figure with constrained layout under :data:`STYLE`
 (font sizes a journal accepts at column width, a colour-blind-safe cycle);
 :func:`panel_letters` labels the panels (a), (b), (c)...;
 :func:`text_overlaps` lists the pairs of texts (titles, axis labels, tick
-labels, legends) that overlap once drawn, which
-:func:`randvib.studies.report.save_figure` turns into a
-:class:`FigureLayoutWarning` (an error in the tests) before it saves.
+labels, legends) that overlap once drawn, which :func:`save_figure` turns
+into a :class:`FigureLayoutWarning` (an error in the tests) before it saves.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from __future__ import annotations
 import warnings
 from contextlib import contextmanager
 from itertools import combinations
+from pathlib import Path
 
 #: Okabe & Ito's colour-blind-safe palette (Nature Methods 8, 441, 2011), black last.
 PALETTE = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9", "#F0E442", "#000000")
@@ -200,3 +202,24 @@ def check_layout(fig, name: str) -> None:
             FigureLayoutWarning,
             stacklevel=3,
         )
+
+
+def save_figure(fig, path) -> Path:
+    """Save ``fig`` as a PNG (:data:`DPI`) and close it; returns the path.
+
+    Before saving, :func:`check_layout` warns if the figure lacks constrained
+    layout or two of its texts overlap. An edited PNG is not replaced
+    (:func:`randvib._io.write_tracked`).
+    """
+    import io
+
+    import matplotlib.pyplot as plt
+
+    from randvib._io import write_tracked
+
+    path = Path(path)
+    check_layout(fig, path.name)
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=DPI)
+    plt.close(fig)
+    return write_tracked(path, buffer.getvalue())
