@@ -204,22 +204,27 @@ def check_layout(fig, name: str) -> None:
         )
 
 
-def save_figure(fig, path) -> Path:
+def save_figure(fig, path, *, tracked: bool = True) -> Path:
     """Save ``fig`` as a PNG (:data:`DPI`) and close it; returns the path.
 
     Before saving, :func:`check_layout` warns if the figure lacks constrained
-    layout or two of its texts overlap. An edited PNG is not replaced
-    (:func:`randvib._io.write_tracked`).
+    layout or two of its texts overlap. In a result folder (``tracked``, the
+    default) an edited PNG is not replaced (:func:`randvib._io.write_tracked`);
+    a path the user named (``--plot``), already checked by its command, is
+    simply written.
     """
     import io
 
     import matplotlib.pyplot as plt
 
-    from randvib._io import write_tracked
+    from randvib._io import atomic_write_bytes, write_tracked
 
     path = Path(path)
     check_layout(fig, path.name)
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png", dpi=DPI)
     plt.close(fig)
+    if not tracked:
+        atomic_write_bytes(path, buffer.getvalue())
+        return path
     return write_tracked(path, buffer.getvalue())

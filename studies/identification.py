@@ -33,6 +33,7 @@ import pandas as pd
 
 import randvib as rv
 from randvib._io import dumps, write_tracked
+from randvib.figure_style import save_figure
 from randvib.identification.plots import figure_costs, figure_fit
 from randvib.models.presets import ALPHA, R_COIL
 from randvib.studies import script_main
@@ -144,15 +145,15 @@ def figure8(fits, electrical, common, out: Path) -> pd.DataFrame:
         for model in ("coulomb", "viscous"):
             pred = fits[(3, model)].predict(wired, electrical=electrical)
             tag = "test6" if rms is None else "low"
-            figure_fit(
+            figure = figure_fit(
                 pred,
-                out / f"figure8_{tag}_{model}.png",
                 window=(0, 2),
                 scale=1e3,
                 unit="mm",
-                title=f"{label} ({level:g} m/s^2 RMS) with coil, R_L = {R_LOAD:g} ohm: "
+                title=f"{label} ({level:g} m s$^{{-2}}$ RMS), coil with R$_L$ = {R_LOAD:g} Ω: "
                 f"{model} model identified on test 3",
             )
+            save_figure(figure, out / f"figure8_{tag}_{model}.png")
             rows.append(
                 {
                     "excitation": f"{label}, {level:g} m/s^2",
@@ -265,9 +266,8 @@ def figure7(costs: pd.DataFrame, path: Path) -> Path:
         }
         for t in TRAINING_TESTS
     }
-    titles = {f"test {t}": f"({'ab'[i]}) trained on test {t}" for i, t in enumerate(TRAINING_TESTS)}
-    figure_costs(per_fit, list(range(1, 10)), path, titles=titles)
-    return path
+    titles = {f"test {t}": f"trained on test {t}" for t in TRAINING_TESTS}
+    return save_figure(figure_costs(per_fit, list(range(1, 10)), titles=titles), path)
 
 
 def report_sections(recovery, exact, recovered, table, costs, fig8, electrical, sentence):

@@ -165,9 +165,12 @@ def test_identify_table_and_plot(tmp_path, capsys, records):
         assert rows[name][-1] == ("fixed" if name == "m" else "identified")
     assert f"J = {saved['cost']:.6g} (Eq. 11)" in out
     png_ok(plot)
+    # a path the user named is written as asked: no checksum file left beside it
+    assert not (tmp_path / ".randvib-written.json").exists()
     # an existing --save or --plot file is refused before any work
     one_line_error(capsys, [*argv, "--save", params], "`--save`")
     one_line_error(capsys, [*argv, "--plot", plot], "`--plot`")
+    assert run(capsys, *argv, "--plot", plot, "--force")[0] == 0
 
 
 def test_validate_table_and_plots(tmp_path, capsys, records):

@@ -130,3 +130,15 @@ def parse_bounds(items) -> dict:
         except ValueError:
             raise ValueError(f"`--bounds` expects NAME=LOWER:UPPER, got {item!r}") from None
     return out
+
+
+def plot_units(args) -> dict:
+    """``scale`` and ``unit`` of the displacement in ``--plot`` figures.
+
+    The default output column is the relative displacement in m, shown in mm
+    as in the paper; a column the user named (``--output-column``) is shown
+    as it is, in the record's own units.
+    """
+    if args.output_column == OUTPUT_COLUMN:
+        return dict(scale=1e3, unit="mm")
+    return dict(scale=1.0, unit=f"{args.output_column}, record units")

@@ -15,6 +15,7 @@ from randvib.cli._records import (
     add_record_arguments,
     parse_assignments,
     parse_bounds,
+    plot_units,
     record_from_args,
     simulation_settings,
 )
@@ -98,12 +99,12 @@ def _new_file(path, option, overwrite=False):
     return None if path is None else check_output_file(path, option, overwrite=overwrite)
 
 
-def _save_plot(result, record, plot: Path, title: str) -> None:
+def _save_plot(result, record, plot: Path, title: str, units: dict) -> None:
     """The figure; if it cannot be written now, say so and keep going (the result is printed)."""
     from randvib.identification.plots import figure_fit
 
     try:
-        figure_fit(result.predict(record), plot, title=title)
+        figure_fit(result.predict(record), plot, title=title, **units)
     except OSError as exc:
         print(f"randvib: could not write `--plot` {str(plot)!r} ({exc})", file=sys.stderr)
 
@@ -134,7 +135,7 @@ def run(args) -> int:
     if save is not None:
         write_or_keep(save, dumps(out, indent=2), "--save")
     if plot is not None:
-        _save_plot(result, record, plot, f"{args.model} model on {record.name}")
+        _save_plot(result, record, plot, f"{args.model} model on {record.name}", plot_units(args))
     if args.json:
         print(dumps(out))
         return 0

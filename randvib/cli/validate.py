@@ -11,6 +11,7 @@ from randvib.cli._output import print_table
 from randvib.cli._records import (
     add_record_arguments,
     parse_assignments,
+    plot_units,
     record_from_args,
     simulation_settings,
 )
@@ -107,9 +108,8 @@ def run(args) -> int:
 
         for i, record in enumerate(records):
             pred = predict_record(parameters, model, record, simulation=settings)
-            figure_fit(
-                pred, plot_dir / f"{i:02d}_{record.name}.png", title=f"{model} on {record.name}"
-            )
+            path = plot_dir / f"{i:02d}_{record.name}.png"
+            figure_fit(pred, path, title=f"{model} model on {record.name}", **plot_units(args))
     if args.json:
         print(
             dumps(

@@ -1,109 +1,131 @@
 """Figures for identification results (paper Figures 7 and 8).
 
 Numbers come from :mod:`randvib.identification.fitting` (``Prediction`` objects and
-cost tables); these functions only draw them.
+cost tables); these functions only draw them, in the shared style of
+:mod:`randvib.figure_style` (constrained layout, panel letters, the Okabe-Ito
+palette, units in mathtext). Each returns the figure; given ``path`` it also
+writes the PNG (after the layout check) and closes it.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from randvib.figure_style import PALETTE, new_figure, panel_letters, save_figure, styled
+
+#: Colour, marker and label of each friction model. Coulomb and tanh fits are
+#: often equal to plotting accuracy: Coulomb is drawn as a larger open marker
+#: under tanh's small filled one, so both stay visible.
 MODEL_STYLE = {
-    "viscous": dict(color="tab:gray", marker="s", label="no friction (viscous)"),
-    "coulomb": dict(color="tab:blue", marker="o", label="Coulomb"),
-    "tanh": dict(color="tab:orange", marker="^", label="tanh"),
-    "lugre": dict(color="tab:green", marker="D", label="LuGre"),
+    "viscous": dict(color="#555555", marker="s", ms=4, label="no friction (viscous)"),
+    "coulomb": dict(color=PALETTE[0], marker="o", ms=7, mfc="none", label="Coulomb"),
+    "tanh": dict(color=PALETTE[1], marker="^", ms=3.5, ls="--", label="tanh"),
+    "lugre": dict(color=PALETTE[2], marker="D", ms=4, ls=":", label="LuGre"),
 }
 
+#: Measured data in black, the model's simulation dashed in vermilion.
+MEASURED = dict(color="black", lw=1.0, label="measured")
+SIMULATED = dict(color=PALETTE[1], lw=1.0, ls="--", label="simulated")
 
-def _pyplot():
-    import matplotlib
+#: Display units of the displacement: scale factor -> mathtext label.
+_UNIT_TEXT = {"m": "m", "mm": "mm", "µm": "µm", "um": "µm"}
 
-    matplotlib.use(matplotlib.get_backend())
-    import matplotlib.pyplot as plt
 
-    return plt
+def _finish(fig, path):
+    if path is not None:
+        save_figure(fig, path, tracked=False)  # the caller checked the path (CLI --plot, --force)
+    return fig
 
 
 def plot_time_history(prediction, ax=None, *, window=None, scale=1.0, unit="m"):
-    """Measured (solid) and simulated (dashed) relative displacement.
+    """Measured (solid black) and simulated (dashed) relative displacement.
 
     Parameters
     ----------
     prediction : randvib.identification.fitting.Prediction
     ax : matplotlib Axes, optional
+        Drawn into a new styled figure when not given.
     window : (t0, t1), optional
         Time window (s) to show; default the first 2 s.
     scale, unit : float, str
         Display scaling, e.g. ``1e3, "mm"``.
     """
-    plt = _pyplot()
     if ax is None:
-        _, ax = plt.subplots(figsize=(8, 3))
+        _, axes = new_figure(figsize=(7.0, 2.6))
+        ax = axes[0, 0]
     rec = prediction.record
     t = rec.time
     t0, t1 = window if window is not None else (0.0, min(t[-1], 2.0))
     sel = (t >= t0) & (t <= t1)
-    ax.plot(t[sel], rec.z[sel] * scale, "k-", lw=1.2, label="measured")
-    ax.plot(t[sel], prediction.z[sel] * scale, "r--", lw=1.2, label="simulated")
+    ax.plot(t[sel], rec.z[sel] * scale, **MEASURED)
+    ax.plot(t[sel], prediction.z[sel] * scale, **SIMULATED)
     ax.set_xlabel("time (s)")
-    ax.set_ylabel(f"relative displacement ({unit})")
-    ax.set_title(f"{rec.name}: J = {prediction.cost:.3g}")
-    ax.legend(loc="upper right", fontsize="small")
-    ax.grid(alpha=0.3)
+    ax.set_ylabel(f"relative displacement z ({_UNIT_TEXT.get(unit, unit)})")
+    ax.set_xlim(t[sel][0], t[sel][-1])
+    ax.set_title(f"J = {prediction.cost:.3g} (Eq. 11)", loc="right")
+    ax.legend(loc="upper left", ncols=2, frameon=False)
     return ax
 
 
 def plot_histograms(prediction, axes=None, *, bins=81, scale=1.0, unit="m"):
-    """Histograms of measured and simulated displacement and, if present, load voltage.
+    """Densities of the measured and simulated displacement and, with a coil, load voltage.
 
     With a circuit the voltage histogram shows the spike at zero volts caused
     by sticking (paper Figure 8b): while the magnet sticks, z' = 0 and so V = 0.
     """
-    plt = _pyplot()
     rec = prediction.record
-    panels = [(rec.z * scale, prediction.z * scale, f"z ({unit})")]
+    z_unit = _UNIT_TEXT.get(unit, unit)
+    panels = [(rec.z * scale, prediction.z * scale, "z", z_unit)]
     if prediction.voltage is not None:
         measured = None if rec.voltage is None else rec.voltage * 1e3
-        panels.append((measured, prediction.voltage * 1e3, "load voltage (mV)"))
+        panels.append((measured, prediction.voltage * 1e3, "load voltage V", "mV"))
     if axes is None:
-        _, axes = plt.subplots(1, len(panels), figsize=(4.5 * len(panels), 3.2))
+        _, grid = new_figure(1, len(panels), figsize=(3.5 * len(panels), 2.6))
+        axes = grid[0]
     axes = np.atleast_1d(axes)
-    for ax, (meas, sim, label) in zip(axes, panels, strict=False):
+    for ax, (meas, sim, name, unit_text) in zip(axes, panels, strict=False):
         values = [x for x in (meas, sim) if x is not None]
         lo = min(np.min(x) for x in values)
         hi = max(np.max(x) for x in values)
         edges = np.linspace(lo, hi, bins + 1)
         if meas is not None:
-            ax.hist(meas, edges, density=True, histtype="step", color="k", lw=1.4, label="measured")
-        ax.hist(
-            sim, edges, density=True, histtype="step", color="r", ls="--", lw=1.4, label="simulated"
-        )
-        ax.set_xlabel(label)
-        ax.set_ylabel("probability density")
-        ax.legend(fontsize="small")
-        ax.grid(alpha=0.3)
+            ax.hist(meas, edges, density=True, histtype="step", **MEASURED)
+        ax.hist(sim, edges, density=True, histtype="step", **SIMULATED)
+        ax.set_xlabel(f"{name} ({unit_text})")
+        ax.set_ylabel(f"probability density (1/{unit_text})")
+        ax.legend(loc="upper right", frameon=False)
     return axes
 
 
+@styled
 def figure_fit(prediction, path=None, *, window=None, scale=1.0, unit="m", title=None):
-    """Paper Figure 8 analogue: time history and histograms in one figure."""
-    plt = _pyplot()
+    """Paper Figure 8 analogue: (a) time history, (b) displacement and (c) voltage densities.
+
+    ``title`` defaults to the record's name.
+    """
     n_hist = 2 if prediction.voltage is not None else 1
-    fig = plt.figure(figsize=(11, 6.5), constrained_layout=True)
-    grid = fig.add_gridspec(2, n_hist)
-    ax_t = fig.add_subplot(grid[0, :])
+    fig, _ = _fit_layout(n_hist)
+    ax_t, *hist_axes = fig.axes
     plot_time_history(prediction, ax_t, window=window, scale=scale, unit=unit)
-    axes = [fig.add_subplot(grid[1, j]) for j in range(n_hist)]
-    plot_histograms(prediction, axes, scale=scale, unit=unit)
-    if title:
-        fig.suptitle(title)
-    if path is not None:
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
-    return fig
+    plot_histograms(prediction, hist_axes, scale=scale, unit=unit)
+    panel_letters(fig.axes)
+    fig.suptitle(title if title else prediction.record.name)
+    return _finish(fig, path)
 
 
+def _fit_layout(n_hist: int):
+    """A figure with the time history on top and ``n_hist`` histograms below."""
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=(7.0, 4.8), layout="constrained")
+    grid = fig.add_gridspec(2, n_hist)
+    fig.add_subplot(grid[0, :])
+    for j in range(n_hist):
+        fig.add_subplot(grid[1, j])
+    return fig, fig.axes
+
+
+@styled
 def figure_costs(costs: dict, tests, path=None, *, titles=None):
     """Paper Figure 7 analogue: J per test for each model, one panel per training set.
 
@@ -113,40 +135,40 @@ def figure_costs(costs: dict, tests, path=None, *, titles=None):
         ``{training_label: {model: [J per test]}}``.
     tests : sequence of int
         Test numbers (x axis).
+    titles : dict, optional
+        Panel titles by training label (the panel letters are added).
     """
-    plt = _pyplot()
     n = len(costs)
-    fig, axes = plt.subplots(1, n, figsize=(6 * n, 4), sharey=True, constrained_layout=True)
-    axes = np.atleast_1d(axes)
+    fig, axes = new_figure(1, n, figsize=(3.5 * n, 3.0), sharey=True)
+    axes = axes[0]
     for ax, (label, table) in zip(axes, costs.items(), strict=True):
         for model, values in table.items():
-            style = MODEL_STYLE.get(model, {})
-            ax.semilogy(tests, values, ls="-", lw=1, ms=6, **style)
+            style = dict(MODEL_STYLE.get(model, dict(label=model)))
+            style.setdefault("ls", "-")
+            ax.semilogy(tests, values, lw=1, **style)
         ax.set_xlabel("test number")
         ax.set_xticks(list(tests))
-        ax.set_title((titles or {}).get(label, label))
+        ax.set_title((titles or {}).get(label, label), loc="right")
         ax.grid(alpha=0.3, which="both")
     axes[0].set_ylabel("cost J (Eq. 11)")
-    axes[0].legend(fontsize="small")
-    if path is not None:
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
-    return fig
+    panel_letters(axes)
+    # one legend for all panels, outside them, so that no point is hidden
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="outside lower center", ncols=len(labels), frameon=False)
+    return _finish(fig, path)
 
 
+@styled
 def figure_convergence(histories: dict, path=None, *, title=None):
     """Best cost against simulations spent, one line per optimiser/run."""
-    plt = _pyplot()
-    fig, ax = plt.subplots(figsize=(6.5, 4), constrained_layout=True)
+    fig, axes = new_figure(figsize=(4.5, 3.2))
+    ax = axes[0, 0]
     for label, (nfev, best) in histories.items():
         ax.loglog(nfev, best, label=label)
     ax.set_xlabel("simulations")
-    ax.set_ylabel("best cost J")
+    ax.set_ylabel("best cost J (Eq. 11)")
     ax.grid(alpha=0.3, which="both")
-    ax.legend(fontsize="small")
+    ax.legend(frameon=False)
     if title:
         ax.set_title(title)
-    if path is not None:
-        fig.savefig(path, dpi=120)
-        plt.close(fig)
-    return fig
+    return _finish(fig, path)
