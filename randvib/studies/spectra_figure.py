@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from randvib.figure_style import DPI, PALETTE, check_layout, new_figure, panel_letters, styled
+from randvib.figure_style import PALETTE, new_figure, panel_letters, save_figure, styled
 
 _PANELS = (
     ("displacement", "$S_z$ (m$^2$/Hz)"),
@@ -52,7 +52,6 @@ def plot_response_spectra(
     matplotlib.figure.Figure or Path
         The figure, or the path it was saved to.
     """
-    import matplotlib.pyplot as plt
 
     fig, axes = new_figure(3, 1, figsize=(6.5, 8.0), sharex=True)
     axes = axes[:, 0]
@@ -92,8 +91,4 @@ def plot_response_spectra(
     panel_letters(axes)
     if path is None:
         return fig
-    path = Path(path)
-    check_layout(fig, path.name)
-    fig.savefig(path, dpi=DPI)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, tracked=False)  # a path the caller chose
