@@ -278,9 +278,10 @@ def test_refusals_and_bad_values(capsys, argv, fragment):
 @pytest.mark.parametrize(
     ("content", "fragment"),
     [
-        ("frequency,psd\n0,1\n10,-1\n20,0\n", "`psd` must be >= 0"),
-        ("frequency,psd\n0,1\n10,1\n10,0\n", "`frequency` must be strictly increasing"),
-        ("frequency,psd\n0,1\n20,1\n10,0\n", "`frequency` must be strictly increasing"),
+        # the file's columns, quoted (not the option `--psd`)
+        ("frequency,psd\n0,1\n10,-1\n20,0\n", "'psd' must be >= 0"),
+        ("frequency,psd\n0,1\n10,1\n10,0\n", "'frequency' must be strictly increasing"),
+        ("frequency,psd\n0,1\n20,1\n10,0\n", "'frequency' must be strictly increasing"),
         ("freq,psd\n0,1\n10,1\n", "must have the columns frequency, psd"),
         ("frequency,psd\n0,1\n10,x\n", "could not convert"),
         ("", "No columns"),
@@ -299,16 +300,16 @@ def test_bad_record(tmp_path, capsys):
     with_nan = acceleration.copy()
     with_nan[10] = np.nan
     file = write_record(tmp_path / "nan.csv", time, with_nan)
-    power_error(capsys, [*DEVICE, "--record", file], "`base_acceleration` must be finite")
+    power_error(capsys, [*DEVICE, "--record", file], "'base_acceleration' must be finite")
     uneven = time.copy()
     uneven[100] += 0.004
     file = write_record(tmp_path / "uneven.csv", uneven, acceleration)
-    power_error(capsys, [*DEVICE, "--record", file], "`time` must be evenly spaced")
+    power_error(capsys, [*DEVICE, "--record", file], "'time' must be evenly spaced")
     power_error(capsys, [*DEVICE, "--record", file], f"`--record` {file}: ")
     nan_time = time.copy()
     nan_time[5] = np.nan
     file = write_record(tmp_path / "nan_time.csv", nan_time, acceleration)
-    power_error(capsys, [*DEVICE, "--record", file], "`time` must be finite")
+    power_error(capsys, [*DEVICE, "--record", file], "'time' must be finite")
 
 
 @pytest.mark.parametrize("option", ["--psd-file", "--record"])

@@ -145,4 +145,6 @@ def _read(flag: str, name: str, path: str):
         return EXCITATIONS[name].from_csv(file)
     except (ValueError, OSError) as exc:  # pandas' parse errors are ValueErrors
         first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise ValueError(f"`{flag}` {path}: {first}") from None
+        # names inside the file's message are its columns ('psd'), not options
+        # (`--psd`): quoted, they are left alone by the CLI's flag wording
+        raise ValueError(f"`{flag}` {path}: {first.replace('`', chr(39))}") from None
