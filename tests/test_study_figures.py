@@ -115,3 +115,16 @@ def test_verdict_lines_show_sentences_then_numbers(tmp_path):
     lines = verdict_lines(tmp_path)
     assert lines == ["- It holds.", "  a.n: 3", "  a.x: 0.1235", "  a.rows: 1 entries"]
     assert verdict_lines(tmp_path / "missing") == []
+
+
+def test_fit_window_holds_about_thirty_cycles():
+    """figure_fit's default window: 30 oscillations of the output, at most 2 s."""
+    from types import SimpleNamespace
+
+    from randvib.identification.plots import default_window
+
+    t = np.arange(0, 10, 1e-3)
+    fast = SimpleNamespace(time=t, z=np.sin(2 * np.pi * 60 * t + 0.3))
+    slow = SimpleNamespace(time=t, z=np.sin(2 * np.pi * 5 * t + 0.3))
+    assert default_window(fast) == pytest.approx(0.5, rel=0.01)
+    assert default_window(slow) == 2.0

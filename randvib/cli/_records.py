@@ -132,6 +132,11 @@ def parse_bounds(items) -> dict:
     return out
 
 
+def output_unit(args) -> str:
+    """The unit of the output column: m for the relative displacement, else the column's own."""
+    return "m" if args.output_column == OUTPUT_COLUMN else f"({args.output_column} units)"
+
+
 def plot_units(args) -> dict:
     """``scale`` and ``unit`` of the displacement in ``--plot`` figures.
 

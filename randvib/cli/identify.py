@@ -13,6 +13,7 @@ from randvib._validation import MAX_SEED, integer_option
 from randvib.cli._output import print_table
 from randvib.cli._records import (
     add_record_arguments,
+    output_unit,
     parse_assignments,
     parse_bounds,
     plot_units,
@@ -139,7 +140,7 @@ def run(args) -> int:
     if args.json:
         print(dumps(out))
         return 0
-    print_report(result, record)
+    print_report(result, record, output_unit(args))
     return 0
 
 
@@ -160,14 +161,19 @@ def _with_precision(value, se, interval) -> list:
     return [shown, se_shown, f"[{lo}, {hi}]"]
 
 
-def print_report(result, record) -> None:
-    """The parameters with standard errors and 95 % intervals, J, the correlations."""
+def print_report(result, record, output_unit: str = "m") -> None:
+    """The parameters with standard errors and 95 % intervals, J, the correlations.
+
+    ``output_unit``: the unit of the record's output column (m for the
+    relative displacement; a named ``--output-column`` keeps its own).
+    """
     se, ci = result.standard_errors, result.confidence_intervals
+    units = {**UNITS, "output_offset": output_unit, "input_offset": INPUT_UNITS[record.input_kind]}
     rows = [
         [
             name,
             *_with_precision(value, se.get(name), ci.get(name)),
-            INPUT_UNITS[record.input_kind] if name == "input_offset" else UNITS[name],
+            units[name],
             "identified" if name in se or name in result.free else "fixed",
         ]
         for name, value in result.parameters.items()
@@ -179,7 +185,9 @@ def print_report(result, record) -> None:
         f"({result.simulations_per_second:.0f} sims/s); {result.message}"
     )
     start = result.initial_state
-    print(f"initial state z0 = {start['z0']:.6g} m, v0 = {start['v0']:.6g} m/s")
+    print(
+        f"initial state z0 = {start['z0']:.6g} {output_unit}, v0 = {start['v0']:.6g} {output_unit}/s"
+    )
     for note in result.notes:
         print(f"note: {note}")
     unc = result.uncertainty

@@ -46,7 +46,7 @@ def plot_time_history(prediction, ax=None, *, window=None, scale=1.0, unit="m"):
     ax : matplotlib Axes, optional
         Drawn into a new styled figure when not given.
     window : (t0, t1), optional
-        Time window (s) to show; default the first 2 s.
+        Time window (s) to show; default :func:`default_window`.
     scale, unit : float, str
         Display scaling, e.g. ``1e3, "mm"``.
     """
@@ -55,7 +55,7 @@ def plot_time_history(prediction, ax=None, *, window=None, scale=1.0, unit="m"):
         ax = axes[0, 0]
     rec = prediction.record
     t = rec.time
-    t0, t1 = window if window is not None else (0.0, min(t[-1], 2.0))
+    t0, t1 = window if window is not None else (0.0, default_window(rec))
     sel = (t >= t0) & (t <= t1)
     ax.plot(t[sel], rec.z[sel] * scale, **MEASURED)
     ax.plot(t[sel], prediction.z[sel] * scale, **SIMULATED)
@@ -67,11 +67,27 @@ def plot_time_history(prediction, ax=None, *, window=None, scale=1.0, unit="m"):
     return ax
 
 
-def plot_histograms(prediction, axes=None, *, bins=81, scale=1.0, unit="m"):
+def default_window(record, cycles: float = 30.0, longest: float = 2.0) -> float:
+    """End (s) of the shown window: about ``cycles`` oscillations of the measured output.
+
+    At most ``longest`` s, so that both curves stay readable whether the
+    device rings at 5 Hz (2 s shown) or at 60 Hz (the Silverbox: 0.5 s); the
+    oscillation rate is counted from the output's mean crossings.
+    """
+    z = record.z - np.mean(record.z)
+    crossings = np.count_nonzero(np.signbit(z[1:]) != np.signbit(z[:-1]))
+    duration = float(record.time[-1] - record.time[0])
+    if crossings < 2:
+        return min(duration, longest)
+    return min(duration, longest, cycles / (crossings / 2.0 / duration))
+
+
+def plot_histograms(prediction, axes=None, *, bins=81, scale=1.0, unit="m", legend=True):
     """Densities of the measured and simulated displacement and, with a coil, load voltage.
 
     With a circuit the voltage histogram shows the spike at zero volts caused
     by sticking (paper Figure 8b): while the magnet sticks, z' = 0 and so V = 0.
+    ``legend=False`` leaves the legends out (a figure that has one elsewhere).
     """
     rec = prediction.record
     z_unit = _UNIT_TEXT.get(unit, unit)
@@ -93,7 +109,8 @@ def plot_histograms(prediction, axes=None, *, bins=81, scale=1.0, unit="m"):
         ax.hist(sim, edges, density=True, histtype="step", **SIMULATED)
         ax.set_xlabel(f"{name} ({unit_text})")
         ax.set_ylabel(f"probability density (1/{unit_text})")
-        ax.legend(loc="upper right", frameon=False)
+        if legend:
+            ax.legend(loc="upper right", frameon=False)
     return axes
 
 
@@ -107,7 +124,8 @@ def figure_fit(prediction, path=None, *, window=None, scale=1.0, unit="m", title
     fig, _ = _fit_layout(n_hist)
     ax_t, *hist_axes = fig.axes
     plot_time_history(prediction, ax_t, window=window, scale=scale, unit=unit)
-    plot_histograms(prediction, hist_axes, scale=scale, unit=unit)
+    # one legend, in (a): in the densities it would cover a tail
+    plot_histograms(prediction, hist_axes, scale=scale, unit=unit, legend=False)
     panel_letters(fig.axes)
     fig.suptitle(title if title else prediction.record.name)
     return _finish(fig, path)
