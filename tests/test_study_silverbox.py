@@ -26,6 +26,7 @@ def test_quick_study_meets_the_arrow_head_target(tmp_path):
     verdicts = json.loads((tmp_path / "sb" / "verdicts.json").read_text())
     assert verdicts["arrow_head_rms_mV"] == rms["arrow-head"]
     assert verdicts["best_model"] == "Duffing" and len(verdicts["verdicts"]) == 1
+    assert verdicts["meets_target"] is (max(rms.values()) <= 0.5)
 
 
 def test_verdicts_follow_from_the_tables():
@@ -39,8 +40,10 @@ def test_verdicts_follow_from_the_tables():
     assert data["best_model"] == "Duffing" and data["duffing_over_linear_arrow_head"] == 20.0
     assert "3.5 times smaller than the 1.4 mV" in sentences[0]  # 1.4 / 0.4
     assert "1.2 times smaller than its 0.36 mV" in sentences[0]  # 0.36 / 0.3
+    assert "It meets the physical model's target of 0.5 mV" in sentences[0]
     assert "20 times the Duffing model's" in sentences[1]
     assert "divides the Duffing model's arrow-head error by 5 (2 -> 0.4 mV)" in sentences[2]
     worse = table.assign(**{"RMS error (mV)": [8.0, 4.0, 2.8, 0.72]})
     _, sentences = study.silverbox_verdicts(worse, pd.DataFrame(), "multisine test", "arrow-head")
     assert "2 times larger than the 1.4 mV" in sentences[0] and len(sentences) == 2
+    assert "It misses the physical model's target of 0.5 mV" in sentences[0]
