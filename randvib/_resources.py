@@ -66,11 +66,17 @@ def check_memory(what: str, n_bytes: float, hint: str) -> None:
         )
 
 
-def announce_duration(what: str, seconds: float, stacklevel: int = 3) -> None:
-    """Warn (:class:`LongRunWarning`) when ``what`` is expected to take long."""
+def announce_duration(
+    what: str, seconds: float, stacklevel: int = 3, basis: str = "at the speed measured here"
+) -> None:
+    """Warn (:class:`LongRunWarning`) when ``what`` is expected to take long.
+
+    ``basis`` says where the estimate comes from (a timed probe of the run,
+    or a rough speed).
+    """
     if seconds > LONG_RUN_SECONDS:
         warnings.warn(
-            f"{what} will take about {duration_text(seconds)} (a rough estimate); Ctrl-C stops it",
+            f"{what} will take about {duration_text(seconds)} ({basis}); Ctrl-C stops it",
             LongRunWarning,
             stacklevel=stacklevel,
         )

@@ -19,6 +19,7 @@ import threading
 import time
 from pathlib import Path
 
+import numba
 import numpy as np
 import pytest
 from _cli import one_line_error, run
@@ -510,13 +511,63 @@ def test_step_advice_never_says_dt_at_most_zero(monkeypatch):
     assert "dt <= 0 s" not in str(info.value)
 
 
-def test_long_run_says_how_long(monkeypatch):
-    from randvib._resources import LongRunWarning
-    from randvib.montecarlo import simulation
+def _probe_clock(seconds_per_probe):
+    """A clock on which the timed probe lasts ``seconds_per_probe``."""
+    ticks = iter(np.arange(100) * seconds_per_probe)
+    return lambda: float(next(ticks))
 
-    monkeypatch.setattr(simulation, "PATH_STEPS_PER_SECOND", 1.0)  # pretend a slow machine
-    with pytest.warns(LongRunWarning, match="will take about"):
-        simulate(BASE, 1.0, t_end=0.05, dt=1e-4, n_paths=4, progress=False)
+
+@pytest.mark.parametrize("probe_seconds, warned", [(1000.0, True), (1e-9, False)])
+def test_long_run_estimate_follows_the_measured_speed(monkeypatch, probe_seconds, warned):
+    """The announcement uses the speed of a timed probe, not a fixed rate: the same
+    run is announced on a (simulated) slow machine and not on a fast one."""
+    import warnings
+
+    from randvib._resources import LongRunWarning, duration_text
+    from randvib.montecarlo import kernel, simulation
+
+    monkeypatch.setattr(simulation, "PATH_STEPS_PER_SECOND", 1.0)  # a run that could be long
+    monkeypatch.setattr(simulation, "_clock", _probe_clock(probe_seconds))
+    n_paths, n_steps = 4, 500
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        simulate(BASE, 1.0, t_end=n_steps * 1e-4, dt=1e-4, n_paths=n_paths, progress=False)
+    said = [str(w.message) for w in caught if issubclass(w.category, LongRunWarning)]
+    assert bool(said) is warned
+    if warned:
+        # the probe ran every path (<= LANES x threads) for every step of this short run
+        probe_paths = min(n_paths, kernel.LANES * numba.get_num_threads())
+        expected = n_paths * n_steps / (probe_paths * n_steps / probe_seconds)
+        assert f"will take about {duration_text(expected)} (at the speed measured here)" in said[0]
+
+
+@pytest.mark.parametrize("probe_seconds, warned", [(1e4, True), (1e-9, False)])
+def test_identification_estimate_follows_the_measured_speed(
+    monkeypatch, record_csv, probe_seconds, warned
+):
+    """identify times its probes of the bounds and announces a long search at that speed."""
+    import warnings
+
+    from randvib._resources import LongRunWarning, duration_text
+    from randvib.identification import fitting
+
+    monkeypatch.setattr(fitting, "_clock", _probe_clock(probe_seconds))
+    probed = []
+    points = fitting._probe_points
+    monkeypatch.setattr(
+        fitting, "_probe_points", lambda space: probed.append(points(space)) or probed[-1]
+    )
+    record = rv.read_record(record_csv[0])
+    settings = rv.SearchSettings(popsize=6, maxiter=1, polish=False)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        rv.identify(record, "coulomb", m=0.0226, search=settings)
+    said = [str(w.message) for w in caught if issubclass(w.category, LongRunWarning)]
+    assert bool(said) is warned
+    if warned:
+        # popsize x (maxiter + 1) runs at the speed of len(probes) runs in probe_seconds
+        expected = 6 * 2 / (len(probed[0]) / probe_seconds)
+        assert f"will take about {duration_text(expected)} (at the speed measured here)" in said[0]
 
 
 def _interrupt_after(seconds):

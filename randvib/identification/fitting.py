@@ -1044,8 +1044,9 @@ def identify(
     fixed, reported, notes = _measurement_model(record, fixed, bool(quadratic))
     space = _search_space(record, model, fixed, bounds, simulation.skip)
     cost = _identification_cost(record, model, fixed, space.free, simulation)
-    _announce(record, search, simulation, len(space.free))
-    _refuse_unsimulable(cost, space)
+    _check_population(search, len(space.free))
+    speed = _refuse_unsimulable(cost, space)
+    _announce(record, search, simulation, speed)
     searched = cost
     if search.search_samples is not None:
         check_int("search_samples", search.search_samples, minimum=SAMPLES_PER_PARAMETER * 2)
@@ -1072,27 +1073,30 @@ def identify(
     )
 
 
-def _announce(record: Record, search: SearchSettings, simulation: SimulationSettings, d) -> None:
-    """Refuse a population that cannot fit; say how long a long identification will take
-    (at most popsize x (maxiter + 1) simulations)."""
-    import numba
-
-    from randvib._resources import announce_duration
+def _check_population(search: SearchSettings, d: int) -> None:
+    """Refuse a SaDE population that cannot fit in memory, before anything runs."""
     from randvib.identification.sade import check_population_memory
 
+    check_population_memory(check_int("popsize", search.popsize, 6), d)
+
+
+def _announce(record: Record, search: SearchSettings, simulation: SimulationSettings, speed):
+    """Say how long a long identification will take: at most popsize x (maxiter + 1)
+    simulations at ``speed``, the record sub-steps per second measured on the
+    probes of :func:`_refuse_unsimulable`."""
+    from randvib._resources import announce_duration
+
     popsize, maxiter = check_int("popsize", search.popsize, 6), check_int("maxiter", search.maxiter)
-    check_population_memory(popsize, d)
     steps = float(popsize) * (maxiter + 1) * record.n * simulation.substeps
     announce_duration(
         f"identification ({popsize} x {maxiter + 1} simulations of {record.n} samples)",
-        steps / (RECORD_STEPS_PER_SECOND * numba.get_num_threads()),
+        steps / speed,
         stacklevel=4,
     )
 
 
-#: Rough speed of the compiled record simulation (sub-steps per second per
-#: thread), for the duration estimate of long identifications.
-RECORD_STEPS_PER_SECOND = 5e7
+#: The clock that times the probes (a test replaces it).
+_clock = time.perf_counter
 
 
 @dataclass(frozen=True)
@@ -1307,18 +1311,23 @@ def _probe_points(space: _SearchSpace) -> np.ndarray:
     return np.vstack([np.where(bits == 1, hi, lo), centre, geometric])
 
 
-def _refuse_unsimulable(cost: CostFunction, space: _SearchSpace) -> None:
+def _refuse_unsimulable(cost: CostFunction, space: _SearchSpace) -> float:
     """Refuse before searching when the model cannot simulate the record anywhere probed.
 
     A fixed value or bound at which the model diverges or overflows (``--fix
     k3=1e308``, ``--bounds k=1e300:1e308``) would make every candidate of the
     search diverge; one batched simulation at the box's corners and centre
     finds it first. Some probes diverging is normal (wide default bounds);
-    all of them diverging is refused.
+    all of them diverging is refused. Returns the record sub-steps per second
+    the probes ran at (after one that compiles the simulation), for the
+    duration estimate.
     """
     probes = _probe_points(space)
     with np.errstate(all="ignore"):
+        cost(probes[:1])  # compiles (or loads) the simulation: not part of the speed
+        started = _clock()
         costs = cost(probes)
+        elapsed = max(_clock() - started, 1e-9)
     if not np.any(np.isfinite(costs)):
         raise ValueError(
             f"the {cost.model} model cannot simulate record {cost.record.name!r} with the "
@@ -1326,6 +1335,7 @@ def _refuse_unsimulable(cost: CostFunction, space: _SearchSpace) -> None:
             "probes (the corners and centre of the bounds) diverged; check `--fix` and "
             "`--bounds` (nothing was searched)"
         )
+    return len(probes) * cost.record.n * cost.substeps / elapsed
 
 
 def _initial_guess(init, space: _SearchSpace):

@@ -42,7 +42,7 @@ from scipy import linalg, special  # Student t quantile; lighter than scipy.stat
 
 from randvib import _display
 from randvib._progress import progress_bar, progress_wanted
-from randvib._resources import announce_duration, check_memory
+from randvib._resources import LONG_RUN_SECONDS, announce_duration, check_memory
 from randvib._validation import (
     MAX_SEED,
     check_choice,
@@ -615,14 +615,63 @@ def _check_scales(run: _Run, linear) -> None:
     )
 
 
-#: Rough speed of the compiled loop, path-steps per second per thread, for
-#: the duration estimate of long runs (Heun, Coulomb friction; measured on a
-#: laptop core, about 3e7).
+#: Rough speed of the compiled loop, path-steps per second per thread (Heun,
+#: Coulomb friction on a laptop core, about 3e7): it only decides whether a run
+#: could be long enough to time a probe of it (:func:`_announce_long_run`).
 PATH_STEPS_PER_SECOND = 3e7
+#: A run shorter than LONG_RUN_SECONDS / PROBE_MARGIN at the rough speed is
+#: not probed: the machine would have to be this many times slower to make it long.
+PROBE_MARGIN = 30.0
+#: Path-steps per thread of the timed probe (about 0.1 s at the rough speed).
+PROBE_PATH_STEPS = 3e6
+#: The clock that times the probe (a test replaces it).
+_clock = time.perf_counter
+
+
+def _announce_long_run(run: _Run, setup: _KernelSetup) -> None:
+    """Say how long a long run will take, at the speed measured on this machine.
+
+    A run that could be long (more than LONG_RUN_SECONDS / PROBE_MARGIN at the
+    rough speed) is timed on a short probe first: the first paths for a few
+    thousand steps, after a call that compiles the loop, so that neither the
+    compilation nor the machine's guessed speed enters the estimate. Input
+    synthesised per path is not probed (its synthesis is per whole path); its
+    estimate uses the rough speed and the synthesis' measured cost (about 3x
+    the white-noise loop, ``benchmarks/bench_engine.py``).
+    """
+    threads = numba.get_num_threads()
+    work = float(run.n_paths) * run.grid.n_steps * (2 if run.companion else 1)
+    rough = work / (PATH_STEPS_PER_SECOND * threads)
+    if rough <= LONG_RUN_SECONDS / PROBE_MARGIN:
+        return
+    what = f"simulating {run.n_paths} paths x {run.grid.n_steps} steps"
+    if run.driver is not None:
+        announce_duration(what, 3.0 * rough, stacklevel=5, basis="a rough estimate")
+    else:
+        announce_duration(what, work / _measured_speed(run, setup, threads), stacklevel=5)
+
+
+def _measured_speed(run: _Run, setup: _KernelSetup, threads: int) -> float:
+    """Path-steps per second of this run's compiled loop on this machine (a timed probe)."""
+    paths = min(run.n_paths, kernel.LANES * threads)
+    steps = int(min(run.grid.n_steps, max(100, PROBE_PATH_STEPS * threads / paths)))
+
+    def probe(n_paths, n_steps):
+        timing = kernel.pack(kernel.Timing, run.grid.dt, n_steps, min(run.grid.n_burn, n_steps - 1))
+        arguments = setup.arguments(run, 0, n_paths)
+        arguments["timing"] = timing
+        arguments["recording"] = arguments["recording"]._replace(n_record=0)
+        kernel.run_ensemble(stop=np.zeros(1, dtype=np.int64), **arguments)
+
+    probe(1, 2)  # compiles (or loads) the loop: not part of the speed
+    started = _clock()
+    probe(paths, steps)
+    elapsed = max(_clock() - started, 1e-9)
+    return paths * steps * (2 if run.companion else 1) / elapsed
 
 
 def _check_resources(run: _Run, batch_paths, progress) -> None:
-    """Refuse a run whose arrays cannot fit in memory; announce a long one."""
+    """Refuse a run whose arrays cannot fit in memory."""
     n_steps, n_paths = run.grid.n_steps, run.n_paths
     batch = n_paths if batch_paths is None else min(int(batch_paths), n_paths)
     chunks = -(-batch // kernel.LANES)
@@ -638,12 +687,6 @@ def _check_resources(run: _Run, batch_paths, progress) -> None:
         n_bytes,
         "reduce `n_paths` (`--paths`), `histogram_bins` or `record_paths`, or run in parts "
         "with `first_path`",
-    )
-    work = float(n_paths) * n_steps * (2 if run.companion else 1)
-    announce_duration(
-        f"simulating {n_paths} paths x {n_steps} steps",
-        work / (PATH_STEPS_PER_SECOND * numba.get_num_threads()),
-        stacklevel=4,
     )
 
 
@@ -962,6 +1005,7 @@ def execute(run: _Run, *, control_variates, check_step, threads, batch_paths, pr
         threads = check_int("threads", threads, 1)
         numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
     _check_resources(run, batch_paths, progress)
+    _announce_long_run(run, setup)
     if progress is None:
         progress = progress_wanted()
     if batch_paths is None and run.driver is not None:  # the input's memory stays bounded
