@@ -2,10 +2,18 @@
 
 While a run writes into a folder it holds the folder's lock
 (:data:`LOCK_FILE`, JSON: pid, host, start time), taken atomically
-(``O_CREAT | O_EXCL``). A second run is refused with the holder named; the
-lock of a run that was killed (its pid gone on this host) is taken over,
-and a lock is re-entrant within its process. Locks are released by
+(``O_CREAT | O_EXCL``). A second run is refused with the holder named; a
+lock is re-entrant within its process. Locks are released by
 :func:`unlock_folder` / :func:`release_all`, and at exit.
+
+A lock left by a run that was killed is taken over:
+
+- on this host, when its pid no longer exists;
+- from another host (a folder on a shared file system, a cluster's nodes),
+  when its heartbeat has stopped: a live holder touches its lock file every
+  :data:`HEARTBEAT_SECONDS`, and a lock not touched for
+  :data:`STALE_AFTER_SECONDS` is a dead run's. The margin between the two
+  covers a busy machine and clocks that differ by a few minutes.
 """
 
 from __future__ import annotations
@@ -16,12 +24,42 @@ import datetime
 import json
 import os
 import socket
+import threading
+import time
 from pathlib import Path
 
 #: The lock of a folder a run is writing into.
 LOCK_FILE = ".randvib.lock"
+#: A holder touches its lock files this often (s).
+HEARTBEAT_SECONDS = 30.0
+#: Another host's lock untouched this long (s) is a dead run's.
+STALE_AFTER_SECONDS = 600.0
 
 _HELD: dict[Path, int] = {}  # folder -> nesting depth, in this process
+_HEARTBEAT: list = []  # the one heartbeat thread of this process, once started
+
+
+def _beat() -> None:
+    """Touch every lock this process holds, every HEARTBEAT_SECONDS, while it lives.
+
+    It wakes twice a second and beats when the period has passed, so that a
+    changed period takes effect at once.
+    """
+    last = time.monotonic()
+    while True:
+        if time.monotonic() - last >= HEARTBEAT_SECONDS:
+            last = time.monotonic()
+            for folder in list(_HELD):
+                with contextlib.suppress(OSError):  # released meanwhile, or a vanished folder
+                    os.utime(folder / LOCK_FILE)
+        time.sleep(min(0.5, HEARTBEAT_SECONDS))
+
+
+def _start_heartbeat() -> None:
+    if not _HEARTBEAT:
+        thread = threading.Thread(target=_beat, name="randvib-lock-heartbeat", daemon=True)
+        thread.start()
+        _HEARTBEAT.append(thread)
 
 
 def _lock_text() -> str:
@@ -69,26 +107,34 @@ def lock_folder(folder) -> None:
         except FileExistsError:
             holder = _holder(lock)
             if holder is None:  # being written this instant, or garbage: look again
-                import time
-
                 time.sleep(0.05)
                 holder = _holder(lock)
-            if _is_stale(holder):
+            if _is_stale(holder, lock):
                 _break_stale(lock, holder)
                 continue
             raise FileExistsError(_busy_message(folder, holder)) from None
         with os.fdopen(fd, "w") as f:
             f.write(_lock_text())
         _HELD[folder] = 1
+        _start_heartbeat()
         return
     raise FileExistsError(_busy_message(folder, _holder(lock)))
 
 
-def _is_stale(holder) -> bool:
+def _silent_for(lock: Path) -> float:
+    """Seconds since the lock's holder last touched it (its heartbeat)."""
+    try:
+        return time.time() - lock.stat().st_mtime
+    except FileNotFoundError:
+        return 0.0
+
+
+def _is_stale(holder, lock: Path) -> bool:
     if holder is None:
         return False
     if holder.get("host") != socket.gethostname():
-        return False  # cannot tell whether a process on another host lives
+        # a process on another host cannot be asked; its heartbeat can
+        return _silent_for(lock) > STALE_AFTER_SECONDS
     return holder["pid"] != os.getpid() and not _pid_alive(holder["pid"])
 
 
@@ -100,14 +146,19 @@ def _break_stale(lock: Path, holder: dict) -> None:
 
 
 def _busy_message(folder: Path, holder) -> str:
-    who = (
-        "an unreadable lock"
-        if holder is None
-        else f"process {holder['pid']} on {holder.get('host')!r} since {holder.get('started')}"
-    )
+    lock = folder / LOCK_FILE
+    if holder is None:
+        who = "an unreadable lock"
+    else:
+        who = f"process {holder['pid']} on {holder.get('host')!r} since {holder.get('started')}"
+        if holder.get("host") != socket.gethostname():
+            who += (
+                f", last heard from {_silent_for(lock):.0f} s ago; its lock is taken over once "
+                f"silent for {STALE_AFTER_SECONDS:.0f} s"
+            )
     return (
         f"folder {str(folder)!r} is in use by another randvib run ({who}); wait for it to "
-        f"finish, or if no such run exists delete {str(folder / LOCK_FILE)!r}"
+        f"finish, or if no such run exists delete {str(lock)!r}"
     )
 
 

@@ -180,6 +180,59 @@ def test_stale_lock_of_a_killed_run_is_recovered(tmp_path):
     assert not (out / _io.LOCK_FILE).exists()
 
 
+def _other_host_lock(folder, silent_seconds):
+    """A lock written by a run on another host whose heartbeat stopped ``silent_seconds`` ago."""
+    lock = folder / _io.LOCK_FILE
+    holder = {"pid": 12345, "host": "node-17.cluster", "started": "2026-11-22T08:00:00+00:00"}
+    lock.write_text(json.dumps(holder))
+    beat = time.time() - silent_seconds
+    os.utime(lock, (beat, beat))
+    return lock
+
+
+def test_another_hosts_lock_is_taken_over_once_its_heartbeat_stops(tmp_path):
+    from randvib import _locks
+
+    folder = tmp_path / "shared"
+    folder.mkdir()
+    lock = _other_host_lock(folder, _locks.STALE_AFTER_SECONDS + 60)
+    out = _io.prepare_output_dir(folder, {"grid": 1})
+    assert json.loads(lock.read_text())["pid"] == os.getpid()
+    _io.unlock_folder(out)
+
+
+def test_another_hosts_live_lock_is_refused_naming_it(tmp_path):
+    from randvib import _locks
+
+    folder = tmp_path / "shared"
+    folder.mkdir()
+    lock = _other_host_lock(folder, 5.0)  # heard from 5 s ago: alive
+    with pytest.raises(FileExistsError, match="12345 on 'node-17.cluster'.*last heard from"):
+        _io.prepare_output_dir(folder, {"grid": 1})
+    assert json.loads(lock.read_text())["host"] == "node-17.cluster"  # untouched
+    assert f"silent for {_locks.STALE_AFTER_SECONDS:.0f} s" in _locks._busy_message(
+        folder, json.loads(lock.read_text())
+    )
+
+
+def test_a_holder_keeps_its_lock_alive(tmp_path, monkeypatch):
+    """The heartbeat: a run's lock file is touched while the run lives, so another
+    host never mistakes a long run for a dead one."""
+    from randvib import _locks
+
+    monkeypatch.setattr(_locks, "HEARTBEAT_SECONDS", 0.02)
+    folder = tmp_path / "long-run"
+    out = _io.prepare_output_dir(folder, {"grid": 1})
+    lock = out / _io.LOCK_FILE
+    old = time.time() - 3600
+    os.utime(lock, (old, old))  # as if the last beat were an hour ago
+    deadline = time.time() + 30
+    while lock.stat().st_mtime < old + 1800 and time.time() < deadline:
+        time.sleep(0.02)
+    assert lock.stat().st_mtime > old + 1800, "the heartbeat did not touch the lock"
+    _io.unlock_folder(out)
+
+
 def test_simultaneous_runs_into_one_new_folder_one_wins(tmp_path):
     # Four runs of different grids start together into the same new folder:
     # exactly one owns it; the others are refused, none exits quietly.
