@@ -1024,3 +1024,15 @@ def test_messages_name_the_flag_the_user_typed(capsys, record_csv, tmp_path, com
             # the few refusals that explain the device (not confining) name its parameters
             assert "not confining" in err, (flag, err)
     assert checked >= 3
+
+
+def test_optimal_load_of_a_device_that_delivers_nothing_is_refused():
+    """Found by the fuzz test with another seed: a coil of 1e308 H passes no current,
+    and the 'optimum' was the search's lower bound at 0 W, returned as a result."""
+    from randvib.models.coupling import Inductive
+
+    device = rv.Harvester.with_coupling(
+        1.0, 0.5, 180.0, Inductive(alpha=50.0, r_load=700.0, r_coil=60.0, inductance=1e308)
+    )
+    with pytest.raises(ValueError, match="no load resistance in `bounds`.*takes any power"):
+        rv.optimal_load_resistance(device, 1.0)

@@ -562,6 +562,14 @@ def optimal_load_resistance(
     # practice but flat tails make a blind bounded search slow to converge.
     grid = np.linspace(np.log(lo), np.log(hi), 61)
     values = [negative_power(g) for g in grid]
+    if not min(values) < 0:
+        # no load takes any power (a coil whose inductance blocks the current,
+        # a power below float64's range): no optimum to report
+        raise ValueError(
+            f"no load resistance in `bounds` {bounds!r} ohm takes any power from this device "
+            f"(the load power is {-max(values):g} W at every load tried) under {psd!r}; "
+            f"check the coupling {harvester.electrical!r}"
+        )
     i = int(np.argmin(values))
     a, b = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
     res = optimize.minimize_scalar(
