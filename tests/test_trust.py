@@ -492,6 +492,8 @@ def test_json_output_is_always_valid_json():
         (["--psd", "1e308"], "linearised scales"),
         (["--t-end", "1e23"], "steps per path"),
         (["--paths", str(10**23)], "of memory"),
+        # found by the fuzz test under another seed: a step warning came before the refusal
+        (["--paths", str(2**63), "--dt", "0.001953125"], "reduce `--paths`, `histogram_bins`"),
         (["--dt", "1e-300"], "steps per path"),
     ],
 )
@@ -1036,3 +1038,15 @@ def test_optimal_load_of_a_device_that_delivers_nothing_is_refused():
     )
     with pytest.raises(ValueError, match="no load resistance in `bounds`.*takes any power"):
         rv.optimal_load_resistance(device, 1.0)
+
+
+def test_circuit_time_constant_beyond_float64_is_refused():
+    """Found by the fuzz test under another seed: R_L C_p = 1e-616 underflowed to 0 and
+    ended in a ZeroDivisionError inside statistical linearisation."""
+    from randvib.models.coupling import Piezo
+
+    device = rv.Harvester.with_coupling(
+        1.0, 0.0, 0.0, Piezo(theta=0.0078125, capacitance=1e-308, r_load=1e-308), k3=1.0
+    )
+    with pytest.raises(ValueError, match="time constant beyond float64's range"):
+        rv.statistical_linearisation(device, rv.BandPass(1.0, 1.0, 1.0))

@@ -89,6 +89,17 @@ class Coupling(DeclaredParameters):
         """
         raise ValueError(f"the {self.name} coupling here is static: it has no circuit state")
 
+    def _representable(self, a, b, f):
+        """``(a, b, f)`` as floats, refused when a time constant leaves float64's range."""
+        a, b, f = (float(x) for x in (a, b, f))
+        if not (np.isfinite(a) and np.isfinite(b) and np.isfinite(f)) or a == 0:
+            raise ValueError(
+                f"the {self.name} circuit of {self!r} has a time constant beyond float64's "
+                f"range (x' = a x + b z' with a = {a:.3g} 1/s, b = {b:.3g}); give its "
+                "parameters a physical size"
+            )
+        return a, b, f
+
     # -------------------------------------------------------------- power
     @property
     def load_fraction(self):
@@ -204,7 +215,11 @@ class Inductive(Coupling):
     def circuit_equation(self):
         if not self.is_dynamic:
             return super().circuit_equation()
-        return -self.resistance / self.inductance, self.alpha / self.inductance, self.alpha
+        with np.errstate(all="ignore"):  # float64 division: an overflow is inf, refused below
+            inductance = np.float64(self.inductance)
+            return self._representable(
+                -self.resistance / inductance, self.alpha / inductance, self.alpha
+            )
 
     def _state_power(self, state_square):
         return self.resistance * state_square  # (R_L + R_C) E[i^2]
@@ -273,8 +288,9 @@ class Piezo(Coupling):
     def circuit_equation(self):
         if not self.is_dynamic:
             return super().circuit_equation()
-        c_p = self.capacitance
-        return -1.0 / (self.r_load * c_p), self.theta / c_p, self.theta
+        with np.errstate(all="ignore"):  # float64 division: an overflow is inf, refused below
+            c_p = np.float64(self.capacitance)
+            return self._representable(-1.0 / (self.r_load * c_p), self.theta / c_p, self.theta)
 
     def _state_power(self, state_square):
         return state_square / self.r_load  # E[V^2] / R_L

@@ -685,8 +685,7 @@ def _check_resources(run: _Run, batch_paths, progress) -> None:
     check_memory(
         f"simulating {n_paths} paths of {n_steps} steps",
         n_bytes,
-        "reduce `n_paths` (`--paths`), `histogram_bins` or `record_paths`, or run in parts "
-        "with `first_path`",
+        "reduce `n_paths`, `histogram_bins` or `record_paths`, or run in parts with `first_path`",
     )
 
 
@@ -992,6 +991,8 @@ def execute(run: _Run, *, control_variates, check_step, threads, batch_paths, pr
     """Run a validated :class:`_Run` (see :func:`simulate` for the options)."""
     _check_coloured_options(run.excitation, run.companion, control_variates)
     _check_circuit_options(run.harvester, run.companion)
+    # refusals before advice: a run that cannot fit is refused before any step warning
+    _check_resources(run, batch_paths, progress)
     # One linear test system per run, built when first needed (a fixed start
     # without a step check may need none): the step check, the random start,
     # the default histogram ranges and the circuit's start all use it.
@@ -1004,7 +1005,6 @@ def execute(run: _Run, *, control_variates, check_step, threads, batch_paths, pr
     if threads is not None:
         threads = check_int("threads", threads, 1)
         numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
-    _check_resources(run, batch_paths, progress)
     _announce_long_run(run, setup)
     if progress is None:
         progress = progress_wanted()
