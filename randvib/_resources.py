@@ -9,6 +9,7 @@ stop it (Ctrl-C) instead of waiting blind.
 from __future__ import annotations
 
 import os
+import time
 import warnings
 
 
@@ -64,6 +65,17 @@ def check_memory(what: str, n_bytes: float, hint: str) -> None:
             f"{what} needs about {size_text(n_bytes)} of memory, more than the "
             f"{size_text(available)} available; {hint}"
         )
+
+
+#: The clock that times probes of a run's speed (a test replaces it).
+clock = time.perf_counter
+
+
+def timed(call):
+    """``(call(), seconds it took)`` on :data:`clock`, never 0 s (a speed divides by it)."""
+    started = clock()
+    value = call()
+    return value, max(clock() - started, 1e-9)
 
 
 def announce_duration(

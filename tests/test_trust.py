@@ -26,7 +26,7 @@ from _cli import one_line_error, run
 
 import randvib as rv
 import randvib.montecarlo.sweep as sweep_module
-from randvib import _io
+from randvib import _io, _resources
 from randvib._resources import available_memory
 from randvib.montecarlo.simulation import simulate
 from randvib.montecarlo.sweep import SweepSettings, cartesian, run_sweep
@@ -582,7 +582,7 @@ def test_long_run_estimate_follows_the_measured_speed(monkeypatch, probe_seconds
     from randvib.montecarlo import kernel, simulation
 
     monkeypatch.setattr(simulation, "PATH_STEPS_PER_SECOND", 1.0)  # a run that could be long
-    monkeypatch.setattr(simulation, "_clock", _probe_clock(probe_seconds))
+    monkeypatch.setattr(_resources, "clock", _probe_clock(probe_seconds))
     n_paths, n_steps = 4, 500
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -606,7 +606,7 @@ def test_identification_estimate_follows_the_measured_speed(
     from randvib._resources import LongRunWarning, duration_text
     from randvib.identification import fitting
 
-    monkeypatch.setattr(fitting, "_clock", _probe_clock(probe_seconds))
+    monkeypatch.setattr(_resources, "clock", _probe_clock(probe_seconds))
     probed = []
     points = fitting._probe_points
     monkeypatch.setattr(

@@ -270,12 +270,12 @@ def _command_parser(parser, command: str) -> argparse.ArgumentParser:
 
 
 def _main(argv) -> int:
-    prog = "randvib"  # "randvib COMMAND" once the command is known, as argparse names it
     try:
         parser = build_parser()
         args, unknown = parser.parse_known_args(argv)
-        prog = f"randvib {args.command}"
-        _Running.prog, _Running.flags = prog, api_flags(_command_parser(parser, args.command))
+        # "randvib COMMAND" from here on, as argparse names it ("randvib" until then)
+        prog = _Running.prog = f"randvib {args.command}"
+        _Running.flags = api_flags(_command_parser(parser, args.command))
         if unknown:  # named by the command, with where to look (argparse names only "randvib")
             raise UserError(
                 f"{prog}: error: unrecognized arguments: {' '.join(unknown)} (see `{prog} --help`)"
@@ -288,7 +288,7 @@ def _main(argv) -> int:
         message = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         message = cli_wording(message)
         if not message.startswith("randvib"):
-            message = f"{prog}: error: {message}"
+            message = f"{_Running.prog}: error: {message}"
         print(message, file=sys.stderr)
         return 2
     except KeyboardInterrupt as exc:  # Ctrl-C, or SIGTERM (Terminated)

@@ -134,7 +134,7 @@ def parse_bounds(items) -> dict:
 
 def output_unit(args) -> str:
     """The unit of the output column: m for the relative displacement, else the column's own."""
-    return "m" if args.output_column == OUTPUT_COLUMN else f"({args.output_column} units)"
+    return "m" if args.output_column == OUTPUT_COLUMN else f"{args.output_column} units"
 
 
 def plot_units(args) -> dict:
@@ -146,4 +146,4 @@ def plot_units(args) -> dict:
     """
     if args.output_column == OUTPUT_COLUMN:
         return dict(scale=1e3, unit="mm")
-    return dict(scale=1.0, unit=f"{args.output_column}, record units")
+    return dict(scale=1.0, unit=output_unit(args))

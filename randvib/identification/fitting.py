@@ -44,6 +44,7 @@ from pathlib import Path
 import numpy as np
 
 from randvib import _display
+from randvib._resources import timed
 from randvib._validation import MAX_SEED, check_finite, check_int, check_nonnegative, check_positive
 from randvib.identification.record_simulation import (
     EXTRA_PARAMETERS,
@@ -1095,10 +1096,6 @@ def _announce(record: Record, search: SearchSettings, simulation: SimulationSett
     )
 
 
-#: The clock that times the probes (a test replaces it).
-_clock = time.perf_counter
-
-
 @dataclass(frozen=True)
 class _SearchSpace:
     """What SaDE searches: the free parameters, their bounds, which are log-scaled."""
@@ -1325,9 +1322,7 @@ def _refuse_unsimulable(cost: CostFunction, space: _SearchSpace) -> float:
     probes = _probe_points(space)
     with np.errstate(all="ignore"):
         cost(probes[:1])  # compiles (or loads) the simulation: not part of the speed
-        started = _clock()
-        costs = cost(probes)
-        elapsed = max(_clock() - started, 1e-9)
+        costs, elapsed = timed(lambda: cost(probes))
     if not np.any(np.isfinite(costs)):
         raise ValueError(
             f"the {cost.model} model cannot simulate record {cost.record.name!r} with the "

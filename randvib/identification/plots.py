@@ -27,9 +27,6 @@ MODEL_STYLE = {
 MEASURED = dict(color="black", lw=1.0, label="measured")
 SIMULATED = dict(color=PALETTE[1], lw=1.0, ls="--", label="simulated")
 
-#: Display units of the displacement: scale factor -> mathtext label.
-_UNIT_TEXT = {"m": "m", "mm": "mm", "µm": "µm", "um": "µm"}
-
 
 def _finish(fig, path):
     if path is not None:
@@ -60,7 +57,7 @@ def plot_time_history(prediction, ax=None, *, window=None, scale=1.0, unit="m"):
     ax.plot(t[sel], rec.z[sel] * scale, **MEASURED)
     ax.plot(t[sel], prediction.z[sel] * scale, **SIMULATED)
     ax.set_xlabel("time (s)")
-    ax.set_ylabel(f"relative displacement z ({_UNIT_TEXT.get(unit, unit)})")
+    ax.set_ylabel(f"relative displacement z ({unit})")
     ax.set_xlim(t[sel][0], t[sel][-1])
     ax.set_title(f"J = {prediction.cost:.3g} (Eq. 11)", loc="right")
     ax.legend(loc="upper left", ncols=2, frameon=False)
@@ -90,8 +87,7 @@ def plot_histograms(prediction, axes=None, *, bins=81, scale=1.0, unit="m", lege
     ``legend=False`` leaves the legends out (a figure that has one elsewhere).
     """
     rec = prediction.record
-    z_unit = _UNIT_TEXT.get(unit, unit)
-    panels = [(rec.z * scale, prediction.z * scale, "z", z_unit)]
+    panels = [(rec.z * scale, prediction.z * scale, "z", unit)]
     if prediction.voltage is not None:
         measured = None if rec.voltage is None else rec.voltage * 1e3
         panels.append((measured, prediction.voltage * 1e3, "load voltage V", "mV"))
@@ -121,7 +117,7 @@ def figure_fit(prediction, path=None, *, window=None, scale=1.0, unit="m", title
     ``title`` defaults to the record's name.
     """
     n_hist = 2 if prediction.voltage is not None else 1
-    fig, _ = _fit_layout(n_hist)
+    fig = _fit_layout(n_hist)
     ax_t, *hist_axes = fig.axes
     plot_time_history(prediction, ax_t, window=window, scale=scale, unit=unit)
     # one legend, in (a): in the densities it would cover a tail
@@ -140,7 +136,7 @@ def _fit_layout(n_hist: int):
     fig.add_subplot(grid[0, :])
     for j in range(n_hist):
         fig.add_subplot(grid[1, j])
-    return fig, fig.axes
+    return fig
 
 
 @styled

@@ -42,7 +42,7 @@ from scipy import linalg, special  # Student t quantile; lighter than scipy.stat
 
 from randvib import _display
 from randvib._progress import progress_bar, progress_wanted
-from randvib._resources import LONG_RUN_SECONDS, announce_duration, check_memory
+from randvib._resources import LONG_RUN_SECONDS, announce_duration, check_memory, timed
 from randvib._validation import (
     MAX_SEED,
     check_choice,
@@ -598,7 +598,7 @@ def _check_scales(run: _Run, linear) -> None:
             warnings.simplefilter("ignore")
             system = linear()
             k_eff, c_eff = system.k_eff, system.c_eff
-            spread = system.spread()
+            spread = system.spread
     except (ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
         problem = f"{type(exc).__name__}: {exc}"
     else:
@@ -624,8 +624,6 @@ PATH_STEPS_PER_SECOND = 3e7
 PROBE_MARGIN = 30.0
 #: Path-steps per thread of the timed probe (about 0.1 s at the rough speed).
 PROBE_PATH_STEPS = 3e6
-#: The clock that times the probe (a test replaces it).
-_clock = time.perf_counter
 
 
 def _announce_long_run(run: _Run, setup: _KernelSetup) -> None:
@@ -664,9 +662,7 @@ def _measured_speed(run: _Run, setup: _KernelSetup, threads: int) -> float:
         kernel.run_ensemble(stop=np.zeros(1, dtype=np.int64), **arguments)
 
     probe(1, 2)  # compiles (or loads) the loop: not part of the speed
-    started = _clock()
-    probe(paths, steps)
-    elapsed = max(_clock() - started, 1e-9)
+    _, elapsed = timed(lambda: probe(paths, steps))
     return paths * steps * (2 if run.companion else 1) / elapsed
 
 
@@ -1268,7 +1264,7 @@ def _auxiliary(run: _Run, linear) -> kernel.Auxiliary | None:
         if driven_input:
             start = np.array([[_driven_circuit_variance(h, excitation)]])
         else:
-            cov = linear().covariance()  # (filter, z, v, circuit)
+            cov = linear().covariance  # (filter, z, v, circuit)
             keep = [*range(n_filter), cov.shape[0] - 1]
             start = cov[np.ix_(keep, keep)]
     chol = np.zeros((n, n))
@@ -1296,7 +1292,7 @@ def _start_states(run: _Run, linear) -> tuple[kernel.Start, kernel.Companion]:
     """Initial states of the device and of its friction-free companion."""
     h, psd = run.harvester, run.psd
     random = run.initial.kind == "stationary"
-    z, v = linear().spread() if random else (run.initial.z, run.initial.v)
+    z, v = linear().spread if random else (run.initial.z, run.initial.v)
     # The friction-free companion starts from its own stationary spread (exact
     # Gaussian velocity, Gibbs displacement variance), so its known moments
     # hold from t = 0 and its control mean is right without a long burn-in.
@@ -1324,7 +1320,7 @@ def _recording(run: _Run, linear) -> kernel.Recording:
     else:
         ranges = run.record.histogram_range
         if ranges is None:
-            sz, sv = linear().spread()
+            sz, sv = linear().spread
             if run.harvester.potential.is_free:
                 c_eff = linear().c_eff
                 sz = sv * np.sqrt(2.0 * run.harvester.m / c_eff * run.grid.t_end)

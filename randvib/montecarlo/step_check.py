@@ -21,6 +21,7 @@ time-step bias (:meth:`LinearTestSystem.bias`).
 
 from __future__ import annotations
 
+import functools
 import warnings
 from dataclasses import dataclass
 
@@ -163,11 +164,13 @@ class LinearTestSystem:
                 hi = mid
         return lo
 
+    @functools.cached_property  # used by the spread and by the circuit's start
     def covariance(self) -> np.ndarray:
         """Stationary covariance of (filter states, z, v, circuit) of the augmented system."""
         f, g, _ = self.augmented
         return linalg.solve_continuous_lyapunov(f, -(g @ g.T))
 
+    @functools.cached_property  # used by the scale check, the start and the histograms
     def spread(self) -> tuple[float, float]:
         """(std of z (m), std of v (m/s)) of the linearised stationary state.
 
@@ -188,7 +191,7 @@ class LinearTestSystem:
         if h.potential.is_free:
             return 0.0, float(np.sqrt(psd * h.m / (4.0 * self.c_eff)))
         if self.augmented is not None:
-            cov = self.covariance()
+            cov = self.covariance
             n_filter = 0 if self.excitation.is_white else self.n_filter
             return float(np.sqrt(cov[n_filter, n_filter])), float(
                 np.sqrt(cov[n_filter + 1, n_filter + 1])
