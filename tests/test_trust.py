@@ -691,6 +691,36 @@ def test_sweep_workers_end_when_the_sweep_is_killed(tmp_path):
     assert alive == []
 
 
+def test_sweep_workers_ignore_ctrl_c_while_they_are_still_starting(tmp_path):
+    """Found by CI: a Ctrl-C that reached a worker while it was still importing
+    (before its initializer could ignore SIGINT) printed a KeyboardInterrupt
+    traceback from multiprocessing's spawn_main. SIGINT sent to every worker
+    the moment the pool returns, long before any has imported randvib: the pool
+    still works and nothing is written to stderr."""
+    script = textwrap.dedent(
+        """
+        import os, signal
+        from randvib.montecarlo.sweep import make_executor
+        if __name__ == "__main__":
+            pool, close = make_executor(workers=2)
+            pids = [p.pid for p in pool._processes.values()]
+            for pid in pids:
+                os.kill(pid, signal.SIGINT)
+            print(len(pids), sum(pool.map(abs, range(-8, 0))), flush=True)
+            close()
+        """
+    )
+    (tmp_path / "main.py").write_text(script)
+    done = subprocess.run(
+        [sys.executable, str(tmp_path / "main.py")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=_subprocess_env(),
+    )
+    assert (done.returncode, done.stdout.split(), done.stderr) == (0, ["2", "36"], "")
+
+
 def _alive(pid):
     try:
         os.waitpid(pid, os.WNOHANG)  # reap if it happens to be our child
@@ -1008,9 +1038,11 @@ def _base_argv(command, record_csv, tmp_path):
 
 
 @pytest.mark.parametrize("command", ["power", "simulate", "record", "identify", "validate"])
-def test_messages_name_the_flag_the_user_typed(capsys, record_csv, tmp_path, command):
+def test_messages_name_the_flag_the_user_typed(capsys, record_csv, tmp_path, monkeypatch, command):
     """Every value option of every command, given a bad value: the refusal names the
     flag (`--burn-in`), never the API argument behind it (`burn_in`, `dt`, `k`)."""
+    # `--out -1` is a valid file name: run where such files may be written
+    monkeypatch.chdir(tmp_path)
     checked = 0
     for flag, dest in _value_options(command):
         for bad in ("-1", "nan", "0"):

@@ -266,12 +266,16 @@ def _worker_start(parent: int, initializer=None) -> None:
     there and ends the worker when it is not. A worker ignores SIGINT: a
     terminal's Ctrl-C reaches the whole process group, and the parent alone
     stops the sweep (keeping the finished points) and ends its workers, so
-    the user sees one line, not a traceback per worker.
+    the user sees one line, not a traceback per worker. The worker was born
+    with SIGINT blocked (:func:`_start_workers`), so a Ctrl-C that came while
+    it was still importing is pending, and is discarded here by ignoring it
+    before unblocking it.
     """
     import signal
     import threading
 
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
     def watch():
         while True:
@@ -317,7 +321,31 @@ def make_executor(workers: int | None = None, scheduler: str | None = None, init
         mp_context=multiprocessing.get_context("spawn"),
         initializer=functools.partial(_worker_start, os.getpid(), initializer),
     )
+    _start_workers(pool, workers)
     return pool, functools.partial(_close_pool, pool)
+
+
+def _start_workers(pool: ProcessPoolExecutor, workers: int) -> None:
+    """Start all ``workers`` processes now, each born with SIGINT blocked.
+
+    A spawned worker spends its first second or so importing numpy, numba and
+    randvib before :func:`_worker_start` can ignore SIGINT; a Ctrl-C in that
+    window used to end it with a KeyboardInterrupt traceback on the user's
+    terminal. A blocked signal mask is inherited across fork and exec, so the
+    workers are spawned while this thread blocks SIGINT (as CPython's own
+    resource tracker is started); a Ctrl-C meanwhile stays pending here and is
+    delivered to the parent when the mask is restored, so none is lost. The
+    pool spawns a worker per submission until it has ``workers``, hence one
+    trivial task each.
+    """
+    import signal
+
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        started = [pool.submit(os.getpid) for _ in range(workers)]
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+    del started  # the tasks only made the pool spawn; their results do not matter
 
 
 def _close_pool(pool: ProcessPoolExecutor) -> None:
