@@ -170,19 +170,3 @@ def figure_costs(costs: dict, tests, path=None, *, titles=None):
     handles, labels = axes[0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="outside lower center", ncols=len(labels), frameon=False)
     return _finish(fig, path)
-
-
-@styled
-def figure_convergence(histories: dict, path=None, *, title=None):
-    """Best cost against simulations spent, one line per optimiser/run."""
-    fig, axes = new_figure(figsize=(4.5, 3.2))
-    ax = axes[0, 0]
-    for label, (nfev, best) in histories.items():
-        ax.loglog(nfev, best, label=label)
-    ax.set_xlabel("simulations")
-    ax.set_ylabel("best cost J (Eq. 11)")
-    ax.grid(alpha=0.3, which="both")
-    ax.legend(frameon=False)
-    if title:
-        ax.set_title(title)
-    return _finish(fig, path)
