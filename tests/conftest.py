@@ -1,10 +1,9 @@
 import os
+from pathlib import Path
+
+import pytest  # imports no matplotlib, so the backend below is still in time
 
 os.environ.setdefault("MPLBACKEND", "Agg")
-
-from pathlib import Path  # noqa: E402
-
-import pytest  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 

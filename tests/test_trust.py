@@ -695,7 +695,7 @@ def test_sweep_workers_ignore_ctrl_c_while_they_are_still_starting(tmp_path):
     """Found by CI: a Ctrl-C that reached a worker while it was still importing
     (before its initializer could ignore SIGINT) printed a KeyboardInterrupt
     traceback from multiprocessing's spawn_main. SIGINT sent to every worker
-    the moment the pool returns, long before any has imported randvib: the pool
+    the moment they are spawned, long before any has imported randvib: the pool
     still works and nothing is written to stderr."""
     script = textwrap.dedent(
         """
@@ -703,10 +703,11 @@ def test_sweep_workers_ignore_ctrl_c_while_they_are_still_starting(tmp_path):
         from randvib.montecarlo.sweep import make_executor
         if __name__ == "__main__":
             pool, close = make_executor(workers=2)
+            futures = [pool.submit(abs, i) for i in range(-8, 0)]  # spawns both workers
             pids = [p.pid for p in pool._processes.values()]
             for pid in pids:
                 os.kill(pid, signal.SIGINT)
-            print(len(pids), sum(pool.map(abs, range(-8, 0))), flush=True)
+            print(len(pids), sum(f.result() for f in futures), flush=True)
             close()
         """
     )

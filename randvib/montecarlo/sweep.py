@@ -267,7 +267,7 @@ def _worker_start(parent: int, initializer=None) -> None:
     terminal's Ctrl-C reaches the whole process group, and the parent alone
     stops the sweep (keeping the finished points) and ends its workers, so
     the user sees one line, not a traceback per worker. The worker was born
-    with SIGINT blocked (:func:`_start_workers`), so a Ctrl-C that came while
+    with SIGINT blocked (:class:`_WorkerPool`), so a Ctrl-C that came while
     it was still importing is pending, and is discarded here by ignoring it
     before unblocking it.
     """
@@ -286,6 +286,29 @@ def _worker_start(parent: int, initializer=None) -> None:
     threading.Thread(target=watch, name="randvib-parent-watch", daemon=True).start()
     if initializer is not None:
         initializer()
+
+
+class _WorkerPool(ProcessPoolExecutor):
+    """A process pool whose workers are born with SIGINT blocked.
+
+    A spawned worker spends its first second or so importing numpy, numba and
+    randvib before :func:`_worker_start` can ignore SIGINT; a Ctrl-C in that
+    window ended it with a KeyboardInterrupt traceback on the user's terminal.
+    The pool spawns its workers inside :meth:`submit` (one per submission
+    until it has ``max_workers``), and a blocked signal mask is inherited
+    across fork and exec, so every submission blocks SIGINT in the submitting
+    thread (as CPython starts its own resource tracker). A Ctrl-C meanwhile
+    stays pending there and is delivered when the mask is restored: none is lost.
+    """
+
+    def submit(self, fn, /, *args, **kwargs):
+        import signal
+
+        previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+        try:
+            return super().submit(fn, *args, **kwargs)
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
 def make_executor(workers: int | None = None, scheduler: str | None = None, initializer=None):
@@ -316,36 +339,12 @@ def make_executor(workers: int | None = None, scheduler: str | None = None, init
     # in this process, and forking it is unsafe (the child aborts)
     import multiprocessing
 
-    pool = ProcessPoolExecutor(
+    pool = _WorkerPool(
         max_workers=workers,
         mp_context=multiprocessing.get_context("spawn"),
         initializer=functools.partial(_worker_start, os.getpid(), initializer),
     )
-    _start_workers(pool, workers)
     return pool, functools.partial(_close_pool, pool)
-
-
-def _start_workers(pool: ProcessPoolExecutor, workers: int) -> None:
-    """Start all ``workers`` processes now, each born with SIGINT blocked.
-
-    A spawned worker spends its first second or so importing numpy, numba and
-    randvib before :func:`_worker_start` can ignore SIGINT; a Ctrl-C in that
-    window used to end it with a KeyboardInterrupt traceback on the user's
-    terminal. A blocked signal mask is inherited across fork and exec, so the
-    workers are spawned while this thread blocks SIGINT (as CPython's own
-    resource tracker is started); a Ctrl-C meanwhile stays pending here and is
-    delivered to the parent when the mask is restored, so none is lost. The
-    pool spawns a worker per submission until it has ``workers``, hence one
-    trivial task each.
-    """
-    import signal
-
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-    try:
-        started = [pool.submit(os.getpid) for _ in range(workers)]
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
-    del started  # the tasks only made the pool spawn; their results do not matter
 
 
 def _close_pool(pool: ProcessPoolExecutor) -> None:
