@@ -17,7 +17,8 @@ import pandas as pd
 from conftest import write_report
 
 import randvib as rv
-from randvib.montecarlo.simulation import estimate, simulate
+from randvib.montecarlo.simulation import simulate
+from randvib.statistics import estimate
 
 BASE = rv.preset("figure9")
 KW = dict(t_end=2.5, dt=1e-4, burn_in=0.5, seed=3, companion=True, progress=False)

@@ -74,8 +74,8 @@ _EXPORTS = {
         "simulate",
         "SimulationDivergedError",
         "SimulationResult",
-        "Statistic",
     ),
+    "randvib.statistics": ("FirstPassage", "Statistic", "estimate"),
     "randvib.montecarlo.step_check": ("StepSizeWarning",),
 }
 _WHERE = {name: module for module, names in _EXPORTS.items() for name in names}

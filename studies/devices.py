@@ -71,7 +71,7 @@ from randvib._progress import progress_bar
 from randvib.analytic.linear_response import mechanical_block, output_variances
 from randvib.figure_style import colour as style_colour
 from randvib.figure_style import new_figure, panel_letters, save_figure, styled
-from randvib.montecarlo.simulation import estimate
+from randvib.statistics import median_first_passage, paired_ratio
 from randvib.studies import script_main
 from randvib.studies.report import (
     markdown_table,
@@ -158,19 +158,6 @@ def first_passage_columns(first) -> dict:
     }  # fmt: skip
 
 
-def median_first_passage(times, horizon: float) -> float:
-    """Median first time (s) with censoring at ``horizon``; NaN unless more than half reached.
-
-    With one censoring time for all paths the Kaplan-Meier survival curve is
-    the empirical one before ``horizon``, so the median is the empirical
-    median of the reached times whenever more than half the paths reached it.
-    """
-    times = np.asarray(times, dtype=float)
-    if 2 * np.count_nonzero(times >= 0) <= times.size:
-        return float("nan")
-    return float(np.quantile(np.where(times >= 0, times, horizon), 0.5))
-
-
 def simulate_device(device, start, excitation, mc, seed, threads):
     """One Monte Carlo run: its results row and the per-path powers (W)."""
     n_paths, t_end, dt, burn = mc
@@ -207,13 +194,6 @@ def predictions(device, excitation, methods) -> list[dict]:
             row["exceedance"] = float(p.stroke_exceedance)
         rows.append(row)
     return rows
-
-
-def paired_ratio(per_path: np.ndarray, reference: np.ndarray) -> tuple[float, float]:
-    """mean(per_path) / mean(reference) on the same paths, and its 95 % half-width (delta method)."""
-    ratio = float(np.mean(per_path) / np.mean(reference))
-    s = estimate(per_path - ratio * reference)
-    return ratio, s.ci95 / float(np.mean(reference))
 
 
 def compute_point(name, g, axes, seed, threads):

@@ -53,8 +53,7 @@ from randvib._progress import progress_bar
 from randvib.analytic.linear_response import mechanical_block, output_variances
 from randvib.figure_style import colour as style_colour
 from randvib.figure_style import new_figure, num_tex, panel_letters, save_figure, styled
-from randvib.montecarlo.simulation import estimate
-from randvib.montecarlo.sweep import holm_significant, two_sided_p_value
+from randvib.statistics import estimate, holm_significant, two_sided_p_value
 from randvib.studies import script_main
 from randvib.studies.report import (
     markdown_table,

@@ -46,7 +46,7 @@ def assert_matches(
 
     Parameters
     ----------
-    stat : randvib.montecarlo.simulation.Statistic
+    stat : randvib.statistics.Statistic
         Estimate with its standard error.
     reference : float
         The independent value it must equal.

@@ -98,7 +98,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="control-variate-mean",
-        path="randvib/montecarlo/simulation.py",
+        path="randvib/statistics.py",
         edits=(
             (
                 "residual[test] = y[test] - x[test] @ coef[1:]",

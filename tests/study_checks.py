@@ -23,7 +23,7 @@ from scipy import stats
 from randvib.analytic.averaging import AveragingValidityWarning
 from randvib.analytic.prediction import expected_power
 from randvib.models.presets import preset
-from randvib.montecarlo.simulation import Statistic
+from randvib.statistics import Statistic
 
 
 def statistic(mean, ci95, n_paths) -> Statistic:

@@ -14,7 +14,7 @@ The README quotes, for the figure9 device (c = 0.2 Ns/m, damping ratio 0.088):
 Each claim is checked at points of its own (a grid over S, k3 and kappa, not
 one point) against a Monte Carlo estimate with the engine's control variates
 (Ito integral, energy change, friction-free companion; cross-fitted,
-:func:`randvib.montecarlo.simulation.estimate`) at a step small enough for its bias:
+:func:`randvib.statistics.estimate`) at a step small enough for its bias:
 
 * **time step**: stochastic Heun's stationary bias is O(dt^2) on smooth
   devices, but the Coulomb jump at v = 0 makes it about O(dt^1.5), positive:
@@ -61,7 +61,7 @@ def fc_at_phi(phi, psd, device=BASE):
 
 
 def mc_power(device, psd, n_paths, seed, dt=DT):
-    """E[P_e] (a :class:`randvib.montecarlo.simulation.Statistic`) with the control variates."""
+    """E[P_e] (a :class:`randvib.statistics.Statistic`) with the control variates."""
     return rv.simulate(
         device, psd, t_end=BURN_IN + WINDOW, burn_in=BURN_IN, dt=dt, n_paths=n_paths,
         seed=seed, companion=True, control_variates=True, progress=False,

@@ -28,8 +28,9 @@ import randvib as rv
 from randvib.analytic.linear_response import device_block, output_variances
 from randvib.models.excitation import BandPass, White
 from randvib.montecarlo import integrators
-from randvib.montecarlo.simulation import estimate, simulate
+from randvib.montecarlo.simulation import simulate
 from randvib.montecarlo.step_check import step_bias
+from randvib.statistics import estimate
 
 M, C_M, K = 0.0226, 0.05, 57.4
 ALPHA, R_LOAD, R_COIL = 0.1992, 1.0, 0.48

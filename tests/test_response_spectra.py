@@ -17,7 +17,8 @@ from scipy import linalg, signal
 import randvib as rv
 from randvib.analytic.linear_response import mechanical_block
 from randvib.montecarlo import integrators
-from randvib.montecarlo.simulation import Statistic, simulate
+from randvib.montecarlo.simulation import simulate
+from randvib.statistics import Statistic
 
 LINEAR = rv.Harvester(m=0.0226, c_m=0.1, c_e=0.1, k=57.4)
 

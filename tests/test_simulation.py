@@ -32,8 +32,9 @@ import randvib as rv
 from randvib.analytic import exact_solutions as exact
 from randvib.montecarlo import integrators
 from randvib.montecarlo.integrators import INTEGRATORS
-from randvib.montecarlo.simulation import SimulationDivergedError, estimate, simulate
+from randvib.montecarlo.simulation import SimulationDivergedError, simulate
 from randvib.montecarlo.step_check import StepSizeWarning
+from randvib.statistics import estimate
 
 LINEAR = rv.Harvester(m=0.0226, c_m=0.1, c_e=0.1, k=57.4)
 DUFFING_COULOMB = rv.preset("figure9").updated(k3=5e5)

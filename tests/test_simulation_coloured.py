@@ -28,8 +28,9 @@ import randvib as rv
 from randvib.analytic.linear_response import mechanical_block, stationary_covariance
 from randvib.models.excitation import BandPass, KanaiTajimi, White
 from randvib.montecarlo import integrators
-from randvib.montecarlo.simulation import estimate, simulate
+from randvib.montecarlo.simulation import simulate
 from randvib.montecarlo.step_check import StepSizeWarning, largest_step, step_bias
+from randvib.statistics import estimate
 
 DETECT = 0.01
 #: A well-damped linear device at 0.32 Hz and a filter near it, for coarse steps.

@@ -25,7 +25,8 @@ from randvib.models.excitation import BandLimited, Measured, Tabulated, synthesi
 from randvib.models.excitation import synthesised_increments as increments
 from randvib.montecarlo import integrators
 from randvib.montecarlo.driven import path_amplitudes
-from randvib.montecarlo.simulation import estimate, simulate
+from randvib.montecarlo.simulation import simulate
+from randvib.statistics import estimate
 
 LINEAR = rv.Harvester(m=0.0226, c_m=0.1, c_e=0.1, k=57.4)
 KW = dict(t_end=0.5, dt=1e-3, n_paths=16, burn_in=0.1, progress=False)

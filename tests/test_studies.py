@@ -323,7 +323,7 @@ def test_interaction_contrasts_holm_at_family_level(monkeypatch):
     """
     from types import SimpleNamespace
 
-    from randvib.montecarlo.simulation import Statistic
+    from randvib.statistics import Statistic
     from randvib.studies import contrasts
 
     points = [{"fc": fc, "k3": k3} for k3 in (0.0, 1.0) for fc in (0.0, 0.1, 0.2, 0.3)]

@@ -9,15 +9,14 @@ from scipy import special
 
 import randvib as rv
 import randvib.montecarlo.sweep as sweep_module
-from randvib.montecarlo.simulation import Statistic
 from randvib.montecarlo.sweep import (
     SweepSettings,
     cartesian,
-    holm_significant,
     linearisation_verdicts,
     paired_contrast,
     run_sweep,
 )
+from randvib.statistics import Statistic, holm_significant
 
 BASE = rv.preset("figure9")
 FAST = SweepSettings(

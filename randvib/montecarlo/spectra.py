@@ -21,10 +21,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import signal, special
+from scipy import signal
 
 from randvib._validation import check_positive
 from randvib.models.excitation import welch_segment_length
+from randvib.statistics import mean_and_half_width
 
 
 @dataclass(frozen=True, eq=False)
@@ -122,7 +123,7 @@ def response_spectra(result, segment_duration: float | None = None) -> SampledSp
     f, pz = signal.welch(z, detrend=False, **welch)
     _, pv = signal.welch(v, detrend=False, **welch)
     c_e = float(result.harvester.c_e)
-    (sz, hz), (sv, hv) = _mean_and_half_width(pz), _mean_and_half_width(pv)
+    (sz, hz), (sv, hv) = mean_and_half_width(pz), mean_and_half_width(pv)
     return SampledSpectra(
         frequency=f,
         displacement=sz,
@@ -134,11 +135,3 @@ def response_spectra(result, segment_duration: float | None = None) -> SampledSp
         n_paths=z.shape[0],
         segment_duration=length * step,
     )
-
-
-def _mean_and_half_width(per_path: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Mean over paths (axis 0) and the t-based 95 % half-width of it."""
-    n = per_path.shape[0]
-    mean = per_path.mean(axis=0)
-    se = per_path.std(axis=0, ddof=1) / np.sqrt(n)
-    return mean, special.stdtrit(n - 1, 0.975) * se

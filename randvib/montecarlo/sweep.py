@@ -57,7 +57,7 @@ from randvib._validation import MAX_SEED, check_int, check_positive
 from randvib.analytic.prediction import METHODS, predict
 from randvib.models.harvester import Harvester
 from randvib.montecarlo.integrators import scheme_argument
-from randvib.montecarlo.simulation import estimate
+from randvib.statistics import estimate
 
 STATISTICS = ("power_electrical", "velocity_variance", "displacement_variance", "mean_abs_velocity")
 
@@ -603,7 +603,7 @@ def paired_contrast(result: SweepResult, base: Harvester, weights: Mapping[int, 
 
     Uses the paths common to all points (the same path indices saw the same
     noise), forms the weighted combination path by path and returns a
-    :class:`randvib.montecarlo.simulation.Statistic`. With the sweep's control variates
+    :class:`randvib.statistics.Statistic`. With the sweep's control variates
     on, each point's Ito integral and energy change (the energy-balance
     controls) serve as controls. The friction-free companions are left out
     here: the companions of points that differ only in Fc are nearly collinear
@@ -633,24 +633,3 @@ def paired_contrast(result: SweepResult, base: Harvester, weights: Mapping[int, 
     if ctrl is not None and ctrl.shape[1] * 10 > n:
         ctrl = None  # too few paths to fit the coefficients reliably
     return estimate(samples, ctrl)
-
-
-def holm_significant(p_values, level: float = 0.05) -> np.ndarray:
-    """Holm-Bonferroni step-down: which of several tests reject at family level ``level``."""
-    p = np.asarray(p_values, dtype=float)
-    order = np.argsort(p)
-    reject = np.zeros(p.size, dtype=bool)
-    for rank, i in enumerate(order):
-        if p[i] > level / (p.size - rank):
-            break
-        reject[i] = True
-    return reject
-
-
-def two_sided_p_value(stat) -> float:
-    """p-value of mean = 0 for a :class:`~randvib.montecarlo.simulation.Statistic` (normal approximation)."""
-    from scipy import stats as _stats
-
-    if stat.std_error == 0:
-        return 0.0 if stat.mean != 0 else 1.0
-    return float(2 * _stats.norm.sf(abs(stat.mean) / stat.std_error))

@@ -22,19 +22,13 @@ import pandas as pd
 from randvib.analytic.averaging import AveragingValidityWarning
 from randvib.analytic.prediction import expected_power
 from randvib.models.harvester import Harvester
-from randvib.montecarlo.sweep import (
-    SweepResult,
-    holm_significant,
-    paired_contrast,
-    two_sided_p_value,
-)
+from randvib.montecarlo.sweep import SweepResult, paired_contrast
+from randvib.statistics import holm_significant, two_sided_p_value
 
 __all__ = [
-    "holm_significant",
     "interaction_contrasts",
     "predicted_contrast_curves",
     "predicted_contrasts",
-    "two_sided_p_value",
 ]
 
 

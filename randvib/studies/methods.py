@@ -33,8 +33,9 @@ from randvib.analytic.linearisation import equivalent_damping
 from randvib.analytic.prediction import expected_power
 from randvib.models.presets import preset
 from randvib.montecarlo import kernel
-from randvib.montecarlo.simulation import estimate, simulate
+from randvib.montecarlo.simulation import simulate
 from randvib.montecarlo.step_check import step_bias
+from randvib.statistics import estimate
 from randvib.studies.report import markdown_table
 
 #: Analytic methods: column suffix -> (method name in randvib.METHODS, label).

@@ -107,7 +107,7 @@ def steps(n_paths):
     """
     import test_claims as tc
 
-    from randvib.montecarlo.simulation import estimate
+    from randvib.statistics import estimate
 
     for psd, k3, kappa in ((1.0, 0.0, 2.0), (1.0, 5e5, 1.0)):
         h = tc.BASE.updated(fc=tc.fc_at_kappa(kappa, psd), k3=k3)

@@ -1,0 +1,220 @@
+"""Monte Carlo statistics over independent paths: one home for every estimator.
+
+Every Monte Carlo number randvib reports is a mean over independent paths
+(each path's time average, or one path's value such as its first-passage
+time) with a 95 % confidence half-width from the spread between paths. This
+module holds the estimators behind them, shared by :func:`randvib.simulate`,
+the sweeps, the response spectra and every study:
+
+- :class:`Statistic` and :func:`estimate`: a mean with its Student-t 95 %
+  half-width, optionally with cross-fitted zero-mean control variates;
+- :func:`mean_and_half_width`: the same, column by column (spectra);
+- :func:`paired_ratio`: the ratio of two ensembles that share their paths
+  (common random numbers), where the paired spread sets the interval;
+- :func:`two_sided_p_value` and :func:`holm_significant`: a test of a zero
+  mean and Holm's step-down correction for a family of them;
+- :class:`FirstPassage` and :func:`median_first_passage`: first-passage times
+  censored at the end of the run.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import special  # Student t quantile; lighter than scipy.stats
+
+
+@dataclass(frozen=True)
+class Statistic:
+    """A Monte Carlo estimate with its 95 % confidence half-width.
+
+    Attributes
+    ----------
+    mean : float
+        Estimate (mean over paths of per-path time averages).
+    ci95 : float
+        Half-width of the 95 % confidence interval (Student t over paths).
+    std_error : float
+        Standard error of ``mean``.
+    n_paths : int
+        Number of independent paths behind it.
+    """
+
+    mean: float
+    ci95: float
+    std_error: float
+    n_paths: int
+
+    @property
+    def relative_ci95(self) -> float:
+        """ci95 / |mean| (nan for a zero mean)."""
+        return self.ci95 / abs(self.mean) if self.mean != 0 else float("nan")
+
+    def to_dict(self) -> dict:
+        return {"mean": self.mean, "ci95": self.ci95}
+
+    def __format__(self, spec):
+        spec = spec or ".6g"
+        return f"{self.mean:{spec}} ± {self.ci95:{spec}}"
+
+
+def estimate(samples, controls=None, folds: int = 4) -> Statistic:
+    """Mean of independent ``samples`` with a t-based 95 % half-width.
+
+    Parameters
+    ----------
+    samples : array_like, shape (n,)
+        One value per independent path.
+    controls : array_like, shape (n, p), optional
+        Control variates with known mean zero. The controlled estimator is the
+        mean of ``Y - X beta``. ``beta`` is fitted by least squares with
+        *cross-fitting*: the paths are split into ``folds`` contiguous groups
+        and each group's residuals use the coefficients fitted on the other
+        groups. The residuals are then independent of their own coefficients,
+        so the estimate is unbiased and its half-width (from the residuals'
+        spread) honest even with many controls and few paths; fitting beta on
+        the same paths under-reports the error (in-sample overfitting). The
+        empirical coverage of the 95 % interval, and the under-coverage of
+        in-sample fitting, are checked over thousands of repeated estimations
+        in ``tests/test_simulation.py::test_cross_fitted_intervals_cover_at_95_percent``.
+    folds : int
+        Number of cross-fitting groups (>= 2).
+    """
+    y = np.asarray(samples, dtype=float)
+    n = y.size
+    if n < 2:
+        raise ValueError(f"need at least 2 paths for a confidence interval, got {n}")
+    residual = y
+    if controls is not None and np.size(controls) > 0:
+        x = np.asarray(controls, dtype=float).reshape(n, -1)
+        x = x[:, np.std(x, axis=0) > 0]  # drop constant columns (e.g. unused controls)
+        p = x.shape[1]
+        if p > 0:
+            fold_size = n // folds
+            if fold_size < 2 or n - fold_size <= p + 1:
+                raise ValueError(
+                    f"need more paths to use {p} control variates with {folds} folds, got {n}"
+                )
+            group = np.minimum(np.arange(n) // fold_size, folds - 1)
+            residual = np.empty(n)
+            for g in range(folds):
+                test = group == g
+                train = ~test
+                design = np.column_stack([np.ones(train.sum()), x[train]])
+                coef, *_ = np.linalg.lstsq(design, y[train], rcond=None)
+                residual[test] = y[test] - x[test] @ coef[1:]
+    mean = float(np.mean(residual))
+    var = float(np.var(residual, ddof=1))
+    se = np.sqrt(var / n)
+    return Statistic(
+        mean=mean, ci95=float(special.stdtrit(n - 1, 0.975) * se), std_error=float(se), n_paths=n
+    )
+
+
+@dataclass(frozen=True)
+class FirstPassage:
+    """Time for |z| to first exceed the stroke, from each path's start state.
+
+    Paths that never reach the stroke within the run (``t_end``) are
+    *censored*: their first-passage time is only known to exceed ``t_end``.
+    The mean first-passage time is reported (``mean``, a t interval over
+    paths) only when every path reached the stroke; otherwise ``mean`` is
+    None and what the data do determine is given instead: how many paths
+    reached it, and the restricted mean E[min(tau, t_end)] (a plain mean
+    over paths, with its interval), a lower bound of the mean first-passage
+    time. With ``initial="stationary"`` the start is random and some paths
+    may start beyond the stroke (time 0); ``initial="rest"`` asks how soon
+    the magnet reaches its stops from rest.
+
+    Attributes
+    ----------
+    mean : Statistic or None
+        E[tau] (s), when every path reached the stroke.
+    restricted_mean : Statistic
+        E[min(tau, t_end)] (s), always defined.
+    paths_reached : int
+        Paths that reached the stroke within the run.
+    n_paths : int
+    horizon : float
+        t_end (s), the censoring time.
+    """
+
+    mean: Statistic | None
+    restricted_mean: Statistic
+    paths_reached: int
+    n_paths: int
+    horizon: float
+
+    @classmethod
+    def from_times(cls, times, horizon: float) -> FirstPassage:
+        """From per-path first times (s; negative: not reached within ``horizon``)."""
+        times = np.asarray(times, dtype=float)
+        reached = times >= 0
+        restricted = np.where(reached, times, horizon)
+        return cls(
+            mean=estimate(times) if np.all(reached) else None,
+            restricted_mean=estimate(restricted),
+            paths_reached=int(reached.sum()),
+            n_paths=int(times.size),
+            horizon=float(horizon),
+        )
+
+    def to_dict(self) -> dict:
+        return {
+            "mean": None if self.mean is None else self.mean.mean,
+            "ci95": None if self.mean is None else self.mean.ci95,
+            "paths_reached": self.paths_reached,
+            "n_paths": self.n_paths,
+            "horizon": self.horizon,
+            "restricted_mean": self.restricted_mean.to_dict(),
+        }
+
+
+def mean_and_half_width(per_path: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Mean over paths (axis 0) and the t-based 95 % half-width of it."""
+    n = per_path.shape[0]
+    mean = per_path.mean(axis=0)
+    se = per_path.std(axis=0, ddof=1) / np.sqrt(n)
+    return mean, special.stdtrit(n - 1, 0.975) * se
+
+
+def paired_ratio(per_path: np.ndarray, reference: np.ndarray) -> tuple[float, float]:
+    """mean(per_path) / mean(reference) on the same paths, and its 95 % half-width (delta method)."""
+    ratio = float(np.mean(per_path) / np.mean(reference))
+    s = estimate(per_path - ratio * reference)
+    return ratio, s.ci95 / float(np.mean(reference))
+
+
+def holm_significant(p_values, level: float = 0.05) -> np.ndarray:
+    """Holm-Bonferroni step-down: which of several tests reject at family level ``level``."""
+    p = np.asarray(p_values, dtype=float)
+    order = np.argsort(p)
+    reject = np.zeros(p.size, dtype=bool)
+    for rank, i in enumerate(order):
+        if p[i] > level / (p.size - rank):
+            break
+        reject[i] = True
+    return reject
+
+
+def two_sided_p_value(stat) -> float:
+    """p-value of mean = 0 for a :class:`Statistic` (normal approximation)."""
+    from scipy import stats as _stats
+
+    if stat.std_error == 0:
+        return 0.0 if stat.mean != 0 else 1.0
+    return float(2 * _stats.norm.sf(abs(stat.mean) / stat.std_error))
+
+
+def median_first_passage(times, horizon: float) -> float:
+    """Median first time (s) with censoring at ``horizon``; NaN unless more than half reached.
+
+    With one censoring time for all paths the Kaplan-Meier survival curve is
+    the empirical one before ``horizon``, so the median is the empirical
+    median of the reached times whenever more than half the paths reached it.
+    """
+    times = np.asarray(times, dtype=float)
+    if 2 * np.count_nonzero(times >= 0) <= times.size:
+        return float("nan")
+    return float(np.quantile(np.where(times >= 0, times, horizon), 0.5))
