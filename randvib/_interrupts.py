@@ -1,4 +1,9 @@
-"""SIGTERM handled as Ctrl-C is, for the command line and the study scripts.
+"""How a run stops on Ctrl-C or SIGTERM: compiled loops and entry points.
+
+* :func:`interruptible` calls a compiled (nogil) loop so that Ctrl-C stops it
+  within a fraction of a second (a compiled loop does not see signals).
+* :func:`sigterm_stops` and :func:`interrupted_exit`: SIGTERM handled as
+  Ctrl-C is, for the command line and the study scripts.
 
 A run stopped by SIGTERM (``kill``, a batch scheduler's time limit) should
 end as one stopped by Ctrl-C: finished points and fits kept, folder locks
@@ -41,3 +46,38 @@ def interrupted_exit(exc: KeyboardInterrupt) -> tuple[int, str]:
     if isinstance(exc, Terminated):
         return 128 + signal.SIGTERM, "randvib: terminated (SIGTERM); finished results were kept"
     return 128 + signal.SIGINT, "randvib: interrupted; finished results were kept"
+
+
+def interruptible(compiled, **kwargs):
+    """Call a compiled (nogil) loop so that Ctrl-C stops it within a fraction of a second.
+
+    A compiled loop does not see signals, so it runs in a worker thread while
+    this (main) thread waits; on KeyboardInterrupt the shared ``stop`` flag is
+    set, the loop ends at its next check, and KeyboardInterrupt is raised
+    (finished batches, points and fits are kept by the callers).
+    """
+    import numpy as np  # here: the command line imports this module before it needs numpy
+
+    stop = np.zeros(1, dtype=np.int64)
+    if threading.current_thread() is not threading.main_thread():
+        return compiled(stop=stop, **kwargs)  # signals only reach the main thread
+    outcome = {}
+
+    def target():
+        try:
+            outcome["value"] = compiled(stop=stop, **kwargs)
+        except BaseException as exc:  # handed to the caller's thread
+            outcome["error"] = exc
+
+    worker = threading.Thread(target=target, name="randvib-kernel", daemon=True)
+    worker.start()
+    try:
+        while worker.is_alive():
+            worker.join(0.05)
+    except KeyboardInterrupt:
+        stop[0] = 1
+        worker.join()
+        raise
+    if "error" in outcome:
+        raise outcome["error"]
+    return outcome["value"]

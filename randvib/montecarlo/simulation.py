@@ -31,7 +31,6 @@ depend on any assumption about correlation times.
 from __future__ import annotations
 
 import functools
-import threading
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -41,6 +40,7 @@ import numpy as np
 from scipy import linalg, special  # Student t quantile; lighter than scipy.stats
 
 from randvib import _display
+from randvib._interrupts import interruptible
 from randvib._progress import progress_bar, progress_wanted
 from randvib._resources import LONG_RUN_SECONDS, announce_duration, check_memory, timed
 from randvib._validation import (
@@ -1223,39 +1223,6 @@ def _run_batches(run: _Run, setup: _KernelSetup, batches, progress: bool):
             bar.close()
     hist_groups = np.concatenate(hist_groups) if hist_groups else None
     return per_path, hist_groups, records
-
-
-def interruptible(compiled, **kwargs):
-    """Call a compiled (nogil) loop so that Ctrl-C stops it within a fraction of a second.
-
-    A compiled loop does not see signals, so it runs in a worker thread while
-    this (main) thread waits; on KeyboardInterrupt the shared ``stop`` flag is
-    set, the loop ends at its next check, and KeyboardInterrupt is raised
-    (finished batches, points and fits are kept by the callers).
-    """
-    stop = np.zeros(1, dtype=np.int64)
-    if threading.current_thread() is not threading.main_thread():
-        return compiled(stop=stop, **kwargs)  # signals only reach the main thread
-    outcome = {}
-
-    def target():
-        try:
-            outcome["value"] = compiled(stop=stop, **kwargs)
-        except BaseException as exc:  # handed to the caller's thread
-            outcome["error"] = exc
-
-    worker = threading.Thread(target=target, name="randvib-kernel", daemon=True)
-    worker.start()
-    try:
-        while worker.is_alive():
-            worker.join(0.05)
-    except KeyboardInterrupt:
-        stop[0] = 1
-        worker.join()
-        raise
-    if "error" in outcome:
-        raise outcome["error"]
-    return outcome["value"]
 
 
 def _raise_if_diverged(run: _Run, lo: int, failed: np.ndarray) -> None:
