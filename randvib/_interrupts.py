@@ -1,7 +1,9 @@
-"""How a run stops on Ctrl-C or SIGTERM: compiled loops and entry points.
+"""How a run stops on Ctrl-C or SIGTERM: compiled loops, worker processes, entry points.
 
 * :func:`interruptible` calls a compiled (nogil) loop so that Ctrl-C stops it
   within a fraction of a second (a compiled loop does not see signals).
+* :func:`ctrl_c_blocked` and :func:`worker_ignores_ctrl_c`: a process pool's
+  workers leave Ctrl-C to their parent from the moment they are spawned.
 * :func:`sigterm_stops` and :func:`interrupted_exit`: SIGTERM handled as
   Ctrl-C is, for the command line and the study scripts.
 
@@ -46,6 +48,35 @@ def interrupted_exit(exc: KeyboardInterrupt) -> tuple[int, str]:
     if isinstance(exc, Terminated):
         return 128 + signal.SIGTERM, "randvib: terminated (SIGTERM); finished results were kept"
     return 128 + signal.SIGINT, "randvib: interrupted; finished results were kept"
+
+
+@contextlib.contextmanager
+def ctrl_c_blocked():
+    """Within the block, SIGINT is blocked in this thread; one that comes stays pending.
+
+    A blocked signal mask is inherited across fork and exec, so a process
+    spawned within the block is born with SIGINT blocked (as CPython starts
+    its own resource tracker); a Ctrl-C meanwhile is delivered here when the
+    mask is restored: none is lost.
+    """
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+
+
+def worker_ignores_ctrl_c() -> None:
+    """In a worker born within :func:`ctrl_c_blocked`: ignore SIGINT, then unblock it.
+
+    A terminal's Ctrl-C reaches the whole process group; the parent alone
+    stops the run (keeping what was finished) and ends its workers, so the
+    user sees one line, not a traceback per worker. A Ctrl-C that came while
+    the worker was still importing is pending, and is discarded by ignoring
+    SIGINT before unblocking it.
+    """
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 
 def interruptible(compiled, **kwargs):

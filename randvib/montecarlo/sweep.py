@@ -43,6 +43,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from randvib._interrupts import ctrl_c_blocked, worker_ignores_ctrl_c
 from randvib._io import (
     atomic_write_bytes,
     atomic_write_text,
@@ -263,19 +264,15 @@ def _worker_start(parent: int, initializer=None) -> None:
     A sweep killed with SIGTERM or SIGKILL cannot shut its pool down; its
     workers would live on (one numba-loaded interpreter each). A daemon
     thread in every worker checks once a second that the parent is still
-    there and ends the worker when it is not. A worker ignores SIGINT: a
-    terminal's Ctrl-C reaches the whole process group, and the parent alone
-    stops the sweep (keeping the finished points) and ends its workers, so
-    the user sees one line, not a traceback per worker. The worker was born
-    with SIGINT blocked (:class:`_WorkerPool`), so a Ctrl-C that came while
-    it was still importing is pending, and is discarded here by ignoring it
-    before unblocking it.
+    there and ends the worker when it is not. A worker ignores SIGINT
+    (:func:`randvib._interrupts.worker_ignores_ctrl_c`): the parent alone
+    stops the sweep (keeping the finished points) and ends its workers. The
+    worker was born with SIGINT blocked (:class:`_WorkerPool`), so a Ctrl-C
+    that came while it was still importing is discarded.
     """
-    import signal
     import threading
 
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    worker_ignores_ctrl_c()
 
     def watch():
         while True:
@@ -295,20 +292,15 @@ class _WorkerPool(ProcessPoolExecutor):
     randvib before :func:`_worker_start` can ignore SIGINT; a Ctrl-C in that
     window ended it with a KeyboardInterrupt traceback on the user's terminal.
     The pool spawns its workers inside :meth:`submit` (one per submission
-    until it has ``max_workers``), and a blocked signal mask is inherited
-    across fork and exec, so every submission blocks SIGINT in the submitting
-    thread (as CPython starts its own resource tracker). A Ctrl-C meanwhile
-    stays pending there and is delivered when the mask is restored: none is lost.
+    until it has ``max_workers``), so every submission blocks SIGINT in the
+    submitting thread (:func:`randvib._interrupts.ctrl_c_blocked`): the
+    workers inherit the mask, and a Ctrl-C meanwhile is delivered to the
+    parent when the mask is restored.
     """
 
     def submit(self, fn, /, *args, **kwargs):
-        import signal
-
-        previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-        try:
+        with ctrl_c_blocked():
             return super().submit(fn, *args, **kwargs)
-        finally:
-            signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
 def make_executor(workers: int | None = None, scheduler: str | None = None, initializer=None):
