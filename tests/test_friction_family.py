@@ -41,7 +41,8 @@ from randvib.cli._device import FRICTION_CHOICES
 from randvib.identification.fitting import MODELS, Record, default_bounds, identify, predict_record
 from randvib.identification.record_simulation import FRICTION_PARAMETERS, simulate_record
 from randvib.models.excitation import band_limited_excitation
-from randvib.models.friction import FRICTION_MODELS, parameter
+from randvib.models.friction import FRICTION_MODELS
+from randvib.models.parameters import parameter
 
 
 @dataclass(frozen=True, eq=False)

@@ -58,7 +58,8 @@ from randvib.identification.record_simulation import (
     run_kernel,
 )
 from randvib.identification.sade import sade
-from randvib.models.friction import FRICTION_MODELS, Parameter, RecordScales, RegistryView
+from randvib.models.friction import FRICTION_MODELS, RegistryView
+from randvib.models.parameters import Parameter, RecordScales
 
 #: The device's own parameters (Eq. 1; friction laws declare theirs): unit,
 #: default bounds from the record's scales, log scale (k3 may be zero).
@@ -689,7 +690,7 @@ def default_bounds(record: Record, model: str, m: float | None = None) -> dict:
     ======  ==========================================  =====
 
     The device's rows are :data:`DEVICE_SPECS`, the friction rows the
-    law's own :func:`~randvib.models.friction.parameter` declarations (the table
+    law's own :func:`~randvib.models.parameters.parameter` declarations (the table
     above is what the built-in laws declare). These cover the paper's
     Table 2 for its records; override any of them with ``bounds=`` in
     :func:`identify` (``--bounds NAME=LO:HI``). A parameter declared without

@@ -3,7 +3,7 @@
 One model family, declared once (like the friction laws of
 :mod:`randvib.models.friction` and the excitations of
 :mod:`randvib.models.excitation`): each coupling is a frozen dataclass whose
-fields are made with :func:`~randvib.models.friction.parameter`, and a
+fields are made with :func:`~randvib.models.parameters.parameter`, and a
 subclass that sets ``name`` is registered in :data:`COUPLINGS`, which the CLI
 and the methods read.
 
@@ -41,7 +41,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from randvib.models.friction import DeclaredParameters, parameter
+from randvib.models.parameters import DeclaredParameters, parameter
 
 #: Registered couplings by name (``resistive``, ``inductive``, ``piezo``).
 COUPLINGS: dict[str, type] = {}
@@ -51,7 +51,7 @@ class Coupling(DeclaredParameters):
     """Base class of the electrical couplings: the declaration every consumer reads.
 
     Subclasses are frozen dataclasses whose fields are made with
-    :func:`~randvib.models.friction.parameter`; one that sets ``name`` is
+    :func:`~randvib.models.parameters.parameter`; one that sets ``name`` is
     registered in :data:`COUPLINGS`.
     """
 

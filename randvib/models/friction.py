@@ -4,7 +4,8 @@ A friction law is one class, a frozen dataclass subclassing
 :class:`FrictionModel`, and that class is the only place that describes it.
 It declares everything the rest of randvib needs:
 
-* **parameters** - the dataclass fields, each made with :func:`parameter`,
+* **parameters** - the dataclass fields, each made with
+  :func:`~randvib.models.parameters.parameter` (:mod:`randvib.models.parameters`),
   which records its unit, whether it must be > 0 or >= 0, and how
   identification searches it (default bounds from a record's scales, log or
   linear scale). Validation, ``parameters()``, the CLI options, the
@@ -39,15 +40,16 @@ Parameters may be numpy arrays: the analytic methods broadcast over them.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, fields, replace
+from collections.abc import Mapping
+from dataclasses import dataclass, fields, replace
 
 import numba
 import numpy as np
 from numba import types
 
 from randvib import _quadrature
-from randvib._validation import check_nonnegative, check_positive, scalar_or_array
+from randvib._validation import scalar_or_array
+from randvib.models.parameters import DeclaredParameters, parameter
 
 #: Length of the parameter vector handed to the compiled kernels.
 N_KERNEL_PARAMETERS = 5
@@ -73,81 +75,6 @@ KERNEL_SIGNATURE = types.UniTuple(types.float64, 2)(
 FRICTION_MODELS: dict[str, type] = {}
 
 
-# ------------------------------------------------------------ declarations
-@dataclass(frozen=True)
-class RecordScales:
-    """Characteristic scales of a record, from which search bounds follow.
-
-    Attributes
-    ----------
-    m : float
-        Mass (kg), given or estimated.
-    omega : float
-        Characteristic angular frequency rms(z')/rms(z) (rad/s).
-    z_max : float
-        Largest |z| (m).
-    v_rms : float
-        RMS velocity (m/s).
-    force : float
-        RMS external force, m rms(y'') or rms(u) (N).
-    """
-
-    m: float
-    omega: float
-    z_max: float
-    v_rms: float
-    force: float
-
-    @property
-    def k_ref(self) -> float:
-        """Stiffness scale m omega^2 (N/m)."""
-        return self.m * self.omega**2
-
-    @property
-    def c_ref(self) -> float:
-        """Damping scale 2 m omega (Ns/m): critical damping at omega."""
-        return 2.0 * self.m * self.omega
-
-
-@dataclass(frozen=True)
-class Parameter:
-    """What a friction law declares about one of its parameters.
-
-    Attributes
-    ----------
-    unit : str
-        SI unit, as printed in messages and tables.
-    positive : bool
-        True: must be > 0; False: must be >= 0.
-    search : callable or None
-        ``search(scales: RecordScales) -> (lower, upper)``: identification's
-        default bounds. None: the parameter has no default bounds and must
-        be fixed or bounded by the user.
-    log : bool
-        Search on a log scale (parameters that span decades).
-    description : str
-        One line for the CLI help.
-    """
-
-    unit: str
-    positive: bool = False
-    search: Callable | None = None
-    log: bool = True
-    description: str = ""
-
-
-def parameter(
-    unit: str,
-    *,
-    positive: bool = False,
-    search: Callable | None = None,
-    log: bool = True,
-    description: str = "",
-):
-    """A friction-law field with its declaration (see :class:`Parameter`)."""
-    return field(metadata={"parameter": Parameter(unit, positive, search, log, description)})
-
-
 @numba.cfunc(KERNEL_SIGNATURE, cache=True)
 def _no_generic_kernel(p, v, theta):
     # Placeholder callback for built-in laws and no friction: the compiled
@@ -159,41 +86,13 @@ def _no_generic_kernel(p, v, theta):
 _COMPILED_KERNELS: dict[type, object] = {}
 
 
-class DeclaredParameters:
-    """What every model family declared with :func:`parameter` fields shares.
-
-    The family's base class (friction laws, couplings) inherits it: the
-    declarations by name, in field order (the kernel's order for friction
-    laws), and one validation from them, so a bad value is named the same
-    way in every family.
-    """
-
-    @classmethod
-    def parameter_specs(cls) -> dict[str, Parameter]:
-        """Declared parameters by name, in field order."""
-        return {f.name: f.metadata["parameter"] for f in fields(cls)}
-
-    @classmethod
-    def parameter_names(cls) -> tuple[str, ...]:
-        """Parameter names in field order."""
-        return tuple(f.name for f in fields(cls))
-
-    def __post_init__(self):
-        # One validation from the declarations: a message names the
-        # parameter, its value, the allowed range and the unit.
-        for name, spec in self.parameter_specs().items():
-            check = check_positive if spec.positive else check_nonnegative
-            object.__setattr__(
-                self, name, scalar_or_array(check(name, getattr(self, name), spec.unit))
-            )
-
-
 class FrictionModel(DeclaredParameters):
     """Base class of the friction laws: the declaration every consumer reads.
 
     Subclasses are frozen dataclasses whose fields are made with
-    :func:`parameter`; a subclass that sets ``name`` is registered in
-    :data:`FRICTION_MODELS`. See the module docstring for what a law declares.
+    :func:`~randvib.models.parameters.parameter`; a subclass that sets
+    ``name`` is registered in :data:`FRICTION_MODELS`. See the module
+    docstring for what a law declares.
     """
 
     #: Short name used by the CLI, presets, identification and tables.
