@@ -70,11 +70,8 @@ _EXPORTS = {
     "randvib.montecarlo.spectra": ("SampledSpectra",),
     "randvib.studies.spectra_figure": ("plot_response_spectra",),
     "randvib.identification.sade": ("sade", "SADEResult"),
-    "randvib.montecarlo.simulation": (
-        "simulate",
-        "SimulationDivergedError",
-        "SimulationResult",
-    ),
+    "randvib.montecarlo.simulation": ("simulate", "SimulationDivergedError"),
+    "randvib.montecarlo.results": ("SimulationResult",),
     "randvib.statistics": ("FirstPassage", "Statistic", "estimate"),
     "randvib.montecarlo.step_check": ("StepSizeWarning",),
 }

@@ -1,6 +1,6 @@
 """How results show themselves: compact reprs, HTML tables for Jupyter, pandas.
 
-The result classes (:class:`~randvib.montecarlo.simulation.SimulationResult`,
+The result classes (:class:`~randvib.montecarlo.results.SimulationResult`,
 :class:`~randvib.analytic.prediction.PowerPrediction`,
 :class:`~randvib.analytic.statistical_linearisation.LinearisationResult`,
 :class:`~randvib.identification.fitting.IdentificationResult`) build a list of

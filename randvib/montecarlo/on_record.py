@@ -35,7 +35,8 @@ from randvib._validation import check_int, check_positive
 from randvib.models.excitation import Measured
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import driven, integrators
-from randvib.montecarlo.simulation import SimulationResult, _validated, execute
+from randvib.montecarlo.results import SimulationResult
+from randvib.montecarlo.simulation import _validated, execute
 
 
 def simulate_on_record(

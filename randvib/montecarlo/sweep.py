@@ -15,7 +15,7 @@ Design choices a careful user expects:
 * **Control variates.** Each path also integrates the friction-free device
   with the same noise, whose stationary E[v^2] = S m / (4c) and E[z^2] (Gibbs)
   are exact, and carries the Ito integral and energy change of the energy
-  balance; see :meth:`randvib.montecarlo.simulation.SimulationResult.controls`.
+  balance; see :meth:`randvib.montecarlo.results.SimulationResult.controls`.
 * **Incremental, resumable output.** Each finished point is written at once
   (one JSON row and one ``.npy`` of per-path powers, each by atomic rename);
   the CSV table is regenerated from them. An interrupted sweep resumes without
