@@ -36,7 +36,8 @@ from randvib.models.excitation import Measured
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import driven, integrators
 from randvib.montecarlo.results import SimulationResult
-from randvib.montecarlo.simulation import _validated, execute
+from randvib.montecarlo.simulation import execute
+from randvib.montecarlo.validation import validated
 
 
 def simulate_on_record(
@@ -93,7 +94,7 @@ def simulate_on_record(
         raise ValueError(f"`burn_in` must be a finite number of seconds >= 0, got {burn_in!r}")
     source = driven.RecordedInput.cut(record, segments, burn_in, substeps)
     dt = check_positive("dt", source.dt, "s")
-    run = _validated(
+    run = validated(
         harvester,
         record.spectrum,  # validated as a spectrum; the record replaces it below
         integrators.scheme_argument(scheme, None),

@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import functools
 import time
-import warnings
 from dataclasses import dataclass
 
 import numba
@@ -43,63 +42,25 @@ from randvib._interrupts import interruptible
 from randvib._progress import progress_bar, progress_wanted
 from randvib._resources import LONG_RUN_SECONDS, announce_duration, check_memory, timed
 from randvib._validation import (
-    MAX_SEED,
     check_int,
-    check_scalar_device,
 )
 from randvib.analytic import exact_solutions as exact
 from randvib.analytic.statistical_linearisation import statistical_linearisation
-from randvib.models.excitation import Excitation, as_excitation
+from randvib.models.excitation import Excitation
 from randvib.models.friction import kernel_arguments
 from randvib.models.harvester import Harvester
-from randvib.models.potential import CONFINING
 from randvib.montecarlo import driven, integrators, kernel
-from randvib.montecarlo.integrators import Integrator, integrator
-from randvib.montecarlo.options import InitialState, RecordOptions, TimeGrid
 from randvib.montecarlo.results import Histogram, Histories, SimulationResult
 from randvib.montecarlo.rng import ZIG_FI, ZIG_KI, ZIG_WI
 from randvib.montecarlo.step_check import (
     LinearTestSystem,
     coarsened,
 )
-
-#: Largest path index (streams are keyed by unsigned 64-bit integers).
-MAX_PATH_INDEX = 2**62
+from randvib.montecarlo.validation import Run, check_options, check_scales, validated
 
 
 class SimulationDivergedError(ValueError):
     """The state became non-finite during a simulation."""
-
-
-def _check_scales(run: _Run, linear) -> None:
-    """Refuse parameters whose linearised scales are not finite float64 numbers.
-
-    Extreme values (m = 1e308, k3 = 1e308, S = 1e308) overflow the
-    step-size check and the stationary start; they are named here instead.
-    ``linear`` gives the run's :class:`LinearTestSystem` (built on first use).
-    """
-    h = run.harvester
-    try:
-        # quadrature warnings at such values would only precede the refusal
-        with np.errstate(all="ignore"), warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            system = linear()
-            k_eff, c_eff = system.k_eff, system.c_eff
-            spread = system.spread
-    except (ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
-        problem = f"{type(exc).__name__}: {exc}"
-    else:
-        values = (k_eff, c_eff, *spread)
-        # the free mass has no stiffness and no stationary spread in z
-        positive = values[1:2] + values[3:] if h.potential.is_free else values
-        if all(np.isfinite(values)) and all(v > 0 for v in positive):
-            return
-        problem = f"k_eff = {k_eff:.3g}, c_eff = {c_eff:.3g}, std z, v = {spread}"
-    raise ValueError(
-        f"the device's linearised scales are not finite positive float64 numbers ({problem}) "
-        f"at psd = {run.psd!r} and {run.harvester.parameters()}: the parameters are out of "
-        "range, or the device has neither damping nor friction"
-    )
 
 
 #: Rough speed of the compiled loop, path-steps per second per thread (Heun,
@@ -113,7 +74,7 @@ PROBE_MARGIN = 30.0
 PROBE_PATH_STEPS = 3e6
 
 
-def _announce_long_run(run: _Run, setup: _KernelSetup) -> None:
+def _announce_long_run(run: Run, setup: _KernelSetup) -> None:
     """Say how long a long run will take, at the speed measured on this machine.
 
     A run that could be long (more than LONG_RUN_SECONDS / PROBE_MARGIN at the
@@ -136,7 +97,7 @@ def _announce_long_run(run: _Run, setup: _KernelSetup) -> None:
         announce_duration(what, work / _measured_speed(run, setup, threads), stacklevel=5)
 
 
-def _measured_speed(run: _Run, setup: _KernelSetup, threads: int) -> float:
+def _measured_speed(run: Run, setup: _KernelSetup, threads: int) -> float:
     """Path-steps per second of this run's compiled loop on this machine (a timed probe)."""
     paths = min(run.n_paths, kernel.LANES * threads)
     steps = int(min(run.grid.n_steps, max(100, PROBE_PATH_STEPS * threads / paths)))
@@ -153,7 +114,7 @@ def _measured_speed(run: _Run, setup: _KernelSetup, threads: int) -> float:
     return paths * steps * (2 if run.companion else 1) / elapsed
 
 
-def _check_resources(run: _Run, batch_paths, progress) -> None:
+def _check_resources(run: Run, batch_paths, progress) -> None:
     """Refuse a run whose arrays cannot fit in memory."""
     n_steps, n_paths = run.grid.n_steps, run.n_paths
     batch = n_paths if batch_paths is None else min(int(batch_paths), n_paths)
@@ -170,27 +131,6 @@ def _check_resources(run: _Run, batch_paths, progress) -> None:
         n_bytes,
         "reduce `n_paths`, `histogram_bins` or `record_paths`, or run in parts with `first_path`",
     )
-
-
-@dataclass(frozen=True)
-class _Run:
-    """:func:`simulate`'s arguments, validated and grouped."""
-
-    harvester: Harvester
-    psd: float
-    excitation: Excitation
-    scheme: Integrator
-    grid: TimeGrid
-    n_paths: int
-    seed: int
-    first_path: int
-    initial: InitialState
-    record: RecordOptions
-    dW: np.ndarray | None
-    companion: bool
-    #: Velocity increments of a given base acceleration, ``driver(first, count)``
-    #: -> (count, n_steps) (m/s): synthesised or recorded input (:mod:`randvib.montecarlo.driven`).
-    driver: object = None
 
 
 # ----------------------------------------------------------------- simulate
@@ -318,7 +258,7 @@ def simulate(
     >>> print(f"{power.mean:.3e} +- {power.ci95:.1e} W")
     2.426e-03 +- 2.5e-04 W
     """
-    run = _validated(
+    run = validated(
         harvester,
         psd,
         integrators.scheme_argument(scheme, method),
@@ -343,10 +283,9 @@ def simulate(
     )
 
 
-def execute(run: _Run, *, control_variates, check_step, threads, batch_paths, progress):
-    """Run a validated :class:`_Run` (see :func:`simulate` for the options)."""
-    _check_coloured_options(run.excitation, run.companion, control_variates)
-    _check_circuit_options(run.harvester, run.companion)
+def execute(run: Run, *, control_variates, check_step, threads, batch_paths, progress):
+    """Run a validated :class:`~randvib.montecarlo.validation.Run` (see :func:`simulate` for the options)."""
+    check_options(run, control_variates)
     # refusals before advice: a run that cannot fit is refused before any step warning
     _check_resources(run, batch_paths, progress)
     # One linear test system per run, built when first needed (a fixed start
@@ -354,7 +293,7 @@ def execute(run: _Run, *, control_variates, check_step, threads, batch_paths, pr
     # the default histogram ranges and the circuit's start all use it.
     linear = functools.cache(lambda: LinearTestSystem.of(run.harvester, run.excitation))
     if check_step or run.initial.kind == "stationary":
-        _check_scales(run, linear)
+        check_scales(run, linear)
     if check_step:
         linear().check_step(run.scheme.name, run.grid.dt)
     setup = _KernelSetup.prepare(run, linear)
@@ -392,144 +331,6 @@ def execute(run: _Run, *, control_variates, check_step, threads, batch_paths, pr
     )
 
 
-# ----------------------------------------------------------------- validation
-def _validated(
-    harvester,
-    psd,
-    scheme_argument,
-    *,
-    t_end,
-    dt,
-    burn_in,
-    n_paths,
-    seed,
-    first_path,
-    initial,
-    dW,
-    companion,
-    record,
-) -> _Run:
-    """:func:`simulate`'s arguments checked, in one place; messages name the argument.
-
-    ``scheme_argument`` is (scheme name, keyword it came by) and ``record``
-    (histogram_bins, histogram_range, record_paths, record_every).
-    """
-    if not isinstance(harvester, Harvester):
-        raise ValueError(f"`harvester` must be a randvib.Harvester, got {type(harvester).__name__}")
-    check_scalar_device(harvester, "simulate")  # device, friction and coupling parameters
-    # Statistics are time averages of a stationary state: a confining
-    # potential, or the free mass for its velocity.
-    harvester.potential.require("simulate", CONFINING + ("free",))
-    if companion and harvester.potential.is_free:
-        raise ValueError(
-            "`companion` needs a confining potential: the friction-free companion's exact "
-            "E[z^2] (Gibbs) does not exist for the free mass (k = k3 = 0)"
-        )
-    scheme = integrator(*scheme_argument)
-    excitation = _simulated_excitation(psd)
-    grid = TimeGrid.from_times(t_end, dt, burn_in)
-    n_paths = check_int("n_paths", n_paths, 1)
-    seed = check_int("seed", seed, 0, MAX_SEED)
-    driver = None
-    if excitation.shaping_filter() is None:  # synthesised input: the kernel takes its increments
-        if dW is not None:
-            raise ValueError(
-                f"`dW` drives white noise or a shaping filter; the {excitation.name} input is "
-                "synthesised from the seed (leave dW=None)"
-            )
-        driver = driven.SynthesisedInput(excitation, grid.n_steps, grid.dt, seed)
-    return _Run(
-        harvester=harvester,
-        psd=getattr(excitation, "level", None),
-        excitation=excitation,
-        driver=driver,
-        scheme=scheme,
-        grid=grid,
-        n_paths=n_paths,
-        seed=seed,
-        first_path=check_int("first_path", first_path, 0, MAX_PATH_INDEX),
-        initial=InitialState.from_argument(initial),
-        record=RecordOptions.validated(*record),
-        dW=_checked_increments(dW, n_paths, grid.n_steps),
-        companion=bool(companion),
-    )
-
-
-def _simulated_excitation(psd) -> Excitation:
-    """``psd`` as an excitation that :func:`simulate` can drive, or a clear refusal.
-
-    White noise and the rational spectra with a 2-state shaping filter
-    (band-pass, Kanai-Tajimi) are integrated with the device; band-limited
-    and tabulated spectra are synthesised (:class:`driven.SynthesisedInput`);
-    a measured record is simulated on the record itself by
-    :func:`randvib.montecarlo.driven.simulate_on_record`.
-    """
-    if not isinstance(psd, Excitation):
-        return as_excitation(psd)  # one positive number (an array refused by name)
-    if psd.is_white:
-        return psd
-    if psd.name == "measured":
-        raise ValueError(
-            "simulate draws its own paths; to simulate the device on the measured record "
-            "itself use randvib.simulate_on_record(harvester, record, ...), for Gaussian "
-            "paths with the record's Welch PSD pass record.spectrum"
-        )
-    shaping = psd.shaping_filter()
-    if shaping is not None and (shaping.system.n_states != 2 or np.any(shaping.system.d != 0)):
-        raise ValueError(
-            f"simulate integrates shaping filters of 2 states without feed-through; the "
-            f"{psd.name} filter has {shaping.system.n_states}"
-        )
-    return psd
-
-
-def _check_coloured_options(excitation: Excitation, companion: bool, control_variates: bool):
-    """Refuse the white-noise-only options under coloured input, saying why."""
-    if excitation.is_white:
-        return
-    if companion:
-        raise ValueError(
-            "`companion` needs white noise: the friction-free companion's exact moments "
-            f"(S m/(4c), Gibbs E[z^2]) do not hold under {excitation.name} excitation"
-        )
-    if control_variates and excitation.shaping_filter() is None:
-        raise ValueError(
-            "`control_variates` needs Brownian increments (white noise, or band-pass and "
-            "Kanai-Tajimi through their filter): under the synthesised or recorded "
-            f"{excitation.name} input the Ito sum is the input power, not a zero-mean control; "
-            "use control_variates=False"
-        )
-
-
-def _check_circuit_options(harvester: Harvester, companion: bool):
-    """Refuse the friction-free companion with a circuit state, saying why.
-
-    The energy-balance controls (the Ito integral, mean exactly zero; the
-    change of mechanical energy, zero in the stationary state) hold for any
-    coupling, so ``control_variates`` stays available.
-    """
-    if harvester.has_circuit and companion:
-        raise ValueError(
-            "`companion` needs the resistive coupling: its exact moments (S m/(4c), Gibbs "
-            f"E[z^2]) assume a viscous c_e, not the {harvester.electrical.name} coupling's "
-            "circuit state; use companion=False"
-        )
-
-
-def _checked_increments(dW, n_paths, n_steps):
-    """Given Brownian increments as a contiguous (n_paths, n_steps) array, or None."""
-    if dW is None:
-        return None
-    dW = np.ascontiguousarray(dW, dtype=float)
-    if dW.shape != (n_paths, n_steps):
-        raise ValueError(
-            f"`dW` must have shape (n_paths, n_steps) = {(n_paths, n_steps)}, got {dW.shape}"
-        )
-    if not np.all(np.isfinite(dW)):
-        raise ValueError("`dW` must be finite")
-    return dW
-
-
 # ----------------------------------------------------------------- kernel set-up
 @dataclass(frozen=True)
 class _KernelSetup:
@@ -549,7 +350,7 @@ class _KernelSetup:
     auxiliary: kernel.Auxiliary | None
 
     @classmethod
-    def prepare(cls, run: _Run, linear) -> _KernelSetup:
+    def prepare(cls, run: Run, linear) -> _KernelSetup:
         """The argument groups; ``linear()`` gives the run's :class:`LinearTestSystem`."""
         h = run.harvester
         # Given base-acceleration input arrives as velocity increments (m/s): amplitude 1.
@@ -567,7 +368,7 @@ class _KernelSetup:
             auxiliary=_auxiliary(run, linear),
         )
 
-    def arguments(self, run: _Run, lo: int, hi: int) -> dict:
+    def arguments(self, run: Run, lo: int, hi: int) -> dict:
         """:func:`kernel.run_ensemble`'s keyword arguments for paths ``lo .. hi - 1``."""
         n_record = max(0, min(run.record.record_paths - lo, hi - lo))
         if run.driver is not None:
@@ -588,7 +389,7 @@ class _KernelSetup:
         )
 
 
-def _auxiliary(run: _Run, linear) -> kernel.Auxiliary | None:
+def _auxiliary(run: Run, linear) -> kernel.Auxiliary | None:
     """The kernel's linear auxiliary block: the excitation's filter and the circuit state.
 
     None for white noise with a resistive (or no) circuit. The filter's states
@@ -650,7 +451,7 @@ def _driven_circuit_variance(harvester: Harvester, excitation: Excitation) -> fl
     return float(statistical_linearisation(h, coarsened(excitation)).circuit_variance)
 
 
-def _start_states(run: _Run, linear) -> tuple[kernel.Start, kernel.Companion]:
+def _start_states(run: Run, linear) -> tuple[kernel.Start, kernel.Companion]:
     """Initial states of the device and of its friction-free companion."""
     h, psd = run.harvester, run.psd
     random = run.initial.kind == "stationary"
@@ -670,7 +471,7 @@ def _start_states(run: _Run, linear) -> tuple[kernel.Start, kernel.Companion]:
     )
 
 
-def _recording(run: _Run, linear) -> kernel.Recording:
+def _recording(run: Run, linear) -> kernel.Recording:
     """Histogram ranges and bins (default ranges +-5 linearised std); records per batch.
 
     The free mass's z spreads like a random walk: its default range is
@@ -694,7 +495,7 @@ def _recording(run: _Run, linear) -> kernel.Recording:
 
 
 # ----------------------------------------------------------------- compiled calls
-def _run_batches(run: _Run, setup: _KernelSetup, batches, progress: bool):
+def _run_batches(run: Run, setup: _KernelSetup, batches, progress: bool):
     """Run the compiled loop batch by batch.
 
     Returns
@@ -732,7 +533,7 @@ def _run_batches(run: _Run, setup: _KernelSetup, batches, progress: bool):
     return per_path, hist_groups, records
 
 
-def _raise_if_diverged(run: _Run, lo: int, failed: np.ndarray) -> None:
+def _raise_if_diverged(run: Run, lo: int, failed: np.ndarray) -> None:
     bad = np.flatnonzero(failed >= 0)
     if bad.size:
         p = bad[0]

@@ -1,0 +1,224 @@
+"""simulate's arguments checked in one place and grouped into a :class:`Run`.
+
+:func:`validated` checks every argument of :func:`randvib.simulate` (the
+device, the input, the time grid, the paths and seed, the start, what is
+recorded, given increments) with messages that name the argument, the value
+and what is allowed, and returns the :class:`Run` that the set-up and the
+batches read. :func:`check_options` refuses the options that the input or
+the circuit cannot honour; :func:`check_scales` refuses parameters whose
+linearised scales overflow float64.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from randvib._validation import MAX_SEED, check_int, check_scalar_device
+from randvib.models.excitation import Excitation, as_excitation
+from randvib.models.harvester import Harvester
+from randvib.models.potential import CONFINING
+from randvib.montecarlo import driven
+from randvib.montecarlo.integrators import Integrator, integrator
+from randvib.montecarlo.options import InitialState, RecordOptions, TimeGrid
+
+#: Largest path index (streams are keyed by unsigned 64-bit integers).
+MAX_PATH_INDEX = 2**62
+
+
+@dataclass(frozen=True)
+class Run:
+    """:func:`randvib.simulate`'s arguments, validated and grouped."""
+
+    harvester: Harvester
+    psd: float
+    excitation: Excitation
+    scheme: Integrator
+    grid: TimeGrid
+    n_paths: int
+    seed: int
+    first_path: int
+    initial: InitialState
+    record: RecordOptions
+    dW: np.ndarray | None
+    companion: bool
+    #: Velocity increments of a given base acceleration, ``driver(first, count)``
+    #: -> (count, n_steps) (m/s): synthesised or recorded input (:mod:`randvib.montecarlo.driven`).
+    driver: object = None
+
+
+def validated(
+    harvester,
+    psd,
+    scheme_argument,
+    *,
+    t_end,
+    dt,
+    burn_in,
+    n_paths,
+    seed,
+    first_path,
+    initial,
+    dW,
+    companion,
+    record,
+) -> Run:
+    """:func:`randvib.simulate`'s arguments checked, in one place; messages name the argument.
+
+    ``scheme_argument`` is (scheme name, keyword it came by) and ``record``
+    (histogram_bins, histogram_range, record_paths, record_every).
+    """
+    if not isinstance(harvester, Harvester):
+        raise ValueError(f"`harvester` must be a randvib.Harvester, got {type(harvester).__name__}")
+    check_scalar_device(harvester, "simulate")  # device, friction and coupling parameters
+    # Statistics are time averages of a stationary state: a confining
+    # potential, or the free mass for its velocity.
+    harvester.potential.require("simulate", CONFINING + ("free",))
+    if companion and harvester.potential.is_free:
+        raise ValueError(
+            "`companion` needs a confining potential: the friction-free companion's exact "
+            "E[z^2] (Gibbs) does not exist for the free mass (k = k3 = 0)"
+        )
+    scheme = integrator(*scheme_argument)
+    excitation = _simulated_excitation(psd)
+    grid = TimeGrid.from_times(t_end, dt, burn_in)
+    n_paths = check_int("n_paths", n_paths, 1)
+    seed = check_int("seed", seed, 0, MAX_SEED)
+    driver = None
+    if excitation.shaping_filter() is None:  # synthesised input: the kernel takes its increments
+        if dW is not None:
+            raise ValueError(
+                f"`dW` drives white noise or a shaping filter; the {excitation.name} input is "
+                "synthesised from the seed (leave dW=None)"
+            )
+        driver = driven.SynthesisedInput(excitation, grid.n_steps, grid.dt, seed)
+    return Run(
+        harvester=harvester,
+        psd=getattr(excitation, "level", None),
+        excitation=excitation,
+        driver=driver,
+        scheme=scheme,
+        grid=grid,
+        n_paths=n_paths,
+        seed=seed,
+        first_path=check_int("first_path", first_path, 0, MAX_PATH_INDEX),
+        initial=InitialState.from_argument(initial),
+        record=RecordOptions.validated(*record),
+        dW=_checked_increments(dW, n_paths, grid.n_steps),
+        companion=bool(companion),
+    )
+
+
+def _simulated_excitation(psd) -> Excitation:
+    """``psd`` as an excitation that :func:`randvib.simulate` can drive, or a clear refusal.
+
+    White noise and the rational spectra with a 2-state shaping filter
+    (band-pass, Kanai-Tajimi) are integrated with the device; band-limited
+    and tabulated spectra are synthesised (:class:`~randvib.montecarlo.driven.SynthesisedInput`);
+    a measured record is simulated on the record itself by
+    :func:`randvib.simulate_on_record`.
+    """
+    if not isinstance(psd, Excitation):
+        return as_excitation(psd)  # one positive number (an array refused by name)
+    if psd.is_white:
+        return psd
+    if psd.name == "measured":
+        raise ValueError(
+            "simulate draws its own paths; to simulate the device on the measured record "
+            "itself use randvib.simulate_on_record(harvester, record, ...), for Gaussian "
+            "paths with the record's Welch PSD pass record.spectrum"
+        )
+    shaping = psd.shaping_filter()
+    if shaping is not None and (shaping.system.n_states != 2 or np.any(shaping.system.d != 0)):
+        raise ValueError(
+            f"simulate integrates shaping filters of 2 states without feed-through; the "
+            f"{psd.name} filter has {shaping.system.n_states}"
+        )
+    return psd
+
+
+def _checked_increments(dW, n_paths, n_steps):
+    """Given Brownian increments as a contiguous (n_paths, n_steps) array, or None."""
+    if dW is None:
+        return None
+    dW = np.ascontiguousarray(dW, dtype=float)
+    if dW.shape != (n_paths, n_steps):
+        raise ValueError(
+            f"`dW` must have shape (n_paths, n_steps) = {(n_paths, n_steps)}, got {dW.shape}"
+        )
+    if not np.all(np.isfinite(dW)):
+        raise ValueError("`dW` must be finite")
+    return dW
+
+
+def check_options(run: Run, control_variates: bool) -> None:
+    """Refuse the options that this run's input or circuit cannot honour, saying why."""
+    _check_coloured_options(run.excitation, run.companion, control_variates)
+    _check_circuit_options(run.harvester, run.companion)
+
+
+def _check_coloured_options(excitation: Excitation, companion: bool, control_variates: bool):
+    """Refuse the white-noise-only options under coloured input, saying why."""
+    if excitation.is_white:
+        return
+    if companion:
+        raise ValueError(
+            "`companion` needs white noise: the friction-free companion's exact moments "
+            f"(S m/(4c), Gibbs E[z^2]) do not hold under {excitation.name} excitation"
+        )
+    if control_variates and excitation.shaping_filter() is None:
+        raise ValueError(
+            "`control_variates` needs Brownian increments (white noise, or band-pass and "
+            "Kanai-Tajimi through their filter): under the synthesised or recorded "
+            f"{excitation.name} input the Ito sum is the input power, not a zero-mean control; "
+            "use control_variates=False"
+        )
+
+
+def _check_circuit_options(harvester: Harvester, companion: bool):
+    """Refuse the friction-free companion with a circuit state, saying why.
+
+    The energy-balance controls (the Ito integral, mean exactly zero; the
+    change of mechanical energy, zero in the stationary state) hold for any
+    coupling, so ``control_variates`` stays available.
+    """
+    if harvester.has_circuit and companion:
+        raise ValueError(
+            "`companion` needs the resistive coupling: its exact moments (S m/(4c), Gibbs "
+            f"E[z^2]) assume a viscous c_e, not the {harvester.electrical.name} coupling's "
+            "circuit state; use companion=False"
+        )
+
+
+def check_scales(run: Run, linear) -> None:
+    """Refuse parameters whose linearised scales are not finite float64 numbers.
+
+    Extreme values (m = 1e308, k3 = 1e308, S = 1e308) overflow the
+    step-size check and the stationary start; they are named here instead.
+    ``linear`` gives the run's
+    :class:`~randvib.montecarlo.step_check.LinearTestSystem` (built on first use).
+    """
+    h = run.harvester
+    try:
+        # quadrature warnings at such values would only precede the refusal
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            system = linear()
+            k_eff, c_eff = system.k_eff, system.c_eff
+            spread = system.spread
+    except (ArithmeticError, ValueError, np.linalg.LinAlgError) as exc:
+        problem = f"{type(exc).__name__}: {exc}"
+    else:
+        values = (k_eff, c_eff, *spread)
+        # the free mass has no stiffness and no stationary spread in z
+        positive = values[1:2] + values[3:] if h.potential.is_free else values
+        if all(np.isfinite(values)) and all(v > 0 for v in positive):
+            return
+        problem = f"k_eff = {k_eff:.3g}, c_eff = {c_eff:.3g}, std z, v = {spread}"
+    raise ValueError(
+        f"the device's linearised scales are not finite positive float64 numbers ({problem}) "
+        f"at psd = {run.psd!r} and {run.harvester.parameters()}: the parameters are out of "
+        "range, or the device has neither damping nor friction"
+    )
