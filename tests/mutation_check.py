@@ -343,7 +343,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="circuit-drive-in-kernel",
-        path="randvib/montecarlo/simulation.py",
+        path="randvib/montecarlo/kernel_setup.py",
         edits=(
             (
                 "a[n_filter, n_filter], b[n_filter], c[n_filter] = a_x, b_x, f / h.m",

@@ -32,11 +32,9 @@ from __future__ import annotations
 
 import functools
 import time
-from dataclasses import dataclass
 
 import numba
 import numpy as np
-from scipy import linalg
 
 from randvib._interrupts import interruptible
 from randvib._progress import progress_bar, progress_wanted
@@ -44,17 +42,13 @@ from randvib._resources import LONG_RUN_SECONDS, announce_duration, check_memory
 from randvib._validation import (
     check_int,
 )
-from randvib.analytic import exact_solutions as exact
-from randvib.analytic.statistical_linearisation import statistical_linearisation
 from randvib.models.excitation import Excitation
-from randvib.models.friction import kernel_arguments
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import driven, integrators, kernel
+from randvib.montecarlo.kernel_setup import KernelSetup
 from randvib.montecarlo.results import Histogram, Histories, SimulationResult
-from randvib.montecarlo.rng import ZIG_FI, ZIG_KI, ZIG_WI
 from randvib.montecarlo.step_check import (
     LinearTestSystem,
-    coarsened,
 )
 from randvib.montecarlo.validation import Run, check_options, check_scales, validated
 
@@ -74,7 +68,7 @@ PROBE_MARGIN = 30.0
 PROBE_PATH_STEPS = 3e6
 
 
-def _announce_long_run(run: Run, setup: _KernelSetup) -> None:
+def _announce_long_run(run: Run, setup: KernelSetup) -> None:
     """Say how long a long run will take, at the speed measured on this machine.
 
     A run that could be long (more than LONG_RUN_SECONDS / PROBE_MARGIN at the
@@ -97,7 +91,7 @@ def _announce_long_run(run: Run, setup: _KernelSetup) -> None:
         announce_duration(what, work / _measured_speed(run, setup, threads), stacklevel=5)
 
 
-def _measured_speed(run: Run, setup: _KernelSetup, threads: int) -> float:
+def _measured_speed(run: Run, setup: KernelSetup, threads: int) -> float:
     """Path-steps per second of this run's compiled loop on this machine (a timed probe)."""
     paths = min(run.n_paths, kernel.LANES * threads)
     steps = int(min(run.grid.n_steps, max(100, PROBE_PATH_STEPS * threads / paths)))
@@ -296,7 +290,7 @@ def execute(run: Run, *, control_variates, check_step, threads, batch_paths, pro
         check_scales(run, linear)
     if check_step:
         linear().check_step(run.scheme.name, run.grid.dt)
-    setup = _KernelSetup.prepare(run, linear)
+    setup = KernelSetup.prepare(run, linear)
     if threads is not None:
         threads = check_int("threads", threads, 1)
         numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
@@ -331,171 +325,8 @@ def execute(run: Run, *, control_variates, check_step, threads, batch_paths, pro
     )
 
 
-# ----------------------------------------------------------------- kernel set-up
-@dataclass(frozen=True)
-class _KernelSetup:
-    """The compiled loop's argument groups (:mod:`randvib.montecarlo.kernel`) for a run.
-
-    Everything but the paths, the noise and the number of recorded paths is
-    the same for every batch; :meth:`arguments` adds those for one batch.
-    """
-
-    scheme: tuple
-    device: kernel.Device
-    friction: kernel.Friction
-    timing: kernel.Timing
-    initial: kernel.Start
-    companion: kernel.Companion
-    recording: kernel.Recording
-    auxiliary: kernel.Auxiliary | None
-
-    @classmethod
-    def prepare(cls, run: Run, linear) -> _KernelSetup:
-        """The argument groups; ``linear()`` gives the run's :class:`LinearTestSystem`."""
-        h = run.harvester
-        # Given base-acceleration input arrives as velocity increments (m/s): amplitude 1.
-        amplitude = 1.0 if run.driver is not None else np.sqrt(run.psd / 2.0)
-        device = (h.m, h.c, h.k, h.k3, amplitude)
-        initial, companion = _start_states(run, linear)
-        return cls(
-            scheme=run.scheme.kernel_weights,
-            device=kernel.pack(kernel.Device, *device),
-            friction=kernel.pack(kernel.Friction, *kernel_arguments(h.friction)),
-            timing=kernel.pack(kernel.Timing, run.grid.dt, run.grid.n_steps, run.grid.n_burn),
-            initial=initial,
-            companion=companion,
-            recording=_recording(run, linear),
-            auxiliary=_auxiliary(run, linear),
-        )
-
-    def arguments(self, run: Run, lo: int, hi: int) -> dict:
-        """:func:`kernel.run_ensemble`'s keyword arguments for paths ``lo .. hi - 1``."""
-        n_record = max(0, min(run.record.record_paths - lo, hi - lo))
-        if run.driver is not None:
-            dw = run.driver(run.first_path + lo, hi - lo)
-        else:
-            dw = run.dW[lo:hi] if run.dW is not None else np.zeros((0, 0))
-        return dict(
-            scheme=self.scheme,
-            device=self.device,
-            friction=self.friction,
-            timing=self.timing,
-            paths=kernel.pack(kernel.Paths, run.seed, run.first_path + lo, hi - lo),
-            initial=self.initial,
-            companion=self.companion,
-            recording=self.recording._replace(n_record=n_record),
-            noise=kernel.Noise(dw, ZIG_KI, ZIG_WI, ZIG_FI),
-            auxiliary=self.auxiliary,
-        )
-
-
-def _auxiliary(run: Run, linear) -> kernel.Auxiliary | None:
-    """The kernel's linear auxiliary block: the excitation's filter and the circuit state.
-
-    None for white noise with a resistive (or no) circuit. The filter's states
-    (A, G, C: :class:`randvib.models.excitation.ShapingFilter`) come first, the
-    circuit's (``x' = a x + b v``, acceleration ``-(f/m) x``) last. With a
-    random start the filter alone starts from its exact stationary law N(0, P),
-    A P + P A^T + q G G^T = 0; with a circuit the block starts from its
-    marginal law under the linearised device (:meth:`LinearTestSystem.covariance`).
-    Synthesised or recorded input (``run.driver``) reaches the velocity as
-    given increments, like white noise: only a circuit needs the block, and it
-    starts from its statistical-linearisation variance under that input.
-    """
-    h, excitation = run.harvester, run.excitation
-    driven_input = run.driver is not None
-    if (excitation.is_white or driven_input) and not h.has_circuit:
-        return None
-    n = kernel.N_AUX
-    a, b, g, c, square = np.zeros((n, n)), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
-    n_filter = 0
-    if not (excitation.is_white or driven_input):
-        shaping = excitation.shaping_filter()
-        system = shaping.system
-        n_filter = system.n_states
-        a[:n_filter, :n_filter] = system.a
-        g[:n_filter] = system.b
-        c[:n_filter] = system.c[0]
-        q = shaping.noise_intensity
-        start = linalg.solve_continuous_lyapunov(system.a, -q * np.outer(system.b, system.b))
-    n_states = n_filter
-    if h.has_circuit:
-        a_x, b_x, f = h.electrical.circuit_equation()
-        a[n_filter, n_filter], b[n_filter], c[n_filter] = a_x, b_x, f / h.m
-        square[n_filter] = 1.0
-        n_states += 1
-        if driven_input:
-            start = np.array([[_driven_circuit_variance(h, excitation)]])
-        else:
-            cov = linear().covariance  # (filter, z, v, circuit)
-            keep = [*range(n_filter), cov.shape[0] - 1]
-            start = cov[np.ix_(keep, keep)]
-    chol = np.zeros((n, n))
-    chol[:n_states, :n_states] = np.linalg.cholesky(start)
-    # white noise (or the given increments) drives the velocity itself
-    gain = 1.0 if excitation.is_white or driven_input else 0.0
-    coefficients = np.concatenate([a.ravel(), b, g, c, [gain]])
-    return kernel.pack(kernel.Auxiliary, n_states, coefficients, square, chol)
-
-
-def _driven_circuit_variance(harvester: Harvester, excitation: Excitation) -> float:
-    """E[x^2] of the circuit state under synthesised or recorded input, for the random start.
-
-    Statistical linearisation under the (coarsened) spectrum; a friction law
-    with memory is left out (it only adds damping, and the burn-in corrects
-    the start).
-    """
-    h = harvester
-    if h.friction is not None and not h.friction.has_equivalent_damping:
-        h = h.updated(friction=None)
-    return float(statistical_linearisation(h, coarsened(excitation)).circuit_variance)
-
-
-def _start_states(run: Run, linear) -> tuple[kernel.Start, kernel.Companion]:
-    """Initial states of the device and of its friction-free companion."""
-    h, psd = run.harvester, run.psd
-    random = run.initial.kind == "stationary"
-    z, v = linear().spread if random else (run.initial.z, run.initial.v)
-    # The friction-free companion starts from its own stationary spread (exact
-    # Gaussian velocity, Gibbs displacement variance), so its known moments
-    # hold from t = 0 and its control mean is right without a long burn-in.
-    comp_z, comp_v = z, v
-    if run.companion and random and h.c > 0:
-        comp_v = float(np.sqrt(exact.linear_velocity_variance(h.m, h.c, psd)))
-        comp_z = float(np.sqrt(exact.gibbs_displacement_moment(h.m, h.c, h.k, h.k3, psd)))
-        if h.friction is None or h.friction.vanishes:  # the device is its own companion
-            z, v = comp_z, comp_v
-    return (
-        kernel.pack(kernel.Start, random, z, v),
-        kernel.pack(kernel.Companion, run.companion, comp_z, comp_v),
-    )
-
-
-def _recording(run: Run, linear) -> kernel.Recording:
-    """Histogram ranges and bins (default ranges +-5 linearised std); records per batch.
-
-    The free mass's z spreads like a random walk: its default range is
-    +-5 sqrt(2 sigma_v^2 (m/c_eff) t_end), five times the walk's spread at the end.
-    """
-    bins = run.record.histogram_bins
-    if bins == 0:
-        lo, hi = np.zeros(2), np.ones(2)  # unused
-    else:
-        ranges = run.record.histogram_range
-        if ranges is None:
-            sz, sv = linear().spread
-            if run.harvester.potential.is_free:
-                c_eff = linear().c_eff
-                sz = sv * np.sqrt(2.0 * run.harvester.m / c_eff * run.grid.t_end)
-            ranges = ((-5 * sz, 5 * sz), (-5 * sv, 5 * sv))
-        arr = np.asarray(ranges, dtype=float)
-        lo, hi = arr[:, 0], arr[:, 1]
-    stroke = np.inf if run.harvester.stroke is None else run.harvester.stroke
-    return kernel.pack(kernel.Recording, lo, hi, bins, 0, run.record.record_every, stroke)
-
-
 # ----------------------------------------------------------------- compiled calls
-def _run_batches(run: Run, setup: _KernelSetup, batches, progress: bool):
+def _run_batches(run: Run, setup: KernelSetup, batches, progress: bool):
     """Run the compiled loop batch by batch.
 
     Returns
