@@ -579,9 +579,9 @@ def test_long_run_estimate_follows_the_measured_speed(monkeypatch, probe_seconds
     import warnings
 
     from randvib._resources import LongRunWarning, duration_text
-    from randvib.montecarlo import kernel, simulation
+    from randvib.montecarlo import kernel, resources
 
-    monkeypatch.setattr(simulation, "PATH_STEPS_PER_SECOND", 1.0)  # a run that could be long
+    monkeypatch.setattr(resources, "PATH_STEPS_PER_SECOND", 1.0)  # a run that could be long
     monkeypatch.setattr(_resources, "clock", _probe_clock(probe_seconds))
     n_paths, n_steps = 4, 500
     with warnings.catch_warnings(record=True) as caught:
