@@ -31,8 +31,9 @@ from scipy import special, stats
 import randvib as rv
 from randvib.analytic import exact_solutions as exact
 from randvib.montecarlo import integrators
+from randvib.montecarlo.batches import SimulationDivergedError
 from randvib.montecarlo.integrators import INTEGRATORS
-from randvib.montecarlo.simulation import SimulationDivergedError, simulate
+from randvib.montecarlo.simulation import simulate
 from randvib.montecarlo.step_check import StepSizeWarning
 from randvib.statistics import estimate
 

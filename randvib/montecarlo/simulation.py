@@ -34,27 +34,22 @@ import functools
 import time
 
 import numba
-import numpy as np
 
-from randvib._interrupts import interruptible
-from randvib._progress import progress_bar, progress_wanted
+from randvib._progress import progress_wanted
 from randvib._validation import (
     check_int,
 )
 from randvib.models.excitation import Excitation
 from randvib.models.harvester import Harvester
-from randvib.montecarlo import driven, integrators, kernel
+from randvib.montecarlo import driven, integrators
+from randvib.montecarlo.batches import batch_bounds, run_batches
 from randvib.montecarlo.kernel_setup import KernelSetup
 from randvib.montecarlo.resources import announce_long_run, check_resources
-from randvib.montecarlo.results import Histogram, Histories, SimulationResult
+from randvib.montecarlo.results import SimulationResult
 from randvib.montecarlo.step_check import (
     LinearTestSystem,
 )
 from randvib.montecarlo.validation import Run, check_options, check_scales, validated
-
-
-class SimulationDivergedError(ValueError):
-    """The state became non-finite during a simulation."""
 
 
 # ----------------------------------------------------------------- simulate
@@ -229,11 +224,11 @@ def execute(run: Run, *, control_variates, check_step, threads, batch_paths, pro
         progress = progress_wanted()
     if batch_paths is None and run.driver is not None:  # the input's memory stays bounded
         batch_paths = driven.batch_paths(run.grid.n_steps)
-    batches = _batches(
+    batches = batch_bounds(
         run.n_paths, batch_paths, run.grid.n_steps, progress, run.record.record_paths
     )
     started = time.perf_counter()
-    per_path, hist_groups, records = _run_batches(run, setup, batches, progress)
+    per_path, histogram, histories = run_batches(run, setup, batches, progress)
     wall = time.perf_counter() - started
     return SimulationResult(
         harvester=run.harvester,
@@ -246,89 +241,8 @@ def execute(run: Run, *, control_variates, check_step, threads, batch_paths, pro
         first_path=run.first_path,
         per_path=per_path,
         control_variates=control_variates,
-        histogram=_histogram(setup.recording, hist_groups, batches, run.grid.window_steps),
-        histories=None
-        if records is None
-        else Histories.from_records(records, run.record.record_every, run.grid.dt),
+        histogram=histogram,
+        histories=histories,
         wall_time=wall,
         excitation=run.excitation,
     )
-
-
-# ----------------------------------------------------------------- compiled calls
-def _run_batches(run: Run, setup: KernelSetup, batches, progress: bool):
-    """Run the compiled loop batch by batch.
-
-    Returns
-    -------
-    per_path : ndarray, shape (n_paths, N_ACC)
-        Per-path time averages.
-    hist_groups : ndarray of int64, shape (n_groups, 2, bins)
-        Histogram counts of z and v per chunk of paths, batches in order.
-    records : ndarray or None
-        Recorded histories of the first paths (from the first batch).
-    """
-    per_path = np.empty((run.n_paths, kernel.N_ACC))
-    hist_groups = []
-    records = None
-    bar = None
-    if progress:
-        bar = progress_bar(run.n_paths, desc="simulate", unit="path", transient=True)
-    try:
-        for lo, hi in batches:
-            acc, failed, hist, rec = interruptible(
-                kernel.run_ensemble, **setup.arguments(run, lo, hi)
-            )
-            _raise_if_diverged(run, lo, failed)
-            per_path[lo:hi] = acc
-            if run.record.histogram_bins > 0:
-                hist_groups.append(hist)
-            if lo == 0 and run.record.record_paths > 0:
-                records = rec
-            if bar is not None:
-                bar.update(hi - lo)
-    finally:
-        if bar is not None:
-            bar.close()
-    hist_groups = np.concatenate(hist_groups) if hist_groups else None
-    return per_path, hist_groups, records
-
-
-def _raise_if_diverged(run: Run, lo: int, failed: np.ndarray) -> None:
-    bad = np.flatnonzero(failed >= 0)
-    if bad.size:
-        p = bad[0]
-        dt = run.grid.dt
-        raise SimulationDivergedError(
-            f"simulation diverged: path {run.first_path + lo + p} became non-finite by step "
-            f"{failed[p]} (t = {failed[p] * dt:.6g} s) with dt = {dt!r} s, "
-            f"scheme {run.scheme.name}, psd = {run.psd!r}, "
-            f"parameters {run.harvester.parameters()}"
-        )
-
-
-def _batches(n_paths, batch_paths, n_steps, progress, record_paths):
-    if batch_paths is None:
-        if progress:
-            # about 1e8 path-steps per call: a second or so, for a live bar
-            batch_paths = max(kernel.LANES * numba.get_num_threads(), int(1e8 // max(n_steps, 1)))
-        else:
-            batch_paths = n_paths
-    batch_paths = check_int("batch_paths", batch_paths, 1)
-    batch_paths = max(batch_paths, min(record_paths, n_paths))  # records come from batch 0
-    edges = list(range(0, n_paths, batch_paths)) + [n_paths]
-    return list(zip(edges[:-1], edges[1:], strict=True))
-
-
-# ----------------------------------------------------------------- result assembly
-
-
-def _histogram(recording: kernel.Recording, groups, batches, window_steps: int):
-    """The run's :class:`Histogram` (None without bins)."""
-    if recording.hist_bins == 0:
-        return None
-    # The kernel's chunks: LANES paths each, the last of each batch possibly fewer.
-    sizes = [
-        min(kernel.LANES, hi - start) for lo, hi in batches for start in range(lo, hi, kernel.LANES)
-    ]
-    return Histogram.from_counts(recording, groups, sizes, window_steps)
