@@ -26,6 +26,21 @@ Each path is an independent realisation; statistics are time averages over
 the window [burn_in, t_end) on each path, and their confidence intervals come
 from the spread between paths (independent by construction), so they do not
 depend on any assumption about correlation times.
+
+:func:`simulate` is the driver (:func:`execute` for an already validated
+run); the parts it orchestrates each have their module:
+
+* :mod:`~randvib.montecarlo.validation` - the arguments checked and grouped
+  into a :class:`~randvib.montecarlo.validation.Run`; the run options
+  (time grid, initial state, recording) in :mod:`~randvib.montecarlo.options`;
+* :mod:`~randvib.montecarlo.resources` - the memory check and the long-run
+  announcement;
+* :mod:`~randvib.montecarlo.kernel_setup` - the compiled loop's arguments:
+  device, friction, start, auxiliary block (filter, circuit), recording;
+* :mod:`~randvib.montecarlo.batches` - the compiled calls, interruptible,
+  batch by batch;
+* :mod:`~randvib.montecarlo.results` - :class:`SimulationResult` and its
+  statistics, histograms and recorded paths.
 """
 
 from __future__ import annotations
@@ -36,9 +51,7 @@ import time
 import numba
 
 from randvib._progress import progress_wanted
-from randvib._validation import (
-    check_int,
-)
+from randvib._validation import check_int
 from randvib.models.excitation import Excitation
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import driven, integrators
@@ -46,13 +59,10 @@ from randvib.montecarlo.batches import batch_bounds, run_batches
 from randvib.montecarlo.kernel_setup import KernelSetup
 from randvib.montecarlo.resources import announce_long_run, check_resources
 from randvib.montecarlo.results import SimulationResult
-from randvib.montecarlo.step_check import (
-    LinearTestSystem,
-)
+from randvib.montecarlo.step_check import LinearTestSystem
 from randvib.montecarlo.validation import Run, check_options, check_scales, validated
 
 
-# ----------------------------------------------------------------- simulate
 def simulate(
     harvester: Harvester,
     psd: float | Excitation,
@@ -203,7 +213,11 @@ def simulate(
 
 
 def execute(run: Run, *, control_variates, check_step, threads, batch_paths, progress):
-    """Run a validated :class:`~randvib.montecarlo.validation.Run` (see :func:`simulate` for the options)."""
+    """Run a validated :class:`~randvib.montecarlo.validation.Run`: check, set up, run, wrap.
+
+    The options are :func:`simulate`'s; :func:`randvib.simulate_on_record`
+    calls this with its own run (the record as the input).
+    """
     check_options(run, control_variates)
     # refusals before advice: a run that cannot fit is refused before any step warning
     check_resources(run, batch_paths)
