@@ -351,7 +351,7 @@ class SimulationResult:
             control_variates=self.control_variates,
             wall_time=self.wall_time,
         )
-        # Added with coloured input (issue 10); `psd` stays the level S.
+        # the input in full (a coloured one has more than a level); `psd` stays the level S
         excitation = self.excitation or as_excitation(self.psd)
         out["excitation"] = excitation.parameters()
         return out
