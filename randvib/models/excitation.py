@@ -40,7 +40,7 @@ the band excludes zero frequency.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 from scipy import signal
@@ -282,6 +282,11 @@ class Excitation:
         """Stationary Gaussian paths of the base acceleration (m/s^2), see :func:`synthesise`."""
         return synthesise(self, duration, dt, n_paths, seed)
 
+    def scaled(self, factor: float) -> Excitation:
+        """The same spectrum with its PSD multiplied by ``factor`` (> 0): the level times it."""
+        factor = float(check_positive("factor", factor))
+        return replace(self, level=self.level * factor)
+
     def parameters(self) -> dict:
         """The excitation's name and parameters (SI units), ready for JSON."""
         out = {"excitation": self.name}
@@ -312,6 +317,11 @@ def as_excitation(value) -> Excitation:
     """An :class:`Excitation` as is; a number S as white noise ``White(S)``."""
     if isinstance(value, Excitation):
         return value
+    if getattr(value, "is_event", False):
+        raise ValueError(
+            f"the {value.name} event is not stationary: its transient response is computed by "
+            "randvib.simulate_transient (Monte Carlo) and randvib.transient_response (analytic)"
+        )
     # an array of levels is refused by name here (float() would fail with numpy's
     # own words); predict, expected_power and equivalent_damping take arrays
     value = check_scalar("psd", value, f"a white-noise level S in {_PSD_UNIT}", BROADCASTING)
@@ -609,10 +619,14 @@ class Tabulated(Excitation):
         object.__setattr__(self, "frequency", f)
         object.__setattr__(self, "density", p)
 
+    def scaled(self, factor: float) -> Tabulated:
+        factor = float(check_positive("factor", factor))
+        return Tabulated(self.frequency, self.density * factor)
+
     @classmethod
     def from_csv(cls, path) -> Tabulated:
         """Read a table with the columns ``frequency`` (Hz) and ``psd`` ((m/s^2)^2/Hz)."""
-        frame = _read_columns(path, ("frequency", "psd"))
+        frame = read_columns(path, ("frequency", "psd"))
         return cls(frame["frequency"], frame["psd"])
 
     def psd(self, frequency):
@@ -733,10 +747,15 @@ class Measured(Excitation):
         object.__setattr__(self, "segment_length", length)
         object.__setattr__(self, "spectrum", Tabulated(f, p))
 
+    def scaled(self, factor: float) -> Measured:
+        """The record's acceleration times sqrt(factor): its PSD times ``factor``."""
+        factor = float(check_positive("factor", factor))
+        return Measured(self.time, self.acceleration * np.sqrt(factor), self.segment_length)
+
     @classmethod
     def from_csv(cls, path, segment_length: int | None = None) -> Measured:
         """Read a record with the columns ``time`` (s) and ``base_acceleration`` (m/s^2)."""
-        frame = _read_columns(path, ("time", "base_acceleration"))
+        frame = read_columns(path, ("time", "base_acceleration"))
         return cls(frame["time"], frame["base_acceleration"], segment_length)
 
     @property
@@ -785,7 +804,8 @@ class Measured(Excitation):
         )
 
 
-def _read_columns(path, columns) -> dict:
+def read_columns(path, columns) -> dict:
+    """The named ``columns`` of a CSV file as float arrays; a missing one is named."""
     import pandas as pd
 
     frame = pd.read_csv(path)
