@@ -149,3 +149,32 @@ def html_table(title: str, rows, note: str = "") -> str:
         "<thead><tr><th>quantity</th><th>value</th><th>unit</th></tr></thead>"
         f"<tbody>{body}</tbody></table>"
     )
+
+
+def time_table(title: str, headers, rows, note: str = "") -> str:
+    """A time-resolved table (one row per time, cells already text) under ``title``."""
+    from tabulate import tabulate
+
+    body = tabulate(rows, headers=headers, disable_numparse=True, stralign="right")
+    lines = [title, body]
+    if note:
+        lines.append(f"({note})")
+    return "\n".join(lines)
+
+
+def time_html_table(title: str, headers, rows, note: str = "") -> str:
+    """:func:`time_table` as a small HTML table (Jupyter's ``_repr_html_``)."""
+    head = "".join(f"<th>{html.escape(h)}</th>" for h in headers)
+    body = "".join(
+        "<tr>"
+        + "".join(f"<td style='text-align:right'>{html.escape(c)}</td>" for c in row)
+        + "</tr>"
+        for row in rows
+    )
+    caption = f"<b>{html.escape(title)}</b>"
+    if note:
+        caption += f"<br><small>{html.escape(note)}</small>"
+    return (
+        f"<table><caption style='text-align:left'>{caption}</caption>"
+        f"<thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+    )
