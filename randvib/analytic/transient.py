@@ -30,7 +30,8 @@ moment equations). It needs a zero-mean response: a start at z = 0, z' = 0
 closure cannot follow; use Monte Carlo there). Friction with memory (LuGre)
 is refused, as in the stationary closure.
 
-The equations are integrated with scipy's DOP853 at rtol = 1e-10 and
+The equations are integrated with scipy's DOP853 (LSODA with friction,
+whose closure is stiff where the motion is small) at rtol = 1e-10 and
 absolute tolerances 1e-14 of each entry's scale (from a stationary
 reference solution), segment by segment between the envelope's kinks, so
 the moments are accurate to about 1e-9 relative (1e-6 is checked against
@@ -70,6 +71,9 @@ from randvib.models.potential import CONFINING
 RTOL = 1e-10
 #: Absolute tolerance of each entry, relative to its stationary reference scale.
 ATOL_SCALE = 1e-14
+#: Velocity spread (relative to its scale) below which the closure's friction
+#: damping is held at its value there (:func:`_equivalent`).
+VELOCITY_FLOOR = 1e-6
 #: Points on which the default time grid reports the response.
 DEFAULT_TIMES = 201
 
@@ -141,16 +145,25 @@ class EventSystem:
         return a, b
 
 
-def _equivalent(harvester: Harvester, friction):
-    """(c_eq, k_eq) of the Gaussian closure as a function of (E[z^2], E[v^2])."""
+def _equivalent(harvester: Harvester, friction, velocity_floor: float = 0.0):
+    """(c_eq, k_eq) of the Gaussian closure as a function of (E[z^2], E[v^2]).
+
+    E[v F(v)] / E[v^2] grows like 1/sigma_v for Coulomb friction as the
+    velocity's spread vanishes (its products with the covariances stay
+    bounded by sigma_v): from rest the closure is stiff without end. Below
+    ``velocity_floor`` (m/s) the increment is that at the floor, which the
+    solver can follow; the floor is 1e-6 of the velocity's scale, where the
+    response is a millionth of its size and the friction term's error is
+    below the tolerance.
+    """
     c, k, k3 = (float(x) for x in (harvester.c, harvester.k, harvester.k3))
 
     def equivalent(z2: float, v2: float) -> tuple[float, float]:
         c_eq = c
-        # E[v F(v)] / E[v^2] ~ 1/sigma for Coulomb, but its product with any
-        # covariance of v is bounded by sigma: at sigma = 0 the term is 0
-        if friction is not None and v2 > 0:
-            c_eq += float(friction.equivalent_damping_increment(np.sqrt(v2)))
+        if friction is not None:
+            sigma = max(np.sqrt(max(v2, 0.0)), velocity_floor)
+            if sigma > 0:
+                c_eq += float(friction.equivalent_damping_increment(sigma))
         return c_eq, k + 3.0 * k3 * z2
 
     return equivalent
@@ -209,17 +222,22 @@ class _Solution:
         return np.unique(np.concatenate(ts))
 
 
-def _solve(system, harvester, event, start, t_end, equivalent, nonlinear) -> _Solution:
-    """Integrate the mean, covariance and the energy integrals from 0 to ``t_end``."""
+def _solve(system, event, mu0, scales, t_end, equivalent, nonlinear, stiff) -> _Solution:
+    """Integrate the mean, covariance and the energy integrals from 0 to ``t_end``.
+
+    ``mu0`` is the start's mean, ``scales`` each state's reference scale
+    (:func:`_reference_scales`) for the absolute tolerances. With friction
+    (``stiff``) the closure's damping grows without bound as the motion
+    starts from rest or dies out after the event (:func:`_equivalent`), so
+    the system is stiff there: LSODA (which switches to BDF where it is),
+    else DOP853.
+    """
     n = system.n
     iz, iv, ix = system.iz, system.iv, system.ix
     envelope = event.envelope
     p0 = np.zeros((n, n))
     nf = system.n_filter
     p0[:nf, :nf] = system.filter_covariance
-    mu0 = np.zeros(n)
-    mu0[iz], mu0[iv] = start.z, start.v
-    scales = _reference_scales(system, harvester, t_end, mu0)
     pair = np.outer(scales, scales)
     atol = ATOL_SCALE * np.concatenate(
         [
@@ -257,7 +275,7 @@ def _solve(system, harvester, event, start, t_end, equivalent, nonlinear) -> _So
             rhs_in(lo, hi),
             (lo, hi),
             y,
-            method="DOP853",
+            method="LSODA" if stiff else "DOP853",
             rtol=RTOL,
             atol=atol,
             dense_output=True,
@@ -365,8 +383,13 @@ def transient_response(
     friction, linear = _check(harvester, event, start)
     times, t_end = _times(times, t_end)
     system = EventSystem(harvester, event)
-    equivalent = _equivalent(harvester, friction)
-    solution = _solve(system, harvester, event, start, t_end, equivalent, not linear)
+    mean = np.zeros(system.n)
+    mean[system.iz], mean[system.iv] = start.z, start.v
+    scales = _reference_scales(system, harvester, t_end, mean)
+    equivalent = _equivalent(harvester, friction, VELOCITY_FLOOR * scales[system.iv])
+    solution = _solve(
+        system, event, mean, scales, t_end, equivalent, not linear, stiff=friction is not None
+    )
     return TransientPrediction._from_solution(
         "lyapunov" if linear else "linearisation",
         harvester,
