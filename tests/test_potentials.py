@@ -435,7 +435,10 @@ def test_cli_simulate_reports_the_stroke_statistics_of_the_api(capsys):
     [
         (["power", *DEVICE, "--k", 10, "--k3", "-5e5"], "is not confining"),
         (["power", *DEVICE, "--k", -10, "--method", "fpk"], "needs a confining potential"),
-        (["power", *DEVICE, "--k", KB, "--k3", 5e5, "--method", "averaging"], "'fpk-fast'"),
+        (
+            ["power", *DEVICE, "--k", KB, "--k3", 5e5, "--method", "averaging"],
+            "`--method fpk-fast`",
+        ),
         (["power", *DEVICE, "--k", 25, "--stroke", -0.01], "`--stroke` must be > 0"),
         (
             ["power", *DEVICE, "--k", 25, "--stroke", 0.01, "--method", "averaging"],
