@@ -564,5 +564,6 @@ class Averaging(AnalyticMethod):
         )
 
 
-#: The method's declaration, which the functions of this module check their input against.
+#: The method's declaration, which the functions of this module check their input against
+#: (:data:`randvib.analytic.prediction.METHODS` holds it).
 AVERAGING = Averaging()

@@ -867,6 +867,7 @@ class FokkerPlanck(AnalyticMethod):
         return PowerPrediction.from_white_noise(harvester, self.name, vv, zz, av, psd, beyond)
 
 
-#: The methods' declarations, which the functions of this module check their input against.
+#: The methods' declarations, which the functions of this module check their input against
+#: (:data:`randvib.analytic.prediction.METHODS` holds them).
 FAST_FOKKER_PLANCK = FastFokkerPlanck()
 FOKKER_PLANCK = FokkerPlanck()

@@ -121,7 +121,7 @@ class AnalyticMethod:
     friction_form: str = "memoryless"
     #: Gives P(|z| > stroke) for a harvester with a stroke.
     stroke_exceedance: bool = False
-    #: A slow reference solver (about a second a point): not for every sweep point.
+    #: A slow reference solver (about half a second a point): not for every sweep point.
     reference: bool = False
     #: Its declared validity limits.
     validity: tuple[Validity, ...] = ()
@@ -144,7 +144,7 @@ class AnalyticMethod:
         From the declarations alone, without computing: a method that accepts
         may still refuse a point beyond a validity limit it refuses at.
         """
-        return self._reason(harvester, psd, self.called) is None
+        return self._reason(harvester, psd, "") is None
 
     def refusal(self, harvester: Harvester, psd, who: str | None = None) -> str | None:
         """Why it does not take the case, as one line naming the methods that do; or None.
@@ -197,11 +197,7 @@ class AnalyticMethod:
         # imports, import this module, so it is looked up when a refusal is written.
         from randvib.analytic.prediction import METHODS
 
-        names = [
-            name
-            for name, method in METHODS.items()
-            if name != self.name and method._reason(harvester, psd, "") is None
-        ]
+        names = [name for name, method in METHODS.items() if method.accepts(harvester, psd)]
         return " or ".join([f"method={name!r}" for name in names] + [MONTE_CARLO])
 
     # ------------------------------------------------------------ computing

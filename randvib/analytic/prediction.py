@@ -29,11 +29,11 @@ from randvib._validation import (
     check_scalar,
     check_scalar_device,
 )
-from randvib.analytic.averaging import Averaging
-from randvib.analytic.fokker_planck import FastFokkerPlanck, FokkerPlanck
+from randvib.analytic.averaging import AVERAGING
+from randvib.analytic.fokker_planck import FAST_FOKKER_PLANCK, FOKKER_PLANCK
 from randvib.analytic.method import AnalyticMethod, non_white, white_level
 from randvib.analytic.power_prediction import PowerPrediction
-from randvib.analytic.statistical_linearisation import Linearisation
+from randvib.analytic.statistical_linearisation import LINEARISATION
 from randvib.models.excitation import BROADCASTING, Excitation
 from randvib.models.harvester import Harvester
 
@@ -48,8 +48,7 @@ from randvib.models.harvester import Harvester
 #: and Richardson extrapolation, fast enough for sweeps; ``"fpk"``: the same
 #: equation on fine grids, the slow reference (:mod:`randvib.analytic.fokker_planck`).
 METHODS: dict[str, AnalyticMethod] = {
-    method.name: method
-    for method in (Linearisation(), Averaging(), FastFokkerPlanck(), FokkerPlanck())
+    method.name: method for method in (LINEARISATION, AVERAGING, FAST_FOKKER_PLANCK, FOKKER_PLANCK)
 }
 
 

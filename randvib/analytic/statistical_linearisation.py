@@ -379,6 +379,10 @@ class Linearisation(AnalyticMethod):
         )
 
 
+#: The method's declaration (:data:`randvib.analytic.prediction.METHODS` holds it).
+LINEARISATION = Linearisation()
+
+
 def _state(harvester: Harvester, outputs: dict):
     """The circuit state's entry of ``outputs`` (variance or PSD), or None without one."""
     return outputs[harvester.electrical.state_name] if harvester.has_circuit else None
