@@ -194,8 +194,14 @@ def test_validity_limits_are_declared_with_the_limits_the_methods_use():
     with pytest.warns(AveragingValidityWarning, match=f"exceeds {AVERAGING_ZETA_LIMIT}"):
         rv.predict(heavy, S, "averaging")
     deep = device(k=-np.sqrt(4.0 * K3 * 20.0 * S * M * M / (4.0 * C)))  # barrier 20 m E[v^2]
-    with pytest.raises(ValueError, match=f"barrier of {FAST_MAX_BARRIER:g} m E"):
+    refusal = (
+        f"method='fpk-fast' treats double wells with friction up to a barrier of "
+        f"{FAST_MAX_BARRIER:g} m E[v^2]; this one is 20 m E[v^2] deep (its one-well corrections "
+        "fail there): use method='linearisation' or method='fpk' or Monte Carlo (randvib.simulate)"
+    )
+    with pytest.raises(ValueError) as raised:
         rv.predict(deep, S, "fpk-fast")
+    assert str(raised.value) == refusal
 
 
 # ------------------------------------------------------- the one linearisation route

@@ -491,6 +491,6 @@ def test_fast_fpk_power_for_deeper_double_wells_with_friction(barrier):
 def test_fast_fpk_refuses_a_double_well_with_friction_beyond_its_depth():
     """Beyond 12 T (194 % off at 32 T in the devices study) fpk-fast refuses, naming fpk."""
     h = device(bistable_k(20.0), friction=rv.Coulomb(fc=0.0058))
-    with pytest.raises(ValueError, match="use `method` 'fpk'"):
+    with pytest.raises(ValueError, match="^method='fpk-fast' treats double wells.*use .*'fpk'"):
         rv.predict(h, S, "fpk-fast")
     assert rv.predict(device(bistable_k(20.0)), S, "fpk-fast").power_electrical > 0  # no friction

@@ -748,7 +748,9 @@ def fast_fpk_moments(harvester: Harvester, psd, *, nz=FAST_NZ, nv=FAST_NV):
         if point.k == 0 and point.k3 == 0:
             moments = _free_mass_point(point)
         else:
-            _refuse_deep_wells_with_friction(point)
+            too_deep = _too_deep_with_friction(point)
+            if too_deep is not None:
+                raise FAST_FOKKER_PLANCK.beyond_validity(harvester, psd, too_deep)
             moments = _fast_point(point, nzs, nvs, harvester.stroke)
         out[(slice(None),) + index] = moments
     return tuple(scalar_or_array(o) for o in out)
@@ -762,20 +764,19 @@ def fast_fpk_moments(harvester: Harvester, psd, *, nz=FAST_NZ, nv=FAST_NV):
 FAST_MAX_BARRIER = 12.0
 
 
-def _refuse_deep_wells_with_friction(point) -> None:
-    """Refuse a double well with friction deeper than :data:`FAST_MAX_BARRIER`."""
+def _too_deep_with_friction(point) -> str | None:
+    """Why fpk-fast refuses a double well with friction deeper than :data:`FAST_MAX_BARRIER`, or None."""
     if not (point.k < 0 < point.k3 and point.fcm > 0 and point.gamma > 0):
-        return
+        return None
     barrier = point.k**2 / (4.0 * point.k3)
     scale = point.m * point.dd / (2.0 * point.gamma)  # m E[v^2] = m S m / (4 c), per kg
     depth = barrier / scale
-    if depth > FAST_MAX_BARRIER:
-        raise ValueError(
-            f"`method` 'fpk-fast' treats double wells with friction up to a barrier of "
-            f"{FAST_MAX_BARRIER:g} m E[v^2]; this one is {depth:.3g} m E[v^2] deep (its "
-            "one-well corrections fail there): use `method` 'fpk' (reference) or Monte Carlo "
-            "(randvib.simulate)"
-        )
+    if depth <= FAST_MAX_BARRIER:
+        return None
+    return (
+        f"treats double wells with friction up to a barrier of {FAST_MAX_BARRIER:g} m E[v^2]; "
+        f"this one is {depth:.3g} m E[v^2] deep (its one-well corrections fail there)"
+    )
 
 
 def _grid_pair(name, value):

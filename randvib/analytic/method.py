@@ -160,6 +160,13 @@ class AnalyticMethod:
         if refusal is not None:
             raise ValueError(refusal)
 
+    def beyond_validity(self, harvester: Harvester, psd, reason: str) -> ValueError:
+        """The refusal of an accepted case beyond a validity limit the method refuses at.
+
+        One line: ``method='NAME' {reason}: use`` the other methods that take the case.
+        """
+        return ValueError(f"{self.called} {reason}: use {self._alternatives(harvester, psd)}")
+
     @property
     def called(self) -> str:
         """``method='NAME'``: how refusals name it (the CLI shows ``--method NAME``)."""
@@ -197,7 +204,11 @@ class AnalyticMethod:
         # imports, import this module, so it is looked up when a refusal is written.
         from randvib.analytic.prediction import METHODS
 
-        names = [name for name, method in METHODS.items() if method.accepts(harvester, psd)]
+        names = [
+            name
+            for name, method in METHODS.items()
+            if name != self.name and method.accepts(harvester, psd)
+        ]
         return " or ".join([f"method={name!r}" for name in names] + [MONTE_CARLO])
 
     # ------------------------------------------------------------ computing
