@@ -183,8 +183,8 @@ def point_device(base: Harvester, point: Mapping) -> Harvester:
 
 def _analytic(device: Harvester, psd: float) -> dict:
     out = {}
-    for name in METHODS:
-        if name == "fpk":  # reference solver: too slow to run at every sweep point
+    for name, method in METHODS.items():
+        if method.reference:  # too slow to run at every sweep point
             continue
         try:
             out[f"{name}_power"] = float(predict(device, psd, name).power_electrical)
