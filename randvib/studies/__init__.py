@@ -1,6 +1,7 @@
 """Building blocks for studies, and the finder of the study scripts.
 
-A study is a short script in the ``studies/`` folder of a randvib checkout,
+A study is a short script in the top-level ``studies/`` folder, installed with
+the package as :mod:`randvib.study_scripts` (a packaging mapping, no copies),
 written against the public API the way a user would write their own sweep:
 compute (a sweep, contrasts), tables, figures, a report with verdicts. What
 such scripts share lives here:
@@ -41,8 +42,9 @@ from pathlib import Path
 from randvib._interrupts import interrupted_exit, sigterm_stops
 from randvib._validation import MAX_SEED, integer_option
 
-#: Where the study scripts are: ``studies/`` beside the package in a checkout.
-STUDIES_DIR = Path(__file__).resolve().parents[2] / "studies"
+#: The package of the study scripts: the top-level ``studies/`` folder, which
+#: pyproject.toml installs as this subpackage.
+SCRIPTS_PACKAGE = "randvib.study_scripts"
 
 #: The registered studies (``randvib study NAME``), each ``studies/NAME.py`` with
 #: dashes as underscores.
@@ -58,39 +60,49 @@ STUDIES = (
 )
 
 
+def _scripts_package():
+    """:mod:`randvib.study_scripts`, from the ``studies/`` folder that belongs to this randvib.
+
+    An install (wheel, ``pip install .`` or editable) maps the folder into the
+    package. A source tree imported without installing it (``PYTHONPATH``, a
+    scratch copy of the project) has the folder beside the package instead;
+    that one is taken first, so the scripts always come with the package
+    they were written for, never from another checkout's install.
+    """
+    if SCRIPTS_PACKAGE in sys.modules:
+        return sys.modules[SCRIPTS_PACKAGE]
+    beside = Path(__file__).resolve().parents[2] / "studies"
+    if not (beside / "__init__.py").is_file():
+        return importlib.import_module(SCRIPTS_PACKAGE)
+    spec = importlib.util.spec_from_file_location(
+        SCRIPTS_PACKAGE, beside / "__init__.py", submodule_search_locations=[str(beside)]
+    )
+    package = importlib.util.module_from_spec(spec)
+    sys.modules[SCRIPTS_PACKAGE] = package
+    try:
+        spec.loader.exec_module(package)
+    except BaseException:
+        del sys.modules[SCRIPTS_PACKAGE]
+        raise
+    sys.modules["randvib"].study_scripts = package  # as an import would set it
+    return package
+
+
 def load(name: str):
-    """The module of the study script ``name`` (loaded once, then the same object).
+    """The module of the study script ``name``: ``randvib.study_scripts.NAME``.
+
+    Imported once, then the same object (a test's monkeypatch and the CLI
+    see the same module).
 
     Raises
     ------
     ValueError
-        ``name`` is not a registered study, or its script is not in
-        :data:`STUDIES_DIR` (an installed copy without the checkout's
-        ``studies/`` folder).
+        ``name`` is not a registered study.
     """
     if name not in STUDIES:
         raise ValueError(f"unknown study {name!r}; available: {', '.join(STUDIES)}")
-    stem = name.replace("-", "_")
-    module_name = f"randvib_study_{stem}"
-    # cached, so that a test's monkeypatch and the CLI see the same module
-    if module_name in sys.modules:
-        return sys.modules[module_name]
-    path = STUDIES_DIR / f"{stem}.py"
-    if not path.is_file():
-        raise ValueError(
-            f"study {name!r} is a script in the `studies/` folder of a randvib checkout, "
-            f"and {path} does not exist; run it from a clone of the repository "
-            "(pip install -e .)"
-        )
-    spec = importlib.util.spec_from_file_location(module_name, path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[module_name] = module
-    try:
-        spec.loader.exec_module(module)
-    except BaseException:
-        del sys.modules[module_name]
-        raise
-    return module
+    package = _scripts_package()
+    return importlib.import_module(f"{package.__name__}.{name.replace('-', '_')}")
 
 
 def add_run_options(parser: argparse.ArgumentParser) -> None:
