@@ -15,7 +15,9 @@ such scripts share lives here:
   records, resumable fits, their tables);
 - :mod:`~randvib.studies.methods`: every analytic method against paired Monte Carlo
   runs, and the accuracy criteria for a fast method;
-- :mod:`~randvib.studies.stepcheck`: the sweep with its half-step re-run, and its verdict;
+- :mod:`~randvib.studies.half_step`: the sweep with its half-step re-run, and its verdict
+  (the time-step bias of a study's sweep; the linear test system's step bias is
+  :mod:`randvib.montecarlo.step_check`);
 - :mod:`~randvib.studies.verdicts`: the verdict sentences, built from the numbers;
 - :mod:`~randvib.studies.evidence`: rows that repeat one experiment (exact rescalings);
 - :mod:`~randvib.studies.figures`: figures of power and contrasts against Fc;
