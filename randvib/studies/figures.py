@@ -1,4 +1,4 @@
-"""Figures the studies share: power and contrasts against the Coulomb level.
+"""Figures the studies share: power and contrasts against the Coulomb level or the bandwidth.
 
 Each function draws from a study's table, saves one PNG at ``path``
 (:func:`randvib.figure_style.save_figure`) and returns the path; nothing
@@ -332,5 +332,74 @@ def k3_change_against_kappa(df: pd.DataFrame, labels: dict, path: Path) -> Path:
         f"P(k$_3$ = {num_tex(max(k3s))}) / P(k$_3$ = {num_tex(min(k3s))}) − 1 (%)"
     )
     fig.legend(*axes[0, 0].get_legend_handles_labels(), loc="outside lower center", ncol=3)
+    panel_letters(axes)
+    return save_figure(fig, path)
+
+
+def _bandwidth_axis(ax, zetas) -> None:
+    """Log zeta axis, narrowing to the right, ticks at the given zetas only; a zero line."""
+    from matplotlib.ticker import NullFormatter
+
+    ticks = sorted(z for z in set(zetas) if np.isfinite(z))
+    ax.set_xscale("log")
+    ax.set_xlim(ticks[-1] * 1.3, ticks[0] / 1.3)  # reversed: the band narrows to the right
+    ax.set_xticks(ticks, [f"{z:g}" for z in ticks])
+    ax.xaxis.set_minor_formatter(NullFormatter())
+    ax.set_xlabel("band-pass damping ratio $\\zeta$ (narrower →)")
+    ax.grid(alpha=0.3, which="major", lw=0.5)
+    ax.axhline(0.0, color="0.5", lw=0.5)
+
+
+@styled
+def error_against_bandwidth(results: pd.DataFrame, centres, path: Path) -> Path:
+    """Linearisation's relative error (%) against the band's zeta, a panel per k3, a line per centre.
+
+    ``results`` has, per band (``centre``, ``zeta``; white noise as centre
+    "white", drawn dotted) and device (``fc`` (N), ``k3``),
+    ``linearisation_rel_error`` and its ``_ci95``; the rows with friction
+    are drawn.
+    """
+    lin = results[results.fc > 0]
+    k3s = sorted(lin.k3.unique())
+    fig, axes = new_figure(1, len(k3s), figsize=(3.2 * len(k3s) + 0.4, 3.4), sharey=True)
+    for ax, k3 in zip(axes[0], k3s, strict=True):
+        for centre in centres:
+            sub = lin[(lin.centre == centre) & (lin.k3 == k3)].sort_values("zeta")
+            ax.errorbar(sub.zeta, 100 * sub.linearisation_rel_error,
+                        yerr=100 * sub.linearisation_rel_error_ci95, marker="o", ms=4, capsize=2,
+                        label=f"centre {centre} f$_n$")  # fmt: skip
+        for error in lin[(lin.centre == "white") & (lin.k3 == k3)].linearisation_rel_error[:1]:
+            ax.axhline(100 * error, color="k", ls=":", lw=1, label="white noise")
+        _bandwidth_axis(ax, lin.zeta)
+        fc = 1e3 * lin[lin.k3 == k3].fc.iloc[0]
+        ax.set_title(f"F$_c$ = {fc:g} mN, k$_3$ = {num_tex(k3)} N/m$^3$", fontsize=9)
+    axes[0, 0].set_ylabel("linearisation error in E[P$_e$] (%)")
+    axes[0, 0].legend(fontsize=7)
+    panel_letters(axes)
+    return save_figure(fig, path)
+
+
+@styled
+def contrast_against_bandwidth(inter: pd.DataFrame, centres, labels: dict, path: Path) -> Path:
+    """Relative interaction contrast (%) against the band's zeta, a panel per centre, a line per k3.
+
+    ``inter`` holds the contrasts of :func:`randvib.studies.contrasts.paired_interactions`
+    per band (``centre``, ``zeta``) with ``linearisation_relative_contrast``
+    (dashed); ``labels`` names some k3 values in the legend.
+    """
+    fig, axes = new_figure(1, len(centres), figsize=(10, 3.6), sharey=True)
+    for ax, centre in zip(axes[0], centres, strict=True):
+        for i, k3 in enumerate(sorted(inter.k3.unique())):
+            sub = inter[(inter.centre == centre) & (inter.k3 == k3)].sort_values("zeta")
+            ax.errorbar(sub.zeta, 100 * sub.relative_contrast, yerr=100 * sub.relative_ci95,
+                        marker="o", ms=4, capsize=2, color=colour(i),
+                        label=_k3_label(k3, labels))  # fmt: skip
+            ax.plot(sub.zeta, 100 * sub.linearisation_relative_contrast, "--", color=colour(i),
+                    lw=1)  # fmt: skip
+        _bandwidth_axis(ax, inter.zeta)
+        ax.set_title(f"band centred {centre} the linear resonance", fontsize=9)
+    axes[0, 0].set_ylabel("interaction contrast / P(F$_c$, 0) (%)")
+    axes[0, 0].legend(fontsize=7, title="markers: Monte Carlo (95 %); dashed: linearisation",
+                      title_fontsize=7)  # fmt: skip
     panel_letters(axes)
     return save_figure(fig, path)
