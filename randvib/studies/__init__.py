@@ -6,21 +6,27 @@ written against the public API the way a user would write their own sweep:
 compute (a sweep, contrasts), tables, figures, a report with verdicts. What
 such scripts share lives here:
 
-- :mod:`~randvib.studies.grids`: friction and Duffing levels, Coulomb grids, burn-in;
-- :mod:`~randvib.studies.contrasts`: paired interaction contrasts with Holm's
-  correction, and analytic predictions of the same contrasts;
+- :mod:`~randvib.studies.grids`: friction and Duffing levels, Coulomb grids, burn-in,
+  coloured inputs at equal response, fixed-size ensemble settings;
+- :mod:`~randvib.studies.contrasts`: paired interaction contrasts (of a sweep, or
+  within the groups of :func:`randvib.run_ensembles`) with Holm's correction, and
+  analytic predictions of the same contrasts;
+- :mod:`~randvib.studies.budget`: the power at a stroke-exceedance budget, and paired
+  gains over a linear device;
 - :mod:`~randvib.studies.accuracy`: where an analytic method can be trusted (trusted
   ranges of the friction level, the collapse of series that scale exactly);
 - :mod:`~randvib.studies.campaign`: an identification campaign (synthetic shaker
   records, resumable fits, their tables);
 - :mod:`~randvib.studies.methods`: every analytic method against paired Monte Carlo
-  runs, and the accuracy criteria for a fast method;
+  runs (a sweep's or :func:`randvib.run_ensembles`'), and the accuracy criteria for a
+  fast method;
 - :mod:`~randvib.studies.half_step`: the sweep with its half-step re-run, and its verdict
   (the time-step bias of a study's sweep; the linear test system's step bias is
   :mod:`randvib.montecarlo.step_check`);
 - :mod:`~randvib.studies.verdicts`: the verdict sentences, built from the numbers;
 - :mod:`~randvib.studies.evidence`: rows that repeat one experiment (exact rescalings);
-- :mod:`~randvib.studies.figures`: figures of power and contrasts against Fc;
+- :mod:`~randvib.studies.figures`: figures of power and contrasts against Fc or the
+  bandwidth, power against stroke exceedance, methods' errors against the level;
 - :mod:`~randvib.studies.report`: CSV, ``verdicts.json``, Markdown tables, ``report.md``.
 
 Every figure is drawn in :mod:`randvib.figure_style` (shared with the
@@ -28,8 +34,9 @@ identification plots).
 
 Every script defines ``run_study(out_dir, *, quick=False, seed=0,
 workers=None, scheduler=None, progress=True) -> Path`` (the report it wrote);
-``workers`` always means local worker *processes* (the sweeps'), and a study
-that simulates in-process on numba threads takes ``threads`` as well.
+``workers`` always means local worker *processes* (of its sweep or
+:func:`randvib.run_ensembles`), and a study that simulates in-process on numba
+threads takes ``threads`` as well.
 :func:`load` finds a script by its name (``randvib study NAME`` runs it).
 """
 

@@ -1,4 +1,5 @@
-"""Figures the studies share: power and contrasts against the Coulomb level or the bandwidth.
+"""Figures the studies share: power and contrasts against the Coulomb level or the bandwidth,
+power against stroke exceedance, the methods' errors against the input level.
 
 Each function draws from a study's table, saves one PNG at ``path``
 (:func:`randvib.figure_style.save_figure`) and returns the path; nothing
@@ -401,5 +402,85 @@ def contrast_against_bandwidth(inter: pd.DataFrame, centres, labels: dict, path:
     axes[0, 0].set_ylabel("interaction contrast / P(F$_c$, 0) (%)")
     axes[0, 0].legend(fontsize=7, title="markers: Monte Carlo (95 %); dashed: linearisation",
                       title_fontsize=7)  # fmt: skip
+    panel_letters(axes)
+    return save_figure(fig, path)
+
+
+@styled
+def power_against_exceedance(
+    results: pd.DataFrame, devices, budget: float, stroke: float, path: Path
+) -> Path:
+    """Power against stroke exceedance over the levels, a panel per input, a line per device.
+
+    ``results`` holds per ``input``, level ``g`` and ``device`` the Monte
+    Carlo ``power_mc`` (W) and ``exceedance_mc`` (fraction of time with
+    |z| > ``stroke`` (m)) with their ``_ci95``; the ``budget`` is a
+    vertical line.
+    """
+    from matplotlib.ticker import LogLocator
+
+    inputs = list(dict.fromkeys(results.input))
+    fig, axes = new_figure(1, len(inputs), figsize=(3.6 * len(inputs), 3.4), sharey=True)
+    for ax, name in zip(axes[0], inputs, strict=True):
+        for dev in devices:
+            sub = results[(results.input == name) & (results.device == dev)].sort_values("g")
+            shown = sub.exceedance_mc > 0
+            ax.errorbar(sub.exceedance_mc[shown], 1e3 * sub.power_mc[shown],
+                        xerr=sub.exceedance_mc_ci95[shown], yerr=1e3 * sub.power_mc_ci95[shown],
+                        marker="o", ms=3, capsize=2, label=dev)  # fmt: skip
+        ax.axvline(budget, color="k", ls=":", lw=1, label=f"budget: {100 * budget:g} % of the time")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        for axis in (ax.xaxis, ax.yaxis):
+            # minor ticks at 2 and 5 only: on a narrow range all eight minor labels collide
+            axis.set_minor_locator(LogLocator(subs=(2.0, 5.0)))
+        ax.set_xlabel(f"fraction of time with |z| > {1e3 * stroke:g} mm")
+        ax.set_title(name, fontsize=9)
+        ax.grid(alpha=0.3, lw=0.5)
+    axes[0, 0].set_ylabel("E[P$_e$] (mW), Monte Carlo")
+    axes[0, 0].legend(fontsize=7, title="markers: levels g; bars: 95 % CI", title_fontsize=7)
+    panel_letters(axes)
+    return save_figure(fig, path)
+
+
+@styled
+def method_errors_against_level(methods: pd.DataFrame, devices, path: Path) -> Path:
+    """Relative errors of the methods against the level g, power and exceedance, a marker per device.
+
+    ``methods`` is a table of :func:`randvib.studies.methods.methods_against_monte_carlo`
+    with the level ``g`` and ``device`` among its labels. A colour per
+    method, a marker per device, 95 % bars; the error axis is linear while
+    every error is within ±10 %, symmetric-log beyond.
+    """
+    from matplotlib.ticker import FuncFormatter, NullFormatter
+
+    fig, axes = new_figure(1, 2, figsize=(9, 3.8))
+    markers = dict(zip(devices, "osD^v", strict=False))
+    levels = sorted(methods.g.unique())
+    for ax, q in zip(axes[0], ("power", "exceedance"), strict=True):
+        for i, (method, rows) in enumerate(methods.groupby("method", sort=False)):
+            for dev, sub in rows.dropna(subset=[f"{q}_rel_error"]).groupby("device"):
+                ax.errorbar(sub.g * (1.04**i), 100 * sub[f"{q}_rel_error"],
+                            yerr=100 * sub[f"{q}_rel_error_ci95"], ls="none", marker=markers[dev],
+                            ms=3.5, capsize=1.5, color=colour(i),
+                            label=f"{method}, {dev}")  # fmt: skip
+        ax.axhline(0.0, color="0.5", lw=0.5, zorder=1)
+        ax.set_xscale("log")
+        ax.set_xticks(levels, [f"{g:g}" for g in levels])
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        reach = (methods[f"{q}_rel_error"].abs() + methods[f"{q}_rel_error_ci95"]).max()
+        if 100 * reach > 10:
+            ax.set_yscale("symlog", linthresh=10)
+            ax.yaxis.set_major_formatter(FuncFormatter(lambda y, _: f"{y:g}"))
+        ax.set_xlabel("level factor g (all inputs)")
+        ax.set_ylabel(f"error in {q} against Monte Carlo (%)")
+    handles, labels = {}, []
+    for ax in axes[0]:
+        for h, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            if label not in handles:
+                handles[label] = h
+                labels.append(label)
+    fig.legend([handles[k] for k in labels], labels, loc="outside lower center", ncol=4,
+               title="colour: method; marker: device; bars: 95 % CI")  # fmt: skip
     panel_letters(axes)
     return save_figure(fig, path)
