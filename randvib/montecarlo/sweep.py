@@ -56,7 +56,6 @@ from randvib._progress import progress_bar
 from randvib._validation import MAX_SEED, check_int, check_positive
 from randvib.analytic.prediction import METHODS, predict
 from randvib.models.harvester import Harvester
-from randvib.montecarlo.integrators import scheme_argument
 from randvib.statistics import estimate
 
 STATISTICS = ("power_electrical", "velocity_variance", "displacement_variance", "mean_abs_velocity")
@@ -92,8 +91,7 @@ class SweepSettings:
     burn_in : float
         Discarded initial time per path (s).
     scheme : str
-        Integrator name (:data:`randvib.montecarlo.integrators.INTEGRATORS`);
-        ``method=`` is accepted as a deprecated alias.
+        Integrator name (:data:`randvib.montecarlo.integrators.INTEGRATORS`).
     target_rel_ci : float
         Stop adding paths when the relative 95 % half-width of E[P_e] is at or
         below this (e.g. 0.005 for 0.5 %).
@@ -127,16 +125,6 @@ class SweepSettings:
         check_int("max_paths", self.max_paths, self.min_paths)
         check_int("seed", self.seed, 0, MAX_SEED)
 
-    @property
-    def method(self) -> str:
-        """Deprecated alias of :attr:`scheme`."""
-        warnings.warn(
-            "SweepSettings.method is deprecated; use SweepSettings.scheme",
-            DeprecationWarning,
-            stacklevel=2,
-        )
-        return self.scheme
-
     def to_dict(self) -> dict:
         """The settings as JSON-ready values, with the integrator under its JSON key ``method``.
 
@@ -145,22 +133,6 @@ class SweepSettings:
         """
         out = asdict(self)
         return {("method" if k == "scheme" else k): v for k, v in out.items()}
-
-
-def _accept_method_alias(init):
-    """Wrap ``SweepSettings.__init__`` to take ``method=`` as a deprecated ``scheme=``."""
-
-    @functools.wraps(init)
-    def wrapped(self, *args, method=None, **kwargs):
-        if method is not None:
-            name, _ = scheme_argument(kwargs.pop("scheme", None), method)
-            kwargs["scheme"] = name
-        init(self, *args, **kwargs)
-
-    return wrapped
-
-
-SweepSettings.__init__ = _accept_method_alias(SweepSettings.__init__)
 
 
 def validate_points(base: Harvester, points: Iterable[Mapping]) -> list[dict]:
