@@ -554,7 +554,7 @@ def run_stored(
     store : PointStore or None
         Finished points are loaded from it, and each new one saved at once;
         it is closed (unlocked) at the end.
-    executor, workers, scheduler
+    executor, workers, scheduler : Executor, int, str, optional
         Where the calls run: a given executor, else ``workers`` local
         processes or the Dask cluster at ``scheduler`` (:func:`make_executor`;
         one worker: in-process).
