@@ -69,6 +69,8 @@ _EXPORTS = {
     "randvib.models.presets": ("MAGNET_MASS", "preset", "PRESETS"),
     "randvib.montecarlo.on_record": ("RecordSimulation", "simulate_on_record"),
     "randvib.montecarlo.spectra": ("SampledSpectra",),
+    "randvib.montecarlo.sweep": ("run_sweep", "SweepSettings"),
+    "randvib.montecarlo.ensembles": ("Case", "EnsembleResult", "run_ensembles"),
     "randvib.studies.spectra_figure": ("plot_response_spectra",),
     "randvib.identification.sade": ("sade", "SADEResult"),
     "randvib.montecarlo.simulation": ("simulate",),
