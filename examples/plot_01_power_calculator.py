@@ -5,7 +5,8 @@ Power calculator: equivalent linearisation
 The expected electrical power of the paper's Section 5 device under white base
 acceleration, by equivalent linearisation (paper Eq. 19-32), swept over the
 Coulomb friction level ``Fc`` and the noise level ``S`` in one broadcast call,
-and the load resistance that maximises the power delivered to the load.
+and the load resistance that maximises the power delivered to the load; then
+which analytic methods accept a case, as they declare it.
 """
 
 import matplotlib.pyplot as plt
@@ -47,3 +48,14 @@ wired = rv.Harvester.from_electrical(
 )
 r_opt, p_opt = rv.optimal_load_resistance(wired, 1.0)
 print(f"R_L* = {r_opt:.3f} ohm, P_L* = {1e3 * p_opt:.4f} mW")
+
+# %%
+# Four analytic methods predict the power (``rv.METHODS``). Each declares what
+# it accepts, so a script asks them rather than keeping its own list: under a
+# band-pass excitation only statistical linearisation applies, and a method
+# that does not refuses with one line naming the ones that do.
+band = rv.BandPass(level=1.0, f0=8.0, zeta=0.2)
+for name, method in rv.METHODS.items():
+    print(f"{name:14} white: {method.accepts(device, 1.0)}, band-pass: "
+          f"{method.accepts(device, band)}  ({method.summary})")  # fmt: skip
+print(rv.METHODS["fpk-fast"].refusal(device, band))

@@ -1,7 +1,7 @@
 """How results show themselves: compact reprs, HTML tables for Jupyter, pandas.
 
 The result classes (:class:`~randvib.montecarlo.results.SimulationResult`,
-:class:`~randvib.analytic.prediction.PowerPrediction`,
+:class:`~randvib.analytic.power_prediction.PowerPrediction`,
 :class:`~randvib.analytic.statistical_linearisation.LinearisationResult`,
 :class:`~randvib.identification.fitting.IdentificationResult`) build a list of
 rows ``(name, value, unit)`` and hand it here, so that the terminal, the

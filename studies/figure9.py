@@ -25,6 +25,7 @@ from randvib.montecarlo.sweep import SweepSettings, linearisation_verdicts
 from randvib.studies import figures, script_main
 from randvib.studies.contrasts import interaction_contrasts
 from randvib.studies.grids import coulomb_grid, highest_friction_points
+from randvib.studies.half_step import half_step_verdict, sweep_with_half_step
 from randvib.studies.report import (
     markdown_table,
     prepare_output_dir,
@@ -33,7 +34,6 @@ from randvib.studies.report import (
     write_table,
     write_verdicts,
 )
-from randvib.studies.stepcheck import step_check_verdict, sweep_with_step_check
 from randvib.studies.verdicts import interaction_verdict, linearisation_verdict
 
 PSDS = (1.0, 0.5, 0.1)
@@ -138,7 +138,7 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
     out = prepare_output_dir(out_dir, {"study": "figure9", "quick": quick, "seed": seed})
 
     # compute: the sweep, and a half-step re-run where the nonlinearity is largest
-    result, check = sweep_with_step_check(
+    result, check = sweep_with_half_step(
         base,
         points,
         settings,
@@ -167,7 +167,7 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
     # verdicts and report
     lin_data, lin_sentence = linearisation_verdict(table)
     inter_data, inter_sentence = interaction_verdict(inter, K3S[1])
-    check_data = step_check_verdict(check)
+    check_data = half_step_verdict(check)
     write_verdicts(
         out,
         {"linearisation": lin_data, "interaction": inter_data, "step_check": check_data},

@@ -47,6 +47,7 @@ from randvib.studies.grids import (
     friction_level,
     highest_friction_points,
 )
+from randvib.studies.half_step import check_step_bias, half_step_verdict, sweep_with_half_step
 from randvib.studies.report import (
     markdown_table,
     plus_minus,
@@ -56,7 +57,6 @@ from randvib.studies.report import (
     write_table,
     write_verdicts,
 )
-from randvib.studies.stepcheck import check_step_bias, step_check_verdict, sweep_with_step_check
 from randvib.studies.verdicts import (
     interaction_counts,
     interaction_summary,
@@ -280,7 +280,7 @@ def run_study(
 
     # compute: half-step check where the dynamics is hardest (most friction,
     # with and without the stiffest spring)
-    result, check = sweep_with_step_check(
+    result, check = sweep_with_half_step(
         base,
         points,
         settings,
@@ -310,7 +310,7 @@ def run_study(
     # verdicts and report
     lin = table[table.fc > 0]
     lin_data = linearisation_by_spring(lin)
-    check_data = step_check_verdict(check)
+    check_data = half_step_verdict(check)
     write_verdicts(
         out,
         {

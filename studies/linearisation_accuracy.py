@@ -53,6 +53,7 @@ from randvib.studies.grids import (
     highest_friction_points,
     power_ratio,
 )
+from randvib.studies.half_step import check_step_bias, half_step_verdict, sweep_with_half_step
 from randvib.studies.report import (
     markdown_table,
     plus_minus,
@@ -62,7 +63,6 @@ from randvib.studies.report import (
     write_table,
     write_verdicts,
 )
-from randvib.studies.stepcheck import check_step_bias, step_check_verdict, sweep_with_step_check
 
 NAME = "linearisation-accuracy"
 #: Series as (S ((m/s^2)^2/Hz), k3 (N/m^3), c_m = c_e (Ns/m)): the figure9 device at three
@@ -234,7 +234,7 @@ def step_section(check, settings, worst_bias) -> str:
         f"Re-run of {len(check)} points (strongest friction of each k3 and damping, at its "
         f"largest S) at dt/2 = {settings.dt / 2:g} s, independent noise. Time-step bias below "
         f"the statistical error at {int(check.bias_below_error.sum())} of {len(check)} points"
-        f"{step_check_verdict(check)['sentence']}. "
+        f"{half_step_verdict(check)['sentence']}. "
         f"Linearised step bias at dt at most {worst_bias:.1e}.\n\n"
         + markdown_table(readable_table(check))
     )
@@ -262,7 +262,7 @@ def run_study(
     out = prepare_output_dir(out_dir, identity)
 
     # compute: the sweep, its half-step re-run, and the trusted ranges
-    result, check = sweep_with_step_check(
+    result, check = sweep_with_half_step(
         base, points, settings, out, NAME, step_check_points(points),
         workers=workers, scheduler=scheduler, progress=progress,
     )  # fmt: skip
@@ -288,7 +288,7 @@ def run_study(
             "collapse": {f"{k:g}": {"spread": a, "ci95": b} for k, (a, b) in spreads.items()},
             "n_error_over_1pct": int(len(signs)),
             "n_negative_over_1pct": int((signs < 0).sum()),
-            "step_check": step_check_verdict(check),
+            "step_check": half_step_verdict(check),
         },
     )
     accuracy = accuracy_section(table, methods, limits, spreads, figure, damping_ratio(base), phis)

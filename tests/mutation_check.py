@@ -391,17 +391,17 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="devices-equal-input",
-        path="studies/devices.py",
+        path="randvib/studies/grids.py",
         edits=(
             (
-                "return rv.BandPass(g * S_REF * base.m / (4 * base.c) / linear, shape.f0, BAND_ZETA)",
-                "return rv.BandPass(g * S_REF * base.m / (4 * base.c_m) / linear, shape.f0, "
-                "BAND_ZETA)",
+                "level = shape.level * psd * device.m / (4 * device.c) / linear",
+                "level = shape.level * psd * device.m / (4 * device.c_m) / linear",
             ),
         ),
         tests=("tests/test_study_devices.py::test_equal_input_power_and_the_bistable_choice",),
-        why="The devices study's band-pass level matched with the mechanical damping c_m "
-        "instead of c = c_m + c_e: the band injects twice the white-noise power into the "
+        why="The band-pass level of the devices study (grids.response_matched) matched with "
+        "the mechanical damping c_m instead of c = c_m + c_e: the band injects twice the "
+        "white-noise power into the "
         "linear device, so the white/band comparison is not at equal input power; the "
         "injected power c E[v^2] must be g S m / 4 to 1e-9 (exact Lyapunov solution).",
     ),

@@ -107,7 +107,12 @@ def test_the_law_is_registered_everywhere_from_its_class():
     assert "stribeck-test" in MODELS and "stribeck-test" in FRICTION_CHOICES
     assert FRICTION_PARAMETERS["stribeck-test"] == ("fc", "fs", "vs", "vt")
     law = Stribeck(FC, 2 * FC, 0.02, 0.0)
-    assert law.analytic_methods == ("linearisation",)  # not of the form Fc tanh(beta v)
+    # memoryless but not of the form Fc tanh(beta v): linearisation's alone, by the declarations
+    accepting = [name for name, method in rv.METHODS.items() if method.accepts_friction(law)]
+    assert accepting == ["linearisation"]
+    refusal = "form Fc tanh.*'stribeck-test' is not of that form: use method='linearisation' or"
+    with pytest.raises(ValueError, match=refusal):
+        rv.predict(_with(law), 0.5, "fpk-fast")
     # The compiled callback the loops call agrees with the numpy force.
     v = np.random.default_rng(0).normal(0.0, 0.05, 50)
     p = law.kernel_parameters()

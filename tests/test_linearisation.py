@@ -31,17 +31,11 @@ def test_eq30_equals_general_fixed_point(fc, c, psd, m):
     assert fixed == pytest.approx(closed, rel=1e-10)
 
 
-def test_expectation_keeps_method_as_a_deprecated_alias():
-    # `method` of equivalent_damping meant how E[v F(v)] is taken, not an analytic
-    # method as in predict(..., method=...): renamed `expectation`, old name warns.
+def test_expectation_is_one_of_its_choices():
+    # `expectation` says how E[v F(v)] is taken (not an analytic method as in predict)
     h = BASE.updated(friction=rv.Tanh(0.0058, 300.0))
-    with pytest.warns(DeprecationWarning, match="`expectation`"):
-        old = rv.equivalent_damping(h, 0.5, method="fixed-point")
-    assert old == rv.equivalent_damping(h, 0.5, expectation="fixed-point")
     with pytest.raises(ValueError, match="`expectation` must be one of"):
         rv.equivalent_damping(h, 0.5, expectation="magic")
-    with pytest.raises(ValueError, match="not both"), pytest.warns(DeprecationWarning):
-        rv.equivalent_damping(h, 0.5, "closed-form", method="fixed-point")
 
 
 def test_zero_friction_gives_viscous_damping():

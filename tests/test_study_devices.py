@@ -7,8 +7,9 @@ linear one's in-well stiffness and a barrier equal to the reference energy
 scale, Monte Carlo's white-noise power agrees with fpk-fast (an independent
 method, accurate to 0.05 %) within its interval for every device, the paired
 ratios and the censored first-passage columns are consistent, the budget
-interpolation is exact on a power law, the verdicts are recomputed from the
-CSVs, and a second run resumes without recomputing.
+interpolation (randvib/studies/budget.py) is exact on a power law, the
+verdicts are recomputed from the CSVs, and a second run resumes from the
+stored cases (randvib.run_ensembles) without recomputing them.
 """
 
 import json
@@ -22,14 +23,16 @@ from study_checks import check_study_run, statistic
 import randvib as rv
 from randvib.cli import main
 from randvib.studies import load
+from randvib.studies.budget import power_at_budget
 
 devices = load("devices")
 TINY = {"inputs": ("white", "band at f_n"), "levels": (0.25, 1.0),
-        "methods": ("linearisation", "fpk-fast"), "mc": (64, 3.0, 2e-4, 0.5)}  # fmt: skip
+        "methods": ("linearisation", "fpk-fast"),
+        "mc": {"n_paths": 64, "window": 2.5, "burn_in": 0.5, "dt": 2e-4}}  # fmt: skip
 
 
 def _run(out, capsys):
-    argv = ["study", "devices", "--quick", "--out", str(out), "--no-progress", "--threads", "1"]
+    argv = ["study", "devices", "--quick", "--out", str(out), "--no-progress", "--workers", "1"]
     assert main(argv) == 0
     check_study_run(capsys.readouterr().out, out)
 
@@ -54,14 +57,14 @@ def test_power_at_budget_is_exact_on_a_power_law():
     g = np.array([0.5, 2.0, 8.0])
     table = pd.DataFrame({"g": g, "power_mc": 2 * g, "exceedance_mc": 1e-3 * g**2,
                           "exceedance_mc_ci95": 1e-4 * g**2})  # fmt: skip
-    at = devices.power_at_budget(table, budget=1e-2)
+    at = power_at_budget(table, 1e-2)
     assert at["bracket"] == "bracketed"
     assert at["g"] == pytest.approx(np.sqrt(10), rel=1e-12)
     assert at["power"] == pytest.approx(2 * np.sqrt(10), rel=1e-12)
     assert at["power_low"] == pytest.approx(2 * np.sqrt(10 / 1.1), rel=1e-12)
     assert at["power_high"] == pytest.approx(2 * np.sqrt(10 / 0.9), rel=1e-12)
-    assert devices.power_at_budget(table, budget=1e-6)["bracket"] == "below"
-    assert devices.power_at_budget(table, budget=0.5)["bracket"] == "above"
+    assert power_at_budget(table, 1e-6)["bracket"] == "below"
+    assert power_at_budget(table, 0.5)["bracket"] == "above"
 
 
 def test_devices_study_end_to_end(tmp_path, monkeypatch, capsys):
@@ -104,6 +107,10 @@ def test_devices_study_end_to_end(tmp_path, monkeypatch, capsys):
     assert devices.answer(verdict) in text
     for figure in ("power_vs_exceedance.png", "method_errors.png"):
         assert (out / figure).stat().st_size > 10_000
-    before = (out / "results.csv").stat().st_mtime_ns
+    # a second run resumes from the stored cases, and writes the same tables
+    stored = {p: p.stat().st_mtime_ns for p in (out / "ensembles" / "points").iterdir()}
+    assert len(stored) == 2 * len(results)  # a row and the per-path averages per case
+    tables = [(out / name).read_bytes() for name in ("results.csv", "methods.csv")]
     _run(out, capsys)
-    assert (out / "results.csv").stat().st_mtime_ns == before
+    assert {p: p.stat().st_mtime_ns for p in (out / "ensembles" / "points").iterdir()} == stored
+    assert [(out / name).read_bytes() for name in ("results.csv", "methods.csv")] == tables

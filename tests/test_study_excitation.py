@@ -5,7 +5,8 @@ at any size: the response-matched levels make the linear device's power
 exactly the white-noise value (S = 1) in every band, Monte Carlo agrees with
 it within its interval, the paired contrast is the combination of the four
 devices' powers (same paths) and narrower than unpaired, the verdicts are
-recomputed from the CSVs, and a second run resumes without recomputing.
+recomputed from the CSVs, and a second run resumes from the stored cases
+(randvib.run_ensembles) without recomputing them.
 """
 
 import json
@@ -22,11 +23,11 @@ from randvib.studies import load
 
 excitation = load("excitation")
 TINY = {"centres": ("at", "above"), "zetas": (0.5, 0.05), "k3s": (0.0, 5e7),
-        "mc": (160, 3.0, 2e-4, 0.5)}  # fmt: skip
+        "mc": {"n_paths": 160, "window": 2.5, "burn_in": 0.5, "dt": 2e-4}}  # fmt: skip
 
 
 def _run(out, capsys):
-    argv = ["study", "excitation", "--quick", "--out", str(out), "--no-progress", "--threads", "1"]
+    argv = ["study", "excitation", "--quick", "--out", str(out), "--no-progress", "--workers", "1"]
     assert main(argv) == 0
     check_study_run(capsys.readouterr().out, out)
 
@@ -63,7 +64,10 @@ def test_excitation_study_end_to_end(tmp_path, monkeypatch, capsys):
     assert f"The largest contrast is {100 * largest:+.1f}" in text
     for figure in ("interaction.png", "linearisation_error.png", "spectra.png"):
         assert (out / figure).stat().st_size > 10_000
-    # a second run resumes from the tables
-    before = (out / "results.csv").stat().st_mtime_ns
+    # a second run resumes from the stored cases, and writes the same tables
+    stored = {p: p.stat().st_mtime_ns for p in (out / "ensembles" / "points").iterdir()}
+    assert len(stored) == 2 * len(results)  # a row and the per-path averages per case
+    tables = [(out / name).read_bytes() for name in ("results.csv", "contrasts.csv")]
     _run(out, capsys)
-    assert (out / "results.csv").stat().st_mtime_ns == before
+    assert {p: p.stat().st_mtime_ns for p in (out / "ensembles" / "points").iterdir()} == stored
+    assert [(out / name).read_bytes() for name in ("results.csv", "contrasts.csv")] == tables

@@ -334,10 +334,8 @@ def test_settings_validation():
         SweepSettings(min_paths=64, max_paths=32)
 
 
-def test_sweep_settings_take_method_as_deprecated_alias_of_scheme():
-    with pytest.warns(DeprecationWarning, match="scheme="):
-        old = SweepSettings(method="euler-maruyama", dt=2e-5)
-    assert old == SweepSettings(scheme="euler-maruyama", dt=2e-5)
-    with pytest.warns(DeprecationWarning):
-        assert old.method == "euler-maruyama"
-    assert old.to_dict()["method"] == "euler-maruyama" and "scheme" not in old.to_dict()
+def test_sweep_settings_store_the_scheme_under_its_folder_key():
+    settings = SweepSettings(scheme="euler-maruyama", dt=2e-5)
+    assert settings.to_dict()["method"] == "euler-maruyama" and "scheme" not in settings.to_dict()
+    with pytest.raises(TypeError, match="method"):
+        SweepSettings(method="euler-maruyama")

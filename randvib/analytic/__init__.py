@@ -1,1 +1,1 @@
-"""Analytic and semi-analytic methods: equivalent linearisation, stochastic averaging, Fokker-Planck solvers, exact reference results."""
+"""Analytic and semi-analytic methods: a declared family (method.py), each beside its mathematics (statistical linearisation, stochastic averaging, Fokker-Planck solvers), the driver that asks them (prediction.py), exact reference results."""

@@ -59,7 +59,7 @@ which explains why a next-order averaging was not pursued.
 
 Potentials. Averaging is implemented for the monostable potential
 (k > 0, k3 >= 0) only and refuses the others with a message naming the
-methods that treat them (:data:`OTHER_POTENTIALS`). A double well would need
+methods that treat them (its declaration, :class:`Averaging`). A double well would need
 orbits of two kinds, inside one well (energy below the barrier, two
 disjoint orbits) and around both (above it), with a period that diverges
 logarithmically at the barrier energy, and a matching condition for the
@@ -94,13 +94,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from randvib._validation import check_nonnegative, check_positive, scalar_or_array
-from randvib.models.excitation import white_level
+from randvib.analytic.method import AnalyticMethod, Validity, white_level
+from randvib.analytic.power_prediction import PowerPrediction
 from randvib.models.friction import one_minus_tanh
 from randvib.models.harvester import Harvester
 
 __all__ = [
     "AVERAGING_ZETA_LIMIT",
-    "OTHER_POTENTIALS",
+    "Averaging",
     "AveragingResult",
     "AveragingValidityWarning",
     "OrbitAverages",
@@ -108,12 +109,6 @@ __all__ = [
     "energy_density",
     "orbit_averages",
 ]
-
-#: The methods named when averaging refuses a potential other than monostable.
-OTHER_POTENTIALS = (
-    "method 'fpk-fast' or 'fpk' (any confining potential, the free mass), 'linearisation' "
-    "(Gaussian closure) or randvib.simulate"
-)
 
 #: Friction damping ratio above which averaging is flagged as unreliable.
 #: Averaging is exact without friction, whatever the viscous damping (the
@@ -348,34 +343,21 @@ def _moments_on_grid(x_max, gamma, omega, lam, fcm, beta, dd):
     return vv, abs_v, zz, fpow, z, ends[:, -1]
 
 
-#: Where a circuit state (coil inductance, piezo capacitance) is handled.
-CIRCUIT_METHODS = (
-    "equivalent linearisation (randvib.predict with method 'linearisation', "
-    "randvib.statistical_linearisation) and Monte Carlo (randvib.simulate)"
-)
-
-
-def memoryless_parameters(harvester: Harvester, psd, method: str = "stochastic averaging"):
+def memoryless_parameters(harvester: Harvester, psd, method: AnalyticMethod):
     """Broadcast (m, c, k, k3, fc, beta, psd) for the semi-analytic methods.
 
     ``beta = inf`` marks Coulomb friction (or none, with ``fc = 0``). Methods
-    that need a memoryless friction law (averaging, the FPK solvers) share
-    this; the law declares (Fc, beta) through ``coulomb_tanh_form()``, and
-    ``method`` names the caller in the error raised for any other law (LuGre)
-    and for a coupling with a circuit state: these methods reduce the device
-    to (z, v) with a viscous electrical damping c_e (resistive coupling).
+    that need the friction form Fc tanh(beta v) (averaging, the FPK solvers)
+    share this; the law declares (Fc, beta) through ``coulomb_tanh_form()``.
+    The case is first checked against ``method``'s declaration
+    (:meth:`~randvib.analytic.method.AnalyticMethod.require`, the refusal
+    naming it by its ``title``): these methods reduce the device to (z, v)
+    under white noise with a viscous electrical damping c_e (resistive coupling).
     """
-    harvester.require_resistive(method, CIRCUIT_METHODS)
+    method.require(harvester, psd, method.title)
     friction = harvester.friction
-    form = (0.0, np.inf) if friction is None else friction.coulomb_tanh_form()
-    if form is None:
-        why = "has internal state" if friction.has_memory else "is not of that form"
-        raise ValueError(
-            f"{method} needs a memoryless friction law of the form Fc tanh(beta v) "
-            f"(coulomb, tanh or none); {friction.name!r} {why}. Use randvib.simulate for it."
-        )
-    fc, beta = form
-    psd = check_positive("psd", white_level(psd, method), "(m/s^2)^2/Hz")
+    fc, beta = (0.0, np.inf) if friction is None else friction.coulomb_tanh_form()
+    psd = check_positive("psd", white_level(psd), "(m/s^2)^2/Hz")
     arrays = np.broadcast_arrays(
         *(
             np.asarray(v, dtype=float)
@@ -417,11 +399,11 @@ def averaging_statistics(harvester: Harvester, psd, *, warn: bool = True) -> Ave
     ValueError
         For bad ``psd``, for LuGre friction (it has memory, so the energy
         drift is not a function of the energy alone), for points with
-        neither damping nor friction, and for a potential other than
-        monostable (the message names :data:`OTHER_POTENTIALS`).
+        neither damping nor friction, and for what :class:`Averaging` does
+        not accept (a potential other than monostable, a circuit state, a
+        non-white excitation: the message names the methods that do).
     """
-    harvester.potential.require("stochastic averaging", ("monostable",), OTHER_POTENTIALS)
-    m, c, k, k3, fc, beta, psd = memoryless_parameters(harvester, psd)
+    m, c, k, k3, fc, beta, psd = memoryless_parameters(harvester, psd, AVERAGING)
     shape = m.shape
     flat = [np.ravel(a) for a in (m, c, k, k3, fc, beta, psd)]
     n = flat[0].size
@@ -488,7 +470,7 @@ def orbit_averages(harvester: Harvester, energy) -> OrbitAverages:
     -------
     OrbitAverages
     """
-    harvester.potential.require("orbit_averages", ("monostable",), OTHER_POTENTIALS)
+    harvester.potential.require("orbit_averages", ("monostable",))
     energy = check_nonnegative("energy", energy, "J")
     m, k, k3, energy = np.broadcast_arrays(
         *(np.asarray(v, dtype=float) for v in (harvester.m, harvester.k, harvester.k3, energy))
@@ -524,9 +506,8 @@ def energy_density(harvester: Harvester, psd, energy):
     energy : array_like
         Energies E (J), >= 0.
     """
-    harvester.potential.require("stochastic averaging", ("monostable",), OTHER_POTENTIALS)
     m, c, k, k3, fc, beta, psd = (
-        float(np.ravel(a)[0]) for a in memoryless_parameters(harvester, psd)
+        float(np.ravel(a)[0]) for a in memoryless_parameters(harvester, psd, AVERAGING)
     )
     if any(np.ndim(v) for v in (harvester.m, harvester.c, harvester.k, harvester.k3)):
         raise ValueError("energy_density needs scalar harvester parameters")
@@ -543,3 +524,46 @@ def energy_density(harvester: Harvester, psd, energy):
     # Normalisation Z = int T exp(-Psi) dH, from the moment grid.
     z = _moments(*(np.array([v]) for v in (m, c, k, k3, fc, beta, psd)))[4][0]
     return (period * np.exp(-psi) / (m * z)).reshape(np.shape(energy))
+
+
+class Averaging(AnalyticMethod):
+    """Energy-envelope stochastic averaging (this module): a non-Gaussian velocity.
+
+    Within 2 % of the FPK reference on the study grid where friction removes
+    little energy per cycle (zeta_friction <= :data:`AVERAGING_ZETA_LIMIT`;
+    beyond it warns), but it overstates the change of power with k3 1.5-5x
+    (module docstring). White noise, resistive coupling, the monostable
+    potential and friction of the form Fc tanh(beta v) only.
+    """
+
+    name = "averaging"
+    title = "stochastic averaging"
+    summary = "stochastic averaging, non-Gaussian velocity, within 2 %, 0.3 ms"
+    potentials = ("monostable",)
+    friction_form = "fc-tanh"
+    validity = (
+        Validity(
+            "zeta_friction",
+            AVERAGING_ZETA_LIMIT,
+            "warns",
+            "friction's damping ratio (E[z' F] / E[z'^2]) / (2 sqrt(k_eq m)), the energy "
+            "friction removes per cycle against the energy stored; beyond it the power may be "
+            "low by 3-6 %",
+        ),
+    )
+
+    def solve(self, harvester: Harvester, psd) -> PowerPrediction:
+        r = averaging_statistics(harvester, psd)
+        return PowerPrediction.from_white_noise(
+            harvester,
+            self.name,
+            r.velocity_variance,
+            r.displacement_variance,
+            r.mean_abs_velocity,
+            psd,
+        )
+
+
+#: The method's declaration, which the functions of this module check their input against
+#: (:data:`randvib.analytic.prediction.METHODS` holds it).
+AVERAGING = Averaging()

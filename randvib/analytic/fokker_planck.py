@@ -51,13 +51,21 @@ from scipy.linalg import lapack
 from scipy.sparse import linalg as sparse_linalg
 
 from randvib._validation import check_int, check_positive, scalar_or_array
-from randvib.analytic.averaging import CIRCUIT_METHODS, linear_psi_root, memoryless_parameters
+from randvib.analytic.averaging import linear_psi_root, memoryless_parameters
 from randvib.analytic.linearisation import equivalent_damping
-from randvib.models.excitation import white_level
+from randvib.analytic.method import AnalyticMethod, Validity, white_level
+from randvib.analytic.power_prediction import PowerPrediction
 from randvib.models.harvester import Harvester
 from randvib.models.potential import CONFINING, Potential
 
-__all__ = ["FPKSolution", "fast_fpk_statistics", "fpk_statistics", "solve_fpk"]
+__all__ = [
+    "FPKSolution",
+    "FastFokkerPlanck",
+    "FokkerPlanck",
+    "fast_fpk_statistics",
+    "fpk_statistics",
+    "solve_fpk",
+]
 
 #: Energy (in units of the linearised velocity variance) at the box edge.
 _ENERGY_EDGE = 30.0
@@ -336,7 +344,7 @@ def solve_fpk(harvester: Harvester, psd: float, n: int = 200, *, nz=None, nv=Non
     harvester.potential.require(
         "solve_fpk", CONFINING, "fpk_statistics, which takes the free mass's exact velocity density"
     )
-    arrays = memoryless_parameters(harvester, psd, "the FPK solver")
+    arrays = memoryless_parameters(harvester, psd, FOKKER_PLANCK)
     if arrays[0].ndim:
         raise ValueError("solve_fpk needs scalar harvester parameters and a scalar `psd`")
     point = _Point.from_parameters(*(float(a) for a in arrays))
@@ -385,9 +393,8 @@ def fpk_moments(harvester: Harvester, psd, n: int = 160):
     the cell cut by the stroke keeps it second order).
     """
     n = check_int("n", n, 16)
-    harvester.require_resistive("the FPK solver", CIRCUIT_METHODS)
-    harvester.potential.require("the FPK solver", CONFINING + ("free",))
-    psd = check_positive("psd", white_level(psd, "the FPK solver"), "(m/s^2)^2/Hz")
+    FOKKER_PLANCK.require(harvester, psd, FOKKER_PLANCK.title)
+    psd = check_positive("psd", white_level(psd), "(m/s^2)^2/Hz")
     friction = harvester.friction
     own = {name: getattr(harvester, name) for name in ("m", "c_m", "c_e", "k", "k3")}
     fric = {} if friction is None else friction.parameters()
@@ -433,7 +440,7 @@ def free_mass_moments(harvester: Harvester, psd) -> np.ndarray:
     displacement diffuses without bound, so E[z^2] and P(|z| > stroke) are
     not stationary: nan.
     """
-    arrays = memoryless_parameters(harvester, psd, "the FPK solver")
+    arrays = memoryless_parameters(harvester, psd, FOKKER_PLANCK)
     return _free_mass_point(_Point.from_parameters(*(float(np.ravel(a)[0]) for a in arrays)))
 
 
@@ -733,9 +740,7 @@ def fast_fpk_moments(harvester: Harvester, psd, *, nz=FAST_NZ, nv=FAST_NV):
     (:func:`free_mass_moments`); its E[z^2] and exceedance are nan.
     """
     nzs, nvs = _grid_pair("nz", nz), _grid_pair("nv", nv)
-    harvester.require_resistive("the FPK solver", CIRCUIT_METHODS)
-    harvester.potential.require("the FPK solver", CONFINING + ("free",))
-    arrays = memoryless_parameters(harvester, psd, "the FPK solver")
+    arrays = memoryless_parameters(harvester, psd, FAST_FOKKER_PLANCK)
     shape = arrays[0].shape
     out = np.empty((4,) + shape)
     for index in np.ndindex(shape):
@@ -743,7 +748,9 @@ def fast_fpk_moments(harvester: Harvester, psd, *, nz=FAST_NZ, nv=FAST_NV):
         if point.k == 0 and point.k3 == 0:
             moments = _free_mass_point(point)
         else:
-            _refuse_deep_wells_with_friction(point)
+            too_deep = _too_deep_with_friction(point)
+            if too_deep is not None:
+                raise FAST_FOKKER_PLANCK.beyond_validity(harvester, psd, too_deep)
             moments = _fast_point(point, nzs, nvs, harvester.stroke)
         out[(slice(None),) + index] = moments
     return tuple(scalar_or_array(o) for o in out)
@@ -757,20 +764,19 @@ def fast_fpk_moments(harvester: Harvester, psd, *, nz=FAST_NZ, nv=FAST_NV):
 FAST_MAX_BARRIER = 12.0
 
 
-def _refuse_deep_wells_with_friction(point) -> None:
-    """Refuse a double well with friction deeper than :data:`FAST_MAX_BARRIER`."""
+def _too_deep_with_friction(point) -> str | None:
+    """Why fpk-fast refuses a double well with friction deeper than :data:`FAST_MAX_BARRIER`, or None."""
     if not (point.k < 0 < point.k3 and point.fcm > 0 and point.gamma > 0):
-        return
+        return None
     barrier = point.k**2 / (4.0 * point.k3)
     scale = point.m * point.dd / (2.0 * point.gamma)  # m E[v^2] = m S m / (4 c), per kg
     depth = barrier / scale
-    if depth > FAST_MAX_BARRIER:
-        raise ValueError(
-            f"`method` 'fpk-fast' treats double wells with friction up to a barrier of "
-            f"{FAST_MAX_BARRIER:g} m E[v^2]; this one is {depth:.3g} m E[v^2] deep (its "
-            "one-well corrections fail there): use `method` 'fpk' (reference) or Monte Carlo "
-            "(randvib.simulate)"
-        )
+    if depth <= FAST_MAX_BARRIER:
+        return None
+    return (
+        f"treats double wells with friction up to a barrier of {FAST_MAX_BARRIER:g} m E[v^2]; "
+        f"this one is {depth:.3g} m E[v^2] deep (its one-well corrections fail there)"
+    )
 
 
 def _grid_pair(name, value):
@@ -812,3 +818,57 @@ def _fast_point(point, nzs, nvs, stroke=None):
         zs = [1, 3]
         best[zs] += (coarse_v[zs] - coarse_z[zs]) / ((nzs[0] / nzs[1]) ** 2 - 1.0)
     return best
+
+
+class FastFokkerPlanck(AnalyticMethod):
+    """The stationary FPK equation on small corrected grids (:func:`fast_fpk_statistics`).
+
+    The power and its k3 dependence to about 0.05 % of :class:`FokkerPlanck`
+    in about 3 ms a point: fast enough for sweeps. Any confining potential and
+    the free mass; double wells with friction up to a barrier of
+    :data:`FAST_MAX_BARRIER` m E[v^2] (refused beyond).
+    """
+
+    name = "fpk-fast"
+    title = "the FPK solver"
+    summary = "corrected small-grid FPK solution, resolves the k3 effect, 3 ms"
+    friction_form = "fc-tanh"
+    stroke_exceedance = True
+    validity = (
+        Validity(
+            "barrier_depth",
+            FAST_MAX_BARRIER,
+            "refuses",
+            "a double well's barrier k^2 / (4 k3) over the noise's energy m E[v^2], with "
+            "friction: its one-well corrections fail beyond",
+        ),
+    )
+
+    def solve(self, harvester: Harvester, psd) -> PowerPrediction:
+        vv, zz, av, beyond = fast_fpk_moments(harvester, psd)
+        return PowerPrediction.from_white_noise(harvester, self.name, vv, zz, av, psd, beyond)
+
+
+class FokkerPlanck(AnalyticMethod):
+    """The stationary FPK equation on fine grids, Richardson-extrapolated (:func:`fpk_statistics`).
+
+    The reference the other methods are measured against (converged to about
+    1e-5), about 0.5 s a point. Any confining potential and the free mass.
+    """
+
+    name = "fpk"
+    title = "the FPK solver"
+    summary = "fine-grid FPK solution, slow reference"
+    friction_form = "fc-tanh"
+    stroke_exceedance = True
+    reference = True
+
+    def solve(self, harvester: Harvester, psd) -> PowerPrediction:
+        vv, zz, av, beyond = fpk_moments(harvester, psd)
+        return PowerPrediction.from_white_noise(harvester, self.name, vv, zz, av, psd, beyond)
+
+
+#: The methods' declarations, which the functions of this module check their input against
+#: (:data:`randvib.analytic.prediction.METHODS` holds them).
+FAST_FOKKER_PLANCK = FastFokkerPlanck()
+FOKKER_PLANCK = FokkerPlanck()

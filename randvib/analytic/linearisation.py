@@ -1,4 +1,12 @@
-"""Equivalent linearisation of the harvester under white noise (paper Eq. 19-32).
+"""Equivalent linearisation under white noise (paper Eq. 19-32): the route's fast path.
+
+Statistical linearisation has one route,
+:func:`randvib.analytic.statistical_linearisation.linearise`: under white
+noise with a resistive coupling it takes the closed forms of this module
+(:func:`white_noise_linearisation`, which broadcasts over arrays of
+parameters and levels); under any other excitation, or with a circuit state,
+the fixed point with the Lyapunov solution
+(:func:`randvib.analytic.statistical_linearisation.statistical_linearisation`).
 
 The nonlinear device is replaced by the linear oscillator
 ``m z'' + c_eq z' + k z = m w(t)`` (Eq. 18) whose damping satisfies the
@@ -48,7 +56,7 @@ E[w(t1) w(t2)] = (S/2) delta(t2 - t1) (Eq. 17).
 
 from __future__ import annotations
 
-import warnings
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -57,6 +65,47 @@ from randvib.models.friction import coulomb_equivalent_damping
 from randvib.models.harvester import Harvester
 
 _BISECTION_STEPS = 200
+
+
+@dataclass(frozen=True, eq=False)
+class LinearisedDevice:
+    """The numbers of a statistical linearisation (SI units).
+
+    What :func:`~randvib.analytic.statistical_linearisation.linearise`
+    returns; :class:`~randvib.analytic.statistical_linearisation.LinearisationResult`
+    adds the harvester and the excitation. On the white-noise fast path the
+    fields broadcast over array parameters and levels.
+
+    Attributes
+    ----------
+    c_eq : float or ndarray
+        Equivalent damping c + E[v F(v)] / E[v^2] (Ns/m), paper Eq. 19.
+    k_eq : float or ndarray
+        Equivalent stiffness k + 3 k3 E[z^2] (N/m); 0 for the free mass.
+    velocity_variance : float or ndarray
+        E[v^2] ((m/s)^2) of the linearised device.
+    displacement_variance : float, ndarray or None
+        E[z^2] (m^2); None for the free mass (not stationary).
+    power_electrical : float or ndarray
+        E[P_e] (W): c_e E[v^2], or from the circuit state ((R_L + R_C) E[i^2],
+        E[V^2] / R_L).
+    power_load : float, ndarray or None
+        The share reaching R_L (W), when the harvester has a circuit.
+    circuit_variance : float or None
+        E[i^2] (A^2) or E[V^2] (V^2) of a circuit state; None without one.
+    method : str
+        How the variances were computed: ``white-noise`` (Eq. 20, the fast
+        path), ``lyapunov`` or ``spectral`` (the fixed point).
+    """
+
+    c_eq: object
+    k_eq: object
+    velocity_variance: object
+    displacement_variance: object
+    power_electrical: object
+    power_load: object
+    circuit_variance: object
+    method: str
 
 
 def _solve_velocity_std(c, m, psd, mean_velocity_force):
@@ -92,20 +141,7 @@ def _solve_velocity_std(c, m, psd, mean_velocity_force):
 EXPECTATIONS = ("auto", "closed-form", "fixed-point")
 
 
-def _renamed_method(expectation, method):
-    """``expectation`` from the deprecated alias ``method=`` of equivalent_damping."""
-    warnings.warn(
-        "equivalent_damping's `method` is deprecated: it is called `expectation` "
-        "(how E[v F(v)] is computed), with the same values",
-        DeprecationWarning,
-        stacklevel=3,
-    )
-    if expectation != "auto" and expectation != method:
-        raise ValueError("give `expectation` or its deprecated alias `method`, not both")
-    return method
-
-
-def equivalent_damping(harvester: Harvester, psd, expectation: str = "auto", *, method=None):
+def equivalent_damping(harvester: Harvester, psd, expectation: str = "auto"):
     """Equivalent viscous damping c_eq (Ns/m), paper Eq. 19-20 and 30.
 
     Parameters
@@ -122,8 +158,6 @@ def equivalent_damping(harvester: Harvester, psd, expectation: str = "auto", *, 
         ``fixed-point`` solves Eq. 19-20 with Gaussian expectations by
         quadrature, for any memoryless odd friction law; ``auto`` picks the
         closed form where it exists.
-    method : str, optional
-        Deprecated alias of ``expectation`` (emits a DeprecationWarning).
 
     Returns
     -------
@@ -139,8 +173,6 @@ def equivalent_damping(harvester: Harvester, psd, expectation: str = "auto", *, 
     >>> print(f"{rv.equivalent_damping(tanh, 1.0):.5f} Ns/m")  # Eq. 19-20, fixed point
     0.22949 Ns/m
     """
-    if method is not None:
-        expectation = _renamed_method(expectation, method)
     psd = check_positive("psd", psd, "(m/s^2)^2/Hz")
     check_choice("expectation", expectation, EXPECTATIONS)
     harvester.require_resistive(
@@ -194,3 +226,54 @@ def linear_displacement_variance(harvester: Harvester, velocity_variance):
     k_eq = 0.5 * (k + np.sqrt(k**2 + 12.0 * k3 * a))
     with np.errstate(divide="ignore"):
         return a / k_eq
+
+
+def white_noise_linearisation(harvester: Harvester, psd, expectation: str = "auto"):
+    """The white-noise fast path of statistical linearisation, resistive coupling (Eq. 19-20).
+
+    c_eq from :func:`equivalent_damping` (Eq. 30 in closed form for Coulomb
+    friction), E[v^2] = S m / (4 c_eq) (Eq. 20), the Gaussian-closure spring
+    (:func:`linear_displacement_variance`) and E[P_e] = c_e E[v^2] (Eq. 32).
+    Broadcasts over ``psd`` and array-valued harvester parameters.
+
+    Returns
+    -------
+    LinearisedDevice
+        ``method`` is ``white-noise``; for the free mass E[z^2] is None and
+        k_eq is 0.
+    """
+    c_eq = equivalent_damping(harvester, psd, expectation)
+    vv = np.asarray(psd) * harvester.m / (4.0 * np.asarray(c_eq))  # Eq. 20
+    if harvester.potential.is_free:
+        zz, k_eq = None, np.zeros_like(vv)
+    else:
+        zz = linear_displacement_variance(harvester, vv)
+        with np.errstate(invalid="ignore"):  # the free points of a grid: 0 * inf
+            k_eq = np.where(np.isfinite(zz), harvester.k + 3.0 * harvester.k3 * zz, 0.0)
+    power, load = linear_power(harvester, vv)
+    return LinearisedDevice(
+        c_eq=c_eq,
+        k_eq=scalar_or_array(k_eq),
+        velocity_variance=scalar_or_array(vv),
+        displacement_variance=None if zz is None else scalar_or_array(zz),
+        power_electrical=scalar_or_array(np.asarray(power)),
+        power_load=None if load is None else scalar_or_array(np.asarray(load)),
+        circuit_variance=None,
+        method="white-noise",
+    )
+
+
+def linear_power(harvester: Harvester, velocity, state=None):
+    """(electrical, load) power (W, or W/Hz for PSDs) from E[v^2] and the circuit's E[x^2].
+
+    Resistive coupling (or a bare c_e): c_e E[v^2] (Eq. 32) and the load's
+    share of it; a circuit state: the coupling's own powers of its mean
+    square ``state``. The load power is None without a coupling.
+    """
+    coupling = harvester.electrical
+    if coupling is None:
+        return harvester.c_e * velocity, None
+    if not coupling.is_dynamic:  # the former c_e E[v^2], to the same bits
+        power = harvester.c_e * velocity
+        return power, power * coupling.load_fraction
+    return coupling.power_electrical(velocity, state), coupling.power_load(velocity, state)

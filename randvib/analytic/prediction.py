@@ -1,314 +1,87 @@
-"""Analytic power prediction: one entry point, methods chosen by name.
+"""Analytic power prediction: the driver that picks a method by name and checks its answer.
 
-``predict(harvester, psd, method)`` returns a :class:`PowerPrediction`;
-``expected_power`` returns just the expected power. Methods register in
-:data:`METHODS`; ``"linearisation"`` is the paper's Eq. 19-32.
+``predict(harvester, psd, method)`` returns a
+:class:`~randvib.analytic.power_prediction.PowerPrediction`;
+``expected_power`` returns just the expected power. The methods are the
+family of :mod:`randvib.analytic.method`, listed in :data:`METHODS`:
+each declares what it accepts (coloured input, a circuit state, potentials,
+friction laws) and its validity, and the driver asks it before it computes;
+a refusal names the methods that do take the case.
 
 Which to use (numbers from the study ``linearisation-vs-averaging``):
 ``"linearisation"`` for quick estimates (low by up to 9 % at strong
-friction, blind to k3); ``"averaging"`` for a closed-form-like
+friction, blind to k3 under white noise; the only method for a non-white
+excitation or a circuit state); ``"averaging"`` for a closed-form-like
 non-Gaussian correction (within 2 %, but it overstates the k3 effect);
 ``"fpk-fast"`` for the power and its k3 dependence to within the Monte Carlo
 intervals (about 3 ms a point); ``"fpk"`` as the slow reference.
-
-``psd`` may also be an excitation object (:mod:`randvib.models.excitation`):
-:class:`~randvib.models.excitation.White` runs exactly the code of its
-level; a non-white one is accepted by the methods of :data:`COLOURED`
-(``"linearisation"``: statistical linearisation for any spectrum) and
-refused by the others, which assume white noise.
 """
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
-
 import numpy as np
-from scipy import optimize, special
+from scipy import optimize
 
-from randvib import _display
 from randvib._validation import (
     check_choice,
     check_nonnegative,
     check_positive,
     check_scalar,
     check_scalar_device,
-    scalar_or_array,
 )
-from randvib.analytic.averaging import averaging_statistics
-from randvib.analytic.fokker_planck import fast_fpk_moments, fpk_moments
-from randvib.analytic.linearisation import equivalent_damping, linear_displacement_variance
-from randvib.analytic.statistical_linearisation import statistical_linearisation
-from randvib.models.excitation import BROADCASTING, Excitation, as_excitation
+from randvib.analytic.averaging import AVERAGING
+from randvib.analytic.fokker_planck import FAST_FOKKER_PLANCK, FOKKER_PLANCK
+from randvib.analytic.method import AnalyticMethod, non_white, white_level
+from randvib.analytic.power_prediction import PowerPrediction
+from randvib.analytic.statistical_linearisation import LINEARISATION
+from randvib.models.excitation import BROADCASTING, Excitation
 from randvib.models.harvester import Harvester
-from randvib.models.potential import CONFINING
 
-
-@dataclass(frozen=True)
-class PowerPrediction:
-    """Stationary statistics predicted by an analytic method (SI units).
-
-    Attributes
-    ----------
-    method : str
-    c_eq : float or ndarray
-        Equivalent viscous damping (Ns/m), defined as S m / (4 E[v^2]) under
-        white noise; under another excitation the statistical linearisation's
-        c + E[v F(v)] / E[v^2] (the two agree under white noise).
-    velocity_variance : float or ndarray
-        E[z'^2] ((m/s)^2) (paper Eq. 20).
-    displacement_variance : float or ndarray
-        E[z^2] (m^2).
-    mean_abs_velocity : float or ndarray
-        E|z'| (m/s).
-    power_electrical : float or ndarray
-        E[P_e] = c_e E[z'^2] (W) (paper Eq. 31-32).
-    power_load : float, ndarray or None
-        E[i^2 R_L] (W), when the harvester has a circuit.
-    circuit_mean_square : float or None
-        E[i^2] (A^2) or E[V^2] (V^2) of a circuit state (inductive or piezo
-        coupling); None without one (and left out of :meth:`to_dict`).
-    stroke_exceedance : float, ndarray or None
-        P(|z| > stroke), the stationary fraction of time beyond the
-        harvester's stroke; None without a stroke, for the free mass and for
-        methods that do not give it (averaging). Linearisation's is the
-        Gaussian estimate erfc(stroke / sqrt(2 E[z^2])) (approximate; far off
-        for a double well, see :mod:`randvib.analytic.linearisation`).
-
-    ``displacement_variance`` is None for the free mass (k = k3 = 0): its
-    displacement has no stationary law.
-    """
-
-    method: str
-    c_eq: object
-    velocity_variance: object
-    displacement_variance: object
-    mean_abs_velocity: object
-    power_electrical: object
-    power_load: object = None
-    circuit_mean_square: object = None
-    stroke_exceedance: object = None
-
-    def to_dict(self) -> dict:
-        """Plain dict with floats or lists, ready for JSON.
-
-        ``circuit_mean_square`` and ``stroke_exceedance`` only when given.
-        """
-        out = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()}
-        for optional in ("circuit_mean_square", "stroke_exceedance"):
-            if out[optional] is None:
-                del out[optional]
-        return out
-
-    def _quantities(self) -> list[tuple[str, object, str]]:
-        """(name, value, unit) of every field with a value."""
-        out = [(name, getattr(self, name), unit) for name, unit in _UNITS.items()]
-        return [(name, value, unit) for name, value, unit in out if value is not None]
-
-    def to_frame(self):
-        """The prediction as a :class:`pandas.DataFrame`.
-
-        One row for scalar inputs; for a broadcast sweep one row per point
-        (the fields broadcast together and are flattened in C order, so row
-        ``i`` is ``numpy.unravel_index(i, shape)`` of the sweep's shape).
-        Columns are the fields (SI units, see the class) and ``method``.
-        """
-        pd = _display.pandas()
-        names = [name for name, _, _ in self._quantities()]
-        values = np.broadcast_arrays(
-            *(np.asarray(v, dtype=float) for _, v, _ in self._quantities())
-        )
-        frame = pd.DataFrame({n: v.ravel() for n, v in zip(names, values, strict=True)})
-        frame.insert(0, "method", self.method)
-        return frame
-
-    def _rows(self):
-        return [(name, _display.number(value), unit) for name, value, unit in self._quantities()]
-
-    def __repr__(self) -> str:
-        fields = ", ".join(
-            f"{name}={_display.number(value)}" for name, value, _ in self._quantities()
-        )
-        return f"PowerPrediction(method={self.method!r}, {fields})"
-
-    def _repr_html_(self) -> str:
-        return _display.html_table(f"Prediction ({self.method})", self._rows())
-
-
-#: Units of the fields of :class:`PowerPrediction`, in the order they are shown.
-_UNITS = {
-    "power_electrical": "W",
-    "power_load": "W",
-    "c_eq": "Ns/m",
-    "velocity_variance": "(m/s)^2",
-    "displacement_variance": "m^2",
-    "mean_abs_velocity": "m/s",
-    "circuit_mean_square": "A^2 or V^2",
-    "stroke_exceedance": "probability",
+#: The analytic methods by name, in the order the CLI and tables show them
+#: (as scipy's ``solve_ivp`` METHODS): instances of
+#: :class:`~randvib.analytic.method.AnalyticMethod`, whose declarations say
+#: what each accepts. ``"linearisation"``: statistical linearisation, paper
+#: Eq. 19-32 (:mod:`randvib.analytic.statistical_linearisation`);
+#: ``"averaging"``: energy-envelope stochastic averaging
+#: (:mod:`randvib.analytic.averaging`); ``"fpk-fast"``: the stationary FPK
+#: equation on small grids made exact without friction, with kink corrections
+#: and Richardson extrapolation, fast enough for sweeps; ``"fpk"``: the same
+#: equation on fine grids, the slow reference (:mod:`randvib.analytic.fokker_planck`).
+METHODS: dict[str, AnalyticMethod] = {
+    method.name: method for method in (LINEARISATION, AVERAGING, FAST_FOKKER_PLANCK, FOKKER_PLANCK)
 }
 
 
-def _finish(
-    harvester: Harvester,
-    method: str,
-    velocity_variance,
-    displacement_variance,
-    mean_abs_velocity,
-    psd,
-    stroke_exceedance=None,
-) -> PowerPrediction:
-    """Fill the derived fields common to every method.
-
-    The free mass's displacement statistics (not stationary) become None.
-    """
-    vv = np.asarray(velocity_variance, dtype=float)
-    c_eq = np.asarray(psd, dtype=float) * harvester.m / (4.0 * vv)
-    power = harvester.c_e * vv
-    power_load = None
-    if harvester.electrical is not None:
-        power_load = power * harvester.electrical.load_fraction
-
-    def clean(x):
-        return scalar_or_array(np.asarray(x, dtype=float))
-
-    free = harvester.potential.is_free
-    if free or harvester.stroke is None:
-        stroke_exceedance = None
-    return PowerPrediction(
-        method=method,
-        c_eq=clean(c_eq),
-        velocity_variance=clean(vv),
-        displacement_variance=None if free else clean(displacement_variance),
-        mean_abs_velocity=clean(mean_abs_velocity),
-        power_electrical=clean(power),
-        power_load=None if power_load is None else clean(power_load),
-        stroke_exceedance=None if stroke_exceedance is None else clean(stroke_exceedance),
-    )
+def method_named(method) -> AnalyticMethod:
+    """The method ``method`` names: a key of :data:`METHODS`, or an AnalyticMethod (class or instance)."""
+    if isinstance(method, type) and issubclass(method, AnalyticMethod):
+        return method()
+    if isinstance(method, AnalyticMethod):
+        return method
+    return METHODS[check_choice("method", method, tuple(METHODS))]
 
 
-def _linearisation(harvester: Harvester, psd) -> PowerPrediction:
-    c_eq = equivalent_damping(harvester, psd)
-    vv = np.asarray(psd) * harvester.m / (4.0 * np.asarray(c_eq))  # Eq. 20
-    zz = None if harvester.potential.is_free else linear_displacement_variance(harvester, vv)
-    return _finish(
-        harvester,
-        "linearisation",
-        vv,
-        zz,
-        np.sqrt(2.0 / np.pi * vv),
-        psd,
-        None if zz is None else _gaussian_exceedance(harvester.stroke, zz),
-    )
-
-
-def _gaussian_exceedance(stroke, displacement_variance):
-    """P(|z| > stroke) = erfc(stroke / sqrt(2 E[z^2])) of a zero-mean Gaussian z (or None)."""
-    if stroke is None:
-        return None
-    return special.erfc(stroke / np.sqrt(2.0 * np.asarray(displacement_variance, dtype=float)))
-
-
-def _averaging(harvester: Harvester, psd) -> PowerPrediction:
-    r = averaging_statistics(harvester, psd)
-    return _finish(
-        harvester,
-        "averaging",
-        r.velocity_variance,
-        r.displacement_variance,
-        r.mean_abs_velocity,
-        psd,
-    )
-
-
-def _fpk(harvester: Harvester, psd) -> PowerPrediction:
-    vv, zz, av, beyond = fpk_moments(harvester, psd)
-    return _finish(harvester, "fpk", vv, zz, av, psd, beyond)
-
-
-def _fpk_fast(harvester: Harvester, psd) -> PowerPrediction:
-    vv, zz, av, beyond = fast_fpk_moments(harvester, psd)
-    return _finish(harvester, "fpk-fast", vv, zz, av, psd, beyond)
-
-
-def _coloured_linearisation(harvester: Harvester, excitation: Excitation) -> PowerPrediction:
-    """Statistical linearisation under a non-white excitation (scalar parameters)."""
-    r = statistical_linearisation(harvester, excitation)
-    beyond = _gaussian_exceedance(harvester.stroke, r.displacement_variance)
-    return PowerPrediction(
-        method="linearisation",
-        c_eq=r.c_eq,
-        velocity_variance=r.velocity_variance,
-        displacement_variance=r.displacement_variance,
-        mean_abs_velocity=float(np.sqrt(2.0 / np.pi * r.velocity_variance)),  # Gaussian v
-        power_electrical=r.power_electrical,
-        power_load=r.power_load,
-        circuit_mean_square=r.circuit_variance,
-        stroke_exceedance=None if beyond is None else float(beyond),
-    )
-
-
-#: Analytic methods by name: callables (harvester, psd) -> PowerPrediction.
-#: ``"averaging"``: energy-envelope stochastic averaging (randvib.analytic.averaging);
-#: ``"fpk"``: finite-volume stationary FPK solution (randvib.analytic.fokker_planck),
-#: the slow reference; ``"fpk-fast"``: the same equation on small grids made
-#: exact without friction, with kink corrections and Richardson
-#: extrapolation (fokker_planck.fast_fpk_statistics), fast enough for sweeps.
-METHODS = {
-    "linearisation": _linearisation,
-    "averaging": _averaging,
-    "fpk-fast": _fpk_fast,
-    "fpk": _fpk,
-}
-
-#: The methods of :data:`METHODS` that accept a non-white excitation:
-#: callables (harvester, excitation) -> PowerPrediction. The others assume
-#: white noise (paper Eq. 17) and refuse it.
-COLOURED = {"linearisation": _coloured_linearisation}
-
-
-def _refuse_coloured(method: str, excitation: Excitation):
-    accepted = ", ".join(repr(name) for name in COLOURED)
-    raise ValueError(
-        f"method {method!r} assumes white noise; the {excitation.name!r} excitation is "
-        f"accepted by method {accepted} (and randvib.statistical_linearisation)"
-    )
-
-
-#: The methods of :data:`METHODS` that accept a coupling with a circuit state
-#: (coil inductance, piezo capacitance), under any excitation they accept:
-#: statistical linearisation with the circuit state in the linear system.
-CIRCUIT = {"linearisation": _coloured_linearisation}
-
-
-def _refuse_circuit(method: str, harvester: Harvester):
-    accepted = ", ".join(repr(name) for name in CIRCUIT)
-    raise ValueError(
-        f"method {method!r} assumes resistive coupling (a viscous c_e); the "
-        f"{harvester.electrical.name} coupling's circuit state is handled by method "
-        f"{accepted} (and randvib.simulate)"
-    )
-
-
-def predict(harvester: Harvester, psd, method: str = "linearisation") -> PowerPrediction:
+def predict(harvester: Harvester, psd, method="linearisation") -> PowerPrediction:
     """Predict the stationary response and power under white noise or another excitation.
 
     Parameters
     ----------
     harvester : Harvester
         Device; parameters may be arrays broadcasting with ``psd`` (scalars
-        under a non-white excitation).
+        under a non-white excitation or with a circuit state).
     psd : array_like or Excitation
         One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0 (white noise,
         paper Eq. 17), or an excitation object: ``White(S)`` is the same as
-        S; a non-white one needs a method of :data:`COLOURED`.
-    method : str
-        A key of :data:`METHODS`: ``"linearisation"`` (paper Eq. 19-32),
-        ``"averaging"`` (stochastic averaging, beyond Gaussian closure),
-        ``"fpk-fast"`` (small corrected FPK grids; the power and its k3
-        dependence to about 0.05 %, about 3 ms per point) or ``"fpk"`` (grid
-        solution of the stationary FPK equation; reference, about 0.5 s per
-        point). Only ``"linearisation"`` accepts a non-white excitation or
-        a coupling with a circuit state (inductive, piezo: the circuit is a
-        state of the linearised system, scalar parameters).
+        S; a non-white one needs a method that declares ``coloured``.
+    method : str or AnalyticMethod
+        A key of :data:`METHODS` (or a method object): ``"linearisation"``
+        (paper Eq. 19-32), ``"averaging"`` (stochastic averaging, beyond
+        Gaussian closure), ``"fpk-fast"`` (small corrected FPK grids; the
+        power and its k3 dependence to about 0.05 %, about 3 ms per point) or
+        ``"fpk"`` (grid solution of the stationary FPK equation; reference,
+        about 0.5 s per point). Only ``"linearisation"`` accepts a non-white
+        excitation or a coupling with a circuit state (inductive, piezo: the
+        circuit is a state of the linearised system, scalar parameters).
 
     Returns
     -------
@@ -317,21 +90,22 @@ def predict(harvester: Harvester, psd, method: str = "linearisation") -> PowerPr
     Raises
     ------
     ValueError
-        For an unknown method, a bad ``psd``, a non-white excitation with
-        a method that assumes white noise, a potential the method cannot
-        treat (one line naming what it accepts), a device with neither
-        damping nor friction (no stationary state), or values at which the
-        method's result is not a finite float64 (overflow at extreme parameters).
+        For an unknown method, a bad ``psd``, a case the method does not
+        accept (a non-white excitation, a circuit state, a potential or a
+        friction law it cannot treat: one line naming the methods that do),
+        a device with neither damping nor friction (no stationary state), or
+        values at which the method's result is not a finite float64 (overflow
+        at extreme parameters).
 
     Notes
     -----
     Potentials: every method refuses a non-confining potential (no
     stationary state); ``"averaging"`` treats the monostable one only;
     ``"fpk"``/``"fpk-fast"`` any confining potential and the free mass;
-    ``"linearisation"`` any confining potential and the free mass (exact
-    power without friction, Gaussian displacement; see
-    :mod:`randvib.analytic.linearisation`). For the free mass
-    ``displacement_variance`` and ``stroke_exceedance`` are None.
+    ``"linearisation"`` any confining potential, and the free mass under
+    white noise with a resistive coupling (exact power without friction,
+    Gaussian displacement; see :mod:`randvib.analytic.linearisation`). For
+    the free mass ``displacement_variance`` and ``stroke_exceedance`` are None.
 
     Examples
     --------
@@ -341,24 +115,15 @@ def predict(harvester: Harvester, psd, method: str = "linearisation") -> PowerPr
     2.4619e-03 W, E[z'^2] = 2.4619e-02 (m/s)^2
     >>> print(f"{rv.predict(rv.preset('figure9'), 1.0, 'fpk-fast').power_electrical:.4e} W")
     2.4642e-03 W
+    >>> rv.METHODS["averaging"].accepts(rv.preset("figure9"), rv.BandPass(1.0, 8.0, 0.1))
+    False
     """
-    check_choice("method", method, tuple(METHODS))
-    harvester.potential.require(f"method {method!r}", CONFINING + ("free",))
+    solver = method_named(method)
+    solver.require(harvester, psd)
     _refuse_undamped(harvester)
-    if harvester.has_circuit:
-        if method not in CIRCUIT:
-            _refuse_circuit(method, harvester)
-        if not isinstance(psd, Excitation):
-            psd = as_excitation(float(check_positive("psd", psd, "(m/s^2)^2/Hz")))
-        return _finite(method, harvester, psd, CIRCUIT[method])
-    if isinstance(psd, Excitation):
-        if not psd.is_white:
-            if method not in COLOURED:
-                _refuse_coloured(method, psd)
-            return _finite(method, harvester, psd, COLOURED[method])
-        psd = psd.level  # white: exactly the code of a plain number
-    check_positive("psd", psd, "(m/s^2)^2/Hz")
-    return _finite(method, harvester, psd, METHODS[method])
+    if not non_white(psd):  # White(S) runs exactly the code of the number S
+        psd = check_positive("psd", white_level(psd), "(m/s^2)^2/Hz")
+    return _finite(solver, harvester, psd)
 
 
 def _refuse_undamped(harvester: Harvester) -> None:
@@ -378,11 +143,12 @@ def _refuse_undamped(harvester: Harvester) -> None:
         )
 
 
-def _finite(method: str, harvester: Harvester, psd, solver) -> PowerPrediction:
-    """``solver(harvester, psd)``, refused where it is not a finite float64 (scalar case)."""
+def _finite(solver: AnalyticMethod, harvester: Harvester, psd) -> PowerPrediction:
+    """``solver.solve(harvester, psd)``, refused where it is not a finite float64 (scalar case)."""
+    method = solver.name
     try:
         with np.errstate(all="ignore"):
-            result = solver(harvester, psd)
+            result = solver.solve(harvester, psd)
     except (ArithmeticError, RuntimeError, ValueError) as exc:
         own = _raised_by_randvib(exc) and not isinstance(exc, ArithmeticError)
         if own and isinstance(exc, ValueError):

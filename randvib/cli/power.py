@@ -3,8 +3,10 @@
 Under white noise (the default) every method of
 :data:`randvib.analytic.prediction.METHODS` applies and the output is what
 it was before excitations existed; under another excitation only the methods
-of :data:`~randvib.analytic.prediction.COLOURED` (statistical linearisation)
-do, and the JSON gains an ``excitation`` object describing it.
+that declare they accept it (statistical linearisation) do, and the JSON
+gains an ``excitation`` object describing it. The ``--method`` choices, their
+help and the refusals come from the methods' declarations
+(:mod:`randvib.analytic.method`).
 
 Sweeps: every number of the device, its friction, coupling and excitation
 may be given several values (``--psd 1 0.5 0.1``) or a range
@@ -24,13 +26,7 @@ import itertools
 import math
 
 from randvib._io import check_output_file, dumps
-from randvib.analytic.prediction import (
-    CIRCUIT,
-    COLOURED,
-    METHODS,
-    optimal_load_resistance,
-    predict,
-)
+from randvib.analytic.prediction import METHODS, optimal_load_resistance, predict
 from randvib.cli._device import add_device_arguments, harvester_from_args, option_flag
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
 from randvib.cli._output import (
@@ -40,9 +36,6 @@ from randvib.cli._output import (
     print_table,
 )
 from randvib.models.excitation import PARAMETER_UNITS, Excitation
-
-#: The methods that report the stationary probability beyond the stroke.
-STROKE_METHODS = ("linearisation", "fpk-fast", "fpk")
 
 
 def register(sub) -> None:
@@ -59,11 +52,7 @@ def register(sub) -> None:
         default="linearisation",
         choices=tuple(METHODS),
         metavar="METHOD",
-        help=f"analytic method: {', '.join(METHODS)} (default linearisation, paper Eq. 32; "
-        "averaging: stochastic averaging, non-Gaussian velocity, 0.3 ms; "
-        "fpk-fast: corrected small-grid FPK solution, resolves the k3 effect, 2 ms; "
-        "fpk: fine-grid FPK solution, slow reference); a non-white excitation: "
-        f"{', '.join(COLOURED)} only",
+        help=_method_help(),
     )
     p.add_argument(
         "--optimal-load",
@@ -80,6 +69,18 @@ def register(sub) -> None:
     p.add_argument("--force", action="store_true", help="overwrite an existing --csv file")
     _allow_sweeps(p)
     p.set_defaults(handler=run)
+
+
+def _method_help() -> str:
+    """The ``--method`` help, from the methods' declarations."""
+    each = "; ".join(f"{name}: {method.summary}" for name, method in METHODS.items())
+    coloured = " or ".join(name for name, method in METHODS.items() if method.coloured)
+    circuit = " or ".join(name for name, method in METHODS.items() if method.circuit)
+    text = (
+        f"analytic method ({each}); a non-white excitation: {coloured} only; a coil "
+        f"inductance or piezo capacitance: {circuit} only"
+    )
+    return text.replace("%", "%%")  # argparse formats help with %
 
 
 #: The options that take a single value even in ``power`` (not physical numbers).
@@ -163,7 +164,7 @@ def _point(args) -> tuple[dict, object, object]:
     harvester = harvester_from_args(args)
     psd = excitation_from_args(args)
     coloured = isinstance(psd, Excitation)
-    _check_method(args.method, harvester, psd, coloured)
+    _check_method(args.method, harvester, psd)
     if args.optimal_load and harvester.electrical is None:
         raise ValueError(
             "`--optimal-load` needs a coupling: give `--alpha/--r-load/--r-coil` (resistive) "
@@ -198,23 +199,21 @@ def _point(args) -> tuple[dict, object, object]:
     return out, harvester, psd
 
 
-def _check_method(method: str, harvester, psd, coloured: bool) -> None:
-    """Refuse a method that does not apply to this excitation, coupling or stroke."""
-    if coloured and method not in COLOURED:
-        accepted = ", ".join(f"`--method {name}`" for name in COLOURED)
-        raise ValueError(
-            f"`--method {method}` assumes white noise; the {psd.name} excitation needs {accepted}"
+def _check_method(name: str, harvester, psd) -> None:
+    """Refuse a method that does not take this case, or gives no stroke exceedance for `--stroke`.
+
+    One line from the methods' declarations, naming those that do.
+    """
+    method = METHODS[name]
+    method.require(harvester, psd)
+    if harvester.stroke is not None and not method.stroke_exceedance:
+        allowed = " or ".join(
+            f"`--method {other}`"
+            for other, declared in METHODS.items()
+            if declared.stroke_exceedance and declared.accepts(harvester, psd)
         )
-    if harvester.has_circuit and method not in CIRCUIT:
-        accepted = ", ".join(f"`--method {name}`" for name in CIRCUIT)
         raise ValueError(
-            f"`--method {method}` assumes the resistive coupling; the "
-            f"{harvester.coupling_name} coupling's circuit state needs {accepted}"
-        )
-    if harvester.stroke is not None and method not in STROKE_METHODS:
-        allowed = " or ".join(f"`--method {name}`" for name in STROKE_METHODS)
-        raise ValueError(
-            f"`--stroke` needs {allowed}: `--method {method}` gives no stroke exceedance"
+            f"`--stroke` needs {allowed}: `--method {name}` gives no stroke exceedance"
         )
 
 

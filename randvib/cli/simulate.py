@@ -13,7 +13,7 @@ from __future__ import annotations
 from randvib._display import estimate_parts
 from randvib._io import dumps
 from randvib._validation import MAX_SEED, integer_option
-from randvib.analytic.prediction import predict
+from randvib.analytic.prediction import METHODS, predict
 from randvib.cli._device import add_device_arguments, harvester_from_args
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
 from randvib.cli._output import (
@@ -124,9 +124,9 @@ def run(args) -> int:
         print(dumps(summary))
         return 0
     analytic = None
-    if harvester.friction is None or harvester.friction.has_equivalent_damping:
+    if METHODS["linearisation"].accepts(harvester, psd):
         try:
-            analytic = predict(harvester, psd)
+            analytic = predict(harvester, psd, "linearisation")
         except ValueError:  # e.g. no zero-mean Gaussian solution for this double well
             analytic = None
     rows = []

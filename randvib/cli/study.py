@@ -1,6 +1,7 @@
 """``randvib study NAME --out DIR``: run one of the study scripts.
 
-The studies are scripts in the ``studies/`` folder of a randvib checkout
+The studies are the scripts of the top-level ``studies/`` folder, installed
+with the package as :mod:`randvib.study_scripts`
 (:data:`randvib.studies.STUDIES`, found by :func:`randvib.studies.load`);
 each defines ``run_study(out_dir, *, quick=False, seed=0, workers=None,
 scheduler=None, progress=True) -> Path`` (the Markdown report it wrote).
@@ -23,7 +24,8 @@ def register(sub) -> None:
     p = sub.add_parser(
         "study",
         help="run a study script (figures, CSV, Markdown report)",
-        description="Run one of the study scripts of the checkout's studies/ folder; "
+        description="Run one of the study scripts (the studies/ folder, installed with the "
+        "package as randvib.study_scripts); "
         "writes PNG figures, CSV tables and a Markdown report into --out.",
     )
     p.add_argument("name", choices=STUDIES, metavar="NAME", help=f"study: {', '.join(STUDIES)}")

@@ -230,7 +230,8 @@ class Excitation:
 
     #: Short name used by the CLI and tables.
     name: str = "excitation"
-    #: True for ideal white noise (the paper's model; every method accepts it).
+    #: True for ideal white noise (the paper's model, which every analytic method
+    #: accepts; each declares whether it accepts another, ``AnalyticMethod.coloured``).
     is_white: bool = False
 
     def __init_subclass__(cls, **kwargs):
@@ -326,46 +327,6 @@ def as_excitation(value) -> Excitation:
     # own words); predict, expected_power and equivalent_damping take arrays
     value = check_scalar("psd", value, f"a white-noise level S in {_PSD_UNIT}", BROADCASTING)
     return White(float(check_positive("psd", value, _PSD_UNIT)))
-
-
-#: The methods that accept a non-white excitation, as the refusals of the
-#: white-noise-only methods (stochastic averaging, the FPK solvers) name them.
-COLOURED_METHODS = (
-    "statistical linearisation (randvib.statistical_linearisation, or "
-    "predict/expected_power with method='linearisation')",
-    "Monte Carlo (randvib.simulate: filter states for band-pass and Kanai-Tajimi, "
-    "spectral synthesis for band-limited and tabulated spectra; "
-    "randvib.simulate_on_record for a measured record)",
-)
-
-
-def white_level(value, method: str):
-    """The white-noise PSD S for a method that assumes white noise.
-
-    A plain number or array is returned as is (so existing callers are
-    untouched), :class:`White` gives its ``level``; any other excitation is
-    refused, naming :data:`COLOURED_METHODS`.
-
-    Parameters
-    ----------
-    value : float, array_like or Excitation
-        The ``psd`` argument of a white-noise method ((m/s^2)^2/Hz).
-    method : str
-        The caller, named in the error ("stochastic averaging").
-
-    Raises
-    ------
-    ValueError
-        For a non-white excitation.
-    """
-    if not isinstance(value, Excitation):
-        return value
-    if value.is_white:
-        return value.level
-    raise ValueError(
-        f"{method} assumes white noise (paper Eq. 17); the {value.name!r} excitation is "
-        f"accepted by {'; '.join(COLOURED_METHODS)}"
-    )
 
 
 # ------------------------------------------------------------ rational

@@ -22,14 +22,17 @@ It declares everything the rest of randvib needs:
   function pointer, so a new law needs no edit anywhere else.
 * **memory** - ``n_states`` (LuGre's bristle deflection: 1) and, for the
   record simulator's sub-cycling, :meth:`FrictionModel.kernel_relaxation_rate`.
-* **analytic methods** - ``mean_velocity_force`` (E[v F(v)] for Gaussian v,
-  paper Eq. 19: equivalent linearisation; by quadrature unless a law gives a
-  closed form, refused for laws with memory);
-  ``closed_form_equivalent_damping`` (Coulomb: Eq. 30);
-  ``coulomb_tanh_form`` (``F = Fc tanh(beta v)``, beta = inf for Coulomb: the
-  form stochastic averaging and the FPK solvers are written for); and
-  ``stick_slip`` (how the record simulator's event-located stick-slip
-  integrator reads ``p``). :attr:`FrictionModel.analytic_methods` lists them.
+* **what the analytic methods read** - ``has_equivalent_damping`` and
+  ``mean_velocity_force`` (E[v F(v)] for Gaussian v, paper Eq. 19:
+  equivalent linearisation; by quadrature unless a law gives a closed form,
+  refused for laws with memory); ``closed_form_equivalent_damping``
+  (Coulomb: Eq. 30); ``coulomb_tanh_form`` (``F = Fc tanh(beta v)``, beta =
+  inf for Coulomb: the form stochastic averaging and the FPK solvers are
+  written for). Which methods take a law is theirs to say: each declares the
+  friction form it treats (:data:`randvib.analytic.method.FRICTION_FORMS`;
+  ``randvib.METHODS[name].accepts_friction(law)``);
+* **stick-slip** - ``stick_slip`` (how the record simulator's event-located
+  stick-slip integrator reads ``p``).
 * **a name** - ``name``, used by the CLI, identification and tables.
 
 Defining a subclass with its own ``name`` registers it in
@@ -183,16 +186,6 @@ class FrictionModel(DeclaredParameters):
         (their orbit integrals and kink corrections use Fc and beta).
         """
         return None
-
-    @property
-    def analytic_methods(self) -> tuple[str, ...]:
-        """The analytic methods that accept this law."""
-        out = []
-        if self.has_equivalent_damping:
-            out.append("linearisation")
-        if self.coulomb_tanh_form() is not None:
-            out += ["averaging", "fpk"]
-        return tuple(out)
 
     # --------------------------------------------------------- compiled code
     @staticmethod

@@ -30,8 +30,8 @@ from scipy import linalg
 
 from randvib.analytic import exact_solutions as exact
 from randvib.analytic.linear_response import device_block, output_variances
-from randvib.analytic.linearisation import equivalent_damping, linear_displacement_variance
-from randvib.analytic.statistical_linearisation import statistical_linearisation
+from randvib.analytic.linearisation import linear_displacement_variance
+from randvib.analytic.statistical_linearisation import linearise
 from randvib.models.excitation import Excitation, Tabulated, as_excitation
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import integrators
@@ -50,31 +50,30 @@ class StepSizeWarning(RuntimeWarning):
 def effective_linear_device(harvester: Harvester, psd: float) -> tuple[float, float]:
     """(k_eff, c_eff) of the linearised device, for step-size checks.
 
-    k_eff = k + 3 k3 E[z^2] with E[z^2] from the exact friction-free density
-    (friction only shrinks the motion, so this stiffness is an upper bound in
-    the mean); c_eff = c_eq from equivalent linearisation, or c for LuGre.
-    With a circuit state, (k_eq, c_eq) of the statistical linearisation with
-    the circuit (a law with memory left out: it only adds damping).
-    Any confining potential: for a double well E[z^2] ~ z_w^2 at low noise,
-    so k_eff ~ -2 k, the wells' own stiffness; the free mass has k_eff = 0.
+    Statistical linearisation's one route
+    (:func:`randvib.analytic.statistical_linearisation.linearise`) at the
+    white-noise level ``psd``, with a friction law that has memory (LuGre)
+    left out: it only adds damping. c_eff is its c_eq (Eq. 30 for Coulomb
+    friction); with a circuit state k_eff is its k_eq. Otherwise k_eff =
+    k + 3 k3 E[z^2] with E[z^2] from the exact friction-free (Gibbs) density
+    where there is viscous damping (friction only shrinks the motion, so this
+    stiffness is an upper bound in the mean), and the linearisation's k_eq
+    without. Any confining potential: for a double well E[z^2] ~ z_w^2 at low
+    noise, so k_eff ~ -2 k, the wells' own stiffness; the free mass has k_eff = 0.
     """
     h = harvester
+    if h.friction is not None and not h.friction.has_equivalent_damping:
+        h = h.updated(friction=None)
+    lin = linearise(h, psd)
     if h.has_circuit:
-        if h.friction is not None and not h.friction.has_equivalent_damping:
-            h = h.updated(friction=None)
-        r = statistical_linearisation(h, psd)
-        return r.k_eq, r.c_eq
-    c_eff = float(h.c)
-    if h.friction is None or h.friction.has_equivalent_damping:
-        c_eff = float(equivalent_damping(h, psd))
+        return lin.k_eq, lin.c_eq
+    c_eff = float(lin.c_eq)
     if h.potential.is_free:
         return 0.0, c_eff
     if h.c > 0:
         z2 = exact.gibbs_displacement_moment(h.m, h.c, h.k, h.k3, psd)
-    else:
-        vv = psd * h.m / (4.0 * c_eff)
-        z2 = float(linear_displacement_variance(h, vv))
-    return float(h.k + 3.0 * h.k3 * z2), c_eff
+        return float(h.k + 3.0 * h.k3 * z2), c_eff
+    return float(lin.k_eq), c_eff
 
 
 @dataclass(frozen=True, eq=False)
@@ -276,8 +275,8 @@ def largest_step(scheme: str, harvester: Harvester, psd, bias: float = MAX_STEP_
 def _linearised_under(harvester: Harvester, excitation: Excitation) -> tuple:
     """(k_eq, c_eq, E[z^2], E[v^2]) of the device linearised under a non-rational input.
 
-    Statistical linearisation (:func:`randvib.statistical_linearisation`) for
-    memoryless friction; with a friction state (LuGre) the viscous device
+    Statistical linearisation's route (:func:`randvib.analytic.statistical_linearisation.linearise`)
+    for memoryless friction; with a friction state (LuGre) the viscous device
     (k, c) and its spectral variances. Used for the step check and the
     random start when the input is synthesised or recorded: there the scheme
     integrates the device alone, the input's step integral being exact.
@@ -285,7 +284,7 @@ def _linearised_under(harvester: Harvester, excitation: Excitation) -> tuple:
     h = harvester
     excitation = coarsened(excitation)
     if h.friction is None or h.friction.has_equivalent_damping:
-        res = statistical_linearisation(h, excitation)
+        res = linearise(h, excitation)
         return res.k_eq, res.c_eq, res.displacement_variance, res.velocity_variance
     block = device_block(float(h.m), float(h.c), float(h.k), h.electrical)
     var = output_variances(block, excitation)

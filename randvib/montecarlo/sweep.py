@@ -57,7 +57,6 @@ from randvib._progress import progress_bar
 from randvib._validation import MAX_SEED, check_int, check_positive
 from randvib.analytic.prediction import METHODS, predict
 from randvib.models.harvester import Harvester
-from randvib.montecarlo.integrators import scheme_argument
 from randvib.statistics import estimate
 
 STATISTICS = ("power_electrical", "velocity_variance", "displacement_variance", "mean_abs_velocity")
@@ -93,8 +92,7 @@ class SweepSettings:
     burn_in : float
         Discarded initial time per path (s).
     scheme : str
-        Integrator name (:data:`randvib.montecarlo.integrators.INTEGRATORS`);
-        ``method=`` is accepted as a deprecated alias.
+        Integrator name (:data:`randvib.montecarlo.integrators.INTEGRATORS`).
     target_rel_ci : float
         Stop adding paths when the relative 95 % half-width of E[P_e] is at or
         below this (e.g. 0.005 for 0.5 %).
@@ -128,16 +126,6 @@ class SweepSettings:
         check_int("max_paths", self.max_paths, self.min_paths)
         check_int("seed", self.seed, 0, MAX_SEED)
 
-    @property
-    def method(self) -> str:
-        """Deprecated alias of :attr:`scheme`."""
-        warnings.warn(
-            "SweepSettings.method is deprecated; use SweepSettings.scheme",
-            DeprecationWarning,
-            stacklevel=2,
-        )
-        return self.scheme
-
     def to_dict(self) -> dict:
         """The settings as JSON-ready values, with the integrator under its JSON key ``method``.
 
@@ -146,22 +134,6 @@ class SweepSettings:
         """
         out = asdict(self)
         return {("method" if k == "scheme" else k): v for k, v in out.items()}
-
-
-def _accept_method_alias(init):
-    """Wrap ``SweepSettings.__init__`` to take ``method=`` as a deprecated ``scheme=``."""
-
-    @functools.wraps(init)
-    def wrapped(self, *args, method=None, **kwargs):
-        if method is not None:
-            name, _ = scheme_argument(kwargs.pop("scheme", None), method)
-            kwargs["scheme"] = name
-        init(self, *args, **kwargs)
-
-    return wrapped
-
-
-SweepSettings.__init__ = _accept_method_alias(SweepSettings.__init__)
 
 
 def validate_points(base: Harvester, points: Iterable[Mapping]) -> list[dict]:
@@ -183,8 +155,8 @@ def point_device(base: Harvester, point: Mapping) -> Harvester:
 
 def _analytic(device: Harvester, psd: float) -> dict:
     out = {}
-    for name in METHODS:
-        if name == "fpk":  # reference solver: too slow to run at every sweep point
+    for name, method in METHODS.items():
+        if method.reference:  # too slow to run at every sweep point
             continue
         try:
             out[f"{name}_power"] = float(predict(device, psd, name).power_electrical)
@@ -193,8 +165,73 @@ def _analytic(device: Harvester, psd: float) -> dict:
     return out
 
 
+def simulate_to_precision(
+    device: Harvester,
+    excitation,
+    settings: SweepSettings,
+    *,
+    seed: int,
+    initial="stationary",
+    threads: int | None = None,
+):
+    """One ensemble simulated to the settings' precision, in batches of paths.
+
+    The first batch has ``settings.min_paths`` paths; batches follow (path
+    streams continuing the ensemble: ``first_path`` = the paths so far) until
+    the 95 % half-width of E[P_e] is at most ``settings.target_rel_ci`` of it
+    or ``settings.max_paths`` is reached (min_paths = max_paths: a fixed size).
+
+    Parameters
+    ----------
+    device : Harvester
+    excitation : float or Excitation
+        As :func:`randvib.simulate` takes it.
+    settings : SweepSettings
+    seed : int
+        The ensemble's seed: path i is stream (seed, i).
+    initial : "stationary", "rest" or (z0, v0)
+        The start of every path (:func:`randvib.simulate`).
+    threads : int, optional
+        numba threads (default: as set).
+
+    Returns
+    -------
+    SimulationResult
+        Of all the batches' paths.
+    """
+    from randvib.montecarlo.simulation import simulate
+
+    kw = dict(
+        t_end=settings.burn_in + settings.window,
+        dt=settings.dt,
+        burn_in=settings.burn_in,
+        scheme=settings.scheme,
+        seed=seed,
+        initial=initial,
+        companion=settings.control_variates,
+        control_variates=settings.control_variates,
+        threads=threads,
+        progress=False,
+    )
+    batches = [simulate(device, excitation, n_paths=settings.min_paths, first_path=0, **kw)]
+    n = settings.min_paths
+    while True:
+        per_path = np.vstack([b.per_path for b in batches])
+        result = dataclasses.replace(batches[0], per_path=per_path)
+        rel = result.power_electrical.relative_ci95
+        if not (rel > settings.target_rel_ci) or n >= settings.max_paths:
+            return result
+        # paths needed if the spread stays the same (CI ~ n^-1/2), plus 10 %
+        wanted = math.ceil(n * (rel / settings.target_rel_ci) ** 2 * 1.1)
+        extra = max(wanted - n, settings.batch_paths)
+        extra = math.ceil(extra / settings.batch_paths) * settings.batch_paths
+        extra = min(extra, settings.max_paths - n)
+        batches.append(simulate(device, excitation, n_paths=extra, first_path=n, **kw))
+        n += extra
+
+
 def run_point(base: Harvester, point: Mapping, settings: SweepSettings, threads: int | None = 1):
-    """Simulate one point to the target precision.
+    """Simulate one point to the target precision (:func:`simulate_to_precision`).
 
     Returns
     -------
@@ -204,53 +241,22 @@ def run_point(base: Harvester, point: Mapping, settings: SweepSettings, threads:
         Per-path accumulators (:mod:`randvib.montecarlo.kernel` columns) for paired
         comparisons between points.
     """
-    import numba
-
-    from randvib.montecarlo.simulation import simulate
-
-    if threads is not None:
-        numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
     device = point_device(base, point)
     psd = float(point["psd"])
     started = time.perf_counter()
-    kw = dict(
-        t_end=settings.burn_in + settings.window,
-        dt=settings.dt,
-        burn_in=settings.burn_in,
-        scheme=settings.scheme,
-        seed=settings.seed,
-        companion=settings.control_variates,
-        control_variates=settings.control_variates,
-        progress=False,
-    )
-    batches = [simulate(device, psd, n_paths=settings.min_paths, first_path=0, **kw)]
-    n = settings.min_paths
-    while True:
-        per_path = np.vstack([b.per_path for b in batches])
-        result = dataclasses.replace(batches[0], per_path=per_path)
-        stat = result.power_electrical
-        rel = stat.relative_ci95
-        if not (rel > settings.target_rel_ci) or n >= settings.max_paths:
-            break
-        # paths needed if the spread stays the same (CI ~ n^-1/2), plus 10 %
-        wanted = math.ceil(n * (rel / settings.target_rel_ci) ** 2 * 1.1)
-        extra = max(wanted - n, settings.batch_paths)
-        extra = math.ceil(extra / settings.batch_paths) * settings.batch_paths
-        extra = min(extra, settings.max_paths - n)
-        batches.append(simulate(device, psd, n_paths=extra, first_path=n, **kw))
-        n += extra
+    result = simulate_to_precision(device, psd, settings, seed=settings.seed, threads=threads)
     row = {**{k: float(v) for k, v in point.items()}, **_analytic(device, psd)}
     for name in STATISTICS:
         s = getattr(result, name)
         row[name] = s.mean
         row[f"{name}_ci95"] = s.ci95
     row.update(
-        n_paths=n,
+        n_paths=result.n_paths,
         averaging_time=settings.window,
-        simulated_time=n * (settings.window + settings.burn_in),
+        simulated_time=result.n_paths * (settings.window + settings.burn_in),
         wall_time=time.perf_counter() - started,
     )
-    return row, per_path
+    return row, result.per_path
 
 
 # ------------------------------------------------------------------ executors
@@ -368,25 +374,49 @@ class SweepResult:
         return c_e * PathAverages(self.per_path[index]).v2
 
 
-class _PointStore:
-    """A sweep's result folder: one JSON row and one ``.npy`` of per-path data per point.
+class PointStore:
+    """A result folder of many ensembles: one JSON row and one ``.npy`` of per-path data each.
 
-    Every finished point is written atomically (unique temporary name, then
-    rename), so an interrupted sweep resumes from the points already on disk;
-    the JSON holds the point, its row, and the shape and SHA-256 of the
-    ``.npy``, and every stored point is checked when resumed (its grid point,
-    finite statistics, the array's checksum, shape and finite values); a bad
-    one is named in a warning and recomputed. ``results.csv`` is rebuilt from
-    the rows on every run and after each point. A folder holding another sweep
-    (different identity) is refused untouched, and the folder is locked while
-    the sweep writes (:func:`randvib._io.prepare_output_dir`).
+    The store of :func:`run_sweep` (a sweep's points) and of
+    :func:`randvib.montecarlo.ensembles.run_ensembles` (paired cases). Every
+    finished point is written atomically (unique temporary name, then
+    rename), so an interrupted run resumes from the points already on disk;
+    the JSON holds the point's key (what it is: a grid point, a case), its
+    row, and the shape and SHA-256 of the ``.npy``, and every stored point is
+    checked when resumed (its key, finite ``required`` statistics, the row's
+    and the array's checksums, shape and finite values); a bad one is named
+    in a warning and recomputed. With a ``table`` name the rows are written
+    as that CSV on every run and after each point. A folder holding another
+    run (different identity) is refused untouched, and the folder is locked
+    while the run writes (:func:`randvib._io.prepare_output_dir`).
+
+    Parameters
+    ----------
+    out_dir : path-like
+    identity : dict
+        What makes two runs the same (JSON-ready).
+    required : tuple of str
+        Row entries that must be finite numbers in a stored point.
+    table : str or None
+        File name of the CSV of the rows, or None for none.
+    what : str
+        What a point is called in a warning ("sweep point", "case").
     """
 
     FORMAT = 2
 
-    def __init__(self, out_dir, identity: dict):
+    def __init__(
+        self,
+        out_dir,
+        identity: dict,
+        *,
+        required: tuple = (*STATISTICS, "n_paths"),
+        table: str | None = "results.csv",
+        what: str = "sweep point",
+    ):
         self.out = prepare_output_dir(out_dir, identity)
         (self.out / "points").mkdir(exist_ok=True)
+        self.required, self.table, self.what = tuple(required), table, what
 
     def _paths(self, index: int) -> Path:
         return self.out / "points" / f"{index:05d}.npy"
@@ -394,24 +424,24 @@ class _PointStore:
     def _row(self, index: int) -> Path:
         return self.out / "points" / f"{index:05d}.json"
 
-    def load_finished(self, points: list):
-        """Rows and per-path arrays of the good points already on disk."""
+    def load_finished(self, keys: list):
+        """Rows and per-path arrays of the good points already on disk (``keys``: JSON-ready)."""
         rows, per_path = {}, {}
-        for i, point in enumerate(points):
+        for i, key in enumerate(keys):
             if not (self._row(i).exists() or self._paths(i).exists()):
                 continue
             try:
-                rows[i], per_path[i] = self._load(i, point)
+                rows[i], per_path[i] = self._load(i, key)
             except _BadPoint as exc:
                 warnings.warn(
-                    f"sweep point {i} in {str(self.out / 'points')!r} is unusable ({exc}); "
+                    f"{self.what} {i} in {str(self.out / 'points')!r} is unusable ({exc}); "
                     "recomputing it",
-                    stacklevel=3,
+                    stacklevel=4,
                 )
         self.write_table(rows)
         return rows, per_path
 
-    def _load(self, index: int, point: Mapping):
+    def _load(self, index: int, key: dict):
         """One stored point, checked; :class:`_BadPoint` says what is wrong."""
         from randvib.montecarlo.kernel import N_ACC
 
@@ -424,9 +454,9 @@ class _PointStore:
         if not isinstance(stored, dict) or stored.get("format") != self.FORMAT:
             raise _BadPoint(f"{row_file.name} is not a point record of this randvib version")
         row, shape = stored.get("row"), stored.get("shape")
-        if stored.get("point") != _jsonable_point(point) or not isinstance(row, dict):
+        if stored.get("point") != key or not isinstance(row, dict):
             raise _BadPoint(f"{row_file.name} holds another grid point: {stored.get('point')}")
-        values = [row.get(k) for k in (*STATISTICS, "n_paths")]
+        values = [row.get(k) for k in self.required]
         if not all(isinstance(v, int | float) and math.isfinite(v) for v in values):
             raise _BadPoint(f"{row_file.name} lacks finite statistics")
         if _row_checksum(row) != stored.get("row_sha256"):
@@ -443,9 +473,10 @@ class _PointStore:
             raise _BadPoint(f"{npy_file.name} has shape {paths.shape}, expected {shape}")
         if not np.all(np.isfinite(paths)):
             raise _BadPoint(f"{npy_file.name} holds non-finite values")
-        return row, paths
+        # stored as null (JSON has no NaN): a statistic not computable at this point
+        return {k: math.nan if v is None else v for k, v in row.items()}, paths
 
-    def save(self, index: int, point: Mapping, row: dict, paths: np.ndarray, rows: dict) -> None:
+    def save(self, index: int, key: dict, row: dict, paths: np.ndarray, rows: dict) -> None:
         buffer = io.BytesIO()
         np.save(buffer, paths, allow_pickle=False)
         data = buffer.getvalue()
@@ -453,7 +484,7 @@ class _PointStore:
         row = finite_json(row, "not computable at this point")[0]
         stored = {
             "format": self.FORMAT,
-            "point": _jsonable_point(point),
+            "point": key,
             "row": row,
             "row_sha256": _row_checksum(row),
             "shape": list(paths.shape),
@@ -463,7 +494,8 @@ class _PointStore:
         self.write_table(rows)
 
     def write_table(self, rows: dict) -> None:
-        atomic_write_text(self.out / "results.csv", _table(rows).to_csv(index=False))
+        if self.table is not None:
+            atomic_write_text(self.out / self.table, _table(rows).to_csv(index=False))
 
     def close(self) -> None:
         unlock_folder(self.out)
@@ -486,13 +518,81 @@ def _table(rows: dict) -> pd.DataFrame:
     return pd.DataFrame([{"point": i, **rows[i]} for i in sorted(rows)])
 
 
-def _computed_points(base, points, settings, todo, executor):
-    """Yield ``(index, row, per_path)`` for each point in ``todo`` as it finishes."""
+def run_stored(
+    calls: list,
+    keys: list,
+    store: PointStore | None,
+    *,
+    executor: Executor | None = None,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    progress: bool = True,
+    name: str = "sweep",
+    unit: str = "point",
+) -> tuple[dict, dict]:
+    """Run every call not finished in ``store``; return the rows and per-path arrays by index.
+
+    The loop of :func:`run_sweep` and :func:`randvib.montecarlo.ensembles.run_ensembles`.
+
+    Parameters
+    ----------
+    calls : list of (function, args)
+        ``function(*args, threads=...)`` returns ``(row, per_path)``; it must be
+        picklable for worker processes or a cluster. In-process it gets
+        ``threads=None`` (numba's threads as set), on a worker ``threads=1``.
+    keys : list of dict
+        What each call computes, JSON-ready: stored with its result and
+        checked when resumed.
+    store : PointStore or None
+        Finished points are loaded from it, and each new one saved at once;
+        it is closed (unlocked) at the end.
+    executor, workers, scheduler : Executor, int, str, optional
+        Where the calls run: a given executor, else ``workers`` local
+        processes or the Dask cluster at ``scheduler`` (:func:`make_executor`;
+        one worker: in-process).
+    progress : bool
+        A progress bar over the calls, ``name`` and ``unit`` on it.
+    """
+    rows: dict[int, dict] = {}
+    per_path: dict[int, np.ndarray] = {}
+    if store is not None:
+        try:
+            rows, per_path = store.load_finished(keys)
+        except BaseException:
+            store.close()
+            raise
+    todo = [i for i in range(len(calls)) if i not in rows]
+    bar = None
+    if progress and todo:
+        bar = progress_bar(len(calls), initial=len(calls) - len(todo), desc=name, unit=unit)
+    own_close = None
+    try:
+        if executor is None and todo:
+            executor, own_close = make_executor(workers, scheduler)
+        for i, row, paths in _computed(calls, todo, executor):
+            rows[i], per_path[i] = row, paths
+            if store is not None:
+                store.save(i, keys[i], row, paths, rows)
+            if bar is not None:
+                bar.update()
+    finally:
+        if bar is not None:
+            bar.close()
+        if own_close is not None:
+            own_close()
+        if store is not None:
+            store.close()
+    return rows, per_path
+
+
+def _computed(calls, todo, executor):
+    """Yield ``(index, row, per_path)`` for each call in ``todo`` as it finishes."""
     if executor is None:
         for i in todo:
-            yield (i, *run_point(base, points[i], settings, threads=None))
+            function, args = calls[i]
+            yield (i, *function(*args, threads=None))
         return
-    futures = {executor.submit(run_point, base, points[i], settings, 1): i for i in todo}
+    futures = {executor.submit(calls[i][0], *calls[i][1], threads=1): i for i in todo}
     for fut in as_completed(futures):
         yield (futures[fut], *fut.result())
 
@@ -511,6 +611,10 @@ def run_sweep(
 ) -> SweepResult:
     """Run a sweep, optionally writing and resuming in ``out_dir``.
 
+    Every point runs on the seed ``settings.seed`` (common random numbers);
+    :func:`randvib.montecarlo.ensembles.run_ensembles` runs cases of any
+    devices, inputs and starts in groups of their own seeds.
+
     Parameters
     ----------
     base : Harvester
@@ -519,8 +623,9 @@ def run_sweep(
         Parameter points (:func:`cartesian` builds grids); each needs ``psd``.
     settings : SweepSettings
     out_dir : path-like, optional
-        Folder for ``results.csv``, ``metadata.json`` and ``points/``.
-        Finished points found there are loaded, not recomputed.
+        Folder for ``results.csv``, ``metadata.json`` and ``points/``
+        (:class:`PointStore`). Finished points found there are loaded, not
+        recomputed.
     executor : concurrent.futures.Executor, optional
         Where points run; default: ``workers`` local processes, or the Dask
         cluster at ``scheduler``.
@@ -531,8 +636,6 @@ def run_sweep(
     # the sweep's power columns are c_e E[v^2]; a circuit state has its own
     base.require_resistive("run_sweep", "randvib.simulate, point by point")
     points = validate_points(base, points)
-    rows: dict[int, dict] = {}
-    per_path: dict[int, np.ndarray] = {}
     store = None
     if out_dir is not None:
         identity = {
@@ -541,33 +644,17 @@ def run_sweep(
             "points": points,
             "settings": settings.to_dict(),
         }
-        store = _PointStore(out_dir, identity)
-        try:
-            rows, per_path = store.load_finished(points)
-        except BaseException:
-            store.close()
-            raise
-    todo = [i for i in range(len(points)) if i not in rows]
-    bar = None
-    if progress and todo:
-        bar = progress_bar(len(points), initial=len(points) - len(todo), desc=name, unit="point")
-    own_close = None
-    try:
-        if executor is None and todo:
-            executor, own_close = make_executor(workers, scheduler)
-        for i, row, paths in _computed_points(base, points, settings, todo, executor):
-            rows[i], per_path[i] = row, paths
-            if store is not None:
-                store.save(i, points[i], row, paths, rows)
-            if bar is not None:
-                bar.update()
-    finally:
-        if bar is not None:
-            bar.close()
-        if own_close is not None:
-            own_close()
-        if store is not None:
-            store.close()
+        store = PointStore(out_dir, identity)
+    rows, per_path = run_stored(
+        [(run_point, (base, p, settings)) for p in points],
+        [_jsonable_point(p) for p in points],
+        store,
+        executor=executor,
+        workers=workers,
+        scheduler=scheduler,
+        progress=progress,
+        name=name,
+    )
     return SweepResult(table=_table(rows), settings=settings, points=points, per_path=per_path)
 
 

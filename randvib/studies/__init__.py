@@ -1,23 +1,32 @@
 """Building blocks for studies, and the finder of the study scripts.
 
-A study is a short script in the ``studies/`` folder of a randvib checkout,
+A study is a short script in the top-level ``studies/`` folder, installed with
+the package as :mod:`randvib.study_scripts` (a packaging mapping, no copies),
 written against the public API the way a user would write their own sweep:
 compute (a sweep, contrasts), tables, figures, a report with verdicts. What
 such scripts share lives here:
 
-- :mod:`~randvib.studies.grids`: friction and Duffing levels, Coulomb grids, burn-in;
-- :mod:`~randvib.studies.contrasts`: paired interaction contrasts with Holm's
-  correction, and analytic predictions of the same contrasts;
+- :mod:`~randvib.studies.grids`: friction and Duffing levels, Coulomb grids, burn-in,
+  coloured inputs at equal response, fixed-size ensemble settings;
+- :mod:`~randvib.studies.contrasts`: paired interaction contrasts (of a sweep, or
+  within the groups of :func:`randvib.run_ensembles`) with Holm's correction, and
+  analytic predictions of the same contrasts;
+- :mod:`~randvib.studies.budget`: the power at a stroke-exceedance budget, and paired
+  gains over a linear device;
 - :mod:`~randvib.studies.accuracy`: where an analytic method can be trusted (trusted
   ranges of the friction level, the collapse of series that scale exactly);
 - :mod:`~randvib.studies.campaign`: an identification campaign (synthetic shaker
   records, resumable fits, their tables);
 - :mod:`~randvib.studies.methods`: every analytic method against paired Monte Carlo
-  runs, and the accuracy criteria for a fast method;
-- :mod:`~randvib.studies.stepcheck`: the sweep with its half-step re-run, and its verdict;
+  runs (a sweep's or :func:`randvib.run_ensembles`'), and the accuracy criteria for a
+  fast method;
+- :mod:`~randvib.studies.half_step`: the sweep with its half-step re-run, and its verdict
+  (the time-step bias of a study's sweep; the linear test system's step bias is
+  :mod:`randvib.montecarlo.step_check`);
 - :mod:`~randvib.studies.verdicts`: the verdict sentences, built from the numbers;
 - :mod:`~randvib.studies.evidence`: rows that repeat one experiment (exact rescalings);
-- :mod:`~randvib.studies.figures`: figures of power and contrasts against Fc;
+- :mod:`~randvib.studies.figures`: figures of power and contrasts against Fc or the
+  bandwidth, power against stroke exceedance, methods' errors against the level;
 - :mod:`~randvib.studies.report`: CSV, ``verdicts.json``, Markdown tables, ``report.md``.
 
 Every figure is drawn in :mod:`randvib.figure_style` (shared with the
@@ -25,8 +34,9 @@ identification plots).
 
 Every script defines ``run_study(out_dir, *, quick=False, seed=0,
 workers=None, scheduler=None, progress=True) -> Path`` (the report it wrote);
-``workers`` always means local worker *processes* (the sweeps'), and a study
-that simulates in-process on numba threads takes ``threads`` as well.
+``workers`` always means local worker *processes* (of its sweep or
+:func:`randvib.run_ensembles`), and a study that simulates in-process on numba
+threads takes ``threads`` as well.
 :func:`load` finds a script by its name (``randvib study NAME`` runs it).
 """
 
@@ -41,8 +51,9 @@ from pathlib import Path
 from randvib._interrupts import interrupted_exit, sigterm_stops
 from randvib._validation import MAX_SEED, integer_option
 
-#: Where the study scripts are: ``studies/`` beside the package in a checkout.
-STUDIES_DIR = Path(__file__).resolve().parents[2] / "studies"
+#: The package of the study scripts: the top-level ``studies/`` folder, which
+#: pyproject.toml installs as this subpackage.
+SCRIPTS_PACKAGE = "randvib.study_scripts"
 
 #: The registered studies (``randvib study NAME``), each ``studies/NAME.py`` with
 #: dashes as underscores.
@@ -58,39 +69,49 @@ STUDIES = (
 )
 
 
+def _scripts_package():
+    """:mod:`randvib.study_scripts`, from the ``studies/`` folder that belongs to this randvib.
+
+    An install (wheel, ``pip install .`` or editable) maps the folder into the
+    package. A source tree imported without installing it (``PYTHONPATH``, a
+    scratch copy of the project) has the folder beside the package instead;
+    that one is taken first, so the scripts always come with the package
+    they were written for, never from another checkout's install.
+    """
+    if SCRIPTS_PACKAGE in sys.modules:
+        return sys.modules[SCRIPTS_PACKAGE]
+    beside = Path(__file__).resolve().parents[2] / "studies"
+    if not (beside / "__init__.py").is_file():
+        return importlib.import_module(SCRIPTS_PACKAGE)
+    spec = importlib.util.spec_from_file_location(
+        SCRIPTS_PACKAGE, beside / "__init__.py", submodule_search_locations=[str(beside)]
+    )
+    package = importlib.util.module_from_spec(spec)
+    sys.modules[SCRIPTS_PACKAGE] = package
+    try:
+        spec.loader.exec_module(package)
+    except BaseException:
+        del sys.modules[SCRIPTS_PACKAGE]
+        raise
+    sys.modules["randvib"].study_scripts = package  # as an import would set it
+    return package
+
+
 def load(name: str):
-    """The module of the study script ``name`` (loaded once, then the same object).
+    """The module of the study script ``name``: ``randvib.study_scripts.NAME``.
+
+    Imported once, then the same object (a test's monkeypatch and the CLI
+    see the same module).
 
     Raises
     ------
     ValueError
-        ``name`` is not a registered study, or its script is not in
-        :data:`STUDIES_DIR` (an installed copy without the checkout's
-        ``studies/`` folder).
+        ``name`` is not a registered study.
     """
     if name not in STUDIES:
         raise ValueError(f"unknown study {name!r}; available: {', '.join(STUDIES)}")
-    stem = name.replace("-", "_")
-    module_name = f"randvib_study_{stem}"
-    # cached, so that a test's monkeypatch and the CLI see the same module
-    if module_name in sys.modules:
-        return sys.modules[module_name]
-    path = STUDIES_DIR / f"{stem}.py"
-    if not path.is_file():
-        raise ValueError(
-            f"study {name!r} is a script in the `studies/` folder of a randvib checkout, "
-            f"and {path} does not exist; run it from a clone of the repository "
-            "(pip install -e .)"
-        )
-    spec = importlib.util.spec_from_file_location(module_name, path)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[module_name] = module
-    try:
-        spec.loader.exec_module(module)
-    except BaseException:
-        del sys.modules[module_name]
-        raise
-    return module
+    package = _scripts_package()
+    return importlib.import_module(f"{package.__name__}.{name.replace('-', '_')}")
 
 
 def add_run_options(parser: argparse.ArgumentParser) -> None:

@@ -7,9 +7,11 @@ Duffing spring),
 
 is zero when the effect of b on the expected power does not depend on a.
 :func:`interaction_contrasts` estimates it from common-random-number paths
-with a per-contrast test and Holm's step-down over the family;
-:func:`predicted_contrasts` and :func:`predicted_contrast_curves` give an
-analytic method's value of the same contrast.
+of a sweep with a per-contrast test and Holm's step-down over the family,
+:func:`paired_interactions` within the groups of a paired run
+(:func:`randvib.run_ensembles`); :func:`predicted_contrasts` and
+:func:`predicted_contrast_curves` give an analytic method's value of the
+same contrast.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from randvib.statistics import holm_significant, two_sided_p_value
 
 __all__ = [
     "interaction_contrasts",
+    "paired_interactions",
     "predicted_contrast_curves",
     "predicted_contrasts",
 ]
@@ -126,6 +129,66 @@ def interaction_contrasts(
     table = pd.DataFrame(rows)
     table["detectable_holm"] = holm_significant(table.p_value, level)
     return table
+
+
+def paired_interactions(result, a: str, b: str, *, predicted: dict | None = None) -> pd.DataFrame:
+    """Interaction contrasts of two labels within each group of a paired run.
+
+    For every case with labels ``a`` and ``b`` both non-zero, the contrast
+
+        [P(a, b) - P(a, 0)] - [P(0, b) - P(0, 0)]
+
+    with the three partner cases of its group (same labels but ``a``/``b``),
+    estimated path by path on their common paths
+    (:meth:`randvib.EnsembleResult.paired`). No test is applied here: the
+    caller chooses the family for Holm's correction
+    (:func:`randvib.statistics.holm_significant`).
+
+    Parameters
+    ----------
+    result : EnsembleResult
+    a, b : str
+        Labels of the two factors (e.g. ``"fc"`` and ``"k3"``).
+    predicted : dict, optional
+        Name -> one value per case (W; e.g. an analytic power): the same
+        contrast of these values, relative to their own P(a, 0), as
+        ``{name}_relative_contrast``.
+
+    Returns
+    -------
+    DataFrame
+        The case's labels but ``a``; ``contrast`` and ``contrast_ci95`` (W),
+        ``reference`` (P(a, 0), W), ``relative_contrast``, ``relative_ci95``,
+        ``p_value`` (two-sided), ``n_paths``; the predicted columns; and
+        ``{b}_alone_relative``, the paired effect of ``b`` without ``a``,
+        [P(0, b) - P(0, 0)] / P(0, 0). One row per contrast, in case order.
+    """
+    table = result.table
+    rows = []
+    for i, case in enumerate(result.cases):
+        if case.labels[a] == 0 or case.labels[b] == 0:
+            continue
+        a0 = result.partner(i, **{b: 0.0})
+        b0, zero = result.partner(i, **{a: 0.0}), result.partner(i, **{a: 0.0, b: 0.0})
+        four = {i: 1.0, a0: -1.0, b0: -1.0, zero: 1.0}
+        s = result.paired(four)
+        reference = table.power_electrical[a0]
+        row = {k: v for k, v in case.labels.items() if k != a}
+        row.update({
+            "contrast": s.mean, "contrast_ci95": s.ci95, "reference": reference,
+            "relative_contrast": s.mean / reference, "relative_ci95": s.ci95 / reference,
+            "p_value": two_sided_p_value(s), "n_paths": s.n_paths,
+        })  # fmt: skip
+        for name, values in (predicted or {}).items():
+            value = np.asarray(values, dtype=float)
+            combined = value[i] - value[a0] - value[b0] + value[zero]
+            row[f"{name}_relative_contrast"] = combined / value[a0]
+        alone = result.paired({b0: 1.0, zero: -1.0})
+        row[f"{b}_alone_relative"] = alone.mean / table.power_electrical[zero]
+        rows.append(row)
+    if not rows:
+        raise ValueError(f"no case of the run has both `{a}` and `{b}` non-zero")
+    return pd.DataFrame(rows)
 
 
 def _power(device, psd, method):

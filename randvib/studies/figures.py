@@ -1,4 +1,5 @@
-"""Figures the studies share: power and contrasts against the Coulomb level.
+"""Figures the studies share: power and contrasts against the Coulomb level or the bandwidth,
+power against stroke exceedance, the methods' errors against the input level.
 
 Each function draws from a study's table, saves one PNG at ``path``
 (:func:`randvib.figure_style.save_figure`) and returns the path; nothing
@@ -332,5 +333,154 @@ def k3_change_against_kappa(df: pd.DataFrame, labels: dict, path: Path) -> Path:
         f"P(k$_3$ = {num_tex(max(k3s))}) / P(k$_3$ = {num_tex(min(k3s))}) − 1 (%)"
     )
     fig.legend(*axes[0, 0].get_legend_handles_labels(), loc="outside lower center", ncol=3)
+    panel_letters(axes)
+    return save_figure(fig, path)
+
+
+def _bandwidth_axis(ax, zetas) -> None:
+    """Log zeta axis, narrowing to the right, ticks at the given zetas only; a zero line."""
+    from matplotlib.ticker import NullFormatter
+
+    ticks = sorted(z for z in set(zetas) if np.isfinite(z))
+    ax.set_xscale("log")
+    ax.set_xlim(ticks[-1] * 1.3, ticks[0] / 1.3)  # reversed: the band narrows to the right
+    ax.set_xticks(ticks, [f"{z:g}" for z in ticks])
+    ax.xaxis.set_minor_formatter(NullFormatter())
+    ax.set_xlabel("band-pass damping ratio $\\zeta$ (narrower →)")
+    ax.grid(alpha=0.3, which="major", lw=0.5)
+    ax.axhline(0.0, color="0.5", lw=0.5)
+
+
+@styled
+def error_against_bandwidth(results: pd.DataFrame, centres, path: Path) -> Path:
+    """Linearisation's relative error (%) against the band's zeta, a panel per k3, a line per centre.
+
+    ``results`` has, per band (``centre``, ``zeta``; white noise as centre
+    "white", drawn dotted) and device (``fc`` (N), ``k3``),
+    ``linearisation_rel_error`` and its ``_ci95``; the rows with friction
+    are drawn.
+    """
+    lin = results[results.fc > 0]
+    k3s = sorted(lin.k3.unique())
+    fig, axes = new_figure(1, len(k3s), figsize=(3.2 * len(k3s) + 0.4, 3.4), sharey=True)
+    for ax, k3 in zip(axes[0], k3s, strict=True):
+        for centre in centres:
+            sub = lin[(lin.centre == centre) & (lin.k3 == k3)].sort_values("zeta")
+            ax.errorbar(sub.zeta, 100 * sub.linearisation_rel_error,
+                        yerr=100 * sub.linearisation_rel_error_ci95, marker="o", ms=4, capsize=2,
+                        label=f"centre {centre} f$_n$")  # fmt: skip
+        for error in lin[(lin.centre == "white") & (lin.k3 == k3)].linearisation_rel_error[:1]:
+            ax.axhline(100 * error, color="k", ls=":", lw=1, label="white noise")
+        _bandwidth_axis(ax, lin.zeta)
+        fc = 1e3 * lin[lin.k3 == k3].fc.iloc[0]
+        ax.set_title(f"F$_c$ = {fc:g} mN, k$_3$ = {num_tex(k3)} N/m$^3$", fontsize=9)
+    axes[0, 0].set_ylabel("linearisation error in E[P$_e$] (%)")
+    axes[0, 0].legend(fontsize=7)
+    panel_letters(axes)
+    return save_figure(fig, path)
+
+
+@styled
+def contrast_against_bandwidth(inter: pd.DataFrame, centres, labels: dict, path: Path) -> Path:
+    """Relative interaction contrast (%) against the band's zeta, a panel per centre, a line per k3.
+
+    ``inter`` holds the contrasts of :func:`randvib.studies.contrasts.paired_interactions`
+    per band (``centre``, ``zeta``) with ``linearisation_relative_contrast``
+    (dashed); ``labels`` names some k3 values in the legend.
+    """
+    fig, axes = new_figure(1, len(centres), figsize=(10, 3.6), sharey=True)
+    for ax, centre in zip(axes[0], centres, strict=True):
+        for i, k3 in enumerate(sorted(inter.k3.unique())):
+            sub = inter[(inter.centre == centre) & (inter.k3 == k3)].sort_values("zeta")
+            ax.errorbar(sub.zeta, 100 * sub.relative_contrast, yerr=100 * sub.relative_ci95,
+                        marker="o", ms=4, capsize=2, color=colour(i),
+                        label=_k3_label(k3, labels))  # fmt: skip
+            ax.plot(sub.zeta, 100 * sub.linearisation_relative_contrast, "--", color=colour(i),
+                    lw=1)  # fmt: skip
+        _bandwidth_axis(ax, inter.zeta)
+        ax.set_title(f"band centred {centre} the linear resonance", fontsize=9)
+    axes[0, 0].set_ylabel("interaction contrast / P(F$_c$, 0) (%)")
+    axes[0, 0].legend(fontsize=7, title="markers: Monte Carlo (95 %); dashed: linearisation",
+                      title_fontsize=7)  # fmt: skip
+    panel_letters(axes)
+    return save_figure(fig, path)
+
+
+@styled
+def power_against_exceedance(
+    results: pd.DataFrame, devices, budget: float, stroke: float, path: Path
+) -> Path:
+    """Power against stroke exceedance over the levels, a panel per input, a line per device.
+
+    ``results`` holds per ``input``, level ``g`` and ``device`` the Monte
+    Carlo ``power_mc`` (W) and ``exceedance_mc`` (fraction of time with
+    |z| > ``stroke`` (m)) with their ``_ci95``; the ``budget`` is a
+    vertical line.
+    """
+    from matplotlib.ticker import LogLocator
+
+    inputs = list(dict.fromkeys(results.input))
+    fig, axes = new_figure(1, len(inputs), figsize=(3.6 * len(inputs), 3.4), sharey=True)
+    for ax, name in zip(axes[0], inputs, strict=True):
+        for dev in devices:
+            sub = results[(results.input == name) & (results.device == dev)].sort_values("g")
+            shown = sub.exceedance_mc > 0
+            ax.errorbar(sub.exceedance_mc[shown], 1e3 * sub.power_mc[shown],
+                        xerr=sub.exceedance_mc_ci95[shown], yerr=1e3 * sub.power_mc_ci95[shown],
+                        marker="o", ms=3, capsize=2, label=dev)  # fmt: skip
+        ax.axvline(budget, color="k", ls=":", lw=1, label=f"budget: {100 * budget:g} % of the time")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        for axis in (ax.xaxis, ax.yaxis):
+            # minor ticks at 2 and 5 only: on a narrow range all eight minor labels collide
+            axis.set_minor_locator(LogLocator(subs=(2.0, 5.0)))
+        ax.set_xlabel(f"fraction of time with |z| > {1e3 * stroke:g} mm")
+        ax.set_title(name, fontsize=9)
+        ax.grid(alpha=0.3, lw=0.5)
+    axes[0, 0].set_ylabel("E[P$_e$] (mW), Monte Carlo")
+    axes[0, 0].legend(fontsize=7, title="markers: levels g; bars: 95 % CI", title_fontsize=7)
+    panel_letters(axes)
+    return save_figure(fig, path)
+
+
+@styled
+def method_errors_against_level(methods: pd.DataFrame, devices, path: Path) -> Path:
+    """Relative errors of the methods against the level g, power and exceedance, a marker per device.
+
+    ``methods`` is a table of :func:`randvib.studies.methods.methods_against_monte_carlo`
+    with the level ``g`` and ``device`` among its labels. A colour per
+    method, a marker per device, 95 % bars; the error axis is linear while
+    every error is within ±10 %, symmetric-log beyond.
+    """
+    from matplotlib.ticker import FuncFormatter, NullFormatter
+
+    fig, axes = new_figure(1, 2, figsize=(9, 3.8))
+    markers = dict(zip(devices, "osD^v", strict=False))
+    levels = sorted(methods.g.unique())
+    for ax, q in zip(axes[0], ("power", "exceedance"), strict=True):
+        for i, (method, rows) in enumerate(methods.groupby("method", sort=False)):
+            for dev, sub in rows.dropna(subset=[f"{q}_rel_error"]).groupby("device"):
+                ax.errorbar(sub.g * (1.04**i), 100 * sub[f"{q}_rel_error"],
+                            yerr=100 * sub[f"{q}_rel_error_ci95"], ls="none", marker=markers[dev],
+                            ms=3.5, capsize=1.5, color=colour(i),
+                            label=f"{method}, {dev}")  # fmt: skip
+        ax.axhline(0.0, color="0.5", lw=0.5, zorder=1)
+        ax.set_xscale("log")
+        ax.set_xticks(levels, [f"{g:g}" for g in levels])
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        reach = (methods[f"{q}_rel_error"].abs() + methods[f"{q}_rel_error_ci95"]).max()
+        if 100 * reach > 10:
+            ax.set_yscale("symlog", linthresh=10)
+            ax.yaxis.set_major_formatter(FuncFormatter(lambda y, _: f"{y:g}"))
+        ax.set_xlabel("level factor g (all inputs)")
+        ax.set_ylabel(f"error in {q} against Monte Carlo (%)")
+    handles, labels = {}, []
+    for ax in axes[0]:
+        for h, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            if label not in handles:
+                handles[label] = h
+                labels.append(label)
+    fig.legend([handles[k] for k in labels], labels, loc="outside lower center", ncol=4,
+               title="colour: method; marker: device; bars: 95 % CI")  # fmt: skip
     panel_letters(axes)
     return save_figure(fig, path)

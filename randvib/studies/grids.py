@@ -4,15 +4,19 @@ The dimensionless levels used across the studies: the friction level
 phi = Fc / (c sigma_v0) (:func:`friction_level`) and the Duffing strength
 mu = k3 sigma_z0^2 / k (:func:`duffing_strength`), with sigma_v0, sigma_z0 the
 friction-free linear oscillator's rms velocity and displacement (paper Eq. 20).
+Coloured inputs are compared with white noise at equal response
+(:func:`response_matched`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from randvib.analytic.linear_response import mechanical_block, output_variances
 from randvib.analytic.linearisation import coulomb_equivalent_damping
+from randvib.models.excitation import Excitation
 from randvib.models.harvester import Harvester
-from randvib.montecarlo.sweep import cartesian
+from randvib.montecarlo.sweep import SweepSettings, cartesian
 
 
 def fc_where_power_halves(device: Harvester, psd: float) -> float:
@@ -108,3 +112,41 @@ def burn_in_for(devices, relaxation_times: float = 6.0, resolution: float = 0.5)
     """
     tau = max(float(d.m) / float(d.c) for d in devices)
     return float(np.ceil(relaxation_times * tau / resolution) * resolution)
+
+
+def response_matched(shape: Excitation, device: Harvester, psd: float) -> Excitation:
+    """``shape`` rescaled so that the linear device responds as to white noise of level ``psd``.
+
+    The level makes E[z'^2] of ``device``'s linear, friction-free part
+    (m, c = c_m + c_e, k; no cubic term, no friction) equal to white noise's
+    S m / (4 c) (paper Eq. 20) at S = ``psd`` ((m/s^2)^2/Hz). That device then
+    dissipates c E[z'^2] = S m / 4, the power white noise injects into any
+    device: the coloured input delivers the same power to the reference
+    device as the white one. E[z'^2] under ``shape`` is the Lyapunov solution
+    of device and shaping filter.
+
+    Parameters
+    ----------
+    shape : BandPass or KanaiTajimi
+        The spectrum's shape, at any level.
+    device : Harvester
+    psd : float
+        The white-noise level S to match ((m/s^2)^2/Hz).
+    """
+    linear = output_variances(mechanical_block(device.m, device.c, device.k), shape)["v"]
+    level = shape.level * psd * device.m / (4 * device.c) / linear
+    return type(shape)(level, shape.f0, shape.zeta)
+
+
+def fixed_paths(
+    n_paths: int, window: float, *, dt: float, burn_in: float, seed: int, scheme: str = "heun"
+) -> SweepSettings:
+    """Settings of ensembles of exactly ``n_paths`` paths (no precision target), plain means.
+
+    ``window`` and ``burn_in`` (s) per path, step ``dt`` (s), the run's
+    ``seed``; no control variates (they need white noise, and a study that
+    compares inputs keeps one estimator for all).
+    """
+    return SweepSettings(dt=dt, window=window, burn_in=burn_in, scheme=scheme, min_paths=n_paths,
+                         max_paths=n_paths, batch_paths=n_paths, seed=seed,
+                         control_variates=False)  # fmt: skip

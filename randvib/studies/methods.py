@@ -17,6 +17,13 @@ exceeds 3 %, at most 5 % everywhere, and the k3 interaction's sign and size
 inside the Monte Carlo interval. The Coulomb level is set by the
 dimensionless kappa = 4 Fc^2 / (pi S m c) (the group of paper Eq. 30: Eq. 32
 halves the power at kappa = 1/4).
+
+For the cases of a paired run (:func:`randvib.run_ensembles`), any device,
+input and stroke: :func:`methods_against_monte_carlo` (every method's power
+and stroke exceedance against Monte Carlo, or why it refused),
+:func:`method_accuracy` and :func:`accuracy_sentences` (its summary), and
+:func:`linearisation_against_monte_carlo` (statistical linearisation with its
+equivalent stiffness and damping); :func:`relative_error` is their error.
 """
 
 from __future__ import annotations
@@ -30,7 +37,8 @@ import pandas as pd
 from randvib.analytic.averaging import AveragingValidityWarning, averaging_statistics
 from randvib.analytic.fokker_planck import fast_fpk_statistics, fpk_statistics
 from randvib.analytic.linearisation import equivalent_damping
-from randvib.analytic.prediction import expected_power
+from randvib.analytic.prediction import expected_power, predict
+from randvib.analytic.statistical_linearisation import statistical_linearisation
 from randvib.models.presets import preset
 from randvib.montecarlo import kernel
 from randvib.montecarlo.simulation import simulate
@@ -364,3 +372,151 @@ def reading(df: pd.DataFrame, timings: dict | None = None) -> str:
         f"{100 * fast:.3f} % at every point{speed}."
     )
     return " ".join(parts)
+
+
+# ----------------------------------------------------------------- the cases of a paired run
+def relative_error(value, reference, ci95):
+    """(value / reference - 1, its 95 % half-width): a prediction against a Monte Carlo estimate.
+
+    The half-width is the estimate's ``ci95`` propagated to first order,
+    value * ci95 / reference^2.
+    """
+    return value / reference - 1.0, value * ci95 / reference**2
+
+
+def predictions(device, excitation, methods) -> list[dict]:
+    """Every method's power (W) and stroke exceedance at one case, or why it refused.
+
+    One row per method: ``method``, ``power``, ``exceedance`` (NaN where the
+    method gives none) and ``refused`` (the first clause of the refusal, ''
+    where it predicted). Averaging's validity warnings are not repeated here.
+    """
+    rows = []
+    for method in methods:
+        row = {"method": method, "power": np.nan, "exceedance": np.nan, "refused": ""}
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", AveragingValidityWarning)
+            try:
+                p = predict(device, excitation, method)
+            except ValueError as err:
+                row["refused"] = str(err).split(";")[0][:160]
+                rows.append(row)
+                continue
+        row["power"] = float(p.power_electrical)
+        if p.stroke_exceedance is not None:
+            row["exceedance"] = float(p.stroke_exceedance)
+        rows.append(row)
+    return rows
+
+
+def methods_against_monte_carlo(result, methods, *, resolved: float = 0.25) -> pd.DataFrame:
+    """Every method at every case of a paired run (:class:`randvib.EnsembleResult`) against Monte Carlo.
+
+    One row per case and method: the case's labels, the columns of
+    :func:`predictions`, then ``power_rel_error`` and ``exceedance_rel_error``
+    with their ``_ci95`` (:func:`relative_error`). An exceedance is compared
+    only where Monte Carlo resolves it (its 95 % half-width at most
+    ``resolved`` times the estimate); NaN where not compared.
+    """
+    rows = []
+    for i, case in enumerate(result.cases):
+        mc = result.table.iloc[i]
+        for row in predictions(case.device, case.excitation, methods):
+            row = {**case.labels, **row}
+            for q, name in (("power", "power_electrical"), ("exceedance", "stroke_exceedance")):
+                ref, ci = mc.get(name, np.nan), mc.get(f"{name}_ci95", np.nan)
+                ok = ref > 0 and (q == "power" or ci <= resolved * ref) and np.isfinite(row[q])
+                error = relative_error(row[q], ref, ci) if ok else (np.nan, np.nan)
+                row[f"{q}_rel_error"], row[f"{q}_rel_error_ci95"] = error
+            rows.append(row)
+    return pd.DataFrame(rows)
+
+
+def method_accuracy(methods: pd.DataFrame, where: str, by: str) -> dict:
+    """Per method of :func:`methods_against_monte_carlo`'s table: how far from Monte Carlo, and where.
+
+    Per method: the cases refused and in all, the negative stroke
+    exceedances (a probability below zero) and the most negative one; per
+    quantity (``power``, ``exceedance``; None where none was compared) the
+    cases compared, the largest |error| with its half-width and where
+    (``where`` formatted with that row's columns, e.g. "{device}, g = {g:g}"),
+    the cases whose error is within the Monte Carlo interval, and the
+    largest |error| by the values of column ``by``.
+    """
+    out = {}
+    for method, rows in methods.groupby("method", sort=False):
+        entry = {
+            "refused": int((rows.refused.fillna("") != "").sum()),
+            "points": int(len(rows)),
+            "negative_exceedance": int((rows.exceedance < 0).sum()),
+            "most_negative_exceedance": float(min(rows.exceedance.min(), 0.0))
+            if rows.exceedance.notna().any() else None,
+        }  # fmt: skip
+        for q in ("power", "exceedance"):
+            err = rows.dropna(subset=[f"{q}_rel_error"])
+            if err.empty:
+                entry[q] = None
+                continue
+            worst = err.loc[err[f"{q}_rel_error"].abs().idxmax()]
+            entry[q] = {
+                "compared": int(len(err)),
+                "largest_abs_error": float(abs(worst[f"{q}_rel_error"])),
+                "largest_ci95": float(worst[f"{q}_rel_error_ci95"]),
+                "where_largest": where.format(**worst),
+                "within_mc_interval": int(
+                    (err[f"{q}_rel_error"].abs() <= err[f"{q}_rel_error_ci95"]).sum()
+                ),
+                f"largest_abs_error_by_{by}": {
+                    d: float(e[f"{q}_rel_error"].abs().max()) for d, e in err.groupby(by)
+                },
+            }
+        out[method] = entry
+    return out
+
+
+def accuracy_sentences(accuracy: dict, by: str) -> list[str]:
+    """A Markdown bullet per method of :func:`method_accuracy`'s summary, in words."""
+    lines = []
+    for method, e in accuracy.items():
+        text = [f"**{method}**: refused at {e['refused']} of {e['points']} points"]
+        if e["negative_exceedance"]:
+            text.append(
+                f"a negative stroke exceedance (a probability below zero) at "
+                f"{e['negative_exceedance']} points, down to {e['most_negative_exceedance']:.2g}"
+            )
+        for q in ("power", "exceedance"):
+            a = e[q]
+            if a is None:
+                text.append(f"no {q} compared")
+                continue
+            by_value = ", ".join(
+                f"{d} {100 * x:.2g} %" for d, x in a[f"largest_abs_error_by_{by}"].items()
+            )
+            text.append(
+                f"{q}: largest |error| {100 * a['largest_abs_error']:.3g} % (± "
+                f"{100 * a['largest_ci95']:.2g} %, {a['where_largest']}) over {a['compared']} "
+                f"points, {a['within_mc_interval']} within the Monte Carlo interval; "
+                f"by {by}: {by_value}"
+            )
+        lines.append("- " + "; ".join(text) + ".")
+    return lines
+
+
+def linearisation_against_monte_carlo(result) -> pd.DataFrame:
+    """Statistical linearisation at every case of a paired run, against its Monte Carlo power.
+
+    Columns ``power_linearisation`` (W), ``k_eq`` (N/m), ``c_eq`` (Ns/m)
+    (:func:`randvib.statistical_linearisation`: any input, Gaussian closure)
+    and ``linearisation_rel_error`` with its ``_ci95`` (:func:`relative_error`),
+    indexed like the run's table.
+    """
+    rows = []
+    for i, case in enumerate(result.cases):
+        sl = statistical_linearisation(case.device, case.excitation)
+        mc = result.table.iloc[i]
+        error = relative_error(sl.power_electrical, mc.power_electrical, mc.power_electrical_ci95)
+        rows.append({
+            "power_linearisation": sl.power_electrical, "k_eq": sl.k_eq, "c_eq": sl.c_eq,
+            "linearisation_rel_error": error[0], "linearisation_rel_error_ci95": error[1],
+        })  # fmt: skip
+    return pd.DataFrame(rows, index=result.table.index)

@@ -1,8 +1,8 @@
 """Is the time-step bias below the statistical error? Half-step re-runs and their verdict.
 
-:func:`sweep_with_step_check` runs a study's sweep and re-runs a few points
+:func:`sweep_with_half_step` runs a study's sweep and re-runs a few points
 (usually the hardest, :func:`randvib.studies.grids.highest_friction_points`)
-at half the step with independent noise; :func:`step_check_verdict` counts
+at half the step with independent noise; :func:`half_step_verdict` counts
 the points whose two estimates agree within their combined 95 % half-width.
 :func:`check_step_bias` refuses a step whose linearised bias is already too
 large before anything runs.
@@ -25,7 +25,7 @@ from randvib.montecarlo.sweep import (
 )
 
 
-def step_size_check(
+def half_step_rerun(
     base: Harvester,
     points: list,
     settings: SweepSettings,
@@ -112,7 +112,7 @@ def check_step_bias(base: Harvester, points: list, settings: SweepSettings) -> f
     return worst
 
 
-def sweep_with_step_check(
+def sweep_with_half_step(
     base: Harvester,
     points: list,
     settings: SweepSettings,
@@ -127,7 +127,7 @@ def sweep_with_step_check(
     """Run a study's sweep into ``out/sweep`` and its half-step re-run of ``check_points``.
 
     Returns the :class:`~randvib.montecarlo.sweep.SweepResult` and the table of
-    :func:`step_size_check`.
+    :func:`half_step_rerun`.
     """
     import warnings
 
@@ -146,7 +146,7 @@ def sweep_with_step_check(
                 progress=progress,
                 name=name,
             )
-            check = step_size_check(
+            check = half_step_rerun(
                 base,
                 check_points,
                 settings,
@@ -160,7 +160,7 @@ def sweep_with_step_check(
     return result, check
 
 
-def step_check_verdict(check: pd.DataFrame) -> dict:
+def half_step_verdict(check: pd.DataFrame) -> dict:
     """Half-step re-run: how many points agree within the combined 95 % half-width."""
     from randvib.studies.evidence import independence_note, independent_count
 

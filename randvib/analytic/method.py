@@ -1,0 +1,242 @@
+"""The analytic methods as a declared family: what a method accepts, and how it is asked.
+
+An analytic method is one class, a subclass of :class:`AnalyticMethod`, and
+that class is the only place that describes it (as a friction law is
+described by its class in :mod:`randvib.models.friction`). It declares
+
+* ``name`` - its key in :data:`randvib.analytic.prediction.METHODS` and the
+  CLI's ``--method`` choice; ``title`` - what sentences call it; ``summary``
+  - one line on its cost and accuracy (the CLI's help);
+* what it accepts: ``coloured`` (a non-white excitation), ``circuit`` (a
+  coupling with a circuit state: coil inductance, piezo capacitance),
+  ``potentials`` (kinds of :mod:`randvib.models.potential`) and
+  ``friction_form`` (a key of :data:`FRICTION_FORMS`: any memoryless law, or
+  the form Fc tanh(beta v));
+* what it gives: ``stroke_exceedance`` (P(|z| > stroke));
+* ``reference`` - a slow reference solver, not one to run at every point of
+  a sweep; ``validity`` - its :class:`Validity` limits, beyond which it warns
+  or refuses;
+
+and computes in :meth:`AnalyticMethod.solve`. The methods live beside their
+mathematics (:mod:`randvib.analytic.statistical_linearisation`,
+:mod:`~randvib.analytic.averaging`, :mod:`~randvib.analytic.fokker_planck`);
+the driver :mod:`randvib.analytic.prediction` lists them in ``METHODS``.
+
+Consumers ask a method what it can do (:meth:`AnalyticMethod.accepts`,
+:meth:`AnalyticMethod.refusal`, the declarations) instead of keeping lists
+of method names; a refusal is one line that names, from the same
+declarations, the methods that do take the case. Its wording uses
+``method='NAME'``, which the CLI shows as ``--method NAME``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from randvib.models.excitation import Excitation
+from randvib.models.harvester import Harvester
+from randvib.models.potential import CONFINING
+
+
+@dataclass(frozen=True)
+class FrictionForm:
+    """A kind of friction law a method is written for.
+
+    Attributes
+    ----------
+    words : str
+        How refusals name it ("a memoryless friction law").
+    accepts : callable
+        ``accepts(law) -> bool`` for a :class:`~randvib.models.friction.FrictionModel`,
+        from what the law declares.
+    """
+
+    words: str
+    accepts: object
+
+
+#: The friction forms the methods declare, by key: laws that are a function of
+#: the velocity alone (E[v F(v)] under a Gaussian v exists: equivalent
+#: linearisation), and the family F = Fc tanh(beta v) with Coulomb as beta =
+#: inf (the orbit integrals of averaging and the kink corrections of the FPK
+#: solvers). No analytic method takes a law with internal state (LuGre).
+FRICTION_FORMS = {
+    "memoryless": FrictionForm("a memoryless friction law", lambda law: law.has_equivalent_damping),
+    "fc-tanh": FrictionForm(
+        "a memoryless friction law of the form Fc tanh(beta v) (coulomb, tanh or none)",
+        lambda law: law.coulomb_tanh_form() is not None,
+    ),
+}
+
+
+@dataclass(frozen=True)
+class Validity:
+    """A declared limit of a method's validity.
+
+    Attributes
+    ----------
+    indicator : str
+        The dimensionless number the limit is on.
+    limit : float
+        Its largest value inside the method's validity.
+    beyond : str
+        What the method does beyond it: ``"warns"`` or ``"refuses"``.
+    meaning : str
+        What the indicator measures and what goes wrong beyond the limit.
+    """
+
+    indicator: str
+    limit: float
+    beyond: str
+    meaning: str
+
+
+#: Named as the alternative of every refusal.
+MONTE_CARLO = "Monte Carlo (randvib.simulate)"
+
+
+class AnalyticMethod:
+    """Base class of the analytic methods: the declaration every consumer reads.
+
+    A subclass sets the class attributes below and implements :meth:`solve`;
+    an instance is what :data:`randvib.analytic.prediction.METHODS` holds and
+    :func:`randvib.predict` accepts as ``method``. See the module docstring.
+    """
+
+    #: Key in METHODS and the CLI's ``--method`` choice.
+    name: str = "analytic"
+    #: What sentences call the method.
+    title: str = "an analytic method"
+    #: One line: what it is, its cost and accuracy (the CLI's help).
+    summary: str = ""
+    #: Accepts a non-white excitation (the others assume white noise, paper Eq. 17).
+    coloured: bool = False
+    #: Accepts a coupling with a circuit state (the others assume a viscous c_e).
+    circuit: bool = False
+    #: Potential kinds it treats (see :data:`randvib.models.potential.KINDS`).
+    potentials: tuple[str, ...] = CONFINING + ("free",)
+    #: The friction laws it treats: a key of :data:`FRICTION_FORMS`.
+    friction_form: str = "memoryless"
+    #: Gives P(|z| > stroke) for a harvester with a stroke.
+    stroke_exceedance: bool = False
+    #: A slow reference solver (about half a second a point): not for every sweep point.
+    reference: bool = False
+    #: Its declared validity limits.
+    validity: tuple[Validity, ...] = ()
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}()"
+
+    # ------------------------------------------------------------ what it takes
+    def potentials_under(self, harvester: Harvester, psd) -> tuple[str, ...]:
+        """The potential kinds it treats for this coupling and excitation."""
+        return self.potentials
+
+    def accepts_friction(self, law) -> bool:
+        """Whether it treats the friction law ``law`` (None: no friction)."""
+        return law is None or FRICTION_FORMS[self.friction_form].accepts(law)
+
+    def accepts(self, harvester: Harvester, psd) -> bool:
+        """Whether it takes the harvester under ``psd`` (a level, array or excitation).
+
+        From the declarations alone, without computing: a method that accepts
+        may still refuse a point beyond a validity limit it refuses at.
+        """
+        return self._reason(harvester, psd, "") is None
+
+    def refusal(self, harvester: Harvester, psd, who: str | None = None) -> str | None:
+        """Why it does not take the case, as one line naming the methods that do; or None.
+
+        ``who`` is the subject of the sentence (default ``method='NAME'``; the
+        mathematics' own functions name themselves, "stochastic averaging").
+        """
+        return self._reason(harvester, psd, who or self.called, alternatives=True)
+
+    def require(self, harvester: Harvester, psd, who: str | None = None) -> None:
+        """Raise ValueError with :meth:`refusal` unless the method takes the case."""
+        refusal = self.refusal(harvester, psd, who)
+        if refusal is not None:
+            raise ValueError(refusal)
+
+    def beyond_validity(self, harvester: Harvester, psd, reason: str) -> ValueError:
+        """The refusal of an accepted case beyond a validity limit the method refuses at.
+
+        One line: ``method='NAME' {reason}: use`` the other methods that take the case.
+        """
+        return ValueError(f"{self.called} {reason}: use {self._alternatives(harvester, psd)}")
+
+    @property
+    def called(self) -> str:
+        """``method='NAME'``: how refusals name it (the CLI shows ``--method NAME``)."""
+        return f"method={self.name!r}"
+
+    def _reason(self, harvester, psd, who, alternatives: bool = False) -> str | None:
+        """The first declaration the case fails, in words (with the alternatives), or None."""
+        potential = harvester.potential
+        if not potential.velocity_is_stationary:  # no method treats it: no alternatives
+            return _potential_refusal(potential, who, CONFINING + ("free",))
+
+        def others() -> str:
+            return self._alternatives(harvester, psd) if alternatives else MONTE_CARLO
+
+        if harvester.has_circuit and not self.circuit:
+            return (
+                f"{who} assumes resistive coupling (a viscous electrical damper); the "
+                f"{harvester.electrical.name} coupling's circuit state needs {others()}"
+            )
+        if non_white(psd) and not self.coloured:
+            return f"{who} assumes white noise; the {psd.name} excitation needs {others()}"
+        kinds = self.potentials_under(harvester, psd)
+        if not set(np.ravel(potential.kind)) <= set(kinds):
+            return _potential_refusal(potential, who, kinds, others())
+        law = harvester.friction
+        if not self.accepts_friction(law):
+            why = "has internal state" if law.has_memory else "is not of that form"
+            words = FRICTION_FORMS[self.friction_form].words
+            return f"{who} needs {words}; {law.name!r} {why}: use {others()}"
+        return None
+
+    def _alternatives(self, harvester, psd) -> str:
+        """The registered methods that take the case, then Monte Carlo, in words."""
+        # The registry is the driver's; the methods' modules, which the driver
+        # imports, import this module, so it is looked up when a refusal is written.
+        from randvib.analytic.prediction import METHODS
+
+        names = [
+            name
+            for name, method in METHODS.items()
+            if name != self.name and method.accepts(harvester, psd)
+        ]
+        return " or ".join([f"method={name!r}" for name in names] + [MONTE_CARLO])
+
+    # ------------------------------------------------------------ computing
+    def solve(self, harvester: Harvester, psd):  # pragma: no cover - abstract
+        """The :class:`~randvib.analytic.power_prediction.PowerPrediction` of an accepted case.
+
+        ``psd`` is the white-noise level S ((m/s^2)^2/Hz, > 0; an array
+        broadcasting with the harvester's parameters) or, for a method that
+        accepts it, a non-white :class:`~randvib.models.excitation.Excitation`.
+        :func:`randvib.predict` checks the case and the answer.
+        """
+        raise NotImplementedError
+
+
+def _potential_refusal(potential, who, kinds, alternatives: str = "") -> str | None:
+    """The one line :meth:`Potential.require` raises for ``kinds``, as text; None if it passes."""
+    try:
+        potential.require(who, kinds, alternatives)
+    except ValueError as refusal:
+        return str(refusal)
+    return None
+
+
+def white_level(psd):
+    """The level S of white noise given as a number, an array or :class:`White`."""
+    return psd.level if isinstance(psd, Excitation) else psd
+
+
+def non_white(psd) -> bool:
+    """Whether ``psd`` is an excitation other than white noise (a level is white)."""
+    return isinstance(psd, Excitation) and not psd.is_white
