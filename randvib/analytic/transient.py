@@ -65,7 +65,6 @@ from randvib.analytic.first_passage import (
 from randvib.analytic.linear_response import device_block, stationary_covariance
 from randvib.models.event import Enveloped, EventStart
 from randvib.models.harvester import Harvester
-from randvib.models.potential import CONFINING
 
 #: Relative tolerance of the moment equations (DOP853).
 RTOL = 1e-10
@@ -289,23 +288,10 @@ def _solve(system, event, mu0, scales, t_end, equivalent, nonlinear, stiff) -> _
     return _Solution(segments, n)
 
 
-def _check(harvester: Harvester, event, start: EventStart):
-    """The closure's friction (None for none or a vanishing law), refusals named."""
-    if not isinstance(harvester, Harvester):
-        raise ValueError(f"`harvester` must be a randvib.Harvester, got {type(harvester).__name__}")
+def _closure_friction(harvester: Harvester, start: EventStart):
+    """(friction law of the closure or None, whether the device is linear); refusals named."""
     check_scalar_device(harvester, "transient_response")
-    if not isinstance(event, Enveloped):
-        raise ValueError(
-            "`event` must be a randvib.Enveloped (an excitation times an envelope, e.g. "
-            f"rv.Enveloped(rv.White(1.0), rv.Step()) for noise switched on at t = 0), got {event!r}"
-        )
-    harvester.potential.require("transient_response", CONFINING + ("free",))
     friction = harvester.friction
-    if friction is not None and not friction.has_equivalent_damping:
-        raise ValueError(
-            f"time-dependent statistical linearisation needs a memoryless friction law; "
-            f"{friction.name!r} has internal state: use Monte Carlo (randvib.simulate_transient)"
-        )
     friction = None if friction is None or friction.vanishes else friction
     linear = friction is None and float(harvester.k3) == 0.0
     if not linear and not start.is_zero:
@@ -342,7 +328,13 @@ def _times(times, t_end):
 
 
 def transient_response(
-    harvester: Harvester, event: Enveloped, times=None, *, t_end=None, start="rest"
+    harvester: Harvester,
+    event: Enveloped,
+    times=None,
+    *,
+    t_end=None,
+    start="rest",
+    method="linearisation",
 ) -> TransientPrediction:
     """Time-dependent moments and energy of the device under an event, by the Lyapunov ODE.
 
@@ -363,6 +355,9 @@ def transient_response(
         Default: the last of ``times``.
     start : "rest", "unexcited" or (z0, v0)
         Where the device starts (:class:`~randvib.models.event.EventStart`).
+    method : str or AnalyticMethod
+        A method of :data:`randvib.analytic.prediction.METHODS` that declares
+        ``transient`` (``"linearisation"``); the stationary ones refuse an event.
 
     Returns
     -------
@@ -376,12 +371,32 @@ def transient_response(
     >>> import randvib as rv
     >>> linear = rv.Harvester(m=0.0226, c_m=0.1, c_e=0.1, k=57.4)
     >>> r = rv.transient_response(linear, rv.Enveloped(rv.White(1.0), rv.Step()), [0.1, 1.0, 5.0])
-    >>> print(r.displacement_variance.round(10), f"{r.energy_electrical:.4e} J")
-    [6.701e-06 1.112e-05 1.112e-05] 1.3841e-02 J
+    >>> print(r.displacement_variance.round(10), f"{r.energy_electrical:.4e} J", r.exact)
+    [6.701e-06 1.112e-05 1.112e-05] 1.3806e-02 J True
     """
-    start = EventStart.of(start, harvester) if isinstance(harvester, Harvester) else start
-    friction, linear = _check(harvester, event, start)
+    from randvib.analytic.prediction import method_named  # the driver lists the methods
+
+    if not isinstance(harvester, Harvester):
+        raise ValueError(f"`harvester` must be a randvib.Harvester, got {type(harvester).__name__}")
+    if not isinstance(event, Enveloped):
+        raise ValueError(
+            "`event` must be a randvib.Enveloped (an excitation times an envelope, e.g. "
+            f"rv.Enveloped(rv.White(1.0), rv.Step()) for noise switched on at t = 0), got {event!r}"
+        )
+    start = EventStart.of(start, harvester)
     times, t_end = _times(times, t_end)
+    solver = method_named(method)
+    solver.require(harvester, event)
+    return solver.solve_transient(harvester, event, times, t_end, start)
+
+
+def solve_transient(method: str, harvester, event, times, t_end, start) -> TransientPrediction:
+    """The moment equations of an accepted event (the engine of :func:`transient_response`).
+
+    ``method`` is the declaring method's name; ``times`` (s) and ``t_end``
+    (s) are checked, ``start`` an :class:`~randvib.models.event.EventStart`.
+    """
+    friction, linear = _closure_friction(harvester, start)
     system = EventSystem(harvester, event)
     mean = np.zeros(system.n)
     mean[system.iz], mean[system.iv] = start.z, start.v
@@ -391,16 +406,7 @@ def transient_response(
         system, event, mean, scales, t_end, equivalent, not linear, stiff=friction is not None
     )
     return TransientPrediction._from_solution(
-        "lyapunov" if linear else "linearisation",
-        harvester,
-        event,
-        start,
-        times,
-        t_end,
-        system,
-        solution,
-        equivalent,
-        linear,
+        method, harvester, event, start, times, t_end, system, solution, equivalent, linear
     )
 
 
@@ -411,8 +417,11 @@ class TransientPrediction:
     Attributes
     ----------
     method : str
-        ``lyapunov`` (the linear device: exact) or ``linearisation``
-        (time-dependent statistical linearisation).
+        The analytic method (``linearisation``: time-dependent statistical
+        linearisation).
+    exact : bool
+        True for the linear device (k3 = 0, no friction), whose Lyapunov
+        solution is exact; False where the closure approximates.
     harvester : Harvester
     event : Enveloped
     start : EventStart
@@ -452,6 +461,7 @@ class TransientPrediction:
     """
 
     method: str
+    exact: bool
     harvester: Harvester
     event: Enveloped
     start: EventStart
@@ -502,6 +512,7 @@ class TransientPrediction:
                 )
         return cls(
             method=method,
+            exact=linear,
             harvester=harvester,
             event=event,
             start=start,
@@ -538,10 +549,10 @@ class TransientPrediction:
             ("circuit_mean_square", circuit_unit),
             ("cumulative_energy", "J"),
             ("stroke_exceedance", "probability"),
-            ("stroke_reached_poisson", "probability (approximate)"),
-            ("stroke_reached_vanmarcke", "probability (approximate)"),
+            ("stroke_reached_poisson", "approximate probability"),
+            ("stroke_reached_vanmarcke", "approximate probability"),
         )
-        if self.method == "linearisation":
+        if not self.exact:
             named += (("c_eq", "Ns/m"), ("k_eq", "N/m"))
         return [(n, getattr(self, n), u) for n, u in named if getattr(self, n) is not None]
 
@@ -555,7 +566,7 @@ class TransientPrediction:
 
     def to_dict(self) -> dict:
         """JSON-ready: ``times``, the quantities as lists over them, the energies and settings."""
-        out = {"method": self.method, "times": self.times.tolist()}
+        out = {"method": self.method, "exact": self.exact, "times": self.times.tolist()}
         out.update({name: np.asarray(v).tolist() for name, v, _ in self._series()})
         out["energy_electrical"] = self.energy_electrical
         if self.energy_load is not None:
@@ -568,8 +579,9 @@ class TransientPrediction:
         return out
 
     def _note(self) -> str:
+        how = "exact (linear device)" if self.exact else "time-dependent closure"
         return (
-            f"{self.method}, {self.event.name}, start {self.start.describe()}; energy "
+            f"{self.method}, {how}, {self.event.name}, start {self.start.describe()}; energy "
             f"int_0^{self.t_end:g} E[P_e] dt = {_display.number(self.energy_electrical)} J"
         )
 
@@ -583,7 +595,7 @@ class TransientPrediction:
 
     def __repr__(self) -> str:
         return (
-            f"TransientPrediction({self.method}, {self.event.name}, {self.times.size} times to "
+            f"TransientPrediction({self.method}, exact={self.exact}, {self.event.name}, {self.times.size} times to "
             f"{self.t_end:g} s; energy_electrical = {_display.number(self.energy_electrical)} J)"
         )
 
