@@ -317,12 +317,14 @@ def _times(times, t_end):
         raise ValueError(f"`times` must be a 1-D list of times (s), got shape {times.shape}")
     if np.any(np.diff(times) <= 0):
         i = int(np.argmax(np.diff(times) <= 0))
-        raise ValueError(f"`times` must be increasing, got {times[i + 1]!r} s after {times[i]!r} s")
+        raise ValueError(
+            f"`times` must be increasing, got {float(times[i + 1])!r} s after {float(times[i])!r} s"
+        )
     t_end = float(times[-1]) if t_end is None else float(check_finite("t_end", t_end))
     if not t_end > 0:
         raise ValueError(f"`t_end` must be > 0 s, got {t_end!r}")
     if times[0] < 0 or times[-1] > t_end:
-        bad = times[0] if times[0] < 0 else times[-1]
+        bad = float(times[0] if times[0] < 0 else times[-1])
         raise ValueError(f"`times` must lie in [0, t_end] = [0, {t_end!r}] s, got {bad!r} s")
     return times, t_end
 
