@@ -147,9 +147,14 @@ class TransientResult:
         return self._powers(v2, x2, which)
 
     @property
+    def path_energies(self) -> np.ndarray:
+        """Per path, int_0^t_end P_e dt (J) (trapezoid rule): for paired comparisons."""
+        return self._energies("power_electrical")
+
+    @property
     def energy_electrical(self) -> Statistic:
-        """E[int_0^t_end P_e dt] (J): the energy the event delivers (per path, trapezoid rule)."""
-        return estimate(self._energies("power_electrical"))
+        """E[int_0^t_end P_e dt] (J): the energy the event delivers, with its interval."""
+        return estimate(self.path_energies)
 
     @property
     def energy_load(self) -> Statistic | None:

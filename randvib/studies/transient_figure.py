@@ -36,8 +36,9 @@ def plot_transient(
     ----------
     series : dict
         Label -> result: a :class:`randvib.TransientResult` (Monte Carlo:
-        markers, 95 % intervals and band) or a
-        :class:`randvib.TransientPrediction` (analytic: a line).
+        markers, 95 % intervals and band), a
+        :class:`randvib.TransientPrediction` (analytic: a line), or a tuple of
+        them drawn in one colour (Monte Carlo beside its analytic curve).
     quantities : sequence of str
         Which panels, from ``displacement_variance``, ``velocity_variance``
         and ``power_electrical``.
@@ -60,25 +61,14 @@ def plot_transient(
     fig, axes = new_figure(len(quantities), 1, figsize=(6.5, 2.6 * len(quantities) + 0.6),
                            sharex=True)  # fmt: skip
     axes = axes[:, 0]
-    t_end = max(float(r.t_end) for r in series.values())
-    for i, (label, result) in enumerate(series.items()):
+    series = {label: r if isinstance(r, tuple | list) else (r,) for label, r in series.items()}
+    t_end = max(float(r.t_end) for group in series.values() for r in group)
+    for i, (label, group) in enumerate(series.items()):
         colour = PALETTE[i % len(PALETTE)]
-        times = np.asarray(result.times)
-        for ax, name in zip(axes, quantities, strict=True):
-            ylabel, factor = PANELS[name]
-            values = getattr(result, name)
-            if hasattr(values, "ci95"):  # Monte Carlo: TimeStatistics
-                mean, half = factor * values.mean, factor * values.ci95
-                ax.fill_between(times, mean - half, mean + half, color=colour, alpha=0.2, lw=0)
-                ax.errorbar(times, mean, yerr=half, fmt="o", ms=3, capsize=2, color=colour,
-                            label=f"{label} (Monte Carlo, 95 %)")  # fmt: skip
-            else:
-                ax.plot(times, factor * np.asarray(values), "-", color=colour, lw=1.4,
-                        label=f"{label} (analytic)")  # fmt: skip
-            ax.set_ylabel(ylabel)
-            ax.grid(alpha=0.3, lw=0.5)
+        for result in group:
+            _draw(axes, quantities, label, result, colour)
     if envelope:
-        first = next(iter(series.values()))
+        first = next(iter(series.values()))[0]
         t = np.linspace(0.0, t_end, 1000)
         twin = axes[0].twinx()
         twin.plot(t, first.event.envelope(t) ** 2, ":", color="0.4", lw=1.0, label="$e(t)^2$")
@@ -92,3 +82,21 @@ def plot_transient(
     if path is None:
         return fig
     return save_figure(fig, path, tracked=False)  # a path the caller chose
+
+
+def _draw(axes, quantities, label, result, colour) -> None:
+    """One result on every panel: Monte Carlo as markers and band, analytic as a line."""
+    times = np.asarray(result.times)
+    for ax, name in zip(axes, quantities, strict=True):
+        ylabel, factor = PANELS[name]
+        values = getattr(result, name)
+        if hasattr(values, "ci95"):  # Monte Carlo: TimeStatistics
+            mean, half = factor * values.mean, factor * values.ci95
+            ax.fill_between(times, mean - half, mean + half, color=colour, alpha=0.2, lw=0)
+            ax.errorbar(times, mean, yerr=half, fmt="o", ms=3, capsize=2, color=colour,
+                        label=f"{label} (Monte Carlo, 95 %)")  # fmt: skip
+        else:
+            ax.plot(times, factor * np.asarray(values), "-", color=colour, lw=1.4,
+                    label=f"{label} (analytic)")  # fmt: skip
+        ax.set_ylabel(ylabel)
+        ax.grid(alpha=0.3, lw=0.5)
