@@ -151,6 +151,28 @@ def html_table(title: str, rows, note: str = "") -> str:
     )
 
 
+#: Column headers of the time-resolved tables (the quantity's name -> a short label).
+TIME_LABELS = {
+    "displacement_variance": "E[z^2]",
+    "velocity_variance": "E[v^2]",
+    "power_electrical": "E[P_e]",
+    "power_load": "E[P_L]",
+    "circuit_mean_square": "E[x^2]",
+    "cumulative_energy": "energy to t",
+    "stroke_exceedance": "P(|z| > stroke)",
+    "stroke_reached": "P(reached)",
+    "stroke_reached_poisson": "reached, Poisson*",
+    "stroke_reached_vanmarcke": "reached, Vanmarcke*",
+    "c_eq": "c_eq",
+    "k_eq": "k_eq",
+}
+
+
+def time_header(name: str, unit: str) -> str:
+    """A time table's header: the short label of ``name`` and its unit."""
+    return f"{TIME_LABELS.get(name, name)} ({unit})" if unit else TIME_LABELS.get(name, name)
+
+
 def time_table(title: str, headers, rows, note: str = "") -> str:
     """A time-resolved table (one row per time, cells already text) under ``title``."""
     from tabulate import tabulate

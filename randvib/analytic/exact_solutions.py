@@ -166,12 +166,10 @@ def caughey_stumpf_moments(m, c, k, psd, t):
     for t >= 0 and z(0) = z'(0) = 0 (Caughey and Stumpf 1961, "Transient
     response of a dynamic system under random excitation", J. Appl. Mech.
     28, 563-566). With omega_n^2 = k/m, 2 zeta omega_n = c/m,
-    omega_d = omega_n sqrt(1 - zeta^2) and r = zeta omega_n / omega_d:
+    omega_d = omega_n sqrt(1 - zeta^2) and r = zeta omega_n / omega_d::
 
-        E[z^2] = S/(8 zeta omega_n^3) {1 - e^(-2 zeta omega_n t) [1 + r sin(2 omega_d t)
-                                                         + 2 r^2 sin^2(omega_d t)]}
-        E[v^2] = S/(8 zeta omega_n)   {1 - e^(-2 zeta omega_n t) [1 - r sin(2 omega_d t)
-                                                         + 2 r^2 sin^2(omega_d t)]}
+        E[z^2] = S/(8 zeta omega_n^3) {1 - e^(-2 zeta omega_n t) [1 + r sin(2 omega_d t) + 2 r^2 sin^2(omega_d t)]}
+        E[v^2] = S/(8 zeta omega_n) {1 - e^(-2 zeta omega_n t) [1 - r sin(2 omega_d t) + 2 r^2 sin^2(omega_d t)]}
         E[z v] = (S/4) e^(-2 zeta omega_n t) sin^2(omega_d t) / omega_d^2
 
     (E[z v] = d E[z^2]/dt / 2), tending to the stationary S m^2/(4 c k) and

@@ -550,9 +550,9 @@ class TransientPrediction:
             ("power_load", "W"),
             ("circuit_mean_square", circuit_unit),
             ("cumulative_energy", "J"),
-            ("stroke_exceedance", "probability"),
-            ("stroke_reached_poisson", "approximate probability"),
-            ("stroke_reached_vanmarcke", "approximate probability"),
+            ("stroke_exceedance", ""),
+            ("stroke_reached_poisson", ""),
+            ("stroke_reached_vanmarcke", ""),
         )
         if not self.exact:
             named += (("c_eq", "Ns/m"), ("k_eq", "N/m"))
@@ -582,13 +582,15 @@ class TransientPrediction:
 
     def _note(self) -> str:
         how = "exact (linear device)" if self.exact else "time-dependent closure"
+        approximate = "; * approximate" if self.stroke_reached_poisson is not None else ""
         return (
             f"{self.method}, {how}, {self.event.name}, start {self.start.describe()}; energy "
             f"int_0^{self.t_end:g} E[P_e] dt = {_display.number(self.energy_electrical)} J"
+            f"{approximate}"
         )
 
     def _table(self):
-        headers = ["time (s)"] + [f"{name} ({unit})" for name, _, unit in self._series()]
+        headers = ["time (s)"] + [_display.time_header(n, u) for n, _, u in self._series()]
         rows = [
             [_display.number(t)] + [_display.number(v[i]) for _, v, _ in self._series()]
             for i, t in enumerate(self.times)

@@ -194,8 +194,8 @@ class TransientResult:
             ("power_electrical", "W"),
             ("power_load", "W"),
             ("circuit_mean_square", circuit_unit),
-            ("stroke_exceedance", "probability"),
-            ("stroke_reached", "probability"),
+            ("stroke_exceedance", ""),
+            ("stroke_reached", ""),
         )
         out = [(name, getattr(self, name), unit) for name, unit in named]
         return [(name, stat, unit) for name, stat, unit in out if stat is not None]
@@ -248,7 +248,7 @@ class TransientResult:
         )
 
     def _table(self):
-        headers = ["time (s)"] + [f"{name} ({unit})" for name, _, unit in self._series()]
+        headers = ["time (s)"] + [_display.time_header(n, u) for n, _, u in self._series()]
         rows = [
             [_display.number(t)]
             + [_display.estimate(stat.mean[i], stat.ci95[i]) for _, stat, _ in self._series()]
