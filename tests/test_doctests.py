@@ -18,14 +18,17 @@ MODULES = (
     "randvib.analytic.linearisation",
     "randvib.analytic.prediction",
     "randvib.analytic.statistical_linearisation",
+    "randvib.analytic.transient",
     "randvib._display",
     "randvib.identification.synthetic",
     "randvib.models.coupling",
+    "randvib.models.event",
     "randvib.models.excitation",
     "randvib.models.harvester",
     "randvib.models.presets",
     "randvib.montecarlo.simulation",
     "randvib.montecarlo.sweep",
+    "randvib.montecarlo.transient",
 )
 
 FLAGS = doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE
