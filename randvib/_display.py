@@ -168,9 +168,40 @@ TIME_LABELS = {
 }
 
 
+#: Units of the time-resolved quantities (a circuit's mean square: A^2 or V^2, by coupling).
+TIME_UNITS = {
+    "displacement_variance": "m^2",
+    "velocity_variance": "(m/s)^2",
+    "power_electrical": "W",
+    "power_load": "W",
+    "cumulative_energy": "J",
+    "c_eq": "Ns/m",
+    "k_eq": "N/m",
+}
+
+
+def time_series(result, names) -> list[tuple]:
+    """(name, values, unit) of the quantities ``names`` that ``result`` has (not None)."""
+    circuit = "V^2" if result.harvester.coupling_name == "piezo" else "A^2"
+    out = []
+    for name in names:
+        values = getattr(result, name)
+        if values is not None:
+            unit = circuit if name == "circuit_mean_square" else TIME_UNITS.get(name, "")
+            out.append((name, values, unit))
+    return out
+
+
 def time_header(name: str, unit: str) -> str:
     """A time table's header: the short label of ``name`` and its unit."""
     return f"{TIME_LABELS.get(name, name)} ({unit})" if unit else TIME_LABELS.get(name, name)
+
+
+def time_rows(times, series, cell) -> tuple[list, list]:
+    """(headers, rows) of a time table: ``series`` (name, values, unit), ``cell(values, i)``."""
+    headers = ["time (s)"] + [time_header(name, unit) for name, _, unit in series]
+    rows = [[number(t)] + [cell(values, i) for _, values, _ in series] for i, t in enumerate(times)]
+    return headers, rows
 
 
 def time_table(title: str, headers, rows, note: str = "") -> str:

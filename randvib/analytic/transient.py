@@ -544,21 +544,18 @@ class TransientPrediction:
     # ------------------------------------------------------------ presenting
     def _series(self) -> list[tuple[str, np.ndarray, str]]:
         """(name, values over times, unit) of every time-resolved quantity this result has."""
-        circuit_unit = "V^2" if self.harvester.coupling_name == "piezo" else "A^2"
-        named = (
-            ("displacement_variance", "m^2"),
-            ("velocity_variance", "(m/s)^2"),
-            ("power_electrical", "W"),
-            ("power_load", "W"),
-            ("circuit_mean_square", circuit_unit),
-            ("cumulative_energy", "J"),
-            ("stroke_exceedance", ""),
-            ("stroke_reached_poisson", ""),
-            ("stroke_reached_vanmarcke", ""),
-        )
-        if not self.exact:
-            named += (("c_eq", "Ns/m"), ("k_eq", "N/m"))
-        return [(n, getattr(self, n), u) for n, u in named if getattr(self, n) is not None]
+        names = [
+            "displacement_variance",
+            "velocity_variance",
+            "power_electrical",
+            "power_load",
+            "circuit_mean_square",
+            "cumulative_energy",
+            "stroke_exceedance",
+            "stroke_reached_poisson",
+            "stroke_reached_vanmarcke",
+        ]
+        return _display.time_series(self, names + ([] if self.exact else ["c_eq", "k_eq"]))
 
     def to_frame(self):
         """One row per time: ``time`` (s) and every time-resolved quantity (SI units)."""
@@ -592,12 +589,9 @@ class TransientPrediction:
         )
 
     def _table(self):
-        headers = ["time (s)"] + [_display.time_header(n, u) for n, _, u in self._series()]
-        rows = [
-            [_display.number(t)] + [_display.number(v[i]) for _, v, _ in self._series()]
-            for i, t in enumerate(self.times)
-        ]
-        return headers, rows
+        return _display.time_rows(
+            self.times, self._series(), lambda values, i: _display.number(values[i])
+        )
 
     def __repr__(self) -> str:
         return (

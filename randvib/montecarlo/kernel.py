@@ -529,6 +529,22 @@ def _drawn_states(rng, j, ki, wi, fi, chol, n):
     return x1, x2, x3
 
 
+@numba.njit(cache=True, inline="always")
+def _snapshots(snapshots, snap, k, state, start, lanes, z, v, square, peak):
+    """Write the lanes' (z, v, P x, peak) for every snapshot k, k + 1, ... at ``state``.
+
+    Returns the index of the next snapshot to take.
+    """
+    while k < snap.shape[0] and snap[k] == state:
+        for j in range(lanes):
+            snapshots[start + j, k, SNAP_Z] = z[j]
+            snapshots[start + j, k, SNAP_V] = v[j]
+            snapshots[start + j, k, SNAP_X] = square[j]
+            snapshots[start + j, k, SNAP_PEAK] = peak[j]
+        k += 1
+    return k
+
+
 @numba.njit(cache=True, parallel=True, nogil=True)
 def run_ensemble(
     scheme,
@@ -627,7 +643,6 @@ def run_ensemble(
     if transient is not None:
         gains = transient.gain
         snap = transient.snap_steps
-        n_snap = snap.shape[0]
         snapshots = transient.snapshots
         event_out = transient.event  # outputs and inputs read once, outside the parallel loop
         scale_noise = transient.scale_noise
@@ -702,14 +717,7 @@ def run_ensemble(
                 records[start + j, 0, 1] = v[j]
         stopped = False
         if transient is not None:
-            next_snap = 0
-            while next_snap < n_snap and snap[next_snap] == 0:
-                for j in range(lanes):
-                    snapshots[start + j, next_snap, SNAP_Z] = z[j]
-                    snapshots[start + j, next_snap, SNAP_V] = v[j]
-                    snapshots[start + j, next_snap, SNAP_X] = square[j]
-                    snapshots[start + j, next_snap, SNAP_PEAK] = peak[j]
-                next_snap += 1
+            next_snap = _snapshots(snapshots, snap, 0, 0, start, lanes, z, v, square, peak)
         for n in range(n_steps):
             in_window = n >= n_burn
             if transient is not None:
@@ -817,13 +825,9 @@ def run_ensemble(
                     records[start + j, r, 1] = v[j]
                     records[start + j, r, 2] = th[j]
             if transient is not None:
-                while next_snap < n_snap and snap[next_snap] == n + 1:
-                    for j in range(lanes):
-                        snapshots[start + j, next_snap, SNAP_Z] = z[j]
-                        snapshots[start + j, next_snap, SNAP_V] = v[j]
-                        snapshots[start + j, next_snap, SNAP_X] = square[j]
-                        snapshots[start + j, next_snap, SNAP_PEAK] = peak[j]
-                    next_snap += 1
+                next_snap = _snapshots(
+                    snapshots, snap, next_snap, n + 1, start, lanes, z, v, square, peak
+                )
             if (n + 1) % CHECK_EVERY == 0 or n == n_steps - 1:
                 for j in range(lanes):
                     if not (np.isfinite(z[j]) and np.isfinite(v[j]) and np.isfinite(th[j])):

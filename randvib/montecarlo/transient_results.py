@@ -187,18 +187,16 @@ class TransientResult:
     # ------------------------------------------------------------ presenting
     def _series(self) -> list[tuple[str, TimeStatistics, str]]:
         """(name, TimeStatistics, unit) of every time-resolved statistic this run has."""
-        circuit_unit = "V^2" if self.harvester.coupling_name == "piezo" else "A^2"
-        named = (
-            ("displacement_variance", "m^2"),
-            ("velocity_variance", "(m/s)^2"),
-            ("power_electrical", "W"),
-            ("power_load", "W"),
-            ("circuit_mean_square", circuit_unit),
-            ("stroke_exceedance", ""),
-            ("stroke_reached", ""),
+        names = (
+            "displacement_variance",
+            "velocity_variance",
+            "power_electrical",
+            "power_load",
+            "circuit_mean_square",
+            "stroke_exceedance",
+            "stroke_reached",
         )
-        out = [(name, getattr(self, name), unit) for name, unit in named]
-        return [(name, stat, unit) for name, stat, unit in out if stat is not None]
+        return _display.time_series(self, names)
 
     def to_frame(self):
         """One row per time: ``time`` (s), each statistic's mean and ``<name>_ci95``."""
@@ -248,13 +246,11 @@ class TransientResult:
         )
 
     def _table(self):
-        headers = ["time (s)"] + [_display.time_header(n, u) for n, _, u in self._series()]
-        rows = [
-            [_display.number(t)]
-            + [_display.estimate(stat.mean[i], stat.ci95[i]) for _, stat, _ in self._series()]
-            for i, t in enumerate(self.times)
-        ]
-        return headers, rows
+        return _display.time_rows(
+            self.times,
+            self._series(),
+            lambda stat, i: _display.estimate(stat.mean[i], stat.ci95[i]),
+        )
 
     def __repr__(self) -> str:
         energy = self.energy_electrical

@@ -21,22 +21,14 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # this checkout's randvib
 
 import test_transient_simulation as t  # noqa: E402
-from _stats import calibrate  # noqa: E402
+from _stats import calibrate, seeds_and_names  # noqa: E402
 
 
 def main():
-    args = sys.argv[1:]
-    first = 1000
-    for arg in [a for a in args if a.startswith("--first=")]:
-        first = int(arg.split("=", 1)[1])
-        args.remove(arg)
-    n = int(args[0]) if args else 40
-    only = args[1:] or None
+    seeds, only = seeds_and_names(sys.argv[1:])
     for name in t.CASES:
-        if only and name not in only:
-            continue
-        calibrate(name, lambda s, name=name: t.case_transient(name, s), range(first, first + n),
-                  widths=(26, 16))  # fmt: skip
+        if only is None or name in only:
+            calibrate(name, lambda s, name=name: t.case_transient(name, s), seeds, widths=(26, 16))
 
 
 if __name__ == "__main__":
