@@ -26,7 +26,7 @@ import time
 
 import numpy as np
 
-from randvib.identification.fitting import CostFunction, Record, default_bounds, identify
+from randvib.identification.fitting import CostFunction, default_bounds, identify
 from randvib.identification.record_simulation import (
     driving_signal,
     parameter_matrix,
@@ -35,14 +35,17 @@ from randvib.identification.record_simulation import (
 )
 from randvib.identification.sade import _Space, sade
 from randvib.models.excitation import band_limited_excitation
+from randvib.models.record import Record
 
 TRUE = dict(m=0.0226, c=0.049, k=57.4, k3=70742.0, fc=0.0058)
 
 
 def coulomb_record(duration=10.0, fs=1000.0, seed=1):
     ex = band_limited_excitation(duration, fs, 1.5, seed=seed)
-    z = simulate_record(TRUE, "coulomb", ex.acceleration, 1 / fs, substeps=8).z[0]
-    return Record(1 / fs, "base_displacement", ex.displacement, z, "bench")
+    z = simulate_record(TRUE, "coulomb", ex["base_acceleration"], 1 / fs, substeps=8).z[0]
+    return Record(
+        1 / fs, name="bench", base_displacement=ex["base_displacement"], relative_displacement=z
+    )
 
 
 # --------------------------------------------------------------- numpy reference

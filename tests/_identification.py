@@ -15,9 +15,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from randvib.identification.fitting import MODELS, Record
+from randvib.identification.fitting import MODELS
 from randvib.identification.record_simulation import simulate_record
 from randvib.models.excitation import band_limited_excitation
+from randvib.models.record import Record
 
 #: Paper Table 2, Coulomb model, training data 1 (m from docs/conventions.md).
 COULOMB = dict(m=0.0226, c=0.049, k=57.4, k3=70742.0, fc=0.0058)
@@ -34,17 +35,16 @@ def excitation(seed, duration, fs, rms=1.07):
 def clean_response(params, model, ex, *, z0=0.0, v0=0.0, substeps=8):
     """Noise-free relative displacement and velocity driven by the exact base acceleration."""
     sim = simulate_record(
-        params, MODELS[model], ex.acceleration, 1 / ex.fs, substeps=substeps, z0=z0, v0=v0
+        params, MODELS[model], ex["base_acceleration"], ex.dt, substeps=substeps, z0=z0, v0=v0
     )
     return sim.z[0], sim.v[0]
 
 
 def make_record(ex, z, *, kind="base_acceleration", noise=0.0, noise_seed=None, name="synthetic"):
     """Record of ``z`` (plus white noise of standard deviation ``noise`` m) and the base input."""
-    inp = ex.displacement if kind == "base_displacement" else ex.acceleration
     if noise:
         z = z + noise * np.random.default_rng(noise_seed).standard_normal(z.size)
-    return Record(1 / ex.fs, kind, inp, z, name)
+    return Record(ex.dt, name=name, relative_displacement=z, **{kind: ex[kind]})
 
 
 def initial_state(z, dt):
@@ -164,8 +164,8 @@ def tapered(ex, ramp=0.2):
     w = a * b
     dw = (da * b - a * db) / ramp
     d2w = (d2a * b - 2 * da * db + a * d2b) / ramp**2
-    y = w * ex.displacement
-    acc = d2w * ex.displacement + 2 * dw * ex.velocity + w * ex.acceleration
+    y = w * ex["base_displacement"]
+    acc = d2w * ex["base_displacement"] + 2 * dw * ex["base_velocity"] + w * ex["base_acceleration"]
     return y, acc
 
 

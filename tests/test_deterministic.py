@@ -33,8 +33,8 @@ def excitation():
 def test_duffing_matches_solve_ivp(excitation):
     # Same continuous problem (linearly interpolated input) solved by a tight
     # adaptive integrator: the difference is the RK4 error, O(h^4) ~ 1e-7.
-    dt = 1 / excitation.fs
-    acc = _interp_input(excitation.acceleration, dt)
+    dt = excitation.dt
+    acc = _interp_input(excitation["base_acceleration"], dt)
     p = DUFFING
 
     def rhs(t, y):
@@ -42,19 +42,22 @@ def test_duffing_matches_solve_ivp(excitation):
         return [v, -acc(t) - (p["c"] * v + p["k"] * z + p["k3"] * z**3) / p["m"]]
 
     ref = _ivp(rhs, [1e-4, 0.0], excitation.time, dt)
-    sim = simulate_record(p, "none", excitation.acceleration, dt, substeps=4, z0=1e-4)
+    sim = simulate_record(p, "none", excitation["base_acceleration"], dt, substeps=4, z0=1e-4)
     scale = np.std(ref[0])
     assert np.max(np.abs(sim.z[0] - ref[0])) < 1e-5 * scale
     assert np.max(np.abs(sim.v[0] - ref[1])) < 1e-5 * np.std(ref[1])
 
 
 def test_rk4_is_fourth_order(excitation):
-    dt = 1 / excitation.fs
-    ref = simulate_record(DUFFING, "none", excitation.acceleration, dt, substeps=64).z[0]
+    dt = excitation.dt
+    ref = simulate_record(DUFFING, "none", excitation["base_acceleration"], dt, substeps=64).z[0]
     errs = [
         np.max(
             np.abs(
-                simulate_record(DUFFING, "none", excitation.acceleration, dt, substeps=n).z[0] - ref
+                simulate_record(DUFFING, "none", excitation["base_acceleration"], dt, substeps=n).z[
+                    0
+                ]
+                - ref
             )
         )
         for n in (1, 2, 4)
@@ -64,8 +67,8 @@ def test_rk4_is_fourth_order(excitation):
 
 
 def test_lugre_matches_stiff_solver(excitation):
-    dt = 1 / excitation.fs
-    acc = _interp_input(excitation.acceleration, dt)
+    dt = excitation.dt
+    acc = _interp_input(excitation["base_acceleration"], dt)
     p = dict(m=0.0226, c=0.055, k=59.7, k3=64926.0)
     s0, s1, fc, fs, vs = 1.98, 0.18, 0.0008, 0.008, 0.007
 
@@ -78,14 +81,17 @@ def test_lugre_matches_stiff_solver(excitation):
 
     ref = _ivp(rhs, [0.0, 0.0, 0.0], excitation.time, dt, method="LSODA")
     sim = simulate_record(
-        dict(p, sigma0=s0, sigma1=s1, fc=fc, fs=fs, vs=vs), "lugre", excitation.acceleration, dt
+        dict(p, sigma0=s0, sigma1=s1, fc=fc, fs=fs, vs=vs),
+        "lugre",
+        excitation["base_acceleration"],
+        dt,
     )
     assert np.max(np.abs(sim.z[0] - ref[0])) < 1e-5 * np.std(ref[0])
 
 
 def test_moderate_tanh_matches_solve_ivp(excitation):
-    dt = 1 / excitation.fs
-    acc = _interp_input(excitation.acceleration, dt)
+    dt = excitation.dt
+    acc = _interp_input(excitation["base_acceleration"], dt)
     fc, beta = 0.0058, 50.0  # tau = m/(Fc beta) = 78 ms: smooth regime, plain RK4
 
     def rhs(t, y):
@@ -98,7 +104,9 @@ def test_moderate_tanh_matches_solve_ivp(excitation):
         ]
 
     ref = _ivp(rhs, [0.0, 0.0], excitation.time, dt)
-    sim = simulate_record(dict(DUFFING, fc=fc, beta=beta), "tanh", excitation.acceleration, dt)
+    sim = simulate_record(
+        dict(DUFFING, fc=fc, beta=beta), "tanh", excitation["base_acceleration"], dt
+    )
     assert np.max(np.abs(sim.z[0] - ref[0])) < 1e-5 * np.std(ref[0])
 
 
@@ -192,10 +200,14 @@ def test_coulomb_sticks_exactly_without_chattering():
 def test_coulomb_substep_convergence():
     ex = band_limited_excitation(2.0, 500.0, 1.0, seed=4)
     p = dict(DUFFING, fc=0.0058)
-    dt = 1 / ex.fs
-    ref = simulate_record(p, "coulomb", ex.acceleration, dt, substeps=32).z[0]
-    e1 = np.max(np.abs(simulate_record(p, "coulomb", ex.acceleration, dt, substeps=1).z[0] - ref))
-    e4 = np.max(np.abs(simulate_record(p, "coulomb", ex.acceleration, dt, substeps=4).z[0] - ref))
+    dt = ex.dt
+    ref = simulate_record(p, "coulomb", ex["base_acceleration"], dt, substeps=32).z[0]
+    e1 = np.max(
+        np.abs(simulate_record(p, "coulomb", ex["base_acceleration"], dt, substeps=1).z[0] - ref)
+    )
+    e4 = np.max(
+        np.abs(simulate_record(p, "coulomb", ex["base_acceleration"], dt, substeps=4).z[0] - ref)
+    )
     assert e4 < e1 / 50  # at least ~third order through the stick-slip events
     assert e4 < 1e-6 * np.std(ref)
 
@@ -203,11 +215,11 @@ def test_coulomb_substep_convergence():
 @pytest.mark.parametrize("beta", [1e7, 4.8e8, 1e9])
 def test_stiff_tanh_is_not_a_step_size_artefact(beta):
     ex = band_limited_excitation(2.0, 500.0, 1.0, seed=5)
-    dt = 1 / ex.fs
+    dt = ex.dt
     p = dict(DUFFING, fc=0.0058)
-    coulomb = simulate_record(p, "coulomb", ex.acceleration, dt).z[0]
+    coulomb = simulate_record(p, "coulomb", ex["base_acceleration"], dt).z[0]
     runs = [
-        simulate_record(dict(p, beta=beta), "tanh", ex.acceleration, dt, substeps=n).z[0]
+        simulate_record(dict(p, beta=beta), "tanh", ex["base_acceleration"], dt, substeps=n).z[0]
         for n in (1, 4, 16)
     ]
     scale = np.std(coulomb)
@@ -219,26 +231,28 @@ def test_stiff_tanh_is_not_a_step_size_artefact(beta):
 
 
 def test_batch_equals_individual_runs(excitation):
-    dt = 1 / excitation.fs
+    dt = excitation.dt
     fcs = np.array([0.0, 0.002, 0.0058, 0.02])
-    batch = simulate_record(dict(DUFFING, fc=fcs), "coulomb", excitation.acceleration, dt)
+    batch = simulate_record(dict(DUFFING, fc=fcs), "coulomb", excitation["base_acceleration"], dt)
     for i, fc in enumerate(fcs):
-        one = simulate_record(dict(DUFFING, fc=fc), "coulomb", excitation.acceleration, dt)
+        one = simulate_record(dict(DUFFING, fc=fc), "coulomb", excitation["base_acceleration"], dt)
         np.testing.assert_array_equal(batch.z[i], one.z[0])
 
 
 def test_zero_friction_equals_viscous(excitation):
-    dt = 1 / excitation.fs
-    a = simulate_record(dict(DUFFING, fc=0.0), "coulomb", excitation.acceleration, dt).z
-    b = simulate_record(DUFFING, "none", excitation.acceleration, dt).z
+    dt = excitation.dt
+    a = simulate_record(dict(DUFFING, fc=0.0), "coulomb", excitation["base_acceleration"], dt).z
+    b = simulate_record(DUFFING, "none", excitation["base_acceleration"], dt).z
     np.testing.assert_allclose(a, b, rtol=0, atol=1e-15)
 
 
 def test_base_displacement_input_agrees_with_acceleration():
     ex = band_limited_excitation(4.0, 1000.0, 1.0, seed=6)
-    dt = 1 / ex.fs
-    a = simulate_record(DUFFING, "none", ex.acceleration, dt).z[0]
-    d = simulate_record(DUFFING, "none", ex.displacement, dt, input_kind="base_displacement").z[0]
+    dt = ex.dt
+    a = simulate_record(DUFFING, "none", ex["base_acceleration"], dt).z[0]
+    d = simulate_record(
+        DUFFING, "none", ex["base_displacement"], dt, input_kind="base_displacement"
+    ).z[0]
     # fourth-order differentiation inside, second order at the record's ends
     assert np.max(np.abs(a - d)) < 1e-3 * np.std(a)
 

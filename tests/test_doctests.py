@@ -24,6 +24,7 @@ MODULES = (
     "randvib.models.excitation",
     "randvib.models.harvester",
     "randvib.models.presets",
+    "randvib.models.record",
     "randvib.montecarlo.simulation",
     "randvib.montecarlo.sweep",
 )

@@ -38,10 +38,11 @@ from scipy import integrate
 
 import randvib as rv
 from randvib.cli._device import FRICTION_CHOICES
-from randvib.identification.fitting import MODELS, Record, default_bounds, identify, predict_record
+from randvib.identification.fitting import MODELS, default_bounds, identify, predict_record
 from randvib.identification.record_simulation import FRICTION_PARAMETERS, simulate_record
 from randvib.models.excitation import band_limited_excitation
 from randvib.models.friction import FRICTION_MODELS, parameter
+from randvib.models.record import Record
 
 
 @dataclass(frozen=True, eq=False)
@@ -205,7 +206,7 @@ VT = 1e-3  # m/s: tanh(beta v) with beta = 1000 s/m, smooth on the RK4 step
 
 @pytest.fixture(scope="module")
 def drive():
-    return band_limited_excitation(2.0, FS_REC, 1.07, seed=0).acceleration
+    return band_limited_excitation(2.0, FS_REC, 1.07, seed=0)["base_acceleration"]
 
 
 def test_record_simulation_reduces_to_the_builtin_tanh_law(drive):
@@ -241,7 +242,7 @@ def test_identification_recovers_the_law_from_a_noise_free_record(drive):
     """
     dt = 1 / FS_REC
     z = simulate_record(TRUE, "stribeck-test", drive, dt, substeps=8).z[0]
-    record = Record(dt, "base_acceleration", drive, z, "stribeck")
+    record = Record(dt, name="stribeck", base_acceleration=drive, relative_displacement=z)
     bounds = default_bounds(record, "stribeck-test", TRUE["m"])
     assert "vt" not in bounds  # declared without default bounds
     with pytest.raises(ValueError, match="declare no default search bounds"):

@@ -400,7 +400,7 @@ def short_record():
 )
 def test_simulate_on_record_refuses_or_is_finite(short_record, p, scale, segments):
     t, a = short_record
-    record = _refused(lambda: rv.Measured(t, a * scale))
+    record = _refused(lambda: rv.Measured(rv.Record(time=t, base_acceleration=a * scale)))
     device = _refused(lambda: rv.preset("figure9").updated(**p))
     if record is None or device is None:
         return

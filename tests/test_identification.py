@@ -11,7 +11,6 @@ from _stats import assert_matches
 from randvib.cli import main
 from randvib.identification.fitting import (
     CostFunction,
-    Record,
     SearchSettings,
     SimulationSettings,
     default_bounds,
@@ -20,11 +19,11 @@ from randvib.identification.fitting import (
     normalised_cost,
     predict,
     predict_record,
-    read_record,
     validate,
 )
 from randvib.identification.record_simulation import simulate_record
 from randvib.models.excitation import band_limited_excitation
+from randvib.models.record import Record
 
 COULOMB = H.COULOMB
 TRUE = COULOMB
@@ -34,10 +33,8 @@ def synthetic(
     seed=0, rms=1.07, duration=3.0, fs=500.0, kind="base_displacement", model="coulomb", params=TRUE
 ):
     ex = band_limited_excitation(duration, fs, rms, seed=seed)
-    inp = ex.displacement if kind == "base_displacement" else ex.acceleration
-    drive = ex.acceleration
-    z = simulate_record(params, model, drive, 1 / fs, substeps=8).z[0]
-    return Record(1 / fs, kind, inp, z, f"test{seed}")
+    z = simulate_record(params, model, ex["base_acceleration"], 1 / fs, substeps=8).z[0]
+    return Record(1 / fs, name=f"test{seed}", relative_displacement=z, **{kind: ex[kind]})
 
 
 @pytest.fixture(scope="module")
@@ -220,8 +217,8 @@ def test_tanh_base_displacement_not_at_rest_recovered_to_optimiser_precision():
     params = dict(COULOMB, beta=100.0)
     ex = H.excitation(0, 1.5, 500.0)
     y, acc = H.tapered(ex)
-    z = simulate_record(params, "tanh", acc, 1 / ex.fs, substeps=8, z0=Z0, v0=V0).z[0]
-    rec = Record(1 / ex.fs, "base_displacement", y, z, "tanh")
+    z = simulate_record(params, "tanh", acc, ex.dt, substeps=8, z0=Z0, v0=V0).z[0]
+    rec = Record(ex.dt, name="tanh", base_displacement=y, relative_displacement=z)
     res = identify_classic(
         rec, "tanh", m=COULOMB["m"], popsize=20, maxiter=60, seed=1, bounds={"beta": (10, 1e4)}
     )
@@ -269,9 +266,9 @@ def test_force_input_identifies_the_mass():
     """Force input, mass free: all five parameters to TOL of the optimum."""
     params = dict(m=0.5, c=2.0, k=800.0, k3=2e7)
     ex = band_limited_excitation(2.0, 400.0, 1.0, f_lo=2.0, f_hi=40.0, seed=2)
-    force = ex.acceleration
+    force = ex["base_acceleration"]
     z = simulate_record(params, "none", force, 1 / 400, input_kind="force", substeps=8).z[0]
-    rec = Record(1 / 400, "force", force, z)
+    rec = Record(1 / 400, force=force, relative_displacement=z)
     res = identify_classic(rec, "viscous", popsize=30, maxiter=100, seed=0)
     assert "m" in res.free
     lin = H.Linearisation(params, "viscous", rec, ("c", "k", "k3", "m"))
@@ -337,73 +334,6 @@ def write_csv(path, record, **rename):
     frame = record.to_frame().rename(columns=rename)
     frame.to_csv(path, index=False)
     return path
-
-
-def test_read_record_round_trip_and_mapping(tmp_path, record):
-    path = write_csv(tmp_path / "r.csv", record)
-    before = path.read_bytes()
-    back = read_record(path)
-    np.testing.assert_allclose(back.z, record.z)
-    assert back.dt == pytest.approx(record.dt) and back.input_kind == "base_acceleration"
-    assert path.read_bytes() == before  # input never modified
-    mapped = write_csv(
-        tmp_path / "m.csv", record, base_acceleration="acc", relative_displacement="laser"
-    )
-    frame = read_record(
-        mapped, input_column="acc", input_kind="base_acceleration", output_column="laser"
-    )
-    np.testing.assert_allclose(frame.input, record.input)
-    no_time = tmp_path / "nt.csv"
-    record.to_frame().drop(columns="time").to_csv(no_time, index=False)
-    assert read_record(no_time, sample_rate=500).dt == pytest.approx(1 / 500)
-    assert read_record(path, rows=(10, 110)).n == 100
-
-
-@pytest.mark.parametrize(
-    "mutate, kwargs, match",
-    [
-        (
-            lambda f: f.drop(columns="relative_displacement"),
-            {},
-            "output column `relative_displacement` not found",
-        ),
-        (lambda f: f.drop(columns="base_acceleration"), {}, "no input column"),
-        (lambda f: f.rename(columns={"base_acceleration": "acc"}), {}, "no input column"),
-        (lambda f: f.assign(force=1.0), {}, "several input columns"),
-        (
-            lambda f: f.assign(relative_displacement=f.relative_displacement.where(f.index != 7)),
-            {},
-            "column `relative_displacement` has 1 NaN.*row 7",
-        ),
-        (
-            lambda f: f.assign(base_acceleration=f.base_acceleration.where(f.index != 3, np.inf)),
-            {},
-            "column `base_acceleration` has 1 NaN or infinite",
-        ),
-        (
-            lambda f: f.assign(time=f.time.where(f.index != 50, f.time + 1e-4)),
-            {},
-            "column `time` is not uniformly sampled",
-        ),
-        (
-            lambda f: f.drop(columns="time"),
-            {},
-            "no 'time' column \\(`time_column`\\); give the sample rate",
-        ),
-        (lambda f: f, dict(sample_rate=1000), "`sample_rate` = 1000 Hz disagrees"),
-        (lambda f: f.iloc[:3], {}, "at least 5"),
-        (
-            lambda f: f,
-            dict(input_column="acc"),
-            "input column 'acc' \\(`input_column`\\) not found",
-        ),
-    ],
-)
-def test_bad_records(tmp_path, record, mutate, kwargs, match):
-    path = tmp_path / "bad.csv"
-    mutate(record.to_frame()).to_csv(path, index=False)
-    with pytest.raises(ValueError, match=match):
-        read_record(path, **kwargs)
 
 
 def test_bad_identify_arguments(record):

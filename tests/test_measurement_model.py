@@ -15,11 +15,12 @@ import pytest
 from scipy import stats
 
 from randvib.cli import main
-from randvib.identification.fitting import Record, identify, validate
+from randvib.identification.fitting import identify, validate
 from randvib.identification.record_simulation import reconstruct_input, simulate_record
 from randvib.identification.synthetic import synthetic_record
 from randvib.models.friction import FRICTION_MODELS
 from randvib.models.harvester import Harvester
+from randvib.models.record import Record
 
 #: Paper Table 2, Coulomb model, training data 1 (m from docs/conventions.md).
 TRUTH = dict(m=0.0226, c=0.049, k=57.4, k3=70742.0, fc=0.0058)
@@ -77,7 +78,10 @@ def _noisy(excitation_seed, noise_seed):
         _CLEAN[excitation_seed] = record(excitation_seed, noise_z=0.0)
     clean = _CLEAN[excitation_seed]
     eps = np.random.default_rng([noise_seed, 99]).standard_normal(clean.n)
-    return Record(clean.dt, clean.input_kind, clean.input, clean.z + NOISE * eps, "noisy")
+    noisy = clean.z + NOISE * eps
+    return Record(
+        clean.dt, name="noisy", relative_displacement=noisy, **{clean.input_kind: clean.input}
+    )
 
 
 def binomial_region(n, p=0.95, alpha=0.01):
@@ -143,7 +147,9 @@ def test_campaign_record_with_a_laser_offset_is_fitted_as_without():
 
     campaign = load("identification")  # the script studies/identification.py
     rec, _ = campaign.make_test(3, duration=4.0, fs=500.0, seed=0)
-    moved = Record(rec.dt, rec.input_kind, rec.input + 2e-3, rec.z + 1e-3, "moved")
+    moved = Record(
+        rec.dt, name="moved", base_displacement=rec.input + 2e-3, relative_displacement=rec.z + 1e-3
+    )
     fits = [
         identify(r, "coulomb", m=campaign.TRUTH["m"], lowpass=50.0, seed=0) for r in (rec, moved)
     ]
@@ -182,7 +188,9 @@ def test_quadratic_stiffness_is_recovered():
     clean = synthetic_record(device(), 1.5, duration=2.0, sample_rate=500.0, seed=3)
     z = simulate_record(params, "coulomb", clean.input, clean.dt).z[0]
     noise = NOISE * np.random.default_rng(1).standard_normal(z.size)
-    rec = Record(clean.dt, clean.input_kind, clean.input, z + noise, "k2")
+    rec = Record(
+        clean.dt, name="k2", base_acceleration=clean.input, relative_displacement=z + noise
+    )
     quad = identify(rec, "coulomb", m=TRUTH["m"], quadratic=True, seed=0)
     assert abs(quad.parameters["k2"] - 2000.0) <= 4 * quad.standard_errors["k2"]
     assert "input_offset" not in quad.parameters  # redundant with k2 free

@@ -448,7 +448,8 @@ def test_identify_unsimulable_fixed_values_refused_before_searching(
 
 
 def test_identify_probe_refuses_nothing_a_search_can_fit(record_csv):
-    from randvib.identification.fitting import identify, read_record
+    from randvib.identification.fitting import identify
+    from randvib.models.record import read_record
 
     fit = identify(read_record(record_csv[0]), "coulomb", m=0.0226, popsize=8, maxiter=2,
                    polish=False, fixed={"k3": 70742.0})  # fmt: skip
@@ -745,7 +746,7 @@ def test_readme_sweep_example_has_the_main_guard():
 
 
 def test_unreadable_stored_fit_is_named_and_fitted_again(tmp_path, record_csv):
-    from randvib.identification.fitting import read_record
+    from randvib.models.record import read_record
     from randvib.studies.campaign import identify_cached
 
     path = tmp_path / "fit.json"

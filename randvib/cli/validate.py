@@ -4,9 +4,8 @@ from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
 
-from randvib._io import check_output_folder, dumps
+from randvib._io import check_output_folder, dumps, existing_file
 from randvib.cli._output import print_table
 from randvib.cli._records import (
     add_record_arguments,
@@ -46,11 +45,7 @@ def register(sub) -> None:
 
 
 def _load_parameters(path):
-    path = Path(path)
-    if path.is_dir():
-        raise IsADirectoryError(f"parameter file {str(path)!r} is a folder; give a JSON file")
-    if not path.is_file():
-        raise FileNotFoundError(f"parameter file {str(path)!r} does not exist")
+    path = existing_file(path, "parameter file", "JSON")
     try:
         data = json.loads(path.read_text())
         model = data["model"]

@@ -39,7 +39,6 @@ import time
 import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
-from pathlib import Path
 
 import numpy as np
 
@@ -49,7 +48,6 @@ from randvib._validation import MAX_SEED, check_finite, check_int, check_nonnega
 from randvib.identification.record_simulation import (
     EXTRA_PARAMETERS,
     HOLDS,
-    INPUT_KINDS,
     SEARCH_SUBCYCLES,
     device_parameters,
     driving_signal,
@@ -59,6 +57,7 @@ from randvib.identification.record_simulation import (
 )
 from randvib.identification.sade import sade
 from randvib.models.friction import FRICTION_MODELS, Parameter, RecordScales, RegistryView
+from randvib.models.record import OUTPUT_CHANNEL, Record
 
 #: The device's own parameters (Eq. 1; friction laws declare theirs): unit,
 #: default bounds from the record's scales, log scale (k3 may be zero).
@@ -113,8 +112,6 @@ class _Units(Mapping):
 
 #: Parameter name -> SI unit (live view; a law's own units win in its results).
 UNITS = _Units()
-OUTPUT_COLUMN = "relative_displacement"
-TIME_COLUMN = "time"
 #: Fewest samples per free parameter that a record must have.
 SAMPLES_PER_PARAMETER = 10
 #: How the simulation's initial state is obtained (SimulationSettings.initial_state).
@@ -244,278 +241,6 @@ def _settings(caller, options: dict, **given):
 _SETTINGS = {"search": SearchSettings, "simulation": SimulationSettings}
 
 
-# ----------------------------------------------------------------------- records
-@dataclass(frozen=True, eq=False)
-class Record:
-    """A measured (or synthetic) test: input and relative displacement on a uniform grid.
-
-    Attributes
-    ----------
-    dt : float
-        Sample interval (s).
-    input_kind : {'base_displacement', 'base_acceleration', 'force'}
-        What ``input`` is: base displacement y (m), base acceleration y''
-        (m/s^2) or force on the mass u (N).
-    input : ndarray
-        Input samples.
-    z : ndarray
-        Measured relative displacement (m).
-    name : str
-        Label used in tables and plots.
-    voltage : ndarray or None
-        Measured load voltage (V), if recorded.
-    """
-
-    dt: float
-    input_kind: str
-    input: np.ndarray
-    z: np.ndarray
-    name: str = "record"
-    voltage: np.ndarray | None = None
-
-    def __post_init__(self):
-        object.__setattr__(self, "dt", float(check_positive("dt", self.dt, "s")))
-        if self.input_kind not in INPUT_KINDS:
-            raise ValueError(
-                f"`input_kind` must be one of {', '.join(INPUT_KINDS)}; got {self.input_kind!r}"
-            )
-        inp = _finite_column(self.input_kind, self.input)
-        z = _finite_column(OUTPUT_COLUMN, self.z)
-        if inp.shape != z.shape:
-            raise ValueError(
-                f"input `{self.input_kind}` has {inp.size} samples but `{OUTPUT_COLUMN}` has {z.size}"
-            )
-        if z.size < 5:
-            raise ValueError(f"record {self.name!r} has {z.size} samples; at least 5 are needed")
-        object.__setattr__(self, "input", inp)
-        object.__setattr__(self, "z", z)
-        if self.voltage is not None:
-            object.__setattr__(self, "voltage", _finite_column("voltage", self.voltage))
-
-    @property
-    def n(self) -> int:
-        return self.z.size
-
-    @property
-    def time(self) -> np.ndarray:
-        return np.arange(self.n) * self.dt
-
-    @property
-    def sample_rate(self) -> float:
-        return 1.0 / self.dt
-
-    def rows(self, start=None, stop=None, name=None) -> Record:
-        """The samples ``start:stop`` as a new record."""
-        sl = slice(start, stop)
-        return Record(
-            self.dt,
-            self.input_kind,
-            self.input[sl],
-            self.z[sl],
-            name or f"{self.name}[{start or 0}:{'' if stop is None else stop}]",
-            None if self.voltage is None else self.voltage[sl],
-        )
-
-    def to_frame(self):
-        """The record as a DataFrame with the CSV column names."""
-        import pandas as pd
-
-        data = {TIME_COLUMN: self.time, self.input_kind: self.input, OUTPUT_COLUMN: self.z}
-        if self.voltage is not None:
-            data["voltage"] = self.voltage
-        return pd.DataFrame(data)
-
-    def to_csv(self, path, *, overwrite: bool = False, float_format: str | None = "%.10g") -> None:
-        """Write the record as the CSV :func:`read_record` reads.
-
-        Parameters
-        ----------
-        path : path-like
-        overwrite : bool
-            Replace an existing file (refused by default).
-        float_format : str or None
-            Number format; None writes every float exactly (shortest
-            round-trip representation), so the samples read back bit for bit.
-        """
-        path = Path(path)
-        if path.exists() and not overwrite:
-            raise FileExistsError(
-                f"{str(path)!r} exists; records are not overwritten unless asked (overwrite=True)"
-            )
-        self.to_frame().to_csv(path, index=False, float_format=float_format)
-
-
-def _finite_column(name, values):
-    try:
-        arr = np.asarray(values, dtype=float)
-    except (TypeError, ValueError):
-        raise ValueError(f"column `{name}` must be numeric") from None
-    if arr.ndim != 1:
-        raise ValueError(f"column `{name}` must be one-dimensional, got shape {arr.shape}")
-    bad = np.flatnonzero(~np.isfinite(arr))
-    if bad.size:
-        raise ValueError(
-            f"column `{name}` has {bad.size} NaN or infinite sample(s), first at data row "
-            f"{bad[0]} (value {arr[bad[0]]!r}); clean or cut the record"
-        )
-    return arr
-
-
-def read_record(
-    path,
-    *,
-    input_column: str | None = None,
-    input_kind: str | None = None,
-    output_column: str = OUTPUT_COLUMN,
-    time_column: str = TIME_COLUMN,
-    sample_rate: float | None = None,
-    rows: tuple[int | None, int | None] | None = None,
-    name: str | None = None,
-) -> Record:
-    """Read a record from CSV (the file is only read, never modified).
-
-    The CSV needs a time column (s, uniform) or ``sample_rate``; one input
-    column named ``base_displacement`` (m), ``base_acceleration`` (m/s^2) or
-    ``force`` (N); and ``relative_displacement`` (m). Other names are mapped
-    with ``input_column``/``input_kind`` and ``output_column``.
-
-    Parameters
-    ----------
-    path : path-like
-    input_column : str, optional
-        Column holding the input; its kind is its name unless ``input_kind``
-        is given.
-    input_kind : {'base_displacement', 'base_acceleration', 'force'}, optional
-    output_column : str
-        Column holding the relative displacement.
-    time_column : str
-        Column of sample times (s); ignored when absent and ``sample_rate``
-        is given.
-    sample_rate : float, optional
-        Sample rate (Hz) for files without a time column.
-    rows : (start, stop), optional
-        Keep data rows ``start:stop`` (0-based, stop exclusive).
-    name : str, optional
-        Record label (default: the file name).
-
-    Raises
-    ------
-    ValueError
-        Missing or ambiguous columns, non-numeric, NaN or infinite samples,
-        a non-uniform time column, an inconsistent sample rate.
-    """
-    path = Path(path)
-    frame = _read_csv(path)
-    columns = list(frame.columns)
-    input_column, input_kind = _input_column(path, columns, input_column, input_kind)
-    if output_column not in columns:
-        raise ValueError(
-            f"{path.name}: output column `{output_column}` not found (relative displacement, m); "
-            f"columns are {columns}; map another name with `--output-column`"
-        )
-    if rows is not None:
-        frame = frame.iloc[slice(*rows)]
-    if len(frame) < 5:
-        raise ValueError(f"{path.name}: {len(frame)} data rows selected; at least 5 are needed")
-    return Record(
-        dt=_sample_interval(path, frame, time_column, sample_rate),
-        input_kind=input_kind,
-        input=_finite_column(input_column, frame[input_column]),
-        z=_finite_column(output_column, frame[output_column]),
-        name=name or path.stem,
-        voltage=(
-            _finite_column("voltage", frame["voltage"])
-            if "voltage" in columns and output_column != "voltage"
-            else None
-        ),
-    )
-
-
-def _read_csv(path: Path):
-    """The CSV as a DataFrame with string column names; parse errors as ValueError."""
-    import pandas as pd
-
-    if path.is_dir():
-        raise IsADirectoryError(f"record file {str(path)!r} is a folder; give a CSV file")
-    if not path.is_file():
-        raise FileNotFoundError(f"record file {str(path)!r} does not exist")
-    try:
-        frame = pd.read_csv(path)
-    except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
-        raise ValueError(f"cannot read {str(path)!r} as CSV: {exc}") from None
-    frame.columns = [str(c) for c in frame.columns]
-    return frame
-
-
-def _input_column(path: Path, columns, input_column, input_kind) -> tuple[str, str]:
-    """(column, kind) of the record's input.
-
-    Without ``input_column`` the input is the one column named like an input
-    kind (``input_kind``, when given, names it); without ``input_kind`` the
-    column's name must be a kind.
-    """
-    if input_kind is not None and input_kind not in INPUT_KINDS:
-        raise ValueError(
-            f"`input_kind` must be one of {', '.join(INPUT_KINDS)}; got {input_kind!r}"
-        )
-    if input_column is None:
-        present = [c for c in INPUT_KINDS if c in columns]
-        if input_kind is not None:
-            present = [input_kind] if input_kind in columns else []
-        if not present:
-            raise ValueError(
-                f"{path.name}: no input column; expected one of {', '.join(INPUT_KINDS)} "
-                f"(or name it with `input_column`); columns are {columns}"
-            )
-        if len(present) > 1:
-            raise ValueError(
-                f"{path.name}: several input columns {present}; choose one with `input_kind`"
-            )
-        input_column = present[0]
-    if input_column not in columns:
-        raise ValueError(
-            f"{path.name}: input column {input_column!r} (`input_column`) not found; "
-            f"columns are {columns}"
-        )
-    if input_kind is None:
-        if input_column not in INPUT_KINDS:
-            raise ValueError(
-                f"input column `{input_column}` is not one of {', '.join(INPUT_KINDS)}; "
-                "say what it holds with `input_kind`"
-            )
-        input_kind = input_column
-    return input_column, input_kind
-
-
-def _sample_interval(path: Path, frame, time_column, sample_rate) -> float:
-    """dt (s): the median step of a uniform time column, checked against
-    ``sample_rate`` when both are given, or ``1 / sample_rate``."""
-    if time_column not in frame.columns:
-        if sample_rate is None:
-            raise ValueError(
-                f"{path.name}: no {time_column!r} column (`time_column`); give the sample rate "
-                "with `sample_rate`"
-            )
-        return 1.0 / float(check_positive("sample_rate", sample_rate, "Hz"))
-    t = _finite_column(time_column, frame[time_column])
-    steps = np.diff(t)
-    dt = float(np.median(steps))
-    if dt <= 0:
-        raise ValueError(f"column `{time_column}` must increase, median step is {dt!r} s")
-    bad = np.flatnonzero(np.abs(steps - dt) > 1e-3 * dt)
-    if bad.size:
-        raise ValueError(
-            f"column `{time_column}` is not uniformly sampled: step {steps[bad[0]]!r} s "
-            f"at data row {bad[0] + 1}, median step {dt!r} s; resample the record"
-        )
-    if sample_rate is not None and abs(float(sample_rate) * dt - 1) > 1e-3:
-        raise ValueError(
-            f"`sample_rate` = {sample_rate} Hz disagrees with column `{time_column}` "
-            f"(step {dt} s, {1 / dt:.6g} Hz)"
-        )
-    return dt
-
-
 # ------------------------------------------------------------------- cost (Eq. 11)
 def initial_velocity(z, dt):
     """Velocity at the first sample from the first five (fourth-order one-sided, m/s)."""
@@ -584,7 +309,7 @@ class CostFunction:
         self.variance = float(np.var(scored))
         if self.variance == 0 or np.ptp(scored) == 0 or not np.isfinite(self.variance):
             raise ValueError(
-                f"`{OUTPUT_COLUMN}` of record {record.name!r} is constant; J (Eq. 11) is undefined"
+                f"`{OUTPUT_CHANNEL}` of record {record.name!r} is constant; J (Eq. 11) is undefined"
             )
         self.n_scored = scored.size
         offset = self.fixed.get(
@@ -1117,7 +842,7 @@ def _search_space(record, model, fixed, bounds, skip) -> _SearchSpace:
         )
     if np.ptp(record.z[skip:]) == 0:
         raise ValueError(
-            f"`{OUTPUT_COLUMN}` of record {record.name!r} is constant; J (Eq. 11) is undefined"
+            f"`{OUTPUT_CHANNEL}` of record {record.name!r} is constant; J (Eq. 11) is undefined"
         )
     box = default_bounds(record, model, fixed.get("m"))
     box.update(_extra_bounds(record, fixed.get("m")))

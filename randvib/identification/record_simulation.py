@@ -91,9 +91,8 @@ from randvib.models.friction import (
     kernel_callback,
 )
 from randvib.models.harvester import Harvester
+from randvib.models.record import INPUT_KINDS
 
-#: Input kinds a record may carry, and what the kernel is driven by.
-INPUT_KINDS = ("base_displacement", "base_acceleration", "force")
 #: Friction law name -> kernel code (``none`` = viscous only); a live view of
 #: the registry :data:`randvib.models.friction.FRICTION_MODELS`.
 FRICTION_KINDS = RegistryView(lambda law: KERNEL_NONE if law is None else law.kernel_code)
