@@ -26,13 +26,12 @@ import time
 
 import numpy as np
 
-from randvib.identification.fitting import CostFunction, default_bounds, identify
-from randvib.identification.record_simulation import (
-    driving_signal,
-    parameter_matrix,
-    run_kernel,
-    simulate_record,
-)
+from randvib.identification.bounds import default_bounds
+from randvib.identification.cost import CostFunction
+from randvib.identification.identify import identify
+from randvib.identification.input_reconstruction import driving_signal
+from randvib.identification.record_integrator import parameter_matrix, run_kernel
+from randvib.identification.record_response import simulate_record
 from randvib.identification.sade import _Space, sade
 from randvib.models.excitation import band_limited_excitation
 from randvib.models.record import Record

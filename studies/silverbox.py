@@ -33,7 +33,8 @@ import pandas as pd
 
 from randvib._io import dumps, write_tracked
 from randvib.datasets import silverbox
-from randvib.identification.fitting import identify, predict_record
+from randvib.identification.identify import identify
+from randvib.identification.prediction import predict_record
 from randvib.studies import script_main
 from randvib.studies.report import (
     markdown_table,

@@ -4,19 +4,19 @@ Shared by ``tests/test_identification.py`` and the seed study
 ``tests/calibration/identification.py``.
 
 The error model is :class:`Linearisation`: sensitivities of the simulated
-response are central differences of :func:`randvib.identification.record_simulation.simulate_record`
+response are central differences of :func:`randvib.identification.record_response.simulate_record`
 (one batched call), and the initial state ``identify`` starts from (first
 sample, fourth-order one-sided velocity :data:`VELOCITY_STENCIL`) is
 re-implemented here, so the reference does not go through
-:mod:`randvib.identification.fitting`.
+:mod:`randvib.identification.cost`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from randvib.identification.fitting import MODELS
-from randvib.identification.record_simulation import simulate_record
+from randvib.identification.models import MODELS
+from randvib.identification.record_response import simulate_record
 from randvib.models.excitation import band_limited_excitation
 from randvib.models.record import Record
 
@@ -153,7 +153,7 @@ def tapered(ex, ramp=0.2):
     ``w'' y + 2 w' y' + w y''`` (``y`` and its derivatives are exact spectral
     integrals). The base is at rest, to third order, at both ends of the
     record, so the second-order stencils that
-    :func:`randvib.identification.record_simulation.second_derivative` uses next to the ends see
+    :func:`randvib.identification.input_reconstruction.second_derivative` uses next to the ends see
     no motion, and the differentiated displacement carries only the interior
     stencil's error (omega dt)^4 / 90.
     """
@@ -191,7 +191,7 @@ def noisy_coulomb_z(noise_seed, lin=None):
     (the record's :class:`Linearisation`) may be passed to reuse it. Returns
     the fit, the z-scores and the standard errors.
     """
-    from randvib.identification.fitting import identify
+    from randvib.identification.identify import identify
 
     clean, noisy = noisy_coulomb_record(noise_seed)
     if lin is None:

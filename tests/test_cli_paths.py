@@ -13,7 +13,7 @@ from _cli import one_line_error, run
 from study_checks import check_study_run
 
 import randvib as rv
-from randvib.identification.fitting import validate as validate_api
+from randvib.identification.prediction import validate as validate_api
 from randvib.models.record import read_record
 from randvib.montecarlo.simulation import simulate
 from randvib.montecarlo.sweep import SweepSettings

@@ -1,11 +1,17 @@
-"""Deterministic simulator of recorded input (randvib.identification.record_simulation)."""
+"""Deterministic response to a recorded input.
+
+Covers randvib.identification.record_response (the public call),
+randvib.identification.record_integrator (RK4, stick-slip events, LuGre sub-cycling)
+and randvib.identification.input_reconstruction (the differentiated displacement).
+"""
 
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from randvib.identification.record_simulation import second_derivative, simulate_record
+from randvib.identification.input_reconstruction import second_derivative
+from randvib.identification.record_response import simulate_record
 from randvib.models.excitation import band_limited_excitation
 
 DUFFING = dict(m=0.0226, c=0.049, k=57.4, k3=70742.0)

@@ -5,7 +5,7 @@ import pytest
 
 import randvib as rv
 from randvib import _display
-from randvib.identification.fitting import IdentificationResult
+from randvib.identification.result import IdentificationResult
 
 
 @pytest.fixture(scope="module")

@@ -38,8 +38,12 @@ from scipy import integrate
 
 import randvib as rv
 from randvib.cli._device import FRICTION_CHOICES
-from randvib.identification.fitting import MODELS, default_bounds, identify, predict_record
-from randvib.identification.record_simulation import FRICTION_PARAMETERS, simulate_record
+from randvib.identification.bounds import default_bounds
+from randvib.identification.identify import identify
+from randvib.identification.models import MODELS
+from randvib.identification.prediction import predict_record
+from randvib.identification.record_integrator import FRICTION_PARAMETERS
+from randvib.identification.record_response import simulate_record
 from randvib.models.excitation import band_limited_excitation
 from randvib.models.friction import FRICTION_MODELS, parameter
 from randvib.models.record import Record

@@ -1,4 +1,8 @@
-"""Identification of friction models (randvib.identification.fitting, CLI identify/validate)."""
+"""Identification of friction models and the CLI commands identify and validate.
+
+Covers randvib.identification.identify (the driver), .cost (Eq. 11), .bounds,
+.settings, .models, .result and .prediction (predict_record, validate).
+"""
 
 import json
 from types import SimpleNamespace
@@ -9,19 +13,12 @@ import pytest
 from _stats import assert_matches
 
 from randvib.cli import main
-from randvib.identification.fitting import (
-    CostFunction,
-    SearchSettings,
-    SimulationSettings,
-    default_bounds,
-    identify,
-    initial_velocity,
-    normalised_cost,
-    predict,
-    predict_record,
-    validate,
-)
-from randvib.identification.record_simulation import simulate_record
+from randvib.identification.bounds import default_bounds
+from randvib.identification.cost import CostFunction, initial_velocity, normalised_cost
+from randvib.identification.identify import identify
+from randvib.identification.prediction import predict, predict_record, validate
+from randvib.identification.record_response import simulate_record
+from randvib.identification.settings import SearchSettings, SimulationSettings
 from randvib.models.excitation import band_limited_excitation
 from randvib.models.record import Record
 

@@ -15,8 +15,10 @@ import pytest
 from scipy import stats
 
 from randvib.cli import main
-from randvib.identification.fitting import identify, validate
-from randvib.identification.record_simulation import reconstruct_input, simulate_record
+from randvib.identification.identify import identify
+from randvib.identification.input_reconstruction import reconstruct_input
+from randvib.identification.prediction import validate
+from randvib.identification.record_response import simulate_record
 from randvib.identification.synthetic import synthetic_record
 from randvib.models.friction import FRICTION_MODELS
 from randvib.models.harvester import Harvester

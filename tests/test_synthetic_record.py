@@ -6,8 +6,8 @@ import pytest
 
 from randvib import BandLimited, Harvester, preset, read_record, synthetic_record
 from randvib.cli import main
-from randvib.identification.fitting import identify
-from randvib.identification.record_simulation import simulate_record
+from randvib.identification.identify import identify
+from randvib.identification.record_response import simulate_record
 from randvib.models.excitation import band_limited_excitation
 from randvib.models.friction import Coulomb
 

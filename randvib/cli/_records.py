@@ -5,8 +5,8 @@ from __future__ import annotations
 import argparse
 
 from randvib._validation import integer_option
-from randvib.identification.fitting import INITIAL_STATES, SimulationSettings
-from randvib.identification.record_simulation import HOLDS
+from randvib.identification.input_reconstruction import HOLDS
+from randvib.identification.settings import INITIAL_STATES, SimulationSettings
 from randvib.models.record import INPUT_KINDS, OUTPUT_CHANNEL, TIME_COLUMN, read_record
 
 

@@ -20,7 +20,9 @@ from randvib.cli._records import (
     record_from_args,
     simulation_settings,
 )
-from randvib.identification.fitting import MODELS, UNITS, SearchSettings, identify
+from randvib.identification.identify import identify
+from randvib.identification.models import MODELS, UNITS
+from randvib.identification.settings import SearchSettings
 
 DEFAULT = SearchSettings()
 INPUT_UNITS = {"base_acceleration": "m/s^2", "base_displacement": "m", "force": "N"}

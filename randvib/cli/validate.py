@@ -14,7 +14,9 @@ from randvib.cli._records import (
     record_from_args,
     simulation_settings,
 )
-from randvib.identification.fitting import MODELS, SimulationSettings, check_parameter, validate
+from randvib.identification.models import MODELS, check_parameter
+from randvib.identification.prediction import validate
+from randvib.identification.settings import SimulationSettings
 
 SIMULATION_FIELDS = tuple(SimulationSettings().to_dict())
 
@@ -98,8 +100,8 @@ def run(args) -> int:
     records = [record_from_args(path, args) for path in args.data]
     rows = validate(parameters, model, records, simulation=settings)
     if plot_dir is not None:
-        from randvib.identification.fitting import predict_record
         from randvib.identification.plots import figure_fit
+        from randvib.identification.prediction import predict_record
 
         for i, record in enumerate(records):
             pred = predict_record(parameters, model, record, simulation=settings)

@@ -2,7 +2,7 @@
 
 One call, :func:`synthetic_record`, replaces the four steps a user needed
 before (realise the excitation, pick the input channel, simulate the device
-with :func:`~randvib.identification.record_simulation.simulate_record`,
+with :func:`~randvib.identification.record_response.simulate_record`,
 wrap a :class:`~randvib.models.record.Record`) and adds what a real
 measurement adds: Gaussian sensor noise and constant offsets on each channel.
 An offset is what the sensor adds: measured value = true value + offset.
@@ -28,7 +28,7 @@ from randvib._validation import (
     check_positive,
     check_scalar_device,
 )
-from randvib.identification.record_simulation import simulate_record
+from randvib.identification.record_response import simulate_record
 from randvib.models.excitation import BaseMotionOverflow, Excitation, band_limited_excitation
 from randvib.models.harvester import Harvester
 from randvib.models.presets import PRESETS, preset

@@ -19,8 +19,10 @@ import numpy as np
 import pandas as pd
 
 from randvib._io import atomic_write_text, dumps
-from randvib.identification.fitting import MODEL_PARAMETERS, IdentificationResult, identify
-from randvib.identification.record_simulation import simulate_record
+from randvib.identification.identify import identify
+from randvib.identification.models import MODEL_PARAMETERS
+from randvib.identification.record_response import simulate_record
+from randvib.identification.result import IdentificationResult
 from randvib.models.excitation import band_limited_excitation
 from randvib.models.record import Record
 

@@ -17,7 +17,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import _identification as H  # noqa: E402
 import test_identification as T  # noqa: E402
 
-from randvib.identification.fitting import identify  # noqa: E402
+from randvib.identification.identify import identify  # noqa: E402
 
 
 def noise_study(n):
