@@ -30,8 +30,9 @@ from randvib.identification.bounds import default_bounds
 from randvib.identification.cost import CostFunction
 from randvib.identification.identify import identify
 from randvib.identification.input_reconstruction import driving_signal
+from randvib.identification.models import device_from_parameters
 from randvib.identification.record_integrator import parameter_matrix, run_kernel
-from randvib.identification.record_response import simulate_record
+from randvib.identification.record_response import record_response
 from randvib.identification.sade import _Space, sade
 from randvib.models.excitation import band_limited_excitation
 from randvib.models.record import Record
@@ -41,7 +42,8 @@ TRUE = dict(m=0.0226, c=0.049, k=57.4, k3=70742.0, fc=0.0058)
 
 def coulomb_record(duration=10.0, fs=1000.0, seed=1):
     ex = band_limited_excitation(duration, fs, 1.5, seed=seed)
-    z = simulate_record(TRUE, "coulomb", ex["base_acceleration"], 1 / fs, substeps=8).z[0]
+    device, _ = device_from_parameters("coulomb", TRUE)
+    z = record_response(device, ex, input_kind="base_acceleration", substeps=8).z[0]
     return Record(
         1 / fs, name="bench", base_displacement=ex["base_displacement"], relative_displacement=z
     )

@@ -92,7 +92,7 @@ def fit_and_score(records, label, options, search, progress):
     sim = {k: res.settings[k] for k in ("substeps", "hold", "initial_state")}
     rows = []
     for rec in records:
-        pred = predict_record(res.parameters, "viscous", rec, **sim)
+        pred = predict_record(res.harvester(), rec, measurement=res.measurement, **sim)
         rows.append(
             {
                 "model": label,

@@ -4,7 +4,7 @@ Shared by ``tests/test_identification.py`` and the seed study
 ``tests/calibration/identification.py``.
 
 The error model is :class:`Linearisation`: sensitivities of the simulated
-response are central differences of :func:`randvib.identification.record_response.simulate_record`
+response are central differences of :func:`randvib.identification.record_response.record_response`
 (one batched call), and the initial state ``identify`` starts from (first
 sample, fourth-order one-sided velocity :data:`VELOCITY_STENCIL`) is
 re-implemented here, so the reference does not go through
@@ -15,9 +15,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from randvib.identification.models import MODELS
-from randvib.identification.record_response import simulate_record
+from randvib.identification.models import MeasurementModel, check_model
+from randvib.identification.record_response import record_response
 from randvib.models.excitation import band_limited_excitation
+from randvib.models.harvester import Harvester
 from randvib.models.record import Record
 
 #: Paper Table 2, Coulomb model, training data 1 (m from docs/conventions.md).
@@ -32,11 +33,27 @@ def excitation(seed, duration, fs, rms=1.07):
     return band_limited_excitation(duration, fs, rms, seed=seed)
 
 
+def harvester(params, model="coulomb"):
+    """The device of identify's named parameters (``c`` as c_m), unchecked: scalars or
+    1-D arrays (a batch). ``model``: an identification model (``viscous``: no friction)."""
+    law = check_model(model)
+    friction = None if law is None else law(**{n: params[n] for n in law.parameter_names()})
+    return Harvester(
+        m=params["m"], c_m=params["c"], c_e=0.0, k=params["k"], k3=params["k3"], friction=friction
+    )
+
+
+def measurement(params):
+    """The measurement model among named parameters (k2 and the offsets; absent ones 0)."""
+    return MeasurementModel.from_parameters(params)
+
+
 def clean_response(params, model, ex, *, z0=0.0, v0=0.0, substeps=8):
     """Noise-free relative displacement and velocity driven by the exact base acceleration."""
-    sim = simulate_record(
-        params, MODELS[model], ex["base_acceleration"], ex.dt, substeps=substeps, z0=z0, v0=v0
-    )
+    sim = record_response(
+        harvester(params, model), ex, input_kind="base_acceleration", substeps=substeps, z0=z0,
+        v0=v0,
+    )  # fmt: skip
     return sim.z[0], sim.v[0]
 
 
@@ -79,16 +96,7 @@ def sensitivities(params, model, record, free, z0, v0, *, substeps=4):
             else:
                 batch[name][row] *= np.exp(sign * h)
         steps.append(h)
-    z = simulate_record(
-        batch,
-        MODELS[model],
-        record.input,
-        record.dt,
-        input_kind=record.input_kind,
-        substeps=substeps,
-        z0=z0s,
-        v0=v0s,
-    ).z
+    z = record_response(harvester(batch, model), record, substeps=substeps, z0=z0s, v0=v0s).z
     d = (z[0:-1:2] - z[1::2]) / (2 * np.array(steps)[:, None])
     return z[-1], d[:-2].T, d[-2], d[-1]
 

@@ -6,6 +6,7 @@ argument.
 
 import json
 
+import _identification as H
 import matplotlib.image
 import numpy as np
 import pytest
@@ -180,7 +181,8 @@ def test_validate_table_and_plots(tmp_path, capsys, records):
     plots = tmp_path / "plots"
     code, out, _ = run(capsys, "validate", params, *records, "--plot", plots)
     assert code == 0
-    expected = validate_api(parameters, "coulomb", [read_record(p) for p in records], substeps=4)
+    device = H.harvester(parameters)
+    expected = validate_api(device, [read_record(p) for p in records], substeps=4)
     rows = table_rows(out)
     for row in expected:
         samples, cost, rms = rows[row.record]

@@ -110,7 +110,7 @@ def test_results_under_a_table_or_a_record_show_themselves():
     record = rv.Measured(
         rv.Record(time=np.arange(4000) * 1e-3, base_acceleration=table.sample(4.0, 1e-3, seed=1)[0])
     )
-    on_record = rv.simulate_on_record(device, record, segments=2, burn_in=0.5, progress=False)
+    on_record = rv.monte_carlo_on_record(device, record, segments=2, burn_in=0.5, progress=False)
     assert on_record.psd is None
     assert repr(on_record).startswith("RecordSimulation(") and "measured" in repr(on_record)
     assert "array" not in repr(on_record)  # not the record's samples

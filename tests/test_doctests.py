@@ -19,6 +19,8 @@ MODULES = (
     "randvib.analytic.prediction",
     "randvib.analytic.statistical_linearisation",
     "randvib._display",
+    "randvib.identification.prediction",
+    "randvib.identification.record_response",
     "randvib.identification.synthetic",
     "randvib.models.coupling",
     "randvib.models.excitation",

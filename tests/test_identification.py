@@ -12,12 +12,14 @@ import numpy as np
 import pytest
 from _stats import assert_matches
 
+import randvib as rv
 from randvib.cli import main
 from randvib.identification.bounds import default_bounds
 from randvib.identification.cost import CostFunction, initial_velocity, normalised_cost
 from randvib.identification.identify import identify
-from randvib.identification.prediction import predict, predict_record, validate
-from randvib.identification.record_response import simulate_record
+from randvib.identification.models import MeasurementModel
+from randvib.identification.prediction import predict_record, validate
+from randvib.identification.record_response import record_response
 from randvib.identification.settings import SearchSettings, SimulationSettings
 from randvib.models.excitation import band_limited_excitation
 from randvib.models.record import Record
@@ -30,7 +32,8 @@ def synthetic(
     seed=0, rms=1.07, duration=3.0, fs=500.0, kind="base_displacement", model="coulomb", params=TRUE
 ):
     ex = band_limited_excitation(duration, fs, rms, seed=seed)
-    z = simulate_record(params, model, ex["base_acceleration"], 1 / fs, substeps=8).z[0]
+    device = H.harvester(params, model)
+    z = record_response(device, ex, input_kind="base_acceleration", substeps=8).z[0]
     return Record(1 / fs, name=f"test{seed}", relative_displacement=z, **{kind: ex[kind]})
 
 
@@ -58,7 +61,12 @@ def test_search_cost_is_eq11_of_predict_record(record):
     x = [COULOMB["c"] * 1.02, COULOMB["k"] * 0.99, COULOMB["k3"] * 1.03, COULOMB["fc"] * 0.95]
     search_cost = CostFunction(record, "coulomb", fixed=fixed, free=free, initial_state="record")
     parameters = {**fixed, **dict(zip(free, x, strict=True))}
-    expected = predict_record(parameters, "coulomb", record, initial_state="record").cost
+    expected = predict_record(
+        H.harvester(parameters),
+        record,
+        measurement=H.measurement(parameters),
+        initial_state="record",
+    ).cost
     assert expected > 0.1  # far from the optimum
     assert search_cost(np.array([x]))[0] == pytest.approx(expected, rel=1e-9)
 
@@ -128,10 +136,11 @@ def test_true_parameters_score_the_residual_of_the_initial_state(skip):
     r = (rec.z - zhat)[skip:]
     reference = 100 * np.mean(r**2) / np.var(rec.z[skip:])
     assert reference < 1e-6
-    assert predict_record(
-        COULOMB, "coulomb", rec, skip=skip, initial_state="record"
-    ).cost == pytest.approx(reference, rel=1e-6)
-    (row,) = validate(COULOMB, "coulomb", [rec], skip=skip, initial_state="record")
+    device = H.harvester(COULOMB)
+    assert predict_record(device, rec, skip=skip, initial_state="record").cost == pytest.approx(
+        reference, rel=1e-6
+    )
+    (row,) = validate(device, [rec], skip=skip, initial_state="record")
     assert row.cost == pytest.approx(reference, rel=1e-6)
 
 
@@ -191,7 +200,9 @@ def test_noisy_record_within_linearised_standard_errors():
     # J (Eq. 11) reported by identify is Eq. 11 over the scored samples
     skip = H.NOISY["skip"]
     _, noisy = H.noisy_coulomb_record(0)
-    pred = predict_record(res.parameters, "coulomb", noisy, skip=skip, initial_state="record")
+    pred = predict_record(
+        res.harvester(), noisy, measurement=res.measurement, skip=skip, initial_state="record"
+    )
     assert res.cost == pytest.approx(pred.cost, rel=1e-9)
     # and sits at the noise floor: 100 sigma^2 / var(z) (fraction (N - d)/N of it)
     floor = 100 * H.NOISY["sigma"] ** 2 / np.var(noisy.z[skip:])
@@ -214,14 +225,15 @@ def test_tanh_base_displacement_not_at_rest_recovered_to_optimiser_precision():
     params = dict(COULOMB, beta=100.0)
     ex = H.excitation(0, 1.5, 500.0)
     y, acc = H.tapered(ex)
-    z = simulate_record(params, "tanh", acc, ex.dt, substeps=8, z0=Z0, v0=V0).z[0]
+    device = H.harvester(params, "tanh")
+    z = record_response(device, Record(ex.dt, base_acceleration=acc), substeps=8, z0=Z0, v0=V0).z[0]
     rec = Record(ex.dt, name="tanh", base_displacement=y, relative_displacement=z)
     res = identify_classic(
         rec, "tanh", m=COULOMB["m"], popsize=20, maxiter=60, seed=1, bounds={"beta": (10, 1e4)}
     )
     lin = H.Linearisation(params, "tanh", rec, H.FREE + ("beta",))
     assert_at_optimum(res, params, lin, "tanh")
-    assert res.cost <= predict_record(params, "tanh", rec, initial_state="record").cost
+    assert res.cost <= predict_record(device, rec, initial_state="record").cost
 
 
 LUGRE = dict(
@@ -241,7 +253,7 @@ def test_lugre_truth_scores_zero_and_the_fit_reaches_the_optimum():
     Stribeck parameters held the fit must reach the optimum to TOL.
     """
     rec = not_at_rest("lugre", LUGRE)
-    truth = predict_record(LUGRE, "lugre", rec, initial_state="record").cost
+    truth = predict_record(H.harvester(LUGRE, "lugre"), rec, initial_state="record").cost
     assert truth < 1e-6
     held = {n: LUGRE[n] for n in ("sigma0", "sigma1", "fs", "vs")}
     res = identify_classic(rec, "lugre", m=LUGRE["m"], fixed=held, popsize=16, maxiter=40, seed=1)
@@ -254,7 +266,8 @@ def test_viscous_model_cannot_match_a_friction_record(record):
     viscous = identify_classic(record, "viscous", m=COULOMB["m"], popsize=20, maxiter=40, seed=0)
     # without friction the record cannot be matched as well (paper Fig. 7)
     assert (
-        viscous.cost > 10 * predict_record(COULOMB, "coulomb", record, initial_state="record").cost
+        viscous.cost
+        > 10 * predict_record(H.harvester(COULOMB), record, initial_state="record").cost
     )
     assert viscous.cost < 100
 
@@ -264,7 +277,8 @@ def test_force_input_identifies_the_mass():
     params = dict(m=0.5, c=2.0, k=800.0, k3=2e7)
     ex = band_limited_excitation(2.0, 400.0, 1.0, f_lo=2.0, f_hi=40.0, seed=2)
     force = ex["base_acceleration"]
-    z = simulate_record(params, "none", force, 1 / 400, input_kind="force", substeps=8).z[0]
+    device = H.harvester(params, "viscous")
+    z = record_response(device, Record(1 / 400, force=force), substeps=8).z[0]
     rec = Record(1 / 400, force=force, relative_displacement=z)
     res = identify_classic(rec, "viscous", popsize=30, maxiter=100, seed=0)
     assert "m" in res.free
@@ -287,7 +301,7 @@ def test_default_bounds_contain_table2_values(record):
 
 def test_validate_scores_each_record(record):
     other = synthetic(seed=1, rms=1.5, kind="base_acceleration")
-    rows = validate(TRUE, "coulomb", [record, other], initial_state="record")
+    rows = validate(H.harvester(TRUE), [record, other], initial_state="record")
     assert [r.record for r in rows] == ["test0", "test1"]
     assert all(r.cost < 1e-6 for r in rows)
 
@@ -318,12 +332,38 @@ def test_settings_objects_are_the_keywords(record):
         SimulationSettings(hold="quintic")
 
 
-def test_predict_is_a_deprecated_alias_of_predict_record(record):
-    with pytest.warns(DeprecationWarning, match="use predict_record"):
-        old = predict(TRUE, "coulomb", record, skip=3)
-    new = predict_record(TRUE, "coulomb", record, simulation=SimulationSettings(skip=3))
-    assert old.cost == new.cost
-    np.testing.assert_array_equal(old.z, new.z)
+def test_result_is_a_harvester_and_its_measurement_model(record):
+    """The identified parameters as a device (c as c_m) and the measurement model; the
+    result's predict is predict_record with them and the fit's settings."""
+    res = identify(
+        record.rows(0, 300), "coulomb", m=TRUE["m"], popsize=8, maxiter=2, seed=0, polish=False,
+        substeps=2,
+    )  # fmt: skip
+    device, offsets = res.harvester(), res.measurement
+    p = res.parameters
+    assert (device.m, device.c_m, device.c_e, device.k, device.k3) == (
+        p["m"], p["c"], 0.0, p["k"], p["k3"],
+    )  # fmt: skip
+    assert device.friction.fc == p["fc"]
+    assert offsets == MeasurementModel(p["input_offset"], p["output_offset"], 0.0)
+    # without the polish the fit starts from the record's first samples
+    assert res.simulation == SimulationSettings(substeps=2, initial_state="record")
+    direct = predict_record(device, record, measurement=offsets, simulation=res.simulation)
+    assert res.predict(record).cost == direct.cost
+    # wired: c_e of the coil added to the identified c, the load voltage simulated
+    coil = rv.ElectricalCoupling(0.1992, 10.0, 0.48)
+    wired = res.harvester(coil)
+    assert wired.c == p["c"] + coil.electrical_damping and wired.c_m == p["c"]
+    assert res.predict(record, electrical=coil).voltage is not None
+
+
+def test_predict_record_refuses_what_it_cannot_simulate(record):
+    with pytest.raises(ValueError, match="predict_record needs a randvib.Harvester"):
+        predict_record(TRUE, record)
+    with pytest.raises(ValueError, match="predict_record needs scalar harvester parameters"):
+        predict_record(H.harvester(dict(TRUE, fc=np.array([0.001, 0.002]))), record)
+    with pytest.raises(ValueError, match="`record` must be a randvib.Record"):
+        predict_record(H.harvester(TRUE), record.z)
 
 
 # ------------------------------------------------------------------- CSV and CLI

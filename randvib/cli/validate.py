@@ -14,7 +14,7 @@ from randvib.cli._records import (
     record_from_args,
     simulation_settings,
 )
-from randvib.identification.models import MODELS, check_parameter
+from randvib.identification.models import MODELS, check_parameter, device_from_parameters
 from randvib.identification.prediction import validate
 from randvib.identification.settings import SimulationSettings
 
@@ -88,6 +88,7 @@ def run(args) -> int:
         except ValueError as exc:
             raise ValueError(f"{str(args.params)!r}: {exc}") from None
     parameters.update(_overrides(args.set, model))
+    harvester, measurement = device_from_parameters(model, parameters)
     settings = _settings(args, saved, args.params)
     plot_dir = None
     if args.plot is not None:
@@ -98,13 +99,13 @@ def run(args) -> int:
             )
         plot_dir.mkdir(parents=True, exist_ok=True)
     records = [record_from_args(path, args) for path in args.data]
-    rows = validate(parameters, model, records, simulation=settings)
+    rows = validate(harvester, records, measurement=measurement, simulation=settings)
     if plot_dir is not None:
         from randvib.identification.plots import figure_fit
         from randvib.identification.prediction import predict_record
 
         for i, record in enumerate(records):
-            pred = predict_record(parameters, model, record, simulation=settings)
+            pred = predict_record(harvester, record, measurement=measurement, simulation=settings)
             path = plot_dir / f"{i:02d}_{record.name}.png"
             figure_fit(pred, path, title=f"{model} model on {record.name}", **plot_units(args))
     if args.json:

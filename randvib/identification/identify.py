@@ -34,10 +34,15 @@ from randvib.identification.bounds import (
     search_space,
 )
 from randvib.identification.cost import CostFunction
-from randvib.identification.models import MODEL_PARAMETERS, check_model, check_parameter
-from randvib.identification.prediction import predict_record
+from randvib.identification.models import (
+    MODEL_PARAMETERS,
+    check_model,
+    check_parameter,
+    check_parameters,
+    device_parameters,
+)
+from randvib.identification.prediction import score
 from randvib.identification.record_integrator import EXTRA_PARAMETERS
-from randvib.identification.record_response import device_parameters
 from randvib.identification.result import IdentificationResult
 from randvib.identification.sade import sade
 from randvib.identification.settings import (
@@ -158,9 +163,9 @@ def identify(
     bounds : dict, optional
         ``name -> (lower, upper)`` overriding
         :func:`~randvib.identification.bounds.default_bounds` (search box).
-    init : dict or Harvester, optional
-        A starting guess ``name -> value`` (or a device, a preset included,
-        with c = c_m + c_e) placed in the initial population.
+    init : Harvester, optional
+        A starting guess (a device, a preset included, with c = c_m + c_e)
+        placed in the initial population.
     quadratic : bool
         Estimate a quadratic stiffness k2 (N/m^2): restoring force
         ``k z + k2 z^2 + k3 z^3``; the input offset is then held at 0. With
@@ -364,12 +369,17 @@ def _refuse_unsimulable(cost: CostFunction, space: SearchSpace) -> float:
 
 
 def _initial_guess(init, space: SearchSpace):
-    """The user's guess as one row of the initial population (None without one)."""
-    if init is not None and not isinstance(init, dict) or isinstance(init, dict) and "c_m" in init:
-        init = device_parameters(init)[0]  # a Harvester (or its parameters()) as the guess
-    if not init:
+    """The user's device as one row of the initial population (None without one).
+
+    Its parameters that the model has (c = c_m + c_e) are the guess, clipped
+    into the box; the others (the offsets, k2, another law's) start at the
+    box's centre.
+    """
+    if init is None:
         return None
-    return [[np.clip(init.get(n, np.mean(space.box[n])), *space.box[n]) for n in space.free]]
+    guess = device_parameters(init, None, "identify's `init`")
+    guess = {name: value for name, value in guess.items() if name not in EXTRA_PARAMETERS}
+    return [[np.clip(guess.get(n, np.mean(space.box[n])), *space.box[n]) for n in space.free]]
 
 
 def _named_callback(callback, free):
@@ -405,7 +415,8 @@ def _identification_result(cost, space, res, refined, elapsed, search, simulatio
             z = cost.simulate(parameters)[0][cost.skip :]
             parameters["output_offset"] = float(np.mean(cost.record.z[cost.skip :] - z))
         simulation = replace(simulation, initial_state="record")
-        pred = predict_record(parameters, cost.model, cost.record, simulation=simulation)
+        checked = check_parameters(parameters, cost.model)
+        pred = score(checked, cost.model, cost.record, simulation)
         j, start = pred.cost, pred.initial_state
     order = ("m",) + MODEL_PARAMETERS[cost.model] + reported
     seconds = cost.seconds

@@ -13,15 +13,31 @@ This module holds the declarations every part of the identification reads:
 the device's own parameters (:data:`DEVICE_SPECS`), the models
 (:data:`MODELS`, :data:`MODEL_PARAMETERS`), the units (:data:`UNITS`) and
 the one check of a parameter's value (:func:`check_parameter`).
+
+**One device.** Outside the search, a model's parameter values are a
+:class:`~randvib.models.harvester.Harvester` (the record simulation uses its
+total damping c = c_m + c_e: a record cannot separate them) plus a
+:class:`MeasurementModel` (the sensors' offsets and the quadratic stiffness
+k2, which a Harvester does not have). :func:`device_parameters` turns the
+pair into the named parameters the compiled simulation takes,
+:func:`device_from_parameters` turns identified parameters back into the pair.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass
 
-from randvib._validation import check_finite, check_nonnegative, check_positive
+from randvib._validation import (
+    check_finite,
+    check_nonnegative,
+    check_positive,
+    check_scalar_device,
+    scalar_or_array,
+)
 from randvib.identification.record_integrator import EXTRA_PARAMETERS
 from randvib.models.friction import FRICTION_MODELS, Parameter, RegistryView
+from randvib.models.harvester import Harvester
 
 #: The device's own parameters (Eq. 1; friction laws declare theirs): unit,
 #: default bounds from the record's scales, log scale (k3 may be zero).
@@ -56,6 +72,7 @@ EXTRA_UNITS = {"k2": "N/m^2", "input_offset": "input unit", "output_offset": "m"
 
 
 def unit_of(model, name):
+    """The unit of parameter ``name`` of ``model`` (a law's own declaration wins)."""
     return EXTRA_UNITS[name] if name in EXTRA_UNITS else parameter_specs(model)[name].unit
 
 
@@ -115,7 +132,9 @@ def check_parameter(model: str, name: str, value, label: str | None = None) -> f
     return float(check(label, value, spec.unit))
 
 
-def check_parameters(parameters, model):
+def check_parameters(parameters, model) -> dict:
+    """Every parameter of ``model`` (``m`` included) from ``parameters``, each checked
+    (:func:`check_parameter`), with the measurement model's that are given."""
     check_model(model)
     names = ("m",) + MODEL_PARAMETERS[model]
     missing = [n for n in names if n not in parameters]
@@ -125,3 +144,107 @@ def check_parameters(parameters, model):
         )
     names += tuple(n for n in EXTRA_PARAMETERS if n in parameters)
     return {n: check_parameter(model, n, parameters[n]) for n in names}
+
+
+# ------------------------------------------------------------- one device
+@dataclass(frozen=True)
+class MeasurementModel:
+    """What a record holds besides the device's motion: offsets, and k2.
+
+    An offset is what a sensor adds (measured = true + offset). The
+    quadratic stiffness k2 is the term of the restoring force
+    ``k z + k2 z^2 + k3 z^3`` that a :class:`~randvib.models.harvester.Harvester`
+    does not have (its potential is even). It is defined about the output
+    sensor's zero: with k3 != 0 a cubic spring centred s away from that zero
+    has the quadratic term 3 k3 s and a constant force that the input offset
+    takes, so the two are estimated together (:func:`randvib.identify`,
+    ``quadratic``). The initial state is not part of it: it belongs to one
+    record and is estimated, or taken from the first samples, record by
+    record (:class:`~randvib.identification.settings.SimulationSettings`).
+
+    Attributes
+    ----------
+    input_offset : float
+        Offset of the input channel, in its unit (m/s^2 for a base
+        acceleration, N for a force; a base displacement's vanishes in its
+        second derivative).
+    output_offset : float
+        Offset of the relative-displacement sensor (m).
+    k2 : float
+        Quadratic stiffness (N/m^2).
+    """
+
+    input_offset: float = 0.0
+    output_offset: float = 0.0
+    k2: float = 0.0
+
+    def __post_init__(self):
+        for name in EXTRA_PARAMETERS:
+            object.__setattr__(self, name, scalar_or_array(check_finite(name, getattr(self, name))))
+
+    def parameters(self) -> dict:
+        """``k2``, ``input_offset`` and ``output_offset`` by name."""
+        return {name: getattr(self, name) for name in EXTRA_PARAMETERS}
+
+    @classmethod
+    def from_parameters(cls, parameters: dict) -> MeasurementModel:
+        """The measurement model among identified ``parameters`` (absent ones: 0)."""
+        return cls(**{name: parameters[name] for name in EXTRA_PARAMETERS if name in parameters})
+
+
+def device_parameters(
+    harvester: Harvester, measurement=None, function: str = "the record simulation", *, scalar=True
+) -> dict:
+    """The record simulation's named parameters of a device and its measurement model.
+
+    ``m``, ``c`` (= c_m + c_e), ``k``, ``k3``, the friction law's
+    parameters, ``k2`` and the offsets. ``function`` is named in refusals:
+    anything but a Harvester, a coupling with a circuit state (the record
+    simulation has none) and, with ``scalar``, array parameters.
+    """
+    if not isinstance(harvester, Harvester):
+        raise ValueError(
+            f"{function} needs a randvib.Harvester (a preset included), got "
+            f"{type(harvester).__name__}"
+        )
+    if measurement is None:
+        measurement = MeasurementModel()
+    elif not isinstance(measurement, MeasurementModel):
+        raise ValueError(
+            f"`measurement` must be a randvib.MeasurementModel, got {type(measurement).__name__}"
+        )
+    if scalar:
+        check_scalar_device(harvester, function)
+    harvester.require_resistive(function, "randvib.simulate")
+    out = {"m": harvester.m, "c": harvester.c, "k": harvester.k, "k3": harvester.k3}
+    if harvester.friction is not None:
+        out.update(harvester.friction.parameters())
+    out.update(measurement.parameters())
+    return out
+
+
+def device_from_parameters(
+    model: str, parameters: dict, electrical=None
+) -> tuple[Harvester, MeasurementModel]:
+    """Identified ``parameters`` of ``model`` as the device and its measurement model.
+
+    The identified damping ``c`` becomes the Harvester's c_m: a record taken
+    in open circuit holds no electrical damping. ``electrical`` (a coupling,
+    e.g. ``ElectricalCoupling(alpha, r_load, r_coil)``) wires the device, its
+    c_e added to c (:meth:`~randvib.models.harvester.Harvester.with_coupling`).
+    """
+    law = check_model(model)
+    p = check_parameters(parameters, model)
+    if law is None and p["c"] == 0:
+        raise ValueError(
+            "`c` must be > 0 (Ns/m) for the viscous model: without friction an undamped "
+            "device is no randvib.Harvester"
+        )
+    friction = None if law is None else law(**{name: p[name] for name in law.parameter_names()})
+    if electrical is None:
+        device = Harvester(m=p["m"], c_m=p["c"], c_e=0.0, k=p["k"], k3=p["k3"], friction=friction)
+    else:
+        device = Harvester.with_coupling(
+            p["m"], p["c"], p["k"], electrical, k3=p["k3"], friction=friction
+        )
+    return device, MeasurementModel.from_parameters(p)

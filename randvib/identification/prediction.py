@@ -1,7 +1,9 @@
-"""A record simulated with given parameters and scored: prediction and validation.
+"""A record simulated with a device and scored: prediction and validation.
 
-:func:`predict_record` simulates a record with given parameters (paper Eq. 1)
-and scores it with J (Eq. 11); :func:`validate` does so on several records.
+:func:`predict_record` simulates a record with a
+:class:`~randvib.models.harvester.Harvester` and its
+:class:`~randvib.identification.models.MeasurementModel` (paper Eq. 1) and
+scores it with J (Eq. 11); :func:`validate` does so on several records.
 By default the initial state is estimated (a two-parameter fit of the
 simulation error, so that a correct model is never penalised for its start).
 (The analytic power prediction is :func:`randvib.predict`.)
@@ -9,21 +11,26 @@ simulation error, so that a correct model is never penalised for its start).
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from randvib.identification.cost import CostFunction, normalised_cost
-from randvib.identification.models import MODELS, check_parameters, model_of
-from randvib.identification.record_response import device_parameters
+from randvib.identification.models import (
+    MeasurementModel,
+    check_parameters,
+    device_parameters,
+    model_of,
+)
 from randvib.identification.settings import SimulationSettings, resolve_settings
+from randvib.models.coupling import Inductive, Resistive
+from randvib.models.harvester import Harvester
 from randvib.models.record import Record
 
 
 @dataclass(frozen=True, eq=False)
 class Prediction:
-    """Simulated response of a parameter set to a record.
+    """Simulated response of a device to a record.
 
     Attributes
     ----------
@@ -36,7 +43,7 @@ class Prediction:
     rms_error : float
         RMS of z - zhat (units of z).
     voltage : ndarray or None
-        Simulated load voltage (V) when a circuit was given:
+        Simulated load voltage (V) when the device has a coil:
         ``V = alpha z' R_L / (R_L + R_C)``.
     initial_state : dict
         ``z0`` (m), ``v0`` (m/s) the simulation started from (estimated by
@@ -50,28 +57,6 @@ class Prediction:
     rms_error: float
     voltage: np.ndarray | None = None
     initial_state: dict = field(default_factory=dict)
-
-
-def _device_and_model(parameters, model, record):
-    """Accept ``(device, record)`` as well as ``(parameters, model, record)``.
-
-    A device is a :class:`~randvib.models.harvester.Harvester` (a preset included)
-    or its ``parameters()`` dict; its friction law names the model and its
-    circuit, if any, gives the voltage. Returns (parameters, model, record,
-    circuit).
-    """
-    from randvib.models.harvester import Harvester
-
-    if record is None and not isinstance(model, str):
-        model, record = None, model
-    circuit = parameters.electrical if isinstance(parameters, Harvester) else None
-    if isinstance(parameters, Harvester) or isinstance(parameters, dict) and "c_m" in parameters:
-        friction = None if model is None else MODELS.get(model, model)
-        parameters, friction = device_parameters(parameters, friction)
-        model = model_of(friction)
-    elif model is None:
-        raise ValueError("`model` is required with a parameter dict; or pass a randvib.Harvester")
-    return parameters, model, record, circuit
 
 
 def _start_estimate(cost: CostFunction):
@@ -101,53 +86,67 @@ def _start_estimate(cost: CostFunction):
 
 
 def predict_record(
-    parameters,
-    model: str | None = None,
-    record: Record | None = None,
+    harvester: Harvester,
+    record: Record,
     *,
-    electrical=None,
+    measurement: MeasurementModel | None = None,
     simulation: SimulationSettings | None = None,
     **options,
 ) -> Prediction:
-    """Simulate a record with given parameters and score it with J (Eq. 11).
+    """Simulate a record with a device and score it with J (Eq. 11).
 
-    Called as ``predict_record(parameters, model, record)`` with identified
-    parameters (total damping ``c``), or as ``predict_record(device, record)``
-    with a :class:`~randvib.models.harvester.Harvester` (a preset included)
-    or its ``parameters()`` dict: the device's law names the model,
-    c = c_m + c_e, and its circuit, if any, gives the load voltage. (The
+    The device is simulated with its total damping c = c_m + c_e (a record
+    cannot separate them); its circuit, if any, gives the load voltage. (The
     analytic power prediction is :func:`randvib.predict`.)
 
     Parameters
     ----------
-    parameters : dict or Harvester
-        ``m`` (kg), ``c`` (Ns/m), ``k`` (N/m), ``k3`` (N/m^3) and the model's
-        friction parameters; or a device.
-    model : str, optional
-        Identification model (see :data:`~randvib.identification.models.MODELS`); only with a parameter dict.
+    harvester : Harvester
+        The device (a preset, or :meth:`IdentificationResult.harvester
+        <randvib.identification.result.IdentificationResult.harvester>`), with
+        scalar parameters; a coupling with a circuit state is refused.
     record : Record
-    electrical : ElectricalCoupling, optional
-        Adds the coil's damping c_e = alpha^2/(R_L + R_C) (Eq. 3) to the
-        identified c and gives the load voltage.
+        Its input channel drives the device; its relative displacement is
+        scored.
+    measurement : MeasurementModel, optional
+        The sensors' offsets and k2 (an identification's ``measurement``);
+        default none.
     simulation : SimulationSettings, optional
         Its fields may also be given as keywords (``substeps=``, ``hold=``,
-        ``lowpass=``, ``skip=``), which override it.
+        ``lowpass=``, ``skip=``, ``initial_state=``), which override it.
 
     Returns
     -------
     Prediction
+
+    Examples
+    --------
+    >>> import randvib as rv
+    >>> device = rv.preset("coulomb-td1")
+    >>> record = rv.synthetic_record(device, 1.07, duration=1.0, sample_rate=500.0, seed=1)
+    >>> rv.predict_record(device, record).cost < 1e-9  # the truth: J ~ 0
+    True
+    >>> print(f"J = {rv.predict_record(device.updated(fc=0.004), record).cost:.2f}")  # Fc 30 % low
+    J = 1.04
     """
     (simulation,) = resolve_settings("predict_record", options, simulation=simulation)
-    parameters, model, record, circuit = _device_and_model(parameters, model, record)
-    params = check_parameters(parameters, model)
-    if electrical is not None:
-        params["c"] += electrical.electrical_damping
-    cost = CostFunction(record, model, fixed=params, free=(), **simulation.to_dict())
+    parameters = device_parameters(harvester, measurement, "predict_record")
+    model = model_of(harvester.friction_name)
+    return score(
+        check_parameters(parameters, model), model, record, simulation, harvester.electrical
+    )
+
+
+def score(parameters: dict, model: str, record: Record, simulation, circuit=None) -> Prediction:
+    """:func:`predict_record` on checked named ``parameters`` of ``model`` (as identify has them)."""
+    if not isinstance(record, Record):
+        raise ValueError(f"`record` must be a randvib.Record, got {type(record).__name__}")
+    cost = CostFunction(record, model, fixed=parameters, free=(), **simulation.to_dict())
     start = {"z0": cost.z0, "v0": cost.v0}
     if simulation.initial_state == "estimate":
         start["z0"], start["v0"] = _start_estimate(cost)
-    z, v = cost.simulate(params, **start)
-    z = z + params.get("output_offset", 0.0)  # what the output sensor reads
+    z, v = cost.simulate(parameters, **start)
+    z = z + parameters.get("output_offset", 0.0)  # what the output sensor reads
     skip = simulation.skip
     if np.all(np.isfinite(z)):
         j = float(normalised_cost(record.z[skip:], z[skip:]))
@@ -155,27 +154,17 @@ def predict_record(
     else:
         j = rms = float("inf")
     voltage = None
-    circuit = electrical if electrical is not None else circuit
-    if circuit is not None:
+    if isinstance(circuit, Resistive | Inductive):  # a coil: V = alpha z' R_L / (R_L + R_C)
         voltage = circuit.alpha * v * circuit.load_fraction
     return Prediction(
         record=record, z=z, v=v, cost=j, rms_error=rms, voltage=voltage, initial_state=start
     )
 
 
-def predict(*args, **kwargs) -> Prediction:
-    """Deprecated name of :func:`predict_record` (``randvib.predict`` is the analytic power)."""
-    warnings.warn(
-        "randvib.identification.fitting.predict is deprecated; use predict_record "
-        "(randvib.predict is the analytic power prediction)",
-        DeprecationWarning,
-        stacklevel=2,
-    )
-    return predict_record(*args, **kwargs)
-
-
 @dataclass(frozen=True)
 class ValidationRow:
+    """J (Eq. 11), RMS error and length of one record in :func:`validate`."""
+
     record: str
     model: str
     cost: float
@@ -183,18 +172,18 @@ class ValidationRow:
     samples: int
 
 
-def validate(parameters, model, records=None, **settings) -> list[ValidationRow]:
-    """J (Eq. 11) and RMS error of given parameters on each of several records.
+def validate(
+    harvester: Harvester, records, *, measurement: MeasurementModel | None = None, **settings
+) -> list[ValidationRow]:
+    """J (Eq. 11) and RMS error of a device on each of several records.
 
-    Called as ``validate(parameters, model, records)`` or
-    ``validate(device, records)`` with a Harvester; ``settings`` are those of
-    :func:`predict_record` (``simulation=`` or its fields as keywords).
+    ``settings`` are those of :func:`predict_record` (``simulation=`` or its
+    fields as keywords); ``measurement`` is the sensors' model, the same on
+    every record.
     """
-    if records is None:
-        model, records = None, model
-    parameters, model, _, _ = _device_and_model(parameters, model, records)
+    model = model_of(harvester.friction_name) if isinstance(harvester, Harvester) else None
     rows = []
     for record in records:
-        pred = predict_record(parameters, model, record, **settings)
+        pred = predict_record(harvester, record, measurement=measurement, **settings)
         rows.append(ValidationRow(record.name, model, pred.cost, pred.rms_error, record.n))
     return rows

@@ -1,7 +1,8 @@
 """The deterministic response of the device to a record's input (paper Eq. 1).
 
-:func:`simulate_record` integrates Eq. 1 driven by a recorded input for one
-device or a whole batch of parameter sets at once (the compiled integrator of
+:func:`record_response` integrates Eq. 1 driven by a record's input channel
+for one :class:`~randvib.models.harvester.Harvester` or a batch of them (array
+parameters) at once (the compiled integrator of
 :mod:`randvib.identification.record_integrator`, on the input reconstructed by
 :mod:`randvib.identification.input_reconstruction`). A candidate whose
 response leaves a sanity bound (``response_limit``) or becomes non-finite is
@@ -14,15 +15,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from randvib._validation import check_finite, check_int, check_positive
+from randvib._validation import check_int
 from randvib.identification.input_reconstruction import HOLDS, driving_signal
+from randvib.identification.models import MeasurementModel, device_parameters
 from randvib.identification.record_integrator import parameter_matrix, run_kernel
 from randvib.models.harvester import Harvester
+from randvib.models.record import INPUT_KINDS, Record
 
 
 @dataclass(frozen=True, eq=False)
 class BatchSimulation:
-    """Responses of a population of parameter sets to one recorded input.
+    """Responses of a batch of devices to one record's input (:func:`record_response`).
 
     Attributes
     ----------
@@ -38,65 +41,12 @@ class BatchSimulation:
     v: np.ndarray
 
 
-def device_parameters(device, friction=None) -> tuple[dict, str]:
-    """Named record-simulation parameters and friction name of a device.
-
-    The record simulator and identification work with the total viscous
-    damping ``c = c_m + c_e`` (Eq. 1): a record cannot separate the two.
-
-    Parameters
-    ----------
-    device : Harvester or dict
-        A :class:`~randvib.models.harvester.Harvester` (a preset included); the dict
-        of its :meth:`~randvib.models.harvester.Harvester.parameters` (``c_m``,
-        ``c_e``, ``friction`` and the friction and circuit parameters); or
-        ``m, c, k, k3`` and the friction parameters, with ``friction``
-        naming the law.
-    friction : str, optional
-        Friction law name; required for the last form, checked against the
-        device's own law for the others.
-
-    Returns
-    -------
-    parameters : dict
-        ``m`` (kg), ``c`` (Ns/m), ``k`` (N/m), ``k3`` (N/m^3) and the law's
-        parameters.
-    friction : str
-    """
-    if isinstance(device, Harvester):
-        params = {"m": device.m, "c": device.c, "k": device.k, "k3": device.k3}
-        if device.friction is not None:
-            params.update(device.friction.parameters())
-        own = device.friction_name
-    elif isinstance(device, dict) and ("c_m" in device or "friction" in device):
-        # Harvester.parameters(): total damping; the circuit's alpha, r_load,
-        # r_coil only explain c_e, which is already in it.
-        params = {k: v for k, v in device.items() if k not in _HARVESTER_ONLY}
-        params["c"] = np.asarray(device.get("c_m", 0.0)) + np.asarray(device.get("c_e", 0.0))
-        own = device.get("friction", "none")
-    else:
-        if friction is None:
-            raise ValueError(
-                "`friction` is required with a parameter dict (m, c, k, k3, ...); "
-                "or pass a randvib.Harvester"
-            )
-        return dict(device), friction
-    if friction is not None and friction != own:
-        raise ValueError(f"`friction` = {friction!r} disagrees with the device's {own!r}")
-    return params, own
-
-
-#: Harvester.parameters() keys that the record simulator does not take.
-_HARVESTER_ONLY = ("c_m", "c_e", "friction", "alpha", "r_load", "r_coil")
-
-
-def simulate_record(
-    parameters,
-    friction=None,
-    input_values=None,
-    dt: float | None = None,
+def record_response(
+    harvester: Harvester,
+    record: Record,
     *,
-    input_kind: str = "base_acceleration",
+    measurement: MeasurementModel | None = None,
+    input_kind: str | None = None,
     substeps: int = 4,
     hold: str = "linear",
     lowpass: float | None = None,
@@ -105,30 +55,32 @@ def simulate_record(
     theta0=0.0,
     response_limit: float = np.inf,
 ) -> BatchSimulation:
-    """Simulate Eq. 1 driven by a recorded input, for many parameter sets at once.
+    """The response of Eq. 1 to a record's input, for one device or a batch at once.
 
-    Called as ``simulate_record(harvester, input_values, dt, ...)`` with a
-    :class:`~randvib.models.harvester.Harvester` (a preset included) or its
-    ``parameters()`` dict, or as ``simulate_record(parameters, friction,
-    input_values, dt, ...)`` with a dict of named parameters.
+    Deterministic: the device is driven by the record's input channel,
+    reconstructed between samples, from a given initial state. (The Monte
+    Carlo simulation driven by a measured base acceleration, with a
+    confidence interval, is :func:`randvib.monte_carlo_on_record`.)
 
     Parameters
     ----------
-    parameters : Harvester or dict
-        A device (simulated with c = c_m + c_e), or ``m`` (kg), ``c`` (Ns/m),
-        ``k`` (N/m), ``k3`` (N/m^3) and the friction parameters (``fc`` N;
-        ``beta`` s/m; ``sigma0`` N/m, ``sigma1`` Ns/m, ``fs`` N, ``vs`` m/s;
-        see :data:`~randvib.identification.record_integrator.FRICTION_PARAMETERS`); scalars or 1-D arrays (one row per
-        candidate).
-    friction : str, optional
-        Friction law name: ``none`` or a registered law (paper Eq. 4-10:
-        ``coulomb``, ``tanh``, ``lugre``); only with a parameter dict.
-    input_values : array_like, shape (n,)
-        Input samples on the uniform grid ``i dt``: base displacement (m),
-        base acceleration (m/s^2) or force on the mass (N).
-    dt : float
-        Sample interval (s).
-    input_kind : {'base_displacement', 'base_acceleration', 'force'}
+    harvester : Harvester
+        The device, simulated with its total damping c = c_m + c_e (a record
+        cannot separate them) and any friction law; a coupling with a circuit
+        state is refused. Its parameters may be 1-D arrays of one length:
+        a batch of devices, one response each, simulated in one parallel
+        compiled call.
+    record : Record
+        Its input channel drives the device: base displacement (m,
+        differentiated twice), base acceleration (m/s^2) or force on the
+        mass (N).
+    measurement : MeasurementModel, optional
+        The input channel's offset (the device is driven by the input less
+        it) and the quadratic stiffness k2; default none. The returned z is
+        the true displacement, without the output offset.
+    input_kind : {'base_displacement', 'base_acceleration', 'force'}, optional
+        The channel that drives the device, for a record with several (the
+        base motion of :func:`randvib.band_limited_excitation`).
     substeps : int, optional
         Integration steps per sample interval (default 4).
     hold : {'linear', 'zero', 'cubic', 'bandlimited'}
@@ -144,20 +96,34 @@ def simulate_record(
     Returns
     -------
     BatchSimulation
+        One row of z and v per device of the batch.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import randvib as rv
+    >>> motion = rv.band_limited_excitation(2.0, 500.0, 1.07, seed=1)
+    >>> devices = rv.preset("coulomb-td1").updated(fc=np.array([0.0, 0.0058]))
+    >>> response = rv.record_response(devices, motion, input_kind="base_acceleration")
+    >>> response.z.shape
+    (2, 1000)
     """
-    if not (friction is None or isinstance(friction, str | type)):
-        # simulate_record(device, input_values, dt): the device names its law.
-        friction, input_values, dt = None, friction, input_values
-    parameters, friction = device_parameters(parameters, friction)
-    values, dt, substeps = _check_record_input(input_values, dt, substeps, hold)
+    parameters = device_parameters(harvester, measurement, "record_response", scalar=False)
+    if not isinstance(record, Record):
+        raise ValueError(f"`record` must be a randvib.Record, got {type(record).__name__}")
+    kind = _input_kind(record, input_kind)
+    substeps = check_int("substeps", substeps, minimum=1)
+    if hold not in HOLDS:
+        raise ValueError(f"`hold` must be one of {', '.join(HOLDS)}; got {hold!r}")
+    friction = None if harvester.friction is None else type(harvester.friction)
     matrix = parameter_matrix(parameters, friction)
-    drive, base_input = driving_signal(values, dt, input_kind, lowpass)
+    drive, base_input = driving_signal(record[kind], record.dt, kind, lowpass)
     _, z, v = run_kernel(
         matrix,
         friction,
         drive,
         base_input,
-        dt,
+        record.dt,
         substeps=substeps,
         hold=hold,
         z0=z0,
@@ -165,20 +131,16 @@ def simulate_record(
         theta0=theta0,
         response_limit=response_limit,
     )
-    return BatchSimulation(time=np.arange(values.shape[0]) * dt, z=z, v=v)
+    return BatchSimulation(time=record.time, z=z, v=v)
 
 
-def _check_record_input(input_values, dt, substeps, hold):
-    """(values, dt, substeps) of :func:`simulate_record`, checked."""
-    if input_values is None or dt is None:
-        raise ValueError("`input_values` and `dt` are required")
-    dt = float(check_positive("dt", dt, "s"))
-    substeps = check_int("substeps", substeps, minimum=1)
-    if hold not in HOLDS:
-        raise ValueError(f"`hold` must be one of {', '.join(HOLDS)}; got {hold!r}")
-    values = check_finite("input_values", input_values)
-    if values.ndim != 1 or values.shape[0] < 2:
+def _input_kind(record: Record, input_kind) -> str:
+    """The channel that drives the device: ``input_kind``, or the record's one input."""
+    if input_kind is None:
+        return record.input_kind
+    if input_kind not in INPUT_KINDS:
         raise ValueError(
-            f"`input_values` must be 1-D with at least 2 samples, got shape {values.shape}"
+            f"`input_kind` must be one of {', '.join(INPUT_KINDS)}; got {input_kind!r}"
         )
-    return values, dt, substeps
+    record[input_kind]  # refused, naming the record's channels, when it has none
+    return input_kind

@@ -1,4 +1,4 @@
-"""The outcome of an identification: :class:`IdentificationResult`."""
+"""The outcome of an identification: :class:`IdentificationResult`, the device it found."""
 
 from __future__ import annotations
 
@@ -7,14 +7,28 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from randvib import _display
-from randvib.identification.models import check_model, parameter_specs, unit_of
+from randvib.identification.models import (
+    MeasurementModel,
+    device_from_parameters,
+    parameter_specs,
+    unit_of,
+)
 from randvib.identification.prediction import Prediction, predict_record
+from randvib.identification.settings import SimulationSettings
+from randvib.models.harvester import Harvester
 from randvib.models.record import Record
 
 
 @dataclass
 class IdentificationResult:
     """Identified parameters of one model on one record.
+
+    The parameters are given back as the identified device,
+    :meth:`harvester` (a :class:`~randvib.models.harvester.Harvester`, its
+    damping c as c_m), and its :attr:`measurement` model (the offsets and
+    k2), which :func:`~randvib.identification.prediction.predict_record` and
+    :func:`~randvib.identification.prediction.validate` take; :meth:`predict`
+    does so with the fit's :attr:`simulation` settings.
 
     Attributes
     ----------
@@ -156,36 +170,43 @@ class IdentificationResult:
     def _repr_html_(self) -> str:
         return _display.html_table("Identification", self._rows(), self._search_line())
 
+    def harvester(self, electrical=None) -> Harvester:
+        """The identified device, its damping c as c_m (c_e = 0).
+
+        Parameters
+        ----------
+        electrical : Coupling, optional
+            A coupling to wire the device with (its c_e is added to the
+            identified c, which a record taken in open circuit does not hold),
+            e.g. ``randvib.ElectricalCoupling(alpha, r_load, r_coil)``.
+        """
+        return device_from_parameters(self.model, self.parameters, electrical)[0]
+
+    @property
+    def measurement(self) -> MeasurementModel:
+        """The identified (or fixed) offsets and k2; those not estimated are 0."""
+        return MeasurementModel.from_parameters(self.parameters)
+
+    @property
+    def simulation(self) -> SimulationSettings:
+        """The simulation settings of the fit, as :func:`predict_record` takes them."""
+        return SimulationSettings(**{k: v for k, v in self.settings.items() if k in _SIMULATION})
+
     def predict(self, record: Record, electrical=None) -> Prediction:
-        """Simulate ``record`` with these parameters (see :func:`~randvib.identification.prediction.predict_record`)."""
+        """``record`` simulated with the identified device and measurement model.
+
+        :func:`~randvib.identification.prediction.predict_record` with
+        :meth:`harvester` (wired with ``electrical``, if given),
+        :attr:`measurement` and the fit's :attr:`simulation` settings; the
+        initial state is obtained for ``record`` as the fit obtained it.
+        """
         return predict_record(
-            self.parameters,
-            self.model,
+            self.harvester(electrical),
             record,
-            electrical=electrical,
-            **_sim_settings(self.settings),
+            measurement=self.measurement,
+            simulation=self.simulation,
         )
 
-    def harvester(self, electrical=None):
-        """The identified device as a :class:`randvib.Harvester` (c as c_m)."""
-        from randvib.models.harvester import Harvester
 
-        p = self.parameters
-        if p.get("k2", 0.0) != 0.0:
-            raise ValueError(
-                f"the identified k2 = {p['k2']:.6g} N/m^2 has no place in a Harvester "
-                "(restoring force k z + k3 z^3); identify without --quadratic"
-            )
-        law = check_model(self.model)
-        friction = None if law is None else law(**{n: p[n] for n in law.parameter_names()})
-        if electrical is None:
-            return Harvester(m=p["m"], c_m=p["c"], c_e=0.0, k=p["k"], k3=p["k3"], friction=friction)
-        return Harvester.from_electrical(
-            m=p["m"], c_m=p["c"], k=p["k"], k3=p["k3"], alpha=electrical.alpha,
-            r_load=electrical.r_load, r_coil=electrical.r_coil, friction=friction,
-        )  # fmt: skip
-
-
-def _sim_settings(settings):
-    names = ("substeps", "hold", "lowpass", "skip", "initial_state")
-    return {k: settings[k] for k in names if k in settings}
+#: The fields of SimulationSettings, among a result's ``settings``.
+_SIMULATION = tuple(SimulationSettings().to_dict())

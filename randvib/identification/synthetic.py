@@ -2,7 +2,7 @@
 
 One call, :func:`synthetic_record`, replaces the four steps a user needed
 before (realise the excitation, pick the input channel, simulate the device
-with :func:`~randvib.identification.record_response.simulate_record`,
+with :func:`~randvib.identification.record_response.record_response`,
 wrap a :class:`~randvib.models.record.Record`) and adds what a real
 measurement adds: Gaussian sensor noise and constant offsets on each channel.
 An offset is what the sensor adds: measured value = true value + offset.
@@ -28,7 +28,7 @@ from randvib._validation import (
     check_positive,
     check_scalar_device,
 )
-from randvib.identification.record_response import simulate_record
+from randvib.identification.record_response import record_response
 from randvib.models.excitation import BaseMotionOverflow, Excitation, band_limited_excitation
 from randvib.models.harvester import Harvester
 from randvib.models.presets import PRESETS, preset
@@ -59,7 +59,7 @@ def synthetic_record(
     """Simulate a device under a band-limited base excitation and record it as sensors would.
 
     The true relative displacement is
-    ``simulate_record(device, true_input, 1/sample_rate, input_kind=input,
+    ``record_response(device, Record(1 / sample_rate, **{input: true_input}),
     substeps=substeps).z`` (Eq. 1 from rest), so a noise-free record without
     offsets is exactly that simulation; the record then holds
     ``true + offset + noise`` on each channel.
@@ -144,7 +144,7 @@ def synthetic_record(
             "signal; lower it (`--rms` / `--psd`)"
         )
     dt = 1.0 / sample_rate
-    z = simulate_record(device, true_input, dt, input_kind=input, substeps=substeps).z[0]
+    z = record_response(device, Record(dt, **{input: true_input}), substeps=substeps).z[0]
     if not np.all(np.isfinite(z)):
         raise ValueError(
             f"the simulated response to `excitation` {_excitation_text(excitation)} diverged; "

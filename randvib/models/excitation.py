@@ -293,7 +293,7 @@ COLOURED_METHODS = (
     "predict/expected_power with method='linearisation')",
     "Monte Carlo (randvib.simulate: filter states for band-pass and Kanai-Tajimi, "
     "spectral synthesis for band-limited and tabulated spectra; "
-    "randvib.simulate_on_record for a measured record)",
+    "randvib.monte_carlo_on_record for a measured record)",
 )
 
 

@@ -741,7 +741,7 @@ def simulate(
         stationary Gaussian synthesis per path (:mod:`randvib.montecarlo.driven`:
         path i's input from the stream (seed, i), the kernel taking its exact
         step integrals; batches bound the memory). ``Measured`` is refused:
-        simulate on the record with :func:`randvib.simulate_on_record`.
+        simulate on the record with :func:`randvib.monte_carlo_on_record`.
         Under coloured input the companion and the control variates
         (white-noise energy balance) are refused, and the step check covers
         the filter too.
@@ -955,7 +955,7 @@ def _simulated_excitation(psd) -> Excitation:
     (band-pass, Kanai-Tajimi) are integrated with the device; band-limited
     and tabulated spectra are synthesised (:class:`driven.SynthesisedInput`);
     a measured record is simulated on the record itself by
-    :func:`randvib.montecarlo.driven.simulate_on_record`.
+    :func:`randvib.montecarlo.on_record.monte_carlo_on_record`.
     """
     if not isinstance(psd, Excitation):
         return as_excitation(psd)  # one positive number (an array refused by name)
@@ -964,7 +964,7 @@ def _simulated_excitation(psd) -> Excitation:
     if psd.name == "measured":
         raise ValueError(
             "simulate draws its own paths; to simulate the device on the measured record "
-            "itself use randvib.simulate_on_record(harvester, record, ...), for Gaussian "
+            "itself use randvib.monte_carlo_on_record(harvester, record, ...), for Gaussian "
             "paths with the record's Welch PSD pass record.spectrum"
         )
     shaping = psd.shaping_filter()

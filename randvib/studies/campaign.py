@@ -20,8 +20,8 @@ import pandas as pd
 
 from randvib._io import atomic_write_text, dumps
 from randvib.identification.identify import identify
-from randvib.identification.models import MODEL_PARAMETERS
-from randvib.identification.record_response import simulate_record
+from randvib.identification.models import MODEL_PARAMETERS, device_from_parameters
+from randvib.identification.record_response import record_response
 from randvib.identification.result import IdentificationResult
 from randvib.models.excitation import band_limited_excitation
 from randvib.models.record import Record
@@ -55,10 +55,8 @@ def synthetic_record(
     """
     n_warm = int(round(warmup * fs))
     ex = band_limited_excitation(duration + warmup, fs, rms, seed=rng)
-    truth = dict(truth)
-    if electrical is not None:
-        truth["c"] = truth["c"] + electrical.electrical_damping
-    sim = simulate_record(truth, "coulomb", ex["base_acceleration"], 1 / fs, substeps=8)
+    device, _ = device_from_parameters("coulomb", truth, electrical)
+    sim = record_response(device, ex, input_kind="base_acceleration", substeps=8)
     y = ex["base_displacement"][n_warm:]
     z = sim.z[0, n_warm:]
     v = sim.v[0, n_warm:]

@@ -39,7 +39,8 @@ def optimiser_study(seeds):
     tanh = dict(H.COULOMB, beta=100.0)
     ex = H.excitation(0, 1.5, 500.0)
     y, acc = H.tapered(ex)
-    z = H.simulate_record(tanh, "tanh", acc, ex.dt, substeps=8, z0=T.Z0, v0=T.V0).z[0]
+    motion = H.Record(ex.dt, base_acceleration=acc)
+    z = H.record_response(H.harvester(tanh, "tanh"), motion, substeps=8, z0=T.Z0, v0=T.V0).z[0]
     trec = H.Record(ex.dt, name="tanh", base_displacement=y, relative_displacement=z)
     cases = {
         "coulomb": (coul, H.COULOMB, "coulomb", H.FREE, dict(popsize=30, maxiter=80)),
