@@ -149,15 +149,16 @@ def check_parameters(parameters, model) -> dict:
 # ------------------------------------------------------------- one device
 @dataclass(frozen=True)
 class MeasurementModel:
-    """What a record holds besides the device's motion: offsets, and k2.
+    """What the record simulation adds to a Harvester: the sensors' offsets and k2.
 
     An offset is what a sensor adds (measured = true + offset). The
     quadratic stiffness k2 is the term of the restoring force
     ``k z + k2 z^2 + k3 z^3`` that a :class:`~randvib.models.harvester.Harvester`
     does not have (its potential is even). It is defined about the output
-    sensor's zero: with k3 != 0 a cubic spring centred s away from that zero
-    has the quadratic term 3 k3 s and a constant force that the input offset
-    takes, so the two are estimated together (:func:`randvib.identify`,
+    sensor's zero: with k3 != 0 a cubic spring whose centre is shifted by s
+    from that zero (z -> z + s) has the quadratic term 3 k3 s and a constant
+    force, which the input offset takes, so k2 belongs with the offsets
+    and is estimated with them (:func:`randvib.identify`,
     ``quadratic``). The initial state is not part of it: it belongs to one
     record and is estimated, or taken from the first samples, record by
     record (:class:`~randvib.identification.settings.SimulationSettings`).
