@@ -26,23 +26,27 @@ import time
 
 import numpy as np
 
-from randvib.identification.fitting import CostFunction, Record, default_bounds, identify
-from randvib.identification.record_simulation import (
-    driving_signal,
-    parameter_matrix,
-    run_kernel,
-    simulate_record,
-)
+from randvib.identification.bounds import default_bounds
+from randvib.identification.cost import CostFunction
+from randvib.identification.identify import identify
+from randvib.identification.input_reconstruction import driving_signal
+from randvib.identification.models import device_from_parameters
+from randvib.identification.record_integrator import parameter_matrix, run_kernel
+from randvib.identification.record_response import record_response
 from randvib.identification.sade import _Space, sade
 from randvib.models.excitation import band_limited_excitation
+from randvib.models.record import Record
 
 TRUE = dict(m=0.0226, c=0.049, k=57.4, k3=70742.0, fc=0.0058)
 
 
 def coulomb_record(duration=10.0, fs=1000.0, seed=1):
     ex = band_limited_excitation(duration, fs, 1.5, seed=seed)
-    z = simulate_record(TRUE, "coulomb", ex.acceleration, 1 / fs, substeps=8).z[0]
-    return Record(1 / fs, "base_displacement", ex.displacement, z, "bench")
+    device, _ = device_from_parameters("coulomb", TRUE)
+    z = record_response(device, ex, input_kind="base_acceleration", substeps=8).z[0]
+    return Record(
+        1 / fs, name="bench", base_displacement=ex["base_displacement"], relative_displacement=z
+    )
 
 
 # --------------------------------------------------------------- numpy reference

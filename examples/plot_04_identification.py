@@ -29,8 +29,13 @@ for name, value in true_values.items():
     print(f"{name:3s} true {value:10.4g}   identified {result.parameters[name]:10.4g}")
 
 # %%
-# The identified model on the record it was fitted to.
-fitted = result.predict(record)
+# The identified device is a Harvester (its damping c as c_m), with a
+# measurement model (the sensors' offsets); simulated on the record it was
+# fitted to, it scores the fit's J.
+device = result.harvester()
+print(device)
+print(result.measurement)
+fitted = rv.predict_record(device, record, measurement=result.measurement)
 print(f"J on the record: {fitted.cost:.3g}, RMS error {1e6 * fitted.rms_error:.2f} um")
 t = record.time
 fig, ax = plt.subplots(layout="constrained")

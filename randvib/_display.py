@@ -3,7 +3,7 @@
 The result classes (:class:`~randvib.montecarlo.results.SimulationResult`,
 :class:`~randvib.analytic.power_prediction.PowerPrediction`,
 :class:`~randvib.analytic.statistical_linearisation.LinearisationResult`,
-:class:`~randvib.identification.fitting.IdentificationResult`) build a list of
+:class:`~randvib.identification.result.IdentificationResult`) build a list of
 rows ``(name, value, unit)`` and hand it here, so that the terminal, the
 notebook and the tables agree on what is shown and to what precision.
 """

@@ -144,6 +144,21 @@ def _read_identity(meta_path: Path) -> dict:
     return old
 
 
+# ------------------------------------------------------------------- input files
+def existing_file(path, what: str, kind: str = "CSV") -> Path:
+    """``path`` as a Path, refused when it is a folder or does not exist.
+
+    ``what`` names the file in the message (``"record file"``), ``kind`` its
+    format (``"CSV"``, ``"JSON"``).
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise IsADirectoryError(f"{what} {str(path)!r} is a folder; give a {kind} file")
+    if not path.is_file():
+        raise FileNotFoundError(f"{what} {str(path)!r} does not exist")
+    return path
+
+
 # ------------------------------------------------------------------ output paths
 def check_output_file(path, option: str, *, overwrite: bool = False) -> Path:
     """Check, before any computation, that ``path`` can be written as a new file.

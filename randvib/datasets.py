@@ -23,7 +23,7 @@ def silverbox_path() -> Path:
 
 
 def silverbox(part: str = "multisine"):
-    """The Silverbox record as a :class:`randvib.identification.fitting.Record`.
+    """The Silverbox record as a :class:`randvib.Record`.
 
     Parameters
     ----------
@@ -40,7 +40,7 @@ def silverbox(part: str = "multisine"):
     """
     if part not in _PARTS:
         raise ValueError(f"part must be one of {sorted(_PARTS)}, got {part!r}")
-    from randvib.identification.fitting import read_record
+    from randvib.models.record import read_record
 
     return read_record(
         silverbox_path(),

@@ -33,7 +33,8 @@ import pandas as pd
 
 from randvib._io import dumps, write_tracked
 from randvib.datasets import silverbox
-from randvib.identification.fitting import identify, predict_record
+from randvib.identification.identify import identify
+from randvib.identification.prediction import predict_record
 from randvib.studies import script_main
 from randvib.studies.report import (
     markdown_table,
@@ -91,7 +92,7 @@ def fit_and_score(records, label, options, search, progress):
     sim = {k: res.settings[k] for k in ("substeps", "hold", "initial_state")}
     rows = []
     for rec in records:
-        pred = predict_record(res.parameters, "viscous", rec, **sim)
+        pred = predict_record(res.harvester(), rec, measurement=res.measurement, **sim)
         rows.append(
             {
                 "model": label,

@@ -4,20 +4,22 @@ Shared by ``tests/test_identification.py`` and the seed study
 ``tests/calibration/identification.py``.
 
 The error model is :class:`Linearisation`: sensitivities of the simulated
-response are central differences of :func:`randvib.identification.record_simulation.simulate_record`
+response are central differences of :func:`randvib.identification.record_response.record_response`
 (one batched call), and the initial state ``identify`` starts from (first
 sample, fourth-order one-sided velocity :data:`VELOCITY_STENCIL`) is
 re-implemented here, so the reference does not go through
-:mod:`randvib.identification.fitting`.
+:mod:`randvib.identification.cost`.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from randvib.identification.fitting import MODELS, Record
-from randvib.identification.record_simulation import simulate_record
+from randvib.identification.models import MeasurementModel, check_model
+from randvib.identification.record_response import record_response
 from randvib.models.excitation import band_limited_excitation
+from randvib.models.harvester import Harvester
+from randvib.models.record import Record
 
 #: Paper Table 2, Coulomb model, training data 1 (m from docs/conventions.md).
 COULOMB = dict(m=0.0226, c=0.049, k=57.4, k3=70742.0, fc=0.0058)
@@ -31,20 +33,35 @@ def excitation(seed, duration, fs, rms=1.07):
     return band_limited_excitation(duration, fs, rms, seed=seed)
 
 
+def harvester(params, model="coulomb"):
+    """The device of identify's named parameters (``c`` as c_m), unchecked: scalars or
+    1-D arrays (a batch). ``model``: an identification model (``viscous``: no friction)."""
+    law = check_model(model)
+    friction = None if law is None else law(**{n: params[n] for n in law.parameter_names()})
+    return Harvester(
+        m=params["m"], c_m=params["c"], c_e=0.0, k=params["k"], k3=params["k3"], friction=friction
+    )
+
+
+def measurement(params):
+    """The measurement model among named parameters (k2 and the offsets; absent ones 0)."""
+    return MeasurementModel.from_parameters(params)
+
+
 def clean_response(params, model, ex, *, z0=0.0, v0=0.0, substeps=8):
     """Noise-free relative displacement and velocity driven by the exact base acceleration."""
-    sim = simulate_record(
-        params, MODELS[model], ex.acceleration, 1 / ex.fs, substeps=substeps, z0=z0, v0=v0
-    )
+    sim = record_response(
+        harvester(params, model), ex, input_kind="base_acceleration", substeps=substeps, z0=z0,
+        v0=v0,
+    )  # fmt: skip
     return sim.z[0], sim.v[0]
 
 
 def make_record(ex, z, *, kind="base_acceleration", noise=0.0, noise_seed=None, name="synthetic"):
     """Record of ``z`` (plus white noise of standard deviation ``noise`` m) and the base input."""
-    inp = ex.displacement if kind == "base_displacement" else ex.acceleration
     if noise:
         z = z + noise * np.random.default_rng(noise_seed).standard_normal(z.size)
-    return Record(1 / ex.fs, kind, inp, z, name)
+    return Record(ex.dt, name=name, relative_displacement=z, **{kind: ex[kind]})
 
 
 def initial_state(z, dt):
@@ -79,16 +96,7 @@ def sensitivities(params, model, record, free, z0, v0, *, substeps=4):
             else:
                 batch[name][row] *= np.exp(sign * h)
         steps.append(h)
-    z = simulate_record(
-        batch,
-        MODELS[model],
-        record.input,
-        record.dt,
-        input_kind=record.input_kind,
-        substeps=substeps,
-        z0=z0s,
-        v0=v0s,
-    ).z
+    z = record_response(harvester(batch, model), record, substeps=substeps, z0=z0s, v0=v0s).z
     d = (z[0:-1:2] - z[1::2]) / (2 * np.array(steps)[:, None])
     return z[-1], d[:-2].T, d[-2], d[-1]
 
@@ -153,7 +161,7 @@ def tapered(ex, ramp=0.2):
     ``w'' y + 2 w' y' + w y''`` (``y`` and its derivatives are exact spectral
     integrals). The base is at rest, to third order, at both ends of the
     record, so the second-order stencils that
-    :func:`randvib.identification.record_simulation.second_derivative` uses next to the ends see
+    :func:`randvib.identification.input_reconstruction.second_derivative` uses next to the ends see
     no motion, and the differentiated displacement carries only the interior
     stencil's error (omega dt)^4 / 90.
     """
@@ -164,8 +172,8 @@ def tapered(ex, ramp=0.2):
     w = a * b
     dw = (da * b - a * db) / ramp
     d2w = (d2a * b - 2 * da * db + a * d2b) / ramp**2
-    y = w * ex.displacement
-    acc = d2w * ex.displacement + 2 * dw * ex.velocity + w * ex.acceleration
+    y = w * ex["base_displacement"]
+    acc = d2w * ex["base_displacement"] + 2 * dw * ex["base_velocity"] + w * ex["base_acceleration"]
     return y, acc
 
 
@@ -191,7 +199,7 @@ def noisy_coulomb_z(noise_seed, lin=None):
     (the record's :class:`Linearisation`) may be passed to reuse it. Returns
     the fit, the z-scores and the standard errors.
     """
-    from randvib.identification.fitting import identify
+    from randvib.identification.identify import identify
 
     clean, noisy = noisy_coulomb_record(noise_seed)
     if lin is None:

@@ -182,7 +182,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="eq11-cost-normalisation",
-        path="randvib/identification/fitting.py",
+        path="randvib/identification/cost.py",
         edits=(
             (
                 "return 100.0 * sse / (self.n_scored * self.variance)",
@@ -220,7 +220,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="identification-mass",
-        path="randvib/identification/fitting.py",
+        path="randvib/identification/identify.py",
         edits=(
             (
                 "        fixed=fixed,\n",
@@ -235,7 +235,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="initial-velocity-zeroed",
-        path="randvib/identification/fitting.py",
+        path="randvib/identification/cost.py",
         edits=(
             (
                 "self.v0 = float(initial_velocity(record.z, record.dt))",
@@ -250,7 +250,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="initial-displacement-zeroed",
-        path="randvib/identification/fitting.py",
+        path="randvib/identification/cost.py",
         edits=(("self.z0 = float(record.z[0] - offset)", "self.z0 = float(0.0 - offset)"),),
         tests=(
             "tests/test_identification.py::test_true_parameters_score_the_residual_of_the_initial_state",
@@ -259,7 +259,7 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="cost-counts-skipped-samples",
-        path="randvib/identification/fitting.py",
+        path="randvib/identification/cost.py",
         edits=(("self.n_scored = scored.size", "self.n_scored = record.n"),),
         tests=(
             "tests/test_identification.py::test_noisy_record_within_linearised_standard_errors",

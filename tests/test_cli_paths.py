@@ -6,6 +6,7 @@ argument.
 
 import json
 
+import _identification as H
 import matplotlib.image
 import numpy as np
 import pytest
@@ -13,8 +14,8 @@ from _cli import one_line_error, run
 from study_checks import check_study_run
 
 import randvib as rv
-from randvib.identification.fitting import read_record
-from randvib.identification.fitting import validate as validate_api
+from randvib.identification.prediction import validate as validate_api
+from randvib.models.record import read_record
 from randvib.montecarlo.simulation import simulate
 from randvib.montecarlo.sweep import SweepSettings
 
@@ -180,7 +181,8 @@ def test_validate_table_and_plots(tmp_path, capsys, records):
     plots = tmp_path / "plots"
     code, out, _ = run(capsys, "validate", params, *records, "--plot", plots)
     assert code == 0
-    expected = validate_api(parameters, "coulomb", [read_record(p) for p in records], substeps=4)
+    device = H.harvester(parameters)
+    expected = validate_api(device, [read_record(p) for p in records], substeps=4)
     rows = table_rows(out)
     for row in expected:
         samples, cost, rms = rows[row.record]

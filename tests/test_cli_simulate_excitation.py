@@ -90,13 +90,13 @@ def _record(tmp_path, n=8000, dt=1e-3, bad=None):
     return path
 
 
-def test_record_equals_simulate_on_record(capsys, tmp_path):
+def test_record_equals_monte_carlo_on_record(capsys, tmp_path):
     path = _record(tmp_path)
     code = main(["simulate", "--preset", "figure9", "--record", str(path), "--segments", "4",
                  "--burn-in", "0.5", "--dt", "5e-4", "--json"])  # fmt: skip
     out = json.loads(capsys.readouterr().out)
     assert code == 0
-    api = rv.simulate_on_record(
+    api = rv.monte_carlo_on_record(
         rv.preset("figure9"), rv.Measured.from_csv(path), segments=4, burn_in=0.5, substeps=2
     ).summary()
     out.pop("wall_time"), api.pop("wall_time")

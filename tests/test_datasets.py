@@ -1,4 +1,4 @@
-"""The shipped Silverbox record: present, complete and split as documented."""
+"""The shipped Silverbox record (randvib.datasets): present, complete and split as documented."""
 
 import numpy as np
 import pytest

@@ -1,14 +1,29 @@
-"""Deterministic simulator of recorded input (randvib.identification.record_simulation)."""
+"""Deterministic response to a recorded input.
 
+Covers randvib.identification.record_response (the public call),
+randvib.identification.record_integrator (RK4, stick-slip events, LuGre sub-cycling)
+and randvib.identification.input_reconstruction (the differentiated displacement).
+"""
+
+import _identification as H
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from randvib.identification.record_simulation import second_derivative, simulate_record
+import randvib as rv
+from randvib.identification.input_reconstruction import second_derivative
+from randvib.identification.models import MeasurementModel
+from randvib.identification.record_response import record_response
 from randvib.models.excitation import band_limited_excitation
+from randvib.models.record import Record
 
 DUFFING = dict(m=0.0226, c=0.049, k=57.4, k3=70742.0)
+
+
+def response(params, model, record, input_kind="base_acceleration", **kwargs):
+    """record_response of the device of identify's named parameters (``c`` as c_m)."""
+    return record_response(H.harvester(params, model), record, input_kind=input_kind, **kwargs)
 
 
 def _interp_input(u, dt):
@@ -33,8 +48,8 @@ def excitation():
 def test_duffing_matches_solve_ivp(excitation):
     # Same continuous problem (linearly interpolated input) solved by a tight
     # adaptive integrator: the difference is the RK4 error, O(h^4) ~ 1e-7.
-    dt = 1 / excitation.fs
-    acc = _interp_input(excitation.acceleration, dt)
+    dt = excitation.dt
+    acc = _interp_input(excitation["base_acceleration"], dt)
     p = DUFFING
 
     def rhs(t, y):
@@ -42,21 +57,16 @@ def test_duffing_matches_solve_ivp(excitation):
         return [v, -acc(t) - (p["c"] * v + p["k"] * z + p["k3"] * z**3) / p["m"]]
 
     ref = _ivp(rhs, [1e-4, 0.0], excitation.time, dt)
-    sim = simulate_record(p, "none", excitation.acceleration, dt, substeps=4, z0=1e-4)
+    sim = response(p, "viscous", excitation, substeps=4, z0=1e-4)
     scale = np.std(ref[0])
     assert np.max(np.abs(sim.z[0] - ref[0])) < 1e-5 * scale
     assert np.max(np.abs(sim.v[0] - ref[1])) < 1e-5 * np.std(ref[1])
 
 
 def test_rk4_is_fourth_order(excitation):
-    dt = 1 / excitation.fs
-    ref = simulate_record(DUFFING, "none", excitation.acceleration, dt, substeps=64).z[0]
+    ref = response(DUFFING, "viscous", excitation, substeps=64).z[0]
     errs = [
-        np.max(
-            np.abs(
-                simulate_record(DUFFING, "none", excitation.acceleration, dt, substeps=n).z[0] - ref
-            )
-        )
+        np.max(np.abs(response(DUFFING, "viscous", excitation, substeps=n).z[0] - ref))
         for n in (1, 2, 4)
     ]
     slopes = np.log2(np.array(errs[:-1]) / np.array(errs[1:]))
@@ -64,8 +74,8 @@ def test_rk4_is_fourth_order(excitation):
 
 
 def test_lugre_matches_stiff_solver(excitation):
-    dt = 1 / excitation.fs
-    acc = _interp_input(excitation.acceleration, dt)
+    dt = excitation.dt
+    acc = _interp_input(excitation["base_acceleration"], dt)
     p = dict(m=0.0226, c=0.055, k=59.7, k3=64926.0)
     s0, s1, fc, fs, vs = 1.98, 0.18, 0.0008, 0.008, 0.007
 
@@ -77,15 +87,17 @@ def test_lugre_matches_stiff_solver(excitation):
         return [v, -acc(t) - (p["c"] * v + p["k"] * z + p["k3"] * z**3 + f) / p["m"], rate]
 
     ref = _ivp(rhs, [0.0, 0.0, 0.0], excitation.time, dt, method="LSODA")
-    sim = simulate_record(
-        dict(p, sigma0=s0, sigma1=s1, fc=fc, fs=fs, vs=vs), "lugre", excitation.acceleration, dt
+    sim = response(
+        dict(p, sigma0=s0, sigma1=s1, fc=fc, fs=fs, vs=vs),
+        "lugre",
+        excitation,
     )
     assert np.max(np.abs(sim.z[0] - ref[0])) < 1e-5 * np.std(ref[0])
 
 
 def test_moderate_tanh_matches_solve_ivp(excitation):
-    dt = 1 / excitation.fs
-    acc = _interp_input(excitation.acceleration, dt)
+    dt = excitation.dt
+    acc = _interp_input(excitation["base_acceleration"], dt)
     fc, beta = 0.0058, 50.0  # tau = m/(Fc beta) = 78 ms: smooth regime, plain RK4
 
     def rhs(t, y):
@@ -98,7 +110,7 @@ def test_moderate_tanh_matches_solve_ivp(excitation):
         ]
 
     ref = _ivp(rhs, [0.0, 0.0], excitation.time, dt)
-    sim = simulate_record(dict(DUFFING, fc=fc, beta=beta), "tanh", excitation.acceleration, dt)
+    sim = response(dict(DUFFING, fc=fc, beta=beta), "tanh", excitation)
     assert np.max(np.abs(sim.z[0] - ref[0])) < 1e-5 * np.std(ref[0])
 
 
@@ -107,6 +119,7 @@ M, C, K, FC = 1.0, 0.1, 40.0, 1.0
 DT = 0.01
 T = np.arange(0, 6.0 + DT / 2, DT)
 U = 2.5 * np.sin(2 * np.pi * 0.5 * T)  # force input; |u| < Fc near its zeros -> sticking
+FORCE = Record(DT, force=U)
 
 
 def _coulomb_reference():
@@ -157,7 +170,7 @@ def _coulomb_reference():
 
 
 def test_coulomb_matches_event_located_reference():
-    sim = simulate_record(dict(m=M, c=C, k=K, k3=0.0, fc=FC), "coulomb", U, DT, input_kind="force")
+    sim = response(dict(m=M, c=C, k=K, k3=0.0, fc=FC), "coulomb", FORCE, input_kind="force")
     ref = _coulomb_reference()
     # interpolating the reference onto the grid inside stick phases is exact
     # (z constant); the remaining difference is RK4 plus event location error
@@ -165,7 +178,7 @@ def test_coulomb_matches_event_located_reference():
 
 
 def test_coulomb_sticks_exactly_without_chattering():
-    sim = simulate_record(dict(m=M, c=C, k=K, k3=0.0, fc=FC), "coulomb", U, DT, input_kind="force")
+    sim = response(dict(m=M, c=C, k=K, k3=0.0, fc=FC), "coulomb", FORCE, input_kind="force")
     z, v = sim.z[0], sim.v[0]
     stuck = v == 0.0
     assert stuck.mean() > 0.1  # the excitation produces real sticking
@@ -192,10 +205,9 @@ def test_coulomb_sticks_exactly_without_chattering():
 def test_coulomb_substep_convergence():
     ex = band_limited_excitation(2.0, 500.0, 1.0, seed=4)
     p = dict(DUFFING, fc=0.0058)
-    dt = 1 / ex.fs
-    ref = simulate_record(p, "coulomb", ex.acceleration, dt, substeps=32).z[0]
-    e1 = np.max(np.abs(simulate_record(p, "coulomb", ex.acceleration, dt, substeps=1).z[0] - ref))
-    e4 = np.max(np.abs(simulate_record(p, "coulomb", ex.acceleration, dt, substeps=4).z[0] - ref))
+    ref = response(p, "coulomb", ex, substeps=32).z[0]
+    e1 = np.max(np.abs(response(p, "coulomb", ex, substeps=1).z[0] - ref))
+    e4 = np.max(np.abs(response(p, "coulomb", ex, substeps=4).z[0] - ref))
     assert e4 < e1 / 50  # at least ~third order through the stick-slip events
     assert e4 < 1e-6 * np.std(ref)
 
@@ -203,13 +215,9 @@ def test_coulomb_substep_convergence():
 @pytest.mark.parametrize("beta", [1e7, 4.8e8, 1e9])
 def test_stiff_tanh_is_not_a_step_size_artefact(beta):
     ex = band_limited_excitation(2.0, 500.0, 1.0, seed=5)
-    dt = 1 / ex.fs
     p = dict(DUFFING, fc=0.0058)
-    coulomb = simulate_record(p, "coulomb", ex.acceleration, dt).z[0]
-    runs = [
-        simulate_record(dict(p, beta=beta), "tanh", ex.acceleration, dt, substeps=n).z[0]
-        for n in (1, 4, 16)
-    ]
+    coulomb = response(p, "coulomb", ex).z[0]
+    runs = [response(dict(p, beta=beta), "tanh", ex, substeps=n).z[0] for n in (1, 4, 16)]
     scale = np.std(coulomb)
     for z in runs:
         assert np.all(np.isfinite(z))
@@ -219,26 +227,23 @@ def test_stiff_tanh_is_not_a_step_size_artefact(beta):
 
 
 def test_batch_equals_individual_runs(excitation):
-    dt = 1 / excitation.fs
     fcs = np.array([0.0, 0.002, 0.0058, 0.02])
-    batch = simulate_record(dict(DUFFING, fc=fcs), "coulomb", excitation.acceleration, dt)
+    batch = response(dict(DUFFING, fc=fcs), "coulomb", excitation)
     for i, fc in enumerate(fcs):
-        one = simulate_record(dict(DUFFING, fc=fc), "coulomb", excitation.acceleration, dt)
+        one = response(dict(DUFFING, fc=fc), "coulomb", excitation)
         np.testing.assert_array_equal(batch.z[i], one.z[0])
 
 
 def test_zero_friction_equals_viscous(excitation):
-    dt = 1 / excitation.fs
-    a = simulate_record(dict(DUFFING, fc=0.0), "coulomb", excitation.acceleration, dt).z
-    b = simulate_record(DUFFING, "none", excitation.acceleration, dt).z
+    a = response(dict(DUFFING, fc=0.0), "coulomb", excitation).z
+    b = response(DUFFING, "viscous", excitation).z
     np.testing.assert_allclose(a, b, rtol=0, atol=1e-15)
 
 
 def test_base_displacement_input_agrees_with_acceleration():
     ex = band_limited_excitation(4.0, 1000.0, 1.0, seed=6)
-    dt = 1 / ex.fs
-    a = simulate_record(DUFFING, "none", ex.acceleration, dt).z[0]
-    d = simulate_record(DUFFING, "none", ex.displacement, dt, input_kind="base_displacement").z[0]
+    a = response(DUFFING, "viscous", ex).z[0]
+    d = response(DUFFING, "viscous", ex, input_kind="base_displacement").z[0]
     # fourth-order differentiation inside, second order at the record's ends
     assert np.max(np.abs(a - d)) < 1e-3 * np.std(a)
 
@@ -253,34 +258,53 @@ def test_second_derivative_is_fourth_order():
 
 
 def test_diverging_candidate_is_flagged():
-    dt = 0.01
-    u = np.ones(50)
-    sim = simulate_record(
-        dict(m=1.0, c=-50.0, k=1.0, k3=0.0), "none", u, dt, input_kind="force", response_limit=10.0
-    )
-    assert np.isnan(sim.z[0, -1])
+    # an unstable spring (k < 0, no cubic term) runs away: NaN from the sample it leaves
+    # the response limit on
+    device = rv.Harvester(m=1.0, c_m=0.1, c_e=0.0, k=-1e4, k3=0.0)
+    sim = record_response(device, Record(0.01, force=np.ones(50)), response_limit=10.0)
+    assert np.isnan(sim.z[0, -1]) and np.isfinite(sim.z[0, 0])
+
+
+def test_measurement_model_offsets_the_input_not_the_response():
+    """The input offset is taken off the input (measured = true + offset); the response is
+    the true displacement, without the output offset."""
+    device = rv.Harvester(m=1.0, c_m=0.3, c_e=0.0, k=40.0, k3=4e4)
+    u = np.random.default_rng(0).standard_normal(300)
+    true = record_response(device, Record(0.02, force=u)).z
+    offsets = MeasurementModel(input_offset=0.7, output_offset=1e-3)
+    measured = record_response(device, Record(0.02, force=u + 0.7), measurement=offsets).z
+    np.testing.assert_allclose(measured, true, rtol=0, atol=1e-15)
 
 
 @pytest.mark.parametrize(
     "kwargs, match",
     [
-        (dict(friction="dry"), "`friction` must be one of"),
-        (dict(dt=-1.0), "`dt` must be > 0"),
+        (dict(harvester=DUFFING), "record_response needs a randvib.Harvester"),
+        (dict(record=np.zeros(10)), "`record` must be a randvib.Record"),
         (dict(substeps=0), "`substeps` must be an integer >= 1"),
         (dict(hold="quintic"), "`hold` must be one of"),
         (dict(input_kind="velocity"), "`input_kind` must be one of"),
-        (dict(input_values=[0.0, np.nan, 1.0]), "`input_values` must be finite"),
-        (dict(parameters=dict(m=1.0, c=0.1, k=1.0)), r"missing parameter\(s\) \['k3'\]"),
-        (dict(parameters=dict(m=0.0, c=0.1, k=1.0, k3=0.0)), "`m` must be > 0"),
+        (dict(input_kind="force"), "has no 'force' channel"),
+        (
+            dict(record=Record(0.01, force=np.zeros(10), base_acceleration=np.zeros(10))),
+            "several input channels",
+        ),
+        (dict(measurement={"k2": 1.0}), "`measurement` must be a randvib.MeasurementModel"),
+        (
+            dict(
+                harvester=rv.Harvester.with_coupling(
+                    1.0, 0.1, 1.0, rv.Inductive(0.2, 1.0, 0.5, 1e-3)
+                )
+            ),
+            "record_response assumes resistive coupling",
+        ),
     ],
 )
 def test_bad_arguments(kwargs, match):
     args = dict(
-        parameters=dict(m=1.0, c=0.1, k=1.0, k3=0.0),
-        friction="none",
-        input_values=np.zeros(10),
-        dt=0.01,
+        harvester=rv.Harvester(m=1.0, c_m=0.1, c_e=0.0, k=1.0),
+        record=Record(0.01, base_acceleration=np.zeros(10)),
     )
     args.update(kwargs)
-    with pytest.raises(ValueError, match=match):
-        simulate_record(**args)
+    with pytest.raises((ValueError, KeyError), match=match):
+        record_response(**args)

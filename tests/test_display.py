@@ -5,7 +5,7 @@ import pytest
 
 import randvib as rv
 from randvib import _display
-from randvib.identification.fitting import IdentificationResult
+from randvib.identification.result import IdentificationResult
 
 
 @pytest.fixture(scope="module")
@@ -107,8 +107,10 @@ def test_results_under_a_table_or_a_record_show_themselves():
     assert result.psd is None
     for text in (repr(result), str(result), result._repr_html_()):
         assert "tabulated" in text and "S = " not in text
-    record = rv.Measured(np.arange(4000) * 1e-3, table.sample(4.0, 1e-3, seed=1)[0])
-    on_record = rv.simulate_on_record(device, record, segments=2, burn_in=0.5, progress=False)
+    record = rv.Measured(
+        rv.Record(time=np.arange(4000) * 1e-3, base_acceleration=table.sample(4.0, 1e-3, seed=1)[0])
+    )
+    on_record = rv.monte_carlo_on_record(device, record, segments=2, burn_in=0.5, progress=False)
     assert on_record.psd is None
     assert repr(on_record).startswith("RecordSimulation(") and "measured" in repr(on_record)
     assert "array" not in repr(on_record)  # not the record's samples
@@ -119,7 +121,12 @@ def test_tables_records_and_spectra_have_compact_reprs(simulation):
     table = rv.Tabulated(np.array([1.0, 5.0, 20.0, 30.0]), np.array([0.0, 1.0, 1.0, 0.0]))
     # variance: the trapezoid's exact integral, 2 + 15 + 5 = 22 (m/s^2)^2
     assert repr(table) == "Tabulated(4 points, 1-30 Hz, variance 22 (m/s^2)^2)"
-    record = rv.Measured(np.arange(4000) * 1e-3, np.random.default_rng(0).normal(size=4000))
+    record = rv.Measured(
+        rv.Record(
+            time=np.arange(4000) * 1e-3,
+            base_acceleration=np.random.default_rng(0).normal(size=4000),
+        )
+    )
     assert repr(record).startswith("Measured(4000 samples at 1000 Hz, 4 s, variance ")
     statistical = rv.statistical_linearisation(rv.preset("figure9"), table)
     assert "array" not in repr(statistical) and "array" not in statistical._repr_html_()

@@ -1,5 +1,6 @@
-"""Excitations at the interfaces (issue 10): predict/expected_power, the refusals
-of the white-noise methods, and ``randvib power --excitation ...``."""
+"""Excitations at the interfaces: predict/expected_power, the refusals of the
+white-noise methods, Measured read from CSV (randvib.models.excitation) and
+``randvib power --excitation ...``."""
 
 import json
 

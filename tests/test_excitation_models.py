@@ -24,6 +24,7 @@ from randvib.models.excitation import (
     as_excitation,
     welch_segment_length,
 )
+from randvib.models.record import Record
 
 RATIONAL = [
     White(0.7),
@@ -172,14 +173,20 @@ ERRORS = [
     (lambda: Tabulated([0, 1], [0, 0]), r"`psd` must be > 0 somewhere"),
     (lambda: Tabulated([0, 1, 2], [1, np.nan, 1]), r"`psd` must be finite"),
     (
-        lambda: Measured(np.arange(100) * 0.01, np.r_[np.zeros(99), np.nan]),
-        r"`base_acceleration` must be finite",
+        lambda: Record(time=np.arange(100) * 0.01, base_acceleration=np.r_[np.zeros(99), np.nan]),
+        r"`base_acceleration` must be finite: 1 NaN",
     ),
     (
-        lambda: Measured(np.r_[np.arange(50), np.arange(50) + 50.5] * 0.01, np.zeros(100)),
+        lambda: Record(
+            time=np.r_[np.arange(50), np.arange(50) + 50.5] * 0.01, base_acceleration=np.zeros(100)
+        ),
         r"`time` must be evenly spaced",
     ),
-    (lambda: Measured(np.arange(10) * 0.01, np.zeros(10)), r"length >= 64"),
+    (
+        lambda: Measured(Record(time=np.arange(10) * 0.01, base_acceleration=np.zeros(10))),
+        r"at least 64 samples",
+    ),
+    (lambda: Measured(Record(0.01, force=np.zeros(100))), r"no base_acceleration channel"),
     (lambda: BandLimited(1.0, 4.0, 20.0).sample(10.0, 0.05), r"`dt` = 0\.05 s resolves"),
     (lambda: BandLimited(1.0, 4.0, 20.0).sample(-1.0, 0.01), r"`duration` must be > 0"),
 ]

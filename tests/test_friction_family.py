@@ -30,6 +30,7 @@ Gaussian quadrature of linearisation take the discontinuous law as it is.
 
 from dataclasses import dataclass
 
+import _identification as H
 import numba
 import numpy as np
 import pytest
@@ -38,11 +39,16 @@ from scipy import integrate
 
 import randvib as rv
 from randvib.cli._device import FRICTION_CHOICES
-from randvib.identification.fitting import MODELS, Record, default_bounds, identify, predict_record
-from randvib.identification.record_simulation import FRICTION_PARAMETERS, simulate_record
+from randvib.identification.bounds import default_bounds
+from randvib.identification.identify import identify
+from randvib.identification.models import MODELS
+from randvib.identification.prediction import predict_record
+from randvib.identification.record_integrator import FRICTION_PARAMETERS
+from randvib.identification.record_response import record_response
 from randvib.models.excitation import band_limited_excitation
 from randvib.models.friction import FRICTION_MODELS
 from randvib.models.parameters import parameter
+from randvib.models.record import Record
 
 
 @dataclass(frozen=True, eq=False)
@@ -211,27 +217,25 @@ VT = 1e-3  # m/s: tanh(beta v) with beta = 1000 s/m, smooth on the RK4 step
 
 @pytest.fixture(scope="module")
 def drive():
-    return band_limited_excitation(2.0, FS_REC, 1.07, seed=0).acceleration
+    """A base acceleration record (m/s^2) at FS_REC."""
+    motion = band_limited_excitation(2.0, FS_REC, 1.07, seed=0)
+    return Record(motion.dt, base_acceleration=motion["base_acceleration"])
 
 
 def test_record_simulation_reduces_to_the_builtin_tanh_law(drive):
     # Fs = Fc, vt > 0 is Tanh(Fc, 1/vt); at h = 2.5e-4 s < 2 m/(Fc beta) the
     # built-in law is integrated by the same RK4, so the two agree to rounding.
-    dt = 1 / FS_REC
-    own = simulate_record(_with(Stribeck(FC, FC, 0.02, VT)), drive, dt, substeps=8).z[0]
-    builtin = simulate_record(_with(rv.Tanh(FC, 1 / VT)), drive, dt, substeps=8).z[0]
+    own = record_response(_with(Stribeck(FC, FC, 0.02, VT)), drive, substeps=8).z[0]
+    builtin = record_response(_with(rv.Tanh(FC, 1 / VT)), drive, substeps=8).z[0]
     assert np.max(np.abs(own - builtin)) <= 1e-9 * np.max(np.abs(builtin))
 
 
-def test_simulate_record_takes_a_harvester_a_preset_and_its_parameters(drive):
-    dt = 1 / FS_REC
-    device = rv.preset("coulomb-td1")
-    as_dict = dict(m=device.m, c=device.c, k=device.k, k3=device.k3, fc=device.friction.fc)
-    reference = simulate_record(as_dict, "coulomb", drive, dt).z
-    assert np.array_equal(simulate_record(device, drive, dt).z, reference)
-    assert np.array_equal(simulate_record(device.parameters(), drive, dt).z, reference)
-    with pytest.raises(ValueError, match="disagrees"):
-        simulate_record(device, "tanh", drive, dt)
+def test_record_response_simulates_the_total_damping(drive):
+    """A record cannot separate c_m from c_e: a preset with both responds as the same
+    device with their sum as c_m (0.25 + 0.125 is exact in binary)."""
+    split = rv.preset("coulomb-td1").updated(c_m=0.25, c_e=0.125)
+    total = rv.preset("coulomb-td1").updated(c_m=0.375, c_e=0.0)
+    assert np.array_equal(record_response(split, drive).z, record_response(total, drive).z)
 
 
 TRUE = dict(m=0.0226, c=0.049, k=57.4, k3=70742.0, fc=FC, fs=2.0 * FC, vs=0.02, vt=VT)
@@ -245,9 +249,10 @@ def test_identification_recovers_the_law_from_a_noise_free_record(drive):
     sqrt(1e-6 / J'') relative, well inside 1 %); m (not identifiable under
     base excitation), k3 and the regularisation vt are fixed.
     """
-    dt = 1 / FS_REC
-    z = simulate_record(TRUE, "stribeck-test", drive, dt, substeps=8).z[0]
-    record = Record(dt, "base_acceleration", drive, z, "stribeck")
+    z = record_response(H.harvester(TRUE, "stribeck-test"), drive, substeps=8).z[0]
+    record = Record(
+        drive.dt, name="stribeck", base_acceleration=drive.input, relative_displacement=z
+    )
     bounds = default_bounds(record, "stribeck-test", TRUE["m"])
     assert "vt" not in bounds  # declared without default bounds
     with pytest.raises(ValueError, match="declare no default search bounds"):

@@ -398,15 +398,15 @@ def short_record():
     scale=st.sampled_from([1.0, 1e-300, 1e150, 1e300]),
     segments=st.sampled_from([2, 4, 1, 0]),
 )
-def test_simulate_on_record_refuses_or_is_finite(short_record, p, scale, segments):
+def test_monte_carlo_on_record_refuses_or_is_finite(short_record, p, scale, segments):
     t, a = short_record
-    record = _refused(lambda: rv.Measured(t, a * scale))
+    record = _refused(lambda: rv.Measured(rv.Record(time=t, base_acceleration=a * scale)))
     device = _refused(lambda: rv.preset("figure9").updated(**p))
     if record is None or device is None:
         return
     with np.errstate(all="ignore"):
         result = _refused(
-            lambda: rv.simulate_on_record(device, record, segments=segments, burn_in=0.2)
+            lambda: rv.monte_carlo_on_record(device, record, segments=segments, burn_in=0.2)
         )
     if result is not None:
         for name in ("power_electrical", "velocity_variance", "displacement_variance"):

@@ -1,4 +1,8 @@
-"""Identification of friction models (randvib.identification.fitting, CLI identify/validate)."""
+"""Identification of friction models and the CLI commands identify and validate.
+
+Covers randvib.identification.identify (the driver), .cost (Eq. 11), .bounds,
+.settings, .models, .result and .prediction (predict_record, validate).
+"""
 
 import json
 from types import SimpleNamespace
@@ -8,23 +12,17 @@ import numpy as np
 import pytest
 from _stats import assert_matches
 
+import randvib as rv
 from randvib.cli import main
-from randvib.identification.fitting import (
-    CostFunction,
-    Record,
-    SearchSettings,
-    SimulationSettings,
-    default_bounds,
-    identify,
-    initial_velocity,
-    normalised_cost,
-    predict,
-    predict_record,
-    read_record,
-    validate,
-)
-from randvib.identification.record_simulation import simulate_record
+from randvib.identification.bounds import default_bounds
+from randvib.identification.cost import CostFunction, initial_velocity, normalised_cost
+from randvib.identification.identify import identify
+from randvib.identification.models import MeasurementModel
+from randvib.identification.prediction import predict_record, validate
+from randvib.identification.record_response import record_response
+from randvib.identification.settings import SearchSettings, SimulationSettings
 from randvib.models.excitation import band_limited_excitation
+from randvib.models.record import Record
 
 COULOMB = H.COULOMB
 TRUE = COULOMB
@@ -34,10 +32,9 @@ def synthetic(
     seed=0, rms=1.07, duration=3.0, fs=500.0, kind="base_displacement", model="coulomb", params=TRUE
 ):
     ex = band_limited_excitation(duration, fs, rms, seed=seed)
-    inp = ex.displacement if kind == "base_displacement" else ex.acceleration
-    drive = ex.acceleration
-    z = simulate_record(params, model, drive, 1 / fs, substeps=8).z[0]
-    return Record(1 / fs, kind, inp, z, f"test{seed}")
+    device = H.harvester(params, model)
+    z = record_response(device, ex, input_kind="base_acceleration", substeps=8).z[0]
+    return Record(1 / fs, name=f"test{seed}", relative_displacement=z, **{kind: ex[kind]})
 
 
 @pytest.fixture(scope="module")
@@ -64,7 +61,12 @@ def test_search_cost_is_eq11_of_predict_record(record):
     x = [COULOMB["c"] * 1.02, COULOMB["k"] * 0.99, COULOMB["k3"] * 1.03, COULOMB["fc"] * 0.95]
     search_cost = CostFunction(record, "coulomb", fixed=fixed, free=free, initial_state="record")
     parameters = {**fixed, **dict(zip(free, x, strict=True))}
-    expected = predict_record(parameters, "coulomb", record, initial_state="record").cost
+    expected = predict_record(
+        H.harvester(parameters),
+        record,
+        measurement=H.measurement(parameters),
+        initial_state="record",
+    ).cost
     assert expected > 0.1  # far from the optimum
     assert search_cost(np.array([x]))[0] == pytest.approx(expected, rel=1e-9)
 
@@ -134,10 +136,11 @@ def test_true_parameters_score_the_residual_of_the_initial_state(skip):
     r = (rec.z - zhat)[skip:]
     reference = 100 * np.mean(r**2) / np.var(rec.z[skip:])
     assert reference < 1e-6
-    assert predict_record(
-        COULOMB, "coulomb", rec, skip=skip, initial_state="record"
-    ).cost == pytest.approx(reference, rel=1e-6)
-    (row,) = validate(COULOMB, "coulomb", [rec], skip=skip, initial_state="record")
+    device = H.harvester(COULOMB)
+    assert predict_record(device, rec, skip=skip, initial_state="record").cost == pytest.approx(
+        reference, rel=1e-6
+    )
+    (row,) = validate(device, [rec], skip=skip, initial_state="record")
     assert row.cost == pytest.approx(reference, rel=1e-6)
 
 
@@ -197,7 +200,9 @@ def test_noisy_record_within_linearised_standard_errors():
     # J (Eq. 11) reported by identify is Eq. 11 over the scored samples
     skip = H.NOISY["skip"]
     _, noisy = H.noisy_coulomb_record(0)
-    pred = predict_record(res.parameters, "coulomb", noisy, skip=skip, initial_state="record")
+    pred = predict_record(
+        res.harvester(), noisy, measurement=res.measurement, skip=skip, initial_state="record"
+    )
     assert res.cost == pytest.approx(pred.cost, rel=1e-9)
     # and sits at the noise floor: 100 sigma^2 / var(z) (fraction (N - d)/N of it)
     floor = 100 * H.NOISY["sigma"] ** 2 / np.var(noisy.z[skip:])
@@ -220,14 +225,15 @@ def test_tanh_base_displacement_not_at_rest_recovered_to_optimiser_precision():
     params = dict(COULOMB, beta=100.0)
     ex = H.excitation(0, 1.5, 500.0)
     y, acc = H.tapered(ex)
-    z = simulate_record(params, "tanh", acc, 1 / ex.fs, substeps=8, z0=Z0, v0=V0).z[0]
-    rec = Record(1 / ex.fs, "base_displacement", y, z, "tanh")
+    device = H.harvester(params, "tanh")
+    z = record_response(device, Record(ex.dt, base_acceleration=acc), substeps=8, z0=Z0, v0=V0).z[0]
+    rec = Record(ex.dt, name="tanh", base_displacement=y, relative_displacement=z)
     res = identify_classic(
         rec, "tanh", m=COULOMB["m"], popsize=20, maxiter=60, seed=1, bounds={"beta": (10, 1e4)}
     )
     lin = H.Linearisation(params, "tanh", rec, H.FREE + ("beta",))
     assert_at_optimum(res, params, lin, "tanh")
-    assert res.cost <= predict_record(params, "tanh", rec, initial_state="record").cost
+    assert res.cost <= predict_record(device, rec, initial_state="record").cost
 
 
 LUGRE = dict(
@@ -247,7 +253,7 @@ def test_lugre_truth_scores_zero_and_the_fit_reaches_the_optimum():
     Stribeck parameters held the fit must reach the optimum to TOL.
     """
     rec = not_at_rest("lugre", LUGRE)
-    truth = predict_record(LUGRE, "lugre", rec, initial_state="record").cost
+    truth = predict_record(H.harvester(LUGRE, "lugre"), rec, initial_state="record").cost
     assert truth < 1e-6
     held = {n: LUGRE[n] for n in ("sigma0", "sigma1", "fs", "vs")}
     res = identify_classic(rec, "lugre", m=LUGRE["m"], fixed=held, popsize=16, maxiter=40, seed=1)
@@ -260,7 +266,8 @@ def test_viscous_model_cannot_match_a_friction_record(record):
     viscous = identify_classic(record, "viscous", m=COULOMB["m"], popsize=20, maxiter=40, seed=0)
     # without friction the record cannot be matched as well (paper Fig. 7)
     assert (
-        viscous.cost > 10 * predict_record(COULOMB, "coulomb", record, initial_state="record").cost
+        viscous.cost
+        > 10 * predict_record(H.harvester(COULOMB), record, initial_state="record").cost
     )
     assert viscous.cost < 100
 
@@ -269,9 +276,10 @@ def test_force_input_identifies_the_mass():
     """Force input, mass free: all five parameters to TOL of the optimum."""
     params = dict(m=0.5, c=2.0, k=800.0, k3=2e7)
     ex = band_limited_excitation(2.0, 400.0, 1.0, f_lo=2.0, f_hi=40.0, seed=2)
-    force = ex.acceleration
-    z = simulate_record(params, "none", force, 1 / 400, input_kind="force", substeps=8).z[0]
-    rec = Record(1 / 400, "force", force, z)
+    force = ex["base_acceleration"]
+    device = H.harvester(params, "viscous")
+    z = record_response(device, Record(1 / 400, force=force), substeps=8).z[0]
+    rec = Record(1 / 400, force=force, relative_displacement=z)
     res = identify_classic(rec, "viscous", popsize=30, maxiter=100, seed=0)
     assert "m" in res.free
     lin = H.Linearisation(params, "viscous", rec, ("c", "k", "k3", "m"))
@@ -293,7 +301,7 @@ def test_default_bounds_contain_table2_values(record):
 
 def test_validate_scores_each_record(record):
     other = synthetic(seed=1, rms=1.5, kind="base_acceleration")
-    rows = validate(TRUE, "coulomb", [record, other], initial_state="record")
+    rows = validate(H.harvester(TRUE), [record, other], initial_state="record")
     assert [r.record for r in rows] == ["test0", "test1"]
     assert all(r.cost < 1e-6 for r in rows)
 
@@ -324,12 +332,38 @@ def test_settings_objects_are_the_keywords(record):
         SimulationSettings(hold="quintic")
 
 
-def test_predict_is_a_deprecated_alias_of_predict_record(record):
-    with pytest.warns(DeprecationWarning, match="use predict_record"):
-        old = predict(TRUE, "coulomb", record, skip=3)
-    new = predict_record(TRUE, "coulomb", record, simulation=SimulationSettings(skip=3))
-    assert old.cost == new.cost
-    np.testing.assert_array_equal(old.z, new.z)
+def test_result_is_a_harvester_and_its_measurement_model(record):
+    """The identified parameters as a device (c as c_m) and the measurement model; the
+    result's predict is predict_record with them and the fit's settings."""
+    res = identify(
+        record.rows(0, 300), "coulomb", m=TRUE["m"], popsize=8, maxiter=2, seed=0, polish=False,
+        substeps=2,
+    )  # fmt: skip
+    device, offsets = res.harvester(), res.measurement
+    p = res.parameters
+    assert (device.m, device.c_m, device.c_e, device.k, device.k3) == (
+        p["m"], p["c"], 0.0, p["k"], p["k3"],
+    )  # fmt: skip
+    assert device.friction.fc == p["fc"]
+    assert offsets == MeasurementModel(p["input_offset"], p["output_offset"], 0.0)
+    # without the polish the fit starts from the record's first samples
+    assert res.simulation == SimulationSettings(substeps=2, initial_state="record")
+    direct = predict_record(device, record, measurement=offsets, simulation=res.simulation)
+    assert res.predict(record).cost == direct.cost
+    # wired: c_e of the coil added to the identified c, the load voltage simulated
+    coil = rv.ElectricalCoupling(0.1992, 10.0, 0.48)
+    wired = res.harvester(coil)
+    assert wired.c == p["c"] + coil.electrical_damping and wired.c_m == p["c"]
+    assert res.predict(record, electrical=coil).voltage is not None
+
+
+def test_predict_record_refuses_what_it_cannot_simulate(record):
+    with pytest.raises(ValueError, match="predict_record needs a randvib.Harvester"):
+        predict_record(TRUE, record)
+    with pytest.raises(ValueError, match="predict_record needs scalar harvester parameters"):
+        predict_record(H.harvester(dict(TRUE, fc=np.array([0.001, 0.002]))), record)
+    with pytest.raises(ValueError, match="`record` must be a randvib.Record"):
+        predict_record(H.harvester(TRUE), record.z)
 
 
 # ------------------------------------------------------------------- CSV and CLI
@@ -337,73 +371,6 @@ def write_csv(path, record, **rename):
     frame = record.to_frame().rename(columns=rename)
     frame.to_csv(path, index=False)
     return path
-
-
-def test_read_record_round_trip_and_mapping(tmp_path, record):
-    path = write_csv(tmp_path / "r.csv", record)
-    before = path.read_bytes()
-    back = read_record(path)
-    np.testing.assert_allclose(back.z, record.z)
-    assert back.dt == pytest.approx(record.dt) and back.input_kind == "base_acceleration"
-    assert path.read_bytes() == before  # input never modified
-    mapped = write_csv(
-        tmp_path / "m.csv", record, base_acceleration="acc", relative_displacement="laser"
-    )
-    frame = read_record(
-        mapped, input_column="acc", input_kind="base_acceleration", output_column="laser"
-    )
-    np.testing.assert_allclose(frame.input, record.input)
-    no_time = tmp_path / "nt.csv"
-    record.to_frame().drop(columns="time").to_csv(no_time, index=False)
-    assert read_record(no_time, sample_rate=500).dt == pytest.approx(1 / 500)
-    assert read_record(path, rows=(10, 110)).n == 100
-
-
-@pytest.mark.parametrize(
-    "mutate, kwargs, match",
-    [
-        (
-            lambda f: f.drop(columns="relative_displacement"),
-            {},
-            "output column `relative_displacement` not found",
-        ),
-        (lambda f: f.drop(columns="base_acceleration"), {}, "no input column"),
-        (lambda f: f.rename(columns={"base_acceleration": "acc"}), {}, "no input column"),
-        (lambda f: f.assign(force=1.0), {}, "several input columns"),
-        (
-            lambda f: f.assign(relative_displacement=f.relative_displacement.where(f.index != 7)),
-            {},
-            "column `relative_displacement` has 1 NaN.*row 7",
-        ),
-        (
-            lambda f: f.assign(base_acceleration=f.base_acceleration.where(f.index != 3, np.inf)),
-            {},
-            "column `base_acceleration` has 1 NaN or infinite",
-        ),
-        (
-            lambda f: f.assign(time=f.time.where(f.index != 50, f.time + 1e-4)),
-            {},
-            "column `time` is not uniformly sampled",
-        ),
-        (
-            lambda f: f.drop(columns="time"),
-            {},
-            "no 'time' column \\(`time_column`\\); give the sample rate",
-        ),
-        (lambda f: f, dict(sample_rate=1000), "`sample_rate` = 1000 Hz disagrees"),
-        (lambda f: f.iloc[:3], {}, "at least 5"),
-        (
-            lambda f: f,
-            dict(input_column="acc"),
-            "input column 'acc' \\(`input_column`\\) not found",
-        ),
-    ],
-)
-def test_bad_records(tmp_path, record, mutate, kwargs, match):
-    path = tmp_path / "bad.csv"
-    mutate(record.to_frame()).to_csv(path, index=False)
-    with pytest.raises(ValueError, match=match):
-        read_record(path, **kwargs)
 
 
 def test_bad_identify_arguments(record):

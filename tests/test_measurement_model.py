@@ -1,6 +1,9 @@
 """The measurement model of identification: offsets, initial state, k2, input reconstruction,
 and the parameters' uncertainty (coverage of the 95 % intervals).
 
+Covers randvib.identification.models (MeasurementModel), the measurement model's
+estimation in randvib.identification.identify, randvib.identification.least_squares
+(the uncertainty) and randvib.identification.input_reconstruction (the holds).
 Records are synthetic (:func:`randvib.synthetic_record`): the truth is known,
 the sensor noise is white and Gaussian on the output (the setting in which the
 least-squares intervals are exact to first order).
@@ -15,11 +18,15 @@ import pytest
 from scipy import stats
 
 from randvib.cli import main
-from randvib.identification.fitting import Record, identify, validate
-from randvib.identification.record_simulation import reconstruct_input, simulate_record
+from randvib.identification.identify import identify
+from randvib.identification.input_reconstruction import reconstruct_input
+from randvib.identification.models import MeasurementModel
+from randvib.identification.prediction import validate
+from randvib.identification.record_response import record_response
 from randvib.identification.synthetic import synthetic_record
 from randvib.models.friction import FRICTION_MODELS
 from randvib.models.harvester import Harvester
+from randvib.models.record import Record
 
 #: Paper Table 2, Coulomb model, training data 1 (m from docs/conventions.md).
 TRUTH = dict(m=0.0226, c=0.049, k=57.4, k3=70742.0, fc=0.0058)
@@ -46,7 +53,7 @@ def polish_from_truth(rec, **kwargs):
     """The least-squares estimate started at the truth (the search box's only candidate
     that matters: the coverage is a property of the local estimator)."""
     return identify(
-        rec, "coulomb", m=TRUTH["m"], init=TRUTH, popsize=6, maxiter=0, seed=0, **kwargs
+        rec, "coulomb", m=TRUTH["m"], init=device(), popsize=6, maxiter=0, seed=0, **kwargs
     )
 
 
@@ -77,7 +84,10 @@ def _noisy(excitation_seed, noise_seed):
         _CLEAN[excitation_seed] = record(excitation_seed, noise_z=0.0)
     clean = _CLEAN[excitation_seed]
     eps = np.random.default_rng([noise_seed, 99]).standard_normal(clean.n)
-    return Record(clean.dt, clean.input_kind, clean.input, clean.z + NOISE * eps, "noisy")
+    noisy = clean.z + NOISE * eps
+    return Record(
+        clean.dt, name="noisy", relative_displacement=noisy, **{clean.input_kind: clean.input}
+    )
 
 
 def binomial_region(n, p=0.95, alpha=0.01):
@@ -143,7 +153,9 @@ def test_campaign_record_with_a_laser_offset_is_fitted_as_without():
 
     campaign = load("identification")  # the script studies/identification.py
     rec, _ = campaign.make_test(3, duration=4.0, fs=500.0, seed=0)
-    moved = Record(rec.dt, rec.input_kind, rec.input + 2e-3, rec.z + 1e-3, "moved")
+    moved = Record(
+        rec.dt, name="moved", base_displacement=rec.input + 2e-3, relative_displacement=rec.z + 1e-3
+    )
     fits = [
         identify(r, "coulomb", m=campaign.TRUTH["m"], lowpass=50.0, seed=0) for r in (rec, moved)
     ]
@@ -163,10 +175,10 @@ def test_correct_model_validates_at_the_noise_floor_whatever_its_start():
     long = record(7, duration=4.0)
     second = long.rows(1000, None, name="second")  # starts 2 s into the motion
     floor = 100 * NOISE**2 / np.var(second.z)
-    (row,) = validate(TRUTH, "coulomb", [second])
+    (row,) = validate(device(), [second])
     n = second.n
     assert abs(row.cost / floor - 1) < 4 * np.sqrt(2 / n) + 4 / n, (row.cost, floor)
-    (old,) = validate(TRUTH, "coulomb", [second], initial_state="record")
+    (old,) = validate(device(), [second], initial_state="record")
     assert old.cost > 3 * floor
 
 
@@ -178,11 +190,12 @@ def test_quadratic_stiffness_is_recovered():
     restoring force about a shifted origin (z -> z + s) has the quadratic term
     3 k3 s, and the constant force it leaves is the input offset, so the two
     parametrisations describe the same family."""
-    params = dict(TRUTH, k2=2000.0)
     clean = synthetic_record(device(), 1.5, duration=2.0, sample_rate=500.0, seed=3)
-    z = simulate_record(params, "coulomb", clean.input, clean.dt).z[0]
+    z = record_response(device(), clean, measurement=MeasurementModel(k2=2000.0)).z[0]
     noise = NOISE * np.random.default_rng(1).standard_normal(z.size)
-    rec = Record(clean.dt, clean.input_kind, clean.input, z + noise, "k2")
+    rec = Record(
+        clean.dt, name="k2", base_acceleration=clean.input, relative_displacement=z + noise
+    )
     quad = identify(rec, "coulomb", m=TRUTH["m"], quadratic=True, seed=0)
     assert abs(quad.parameters["k2"] - 2000.0) <= 4 * quad.standard_errors["k2"]
     assert "input_offset" not in quad.parameters  # redundant with k2 free
@@ -224,6 +237,8 @@ def test_curved_input_substeps_converge_at_fourth_order_to_the_reconstruction():
     from scipy.interpolate import CubicSpline
 
     params = dict(m=1.0, c=0.3, k=40.0, k3=4e4, k2=500.0)
+    duffing = Harvester(m=1.0, c_m=0.3, c_e=0.0, k=40.0, k3=4e4)
+    k2 = MeasurementModel(k2=500.0)
     dt, n = 0.02, 300
     u = np.random.default_rng(0).standard_normal(n)
     t = np.arange(n) * dt
@@ -237,7 +252,7 @@ def test_curved_input_substeps_converge_at_fourth_order_to_the_reconstruction():
     ref = solve_ivp(rhs, (0, t[-1]), [0, 0], t_eval=t, rtol=1e-11, atol=1e-14, max_step=dt / 8).y[0]
     errs = [
         np.max(np.abs(
-            simulate_record(params, "none", u, dt, input_kind="force", hold="cubic", substeps=s).z[0]
+            record_response(duffing, Record(dt, force=u), measurement=k2, hold="cubic", substeps=s).z[0]
             - ref
         ))
         for s in (4, 8)

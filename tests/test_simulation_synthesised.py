@@ -137,8 +137,13 @@ def test_synthesised_results_do_not_depend_on_batching_or_threads():
 
 
 def test_synthesised_input_refusals_name_what_to_use():
-    record = Measured(np.arange(4096) * 1e-3, np.random.default_rng(0).standard_normal(4096))
-    with pytest.raises(ValueError, match="simulate_on_record"):
+    record = Measured(
+        rv.Record(
+            time=np.arange(4096) * 1e-3,
+            base_acceleration=np.random.default_rng(0).standard_normal(4096),
+        )
+    )
+    with pytest.raises(ValueError, match="monte_carlo_on_record"):
         simulate(LINEAR, record, **KW)
     with pytest.raises(ValueError, match="`dW` drives white noise"):
         simulate(LINEAR, BandLimited(1.0, 4.0, 20.0), dW=np.zeros((16, 500)), **KW)
@@ -158,8 +163,8 @@ def test_device_on_a_sine_record_gives_the_harmonic_response():
     """
     fs, f0, amp = 1200.0, 6.0, 2.0
     t = np.arange(int(60 * fs) + 1) / fs
-    record = Measured(t, amp * np.sin(2 * np.pi * f0 * t))
-    r = rv.simulate_on_record(LINEAR, record, segments=6, burn_in=4.0, initial="rest")
+    record = Measured(rv.Record(time=t, base_acceleration=amp * np.sin(2 * np.pi * f0 * t)))
+    r = rv.monte_carlo_on_record(LINEAR, record, segments=6, burn_in=4.0, initial="rest")
     dt, w = 1 / fs, 2 * np.pi * f0
     block = mechanical_block(LINEAR.m, LINEAR.c, LINEAR.k)
     a, b = integrators.integrator("heun").linear_recursion(block.a, [[0.0], [1.0]], dt)
@@ -184,8 +189,8 @@ def test_device_on_a_long_gaussian_record_matches_the_spectral_integral():
     ex = BandLimited(1.0, 4.0, 20.0)
     dt = 2e-3
     x = ex.sample(2000.0, dt, 1, seed=9)[0]
-    record = Measured(np.arange(x.size) * dt, x)
-    r = rv.simulate_on_record(LINEAR, record, segments=20, burn_in=2.0, substeps=2)
+    record = Measured(rv.Record(time=np.arange(x.size) * dt, base_acceleration=x))
+    r = rv.monte_carlo_on_record(LINEAR, record, segments=20, burn_in=2.0, substeps=2)
     exact = output_variances(mechanical_block(LINEAR.m, LINEAR.c, LINEAR.k), ex)
     assert_matches(r.velocity_variance, exact["v"], detect=0.1, what="record E[v^2]")
     assert abs(r.lag1_correlation) < 0.6
@@ -201,6 +206,11 @@ def test_device_on_a_long_gaussian_record_matches_the_spectral_integral():
     ],
 )
 def test_record_simulation_bad_arguments(kwargs, fragment):
-    record = Measured(np.arange(4096) * 1e-3, np.random.default_rng(0).standard_normal(4096))
+    record = Measured(
+        rv.Record(
+            time=np.arange(4096) * 1e-3,
+            base_acceleration=np.random.default_rng(0).standard_normal(4096),
+        )
+    )
     with pytest.raises(ValueError, match=fragment):
-        rv.simulate_on_record(LINEAR, record, **kwargs)
+        rv.monte_carlo_on_record(LINEAR, record, **kwargs)

@@ -262,7 +262,12 @@ def test_result_tables_and_json():
         (
             dict(
                 event=rv.Enveloped(
-                    rv.Measured(np.arange(200) * 0.01, np.sin(np.arange(200))), rv.Step()
+                    rv.Measured(
+                        rv.Record(
+                            time=np.arange(200) * 0.01, base_acceleration=np.sin(np.arange(200))
+                        )
+                    ),
+                    rv.Step(),
                 )
             ),
             "measured record is one",

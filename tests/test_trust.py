@@ -443,12 +443,13 @@ def test_identify_unsimulable_fixed_values_refused_before_searching(
     def no_search(*args, **kwargs):
         raise AssertionError("the search ran")
 
-    monkeypatch.setattr("randvib.identification.fitting.sade", no_search)
+    monkeypatch.setattr("randvib.identification.identify.sade", no_search)
     one_line_error(capsys, _fit_args(record_csv[0], *extra), "nothing was searched")
 
 
 def test_identify_probe_refuses_nothing_a_search_can_fit(record_csv):
-    from randvib.identification.fitting import identify, read_record
+    from randvib.identification.identify import identify
+    from randvib.models.record import read_record
 
     fit = identify(read_record(record_csv[0]), "coulomb", m=0.0226, popsize=8, maxiter=2,
                    polish=False, fixed={"k3": 70742.0})  # fmt: skip
@@ -603,14 +604,14 @@ def test_identification_estimate_follows_the_measured_speed(
     """identify times its probes of the bounds and announces a long search at that speed."""
     import warnings
 
+    import randvib.identification.identify as driver
     from randvib._resources import LongRunWarning, duration_text
-    from randvib.identification import fitting
 
     monkeypatch.setattr(_resources, "clock", _probe_clock(probe_seconds))
     probed = []
-    points = fitting._probe_points
+    points = driver.probe_points
     monkeypatch.setattr(
-        fitting, "_probe_points", lambda space: probed.append(points(space)) or probed[-1]
+        driver, "probe_points", lambda space: probed.append(points(space)) or probed[-1]
     )
     record = rv.read_record(record_csv[0])
     settings = rv.SearchSettings(popsize=6, maxiter=1, polish=False)
@@ -745,7 +746,7 @@ def test_readme_sweep_example_has_the_main_guard():
 
 
 def test_unreadable_stored_fit_is_named_and_fitted_again(tmp_path, record_csv):
-    from randvib.identification.fitting import read_record
+    from randvib.models.record import read_record
     from randvib.studies.campaign import identify_cached
 
     path = tmp_path / "fit.json"

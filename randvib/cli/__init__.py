@@ -35,8 +35,8 @@ API_NAMES = {
     "--popsize": "SearchSettings.popsize (randvib.identify)",
     "--no-polish": "SearchSettings.polish=False (randvib.identify)",
     "--psd": "psd, or an excitation's level",
-    "--segments": "segments (randvib.simulate_on_record)",
-    "--dt (with --record)": "substeps = record step / dt (randvib.simulate_on_record)",
+    "--segments": "segments (randvib.monte_carlo_on_record)",
+    "--dt (with --record)": "substeps = record step / dt (randvib.monte_carlo_on_record)",
     "--model": "model (randvib.identify)",
     "--no-progress": "progress=False",
 }

@@ -5,14 +5,9 @@ from __future__ import annotations
 import argparse
 
 from randvib._validation import integer_option
-from randvib.identification.fitting import (
-    INITIAL_STATES,
-    OUTPUT_COLUMN,
-    TIME_COLUMN,
-    SimulationSettings,
-    read_record,
-)
-from randvib.identification.record_simulation import HOLDS, INPUT_KINDS
+from randvib.identification.input_reconstruction import HOLDS
+from randvib.identification.settings import INITIAL_STATES, SimulationSettings
+from randvib.models.record import INPUT_KINDS, OUTPUT_CHANNEL, TIME_COLUMN, read_record
 
 
 def add_record_arguments(parser: argparse.ArgumentParser) -> None:
@@ -24,7 +19,7 @@ def add_record_arguments(parser: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--output-column",
         metavar="NAME",
-        default=OUTPUT_COLUMN,
+        default=OUTPUT_CHANNEL,
         help="relative-displacement column",
     )
     g.add_argument(
@@ -134,7 +129,7 @@ def parse_bounds(items) -> dict:
 
 def output_unit(args) -> str:
     """The unit of the output column: m for the relative displacement, else the column's own."""
-    return "m" if args.output_column == OUTPUT_COLUMN else f"{args.output_column} units"
+    return "m" if args.output_column == OUTPUT_CHANNEL else f"{args.output_column} units"
 
 
 def plot_units(args) -> dict:
@@ -144,6 +139,6 @@ def plot_units(args) -> dict:
     as in the paper; a column the user named (``--output-column``) is shown
     as it is, in the record's own units.
     """
-    if args.output_column == OUTPUT_COLUMN:
+    if args.output_column == OUTPUT_CHANNEL:
         return dict(scale=1e3, unit="mm")
     return dict(scale=1.0, unit=output_unit(args))

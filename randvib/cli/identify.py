@@ -20,10 +20,12 @@ from randvib.cli._records import (
     record_from_args,
     simulation_settings,
 )
-from randvib.identification.fitting import MODELS, UNITS, SearchSettings, identify
+from randvib.identification.identify import identify
+from randvib.identification.models import MODELS, UNITS
+from randvib.identification.settings import SearchSettings
+from randvib.models.record import CHANNELS
 
 DEFAULT = SearchSettings()
-INPUT_UNITS = {"base_acceleration": "m/s^2", "base_displacement": "m", "force": "N"}
 
 
 def register(sub) -> None:
@@ -168,7 +170,7 @@ def print_report(result, record, output_unit: str = "m") -> None:
     relative displacement; a named ``--output-column`` keeps its own).
     """
     se, ci = result.standard_errors, result.confidence_intervals
-    units = {**UNITS, "output_offset": output_unit, "input_offset": INPUT_UNITS[record.input_kind]}
+    units = {**UNITS, "output_offset": output_unit, "input_offset": CHANNELS[record.input_kind][0]}
     rows = [
         [
             name,

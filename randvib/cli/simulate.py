@@ -7,7 +7,7 @@ White noise as before; ``--excitation band-pass|kanai-tajimi`` integrates the
 shaping filter with the device, ``band-limited`` and ``--psd-file`` are
 synthesised path by path (the options of :mod:`randvib.cli._excitation`,
 shared with ``randvib power``); ``--record FILE`` simulates the device on the
-record itself (:func:`randvib.simulate_on_record`), ``--segments`` windows
+record itself (:func:`randvib.monte_carlo_on_record`), ``--segments`` windows
 giving the interval.
 """
 
@@ -185,8 +185,8 @@ def run(args) -> int:
 
 
 def _on_record(harvester, record, args, burn_in):
-    """``--record``: :func:`randvib.simulate_on_record`, the options checked one line each."""
-    from randvib.montecarlo.on_record import simulate_on_record
+    """``--record``: :func:`randvib.monte_carlo_on_record`, the options checked one line each."""
+    from randvib.montecarlo.on_record import monte_carlo_on_record
 
     for flag in ("paths", "t_end"):
         if getattr(args, flag) is not None:
@@ -207,7 +207,7 @@ def _on_record(harvester, record, args, burn_in):
                 f"(record step / dt an integer), got {args.dt!r}"
             )
     try:
-        return simulate_on_record(
+        return monte_carlo_on_record(
             harvester,
             record,
             segments=10 if args.segments is None else args.segments,

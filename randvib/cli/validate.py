@@ -4,9 +4,8 @@ from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
 
-from randvib._io import check_output_folder, dumps
+from randvib._io import check_output_folder, dumps, existing_file
 from randvib.cli._output import print_table
 from randvib.cli._records import (
     add_record_arguments,
@@ -15,7 +14,9 @@ from randvib.cli._records import (
     record_from_args,
     simulation_settings,
 )
-from randvib.identification.fitting import MODELS, SimulationSettings, check_parameter, validate
+from randvib.identification.models import MODELS, check_parameter, device_from_parameters
+from randvib.identification.prediction import validate
+from randvib.identification.settings import SimulationSettings
 
 SIMULATION_FIELDS = tuple(SimulationSettings().to_dict())
 
@@ -46,11 +47,7 @@ def register(sub) -> None:
 
 
 def _load_parameters(path):
-    path = Path(path)
-    if path.is_dir():
-        raise IsADirectoryError(f"parameter file {str(path)!r} is a folder; give a JSON file")
-    if not path.is_file():
-        raise FileNotFoundError(f"parameter file {str(path)!r} does not exist")
+    path = existing_file(path, "parameter file", "JSON")
     try:
         data = json.loads(path.read_text())
         model = data["model"]
@@ -91,6 +88,7 @@ def run(args) -> int:
         except ValueError as exc:
             raise ValueError(f"{str(args.params)!r}: {exc}") from None
     parameters.update(_overrides(args.set, model))
+    harvester, measurement = device_from_parameters(model, parameters)
     settings = _settings(args, saved, args.params)
     plot_dir = None
     if args.plot is not None:
@@ -101,13 +99,13 @@ def run(args) -> int:
             )
         plot_dir.mkdir(parents=True, exist_ok=True)
     records = [record_from_args(path, args) for path in args.data]
-    rows = validate(parameters, model, records, simulation=settings)
+    rows = validate(harvester, records, measurement=measurement, simulation=settings)
     if plot_dir is not None:
-        from randvib.identification.fitting import predict_record
         from randvib.identification.plots import figure_fit
+        from randvib.identification.prediction import predict_record
 
         for i, record in enumerate(records):
-            pred = predict_record(parameters, model, record, simulation=settings)
+            pred = predict_record(harvester, record, measurement=measurement, simulation=settings)
             path = plot_dir / f"{i:02d}_{record.name}.png"
             figure_fit(pred, path, title=f"{model} model on {record.name}", **plot_units(args))
     if args.json:

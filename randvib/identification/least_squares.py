@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from randvib.identification.record_simulation import SEARCH_SUBCYCLES, parameter_matrix
+from randvib.identification.record_integrator import SEARCH_SUBCYCLES, parameter_matrix
 
 #: Names of the initial-state coordinates in the least-squares vector.
 INITIAL_STATE = ("z0", "v0")

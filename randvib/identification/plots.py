@@ -1,6 +1,6 @@
 """Figures for identification results (paper Figures 7 and 8).
 
-Numbers come from :mod:`randvib.identification.fitting` (``Prediction`` objects and
+Numbers come from :mod:`randvib.identification.prediction` (``Prediction`` objects and
 cost tables); these functions only draw them, in the shared style of
 :mod:`randvib.figure_style` (constrained layout, panel letters, the Okabe-Ito
 palette, units in mathtext). Each returns the figure; given ``path`` it also
@@ -39,7 +39,7 @@ def plot_time_history(prediction, ax=None, *, window=None, scale=1.0, unit="m"):
 
     Parameters
     ----------
-    prediction : randvib.identification.fitting.Prediction
+    prediction : randvib.identification.prediction.Prediction
     ax : matplotlib Axes, optional
         Drawn into a new styled figure when not given.
     window : (t0, t1), optional

@@ -2,8 +2,8 @@
 
 One call, :func:`synthetic_record`, replaces the four steps a user needed
 before (realise the excitation, pick the input channel, simulate the device
-with :func:`~randvib.identification.record_simulation.simulate_record`,
-wrap a :class:`~randvib.identification.fitting.Record`) and adds what a real
+with :func:`~randvib.identification.record_response.record_response`,
+wrap a :class:`~randvib.models.record.Record`) and adds what a real
 measurement adds: Gaussian sensor noise and constant offsets on each channel.
 An offset is what the sensor adds: measured value = true value + offset.
 
@@ -28,11 +28,11 @@ from randvib._validation import (
     check_positive,
     check_scalar_device,
 )
-from randvib.identification.fitting import Record
-from randvib.identification.record_simulation import simulate_record
-from randvib.models.excitation import BaseExcitation, Excitation, band_limited_excitation
+from randvib.identification.record_response import record_response
+from randvib.models.excitation import BaseMotionOverflow, Excitation, band_limited_excitation
 from randvib.models.harvester import Harvester
 from randvib.models.presets import PRESETS, preset
+from randvib.models.record import Record
 
 #: The input channels a synthetic record can carry (the shaker's sensors).
 SYNTHETIC_INPUTS = ("base_acceleration", "base_displacement")
@@ -59,7 +59,7 @@ def synthetic_record(
     """Simulate a device under a band-limited base excitation and record it as sensors would.
 
     The true relative displacement is
-    ``simulate_record(device, true_input, 1/sample_rate, input_kind=input,
+    ``record_response(device, Record(1 / sample_rate, **{input: true_input}),
     substeps=substeps).z`` (Eq. 1 from rest), so a noise-free record without
     offsets is exactly that simulation; the record then holds
     ``true + offset + noise`` on each channel.
@@ -68,13 +68,15 @@ def synthetic_record(
     ----------
     device : Harvester or str
         The device (any friction law) or a preset name (:data:`PRESETS`).
-    excitation : float, Excitation or BaseExcitation
+    excitation : float, Excitation or Record
         A number is the RMS base acceleration (m/s^2), > 0, of a flat band
         over :data:`PAPER_BAND` scaled exactly to it (paper Table 1: 1.07,
         1.21, ... m/s^2); an :class:`~randvib.models.excitation.Excitation`
         with ``sample()`` (e.g. ``BandLimited(S, f_lo, f_hi)``) is realised
-        by frequency-domain synthesis; a ``BaseExcitation`` is used as is
-        (its sample rate and length must match).
+        by frequency-domain synthesis; a :class:`~randvib.models.record.Record`
+        of base motion (:func:`~randvib.models.excitation.band_limited_excitation`)
+        is used as is (its sample interval and length must match, and it
+        must hold the ``input`` channel).
     duration : float
         Record length (s), > 0.
     sample_rate : float
@@ -132,14 +134,17 @@ def synthetic_record(
     substeps = check_int("substeps", substeps, minimum=1)
     excitation_rng, noise_rng = np.random.default_rng(seed).spawn(2)
     with np.errstate(all="ignore"):
-        true_input = _true_input(excitation, input, duration, sample_rate, band, excitation_rng)
-    if not np.all(np.isfinite(true_input)):
+        try:
+            true_input = _true_input(excitation, input, duration, sample_rate, band, excitation_rng)
+        except BaseMotionOverflow:  # the RMS's velocity or displacement overflows
+            true_input = None
+    if true_input is None or not np.all(np.isfinite(true_input)):
         raise ValueError(
             f"`excitation` {_excitation_text(excitation)} overflows float64 in the {input} "
             "signal; lower it (`--rms` / `--psd`)"
         )
     dt = 1.0 / sample_rate
-    z = simulate_record(device, true_input, dt, input_kind=input, substeps=substeps).z[0]
+    z = record_response(device, Record(dt, **{input: true_input}), substeps=substeps).z[0]
     if not np.all(np.isfinite(z)):
         raise ValueError(
             f"the simulated response to `excitation` {_excitation_text(excitation)} diverged; "
@@ -148,19 +153,17 @@ def synthetic_record(
     # Independent draws per channel, always drawn so that one channel's noise
     # does not depend on whether the other has any.
     eps_input, eps_z = noise_rng.standard_normal((2, z.size))
-    return Record(
-        dt,
-        input,
-        true_input + sensor["offset_input"] + sensor["noise_input"] * eps_input,
-        z + sensor["offset_z"] + sensor["noise_z"] * eps_z,
-        name,
-    )
+    measured = {
+        input: true_input + sensor["offset_input"] + sensor["noise_input"] * eps_input,
+        "relative_displacement": z + sensor["offset_z"] + sensor["noise_z"] * eps_z,
+    }
+    return Record(dt, name=name, **measured)
 
 
 def _excitation_text(excitation) -> str:
     if isinstance(excitation, Real):
         return f"{excitation!r} m/s^2 RMS"
-    return repr(excitation) if not isinstance(excitation, BaseExcitation) else "(given signal)"
+    return repr(excitation) if not isinstance(excitation, Record) else "(given signal)"
 
 
 def _device(device) -> Harvester:
@@ -179,12 +182,17 @@ def _device(device) -> Harvester:
 
 def _true_input(excitation, kind, duration, sample_rate, band, rng) -> np.ndarray:
     """The true input channel ``kind`` of one realisation on the record's grid."""
-    if isinstance(excitation, BaseExcitation):
+    if isinstance(excitation, Record):
         n = round(duration * sample_rate)
-        if excitation.fs != sample_rate or excitation.time.size != n:
+        if excitation.dt != 1.0 / sample_rate or excitation.n != n:
             raise ValueError(
-                f"`excitation` is sampled at {excitation.fs} Hz with {excitation.time.size} "
+                f"`excitation` is sampled at {excitation.sample_rate} Hz with {excitation.n} "
                 f"samples; the record needs {sample_rate} Hz and {n}"
+            )
+        if kind not in excitation:
+            raise ValueError(
+                f"`excitation` {excitation.name!r} has no {kind} channel for `input` {kind!r}; "
+                f"it has {', '.join(excitation.channels)}"
             )
         base = excitation
     elif isinstance(excitation, Real) and not isinstance(excitation, bool):
@@ -198,9 +206,9 @@ def _true_input(excitation, kind, duration, sample_rate, band, rng) -> np.ndarra
     else:
         raise ValueError(
             "`excitation` must be an RMS (m/s^2), an Excitation such as BandLimited(S, f_lo, "
-            f"f_hi) or a BaseExcitation; got {type(excitation).__name__}"
+            f"f_hi) or a Record of base motion; got {type(excitation).__name__}"
         )
-    return base.acceleration if kind == "base_acceleration" else base.displacement
+    return base[kind]
 
 
 def _displacement(acceleration, sample_rate, excitation) -> np.ndarray:

@@ -24,18 +24,24 @@ Defining a subclass with its own ``name`` registers it in
 :data:`EXCITATIONS`. :func:`as_excitation` turns a plain number into white
 noise, so a ``psd`` argument can take either.
 
-**Synthetic shaker campaigns.** The paper's experiments (Sec. 3) drove the shaker under displacement control
-so that the base *acceleration* had a flat power spectral density between
-4 and 20 Hz; the model was then driven by the recorded *displacement*.
-:func:`band_limited_excitation` makes both signals from one realisation: a Gaussian acceleration with
-a flat one-sided PSD on ``[f_lo, f_hi]`` and the displacement (and velocity)
-a shaker table would follow to produce it.
+**Synthetic shaker campaigns.** The paper's experiments (Sec. 3) drove the
+shaker under displacement control so that the base *acceleration* had a flat
+power spectral density between 4 and 20 Hz; the model was then driven by the
+recorded *displacement*. :func:`band_limited_excitation` makes both signals
+from one realisation, as a :class:`~randvib.models.record.Record` of the base
+motion: a Gaussian acceleration with a flat one-sided PSD on
+``[f_lo, f_hi]`` and the displacement (and velocity) a shaker table would
+follow to produce it.
 
 The signal is synthesised in the frequency domain (white Gaussian noise,
 band-pass by zeroing FFT bins), so it is exactly band-limited and periodic
 with the record length; displacement and velocity are its exact spectral
 integrals ``Y = -A / omega^2``, ``V = A / (i omega)``, which exist because
 the band excludes zero frequency.
+
+**Measured records.** :class:`Measured` is the excitation of a measured base
+acceleration: a :class:`~randvib.models.record.Record` with a
+``base_acceleration`` channel and its Welch PSD.
 """
 
 from __future__ import annotations
@@ -46,59 +52,17 @@ import numpy as np
 from scipy import signal
 
 from randvib._validation import (
-    check_finite,
     check_int,
     check_nonnegative,
     check_positive,
     check_scalar,
 )
+from randvib.models.record import Record, read_csv, read_record
 from randvib.models.state_space import StateSpace
 
 
-@dataclass(frozen=True, eq=False)
-class BaseExcitation:
-    """One realisation of band-limited base motion on a uniform grid.
-
-    Attributes
-    ----------
-    time : ndarray
-        Sample times (s), starting at 0.
-    acceleration, velocity, displacement : ndarray
-        Base acceleration y'' (m/s^2), velocity y' (m/s) and displacement y (m).
-    fs : float
-        Sample rate (Hz).
-    f_lo, f_hi : float
-        Band edges (Hz).
-    rms : float
-        RMS of the acceleration (m/s^2), exact for this realisation.
-    """
-
-    time: np.ndarray
-    acceleration: np.ndarray
-    velocity: np.ndarray
-    displacement: np.ndarray
-    fs: float
-    f_lo: float
-    f_hi: float
-    rms: float
-
-    @property
-    def psd(self) -> float:
-        """Nominal one-sided PSD height S = rms^2 / (f_hi - f_lo) ((m/s^2)^2/Hz)."""
-        return self.rms**2 / (self.f_hi - self.f_lo)
-
-    def to_frame(self):
-        """The signals as a :class:`pandas.DataFrame` with CSV-ready column names."""
-        import pandas as pd
-
-        return pd.DataFrame(
-            {
-                "time": self.time,
-                "base_acceleration": self.acceleration,
-                "base_velocity": self.velocity,
-                "base_displacement": self.displacement,
-            }
-        )
+class BaseMotionOverflow(ValueError):
+    """The base motion of an RMS beyond float64 (:func:`band_limited_excitation`, rms = 1e308)."""
 
 
 def band_limited_excitation(
@@ -109,7 +73,7 @@ def band_limited_excitation(
     f_hi: float = 20.0,
     *,
     seed=None,
-) -> BaseExcitation:
+) -> Record:
     """Gaussian base acceleration with a flat one-sided PSD between two frequencies.
 
     Parameters
@@ -127,10 +91,13 @@ def band_limited_excitation(
 
     Returns
     -------
-    BaseExcitation
-        Acceleration scaled to exactly ``rms``, with the velocity and
-        displacement a shaker would follow (exact spectral integrals; the
-        record is periodic, so the motion has no drift).
+    Record
+        The base motion on the grid ``i / fs``: the channels
+        ``base_acceleration`` (m/s^2), scaled to exactly ``rms``, and the
+        ``base_velocity`` (m/s) and ``base_displacement`` (m) a shaker would
+        follow (exact spectral integrals; the record is periodic, so the
+        motion has no drift). The nominal one-sided PSD height is
+        ``rms^2 / (f_hi - f_lo)``.
 
     Raises
     ------
@@ -167,15 +134,16 @@ def band_limited_excitation(
     acceleration = np.fft.irfft(spectrum, n)
     velocity = np.fft.irfft(np.where(band, spectrum / (1j * safe), 0.0), n)
     displacement = np.fft.irfft(np.where(band, -spectrum / safe**2, 0.0), n)
-    return BaseExcitation(
-        time=np.arange(n) / fs,
-        acceleration=acceleration,
-        velocity=velocity,
-        displacement=displacement,
-        fs=fs,
-        f_lo=f_lo,
-        f_hi=f_hi,
-        rms=rms,
+    if not all(np.all(np.isfinite(x)) for x in (acceleration, velocity, displacement)):
+        raise BaseMotionOverflow(
+            f"`rms` = {rms!r} m/s^2 overflows float64 in the base motion; lower it"
+        )
+    return Record(
+        1.0 / fs,
+        base_acceleration=acceleration,
+        base_velocity=velocity,
+        base_displacement=displacement,
+        name=f"band-limited {f_lo:g}-{f_hi:g} Hz, {rms:g} m/s^2 RMS",
     )
 
 
@@ -656,79 +624,94 @@ class Measured(Excitation):
     overlap, each segment's mean removed, ``segment_length`` samples per
     segment (default :func:`welch_segment_length`: the largest power of
     two <= n/8, 15 to 31 segments), linearly interpolated between its
-    frequency bins (:class:`Tabulated`). The record itself is kept
-    (``time``, ``acceleration``) for simulations driven by it; ``sample``
-    synthesises Gaussian surrogates with the estimated PSD.
+    frequency bins (:class:`Tabulated`). The record itself is kept for
+    simulations driven by it (:func:`randvib.monte_carlo_on_record`);
+    ``sample`` synthesises Gaussian surrogates with the estimated PSD.
 
     Parameters
     ----------
-    time : array_like
-        Sample times (s), evenly spaced (each within 1 % of a step of the
-        uniform grid), at least 64 samples.
-    acceleration : array_like
-        Base acceleration (m/s^2), finite.
+    record : Record
+        A record with a ``base_acceleration`` channel (m/s^2) and at least
+        64 samples (its time grid is checked by :class:`~randvib.models.record.Record`).
     segment_length : int, optional
         Welch segment length (samples), 16 <= L <= n.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import randvib as rv
+    >>> t = np.arange(4096) * 1e-3
+    >>> acceleration = np.random.default_rng(0).standard_normal(t.size)
+    >>> rv.Measured(rv.Record(time=t, base_acceleration=acceleration)).segment_length
+    512
     """
 
-    time: np.ndarray
-    acceleration: np.ndarray
+    record: Record
     segment_length: int | None = None
     name = "measured"
 
     def __post_init__(self):
-        t = check_finite("time", self.time)
-        a = check_finite("base_acceleration", self.acceleration)
-        if t.ndim != 1 or a.shape != t.shape or t.size < 64:
+        record = self.record
+        if not isinstance(record, Record):
             raise ValueError(
-                "`time` and `base_acceleration` must be 1-D of the same length >= 64, got "
-                f"shapes {t.shape} and {a.shape}"
+                "`record` must be a randvib.Record with a base_acceleration channel, got "
+                f"{type(record).__name__}"
             )
-        dt = (t[-1] - t[0]) / (t.size - 1)
-        if not dt > 0:
-            raise ValueError(f"`time` must increase, got {float(t[0])!r} s to {float(t[-1])!r} s")
-        off = np.abs(t - (t[0] + dt * np.arange(t.size)))
-        if np.max(off) > 0.01 * dt:
-            i = int(np.argmax(off))
+        if "base_acceleration" not in record:
             raise ValueError(
-                f"`time` must be evenly spaced: sample {i} is at {float(t[i])!r} s, {off[i]:.3g} s "
-                f"off the uniform grid of step {dt:.6g} s (allowed: 1 % of a step)"
+                f"`record` {record.name!r} has no base_acceleration channel (it has "
+                f"{', '.join(record.channels)}); a measured excitation is a base acceleration"
             )
+        if record.n < 64:
+            raise ValueError(f"`record` must have at least 64 samples, got {record.n}")
         length = (
-            welch_segment_length(t.size) if self.segment_length is None else self.segment_length
+            welch_segment_length(record.n) if self.segment_length is None else self.segment_length
         )
         length = check_int("segment_length", length, minimum=16)
-        if length > t.size:
+        if length > record.n:
             raise ValueError(
-                f"`segment_length` must be <= the record's {t.size} samples, got {length}"
+                f"`segment_length` must be <= the record's {record.n} samples, got {length}"
             )
-        f, p = signal.welch(a, fs=1.0 / dt, window="hann", nperseg=length, noverlap=length // 2)
-        object.__setattr__(self, "time", t)
-        object.__setattr__(self, "acceleration", a)
+        f, p = signal.welch(
+            self.acceleration, fs=1.0 / record.dt, window="hann", nperseg=length,
+            noverlap=length // 2,
+        )  # fmt: skip
         object.__setattr__(self, "segment_length", length)
         object.__setattr__(self, "spectrum", Tabulated(f, p))
 
     def scaled(self, factor: float) -> Measured:
         """The record's acceleration times sqrt(factor): its PSD times ``factor``."""
         factor = float(check_positive("factor", factor))
-        return Measured(self.time, self.acceleration * np.sqrt(factor), self.segment_length)
+        scaled = Record(time=self.time, base_acceleration=self.acceleration * np.sqrt(factor))
+        return Measured(scaled, self.segment_length)
 
     @classmethod
     def from_csv(cls, path, segment_length: int | None = None) -> Measured:
         """Read a record with the columns ``time`` (s) and ``base_acceleration`` (m/s^2)."""
-        frame = read_columns(path, ("time", "base_acceleration"))
-        return cls(frame["time"], frame["base_acceleration"], segment_length)
+        return cls(
+            read_record(path, input_kind="base_acceleration", output_column=None), segment_length
+        )
+
+    @property
+    def time(self) -> np.ndarray:
+        """Sample times (s)."""
+        return self.record.time
+
+    @property
+    def acceleration(self) -> np.ndarray:
+        """The measured base acceleration (m/s^2)."""
+        return self.record["base_acceleration"]
 
     @property
     def dt(self) -> float:
         """Sample step (s)."""
-        return float((self.time[-1] - self.time[0]) / (self.time.size - 1))
+        return self.record.dt
 
     @property
     def n_segments(self) -> int:
         """Number of Welch segments averaged (50 % overlap)."""
         step = self.segment_length - self.segment_length // 2
-        return (self.time.size - self.segment_length) // step + 1
+        return (self.record.n - self.segment_length) // step + 1
 
     def psd(self, frequency):
         return self.spectrum.psd(frequency)
@@ -748,28 +731,31 @@ class Measured(Excitation):
     def breakpoints(self):
         return self.spectrum.breakpoints()
 
+    @property
+    def duration(self) -> float:
+        """Length of the record (s): n steps."""
+        return float(self.time[-1] - self.time[0] + self.dt)
+
     def parameters(self) -> dict:
         return {
             "excitation": self.name,
-            "duration": float(self.time[-1] - self.time[0] + self.dt),
+            "duration": self.duration,
             "dt": self.dt,
             "segment_length": self.segment_length,
             "variance": self.variance,
         }
 
     def __repr__(self) -> str:  # the record's size, not its samples
-        duration = float(self.time[-1] - self.time[0] + self.dt)
         return (
-            f"Measured({self.time.size} samples at {1.0 / self.dt:.6g} Hz, {duration:.6g} s, "
+            f"Measured({self.record.n} samples at {1.0 / self.dt:.6g} Hz, {self.duration:.6g} s, "
             f"variance {self.variance:.4g} (m/s^2)^2)"
         )
 
 
 def read_columns(path, columns) -> dict:
-    """The named ``columns`` of a CSV file as float arrays; a missing one is named."""
-    import pandas as pd
-
-    frame = pd.read_csv(path)
+    """The named ``columns`` of a CSV file (:func:`~randvib.models.record.read_csv`) as floats;
+    a missing one is named."""
+    frame = read_csv(path, "file")
     missing = [c for c in columns if c not in frame.columns]
     if missing:
         raise ValueError(

@@ -15,7 +15,7 @@ It declares everything the rest of randvib needs:
   numba-compilable function of the kernel parameter vector ``p`` (the fields
   in declaration order) used by the Monte Carlo engine
   (:mod:`randvib.montecarlo.kernel`) and the record simulator
-  (:mod:`randvib.identification.record_simulation`). The built-in laws also carry a
+  (:mod:`randvib.identification.record_integrator`). The built-in laws also carry a
   ``kernel_code`` so that the compiled loops inline their force (see
   :func:`evaluate_friction`); any other law is compiled on first use into a
   C callback (``numba.cfunc``) that the same cached loops call through a

@@ -17,7 +17,7 @@ amplitude. Two sources provide those increments, path by path:
   batches bound the memory;
 * :class:`RecordedInput` - a measured record, linearly interpolated between
   its samples, cut into segments that become the paths of
-  :func:`randvib.montecarlo.on_record.simulate_on_record`.
+  :func:`randvib.montecarlo.on_record.monte_carlo_on_record`.
 """
 
 from __future__ import annotations

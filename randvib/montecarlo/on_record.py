@@ -1,10 +1,15 @@
-"""The device simulated on a measured base-acceleration record: ``simulate_on_record``.
+"""Monte Carlo on a measured base-acceleration record: ``monte_carlo_on_record``.
 
-A user's accelerometer record (:class:`randvib.Measured`, CSV columns
-``time``, ``base_acceleration``) is the input itself, not a spectrum to
-draw from: the device is integrated on the record (linearly interpolated
-between samples, each device step taking the exact integral of that line,
-:class:`randvib.montecarlo.driven.RecordedInput`).
+A user's accelerometer record (:class:`randvib.Measured`, built from a
+:class:`randvib.Record` with a ``base_acceleration`` channel, or read from
+CSV columns ``time``, ``base_acceleration``) is the input itself, not a
+spectrum to draw from: the stochastic simulation of :func:`randvib.simulate`
+(its schemes, friction laws, circuits and step check) is driven by the record
+(linearly interpolated between samples, each device step taking the exact
+integral of that line, :class:`randvib.montecarlo.driven.RecordedInput`), and
+its segments are the paths of a confidence interval. The deterministic
+response to a record's input, for identification, is
+:func:`randvib.record_response`.
 
 **Confidence interval: segments as paths (batch means).** One record is one
 realisation, so there are no independent paths. The record after a first
@@ -40,7 +45,7 @@ from randvib.montecarlo.simulation import execute
 from randvib.montecarlo.validation import validated
 
 
-def simulate_on_record(
+def monte_carlo_on_record(
     harvester: Harvester,
     record: Measured,
     *,
@@ -56,15 +61,16 @@ def simulate_on_record(
     progress: bool | None = None,
     check_step: bool = True,
 ) -> SimulationResult:
-    """Simulate the harvester driven by a measured record; CI from segments.
+    """Monte Carlo of the harvester driven by a measured record; CI from segments.
 
     Parameters
     ----------
     harvester : Harvester
         Device with scalar parameters; any friction law.
     record : Measured
-        The record (evenly spaced time, finite acceleration; checked by
-        :class:`randvib.Measured`). Its mean is removed: a constant base
+        The measured base acceleration (``rv.Measured(record)`` of a
+        :class:`randvib.Record`, or ``rv.Measured.from_csv(path)``). Its mean
+        is removed: a constant base
         acceleration cannot persist, and an offset is the sensor's.
     segments : int
         Number K of windows (paths), >= 2; see the module docstring.
@@ -86,7 +92,10 @@ def simulate_on_record(
         ``psd`` None; ``t_end`` and ``burn_in`` those of each path.
     """
     if not isinstance(record, Measured):
-        raise ValueError(f"`record` must be a randvib.Measured, got {type(record).__name__}")
+        raise ValueError(
+            "`record` must be a randvib.Measured (rv.Measured(record) of a Record with a "
+            f"base_acceleration channel), got {type(record).__name__}"
+        )
     segments = check_int("segments", segments, 2)
     substeps = check_int("substeps", substeps, 1)
     burn_in = float(np.asarray(burn_in, dtype=float))
@@ -124,7 +133,7 @@ def simulate_on_record(
 # repr=False: keep SimulationResult's compact repr (a generated one would print the record's arrays)
 @dataclasses.dataclass(frozen=True, repr=False)
 class RecordSimulation(SimulationResult):
-    """:class:`SimulationResult` of :func:`simulate_on_record`: paths are successive windows."""
+    """:class:`SimulationResult` of :func:`monte_carlo_on_record`: paths are successive windows."""
 
     @property
     def lag1_correlation(self) -> float:

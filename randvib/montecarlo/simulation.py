@@ -115,7 +115,7 @@ def simulate(
         stationary Gaussian synthesis per path (:mod:`randvib.montecarlo.driven`:
         path i's input from the stream (seed, i), the kernel taking its exact
         step integrals; batches bound the memory). ``Measured`` is refused:
-        simulate on the record with :func:`randvib.simulate_on_record`.
+        simulate on the record with :func:`randvib.monte_carlo_on_record`.
         Under coloured input the companion and the control variates
         (white-noise energy balance) are refused, and the step check covers
         the filter too.
@@ -215,7 +215,7 @@ def simulate(
 def execute(run: Run, *, control_variates, check_step, threads, batch_paths, progress):
     """Run a validated :class:`~randvib.montecarlo.validation.Run`: check, set up, run, wrap.
 
-    The options are :func:`simulate`'s; :func:`randvib.simulate_on_record`
+    The options are :func:`simulate`'s; :func:`randvib.monte_carlo_on_record`
     calls this with its own run (the record as the input).
     """
     check_options(run, control_variates)

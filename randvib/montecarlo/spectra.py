@@ -81,7 +81,7 @@ def response_spectra(result, segment_duration: float | None = None) -> SampledSp
     Parameters
     ----------
     result : SimulationResult
-        From :func:`randvib.simulate` (or :func:`randvib.simulate_on_record`)
+        From :func:`randvib.simulate` (or :func:`randvib.monte_carlo_on_record`)
         with ``record_paths >= 2``; ``record_every`` sets the sample step
         (keep its Nyquist frequency well above the response's band).
     segment_duration : float, optional

@@ -118,7 +118,7 @@ def _simulated_excitation(psd) -> Excitation:
     (band-pass, Kanai-Tajimi) are integrated with the device; band-limited
     and tabulated spectra are synthesised (:class:`~randvib.montecarlo.driven.SynthesisedInput`);
     a measured record is simulated on the record itself by
-    :func:`randvib.simulate_on_record`.
+    :func:`randvib.monte_carlo_on_record`.
     """
     if not isinstance(psd, Excitation):
         return as_excitation(psd)  # one positive number (an array refused by name)
@@ -127,7 +127,7 @@ def _simulated_excitation(psd) -> Excitation:
     if psd.name == "measured":
         raise ValueError(
             "simulate draws its own paths; to simulate the device on the measured record "
-            "itself use randvib.simulate_on_record(harvester, record, ...), for Gaussian "
+            "itself use randvib.monte_carlo_on_record(harvester, record, ...), for Gaussian "
             "paths with the record's Welch PSD pass record.spectrum"
         )
     shaping = psd.shaping_filter()

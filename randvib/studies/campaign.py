@@ -19,9 +19,12 @@ import numpy as np
 import pandas as pd
 
 from randvib._io import atomic_write_text, dumps
-from randvib.identification.fitting import MODEL_PARAMETERS, IdentificationResult, Record, identify
-from randvib.identification.record_simulation import simulate_record
+from randvib.identification.identify import identify
+from randvib.identification.models import MODEL_PARAMETERS, device_from_parameters
+from randvib.identification.record_response import record_response
+from randvib.identification.result import IdentificationResult
 from randvib.models.excitation import band_limited_excitation
+from randvib.models.record import Record
 
 #: Every parameter name of the paper's four models, in Table 2's order.
 PARAMETER_ORDER = ("c", "k", "k3", "fc", "beta", "sigma0", "sigma1", "fs", "vs")
@@ -52,11 +55,9 @@ def synthetic_record(
     """
     n_warm = int(round(warmup * fs))
     ex = band_limited_excitation(duration + warmup, fs, rms, seed=rng)
-    truth = dict(truth)
-    if electrical is not None:
-        truth["c"] = truth["c"] + electrical.electrical_damping
-    sim = simulate_record(truth, "coulomb", ex.acceleration, 1 / fs, substeps=8)
-    y = ex.displacement[n_warm:]
+    device, _ = device_from_parameters("coulomb", truth, electrical)
+    sim = record_response(device, ex, input_kind="base_acceleration", substeps=8)
+    y = ex["base_displacement"][n_warm:]
     z = sim.z[0, n_warm:]
     v = sim.v[0, n_warm:]
     voltage = None
@@ -67,7 +68,10 @@ def synthetic_record(
         voltage = electrical.alpha * v * electrical.load_fraction
         if noise is not None:
             voltage = voltage + noise[2] * rng.standard_normal(v.size)
-    return Record(1 / fs, "base_displacement", y, z, name, voltage), v
+    record = Record(
+        1 / fs, base_displacement=y, relative_displacement=z, voltage=voltage, name=name
+    )
+    return record, v
 
 
 def load_fit(path: Path) -> IdentificationResult:

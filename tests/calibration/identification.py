@@ -17,7 +17,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import _identification as H  # noqa: E402
 import test_identification as T  # noqa: E402
 
-from randvib.identification.fitting import identify  # noqa: E402
+from randvib.identification.identify import identify  # noqa: E402
 
 
 def noise_study(n):
@@ -39,8 +39,9 @@ def optimiser_study(seeds):
     tanh = dict(H.COULOMB, beta=100.0)
     ex = H.excitation(0, 1.5, 500.0)
     y, acc = H.tapered(ex)
-    z = H.simulate_record(tanh, "tanh", acc, 1 / ex.fs, substeps=8, z0=T.Z0, v0=T.V0).z[0]
-    trec = H.Record(1 / ex.fs, "base_displacement", y, z, "tanh")
+    motion = H.Record(ex.dt, base_acceleration=acc)
+    z = H.record_response(H.harvester(tanh, "tanh"), motion, substeps=8, z0=T.Z0, v0=T.V0).z[0]
+    trec = H.Record(ex.dt, name="tanh", base_displacement=y, relative_displacement=z)
     cases = {
         "coulomb": (coul, H.COULOMB, "coulomb", H.FREE, dict(popsize=30, maxiter=80)),
         "lugre": (lugre, T.LUGRE, "lugre", H.FREE, dict(popsize=16, maxiter=40, fixed=held)),

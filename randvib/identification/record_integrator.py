@@ -1,28 +1,14 @@
-"""Deterministic simulation of the device driven by a recorded input (paper Eq. 1).
+"""Eq. 1 integrated on a recorded input: the compiled batch integrator.
 
-    m z'' + c z' + k z + k3 z^3 + F(z', theta) = e(t)
+    m z'' + c z' + k z + k2 z^2 + k3 z^3 + F(z', theta) = e(t)
 
 with ``e(t) = -m y''(t)`` for base excitation and ``e(t) = u(t)`` for a force
-applied to the mass. The input is sampled on a uniform grid ``t_i = i dt``;
-between samples it is reconstructed (:func:`reconstruct_input`: linear by
-default; cubic spline or band-limited (sinc) interpolation for records
-sampled not far above their bandwidth; a zero-order hold), and each sample
-interval is split into ``substeps`` equal steps. Each sub-step reads the
-reconstruction at its start, middle and end (RK4's stages) and uses the
-quadratic through them in between.
-
-The restoring force may have a quadratic term, ``k z + k2 z^2 + k3 z^3``,
-and the input channel a constant offset (the kernel is driven by
-``input - input_offset``); a constant output offset is added to z where it is
-scored (measured = true + offset).
-
-A recorded base displacement is turned into base acceleration by the
-fourth-order central difference
-``y''_i = (-y_{i-2} + 16 y_{i-1} - 30 y_i + 16 y_{i+1} - y_{i+2}) / (12 dt^2)``
-(relative error (omega dt)^4 / 90, 2e-7 at 20 Hz and 1 kHz), with the
-second-order stencil next to the ends. Differentiation amplifies sensor noise
-at high frequency; ``lowpass`` applies a zero-phase Butterworth filter to the
-derived acceleration.
+applied to the mass, the input less its channel's offset (measured = true +
+offset; :mod:`randvib.identification.input_reconstruction` gives the input
+between samples). Each sample interval is split into ``substeps`` equal
+steps; each sub-step reads the reconstruction at its start, middle and end
+(RK4's stages) and uses the quadratic through them in between. A constant
+output offset is added to z where it is scored.
 
 Integration (one compiled kernel, ``parallel=True`` over a population of
 parameter sets):
@@ -72,12 +58,12 @@ becomes non-finite is stopped and gets an infinite cost / NaN samples.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numba
 import numpy as np
 
-from randvib._validation import check_finite, check_int, check_positive
+from randvib._validation import check_finite
+from randvib.identification.input_reconstruction import HOLDS, reconstruct_input
 from randvib.models.friction import (
     FRICTION_MODELS,
     KERNEL_NONE,
@@ -90,33 +76,49 @@ from randvib.models.friction import (
     evaluate_friction,
     kernel_callback,
 )
-from randvib.models.harvester import Harvester
 
-#: Input kinds a record may carry, and what the kernel is driven by.
-INPUT_KINDS = ("base_displacement", "base_acceleration", "force")
 #: Friction law name -> kernel code (``none`` = viscous only); a live view of
 #: the registry :data:`randvib.models.friction.FRICTION_MODELS`.
 FRICTION_KINDS = RegistryView(lambda law: KERNEL_NONE if law is None else law.kernel_code)
+
+
 #: Friction law name -> parameter names in kernel order (live view, as above).
 FRICTION_PARAMETERS = RegistryView(lambda law: () if law is None else law.parameter_names())
+
+
 #: Device parameters shared by every model.
 DEVICE_PARAMETERS = ("m", "c", "k", "k3")
+
+
 #: Measurement-model and extra stiffness parameters every model may take
 #: (default 0): quadratic stiffness k2 (N/m^2), the input channel's offset
 #: (units of the driving signal: m/s^2 or N) and the output's (m).
 EXTRA_PARAMETERS = ("k2", "input_offset", "output_offset")
+
+
 #: Columns of a kernel parameter row: m, c, k, k3, the friction law's
 #: parameters (padded to N_KERNEL_PARAMETERS), then EXTRA_PARAMETERS.
 MATRIX_COLUMNS = 4 + N_KERNEL_PARAMETERS + len(EXTRA_PARAMETERS)
+
+
 _K2 = 4 + N_KERNEL_PARAMETERS
+
+
 _INPUT_OFFSET = _K2 + 1
+
+
 _OUTPUT_OFFSET = _K2 + 2
-#: Reconstructions of the input between samples (see :func:`reconstruct_input`).
-HOLDS = ("linear", "zero", "cubic", "bandlimited")
+
 
 _SLIP = 0
+
+
 _STICK = 1
+
+
 _MAX_EVENTS = 24  # events handled inside one sub-step before the step is forced
+
+
 #: LuGre sub-cycles per sub-step allowed while searching: stiffer candidates
 #: (bristle relaxation much faster than the record's dynamics) are rejected as
 #: diverged instead of costing thousands of steps each. Single simulations
@@ -515,158 +517,6 @@ def _run_batch(params, relax, state0, friction, drive, scoring, out_z, out_v, st
     return sums
 
 
-# ----------------------------------------------------------------- python API
-def second_derivative(y, dt):
-    """Acceleration from displacement samples by central differences (m/s^2).
-
-    Fourth-order five-point stencil inside, second-order three-point stencil
-    at the second and second-to-last samples, the end values copied from
-    their neighbours.
-    """
-    y = np.asarray(y, dtype=float)
-    n = y.shape[-1]
-    if n < 5:
-        raise ValueError(
-            f"a base-displacement record needs at least 5 samples to be differentiated, got {n}"
-        )
-    a = np.empty_like(y)
-    a[..., 2:-2] = (
-        -y[..., :-4] + 16 * y[..., 1:-3] - 30 * y[..., 2:-2] + 16 * y[..., 3:-1] - y[..., 4:]
-    ) / (12 * dt**2)
-    a[..., 1] = (y[..., 0] - 2 * y[..., 1] + y[..., 2]) / dt**2
-    a[..., -2] = (y[..., -3] - 2 * y[..., -2] + y[..., -1]) / dt**2
-    a[..., 0] = a[..., 1]
-    a[..., -1] = a[..., -2]
-    return a
-
-
-def lowpass_filter(x, dt, cutoff):
-    """Zero-phase 4th-order Butterworth low-pass (``cutoff`` in Hz)."""
-    from scipy import signal
-
-    cutoff = float(check_positive("lowpass", cutoff, "Hz"))
-    nyquist = 0.5 / dt
-    if cutoff >= nyquist:
-        raise ValueError(
-            f"`lowpass` must be below the Nyquist frequency {nyquist:.6g} Hz, got {cutoff}"
-        )
-    lowest = 1.0 / (max(len(x), 1) * dt)  # one cycle over the record
-    if cutoff < lowest:
-        raise ValueError(
-            f"`lowpass` must be at least {lowest:.6g} Hz (one cycle over the record's "
-            f"{len(x) * dt:.6g} s), got {cutoff!r}"
-        )
-    sos = signal.butter(4, cutoff / nyquist, output="sos")
-    return signal.sosfiltfilt(sos, x)
-
-
-def driving_signal(values, dt, input_kind, lowpass=None):
-    """The samples the kernel is driven by: base acceleration (m/s^2) or force (N).
-
-    Parameters
-    ----------
-    values : array_like
-        Recorded input samples (units of ``input_kind``).
-    dt : float
-        Sample interval (s).
-    input_kind : {'base_displacement', 'base_acceleration', 'force'}
-        What ``values`` are.
-    lowpass : float, optional
-        Cut-off (Hz) of a zero-phase low-pass applied to the driving signal.
-
-    Returns
-    -------
-    samples : ndarray
-    base_input : bool
-        True for base excitation (``e = -m y''``), False for a force.
-    """
-    if input_kind not in INPUT_KINDS:
-        raise ValueError(
-            f"`input_kind` must be one of {', '.join(INPUT_KINDS)}; got {input_kind!r}"
-        )
-    x = np.asarray(values, dtype=float)
-    if input_kind == "base_displacement":
-        x = second_derivative(x, dt)
-    if lowpass is not None:
-        x = lowpass_filter(x, dt, lowpass)
-    return np.ascontiguousarray(x), input_kind != "force"
-
-
-def reconstruct_input(samples, dt, substeps, hold="linear"):
-    """The input between samples, at every half sub-step (what the integrator reads).
-
-    Parameters
-    ----------
-    samples : ndarray, shape (n,)
-        The driving signal at ``t_i = i dt``.
-    dt : float
-        Sample interval (s).
-    substeps : int
-        Integration steps per sample interval.
-    hold : {'linear', 'cubic', 'bandlimited'}
-        ``linear``: straight lines between samples (first-order hold).
-        ``cubic``: the not-a-knot cubic spline through the samples (error
-        about (omega dt)^4 / 384 of the amplitude at angular frequency
-        omega). ``bandlimited``: the band-limited (sinc) interpolant,
-        computed by FFT zero-padding of the record's even (mirrored)
-        extension, which is continuous, so the ends do not ring as a
-        periodic extension would; exact for a signal with no power above
-        the Nyquist frequency that the mirror keeps smooth, the right
-        choice when the record is sampled not far above its bandwidth.
-
-    Returns
-    -------
-    ndarray, shape ((n - 1) * 2 substeps + 1,)
-        Values at ``t = q dt / (2 substeps)``.
-    """
-    x = np.asarray(samples, dtype=float)
-    n = x.shape[0]
-    up = 2 * int(substeps)
-    fine_t = np.arange((n - 1) * up + 1) / up  # in samples
-    if hold == "linear":
-        return np.ascontiguousarray(np.interp(fine_t, np.arange(n), x))
-    if hold == "cubic":
-        from scipy.interpolate import CubicSpline
-
-        return np.ascontiguousarray(CubicSpline(np.arange(n), x)(fine_t))
-    if hold == "bandlimited":
-        return np.ascontiguousarray(_sinc_interpolation(x, up)[: fine_t.size])
-    raise ValueError(
-        f"`hold` must be one of {', '.join(h for h in HOLDS if h != 'zero')}; got {hold!r}"
-    )
-
-
-def _sinc_interpolation(x, up):
-    """Band-limited interpolation of x by a factor ``up`` via its even periodic extension."""
-    n = x.shape[0]
-    ext = np.concatenate([x, x[-2:0:-1]])  # period 2n - 2, continuous
-    m = ext.shape[0]
-    spectrum = np.fft.rfft(ext)
-    if m % 2 == 0:
-        spectrum[-1] *= 0.5  # split the Nyquist bin between +-fs/2
-    padded = np.zeros(m * up // 2 + 1, dtype=complex)
-    padded[: spectrum.shape[0]] = spectrum
-    return np.fft.irfft(padded, m * up)[: (n - 1) * up + 1] * up
-
-
-@dataclass(frozen=True, eq=False)
-class BatchSimulation:
-    """Responses of a population of parameter sets to one recorded input.
-
-    Attributes
-    ----------
-    time : ndarray, shape (n,)
-        Sample times (s).
-    z, v : ndarray, shape (n_pop, n)
-        Relative displacement (m) and velocity (m/s) at the samples; NaN after
-        a candidate diverged.
-    """
-
-    time: np.ndarray
-    z: np.ndarray
-    v: np.ndarray
-
-
 def _law(friction):
     """The law class named ``friction`` (``none``: None); a law class or None passes through."""
     if friction is None or isinstance(friction, type) and issubclass(friction, FrictionModel):
@@ -674,58 +524,6 @@ def _law(friction):
     if friction not in FRICTION_KINDS:
         raise ValueError(f"`friction` must be one of {', '.join(FRICTION_KINDS)}; got {friction!r}")
     return None if friction == "none" else FRICTION_MODELS[friction]
-
-
-def device_parameters(device, friction=None) -> tuple[dict, str]:
-    """Named record-simulation parameters and friction name of a device.
-
-    The record simulator and identification work with the total viscous
-    damping ``c = c_m + c_e`` (Eq. 1): a record cannot separate the two.
-
-    Parameters
-    ----------
-    device : Harvester or dict
-        A :class:`~randvib.models.harvester.Harvester` (a preset included); the dict
-        of its :meth:`~randvib.models.harvester.Harvester.parameters` (``c_m``,
-        ``c_e``, ``friction`` and the friction and circuit parameters); or
-        ``m, c, k, k3`` and the friction parameters, with ``friction``
-        naming the law.
-    friction : str, optional
-        Friction law name; required for the last form, checked against the
-        device's own law for the others.
-
-    Returns
-    -------
-    parameters : dict
-        ``m`` (kg), ``c`` (Ns/m), ``k`` (N/m), ``k3`` (N/m^3) and the law's
-        parameters.
-    friction : str
-    """
-    if isinstance(device, Harvester):
-        params = {"m": device.m, "c": device.c, "k": device.k, "k3": device.k3}
-        if device.friction is not None:
-            params.update(device.friction.parameters())
-        own = device.friction_name
-    elif isinstance(device, dict) and ("c_m" in device or "friction" in device):
-        # Harvester.parameters(): total damping; the circuit's alpha, r_load,
-        # r_coil only explain c_e, which is already in it.
-        params = {k: v for k, v in device.items() if k not in _HARVESTER_ONLY}
-        params["c"] = np.asarray(device.get("c_m", 0.0)) + np.asarray(device.get("c_e", 0.0))
-        own = device.get("friction", "none")
-    else:
-        if friction is None:
-            raise ValueError(
-                "`friction` is required with a parameter dict (m, c, k, k3, ...); "
-                "or pass a randvib.Harvester"
-            )
-        return dict(device), friction
-    if friction is not None and friction != own:
-        raise ValueError(f"`friction` = {friction!r} disagrees with the device's {own!r}")
-    return params, own
-
-
-#: Harvester.parameters() keys that the record simulator does not take.
-_HARVESTER_ONLY = ("c_m", "c_e", "friction", "alpha", "r_load", "r_coil")
 
 
 def parameter_matrix(parameters: dict, friction) -> np.ndarray:
@@ -799,7 +597,7 @@ def run_kernel(
         Parameter rows from :func:`parameter_matrix`.
     friction : str or FrictionModel subclass or None
     drive, base_input
-        From :func:`driving_signal`.
+        From :func:`~randvib.identification.input_reconstruction.driving_signal`.
     dt : float
         Sample interval (s).
     reference : ndarray, optional
@@ -863,96 +661,3 @@ def run_kernel(
         # the best constant added to z: J's minimum over the output offset
         sse = sse - sums[:, 1] ** 2 / (zref.size - int(skip))
     return sse, (out_z if store else None), (out_v if store else None)
-
-
-def simulate_record(
-    parameters,
-    friction=None,
-    input_values=None,
-    dt: float | None = None,
-    *,
-    input_kind: str = "base_acceleration",
-    substeps: int = 4,
-    hold: str = "linear",
-    lowpass: float | None = None,
-    z0=0.0,
-    v0=0.0,
-    theta0=0.0,
-    response_limit: float = np.inf,
-) -> BatchSimulation:
-    """Simulate Eq. 1 driven by a recorded input, for many parameter sets at once.
-
-    Called as ``simulate_record(harvester, input_values, dt, ...)`` with a
-    :class:`~randvib.models.harvester.Harvester` (a preset included) or its
-    ``parameters()`` dict, or as ``simulate_record(parameters, friction,
-    input_values, dt, ...)`` with a dict of named parameters.
-
-    Parameters
-    ----------
-    parameters : Harvester or dict
-        A device (simulated with c = c_m + c_e), or ``m`` (kg), ``c`` (Ns/m),
-        ``k`` (N/m), ``k3`` (N/m^3) and the friction parameters (``fc`` N;
-        ``beta`` s/m; ``sigma0`` N/m, ``sigma1`` Ns/m, ``fs`` N, ``vs`` m/s;
-        see :data:`FRICTION_PARAMETERS`); scalars or 1-D arrays (one row per
-        candidate).
-    friction : str, optional
-        Friction law name: ``none`` or a registered law (paper Eq. 4-10:
-        ``coulomb``, ``tanh``, ``lugre``); only with a parameter dict.
-    input_values : array_like, shape (n,)
-        Input samples on the uniform grid ``i dt``: base displacement (m),
-        base acceleration (m/s^2) or force on the mass (N).
-    dt : float
-        Sample interval (s).
-    input_kind : {'base_displacement', 'base_acceleration', 'force'}
-    substeps : int, optional
-        Integration steps per sample interval (default 4).
-    hold : {'linear', 'zero', 'cubic', 'bandlimited'}
-        Reconstruction of the input between samples (:func:`reconstruct_input`).
-    lowpass : float, optional
-        Zero-phase low-pass cut-off (Hz) for the driving signal.
-    z0, v0, theta0 : float or array_like
-        Initial displacement (m), velocity (m/s), LuGre bristle state (m).
-    response_limit : float, optional
-        |z| above which a candidate counts as diverged (m).
-
-    Returns
-    -------
-    BatchSimulation
-    """
-    if not (friction is None or isinstance(friction, str | type)):
-        # simulate_record(device, input_values, dt): the device names its law.
-        friction, input_values, dt = None, friction, input_values
-    parameters, friction = device_parameters(parameters, friction)
-    values, dt, substeps = _check_record_input(input_values, dt, substeps, hold)
-    matrix = parameter_matrix(parameters, friction)
-    drive, base_input = driving_signal(values, dt, input_kind, lowpass)
-    _, z, v = run_kernel(
-        matrix,
-        friction,
-        drive,
-        base_input,
-        dt,
-        substeps=substeps,
-        hold=hold,
-        z0=z0,
-        v0=v0,
-        theta0=theta0,
-        response_limit=response_limit,
-    )
-    return BatchSimulation(time=np.arange(values.shape[0]) * dt, z=z, v=v)
-
-
-def _check_record_input(input_values, dt, substeps, hold):
-    """(values, dt, substeps) of :func:`simulate_record`, checked."""
-    if input_values is None or dt is None:
-        raise ValueError("`input_values` and `dt` are required")
-    dt = float(check_positive("dt", dt, "s"))
-    substeps = check_int("substeps", substeps, minimum=1)
-    if hold not in HOLDS:
-        raise ValueError(f"`hold` must be one of {', '.join(HOLDS)}; got {hold!r}")
-    values = check_finite("input_values", input_values)
-    if values.ndim != 1 or values.shape[0] < 2:
-        raise ValueError(
-            f"`input_values` must be 1-D with at least 2 samples, got shape {values.shape}"
-        )
-    return values, dt, substeps

@@ -1,0 +1,161 @@
+"""The recorded input as the integrator reads it: derivative, filter, reconstruction.
+
+The input is sampled on a uniform grid ``t_i = i dt``. The kernel
+(:mod:`randvib.identification.record_integrator`) is driven by a base
+acceleration (m/s^2) or a force (N) (:func:`driving_signal`); between samples
+the signal is reconstructed (:func:`reconstruct_input`: linear by default;
+cubic spline or band-limited (sinc) interpolation for records sampled not far
+above their bandwidth; a zero-order hold).
+
+A recorded base displacement is turned into base acceleration by the
+fourth-order central difference
+``y''_i = (-y_{i-2} + 16 y_{i-1} - 30 y_i + 16 y_{i+1} - y_{i+2}) / (12 dt^2)``
+(relative error (omega dt)^4 / 90, 2e-7 at 20 Hz and 1 kHz), with the
+second-order stencil next to the ends (:func:`second_derivative`).
+Differentiation amplifies sensor noise at high frequency; ``lowpass``
+applies a zero-phase Butterworth filter to the derived acceleration
+(:func:`lowpass_filter`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from randvib._validation import check_positive
+from randvib.models.record import INPUT_KINDS
+
+#: Reconstructions of the input between samples (see :func:`reconstruct_input`).
+HOLDS = ("linear", "zero", "cubic", "bandlimited")
+
+
+def second_derivative(y, dt):
+    """Acceleration from displacement samples by central differences (m/s^2).
+
+    Fourth-order five-point stencil inside, second-order three-point stencil
+    at the second and second-to-last samples, the end values copied from
+    their neighbours.
+    """
+    y = np.asarray(y, dtype=float)
+    n = y.shape[-1]
+    if n < 5:
+        raise ValueError(
+            f"a base-displacement record needs at least 5 samples to be differentiated, got {n}"
+        )
+    a = np.empty_like(y)
+    a[..., 2:-2] = (
+        -y[..., :-4] + 16 * y[..., 1:-3] - 30 * y[..., 2:-2] + 16 * y[..., 3:-1] - y[..., 4:]
+    ) / (12 * dt**2)
+    a[..., 1] = (y[..., 0] - 2 * y[..., 1] + y[..., 2]) / dt**2
+    a[..., -2] = (y[..., -3] - 2 * y[..., -2] + y[..., -1]) / dt**2
+    a[..., 0] = a[..., 1]
+    a[..., -1] = a[..., -2]
+    return a
+
+
+def lowpass_filter(x, dt, cutoff):
+    """Zero-phase 4th-order Butterworth low-pass (``cutoff`` in Hz)."""
+    from scipy import signal
+
+    cutoff = float(check_positive("lowpass", cutoff, "Hz"))
+    nyquist = 0.5 / dt
+    if cutoff >= nyquist:
+        raise ValueError(
+            f"`lowpass` must be below the Nyquist frequency {nyquist:.6g} Hz, got {cutoff}"
+        )
+    lowest = 1.0 / (max(len(x), 1) * dt)  # one cycle over the record
+    if cutoff < lowest:
+        raise ValueError(
+            f"`lowpass` must be at least {lowest:.6g} Hz (one cycle over the record's "
+            f"{len(x) * dt:.6g} s), got {cutoff!r}"
+        )
+    sos = signal.butter(4, cutoff / nyquist, output="sos")
+    return signal.sosfiltfilt(sos, x)
+
+
+def driving_signal(values, dt, input_kind, lowpass=None):
+    """The samples the kernel is driven by: base acceleration (m/s^2) or force (N).
+
+    Parameters
+    ----------
+    values : array_like
+        Recorded input samples (units of ``input_kind``).
+    dt : float
+        Sample interval (s).
+    input_kind : {'base_displacement', 'base_acceleration', 'force'}
+        What ``values`` are.
+    lowpass : float, optional
+        Cut-off (Hz) of a zero-phase low-pass applied to the driving signal.
+
+    Returns
+    -------
+    samples : ndarray
+    base_input : bool
+        True for base excitation (``e = -m y''``), False for a force.
+    """
+    if input_kind not in INPUT_KINDS:
+        raise ValueError(
+            f"`input_kind` must be one of {', '.join(INPUT_KINDS)}; got {input_kind!r}"
+        )
+    x = np.asarray(values, dtype=float)
+    if input_kind == "base_displacement":
+        x = second_derivative(x, dt)
+    if lowpass is not None:
+        x = lowpass_filter(x, dt, lowpass)
+    return np.ascontiguousarray(x), input_kind != "force"
+
+
+def reconstruct_input(samples, dt, substeps, hold="linear"):
+    """The input between samples, at every half sub-step (what the integrator reads).
+
+    Parameters
+    ----------
+    samples : ndarray, shape (n,)
+        The driving signal at ``t_i = i dt``.
+    dt : float
+        Sample interval (s).
+    substeps : int
+        Integration steps per sample interval.
+    hold : {'linear', 'cubic', 'bandlimited'}
+        ``linear``: straight lines between samples (first-order hold).
+        ``cubic``: the not-a-knot cubic spline through the samples (error
+        about (omega dt)^4 / 384 of the amplitude at angular frequency
+        omega). ``bandlimited``: the band-limited (sinc) interpolant,
+        computed by FFT zero-padding of the record's even (mirrored)
+        extension, which is continuous, so the ends do not ring as a
+        periodic extension would; exact for a signal with no power above
+        the Nyquist frequency that the mirror keeps smooth, the right
+        choice when the record is sampled not far above its bandwidth.
+
+    Returns
+    -------
+    ndarray, shape ((n - 1) * 2 substeps + 1,)
+        Values at ``t = q dt / (2 substeps)``.
+    """
+    x = np.asarray(samples, dtype=float)
+    n = x.shape[0]
+    up = 2 * int(substeps)
+    fine_t = np.arange((n - 1) * up + 1) / up  # in samples
+    if hold == "linear":
+        return np.ascontiguousarray(np.interp(fine_t, np.arange(n), x))
+    if hold == "cubic":
+        from scipy.interpolate import CubicSpline
+
+        return np.ascontiguousarray(CubicSpline(np.arange(n), x)(fine_t))
+    if hold == "bandlimited":
+        return np.ascontiguousarray(_sinc_interpolation(x, up)[: fine_t.size])
+    raise ValueError(
+        f"`hold` must be one of {', '.join(h for h in HOLDS if h != 'zero')}; got {hold!r}"
+    )
+
+
+def _sinc_interpolation(x, up):
+    """Band-limited interpolation of x by a factor ``up`` via its even periodic extension."""
+    n = x.shape[0]
+    ext = np.concatenate([x, x[-2:0:-1]])  # period 2n - 2, continuous
+    m = ext.shape[0]
+    spectrum = np.fft.rfft(ext)
+    if m % 2 == 0:
+        spectrum[-1] *= 0.5  # split the Nyquist bin between +-fs/2
+    padded = np.zeros(m * up // 2 + 1, dtype=complex)
+    padded[: spectrum.shape[0]] = spectrum
+    return np.fft.irfft(padded, m * up)[: (n - 1) * up + 1] * up

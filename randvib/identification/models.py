@@ -1,0 +1,252 @@
+"""The identification models and their parameters.
+
+A model is the device of paper Eq. 1 with one friction law: ``viscous`` (c
+(Ns/m), k (N/m), k3 (N/m^3): the paper's "no friction") and one per
+registered friction law (:data:`randvib.models.friction.FRICTION_MODELS`:
+``coulomb`` Eq. 4-5, ``tanh`` Eq. 6, ``lugre`` Eq. 8-10, and any law defined
+elsewhere), which adds that law's parameters with the units, search bounds and
+scales it declares; plus the mass ``m`` (kg). With base excitation the mass
+cannot be identified (dividing Eq. 1 by m leaves c/m, k/m, k3/m, F/m), so it
+must be given; with a force input it may be left free and is identified.
+
+This module holds the declarations every part of the identification reads:
+the device's own parameters (:data:`DEVICE_SPECS`), the models
+(:data:`MODELS`, :data:`MODEL_PARAMETERS`), the units (:data:`UNITS`) and
+the one check of a parameter's value (:func:`check_parameter`).
+
+**One device.** Outside the search, a model's parameter values are a
+:class:`~randvib.models.harvester.Harvester` (the record simulation uses its
+total damping c = c_m + c_e: a record cannot separate them) plus a
+:class:`MeasurementModel` (the sensors' offsets and the quadratic stiffness
+k2, which a Harvester does not have). :func:`device_parameters` turns the
+pair into the named parameters the compiled simulation takes,
+:func:`device_from_parameters` turns identified parameters back into the pair.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+from randvib._validation import (
+    check_finite,
+    check_nonnegative,
+    check_positive,
+    check_scalar_device,
+    scalar_or_array,
+)
+from randvib.identification.record_integrator import EXTRA_PARAMETERS
+from randvib.models.friction import FRICTION_MODELS, RegistryView
+from randvib.models.harvester import Harvester
+from randvib.models.parameters import Parameter
+
+#: The device's own parameters (Eq. 1; friction laws declare theirs): unit,
+#: default bounds from the record's scales, log scale (k3 may be zero).
+DEVICE_SPECS = {
+    "m": Parameter("kg", True, lambda s: (0.1 * s.m, 10 * s.m)),
+    "c": Parameter("Ns/m", False, lambda s: (1e-4 * s.c_ref, 2 * s.c_ref)),
+    "k": Parameter("N/m", True, lambda s: (0.1 * s.k_ref, 10 * s.k_ref)),
+    "k3": Parameter("N/m^3", False, lambda s: (0.0, 2 * s.k_ref / s.z_max**2), log=False),
+}
+
+
+#: Identification model name -> friction law name of the simulator (live view
+#: of the registry: ``viscous`` is no friction, every law is a model).
+MODELS = RegistryView(lambda law: "none" if law is None else law.name, none_key="viscous")
+
+
+#: Parameters of each model, in reporting order (``m`` comes in addition).
+MODEL_PARAMETERS = RegistryView(
+    lambda law: ("c", "k", "k3") + (() if law is None else law.parameter_names()),
+    none_key="viscous",
+)
+
+
+def parameter_specs(model) -> dict[str, Parameter]:
+    """Declarations of every parameter of a model, ``m`` included."""
+    law = check_model(model)
+    return {**DEVICE_SPECS, **({} if law is None else law.parameter_specs())}
+
+
+#: Units of the quadratic stiffness and the sensor offsets.
+EXTRA_UNITS = {"k2": "N/m^2", "input_offset": "input unit", "output_offset": "m"}
+
+
+def unit_of(model, name):
+    """The unit of parameter ``name`` of ``model`` (a law's own declaration wins)."""
+    return EXTRA_UNITS[name] if name in EXTRA_UNITS else parameter_specs(model)[name].unit
+
+
+class _Units(Mapping):
+    """Parameter name -> unit, from the device's and the laws' declarations."""
+
+    def _table(self):
+        out = {name: spec.unit for name, spec in DEVICE_SPECS.items()} | EXTRA_UNITS
+        for law in FRICTION_MODELS.values():
+            out.update({name: spec.unit for name, spec in law.parameter_specs().items()})
+        return out
+
+    def __getitem__(self, key):
+        return self._table()[key]
+
+    def __iter__(self):
+        return iter(self._table())
+
+    def __len__(self):
+        return len(self._table())
+
+
+#: Parameter name -> SI unit (live view; a law's own units win in its results).
+UNITS = _Units()
+
+
+def check_model(model):
+    """The friction law class of an identification model (``viscous``: None)."""
+    if model not in MODELS:
+        raise ValueError(f"`model` must be one of {', '.join(MODELS)}; got {model!r}")
+    return None if model == "viscous" else FRICTION_MODELS[model]
+
+
+def model_of(friction_name: str) -> str:
+    """Identification model of a friction law name (``none`` -> ``viscous``)."""
+    return "viscous" if friction_name == "none" else friction_name
+
+
+def check_parameter(model: str, name: str, value, label: str | None = None) -> float:
+    """``value`` of parameter ``name`` of ``model`` as a float, if the model allows it.
+
+    The rules are the declarations' (:data:`DEVICE_SPECS` and the friction
+    law's ``parameter(...)`` fields): finite, and > 0 for a positive
+    parameter (m, k, Fc, ...), >= 0 for the others (c, k3, ...). They hold
+    for fixed values, search bounds and validated parameters alike.
+    """
+    label = label or name
+    if name in EXTRA_PARAMETERS:  # k2 and the sensor offsets: any finite value
+        return float(check_finite(label, value))
+    spec = parameter_specs(model).get(name)
+    if spec is None:
+        raise ValueError(
+            f"`{label}`: unknown parameter for model {model!r}; allowed: "
+            f"{', '.join(('m',) + MODEL_PARAMETERS[model])}"
+        )
+    check = check_positive if spec.positive else check_nonnegative
+    return float(check(label, value, spec.unit))
+
+
+def check_parameters(parameters, model) -> dict:
+    """Every parameter of ``model`` (``m`` included) from ``parameters``, each checked
+    (:func:`check_parameter`), with the measurement model's that are given."""
+    check_model(model)
+    names = ("m",) + MODEL_PARAMETERS[model]
+    missing = [n for n in names if n not in parameters]
+    if missing:
+        raise ValueError(
+            f"parameters for model {model!r} lack {missing}; needed: {', '.join(names)}"
+        )
+    names += tuple(n for n in EXTRA_PARAMETERS if n in parameters)
+    return {n: check_parameter(model, n, parameters[n]) for n in names}
+
+
+# ------------------------------------------------------------- one device
+@dataclass(frozen=True)
+class MeasurementModel:
+    """What the record simulation adds to a Harvester: the sensors' offsets and k2.
+
+    An offset is what a sensor adds (measured = true + offset). The
+    quadratic stiffness k2 is the term of the restoring force
+    ``k z + k2 z^2 + k3 z^3`` that a :class:`~randvib.models.harvester.Harvester`
+    does not have (its potential is even). It is defined about the output
+    sensor's zero: with k3 != 0 a cubic spring whose centre is shifted by s
+    from that zero (z -> z + s) has the quadratic term 3 k3 s and a constant
+    force, which the input offset takes, so k2 belongs with the offsets
+    and is estimated with them (:func:`randvib.identify`,
+    ``quadratic``). The initial state is not part of it: it belongs to one
+    record and is estimated, or taken from the first samples, record by
+    record (:class:`~randvib.identification.settings.SimulationSettings`).
+
+    Attributes
+    ----------
+    input_offset : float
+        Offset of the input channel, in its unit (m/s^2 for a base
+        acceleration, N for a force; a base displacement's vanishes in its
+        second derivative).
+    output_offset : float
+        Offset of the relative-displacement sensor (m).
+    k2 : float
+        Quadratic stiffness (N/m^2).
+    """
+
+    input_offset: float = 0.0
+    output_offset: float = 0.0
+    k2: float = 0.0
+
+    def __post_init__(self):
+        for name in EXTRA_PARAMETERS:
+            object.__setattr__(self, name, scalar_or_array(check_finite(name, getattr(self, name))))
+
+    def parameters(self) -> dict:
+        """``k2``, ``input_offset`` and ``output_offset`` by name."""
+        return {name: getattr(self, name) for name in EXTRA_PARAMETERS}
+
+    @classmethod
+    def from_parameters(cls, parameters: dict) -> MeasurementModel:
+        """The measurement model among identified ``parameters`` (absent ones: 0)."""
+        return cls(**{name: parameters[name] for name in EXTRA_PARAMETERS if name in parameters})
+
+
+def device_parameters(
+    harvester: Harvester, measurement=None, function: str = "the record simulation", *, scalar=True
+) -> dict:
+    """The record simulation's named parameters of a device and its measurement model.
+
+    ``m``, ``c`` (= c_m + c_e), ``k``, ``k3``, the friction law's
+    parameters, ``k2`` and the offsets. ``function`` is named in refusals:
+    anything but a Harvester, a coupling with a circuit state (the record
+    simulation has none) and, with ``scalar``, array parameters.
+    """
+    if not isinstance(harvester, Harvester):
+        raise ValueError(
+            f"{function} needs a randvib.Harvester (a preset included), got "
+            f"{type(harvester).__name__}"
+        )
+    if measurement is None:
+        measurement = MeasurementModel()
+    elif not isinstance(measurement, MeasurementModel):
+        raise ValueError(
+            f"`measurement` must be a randvib.MeasurementModel, got {type(measurement).__name__}"
+        )
+    if scalar:
+        check_scalar_device(harvester, function)
+    harvester.require_resistive(function, "randvib.simulate")
+    out = {"m": harvester.m, "c": harvester.c, "k": harvester.k, "k3": harvester.k3}
+    if harvester.friction is not None:
+        out.update(harvester.friction.parameters())
+    out.update(measurement.parameters())
+    return out
+
+
+def device_from_parameters(
+    model: str, parameters: dict, electrical=None
+) -> tuple[Harvester, MeasurementModel]:
+    """Identified ``parameters`` of ``model`` as the device and its measurement model.
+
+    The identified damping ``c`` becomes the Harvester's c_m: a record taken
+    in open circuit holds no electrical damping. ``electrical`` (a coupling,
+    e.g. ``ElectricalCoupling(alpha, r_load, r_coil)``) wires the device, its
+    c_e added to c (:meth:`~randvib.models.harvester.Harvester.with_coupling`).
+    """
+    law = check_model(model)
+    p = check_parameters(parameters, model)
+    if law is None and p["c"] == 0:
+        raise ValueError(
+            "`c` must be > 0 (Ns/m) for the viscous model: without friction an undamped "
+            "device is no randvib.Harvester"
+        )
+    friction = None if law is None else law(**{name: p[name] for name in law.parameter_names()})
+    if electrical is None:
+        device = Harvester(m=p["m"], c_m=p["c"], c_e=0.0, k=p["k"], k3=p["k3"], friction=friction)
+    else:
+        device = Harvester.with_coupling(
+            p["m"], p["c"], p["k"], electrical, k3=p["k3"], friction=friction
+        )
+    return device, MeasurementModel.from_parameters(p)
