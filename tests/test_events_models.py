@@ -131,6 +131,8 @@ def test_event_start():
     well = rv.EventStart.of("unexcited", bistable)
     assert well.z == pytest.approx(np.sqrt(57.4 / 5e5)) and well.v == 0.0
     assert rv.EventStart.of("unexcited", mono).is_zero
+    free = rv.Harvester(m=0.0226, c_m=0.1, c_e=0.0, k=0.0)
+    assert rv.EventStart.of("unexcited", free).is_zero
     given = rv.EventStart.of((1e-3, -0.1), mono)
     assert (given.kind, given.z, given.v) == ("state", 1e-3, -0.1)
     assert "unexcited (z = 0.01071 m" in well.describe()

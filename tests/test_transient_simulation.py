@@ -275,6 +275,8 @@ def test_result_tables_and_json():
     ],
 )
 def test_refusals(kwargs, fragment):
+    with pytest.raises(ValueError, match="`harvester` must be a randvib.Harvester"):
+        rv.simulate_transient("device", rv.Enveloped(1.0, rv.Step()), t_end=1, dt=1e-3, n_paths=4)
     arguments = dict(event=rv.Enveloped(rv.White(1.0), rv.Step()), t_end=1.0, dt=1e-3,
                      n_paths=8, progress=False)  # fmt: skip
     arguments.update(kwargs)

@@ -480,7 +480,12 @@ class EventStart:
                 )
             if start == "rest":
                 return cls("rest")
-            return cls("unexcited", max(harvester.potential.wells), 0.0)
+            # the bottom of the potential: a bistable device's positive well, else z = 0
+            # (the free mass rests anywhere; z = 0 is its rest too)
+            bottom = (
+                max(harvester.potential.wells) if harvester.potential.kind == "bistable" else 0.0
+            )
+            return cls("unexcited", bottom, 0.0)
         try:
             z0, v0 = (float(x) for x in start)
         except (TypeError, ValueError):

@@ -137,8 +137,9 @@ def simulate_transient(
             "realisation: pass its spectrum, rv.Enveloped(record.spectrum, envelope), for "
             "Gaussian paths with the record's Welch PSD"
         )
-    if isinstance(harvester, Harvester):
-        start = EventStart.of(start, harvester)
+    if not isinstance(harvester, Harvester):
+        raise ValueError(f"`harvester` must be a randvib.Harvester, got {type(harvester).__name__}")
+    start = EventStart.of(start, harvester)
     run = validated(
         harvester,
         event.excitation,
