@@ -91,7 +91,7 @@ def test_a_wheel_ships_the_study_scripts(tmp_path):
 
 #: Scripts still importing private modules (randvib._io, randvib._progress), to be
 #: rewritten over the public API like the others.
-PRIVATE_IMPORTS_LEFT = {"identification", "silverbox", "linearisation-vs-averaging"}
+PRIVATE_IMPORTS_LEFT = {"identification", "silverbox"}
 
 
 @pytest.mark.parametrize("name", sorted(set(STUDIES) - PRIVATE_IMPORTS_LEFT))

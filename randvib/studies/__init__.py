@@ -130,8 +130,8 @@ def add_run_options(parser: argparse.ArgumentParser) -> None:
         "--threads",
         type=integer_option(1),
         default=None,
-        help="numba threads of a study that simulates in-process (identification, "
-        "linearisation-vs-averaging; default: all cores)",
+        help="numba threads of a study that simulates in-process (identification; "
+        "default: all cores)",
     )
     parser.add_argument(
         "--scheduler",

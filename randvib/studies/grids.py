@@ -139,14 +139,17 @@ def response_matched(shape: Excitation, device: Harvester, psd: float) -> Excita
 
 
 def fixed_paths(
-    n_paths: int, window: float, *, dt: float, burn_in: float, seed: int, scheme: str = "heun"
-) -> SweepSettings:
-    """Settings of ensembles of exactly ``n_paths`` paths (no precision target), plain means.
+    n_paths: int, window: float, *, dt: float, burn_in: float, seed: int, scheme: str = "heun",
+    control_variates: bool = False,
+) -> SweepSettings:  # fmt: skip
+    """Settings of ensembles of exactly ``n_paths`` paths (no precision target).
 
     ``window`` and ``burn_in`` (s) per path, step ``dt`` (s), the run's
-    ``seed``; no control variates (they need white noise, and a study that
-    compares inputs keeps one estimator for all).
+    ``seed``. Plain means by default: the control variates need white noise,
+    and a study that compares inputs keeps one estimator for all; a
+    white-noise study may ask for them (``control_variates=True``: the
+    friction-free companion and the energy-balance controls).
     """
     return SweepSettings(dt=dt, window=window, burn_in=burn_in, scheme=scheme, min_paths=n_paths,
                          max_paths=n_paths, batch_paths=n_paths, seed=seed,
-                         control_variates=False)  # fmt: skip
+                         control_variates=control_variates)  # fmt: skip
