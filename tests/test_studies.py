@@ -90,7 +90,7 @@ def test_a_wheel_ships_the_study_scripts(tmp_path):
 
 
 #: Scripts not yet written over the public API alone.
-NOT_YET_PUBLIC = {"identification", "silverbox", "figure9", "interaction", "linearisation-accuracy"}
+NOT_YET_PUBLIC = {"identification", "silverbox", "interaction", "linearisation-accuracy"}
 
 
 def _public_module(module: str) -> bool:

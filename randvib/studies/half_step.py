@@ -5,7 +5,8 @@
 at half the step with independent noise; :func:`half_step_verdict` counts
 the points whose two estimates agree within their combined 95 % half-width.
 :func:`check_step_bias` refuses a step whose linearised bias is already too
-large before anything runs.
+large before anything runs; :func:`half_step_section` is the report's
+section on the re-run.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ from randvib.montecarlo.sweep import (
     point_device,
     run_sweep,
 )
+from randvib.studies.report import markdown_table, readable_table
 
 
 def half_step_rerun(
@@ -185,3 +187,24 @@ def half_step_verdict(check: pd.DataFrame) -> dict:
             f"{0.05 * n_independent:.1f} expected by chance{note})"
         )
     return data
+
+
+def half_step_section(check: pd.DataFrame, settings: SweepSettings, which: str,
+                      worst_bias: float | None = None) -> str:  # fmt: skip
+    """A report's time-step section: the half-step re-run of ``which`` points and its verdict.
+
+    ``check`` is the table of :func:`half_step_rerun`, ``settings`` the
+    sweep's; ``worst_bias`` (:func:`check_step_bias`), when given, is quoted
+    as the largest linearised step bias at the sweep's step.
+    """
+    verdict = half_step_verdict(check)
+    bias = "" if worst_bias is None else (
+        " Linearised step bias at dt (randvib.montecarlo.step_check.step_bias) at most "
+        f"{worst_bias:.1e}."
+    )  # fmt: skip
+    return (
+        f"Re-run of {len(check)} points ({which}) at dt/2 = {settings.dt / 2:g} s, independent "
+        f"noise. Time-step bias below the statistical error at {verdict['n_below']} of "
+        f"{len(check)} points{verdict['sentence']}.{bias}\n\n"
+        + markdown_table(readable_table(check))
+    )
