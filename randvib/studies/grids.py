@@ -11,12 +11,13 @@ Coloured inputs are compared with white noise at equal response
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 
 from randvib.analytic.linear_response import mechanical_block, output_variances
 from randvib.analytic.linearisation import coulomb_equivalent_damping
 from randvib.models.excitation import Excitation
 from randvib.models.harvester import Harvester
-from randvib.montecarlo.sweep import SweepSettings, cartesian
+from randvib.montecarlo.sweep import SweepSettings, cartesian, point_device
 
 
 def fc_where_power_halves(device: Harvester, psd: float) -> float:
@@ -91,6 +92,30 @@ def coulomb_grid(base: Harvester, psds, k3s, n_fc: int, reach: float = 2.0) -> l
     return points
 
 
+def friction_level_points(base: Harvester, series, phis) -> list[dict]:
+    """(psd, k3, c_m, c_e, fc) points: each series at the friction levels ``phis``.
+
+    ``series`` holds (S ((m/s^2)^2/Hz), k3 (N/m^3), c_m = c_e (Ns/m)); Fc is
+    set by phi = Fc / (c sigma_v0) (:func:`fc_at_friction_level`) for that
+    series' device and S. Points come series by series, phi by phi.
+    """
+    if min(phis) <= 0:
+        raise ValueError(f"`phis` must be > 0 (the error at phi = 0 is zero), got {phis}")
+    return [{"psd": psd, "k3": k3, "c_m": c_each, "c_e": c_each,
+             "fc": float(fc_at_friction_level(base.updated(c_m=c_each, c_e=c_each), psd, phi))}
+            for psd, k3, c_each in series for phi in phis]  # fmt: skip
+
+
+def point_levels(base: Harvester, points) -> pd.DataFrame:
+    """The friction level phi (:func:`friction_level`) and damping ratio zeta
+    (:func:`damping_ratio`) of every point's device (``base`` updated by the point)."""
+    devices = [point_device(base, p) for p in points]
+    return pd.DataFrame({
+        "phi": [float(friction_level(d, p["psd"], p["fc"])) for d, p in zip(devices, points, strict=True)],
+        "zeta": [damping_ratio(d) for d in devices],
+    })  # fmt: skip
+
+
 def highest_friction_points(points: list, group=("psd",)) -> list:
     """The points with the largest Fc within each group: the hardest dynamics."""
     top: dict = {}
@@ -98,6 +123,17 @@ def highest_friction_points(points: list, group=("psd",)) -> list:
         key = tuple(p[g] for g in group)
         top[key] = max(top.get(key, -np.inf), p["fc"])
     return [p for p in points if p["fc"] == top[tuple(p[g] for g in group)]]
+
+
+def hardest_at_largest_psd(points: list, series=("k3", "c_m")) -> list:
+    """The strongest friction of each ``series`` at its largest S: the hardest dynamics of a
+    grid whose series differ in more than S (:func:`highest_friction_points` of those)."""
+    largest = {}
+    for p in points:
+        key = tuple(p[g] for g in series)
+        largest[key] = max(largest.get(key, 0.0), p["psd"])
+    hardest = [p for p in points if p["psd"] == largest[tuple(p[g] for g in series)]]
+    return highest_friction_points(hardest, ("psd", *series))
 
 
 def burn_in_for(devices, relaxation_times: float = 6.0, resolution: float = 0.5) -> float:

@@ -5,8 +5,8 @@
 at half the step with independent noise; :func:`half_step_verdict` counts
 the points whose two estimates agree within their combined 95 % half-width.
 :func:`check_step_bias` refuses a step whose linearised bias is already too
-large before anything runs; :func:`half_step_section` is the report's
-section on the re-run.
+large before anything runs; :func:`sweep_text` says in words how the sweep
+ran, :func:`half_step_section` is the report's section on the re-run.
 """
 
 from __future__ import annotations
@@ -207,4 +207,20 @@ def half_step_section(check: pd.DataFrame, settings: SweepSettings, which: str,
         f"noise. Time-step bias below the statistical error at {verdict['n_below']} of "
         f"{len(check)} points{verdict['sentence']}.{bias}\n\n"
         + markdown_table(readable_table(check))
+    )
+
+
+def sweep_text(settings: SweepSettings, n_paths: int, quick: bool) -> str:
+    """How a study's sweep ran, in words: step, burn-in, window, precision, paths, seed.
+
+    For a sweep whose burn-in comes from :func:`randvib.studies.grids.burn_in_for`
+    (six energy relaxation times); ``n_paths`` is the paths over all points.
+    """
+    return (
+        f"Heun, dt = {settings.dt:g} s, {settings.burn_in:g} s burn-in (at least six energy "
+        "relaxation times m/c, so that each path, started from the Gaussian linearised state, "
+        f"has forgotten its start) + {settings.window:g} s per path, paths added until the 95 % "
+        f"half-width of each power is {100 * settings.target_rel_ci:g} % ({n_paths} paths in "
+        f"all), seed {settings.seed}, common random numbers across points, control variates "
+        f"{'on' if settings.control_variates else 'off'}.{' Quick mode.' if quick else ''}"
     )

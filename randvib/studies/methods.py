@@ -20,6 +20,9 @@ inside the Monte Carlo interval. The Coulomb level is set by the
 dimensionless kappa = 4 Fc^2 / (pi S m c) (the group of paper Eq. 30: Eq. 32
 halves the power at kappa = 1/4).
 
+At the points of a sweep (:func:`randvib.run_sweep`): :func:`method_errors`
+(each method's error against Monte Carlo, and averaging's validity).
+
 For the cases of a paired run (:func:`randvib.run_ensembles`), any device,
 input and stroke: :func:`methods_against_monte_carlo` (every method's power
 and stroke exceedance against Monte Carlo, or why it refused),
@@ -44,6 +47,7 @@ from randvib.analytic.statistical_linearisation import statistical_linearisation
 from randvib.models.presets import preset
 from randvib.montecarlo.ensembles import Case
 from randvib.montecarlo.step_check import step_bias
+from randvib.montecarlo.sweep import linearisation_verdicts, point_device
 from randvib.studies.report import markdown_table
 
 #: Analytic methods: column suffix -> (method name in randvib.METHODS, label).
@@ -339,6 +343,35 @@ def reading(df: pd.DataFrame, timings: dict | None = None) -> str:
         f"{100 * fast:.3f} % at every point{speed}."
     )
     return " ".join(parts)
+
+
+# ----------------------------------------------------------------- the points of a sweep
+def method_errors(result, base, methods=("linearisation", "averaging")) -> pd.DataFrame:
+    """A sweep's table with each method's error against Monte Carlo at every point.
+
+    For each method m the columns of :func:`randvib.linearisation_verdicts`
+    (``m_rel_error``, ``m_rel_error_ci95``, ``m_consistent``: the method
+    inside the Monte Carlo 95 % interval); with averaging, also
+    ``averaging_zeta_friction``, the friction damping ratio of each point's
+    device (zeta_f > 0.5: outside the method's stated validity, where it warns).
+
+    Parameters
+    ----------
+    result : SweepResult
+        Of :func:`randvib.run_sweep` on ``base``, whose table holds each
+        method's ``m_power`` (every method but the slow reference).
+    base : Harvester
+    methods : sequence of str
+    """
+    table = result.table
+    for method in methods:
+        table = linearisation_verdicts(table, method)
+    if "averaging" in methods:
+        table["averaging_zeta_friction"] = [
+            float(averaging_statistics(point_device(base, p), p["psd"], warn=False).zeta_friction)
+            for p in result.points
+        ]
+    return table
 
 
 # ----------------------------------------------------------------- the cases of a paired run
