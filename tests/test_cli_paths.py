@@ -241,7 +241,7 @@ def test_study_identification_cli(tmp_path, capsys, monkeypatch):
     identification = load("identification")
     monkeypatch.setattr(
         identification,
-        "_settings",
+        "settings_for",
         lambda quick: dict(duration=0.6, fs=250.0, popsize=6, generations=1, substeps=2),
     )
     out = tmp_path / "ident"
