@@ -44,6 +44,7 @@ from randvib.studies.contrasts import paired_interactions
 from randvib.studies.grids import fixed_paths, response_matched
 from randvib.studies.methods import linearisation_against_monte_carlo
 from randvib.studies.spectra_figure import spectra_against_linearisation
+from randvib.studies.verdicts import contrast_range, holds_down_to
 
 NAME = "excitation"
 FC = 0.0058  #: N, the paper's Coulomb level (Table 2, training data 1)
@@ -89,13 +90,11 @@ def compute(base, axes, settings, out, workers, scheduler, progress):
         run, "fc", "k3", predicted={"linearisation": results.power_linearisation}
     )
     inter = inter.rename(columns={"k3_alone_relative": "spring_alone_relative"})
-    banded = inter.centre != "white"
-    inter["detectable"] = inter.p_value < 0.05
-    inter["detectable_holm"] = False
+    banded = inter.centre != "white"  # Holm's family: the bands (white noise is the reference)
+    inter["detectable"], inter["detectable_holm"] = inter.p_value < 0.05, False
     inter.loc[banded, "detectable_holm"] = holm_significant(inter.p_value[banded])
-    inter["breaks_no_interaction"] = inter.detectable_holm & (
-        inter.relative_contrast.abs() >= PRACTICAL
-    )
+    practical = inter.relative_contrast.abs() >= PRACTICAL
+    inter["breaks_no_interaction"] = inter.detectable_holm & practical
     return results, inter
 
 
@@ -106,14 +105,11 @@ def verdicts(results: pd.DataFrame, inter: pd.DataFrame) -> dict:
     by_zeta = lin.groupby("zeta").linearisation_rel_error.agg(lambda e: float(e.abs().max()))
     worst = lin.loc[lin.linearisation_rel_error.abs().idxmax()]
     exact = results[(results.fc == 0) & (results.k3 == 0)]
-    z_exact = (exact.power_linearisation - exact.power_mc) / (
-        exact.power_mc_ci95 / special.stdtrit(exact.n_paths - 1, 0.975)
-    )
+    se = exact.power_mc_ci95 / special.stdtrit(exact.n_paths - 1, 0.975)
+    z_exact = (exact.power_linearisation - exact.power_mc) / se
     band = inter[inter.centre != "white"]
-    breaks, largest = (
-        band[band.breaks_no_interaction],
-        band.loc[band.relative_contrast.abs().idxmax()],
-    )
+    breaks = band[band.breaks_no_interaction]
+    largest = band.loc[band.relative_contrast.abs().idxmax()]
     white = results[(results.centre == "white") & (results.fc > 0)]
     return {
         "linearisation": {
@@ -129,10 +125,9 @@ def verdicts(results: pd.DataFrame, inter: pd.DataFrame) -> dict:
             "n_detectable_holm": int(band.detectable_holm.sum()),
             "n_breaks": int(len(breaks)),
             "practical_threshold": PRACTICAL,
-            "breaks": [{"centre": r.centre, "zeta": float(r.zeta), "k3": float(r.k3),
-                        "relative_contrast": float(r.relative_contrast),
-                        "relative_ci95": float(r.relative_ci95)} for r in breaks.itertuples()],
-            "by_k3": {f"{k3:g}": _range_of(sub) for k3, sub in band.groupby("k3")},
+            "breaks": breaks[["centre", "zeta", "k3", "relative_contrast", "relative_ci95"]
+                             ].to_dict("records"),
+            "by_k3": {f"{k3:g}": contrast_range(sub) for k3, sub in band.groupby("k3")},
             "largest_relative_contrast": float(largest.relative_contrast),
             "largest_relative_ci95": float(largest.relative_ci95),
             "where_largest": f"{largest.centre}, zeta = {largest.zeta:g}, k3 = {largest.k3:g}",
@@ -140,47 +135,24 @@ def verdicts(results: pd.DataFrame, inter: pd.DataFrame) -> dict:
                 f"{r.k3:g}": [float(r.relative_contrast), float(r.relative_ci95)]
                 for r in inter[inter.centre == "white"].itertuples()},
             "no_interaction_holds_down_to_zeta": {
-                f"{centre}, k3={k3:g}": _holds_down_to(sub)
+                f"{centre}, k3={k3:g}": holds_down_to(sub)
                 for (centre, k3), sub in band.groupby(["centre", "k3"])},
         },
     }  # fmt: skip
 
 
-def _range_of(sub: pd.DataFrame) -> dict:
-    """Breaks, the contrast's range and where it is smallest in magnitude, for one k3."""
-    small = sub.loc[sub.relative_contrast.abs().idxmin()]
-    return {"n_breaks": int(sub.breaks_no_interaction.sum()), "n_points": int(len(sub)),
-            "min_relative_contrast": float(sub.relative_contrast.min()),
-            "max_relative_contrast": float(sub.relative_contrast.max()),
-            "smallest_abs": float(small.relative_contrast),
-            "smallest_abs_ci95": float(small.relative_ci95),
-            "smallest_abs_where": f"{small.centre}, zeta = {small.zeta:g}"}  # fmt: skip
-
-
-def _holds_down_to(sub: pd.DataFrame) -> float | None:
-    """Narrowest zeta down to which (from the broadest band) no contrast breaks no-interaction."""
-    held = None
-    for row in sub.sort_values("zeta", ascending=False).itertuples():
-        if row.breaks_no_interaction:
-            break
-        held = float(row.zeta)
-    return held
-
-
 # ----------------------------------------------------------------- report
 def setup_section(axes, results, settings, quick, wall) -> str:
     levels = results.drop_duplicates(["centre", "zeta"])[["centre", "f0", "zeta", "level"]]
+    mc = report.ensembles_text(settings, quick, wall, how=" with the filter's two states",
+                               paired="one seed per band, shared by its eight devices")  # fmt: skip
     return (
         "Device: preset `figure9` (c_m = c_e = 0.1 Ns/m, k = 57.4 N/m, m = 0.0226 kg assumed; "
         f"linear resonance 8.02 Hz), Coulomb Fc = 0 and {1e3 * FC:g} mN, k3 = "
         + ", ".join(f"{k:g}" for k in axes["k3s"])
         + " N/m^3. Band-pass input (peak S at f0, half-power bandwidth 2 zeta f0), peak level "
         "matched so that the linear device's E[z'^2] equals that under white noise S = 1 "
-        f"(levels below). Monte Carlo: Heun with the filter's two states, dt = {settings.dt:g} "
-        f"s, {settings.min_paths} paths x {settings.window:g} s after {settings.burn_in:g} s "
-        f"burn-in, seed {settings.seed} (one seed per band, shared by its eight devices: "
-        f"paired). {'Quick mode. ' if quick else ''}Wall time {wall:.0f} s.\n\n"
-        + report.markdown_table(levels, floatfmt=".4g")
+        "(levels below). " + mc + "\n\n" + report.markdown_table(levels, floatfmt=".4g")
     )
 
 
@@ -219,9 +191,8 @@ def interaction_section(inter, v, figure) -> str:
     holds = "; ".join(f"{key}: {'none' if z is None else f'zeta >= {z:g}'}"
                       for key, z in it["no_interaction_holds_down_to_zeta"].items())  # fmt: skip
     shown = inter[["centre", "zeta", "k3"]].copy()
-    shown["contrast / P(Fc,0) (%)"] = report.plus_minus(
-        inter.relative_contrast, inter.relative_ci95
-    )
+    shown["contrast / P(Fc,0) (%)"] = report.plus_minus(inter.relative_contrast,
+                                                        inter.relative_ci95)  # fmt: skip
     shown["linearisation (%)"] = [f"{100 * x:+.2f}" for x in inter.linearisation_relative_contrast]
     shown["spring alone, Fc = 0 (%)"] = [f"{100 * x:+.2f}" for x in inter.spring_alone_relative]
     shown["p"], shown["Holm"] = inter.p_value, inter.detectable_holm

@@ -26,7 +26,8 @@ At the points of a sweep (:func:`randvib.run_sweep`): :func:`method_errors`
 For the cases of a paired run (:func:`randvib.run_ensembles`), any device,
 input and stroke: :func:`methods_against_monte_carlo` (every method's power
 and stroke exceedance against Monte Carlo, or why it refused),
-:func:`method_accuracy` and :func:`accuracy_sentences` (its summary), and
+:func:`method_accuracy` and :func:`accuracy_sentences` (its summary),
+:func:`methods_shown` (its table for a report), and
 :func:`linearisation_against_monte_carlo` (statistical linearisation with its
 equivalent stiffness and damping); :func:`relative_error` is their error.
 """
@@ -48,7 +49,7 @@ from randvib.models.presets import preset
 from randvib.montecarlo.ensembles import Case
 from randvib.montecarlo.step_check import step_bias
 from randvib.montecarlo.sweep import linearisation_verdicts, point_device
-from randvib.studies.report import markdown_table
+from randvib.studies.report import markdown_table, plus_minus
 
 #: Analytic methods: column suffix -> (method name in randvib.METHODS, label).
 ANALYTIC = {
@@ -430,6 +431,17 @@ def methods_against_monte_carlo(result, methods, *, resolved: float = 0.25) -> p
                 row[f"{q}_rel_error"], row[f"{q}_rel_error_ci95"] = error
             rows.append(row)
     return pd.DataFrame(rows)
+
+
+def methods_shown(methods: pd.DataFrame, labels) -> pd.DataFrame:
+    """:func:`methods_against_monte_carlo`'s table for a report: the case's ``labels``, the
+    method, each error ± its half-width in % (blank where not compared) and the refusal."""
+    shown = methods[[*labels, "method"]].copy()
+    for q in ("power", "exceedance"):
+        cells = plus_minus(methods[f"{q}_rel_error"], methods[f"{q}_rel_error_ci95"])
+        shown[f"{q} error (%)"] = ["" if "nan" in c else c for c in cells]
+    shown["refused"] = methods.refused.fillna("").str.slice(0, 60)
+    return shown
 
 
 def method_accuracy(methods: pd.DataFrame, where: str, by: str) -> dict:
