@@ -48,7 +48,7 @@ import pandas as pd
 
 import randvib as rv
 from randvib.studies import budget, figures, report, script_main
-from randvib.studies.grids import fixed_paths, response_matched
+from randvib.studies.grids import fixed_paths, matched_band
 from randvib.studies.methods import (
     accuracy_sentences,
     method_accuracy,
@@ -99,9 +99,7 @@ def input_of(name: str, g: float, base: rv.Harvester | None = None) -> rv.Excita
         return rv.White(g * S_REF)
     if name not in BANDS:
         raise ValueError(f"unknown input {name!r}; available: white, {', '.join(BANDS)}")
-    base = base or rv.preset("figure9")
-    f_n = base.natural_frequency / (2 * np.pi)
-    return response_matched(rv.BandPass(1.0, BANDS[name] * f_n, BAND_ZETA), base, g * S_REF)
+    return matched_band(base or rv.preset("figure9"), BANDS[name], BAND_ZETA, g * S_REF)
 
 
 # ----------------------------------------------------------------- verdicts

@@ -41,7 +41,7 @@ from randvib.figure_style import num_tex
 from randvib.statistics import holm_significant
 from randvib.studies import figures, report, script_main
 from randvib.studies.contrasts import paired_interactions
-from randvib.studies.grids import fixed_paths, response_matched
+from randvib.studies.grids import fixed_paths, matched_band
 from randvib.studies.methods import linearisation_against_monte_carlo
 from randvib.studies.spectra_figure import spectra_against_linearisation
 from randvib.studies.verdicts import contrast_range, holds_down_to
@@ -55,7 +55,7 @@ PRACTICAL = 0.01  #: a contrast below this fraction of P(Fc, 0) is practically a
 QUICK_MC = {"n_paths": 128, "window": 10.0, "burn_in": 1.0, "dt": 2e-4}
 FULL_MC = {"n_paths": 512, "window": 30.0, "burn_in": 1.0, "dt": 2e-4}
 
-__all__ = ["grid", "matched_excitation", "run_study"]
+__all__ = ["grid", "run_study", "verdicts"]
 
 
 def grid(quick: bool) -> dict:
@@ -67,15 +67,10 @@ def grid(quick: bool) -> dict:
             "k3s": (0.0, 5e5, 5e6, 5e7), "mc": FULL_MC}  # fmt: skip
 
 
-def matched_excitation(base: rv.Harvester, centre: str, zeta: float) -> rv.BandPass:
-    """Band-pass noise whose linear response E[z'^2] equals white noise S = 1's, S m / (4 c)."""
-    f_n = base.natural_frequency / (2 * np.pi)
-    return response_matched(rv.BandPass(1.0, CENTRES[centre] * f_n, zeta), base, 1.0)
-
-
 def compute(base, axes, settings, out, workers, scheduler, progress):
     """results.csv (every device and band) and contrasts.csv (every band and k3 > 0)."""
-    bands = [(c, z, matched_excitation(base, c, z)) for c in axes["centres"] for z in axes["zetas"]]
+    bands = [(c, z, matched_band(base, CENTRES[c], z, 1.0)) for c in axes["centres"]
+             for z in axes["zetas"]]  # fmt: skip
     cases = [rv.Case({"centre": c, "f0": getattr(x, "f0", np.nan), "zeta": z, "level": x.level,
                       "fc": fc, "k3": k3}, base.updated(fc=fc, k3=k3), x, group=(c, z))
              for c, z, x in [*bands, ("white", np.inf, rv.White(1.0))]
@@ -229,7 +224,7 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
     fig_lin = figures.error_against_bandwidth(results, CENTRES, out / "linearisation_error.png")
     fig_inter = figures.contrast_against_bandwidth(inter, CENTRES, K3_LABELS,
                                                    out / "interaction.png")  # fmt: skip
-    narrowest = matched_excitation(base, "at", min(axes["zetas"]))
+    narrowest = matched_band(base, CENTRES["at"], min(axes["zetas"]), 1.0)
     spectra_against_linearisation(
         {f"k$_3$ = {num_tex(k3)} N/m$^3$": base.updated(fc=FC, k3=k3)
          for k3 in (0.0, max(axes["k3s"]))}, narrowest, settings, out / "spectra.png",

@@ -5,7 +5,7 @@ phi = Fc / (c sigma_v0) (:func:`friction_level`) and the Duffing strength
 mu = k3 sigma_z0^2 / k (:func:`duffing_strength`), with sigma_v0, sigma_z0 the
 friction-free linear oscillator's rms velocity and displacement (paper Eq. 20).
 Coloured inputs are compared with white noise at equal response
-(:func:`response_matched`).
+(:func:`response_matched`, :func:`matched_band`).
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ import pandas as pd
 
 from randvib.analytic.linear_response import mechanical_block, output_variances
 from randvib.analytic.linearisation import coulomb_equivalent_damping
-from randvib.models.excitation import Excitation
+from randvib.models.excitation import BandPass, Excitation
 from randvib.models.harvester import Harvester
 from randvib.montecarlo.sweep import SweepSettings, cartesian, point_device
 
@@ -172,6 +172,13 @@ def response_matched(shape: Excitation, device: Harvester, psd: float) -> Excita
     linear = output_variances(mechanical_block(device.m, device.c, device.k), shape)["v"]
     level = shape.level * psd * device.m / (4 * device.c) / linear
     return type(shape)(level, shape.f0, shape.zeta)
+
+
+def matched_band(device: Harvester, centre: float, zeta: float, psd: float) -> BandPass:
+    """Band-pass noise centred at ``centre`` times ``device``'s linear natural frequency, with
+    damping ratio ``zeta``, at the level of :func:`response_matched` to white noise ``psd``."""
+    f_n = device.natural_frequency / (2 * np.pi)
+    return response_matched(BandPass(1.0, centre * f_n, zeta), device, psd)
 
 
 def fixed_paths(
