@@ -76,7 +76,7 @@ _EXPORTS = {
     "randvib.models.record": ("read_record", "Record"),
     "randvib.montecarlo.on_record": ("RecordSimulation", "monte_carlo_on_record"),
     "randvib.montecarlo.spectra": ("SampledSpectra",),
-    "randvib.montecarlo.sweep": ("run_sweep", "SweepSettings"),
+    "randvib.montecarlo.sweep": ("linearisation_verdicts", "run_sweep", "SweepSettings"),
     "randvib.montecarlo.ensembles": ("Case", "EnsembleResult", "run_ensembles"),
     "randvib.studies.spectra_figure": ("plot_response_spectra",),
     "randvib.studies.transient_figure": ("plot_transient",),

@@ -28,14 +28,13 @@ variance is not used: white noise has none.
 **Measured** by Monte Carlo (Heun, the band's filter states with the device,
 the three devices of a level on the same paths: paired), from rest at a
 stable equilibrium (z = 0; z = +z_w for the bistable device): E[P_e], the
-fraction of time with |z| > stroke and the first time |z| reaches it
-(censored at the end of the run: the mean only when every path reached it,
-else E[min(tau, t_end)], a lower bound, and the median when more than half
-did). **Predicted** by statistical linearisation, fpk-fast and fpk (white
-noise) and stochastic averaging (white noise, monostable), each against
-Monte Carlo with the relative error's 95 % interval. **The trade-off**: the
-power at ``BUDGET`` = 1 % of the time beyond the gap, interpolated over the
-levels (:mod:`randvib.studies.budget`).
+fraction of time with |z| > stroke and the first time |z| reaches it,
+censored at the end of the run (:func:`randvib.studies.budget.stroke_results`).
+**Predicted** by statistical linearisation, fpk-fast and fpk (white noise)
+and stochastic averaging (white noise, monostable), each against Monte Carlo
+with the relative error's 95 % interval. **The trade-off**: the power at
+``BUDGET`` = 1 % of the time beyond the gap, interpolated over the levels
+(:mod:`randvib.studies.budget`).
 """
 
 from __future__ import annotations
@@ -49,8 +48,13 @@ import pandas as pd
 
 import randvib as rv
 from randvib.studies import budget, figures, report, script_main
-from randvib.studies.grids import fixed_paths, response_matched
-from randvib.studies.methods import accuracy_sentences, method_accuracy, methods_against_monte_carlo
+from randvib.studies.grids import fixed_paths, matched_band
+from randvib.studies.methods import (
+    accuracy_sentences,
+    method_accuracy,
+    methods_against_monte_carlo,
+    methods_shown,
+)
 
 NAME = "devices"
 FC = 0.0058  #: N, the paper's Coulomb level (Table 2, training data 1)
@@ -95,30 +99,7 @@ def input_of(name: str, g: float, base: rv.Harvester | None = None) -> rv.Excita
         return rv.White(g * S_REF)
     if name not in BANDS:
         raise ValueError(f"unknown input {name!r}; available: white, {', '.join(BANDS)}")
-    base = base or rv.preset("figure9")
-    f_n = base.natural_frequency / (2 * np.pi)
-    return response_matched(rv.BandPass(1.0, BANDS[name] * f_n, BAND_ZETA), base, g * S_REF)
-
-
-def compute(axes, settings, out, workers, scheduler, progress):
-    """results.csv (device x input x level) and methods.csv (the same x method)."""
-    cases = [rv.Case({"input": name, "g": g, "level": input_of(name, g).level, "device": dev},
-                     device, input_of(name, g), group=(name, g), initial=start)
-             for name in axes["inputs"] for g in axes["levels"]
-             for dev, (device, start) in devices().items()]  # fmt: skip
-    run = rv.run_ensembles(cases, settings, out_dir=out / "ensembles", workers=workers,
-                           scheduler=scheduler, progress=progress, name=NAME)  # fmt: skip
-    t, ratio = run.table, run.paired_ratios(device="linear")
-    results = t[["input", "g", "level", "device"]].assign(
-        power_mc=t.power_electrical, power_mc_ci95=t.power_electrical_ci95, n_paths=t.n_paths,
-        exceedance_mc=t.stroke_exceedance, exceedance_mc_ci95=t.stroke_exceedance_ci95,
-        z_rms_mc=np.sqrt(t.displacement_variance), fp_paths_reached=t.first_passage_reached,
-        fp_n_paths=t.n_paths, fp_horizon=t.first_passage_horizon, fp_mean=t.first_passage_mean,
-        fp_mean_ci95=t.first_passage_mean_ci95, fp_restricted_mean=t.first_passage_restricted_mean,
-        fp_restricted_ci95=t.first_passage_restricted_mean_ci95, fp_median=t.first_passage_median,
-        power_ratio_to_linear=ratio.ratio, power_ratio_ci95=ratio.ratio_ci95,
-    )  # fmt: skip
-    return results, methods_against_monte_carlo(run, axes["methods"], resolved=RESOLVED)
+    return matched_band(base or rv.preset("figure9"), BANDS[name], BAND_ZETA, g * S_REF)
 
 
 # ----------------------------------------------------------------- verdicts
@@ -179,6 +160,9 @@ def setup_section(axes, results, settings, quick, wall) -> str:
     rows = [{"device": name, "k (N/m)": d.k, "k3 (N/m^3)": d.k3, "start z0 (mm)": 1e3 * z0,
              "kind": d.potential.kind} for name, (d, (z0, _)) in devices().items()]  # fmt: skip
     levels = results.drop_duplicates(["input", "g"])[["input", "g", "level"]]
+    mc = report.ensembles_text(
+        settings, quick, wall, start=", from rest at a stable equilibrium",
+        paired="one seed per input and level, shared by the three devices")  # fmt: skip
     return (
         "Same magnet, damping, circuit and friction (figure9: m = 0.0226 kg, c_m = c_e = 0.1 Ns/m, "
         f"resistive, Coulomb Fc = {1e3 * FC:g} mN); the spring differs (module docstring: the "
@@ -186,11 +170,7 @@ def setup_section(axes, results, settings, quick, wall) -> str:
         f"motion's energy scale at the reference level). Gap {1e3 * STROKE:g} mm for all. "
         "Levels g scale the input so that the power injected into the linear friction-free "
         "device is g S_ref m / 4 with S_ref = 1 (m/s^2)^2/Hz: white S = g; band-pass inputs "
-        f"(damping ratio {BAND_ZETA:g}) have the peak level below. Monte Carlo: Heun, dt = "
-        f"{settings.dt:g} s, {settings.min_paths} paths x {settings.window:g} s after "
-        f"{settings.burn_in:g} s burn-in, from rest at a stable equilibrium, one seed per input "
-        f"and level shared by the three devices (paired; seed {settings.seed}). "
-        f"{'Quick mode. ' if quick else ''}Wall time {wall:.0f} s.\n\n"
+        f"(damping ratio {BAND_ZETA:g}) have the peak level below. {mc}\n\n"
         + report.markdown_table(pd.DataFrame(rows), floatfmt=".4g") + "\n\n"
         + report.markdown_table(levels, floatfmt=".4g")
     )  # fmt: skip
@@ -204,15 +184,7 @@ def power_section(results, v, figure) -> str:
                                     ".3f")  # fmt: skip
     shown["beyond gap (%)"] = pm(results.exceedance_mc, results.exceedance_mc_ci95, 100.0, ".3g")
     shown["z_rms (mm)"] = 1e3 * results.z_rms_mc
-    shown["reached"] = [f"{a}/{b}" for a, b in zip(results.fp_paths_reached, results.fp_n_paths,
-                                                   strict=True)]  # fmt: skip
-    shown["mean first time (s)"] = [
-        f"{r.fp_mean:.3g} ± {r.fp_mean_ci95:.2g}" if np.isfinite(r.fp_mean)
-        else f">= {r.fp_restricted_mean:.3g} ± {r.fp_restricted_ci95:.2g}"
-        for r in results.itertuples()
-    ]  # fmt: skip
-    shown["median (s)"] = [f"{m:.3g}" if np.isfinite(m) else f"> {h:g}"
-                           for m, h in zip(results.fp_median, results.fp_horizon, strict=True)]  # fmt: skip
+    shown = shown.join(budget.first_passage_cells(results))
     return (
         f"![power against exceedance]({figure.name})\n\n**Verdict.** {answer(v)}\n\n"
         "First passage from rest: the mean is shown only when every path reached the gap; "
@@ -226,12 +198,7 @@ def power_section(results, v, figure) -> str:
 def budget_section(results, v) -> str:
     table = budget.budget_table(results, BUDGET)
     shown = table[["input", "device", "bracket"]].assign(**{"g at budget": table.g})
-    shown["E[P_e] at budget (mW)"] = [
-        f"{1e3 * p:.4g} [{1e3 * lo:.4g}, {1e3 * hi:.4g}]"
-        for p, lo, hi in zip(table.power, table.power_low, table.power_high, strict=True)
-    ]
-    shown["/ linear"] = [f"{budget.bound_mark(v['at_budget'][r.input][r.device])}"
-                         f"{r.ratio_to_linear:.3g}" for r in table.itertuples()]  # fmt: skip
+    shown = shown.join(budget.budget_cells(table, v["at_budget"]))
     return (
         f"Power at the budget of {100 * BUDGET:g} % of the time beyond the {1e3 * STROKE:g} mm gap "
         "(log-log interpolation over the levels; brackets: the same through the exceedance's "
@@ -241,11 +208,7 @@ def budget_section(results, v) -> str:
 
 
 def methods_section(methods, v, figure) -> str:
-    shown = methods[["input", "g", "device", "method"]].copy()
-    for q in ("power", "exceedance"):
-        cells = report.plus_minus(methods[f"{q}_rel_error"], methods[f"{q}_rel_error_ci95"])
-        shown[f"{q} error (%)"] = ["" if "nan" in c else c for c in cells]  # not compared
-    shown["refused"] = methods.refused.fillna("").str.slice(0, 60)
+    shown = methods_shown(methods, ["input", "g", "device"])
     return (
         f"![method errors]({figure.name})\n\n**Verdict.**\n\n"
         + "\n".join(accuracy_sentences(v["methods"], by="device")) + "\n\nExceedance is compared "
@@ -267,7 +230,14 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
     settings = fixed_paths(**axes["mc"], seed=seed)
     out = report.prepare_output_dir(out_dir, {"study": NAME, "quick": quick, "seed": seed, **axes})
     started = time.perf_counter()
-    results, methods = compute(axes, settings, out, workers, scheduler, progress)
+    cases = [rv.Case({"input": name, "g": g, "level": input_of(name, g).level, "device": dev},
+                     device, input_of(name, g), group=(name, g), initial=start)
+             for name in axes["inputs"] for g in axes["levels"]
+             for dev, (device, start) in devices().items()]  # fmt: skip
+    run = rv.run_ensembles(cases, settings, out_dir=out / "ensembles", workers=workers,
+                           scheduler=scheduler, progress=progress, name=NAME)  # fmt: skip
+    results = budget.stroke_results(run, ["input", "g", "level", "device"], device="linear")
+    methods = methods_against_monte_carlo(run, axes["methods"], resolved=RESOLVED)
     report.write_table(out, "results.csv", results)
     report.write_table(out, "methods.csv", methods)
     v = verdicts(results, methods)

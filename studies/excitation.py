@@ -41,9 +41,10 @@ from randvib.figure_style import num_tex
 from randvib.statistics import holm_significant
 from randvib.studies import figures, report, script_main
 from randvib.studies.contrasts import paired_interactions
-from randvib.studies.grids import fixed_paths, response_matched
+from randvib.studies.grids import fixed_paths, matched_band
 from randvib.studies.methods import linearisation_against_monte_carlo
 from randvib.studies.spectra_figure import spectra_against_linearisation
+from randvib.studies.verdicts import contrast_range, holds_down_to
 
 NAME = "excitation"
 FC = 0.0058  #: N, the paper's Coulomb level (Table 2, training data 1)
@@ -54,7 +55,7 @@ PRACTICAL = 0.01  #: a contrast below this fraction of P(Fc, 0) is practically a
 QUICK_MC = {"n_paths": 128, "window": 10.0, "burn_in": 1.0, "dt": 2e-4}
 FULL_MC = {"n_paths": 512, "window": 30.0, "burn_in": 1.0, "dt": 2e-4}
 
-__all__ = ["grid", "matched_excitation", "run_study"]
+__all__ = ["grid", "run_study", "verdicts"]
 
 
 def grid(quick: bool) -> dict:
@@ -66,15 +67,10 @@ def grid(quick: bool) -> dict:
             "k3s": (0.0, 5e5, 5e6, 5e7), "mc": FULL_MC}  # fmt: skip
 
 
-def matched_excitation(base: rv.Harvester, centre: str, zeta: float) -> rv.BandPass:
-    """Band-pass noise whose linear response E[z'^2] equals white noise S = 1's, S m / (4 c)."""
-    f_n = base.natural_frequency / (2 * np.pi)
-    return response_matched(rv.BandPass(1.0, CENTRES[centre] * f_n, zeta), base, 1.0)
-
-
 def compute(base, axes, settings, out, workers, scheduler, progress):
     """results.csv (every device and band) and contrasts.csv (every band and k3 > 0)."""
-    bands = [(c, z, matched_excitation(base, c, z)) for c in axes["centres"] for z in axes["zetas"]]
+    bands = [(c, z, matched_band(base, CENTRES[c], z, 1.0)) for c in axes["centres"]
+             for z in axes["zetas"]]  # fmt: skip
     cases = [rv.Case({"centre": c, "f0": getattr(x, "f0", np.nan), "zeta": z, "level": x.level,
                       "fc": fc, "k3": k3}, base.updated(fc=fc, k3=k3), x, group=(c, z))
              for c, z, x in [*bands, ("white", np.inf, rv.White(1.0))]
@@ -89,13 +85,11 @@ def compute(base, axes, settings, out, workers, scheduler, progress):
         run, "fc", "k3", predicted={"linearisation": results.power_linearisation}
     )
     inter = inter.rename(columns={"k3_alone_relative": "spring_alone_relative"})
-    banded = inter.centre != "white"
-    inter["detectable"] = inter.p_value < 0.05
-    inter["detectable_holm"] = False
+    banded = inter.centre != "white"  # Holm's family: the bands (white noise is the reference)
+    inter["detectable"], inter["detectable_holm"] = inter.p_value < 0.05, False
     inter.loc[banded, "detectable_holm"] = holm_significant(inter.p_value[banded])
-    inter["breaks_no_interaction"] = inter.detectable_holm & (
-        inter.relative_contrast.abs() >= PRACTICAL
-    )
+    practical = inter.relative_contrast.abs() >= PRACTICAL
+    inter["breaks_no_interaction"] = inter.detectable_holm & practical
     return results, inter
 
 
@@ -106,14 +100,11 @@ def verdicts(results: pd.DataFrame, inter: pd.DataFrame) -> dict:
     by_zeta = lin.groupby("zeta").linearisation_rel_error.agg(lambda e: float(e.abs().max()))
     worst = lin.loc[lin.linearisation_rel_error.abs().idxmax()]
     exact = results[(results.fc == 0) & (results.k3 == 0)]
-    z_exact = (exact.power_linearisation - exact.power_mc) / (
-        exact.power_mc_ci95 / special.stdtrit(exact.n_paths - 1, 0.975)
-    )
+    se = exact.power_mc_ci95 / special.stdtrit(exact.n_paths - 1, 0.975)
+    z_exact = (exact.power_linearisation - exact.power_mc) / se
     band = inter[inter.centre != "white"]
-    breaks, largest = (
-        band[band.breaks_no_interaction],
-        band.loc[band.relative_contrast.abs().idxmax()],
-    )
+    breaks = band[band.breaks_no_interaction]
+    largest = band.loc[band.relative_contrast.abs().idxmax()]
     white = results[(results.centre == "white") & (results.fc > 0)]
     return {
         "linearisation": {
@@ -129,10 +120,9 @@ def verdicts(results: pd.DataFrame, inter: pd.DataFrame) -> dict:
             "n_detectable_holm": int(band.detectable_holm.sum()),
             "n_breaks": int(len(breaks)),
             "practical_threshold": PRACTICAL,
-            "breaks": [{"centre": r.centre, "zeta": float(r.zeta), "k3": float(r.k3),
-                        "relative_contrast": float(r.relative_contrast),
-                        "relative_ci95": float(r.relative_ci95)} for r in breaks.itertuples()],
-            "by_k3": {f"{k3:g}": _range_of(sub) for k3, sub in band.groupby("k3")},
+            "breaks": breaks[["centre", "zeta", "k3", "relative_contrast", "relative_ci95"]
+                             ].to_dict("records"),
+            "by_k3": {f"{k3:g}": contrast_range(sub) for k3, sub in band.groupby("k3")},
             "largest_relative_contrast": float(largest.relative_contrast),
             "largest_relative_ci95": float(largest.relative_ci95),
             "where_largest": f"{largest.centre}, zeta = {largest.zeta:g}, k3 = {largest.k3:g}",
@@ -140,47 +130,24 @@ def verdicts(results: pd.DataFrame, inter: pd.DataFrame) -> dict:
                 f"{r.k3:g}": [float(r.relative_contrast), float(r.relative_ci95)]
                 for r in inter[inter.centre == "white"].itertuples()},
             "no_interaction_holds_down_to_zeta": {
-                f"{centre}, k3={k3:g}": _holds_down_to(sub)
+                f"{centre}, k3={k3:g}": holds_down_to(sub)
                 for (centre, k3), sub in band.groupby(["centre", "k3"])},
         },
     }  # fmt: skip
 
 
-def _range_of(sub: pd.DataFrame) -> dict:
-    """Breaks, the contrast's range and where it is smallest in magnitude, for one k3."""
-    small = sub.loc[sub.relative_contrast.abs().idxmin()]
-    return {"n_breaks": int(sub.breaks_no_interaction.sum()), "n_points": int(len(sub)),
-            "min_relative_contrast": float(sub.relative_contrast.min()),
-            "max_relative_contrast": float(sub.relative_contrast.max()),
-            "smallest_abs": float(small.relative_contrast),
-            "smallest_abs_ci95": float(small.relative_ci95),
-            "smallest_abs_where": f"{small.centre}, zeta = {small.zeta:g}"}  # fmt: skip
-
-
-def _holds_down_to(sub: pd.DataFrame) -> float | None:
-    """Narrowest zeta down to which (from the broadest band) no contrast breaks no-interaction."""
-    held = None
-    for row in sub.sort_values("zeta", ascending=False).itertuples():
-        if row.breaks_no_interaction:
-            break
-        held = float(row.zeta)
-    return held
-
-
 # ----------------------------------------------------------------- report
 def setup_section(axes, results, settings, quick, wall) -> str:
     levels = results.drop_duplicates(["centre", "zeta"])[["centre", "f0", "zeta", "level"]]
+    mc = report.ensembles_text(settings, quick, wall, how=" with the filter's two states",
+                               paired="one seed per band, shared by its eight devices")  # fmt: skip
     return (
         "Device: preset `figure9` (c_m = c_e = 0.1 Ns/m, k = 57.4 N/m, m = 0.0226 kg assumed; "
         f"linear resonance 8.02 Hz), Coulomb Fc = 0 and {1e3 * FC:g} mN, k3 = "
         + ", ".join(f"{k:g}" for k in axes["k3s"])
         + " N/m^3. Band-pass input (peak S at f0, half-power bandwidth 2 zeta f0), peak level "
         "matched so that the linear device's E[z'^2] equals that under white noise S = 1 "
-        f"(levels below). Monte Carlo: Heun with the filter's two states, dt = {settings.dt:g} "
-        f"s, {settings.min_paths} paths x {settings.window:g} s after {settings.burn_in:g} s "
-        f"burn-in, seed {settings.seed} (one seed per band, shared by its eight devices: "
-        f"paired). {'Quick mode. ' if quick else ''}Wall time {wall:.0f} s.\n\n"
-        + report.markdown_table(levels, floatfmt=".4g")
+        "(levels below). " + mc + "\n\n" + report.markdown_table(levels, floatfmt=".4g")
     )
 
 
@@ -219,9 +186,8 @@ def interaction_section(inter, v, figure) -> str:
     holds = "; ".join(f"{key}: {'none' if z is None else f'zeta >= {z:g}'}"
                       for key, z in it["no_interaction_holds_down_to_zeta"].items())  # fmt: skip
     shown = inter[["centre", "zeta", "k3"]].copy()
-    shown["contrast / P(Fc,0) (%)"] = report.plus_minus(
-        inter.relative_contrast, inter.relative_ci95
-    )
+    shown["contrast / P(Fc,0) (%)"] = report.plus_minus(inter.relative_contrast,
+                                                        inter.relative_ci95)  # fmt: skip
     shown["linearisation (%)"] = [f"{100 * x:+.2f}" for x in inter.linearisation_relative_contrast]
     shown["spring alone, Fc = 0 (%)"] = [f"{100 * x:+.2f}" for x in inter.spring_alone_relative]
     shown["p"], shown["Holm"] = inter.p_value, inter.detectable_holm
@@ -258,7 +224,7 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
     fig_lin = figures.error_against_bandwidth(results, CENTRES, out / "linearisation_error.png")
     fig_inter = figures.contrast_against_bandwidth(inter, CENTRES, K3_LABELS,
                                                    out / "interaction.png")  # fmt: skip
-    narrowest = matched_excitation(base, "at", min(axes["zetas"]))
+    narrowest = matched_band(base, CENTRES["at"], min(axes["zetas"]), 1.0)
     spectra_against_linearisation(
         {f"k$_3$ = {num_tex(k3)} N/m$^3$": base.updated(fc=FC, k3=k3)
          for k3 in (0.0, max(axes["k3s"]))}, narrowest, settings, out / "spectra.png",

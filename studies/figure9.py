@@ -17,15 +17,16 @@ from __future__ import annotations
 
 import sys
 
-import numpy as np
-import pandas as pd
-
 import randvib as rv
-from randvib.montecarlo.sweep import SweepSettings, linearisation_verdicts
 from randvib.studies import figures, script_main
-from randvib.studies.contrasts import interaction_contrasts
+from randvib.studies.contrasts import interaction_contrasts, predicted_power_curves
 from randvib.studies.grids import coulomb_grid, highest_friction_points
-from randvib.studies.half_step import half_step_verdict, sweep_with_half_step
+from randvib.studies.half_step import (
+    check_step_bias,
+    half_step_section,
+    half_step_verdict,
+    sweep_with_half_step,
+)
 from randvib.studies.report import (
     markdown_table,
     prepare_output_dir,
@@ -45,10 +46,10 @@ def study_points(n_fc: int) -> list[dict]:
     return coulomb_grid(rv.preset("figure9"), PSDS, K3S, n_fc)
 
 
-def settings_for(quick: bool, seed: int) -> SweepSettings:
+def settings_for(quick: bool, seed: int) -> rv.SweepSettings:
     # 128 paths at least, quick mode too: the paired interaction contrasts use
     # eight control variates and need ten paths per control (sweep.paired_contrast)
-    return SweepSettings(
+    return rv.SweepSettings(
         target_rel_ci=0.01 if quick else 0.005,
         window=1.0 if quick else 2.0,
         burn_in=0.5,
@@ -56,19 +57,6 @@ def settings_for(quick: bool, seed: int) -> SweepSettings:
         min_paths=128,
         batch_paths=64,
     )
-
-
-def eq32_curves(base, table: pd.DataFrame) -> pd.DataFrame:
-    """Eq. 32 on a fine Fc grid per (S, k3), for ``curves.csv``."""
-    curves = []
-    for psd in PSDS:
-        for k3 in K3S:
-            fc = np.linspace(0, table[table.psd == psd].fc.max(), 200)
-            power = rv.expected_power(base.updated(k3=k3, fc=fc), psd)
-            curves.append(
-                pd.DataFrame({"psd": psd, "k3": k3, "fc": fc, "linearisation_power": power})
-            )
-    return pd.concat(curves)
 
 
 def linearisation_section(table, settings, lin_data, lin_sentence) -> str:
@@ -110,15 +98,6 @@ def interaction_section(inter, inter_data, inter_sentence, figure) -> str:
     )
 
 
-def step_section(check, settings, check_data) -> str:
-    return (
-        f"Re-run of {len(check)} highest-friction points at dt/2 = {settings.dt / 2:g} s (independent "
-        f"noise). Time-step bias below statistical error at {check_data['n_below']} of "
-        f"{check_data['n_points']} points"
-        f"{check_data['sentence']}.\n\n" + markdown_table(readable_table(check))
-    )
-
-
 def setup_section(settings, seed, quick, figure) -> str:
     return (
         f"Device: paper Section 5 (preset `figure9`: c_m = c_e = 0.1 Ns/m, k = 57.4 N/m, "
@@ -135,60 +114,50 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
     base = rv.preset("figure9")
     points = study_points(7 if quick else 13)
     settings = settings_for(quick, seed)
+    worst_bias = check_step_bias(base, points, settings)
     out = prepare_output_dir(out_dir, {"study": "figure9", "quick": quick, "seed": seed})
 
     # compute: the sweep, and a half-step re-run where the nonlinearity is largest
     result, check = sweep_with_half_step(
-        base,
-        points,
-        settings,
-        out,
-        "figure9",
-        highest_friction_points(points),
-        workers=workers,
-        scheduler=scheduler,
-        progress=progress,
-    )
-    table = linearisation_verdicts(result.table)
+        base, points, settings, out, "figure9", highest_friction_points(points),
+        workers=workers, scheduler=scheduler, progress=progress,
+    )  # fmt: skip
+    table = rv.linearisation_verdicts(result.table)
     inter = interaction_contrasts(result, base, "fc", "k3")
+    fc_max = {psd: table[table.psd == psd].fc.max() for psd in PSDS}
 
     # tables and figures
     write_table(out, "results.csv", table)
     write_table(out, "interaction.csv", inter)
     write_table(out, "step_check.csv", check)
-    write_table(out, "curves.csv", eq32_curves(base, table))
+    write_table(out, "curves.csv", predicted_power_curves(base, PSDS, K3S, fc_max))
     fig_main = figures.power_against_friction(table, base, PSDS, K3S, out / "figure9.png")
     fig_inter = figures.contrast_against_friction(
-        inter,
-        "Duffing-Coulomb interaction at k$_3$ = 5 × 10$^5$ N/m$^3$",
-        out / "interaction.png",
+        inter, "Duffing-Coulomb interaction at k$_3$ = 5 × 10$^5$ N/m$^3$", out / "interaction.png"
     )
 
     # verdicts and report
     lin_data, lin_sentence = linearisation_verdict(table)
     inter_data, inter_sentence = interaction_verdict(inter, K3S[1])
-    check_data = half_step_verdict(check)
     write_verdicts(
         out,
-        {"linearisation": lin_data, "interaction": inter_data, "step_check": check_data},
+        {"linearisation": lin_data, "interaction": inter_data, "step_check": half_step_verdict(check)},
         [lin_sentence, "Interaction at the paper's k3: " + inter_sentence],
-    )
+    )  # fmt: skip
+    top = ", ".join(f"{k3:.3g}" for k3 in K3S)
     return write_report(
         out,
         "Figure 9 study: equivalent linearisation and the Duffing-Coulomb interaction",
         [
             ("Set-up", setup_section(settings, seed, quick, fig_main)),
-            (
-                "Equivalent linearisation against Monte Carlo",
-                linearisation_section(table, settings, lin_data, lin_sentence),
-            ),
-            (
-                "Duffing-Coulomb interaction",
-                interaction_section(inter, inter_data, inter_sentence, fig_inter),
-            ),
-            ("Time-step check", step_section(check, settings, check_data)),
+            ("Equivalent linearisation against Monte Carlo",
+             linearisation_section(table, settings, lin_data, lin_sentence)),
+            ("Duffing-Coulomb interaction",
+             interaction_section(inter, inter_data, inter_sentence, fig_inter)),
+            ("Time-step check", half_step_section(
+                check, settings, f"the highest Fc at each S, with k3 = {top}", worst_bias)),
         ],
-    )
+    )  # fmt: skip
 
 
 if __name__ == "__main__":

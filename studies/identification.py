@@ -32,27 +32,7 @@ import numpy as np
 import pandas as pd
 
 import randvib as rv
-from randvib._io import dumps, write_tracked
-from randvib.figure_style import save_figure
-from randvib.identification.plots import figure_costs, figure_fit
-from randvib.models.presets import ALPHA, R_COIL
-from randvib.studies import script_main
-from randvib.studies.campaign import (
-    cost_matrix,
-    cost_table,
-    identify_cached,
-    parameter_table,
-    recovery_table,
-    share_near_zero,
-    synthetic_record,
-)
-from randvib.studies.report import (
-    markdown_table,
-    prepare_output_dir,
-    write_report,
-    write_table,
-    write_verdicts,
-)
+from randvib.studies import campaign, report, script_main
 
 #: The paper's four models (Table 2). Not identification.MODELS: that lists
 #: every registered friction law, including ones a user defines later.
@@ -72,20 +52,12 @@ WARMUP = 2.0  # s simulated before each record starts
 #: The search runs on each record's first 3 s (the polish on all of it).
 SEARCH_SAMPLES = 3000
 LOW_RMS = 0.3  # m/s^2, Figure 8 at a level where the magnet sticks often
-SIMULATED, MEASURED = "share |V| < 0.5 mV, simulated", "share |V| < 0.5 mV, measured"
 
-__all__ = [
-    "MEASURED",
-    "SIMULATED",
-    "TEST_RMS",
-    "TRUTH",
-    "figure8_verdict",
-    "make_test",
-    "run_study",
-]
+__all__ = ["TEST_RMS", "TRUTH", "figure8_verdict", "make_test", "run_study", "settings_for"]
 
 
-def _settings(quick: bool) -> dict:
+def settings_for(quick: bool) -> dict:
+    """Record length and rate, SaDE population and generations, record sub-steps."""
     # The search only has to find the basin: the least-squares polish that
     # follows identify's search reaches the optimum (popsize 50 x 200
     # generations before the polish existed).
@@ -94,76 +66,15 @@ def _settings(quick: bool) -> dict:
     return dict(duration=10.0, fs=1000.0, popsize=30, generations=60, substeps=4)
 
 
-def make_test(number: int, *, duration, fs, seed, noise=True, electrical=None, rms=None):
+def make_test(number, *, duration, fs, seed, noise=True, electrical=None, rms=None):
     """Synthetic test ``number`` (1-9), or at RMS ``rms``: (Record, true relative velocity)."""
     rms = TEST_RMS[number - 1] if rms is None else rms
     name = (f"test{number}" if rms == TEST_RMS[number - 1] else f"{rms:g} m/s^2") + (
         "" if noise else "-noise-free"
     )
-    return synthetic_record(
-        TRUTH,
-        rms,
-        duration=duration,
-        fs=fs,
-        rng=np.random.default_rng([seed, number]),
-        name=name,
-        warmup=WARMUP,
-        electrical=electrical,
-        noise=(BASE_NOISE, LASER_NOISE, VOLTAGE_NOISE) if noise else None,
-    )
-
-
-# ----------------------------------------------------------------- compute
-def identify_all(tests, out: Path, settings, seed, progress) -> dict:
-    """Every model identified on every training test: {(test, model): result}, cached."""
-    (out / "fits").mkdir(exist_ok=True)
-    fits = {}
-    for train in TRAINING_TESTS:
-        for model in MODELS:
-            fits[(train, model)] = identify_cached(
-                out / "fits" / f"test{train}-{model}.json",
-                tests[train],
-                model,
-                m=TRUTH["m"],
-                seed=seed,
-                substeps=settings["substeps"],
-                lowpass=LOWPASS,
-                popsize=settings["popsize"],
-                maxiter=settings["generations"],
-                search_samples=SEARCH_SAMPLES,
-                progress=progress,
-            )
-    return fits
-
-
-def figure8(fits, electrical, common, out: Path) -> pd.DataFrame:
-    """Load voltage with the coil at test 6 and the low level; one figure per model."""
-    rows = []
-    for label, rms in (("test 6", None), ("low level", LOW_RMS)):
-        wired, _ = make_test(6, electrical=electrical, rms=rms, **common)
-        level = TEST_RMS[5] if rms is None else rms
-        for model in ("coulomb", "viscous"):
-            pred = fits[(3, model)].predict(wired, electrical=electrical)
-            tag = "test6" if rms is None else "low"
-            figure = figure_fit(
-                pred,
-                window=(0, 2),
-                scale=1e3,
-                unit="mm",
-                title=f"{label} ({level:g} m s$^{{-2}}$ RMS), coil with R$_L$ = {R_LOAD:g} Ω: "
-                f"{model} model identified on test 3",
-            )
-            save_figure(figure, out / f"figure8_{tag}_{model}.png")
-            rows.append(
-                {
-                    "excitation": f"{label}, {level:g} m/s^2",
-                    "model": model,
-                    "J": pred.cost,
-                    SIMULATED: share_near_zero(pred.voltage),
-                    MEASURED: share_near_zero(wired.voltage),
-                }
-            )
-    return pd.DataFrame(rows)
+    noise = (BASE_NOISE, LASER_NOISE, VOLTAGE_NOISE) if noise else None
+    return campaign.shaker_test(TRUTH, rms, number, seed=seed, duration=duration, fs=fs,
+                                name=name, warmup=WARMUP, electrical=electrical, noise=noise)  # fmt: skip
 
 
 def figure8_verdict(fig8: pd.DataFrame) -> str:
@@ -173,7 +84,7 @@ def figure8_verdict(fig8: pd.DataFrame) -> str:
     level, with the simulated and measured shares.
     """
     levels = list(dict.fromkeys(fig8.excitation))
-    measured = {e: float(fig8[fig8.excitation == e][MEASURED].iloc[0]) for e in levels}
+    measured = {e: float(fig8[fig8.excitation == e][campaign.MEASURED].iloc[0]) for e in levels}
     test6, low = levels[0], levels[-1]
     inertia = TRUTH["m"] * TEST_RMS[5]
     text = (
@@ -185,7 +96,7 @@ def figure8_verdict(fig8: pd.DataFrame) -> str:
         text += ": the spike at zero volts caused by sticking is clearer at the low level."
     else:
         text += ": the low level shows no clearer spike at zero volts."
-    sim = fig8[fig8.excitation == low].set_index("model")[SIMULATED]
+    sim = fig8[fig8.excitation == low].set_index("model")[campaign.SIMULATED]
     visc, coul, meas = float(sim["viscous"]), float(sim["coulomb"]), measured[low]
     if abs(visc - meas) > abs(coul - meas):
         text += (
@@ -220,11 +131,12 @@ def setup_text(settings, seed, quick, elapsed) -> str:
 
 def voltage_section(fig8, electrical, sentence) -> str:
     return (
-        f"Test 6 repeated with the coil: alpha = {ALPHA} Wb/m, R_C = {R_COIL} ohm, "
+        f"Test 6 repeated with the coil: alpha = {electrical.alpha:g} Wb/m, R_C = "
+        f"{electrical.r_coil:g} ohm, "
         f"R_L = {R_LOAD:g} ohm (c_e = {electrical.electrical_damping:.4g} Ns/m added to the "
         "identified c). Share of samples with |V| < 0.5 mV (the spike at zero volts caused by "
         "sticking; the measured voltage carries 0.1 mV RMS noise):\n\n"
-        + markdown_table(fig8, ".3g")
+        + report.markdown_table(fig8, ".3g")
         + f"\n\n{sentence}\n\n"
         "![Figure 8, test 6, Coulomb](figure8_test6_coulomb.png)\n\n"
         "![Figure 8, low level, Coulomb](figure8_low_coulomb.png)\n\n"
@@ -234,54 +146,22 @@ def voltage_section(fig8, electrical, sentence) -> str:
     )
 
 
-def write_records(tests, out: Path) -> None:
-    """The synthetic records as ``records/testN.csv`` (usable with ``randvib identify``)."""
-    (out / "records").mkdir(exist_ok=True)
-    for n, rec in tests.items():
-        if not (out / "records" / f"test{n}.csv").exists():
-            rec.to_csv(out / "records" / f"test{n}.csv")
-
-
-def noise_free_fit(common, settings, seed, progress):
-    """The Coulomb model identified on a noise-free test 3: exact recovery expected."""
-    clean, _ = make_test(3, noise=False, **common)
-    return rv.identify(
-        clean,
-        "coulomb",
-        m=TRUTH["m"],
-        seed=seed,
-        substeps=settings["substeps"],
-        popsize=settings["popsize"],
-        maxiter=settings["generations"],
-        progress=progress,
-    )
-
-
-def figure7(costs: pd.DataFrame, path: Path) -> Path:
-    """J of every fit on every test, one panel per training test (paper Figure 7)."""
-    per_fit = {
-        f"test {t}": {
-            m: costs.loc[(costs.training_test == t) & (costs.model == m), "J"].tolist()
-            for m in MODELS
-        }
-        for t in TRAINING_TESTS
-    }
-    titles = {f"test {t}": f"trained on test {t}" for t in TRAINING_TESTS}
-    return save_figure(figure_costs(per_fit, list(range(1, 10)), titles=titles), path)
-
-
 def report_sections(recovery, exact, recovered, table, costs, fig8, electrical, sentence):
     return [
         (
             "Noise-free recovery (Coulomb model, test 3)",
-            markdown_table(recovery, ".6g")
+            report.markdown_table(recovery, ".6g")
             + f"\n\nJ = {exact.cost:.3g}; all parameters within 1 % and J < 1: "
             f"**{'yes' if recovered else 'NO'}**.",
         ),
-        ("Identified parameters beside the truth (Table 2 analogue)", markdown_table(table, ".4g")),
+        (
+            "Identified parameters beside the truth (Table 2 analogue)",
+            report.markdown_table(table, ".4g"),
+        ),
         (
             "J on all nine tests (Figure 7)",
-            "![Figure 7](figure7_costs.png)\n\n" + markdown_table(cost_matrix(costs), ".3g"),
+            "![Figure 7](figure7_costs.png)\n\n"
+            + report.markdown_table(campaign.cost_matrix(costs), ".3g"),
         ),
         ("Load voltage (Figure 8)", voltage_section(fig8, electrical, sentence)),
     ]
@@ -295,54 +175,54 @@ def run_study(
     ``threads`` sets the number of numba threads for the batched simulations
     (``randvib study identification --threads N``). ``workers`` (processes)
     and ``scheduler`` are not used: each identification runs in this process.
+    Every fit is kept in ``OUT/fits`` (a rerun resumes).
     """
-    import numba
-
-    settings = _settings(quick)
+    settings = settings_for(quick)
     identity = {"study": "identification", "quick": bool(quick), "seed": int(seed), **settings}
-    out = prepare_output_dir(out_dir, identity, {"threads": threads, "scheduler": scheduler})
-    if (out / "report.md").exists():
-        return out / "report.md"
-    if threads is not None:
-        numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
+    out = report.prepare_output_dir(out_dir, identity, {"threads": threads, "scheduler": scheduler})
+    campaign.set_threads(threads)
     start = time.perf_counter()
 
     # compute: the records, the fits, their costs, the exact recovery
     common = dict(duration=settings["duration"], fs=settings["fs"], seed=seed)
+    search = dict(m=TRUTH["m"], seed=seed, substeps=settings["substeps"], progress=progress,
+                  popsize=settings["popsize"], maxiter=settings["generations"])  # fmt: skip
     tests = {n: make_test(n, **common)[0] for n in range(1, 10)}
-    write_records(tests, out)
-    fits = identify_all(tests, out, settings, seed, progress)
-    write_tracked(
-        out / "identified.json",
-        dumps({f"test{t}-{m}": r.to_dict() for (t, m), r in fits.items()}, indent=2),
-    )
-    costs = cost_table(fits, tests, dict(enumerate(TEST_RMS, start=1)))
-    exact = noise_free_fit(common, settings, seed, progress)
-    recovery = recovery_table(exact, TRUTH)
+    campaign.write_records(tests, out / "records")
+    training = {n: tests[n] for n in TRAINING_TESTS}
+    fits = campaign.identify_all(training, MODELS, out / "fits", lowpass=LOWPASS,
+                                 search_samples=SEARCH_SAMPLES, **search)  # fmt: skip
+    campaign.write_fits(out / "identified.json", fits)
+    costs = campaign.cost_table(fits, tests, dict(enumerate(TEST_RMS, start=1)))
+    clean, _ = make_test(3, noise=False, **common)
+    exact = campaign.identify_cached(out / "fits" / "test3-coulomb-noise-free.json", clean,
+                                     "coulomb", **search)  # fmt: skip
+    recovery = campaign.recovery_table(exact, TRUTH)
     recovered = bool(np.all(np.abs(recovery["error_percent"]) < 1.0) and exact.cost < 1.0)
 
     # tables and figures (Figure 8 simulates the load voltage with the coil)
-    write_table(out, "costs.csv", costs)
-    figure7(costs, out / "figure7_costs.png")
-    table = parameter_table(fits, MODELS, TRAINING_TESTS, TRUTH)
-    write_table(out, "table2_identified.csv", table)
-    write_table(out, "noise_free_recovery.csv", recovery)
-    electrical = rv.ElectricalCoupling(ALPHA, R_LOAD, R_COIL)
-    fig8 = figure8(fits, electrical, common, out)
+    report.write_table(out, "costs.csv", costs)
+    campaign.figure7(costs, MODELS, TRAINING_TESTS, out / "figure7_costs.png")
+    table = campaign.parameter_table(fits, MODELS, TRAINING_TESTS, TRUTH)
+    report.write_table(out, "table2_identified.csv", table)
+    report.write_table(out, "noise_free_recovery.csv", recovery)
+    electrical = campaign.paper_coil(R_LOAD)
+    wired = [("test6", "test 6", TEST_RMS[5], make_test(6, electrical=electrical, **common)[0]),
+             ("low", "low level", LOW_RMS,
+              make_test(6, electrical=electrical, rms=LOW_RMS, **common)[0])]  # fmt: skip
+    fig8 = campaign.voltage_figures({m: fits[(3, m)] for m in ("coulomb", "viscous")}, wired,
+                                    electrical, out, trained_on="test 3")  # fmt: skip
     elapsed = time.perf_counter() - start
-    write_table(out, "figure8.csv", fig8)
+    report.write_table(out, "figure8.csv", fig8)
 
     # verdicts and report
     sentence = figure8_verdict(fig8)
-    write_verdicts(
+    report.write_verdicts(
         out,
-        {
-            "noise_free_recovered": recovered,
-            "noise_free_cost": exact.cost,
-            "figure8": {"sentence": sentence},
-        },
-    )
-    return write_report(
+        {"noise_free_recovered": recovered, "noise_free_cost": exact.cost,
+         "figure8": {"sentence": sentence}},
+    )  # fmt: skip
+    return report.write_report(
         out,
         "Identification of friction models: synthetic campaign",
         report_sections(recovery, exact, recovered, table, costs, fig8, electrical, sentence),

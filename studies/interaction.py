@@ -30,10 +30,8 @@ from __future__ import annotations
 import sys
 
 import numpy as np
-import pandas as pd
 
 import randvib as rv
-from randvib.montecarlo.sweep import SweepSettings, linearisation_verdicts
 from randvib.studies import figures, script_main
 from randvib.studies.contrasts import (
     interaction_contrasts,
@@ -47,12 +45,18 @@ from randvib.studies.grids import (
     friction_level,
     highest_friction_points,
 )
-from randvib.studies.half_step import check_step_bias, half_step_verdict, sweep_with_half_step
+from randvib.studies.half_step import (
+    check_step_bias,
+    half_step_section,
+    half_step_verdict,
+    sweep_text,
+    sweep_with_half_step,
+)
+from randvib.studies.methods import method_errors
 from randvib.studies.report import (
     markdown_table,
     plus_minus,
     prepare_output_dir,
-    readable_table,
     write_report,
     write_table,
     write_verdicts,
@@ -74,7 +78,7 @@ N_FC, QUICK_N_FC = 7, 4
 #: Heun step (s): bias on the linearised device below 1e-4 even at k3 = 5e7, S = 1.
 DT = 1e-4
 
-__all__ = ["duffing_strength", "grid", "run_study", "settings_for", "study_points"]
+__all__ = ["grid", "run_study", "settings_for", "study_points"]
 
 
 def grid(quick: bool) -> dict:
@@ -91,10 +95,10 @@ def study_points(base, psds, k3s, n_fc) -> list[dict]:
     return coulomb_grid(base, psds, k3s, n_fc)
 
 
-def settings_for(quick: bool, seed: int) -> SweepSettings:
+def settings_for(quick: bool, seed: int) -> rv.SweepSettings:
     # 128 paths at least in both modes: a paired contrast regresses on the energy-balance
     # controls of its points, which paired_contrast only uses with ten paths per control
-    return SweepSettings(
+    return rv.SweepSettings(
         dt=DT,
         target_rel_ci=0.01 if quick else 0.0015,
         window=1.0 if quick else 2.0,
@@ -105,202 +109,111 @@ def settings_for(quick: bool, seed: int) -> SweepSettings:
     )
 
 
-# ----------------------------------------------------------------- compute
-def point_table(result, base, has_avg: bool) -> pd.DataFrame:
-    """The sweep table with Eq. 32's (and averaging's) verdicts, zeta_f and phi per point."""
-    table = linearisation_verdicts(result.table)
-    if has_avg:
-        table = linearisation_verdicts(table, "averaging")
-        table["averaging_zeta_friction"] = [
-            float(
-                rv.averaging_statistics(
-                    base.updated(k3=r.k3, fc=r.fc), r.psd, warn=False
-                ).zeta_friction
-            )
-            for r in table.itertuples()
-        ]
-    table["phi"] = friction_level(base, table.psd, table.fc)
-    return table
-
-
-def contrast_table(result, base, has_avg: bool) -> pd.DataFrame:
-    """The paired contrasts with phi, mu and (if available) averaging's prediction."""
+def contrast_table(result, base):
+    """The paired contrasts with phi, mu and averaging's prediction of them."""
     # k3's effect without friction is zero by theory (exact stationary density)
     inter = interaction_contrasts(result, base, "fc", "k3", zero_baseline=True)
     inter.insert(3, "phi", friction_level(base, inter.psd, inter.fc))
     inter.insert(4, "mu", duffing_strength(base, inter.psd, inter.k3))
-    if has_avg:
-        inter["averaging_relative_contrast"] = predicted_contrasts(base, inter, "averaging")
+    inter["averaging_relative_contrast"] = predicted_contrasts(base, inter, "averaging")
     return inter
 
 
 # ----------------------------------------------------------------- report sections
-def setup_section(settings, axes, table, seed, quick) -> str:
-    psds, k3s, n_fc = axes
+def setup_section(settings, axes, table, quick) -> str:
     return (
         "Device: preset `figure9` (paper Section 5: Coulomb, training data 1, "
         "c_m = c_e = 0.1 Ns/m, k = 57.4 N/m; m = 0.0226 kg assumed). "
-        f"S = {', '.join(f'{s:g}' for s in psds)} (m/s^2)^2/Hz; "
-        f"k3 = {', '.join(f'{k:.3g}' for k in k3s)} N/m^3; "
-        f"{n_fc} Fc levels per S from 0 to twice the level where Eq. 32 halves the power "
-        f"(phi = Fc / (c sigma_v0) from 0 to {2 * np.sqrt(np.pi) / 2:.2f}, sigma_v0^2 = S m / (4c)). "
-        f"Heun, dt = {settings.dt:g} s, {settings.burn_in:g} s burn-in "
-        "(at least six energy relaxation times m/c, so that each path, started from the "
-        "Gaussian linearised state, has forgotten "
-        f"its start) + {settings.window:g} s "
-        f"per path, paths added until the 95 % half-width of each power is "
-        f"{100 * settings.target_rel_ci:g} % ({int(table.n_paths.sum())} paths in all), seed "
-        f"{seed}, common random numbers across points, control variates "
-        f"{'on' if settings.control_variates else 'off'}.{' Quick mode.' if quick else ''}"
+        f"S = {', '.join(f'{s:g}' for s in axes['psds'])} (m/s^2)^2/Hz; "
+        f"k3 = {', '.join(f'{k:.3g}' for k in axes['k3s'])} N/m^3; "
+        f"{axes['n_fc']} Fc levels per S from 0 to twice the level where Eq. 32 halves the "
+        f"power (phi = Fc / (c sigma_v0) from 0 to {2 * np.sqrt(np.pi) / 2:.2f}, sigma_v0^2 = "
+        f"S m / (4c)). " + sweep_text(settings, int(table.n_paths.sum()), quick)
     )
 
 
-def contrasts_shown(inter: pd.DataFrame, has_avg: bool) -> pd.DataFrame:
-    shown = inter[["psd", "k3", "fc", "phi"]].copy()
-    shown["fc"] = 1e3 * shown.fc
-    shown = shown.rename(columns={"fc": "Fc (mN)"})
+def contrasts_shown(inter):
+    shown = inter[["psd", "k3"]].assign(**{"Fc (mN)": 1e3 * inter.fc, "phi": inter.phi})
     shown["contrast / P(Fc,0) (%)"] = plus_minus(inter.relative_contrast, inter.relative_ci95)
-    if has_avg:
-        shown["averaging (%)"] = [f"{100 * x:+.2f}" for x in inter.averaging_relative_contrast]
-    shown["p"] = inter.p_value
-    shown["n_paths"] = inter.n_paths
-    shown["detectable"] = inter.detectable
-    shown["Holm"] = inter.detectable_holm
+    shown["averaging (%)"] = [f"{100 * x:+.2f}" for x in inter.averaging_relative_contrast]
+    shown["p"], shown["n_paths"] = inter.p_value, inter.n_paths
+    shown["detectable"], shown["Holm"] = inter.detectable, inter.detectable_holm
     return shown
 
 
-def interaction_section(inter, k3s, has_avg, figure) -> str:
+def interaction_section(inter, k3s, figure) -> str:
     verdict, summary = interaction_summary(inter, k3s, K3_LABELS)
     mu_fig9 = float(duffing_strength(rv.preset("figure9"), 1.0, 5e5))
     baseline = float(((inter.baseline.abs() + inter.baseline_ci95) / inter.reference).max())
-    avg_note = (
-        "Stochastic averaging (dashed in the figure, `averaging` column) does depend on k3: "
-        "the spring changes the orbit shapes over which the friction work is averaged. "
-        if has_avg
-        else ""
-    )
     return (
-        f"![interaction]({figure.name})\n\n"
-        f"**Verdict.** {verdict}\n\n"
+        f"![interaction]({figure.name})\n\n**Verdict.** {verdict}\n\n"
         "Equivalent linearisation predicts no interaction at all: Eq. 30 for c_eq contains no "
-        "k3, so Eq. 32 gives the same power for every spring. "
-        + avg_note
-        + "\n\nHow it is estimated: without friction E[z'^2] = S m / (4c) for every k3 (exact "
-        "stationary density), so the second bracket P(0, k3) - P(0, 0) is zero by theory; the "
-        "sweep's estimates of it, exact through the friction-free companion control, are at most "
-        f"{100 * baseline:.1e} % of P(Fc, 0). The contrast is therefore the paired difference "
-        "P(Fc, k3) - P(Fc, 0) over the paths the two points share (same Brownian increments; "
-        "Ito-integral and energy-change controls of both), `n_paths` below. The contrasts "
-        "share their paths (common random numbers), so neighbouring verdicts are correlated; "
-        "Holm's step-down keeps the family-wise error at 5 %.\n\n"
-        f"Scaling: the friction level phi and the Duffing strength mu = k3 sigma_z0^2 / k "
-        f"(here {inter.mu.min():.2g} to {inter.mu.max():.2g}; {mu_fig9:.2g} in the paper's "
-        "Figure 9 at S = 1) are the only parameters that S and k3 enter through (z scales "
-        "with sqrt(S)), so rows with equal k3 S repeat one problem on the same paths"
-        + scaling_sentence(inter)
-        + "\n\n"
-        + markdown_table(summary)
-        + "\n\nEvery contrast (relative to the Monte Carlo P(Fc, k3 = 0); phi = Fc / (c sigma_v0)):\n\n"
-        + markdown_table(contrasts_shown(inter, has_avg), floatfmt=".3g")
-    )
+        "k3, so Eq. 32 gives the same power for every spring. Stochastic averaging (dashed in "
+        "the figure, `averaging` column) does depend on k3: the spring changes the orbit shapes "
+        "over which the friction work is averaged. \n\nHow it is estimated: without friction "
+        "E[z'^2] = S m / (4c) for every k3 (exact stationary density), so the second bracket "
+        "P(0, k3) - P(0, 0) is zero by theory; the sweep's estimates of it, exact through the "
+        f"friction-free companion control, are at most {100 * baseline:.1e} % of P(Fc, 0). The "
+        "contrast is therefore the paired difference P(Fc, k3) - P(Fc, 0) over the paths the "
+        "two points share (same Brownian increments; Ito-integral and energy-change controls "
+        "of both), `n_paths` below. The contrasts share their paths (common random numbers), "
+        "so neighbouring verdicts are correlated; Holm's step-down keeps the family-wise error "
+        "at 5 %.\n\nScaling: the friction level phi and the Duffing strength mu = k3 "
+        f"sigma_z0^2 / k (here {inter.mu.min():.2g} to {inter.mu.max():.2g}; {mu_fig9:.2g} in "
+        "the paper's Figure 9 at S = 1) are the only parameters that S and k3 enter through "
+        "(z scales with sqrt(S)), so rows with equal k3 S repeat one problem on the same paths"
+        + scaling_sentence(inter) + "\n\n" + markdown_table(summary)
+        + "\n\nEvery contrast (relative to the Monte Carlo P(Fc, k3 = 0); phi = Fc / (c "
+        "sigma_v0)):\n\n" + markdown_table(contrasts_shown(inter), floatfmt=".3g")
+    )  # fmt: skip
 
 
-def linearisation_section(lin, lin_data, has_avg, figure) -> str:
-    err = lin.linearisation_rel_error
+def linearisation_section(lin, lin_data, figure) -> str:
     by_k3 = lin.groupby("k3").linearisation_rel_error.agg(lambda e: e.abs().max())
-    shown = lin[["psd", "k3", "fc", "phi"]].copy()
-    shown["fc"] = 1e3 * shown.fc
-    shown = shown.rename(columns={"fc": "Fc (mN)"})
+    shown = lin[["psd", "k3"]].assign(**{"Fc (mN)": 1e3 * lin.fc, "phi": lin.phi})
     shown["P_MC (mW)"] = plus_minus(lin.power_electrical, lin.power_electrical_ci95, 1e3, ".4f")
-    shown["Eq. 32 error (%)"] = plus_minus(
-        lin.linearisation_rel_error, lin.linearisation_rel_error_ci95
-    )
-    if has_avg:
-        shown["averaging error (%)"] = plus_minus(
-            lin.averaging_rel_error, lin.averaging_rel_error_ci95
-        )
-        shown["zeta_f"] = lin.averaging_zeta_friction
-    shown["n_paths"] = lin.n_paths
+    shown["Eq. 32 error (%)"] = plus_minus(lin.linearisation_rel_error,
+                                           lin.linearisation_rel_error_ci95)  # fmt: skip
+    shown["averaging error (%)"] = plus_minus(lin.averaging_rel_error, lin.averaging_rel_error_ci95)
+    shown["zeta_f"], shown["n_paths"] = lin.averaging_zeta_friction, lin.n_paths
+    invalid = (lin.averaging_zeta_friction > 0.5).any()
     return (
-        f"![linearisation error]({figure.name})\n\n"
-        f"Eq. 32 against Monte Carlo at the {len(lin)} points with friction: the error reaches "
-        f"{100 * err.abs().max():.2f} % ({lin_data['where_largest']}); "
+        f"![linearisation error]({figure.name})\n\nEq. 32 against Monte Carlo at the "
+        f"{len(lin)} points with friction: the error reaches "
+        f"{100 * lin.linearisation_rel_error.abs().max():.2f} % ({lin_data['where_largest']}); "
         "its largest magnitude per k3: "
         + ", ".join(f"{100 * v:.2f} % at k3 = {k:.3g}" for k, v in by_k3.items())
         + f". {lin_data['sentence']}"
-        + (
-            " The averaging predictions at points with zeta_f > 0.5 are outside that method's "
-            "stated validity (it warns there)."
-            if has_avg and (lin.averaging_zeta_friction > 0.5).any()
-            else ""
-        )
-        + "\n\n"
-        + markdown_table(shown, floatfmt=".3g")
-    )
-
-
-def step_section(check, check_data, settings, worst_bias) -> str:
-    return (
-        f"Re-run of {len(check)} points (the highest Fc at each S, with k3 = "
-        + ", ".join(f"{k:.3g}" for k in sorted(check.k3.unique()))
-        + f") at dt/2 = {settings.dt / 2:g} s, independent noise. Time-step bias below the "
-        f"statistical error at {check_data['n_below']} of {len(check)} points"
-        f"{check_data['sentence']}. "
-        f"Linearised step bias at dt (randvib.montecarlo.step_check.step_bias) at most {worst_bias:.1e}.\n\n"
-        + markdown_table(readable_table(check))
-    )
+        + (" The averaging predictions at points with zeta_f > 0.5 are outside that method's "
+           "stated validity (it warns there)." if invalid else "")
+        + "\n\n" + markdown_table(shown, floatfmt=".3g")
+    )  # fmt: skip
 
 
 # ----------------------------------------------------------------- the study
-def run_study(
-    out_dir,
-    *,
-    quick: bool = False,
-    seed: int = 0,
-    workers=None,
-    scheduler=None,
-    progress: bool = True,
-    _grid: dict | None = None,
-    _settings: SweepSettings | None = None,
-):
-    """Run the interaction study; write figures, CSVs and ``report.md`` into ``out_dir``.
-
-    ``_grid`` ({"psds", "k3s", "n_fc"}) and ``_settings`` replace the study's
-    grid and sweep settings (for tests); they are part of the folder's identity.
-    """
-    base = rv.preset("figure9")
-    axes = dict(_grid) if _grid is not None else grid(quick)
-    psds, k3s, n_fc = tuple(axes["psds"]), tuple(axes["k3s"]), int(axes["n_fc"])
-    settings = _settings or settings_for(quick, seed)
-    points = study_points(base, psds, k3s, n_fc)
+def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, progress=True):
+    """Run the interaction study; write figures, CSVs and ``report.md`` into ``out_dir``."""
+    base, axes = rv.preset("figure9"), grid(quick)
+    settings = settings_for(quick, seed)
+    points = study_points(base, axes["psds"], axes["k3s"], axes["n_fc"])
     worst_bias = check_step_bias(base, points, settings)
-    identity = {"study": NAME, "quick": quick, "seed": seed}
-    identity["grid"] = {"psds": psds, "k3s": k3s, "n_fc": n_fc}
+    identity = {"study": NAME, "quick": quick, "seed": seed, "grid": axes}
     out = prepare_output_dir(out_dir, {**identity, "settings": settings.to_dict()})
 
     # compute: half-step check where the dynamics is hardest (most friction,
     # with and without the stiffest spring)
     result, check = sweep_with_half_step(
-        base,
-        points,
-        settings,
-        out,
-        NAME,
-        highest_friction_points(points),
-        workers=workers,
-        scheduler=scheduler,
-        progress=progress,
-    )
-    has_avg = "averaging" in rv.METHODS and "averaging_power" in result.table
-    table = point_table(result, base, has_avg)
-    inter = contrast_table(result, base, has_avg)
-    curves = None
-    if has_avg:
-        fc_max = {psd: inter[inter.psd == psd].fc.max() for psd in psds}
-        curves = predicted_contrast_curves(base, psds, k3s, fc_max, "averaging")
-        write_table(out, "averaging_curves.csv", curves)
+        base, points, settings, out, NAME, highest_friction_points(points),
+        workers=workers, scheduler=scheduler, progress=progress,
+    )  # fmt: skip
+    table = method_errors(result, base)
+    table["phi"] = friction_level(base, table.psd, table.fc)
+    inter = contrast_table(result, base)
+    fc_max = {psd: inter[inter.psd == psd].fc.max() for psd in axes["psds"]}
+    curves = predicted_contrast_curves(base, axes["psds"], axes["k3s"], fc_max, "averaging")
 
     # tables and figures
+    write_table(out, "averaging_curves.csv", curves)
     write_table(out, "results.csv", table)
     write_table(out, "interaction.csv", inter)
     write_table(out, "step_check.csv", check)
@@ -309,30 +222,23 @@ def run_study(
 
     # verdicts and report
     lin = table[table.fc > 0]
-    lin_data = linearisation_by_spring(lin)
-    check_data = half_step_verdict(check)
+    lin_data, k3s = linearisation_by_spring(lin), axes["k3s"]
     write_verdicts(
         out,
-        {
-            "interaction": interaction_counts(inter, k3s),
-            "linearisation": lin_data,
-            "step_check": check_data,
-        },
+        {"interaction": interaction_counts(inter, k3s), "linearisation": lin_data,
+         "step_check": half_step_verdict(check)},
         [interaction_summary(inter, k3s, K3_LABELS)[0]],
-    )
+    )  # fmt: skip
+    top = ", ".join(f"{k:.3g}" for k in sorted(check.k3.unique()))
     return write_report(
         out,
         "Duffing-Coulomb interaction beyond the paper's k3",
-        [
-            ("Set-up", setup_section(settings, (psds, k3s, n_fc), table, seed, quick)),
-            ("Interaction contrast", interaction_section(inter, k3s, has_avg, fig_inter)),
-            (
-                "Equivalent linearisation at every point",
-                linearisation_section(lin, lin_data, has_avg, fig_lin),
-            ),
-            ("Time-step check", step_section(check, check_data, settings, worst_bias)),
-        ],
-    )
+        [("Set-up", setup_section(settings, axes, table, quick)),
+         ("Interaction contrast", interaction_section(inter, k3s, fig_inter)),
+         ("Equivalent linearisation at every point", linearisation_section(lin, lin_data, fig_lin)),
+         ("Time-step check", half_step_section(
+             check, settings, f"the highest Fc at each S, with k3 = {top}", worst_bias))],
+    )  # fmt: skip
 
 
 if __name__ == "__main__":

@@ -13,8 +13,8 @@ fifth of the friction-free power).
 
 At every point: E[P_e] from equivalent linearisation (Eq. 32), stochastic
 averaging, the fast corrected FPK grids (``method="fpk-fast"``), the FPK
-reference grid solution and Monte Carlo (:func:`randvib.simulate`, stochastic
-Heun, with the energy-identity and friction-free-companion control
+reference grid solution and Monte Carlo (:func:`randvib.run_ensembles`,
+stochastic Heun, with the energy-identity and friction-free-companion control
 variates). Relative errors are taken against Monte Carlo. The two fast
 candidates (averaging and fpk-fast) are judged against the accuracy criteria
 for a fast method (:mod:`randvib.studies.methods`): speed (one point under
@@ -23,9 +23,10 @@ linearisation's error where that exceeds 3 %, at most 5 % everywhere, and the
 k3 interaction's sign and size inside the Monte Carlo interval.
 
 The k3 interaction, P(Fc, k3) / P(Fc, 0) - 1, is estimated from paired runs:
-all k3 values at one (S, kappa) share their Brownian paths (same seed and
-streams), and the per-path differences, with both runs' control variates,
-give its mean and 95 % interval.
+all k3 values at one (S, kappa) are one group of the ensembles (the same
+Brownian paths), and the per-path differences, with both runs' control
+variates (:meth:`randvib.EnsembleResult.paired`), give its mean and 95 %
+interval.
 """
 
 from __future__ import annotations
@@ -38,16 +39,15 @@ import numpy as np
 import pandas as pd
 
 import randvib as rv
-from randvib._progress import progress_bar
 from randvib.studies import figures, script_main
+from randvib.studies.grids import fixed_paths
 from randvib.studies.methods import (
     ANALYTIC,
     CANDIDATES,
     criteria_table,
-    errors_against_mc,
-    fill_missing_powers,
     k3_change_interval,
-    paired_column,
+    kappa_cases,
+    paired_k3_table,
     reading,
     time_methods,
 )
@@ -64,53 +64,18 @@ NAME = "linearisation-vs-averaging"
 PSDS = (1.0, 0.5, 0.1)
 K3S = (0.0, 7.07e4, 5e5, 7e6)
 KAPPAS = (0.0, 0.1, 0.25, 0.5, 1.0, 2.0)
-#: Monte Carlo sizes: (paths, simulated time per path (s), dt (s), burn-in (s)).
-FULL_MC = (256, 80.0, 2.5e-4, 2.0)
-QUICK_MC = (64, 40.0, 5e-4, 2.0)
+#: Monte Carlo per case: paths, window and burn-in (s), step (s).
+FULL_MC = {"n_paths": 256, "window": 80.0, "burn_in": 2.0, "dt": 2.5e-4}
+QUICK_MC = {"n_paths": 64, "window": 40.0, "burn_in": 2.0, "dt": 5e-4}
 
 __all__ = ["grid", "reading", "run_study", "verdicts"]
 
 
-def grid(quick: bool) -> tuple[tuple, tuple, tuple]:
-    """(psds, kappas, k3s) of the study."""
+def grid(quick: bool) -> dict:
+    """The study's axes: S values, friction levels kappa, k3 values and the Monte Carlo sizes."""
     if quick:
-        return (1.0, 0.1), (0.0, 0.5, 2.0), (0.0, 7e6)
-    return PSDS, KAPPAS, K3S
-
-
-# ----------------------------------------------------------------- compute
-def compute_table(quick: bool, seed: int, threads, progress: bool) -> pd.DataFrame:
-    """Every (S, kappa) column of the grid, its k3 values on shared paths, with the errors."""
-    base = rv.preset("figure9")
-    psds, kappas, k3s = grid(quick)
-    mc = QUICK_MC if quick else FULL_MC
-    columns = [(psd, kappa) for psd in psds for kappa in kappas]
-    bar = None
-    if progress:
-        bar = progress_bar(len(columns), desc=NAME, unit="column")
-    rows = []
-    for i, (psd, kappa) in enumerate(columns):
-        # A fresh seed per (S, kappa) column; shared within it (paired k3).
-        rows += paired_column(psd, kappa, k3s, base, mc, seed * 1000 + i, threads)
-        if bar is not None:
-            bar.update()
-    if bar is not None:
-        bar.close()
-    return errors_against_mc(pd.DataFrame(rows))
-
-
-def table_of(out: Path, quick, seed, threads, progress) -> pd.DataFrame:
-    """``results.csv``: computed, or resumed from a run of the same identity."""
-    csv = out / "results.csv"
-    if not csv.exists():
-        df = compute_table(quick, seed, threads, progress)
-        write_table(out, "results.csv", df)
-        return df
-    df = pd.read_csv(csv)
-    filled = fill_missing_powers(df)
-    if filled is not df:
-        write_table(out, "results.csv", filled)
-    return filled
+        return {"psds": (1.0, 0.1), "kappas": (0.0, 0.5, 2.0), "k3s": (0.0, 7e6), "mc": QUICK_MC}
+    return {"psds": PSDS, "kappas": KAPPAS, "k3s": K3S, "mc": FULL_MC}
 
 
 # ----------------------------------------------------------------- report sections
@@ -161,7 +126,7 @@ def k3_changes_shown(df: pd.DataFrame) -> pd.DataFrame:
 
 
 def setup_text(df, mc, wall) -> str:
-    n_paths, t_sim, dt, _burn = mc
+    n_paths, t_sim, dt = mc["n_paths"], mc["window"], mc["dt"]
     return (
         "Figure9 device (c_m = c_e = 0.1 Ns/m, k = 57.4 N/m, m = 0.0226 kg assumed), "
         "Coulomb friction at levels kappa = 4 Fc^2/(pi S m c) (Eq. 30's group; half power "
@@ -197,38 +162,25 @@ def verdicts_section(df, v, timings) -> str:
     )
 
 
-def run_study(
-    out_dir,
-    *,
-    quick: bool = False,
-    seed: int = 0,
-    workers=None,
-    threads=None,
-    scheduler=None,
-    progress=True,
-) -> Path:
+def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, progress=True) -> Path:
     """Run the study and write ``report.md``, ``results.csv`` and two PNG figures.
 
-    ``quick``: smaller grid and Monte Carlo (about half a minute); ``seed``:
-    base seed of the Monte Carlo streams; ``threads``: numba threads for the
-    Monte Carlo kernel (default: all cores); ``workers`` (worker processes in
-    the sweeping studies) is accepted and unused: this study simulates
-    in-process; ``scheduler`` is not supported for the same reason;
-    ``progress``: a bar over the (S, kappa) columns. Returns the Markdown report.
+    ``quick``: smaller grid and Monte Carlo (about half a minute). The k3
+    values of each (S, kappa) run on shared paths (one group of
+    :func:`randvib.run_ensembles`) on ``workers`` local processes or the Dask
+    cluster at ``scheduler``, and resume from ``OUT/ensembles``.
     """
-    if scheduler is not None:
-        raise ValueError(
-            f"study {NAME!r} runs its Monte Carlo in-process on local threads; `scheduler` "
-            f"is not supported (got {scheduler!r}); use `threads` instead"
-        )
-    psds, kappas, k3s = grid(quick)
-    mc = QUICK_MC if quick else FULL_MC
-    identity = {"study": NAME, "quick": quick, "seed": seed, "psds": psds, "kappas": kappas}
-    out = prepare_output_dir(out_dir, identity | {"k3s": k3s, "monte_carlo": mc})
+    axes = grid(quick)
+    settings = fixed_paths(**axes["mc"], seed=seed, control_variates=True)
+    out = prepare_output_dir(out_dir, {"study": NAME, "quick": quick, "seed": seed, **axes})
     started = time.perf_counter()
 
     # compute (or resume), then time the fast candidates
-    df = table_of(out, quick, seed, threads, progress)
+    cases = kappa_cases(rv.preset("figure9"), axes["psds"], axes["kappas"], axes["k3s"])
+    run = rv.run_ensembles(cases, settings, out_dir=out / "ensembles", workers=workers,
+                           scheduler=scheduler, progress=progress, name=NAME)  # fmt: skip
+    df = paired_k3_table(run)
+    write_table(out, "results.csv", df)
     timings = time_methods(K3S)
     v = verdicts(df, timings)
 
@@ -254,7 +206,7 @@ def run_study(
                 + "\n\nFiles: `results.csv` (every column), the two PNG figures, `metadata.json`.",
             ),
         ],
-        intro=setup_text(df, mc, time.perf_counter() - started),
+        intro=setup_text(df, axes["mc"], time.perf_counter() - started),
     )
 
 

@@ -241,7 +241,7 @@ def test_study_identification_cli(tmp_path, capsys, monkeypatch):
     identification = load("identification")
     monkeypatch.setattr(
         identification,
-        "_settings",
+        "settings_for",
         lambda quick: dict(duration=0.6, fs=250.0, popsize=6, generations=1, substeps=2),
     )
     out = tmp_path / "ident"
@@ -260,23 +260,18 @@ def test_study_linearisation_vs_averaging_cli(tmp_path, capsys, monkeypatch):
 
     lva = load("linearisation-vs-averaging")
 
-    monkeypatch.setattr(lva, "grid", lambda quick: ((1.0,), (0.0, 0.5), (0.0, 7e6)))
-    monkeypatch.setattr(lva, "QUICK_MC", (16, 0.5, 5e-4, 0.2))
+    mc = {"n_paths": 16, "window": 0.5, "burn_in": 0.2, "dt": 5e-4}
+    axes = {"psds": (1.0,), "kappas": (0.0, 0.5), "k3s": (0.0, 7e6), "mc": mc}
+    monkeypatch.setattr(lva, "grid", lambda quick: axes)
     out = tmp_path / "lva"
     report = _study(capsys, "linearisation-vs-averaging", out)
     verdict = json.loads((out / "verdicts.json").read_text())
     assert verdict["points"] == 4 and verdict["reading"] in report
+    # its Monte Carlo runs on --workers processes (rv.run_ensembles), not in-process threads
     one_line_error(
         capsys,
-        [
-            "study",
-            "linearisation-vs-averaging",
-            "--out",
-            tmp_path / "x",
-            "--scheduler",
-            "tcp://h:1",
-        ],
-        "`--scheduler` is not supported",
+        ["study", "linearisation-vs-averaging", "--out", tmp_path / "x", "--threads", "2"],
+        "has no `--threads` option",
     )
 
 

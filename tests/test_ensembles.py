@@ -79,6 +79,33 @@ def test_paired_ratio_and_contrast_are_the_cases_combinations(run):
         run.paired_ratios(input="white")
 
 
+def test_with_control_variates_a_case_is_its_simulation_and_paired_uses_its_controls():
+    """With the run's control variates, :meth:`simulation` is :func:`randvib.simulate`'s result
+    (statistics and controls), and the paired contrast regresses on both cases' controls,
+    exactly as the same estimate formed from the two direct runs."""
+    from randvib.statistics import estimate
+
+    settings = rv.SweepSettings(dt=2e-4, window=1.0, burn_in=0.25, min_paths=48, max_paths=48,
+                                batch_paths=48, seed=3, control_variates=True)  # fmt: skip
+    cases = [rv.Case({"k3": k3}, BASE.updated(k3=k3, stroke=None), 1.0, group="w")
+             for k3 in (0.0, 5e5)]  # fmt: skip
+    run = rv.run_ensembles(cases, settings, workers=1, progress=False)
+    direct = [rv.simulate(c.device, 1.0, t_end=1.25, dt=2e-4, n_paths=48, burn_in=0.25,
+                          seed=GROUP_SEEDS * 3, companion=True, control_variates=True,
+                          progress=False) for c in cases]  # fmt: skip
+    for i, d in enumerate(direct):
+        rebuilt = run.simulation(i)
+        assert rebuilt.power_electrical == d.power_electrical
+        assert np.array_equal(rebuilt.controls(), d.controls())
+    power = [d.harvester.c_e * d.averages.v2 for d in direct]
+    expected = estimate(
+        power[1] - power[0], np.hstack([direct[1].controls(), direct[0].controls()])
+    )
+    assert run.paired({1: 1.0, 0: -1.0}) == expected
+    plain = estimate(power[1] - power[0])
+    assert expected.ci95 < plain.ci95  # the controls absorb most of the paired noise
+
+
 def test_a_run_resumes_names_a_corrupted_case_and_refuses_another(tmp_path, monkeypatch):
     cases = _cases()[:2]
     first = rv.run_ensembles(cases, SETTINGS, out_dir=tmp_path, workers=1, progress=False)

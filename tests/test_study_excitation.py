@@ -71,3 +71,20 @@ def test_excitation_study_end_to_end(tmp_path, monkeypatch, capsys):
     _run(out, capsys)
     assert {p: p.stat().st_mtime_ns for p in (out / "ensembles" / "points").iterdir()} == stored
     assert [(out / name).read_bytes() for name in ("results.csv", "contrasts.csv")] == tables
+
+
+def test_no_interaction_holds_down_to_the_first_break_from_the_broadest_band():
+    from randvib.studies.verdicts import contrast_range, holds_down_to
+
+    sub = pd.DataFrame({"centre": "at", "zeta": [0.02, 0.5, 0.1, 0.05],
+                        "relative_contrast": [0.03, -0.001, 0.004, 0.02],
+                        "relative_ci95": 0.002,
+                        "breaks_no_interaction": [False, False, False, True]})  # fmt: skip
+    # 0.5 and 0.1 hold, 0.05 breaks: the narrower 0.02 after it does not extend the range
+    assert holds_down_to(sub) == 0.1
+    assert holds_down_to(sub.assign(breaks_no_interaction=False)) == 0.02
+    assert holds_down_to(sub.assign(breaks_no_interaction=[False, True, False, False])) is None
+    summary = contrast_range(sub)
+    assert (summary["n_breaks"], summary["n_points"]) == (1, 4)
+    assert (summary["min_relative_contrast"], summary["max_relative_contrast"]) == (-0.001, 0.03)
+    assert summary["smallest_abs"] == -0.001 and summary["smallest_abs_where"] == "at, zeta = 0.5"

@@ -182,6 +182,30 @@ class EnsembleResult:
 
         return PathAverages(self.per_path[index])
 
+    def simulation(self, index: int):
+        """Case ``index`` as :func:`randvib.simulate` returned it: its paths' averages and statistics.
+
+        A :class:`~randvib.SimulationResult` of the stored per-path averages
+        (no histogram, no recorded paths), with the run's time grid, seed and
+        control variates: its statistics, and the zero-mean controls of its
+        paths (:meth:`~randvib.SimulationResult.controls`), are those of the case.
+        """
+        from randvib.montecarlo.options import TimeGrid
+        from randvib.montecarlo.results import SimulationResult
+
+        case, settings = self.cases[index], self.settings
+        excitation = as_excitation(case.excitation)
+        grid = TimeGrid.from_times(
+            settings.burn_in + settings.window, settings.dt, settings.burn_in
+        )
+        return SimulationResult(
+            harvester=case.device, psd=getattr(excitation, "level", None),
+            scheme=settings.scheme, dt=grid.dt, t_end=grid.t_end, burn_in=grid.burn_in,
+            seed=GROUP_SEEDS * settings.seed + self.groups[index], first_path=0,
+            per_path=self.per_path[index], control_variates=settings.control_variates,
+            excitation=excitation,
+        )  # fmt: skip
+
     def power_samples(self, index: int) -> np.ndarray:
         """Each path's time-averaged electrical power (W) in case ``index``.
 
@@ -223,14 +247,19 @@ class EnsembleResult:
         The weighted sum of the cases' per-path powers is formed path by path
         (over the paths all of them have), and its mean and 95 % half-width
         are a :class:`~randvib.statistics.Statistic` (Student t over paths).
-        The cases must share a group.
+        With the run's control variates (``settings.control_variates``) every
+        case's zero-mean controls (:meth:`simulation`) join the estimate, in
+        the order of ``weights``. The cases must share a group.
         """
         self._one_group(weights)
         n = min(self.per_path[i].shape[0] for i in weights)
         samples = np.zeros(n)
         for i, w in weights.items():
             samples += w * self.power_samples(i)[:n]
-        return estimate(samples)
+        controls = None
+        if self.settings.control_variates:
+            controls = np.hstack([self.simulation(i).controls()[:n] for i in weights])
+        return estimate(samples, controls)
 
     def paired_ratios(self, **reference) -> pd.DataFrame:
         """Every case's E[P_e] over that of its group's reference case, with a paired 95 % interval.

@@ -6,28 +6,35 @@ written against the public API the way a user would write their own sweep:
 compute (a sweep, contrasts), tables, figures, a report with verdicts. What
 such scripts share lives here:
 
-- :mod:`~randvib.studies.grids`: friction and Duffing levels, Coulomb grids, burn-in,
-  coloured inputs at equal response, fixed-size ensemble settings;
+- :mod:`~randvib.studies.grids`: friction and Duffing levels, Coulomb and
+  friction-level grids, the points of a half-step re-run, burn-in, coloured inputs at
+  equal response, fixed-size ensemble settings;
 - :mod:`~randvib.studies.contrasts`: paired interaction contrasts (of a sweep, or
   within the groups of :func:`randvib.run_ensembles`) with Holm's correction, and
-  analytic predictions of the same contrasts;
-- :mod:`~randvib.studies.budget`: the power at a stroke-exceedance budget, and paired
-  gains over a linear device;
+  analytic predictions of the same contrasts and of the power on fine grids;
+- :mod:`~randvib.studies.budget`: a stroke study's Monte Carlo table, the power at a
+  stroke-exceedance budget, and paired gains over a linear device;
 - :mod:`~randvib.studies.accuracy`: where an analytic method can be trusted (trusted
   ranges of the friction level, the collapse of series that scale exactly);
 - :mod:`~randvib.studies.campaign`: an identification campaign (synthetic shaker
-  records, resumable fits, their tables);
-- :mod:`~randvib.studies.methods`: every analytic method against paired Monte Carlo
-  runs (a sweep's or :func:`randvib.run_ensembles`'), and the accuracy criteria for a
-  fast method;
-- :mod:`~randvib.studies.half_step`: the sweep with its half-step re-run, and its verdict
-  (the time-step bias of a study's sweep; the linear test system's step bias is
-  :mod:`randvib.montecarlo.step_check`);
+  records on the campaign's seed, resumable fits, their tables and figures);
+- :mod:`~randvib.studies.methods`: every analytic method against Monte Carlo (a sweep's
+  points, or the cases of :func:`randvib.run_ensembles`), and the accuracy criteria for
+  a fast method;
+- :mod:`~randvib.studies.half_step`: the sweep with its half-step re-run, its verdict
+  and its report section (the time-step bias of a study's sweep; the linear test
+  system's step bias is :mod:`randvib.montecarlo.step_check`);
 - :mod:`~randvib.studies.verdicts`: the verdict sentences, built from the numbers;
 - :mod:`~randvib.studies.evidence`: rows that repeat one experiment (exact rescalings);
 - :mod:`~randvib.studies.figures`: figures of power and contrasts against Fc or the
   bandwidth, power against stroke exceedance, methods' errors against the level;
 - :mod:`~randvib.studies.report`: CSV, ``verdicts.json``, Markdown tables, ``report.md``.
+
+A script imports only ``randvib`` (its exports), these building blocks and the
+package's top-level public modules (``randvib.statistics``,
+``randvib.figure_style``); its loops over paths, points and cases, its seeds
+and its resume are the runner's (:func:`randvib.run_sweep`,
+:func:`randvib.run_ensembles`) or a building block's.
 
 Every figure is drawn in :mod:`randvib.figure_style` (shared with the
 identification plots).
@@ -131,8 +138,8 @@ def add_run_options(parser: argparse.ArgumentParser) -> None:
         "--threads",
         type=integer_option(1),
         default=None,
-        help="numba threads of a study that simulates in-process (identification, "
-        "linearisation-vs-averaging; default: all cores)",
+        help="numba threads of a study that simulates in-process (identification; "
+        "default: all cores)",
     )
     parser.add_argument(
         "--scheduler",

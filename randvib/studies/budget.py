@@ -14,7 +14,10 @@ same paths (:meth:`randvib.EnsembleResult.paired_ratios`).
 The tables hold per ``input``, level ``g`` and ``device`` (one named
 "linear"): ``power_mc`` (W), ``exceedance_mc`` (the fraction of time beyond
 the stroke) with ``exceedance_mc_ci95``, and the paired
-``power_ratio_to_linear`` with ``power_ratio_ci95``.
+``power_ratio_to_linear`` with ``power_ratio_ci95``: :func:`stroke_results`
+makes them from a paired run, with the first passage to the stroke, which
+:func:`first_passage_cells` writes for a report (:func:`budget_cells` the
+power at the budget).
 """
 
 from __future__ import annotations
@@ -24,12 +27,57 @@ import pandas as pd
 
 __all__ = [
     "bound_mark",
+    "budget_cells",
     "budget_table",
     "budget_verdicts",
+    "first_passage_cells",
     "gains_over_linear",
     "power_at_budget",
     "ratio_bound",
+    "stroke_results",
 ]
+
+
+def stroke_results(run, labels, **reference) -> pd.DataFrame:
+    """The Monte Carlo table of a stroke study from a paired run (:func:`randvib.run_ensembles`).
+
+    Per case: its ``labels`` (column names), ``power_mc`` (W) with
+    ``power_mc_ci95``, ``n_paths``, ``exceedance_mc`` (fraction of time with
+    |z| > stroke) with ``exceedance_mc_ci95``, ``z_rms_mc`` (m), the first
+    passage to the stroke (``fp_paths_reached``, ``fp_n_paths``,
+    ``fp_horizon`` (s), ``fp_mean`` with ``fp_mean_ci95`` (NaN unless every
+    path reached it), ``fp_restricted_mean`` with ``fp_restricted_ci95``
+    (E[min(tau, t_end)]), ``fp_median``), and the power over the reference
+    case's of its group (``reference``: labels, e.g. ``device="linear"``),
+    ``power_ratio_to_linear`` with ``power_ratio_ci95``
+    (:meth:`randvib.EnsembleResult.paired_ratios`).
+    """
+    t, ratio = run.table, run.paired_ratios(**reference)
+    return t[list(labels)].assign(
+        power_mc=t.power_electrical, power_mc_ci95=t.power_electrical_ci95, n_paths=t.n_paths,
+        exceedance_mc=t.stroke_exceedance, exceedance_mc_ci95=t.stroke_exceedance_ci95,
+        z_rms_mc=np.sqrt(t.displacement_variance), fp_paths_reached=t.first_passage_reached,
+        fp_n_paths=t.n_paths, fp_horizon=t.first_passage_horizon, fp_mean=t.first_passage_mean,
+        fp_mean_ci95=t.first_passage_mean_ci95, fp_restricted_mean=t.first_passage_restricted_mean,
+        fp_restricted_ci95=t.first_passage_restricted_mean_ci95, fp_median=t.first_passage_median,
+        power_ratio_to_linear=ratio.ratio, power_ratio_ci95=ratio.ratio_ci95,
+    )  # fmt: skip
+
+
+def first_passage_cells(results: pd.DataFrame) -> pd.DataFrame:
+    """The first passage of :func:`stroke_results` as report cells: paths that reached the
+    stroke, the mean time ('>= x': the restricted mean, a lower bound, where some paths did
+    not) and the median ('> horizon' where half or more did not)."""
+    return pd.DataFrame({
+        "reached": [f"{a}/{b}" for a, b in zip(results.fp_paths_reached, results.fp_n_paths,
+                                               strict=True)],
+        "mean first time (s)": [
+            f"{r.fp_mean:.3g} ± {r.fp_mean_ci95:.2g}" if np.isfinite(r.fp_mean)
+            else f">= {r.fp_restricted_mean:.3g} ± {r.fp_restricted_ci95:.2g}"
+            for r in results.itertuples()],
+        "median (s)": [f"{m:.3g}" if np.isfinite(m) else f"> {h:g}"
+                       for m, h in zip(results.fp_median, results.fp_horizon, strict=True)],
+    }, index=results.index)  # fmt: skip
 
 
 def power_at_budget(sub: pd.DataFrame, budget: float) -> dict:
@@ -145,3 +193,15 @@ def gains_over_linear(sub: pd.DataFrame, budget: float) -> dict:
             ],
         }  # fmt: skip
     return out
+
+
+def budget_cells(table: pd.DataFrame, verdicts: dict) -> pd.DataFrame:
+    """:func:`budget_table` as report cells: the power at the budget (mW) with its bracket,
+    and the ratio to the linear device, marked as a bound where it is one (:func:`bound_mark`;
+    ``verdicts``: :func:`budget_verdicts` by input, then device)."""
+    return pd.DataFrame({
+        "E[P_e] at budget (mW)": [f"{1e3 * p:.4g} [{1e3 * lo:.4g}, {1e3 * hi:.4g}]" for p, lo, hi
+                                  in zip(table.power, table.power_low, table.power_high, strict=True)],
+        "/ linear": [f"{bound_mark(verdicts[r.input][r.device])}{r.ratio_to_linear:.3g}"
+                     for r in table.itertuples()],
+    }, index=table.index)  # fmt: skip

@@ -2,11 +2,17 @@
 
 The pieces of a study that identifies friction models on records (paper
 Sec. 3-4): :func:`synthetic_record` makes a shaker test from a known device,
-with the sensor noise of the paper's rig; :func:`identify_cached` runs
-:func:`randvib.identify` once per (record, model) and keeps the fit on disk,
-so that an interrupted campaign resumes; :func:`cost_table`,
+with the sensor noise of the paper's rig, and :func:`shaker_test` test N of
+a campaign on its own stream of the campaign's seed; :func:`identify_cached`
+runs :func:`randvib.identify` once per (record, model) and keeps the fit on
+disk, so that an interrupted campaign resumes, and :func:`identify_all` does
+so for every model on every training record; :func:`cost_table`,
 :func:`parameter_table` and :func:`recovery_table` tabulate the fits (paper
-Figure 7, Table 2, exact recovery).
+Figure 7, Table 2, exact recovery), :func:`figure7` draws the costs and
+:func:`voltage_figures` the load voltage the fits predict with the paper's
+coil (:func:`paper_coil`; Figure 8); :func:`write_records` and
+:func:`write_fits` keep the records and the fits in the study's folder;
+:func:`set_threads` sets the threads of the record simulations.
 """
 
 from __future__ import annotations
@@ -18,16 +24,28 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from randvib._io import atomic_write_text, dumps
+from randvib._io import atomic_write_text, dumps, write_tracked
+from randvib.figure_style import save_figure
 from randvib.identification.identify import identify
 from randvib.identification.models import MODEL_PARAMETERS, device_from_parameters
+from randvib.identification.plots import figure_costs, figure_fit
 from randvib.identification.record_response import record_response
 from randvib.identification.result import IdentificationResult
 from randvib.models.excitation import band_limited_excitation
+from randvib.models.harvester import ElectricalCoupling
+from randvib.models.presets import ALPHA, R_COIL
 from randvib.models.record import Record
 
 #: Every parameter name of the paper's four models, in Table 2's order.
 PARAMETER_ORDER = ("c", "k", "k3", "fc", "beta", "sigma0", "sigma1", "fs", "vs")
+#: The columns of :func:`voltage_figures`: the share of samples with |V| < 0.5 mV (the
+#: spike at zero volts of sticking), in the simulated and in the measured voltage.
+SIMULATED, MEASURED = "share |V| < 0.5 mV, simulated", "share |V| < 0.5 mV, measured"
+
+
+def paper_coil(r_load: float) -> ElectricalCoupling:
+    """The paper's coil (alpha = 0.1992 Wb/m, R_C = 0.48 ohm, measured) with load ``r_load`` (ohm)."""
+    return ElectricalCoupling(ALPHA, r_load, R_COIL)
 
 
 def synthetic_record(
@@ -74,6 +92,36 @@ def synthetic_record(
     return record, v
 
 
+def shaker_test(truth: dict, rms: float, number: int, *, seed: int, **kwargs):
+    """Test ``number`` of a campaign seeded ``seed``: :func:`synthetic_record` on its own stream.
+
+    The stream is ``numpy.random.default_rng([seed, number])``: each test has
+    its excitation and noise whatever other tests the campaign makes, and in
+    whatever order. ``kwargs`` are :func:`synthetic_record`'s.
+    """
+    return synthetic_record(truth, rms, rng=np.random.default_rng([seed, number]), **kwargs)
+
+
+def set_threads(threads: int | None) -> None:
+    """numba threads of the batched record simulations: ``threads`` (at most what numba
+    has), or left as set when None."""
+    if threads is not None:
+        import numba
+
+        numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
+
+
+def write_records(records: dict, folder: Path) -> None:
+    """Each record as ``folder/testN.csv`` (usable with ``randvib identify``), unless there.
+
+    ``records`` maps test numbers to :class:`~randvib.Record`.
+    """
+    Path(folder).mkdir(exist_ok=True)
+    for n, record in records.items():
+        if not (Path(folder) / f"test{n}.csv").exists():
+            record.to_csv(Path(folder) / f"test{n}.csv")
+
+
 def load_fit(path: Path) -> IdentificationResult:
     """An :class:`~randvib.IdentificationResult` saved as its ``to_dict()`` JSON."""
     d = json.loads(Path(path).read_text())
@@ -114,6 +162,26 @@ def identify_cached(path: Path, record: Record, model: str, **kwargs) -> Identif
     result = identify(record, model, **kwargs)
     atomic_write_text(path, dumps(result.to_dict(), indent=2))
     return result
+
+
+def identify_all(records: dict, models, folder: Path, **kwargs) -> dict:
+    """Every model identified on every record, each fit kept in ``folder`` (resumable).
+
+    ``records`` maps test numbers to :class:`~randvib.Record`; the fit of
+    ``model`` on test N is :func:`identify_cached` at ``folder/testN-model.json``
+    with ``kwargs`` (:func:`randvib.identify`'s). Returns
+    ``{(test, model): IdentificationResult}``, test by test.
+    """
+    Path(folder).mkdir(exist_ok=True)
+    return {(n, model): identify_cached(Path(folder) / f"test{n}-{model}.json", record, model,
+                                        **kwargs)
+            for n, record in records.items() for model in models}  # fmt: skip
+
+
+def write_fits(path: Path, fits: dict) -> Path:
+    """The fits of :func:`identify_all` as one JSON file, ``testN-model``: ``to_dict()``."""
+    data = {f"test{t}-{m}": fit.to_dict() for (t, m), fit in fits.items()}
+    return write_tracked(path, dumps(data, indent=2))
 
 
 def cost_table(fits: dict, records: dict, rms: dict) -> pd.DataFrame:
@@ -188,3 +256,53 @@ def recovery_table(fit: IdentificationResult, truth: dict, names=("c", "k", "k3"
 def share_near_zero(voltage, threshold: float = 5e-4) -> float:
     """Share of samples with |V| < ``threshold`` (V): the spike at zero volts of sticking."""
     return float(np.mean(np.abs(voltage) < threshold))
+
+
+def figure7(costs: pd.DataFrame, models, training, path: Path) -> Path:
+    """J of every fit on every test, one panel per training test (paper Figure 7).
+
+    ``costs`` is :func:`cost_table`'s; ``training`` the training tests' numbers.
+    """
+    per_fit = {f"test {t}": {m: costs.J[(costs.training_test == t) & (costs.model == m)].tolist()
+                             for m in models} for t in training}  # fmt: skip
+    titles = {f"test {t}": f"trained on test {t}" for t in training}
+    tests = sorted(costs.test.unique().tolist())
+    return save_figure(figure_costs(per_fit, tests, titles=titles), path)
+
+
+def voltage_figures(fits: dict, wired, electrical, out: Path, *, trained_on: str) -> pd.DataFrame:
+    """The load voltage each fit predicts on records taken with the coil (paper Figure 8).
+
+    Parameters
+    ----------
+    fits : dict
+        Model -> :class:`~randvib.IdentificationResult` (identified without
+        the coil; ``electrical`` is added to its c).
+    wired : sequence of (tag, label, rms, Record)
+        Records with the load voltage: a file tag, words and the RMS base
+        acceleration (m/s^2) for the title and the table.
+    electrical : ElectricalCoupling
+    out : Path
+        Folder of the figures ``figure8_{tag}_{model}.png`` (time history and
+        densities, :func:`randvib.identification.plots.figure_fit`).
+    trained_on : str
+        Where the fits come from, for the titles ("test 3").
+
+    Returns
+    -------
+    DataFrame
+        One row per record and model: ``excitation``, ``model``, ``J`` (Eq. 11)
+        and the shares :data:`SIMULATED` and :data:`MEASURED`.
+    """
+    rows = []
+    for tag, label, rms, record in wired:
+        for model, fit in fits.items():
+            prediction = fit.predict(record, electrical=electrical)
+            title = (f"{label} ({rms:g} m s$^{{-2}}$ RMS), coil with R$_L$ = {electrical.r_load:g}"
+                     f" Ω: {model} model identified on {trained_on}")  # fmt: skip
+            figure = figure_fit(prediction, window=(0, 2), scale=1e3, unit="mm", title=title)
+            save_figure(figure, Path(out) / f"figure8_{tag}_{model}.png")
+            rows.append({"excitation": f"{label}, {rms:g} m/s^2", "model": model,
+                         "J": prediction.cost, SIMULATED: share_near_zero(prediction.voltage),
+                         MEASURED: share_near_zero(record.voltage)})  # fmt: skip
+    return pd.DataFrame(rows)

@@ -11,7 +11,8 @@ of a sweep with a per-contrast test and Holm's step-down over the family,
 :func:`paired_interactions` within the groups of a paired run
 (:func:`randvib.run_ensembles`); :func:`predicted_contrasts` and
 :func:`predicted_contrast_curves` give an analytic method's value of the
-same contrast.
+same contrast, :func:`predicted_power_curves` the method's power itself on a
+fine Fc grid (the curves under a figure's Monte Carlo points).
 """
 
 from __future__ import annotations
@@ -32,6 +33,7 @@ __all__ = [
     "paired_interactions",
     "predicted_contrast_curves",
     "predicted_contrasts",
+    "predicted_power_curves",
 ]
 
 
@@ -250,3 +252,20 @@ def predicted_contrast_curves(
                 )
             )
     return pd.concat(frames, ignore_index=True)
+
+
+def predicted_power_curves(
+    base: Harvester, psds, k3s, fc_max: dict, method: str = "linearisation", n: int = 200
+) -> pd.DataFrame:
+    """E[P_e] (W) by ``method`` on a fine Fc grid from 0 per S and k3, for figures and tables.
+
+    ``fc_max`` maps each S to the largest Fc (N). Columns ``psd``, ``k3``,
+    ``fc`` and ``{method}_power``, S by S, then k3.
+    """
+    frames = []
+    for psd in psds:
+        fc = np.linspace(0, fc_max[psd], n)
+        for k3 in k3s:
+            power = _power(base.updated(k3=k3, fc=fc), psd, method)
+            frames.append(pd.DataFrame({"psd": psd, "k3": k3, "fc": fc, f"{method}_power": power}))
+    return pd.concat(frames)

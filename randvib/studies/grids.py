@@ -5,18 +5,19 @@ phi = Fc / (c sigma_v0) (:func:`friction_level`) and the Duffing strength
 mu = k3 sigma_z0^2 / k (:func:`duffing_strength`), with sigma_v0, sigma_z0 the
 friction-free linear oscillator's rms velocity and displacement (paper Eq. 20).
 Coloured inputs are compared with white noise at equal response
-(:func:`response_matched`).
+(:func:`response_matched`, :func:`matched_band`).
 """
 
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 
 from randvib.analytic.linear_response import mechanical_block, output_variances
 from randvib.analytic.linearisation import coulomb_equivalent_damping
-from randvib.models.excitation import Excitation
+from randvib.models.excitation import BandPass, Excitation
 from randvib.models.harvester import Harvester
-from randvib.montecarlo.sweep import SweepSettings, cartesian
+from randvib.montecarlo.sweep import SweepSettings, cartesian, point_device
 
 
 def fc_where_power_halves(device: Harvester, psd: float) -> float:
@@ -91,6 +92,30 @@ def coulomb_grid(base: Harvester, psds, k3s, n_fc: int, reach: float = 2.0) -> l
     return points
 
 
+def friction_level_points(base: Harvester, series, phis) -> list[dict]:
+    """(psd, k3, c_m, c_e, fc) points: each series at the friction levels ``phis``.
+
+    ``series`` holds (S ((m/s^2)^2/Hz), k3 (N/m^3), c_m = c_e (Ns/m)); Fc is
+    set by phi = Fc / (c sigma_v0) (:func:`fc_at_friction_level`) for that
+    series' device and S. Points come series by series, phi by phi.
+    """
+    if min(phis) <= 0:
+        raise ValueError(f"`phis` must be > 0 (the error at phi = 0 is zero), got {phis}")
+    return [{"psd": psd, "k3": k3, "c_m": c_each, "c_e": c_each,
+             "fc": float(fc_at_friction_level(base.updated(c_m=c_each, c_e=c_each), psd, phi))}
+            for psd, k3, c_each in series for phi in phis]  # fmt: skip
+
+
+def point_levels(base: Harvester, points) -> pd.DataFrame:
+    """The friction level phi (:func:`friction_level`) and damping ratio zeta
+    (:func:`damping_ratio`) of every point's device (``base`` updated by the point)."""
+    devices = [point_device(base, p) for p in points]
+    return pd.DataFrame({
+        "phi": [float(friction_level(d, p["psd"], p["fc"])) for d, p in zip(devices, points, strict=True)],
+        "zeta": [damping_ratio(d) for d in devices],
+    })  # fmt: skip
+
+
 def highest_friction_points(points: list, group=("psd",)) -> list:
     """The points with the largest Fc within each group: the hardest dynamics."""
     top: dict = {}
@@ -98,6 +123,17 @@ def highest_friction_points(points: list, group=("psd",)) -> list:
         key = tuple(p[g] for g in group)
         top[key] = max(top.get(key, -np.inf), p["fc"])
     return [p for p in points if p["fc"] == top[tuple(p[g] for g in group)]]
+
+
+def hardest_at_largest_psd(points: list, series=("k3", "c_m")) -> list:
+    """The strongest friction of each ``series`` at its largest S: the hardest dynamics of a
+    grid whose series differ in more than S (:func:`highest_friction_points` of those)."""
+    largest = {}
+    for p in points:
+        key = tuple(p[g] for g in series)
+        largest[key] = max(largest.get(key, 0.0), p["psd"])
+    hardest = [p for p in points if p["psd"] == largest[tuple(p[g] for g in series)]]
+    return highest_friction_points(hardest, ("psd", *series))
 
 
 def burn_in_for(devices, relaxation_times: float = 6.0, resolution: float = 0.5) -> float:
@@ -138,15 +174,25 @@ def response_matched(shape: Excitation, device: Harvester, psd: float) -> Excita
     return type(shape)(level, shape.f0, shape.zeta)
 
 
+def matched_band(device: Harvester, centre: float, zeta: float, psd: float) -> BandPass:
+    """Band-pass noise centred at ``centre`` times ``device``'s linear natural frequency, with
+    damping ratio ``zeta``, at the level of :func:`response_matched` to white noise ``psd``."""
+    f_n = device.natural_frequency / (2 * np.pi)
+    return response_matched(BandPass(1.0, centre * f_n, zeta), device, psd)
+
+
 def fixed_paths(
-    n_paths: int, window: float, *, dt: float, burn_in: float, seed: int, scheme: str = "heun"
-) -> SweepSettings:
-    """Settings of ensembles of exactly ``n_paths`` paths (no precision target), plain means.
+    n_paths: int, window: float, *, dt: float, burn_in: float, seed: int, scheme: str = "heun",
+    control_variates: bool = False,
+) -> SweepSettings:  # fmt: skip
+    """Settings of ensembles of exactly ``n_paths`` paths (no precision target).
 
     ``window`` and ``burn_in`` (s) per path, step ``dt`` (s), the run's
-    ``seed``; no control variates (they need white noise, and a study that
-    compares inputs keeps one estimator for all).
+    ``seed``. Plain means by default: the control variates need white noise,
+    and a study that compares inputs keeps one estimator for all; a
+    white-noise study may ask for them (``control_variates=True``: the
+    friction-free companion and the energy-balance controls).
     """
     return SweepSettings(dt=dt, window=window, burn_in=burn_in, scheme=scheme, min_paths=n_paths,
                          max_paths=n_paths, batch_paths=n_paths, seed=seed,
-                         control_variates=False)  # fmt: skip
+                         control_variates=control_variates)  # fmt: skip

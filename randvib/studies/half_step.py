@@ -5,7 +5,8 @@
 at half the step with independent noise; :func:`half_step_verdict` counts
 the points whose two estimates agree within their combined 95 % half-width.
 :func:`check_step_bias` refuses a step whose linearised bias is already too
-large before anything runs.
+large before anything runs; :func:`sweep_text` says in words how the sweep
+ran, :func:`half_step_section` is the report's section on the re-run.
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ from randvib.montecarlo.sweep import (
     point_device,
     run_sweep,
 )
+from randvib.studies.report import markdown_table, readable_table
 
 
 def half_step_rerun(
@@ -185,3 +187,40 @@ def half_step_verdict(check: pd.DataFrame) -> dict:
             f"{0.05 * n_independent:.1f} expected by chance{note})"
         )
     return data
+
+
+def half_step_section(check: pd.DataFrame, settings: SweepSettings, which: str,
+                      worst_bias: float | None = None) -> str:  # fmt: skip
+    """A report's time-step section: the half-step re-run of ``which`` points and its verdict.
+
+    ``check`` is the table of :func:`half_step_rerun`, ``settings`` the
+    sweep's; ``worst_bias`` (:func:`check_step_bias`), when given, is quoted
+    as the largest linearised step bias at the sweep's step.
+    """
+    verdict = half_step_verdict(check)
+    bias = "" if worst_bias is None else (
+        " Linearised step bias at dt (randvib.montecarlo.step_check.step_bias) at most "
+        f"{worst_bias:.1e}."
+    )  # fmt: skip
+    return (
+        f"Re-run of {len(check)} points ({which}) at dt/2 = {settings.dt / 2:g} s, independent "
+        f"noise. Time-step bias below the statistical error at {verdict['n_below']} of "
+        f"{len(check)} points{verdict['sentence']}.{bias}\n\n"
+        + markdown_table(readable_table(check))
+    )
+
+
+def sweep_text(settings: SweepSettings, n_paths: int, quick: bool) -> str:
+    """How a study's sweep ran, in words: step, burn-in, window, precision, paths, seed.
+
+    For a sweep whose burn-in comes from :func:`randvib.studies.grids.burn_in_for`
+    (six energy relaxation times); ``n_paths`` is the paths over all points.
+    """
+    return (
+        f"Heun, dt = {settings.dt:g} s, {settings.burn_in:g} s burn-in (at least six energy "
+        "relaxation times m/c, so that each path, started from the Gaussian linearised state, "
+        f"has forgotten its start) + {settings.window:g} s per path, paths added until the 95 % "
+        f"half-width of each power is {100 * settings.target_rel_ci:g} % ({n_paths} paths in "
+        f"all), seed {settings.seed}, common random numbers across points, control variates "
+        f"{'on' if settings.control_variates else 'off'}.{' Quick mode.' if quick else ''}"
+    )

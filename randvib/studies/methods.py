@@ -4,11 +4,13 @@ At one point (device, S) :func:`analytic_powers` gives E[P_e] by every
 analytic method: equivalent linearisation (Eq. 32), stochastic averaging
 (:mod:`randvib.analytic.averaging`), the fast corrected FPK grids
 (``method="fpk-fast"``) and the FPK reference grid solution.
-:func:`paired_column` simulates several Duffing stiffnesses k3 on the same
-Brownian paths (stochastic Heun, energy-identity and friction-free-companion
-control variates), so that the change of power with k3,
-P(Fc, k3) / P(Fc, k3_0) - 1, comes with a paired 95 % interval;
-:func:`errors_against_mc` adds the methods' relative errors and k3 changes.
+:func:`kappa_cases` puts several Duffing stiffnesses k3 of one (S, kappa) in
+one group of :func:`randvib.run_ensembles` (the same Brownian paths;
+stochastic Heun with the energy-identity and friction-free-companion control
+variates), so that :func:`paired_k3_table` gives the change of power with k3,
+P(Fc, k3) / P(Fc, k3_0) - 1, with a paired 95 % interval, beside every
+method's power; :func:`errors_against_mc` adds the methods' relative errors
+and k3 changes.
 
 The accuracy criteria for a fast method (:func:`fast_method_verdicts`):
 speed (one point under 10 ms, a 100-point sweep under 1 s, timed by
@@ -18,10 +20,14 @@ inside the Monte Carlo interval. The Coulomb level is set by the
 dimensionless kappa = 4 Fc^2 / (pi S m c) (the group of paper Eq. 30: Eq. 32
 halves the power at kappa = 1/4).
 
+At the points of a sweep (:func:`randvib.run_sweep`): :func:`method_errors`
+(each method's error against Monte Carlo, and averaging's validity).
+
 For the cases of a paired run (:func:`randvib.run_ensembles`), any device,
 input and stroke: :func:`methods_against_monte_carlo` (every method's power
 and stroke exceedance against Monte Carlo, or why it refused),
-:func:`method_accuracy` and :func:`accuracy_sentences` (its summary), and
+:func:`method_accuracy` and :func:`accuracy_sentences` (its summary),
+:func:`methods_shown` (its table for a report), and
 :func:`linearisation_against_monte_carlo` (statistical linearisation with its
 equivalent stiffness and damping); :func:`relative_error` is their error.
 """
@@ -40,11 +46,10 @@ from randvib.analytic.linearisation import equivalent_damping
 from randvib.analytic.prediction import expected_power, predict
 from randvib.analytic.statistical_linearisation import statistical_linearisation
 from randvib.models.presets import preset
-from randvib.montecarlo import kernel
-from randvib.montecarlo.simulation import simulate
+from randvib.montecarlo.ensembles import Case
 from randvib.montecarlo.step_check import step_bias
-from randvib.statistics import estimate
-from randvib.studies.report import markdown_table
+from randvib.montecarlo.sweep import linearisation_verdicts, point_device
+from randvib.studies.report import markdown_table, plus_minus
 
 #: Analytic methods: column suffix -> (method name in randvib.METHODS, label).
 ANALYTIC = {
@@ -83,59 +88,46 @@ def analytic_powers(device, psd) -> dict:
     }
 
 
-def paired_column(psd, kappa, k3s, base, mc, seed, threads):
-    """All ``k3s`` at one (S, kappa), sharing Brownian paths: one row per k3.
+def kappa_cases(base, psds, kappas, k3s) -> list:
+    """The cases of the methods' comparison: ``base`` at every (S, kappa, k3), white noise.
 
-    Each row holds the Monte Carlo power with its 95 % half-width, the
-    linearised step bias, :func:`analytic_powers`, and ``dk3_mc``: the
-    paired change P(k3) / P(k3s[0]) - 1 with its 95 % half-width.
-    ``mc`` = (paths, simulated time per path (s), dt (s), burn-in (s)).
+    One :class:`randvib.Case` per point, labelled ``psd``, ``kappa`` and
+    ``k3``, with Fc from kappa (:func:`fc_of_kappa`); the k3 values of one
+    (S, kappa) form a group (the same Brownian paths: the change of power
+    with k3 is paired). Groups come S by S, then kappa.
     """
-    n_paths, t_sim, dt, burn_in = mc
-    rows, per_path, controls = [], {}, {}
-    for k3 in k3s:
-        device = base.updated(k3=k3, fc=fc_of_kappa(kappa, psd, base))
-        started = time.perf_counter()
-        res = simulate(
-            device,
-            psd,
-            t_end=burn_in + t_sim,
-            dt=dt,
-            n_paths=n_paths,
-            burn_in=burn_in,
-            seed=seed,
-            companion=True,
-            control_variates=True,
-            threads=threads,
-            progress=False,
-        )
-        power = res.power_electrical
-        row = {
-            "psd": psd,
-            "kappa": kappa,
-            "fc": float(device.friction.fc),
-            "k3": k3,
-            "power_mc": power.mean,
-            "power_mc_ci95": power.ci95,
-            "step_bias": abs(step_bias("heun", device, psd, dt)),
-            "n_paths": n_paths,
-            "mc_seconds": time.perf_counter() - started,
-        }
-        row.update(analytic_powers(device, psd))
+    return [Case({"psd": psd, "kappa": kappa, "k3": k3}, base.updated(k3=k3, fc=fc_of_kappa(
+        kappa, psd, base)), psd, group=(psd, kappa)) for psd in psds for kappa in kappas
+        for k3 in k3s]  # fmt: skip
+
+
+def paired_k3_table(run) -> pd.DataFrame:
+    """Every case of :func:`kappa_cases` run by :func:`randvib.run_ensembles`, with every method.
+
+    Per case: ``psd``, ``kappa``, ``fc`` (N), ``k3``, the Monte Carlo power
+    ``power_mc`` with its 95 % half-width, the linearised step bias of the
+    run's scheme and step, ``n_paths``, ``mc_seconds`` (wall time),
+    :func:`analytic_powers`, and ``dk3_mc``: the paired change
+    P(k3) / P(k3_0) - 1 against the smallest k3 of the run, with its 95 %
+    half-width (the run's control variates in the paired estimate); then
+    :func:`errors_against_mc`.
+    """
+    t, settings = run.table, run.settings
+    k3_0, rows = float(t.k3.min()), []
+    for i, case in enumerate(run.cases):
+        device, psd = case.device, case.excitation
+        row = {"psd": psd, "kappa": case.labels["kappa"], "fc": float(device.friction.fc),
+               "k3": case.labels["k3"], "power_mc": t.power_electrical[i],
+               "power_mc_ci95": t.power_electrical_ci95[i],
+               "step_bias": abs(step_bias(settings.scheme, device, psd, settings.dt)),
+               "n_paths": t.n_paths[i], "mc_seconds": t.wall_time[i],
+               **analytic_powers(device, psd)}  # fmt: skip
+        ref = run.partner(i, k3=k3_0)
+        change = run.paired({i: 1.0, ref: -1.0}) if ref != i else None
+        row["dk3_mc"] = 0.0 if change is None else change.mean / t.power_electrical[ref]
+        row["dk3_mc_ci95"] = 0.0 if change is None else change.ci95 / t.power_electrical[ref]
         rows.append(row)
-        per_path[k3] = device.c_e * res.column(kernel.ACC_V2)
-        controls[k3] = res.controls()
-    k0 = k3s[0]
-    for row in rows:
-        k3 = row["k3"]
-        ref = next(r for r in rows if r["k3"] == k0)
-        if k3 == k0:
-            row["dk3_mc"], row["dk3_mc_ci95"] = 0.0, 0.0
-            continue
-        diff = estimate(per_path[k3] - per_path[k0], np.hstack([controls[k3], controls[k0]]))
-        row["dk3_mc"] = diff.mean / ref["power_mc"]
-        row["dk3_mc_ci95"] = diff.ci95 / ref["power_mc"]
-    return rows
+    return errors_against_mc(pd.DataFrame(rows))
 
 
 def errors_against_mc(df: pd.DataFrame) -> pd.DataFrame:
@@ -149,26 +141,6 @@ def errors_against_mc(df: pd.DataFrame) -> pd.DataFrame:
         df[f"dk3_{name}"] = df[f"power_{name}"] / base[f"power_{name}"].reindex(key).values - 1.0
     df["mc_rel_ci95"] = df["power_mc_ci95"] / df["power_mc"]
     return df
-
-
-def fill_missing_powers(df: pd.DataFrame) -> pd.DataFrame:
-    """Add analytic columns a table written by an older version lacks (fpk-fast).
-
-    The table's points are the figure9 device at its (k3, fc, psd); returns
-    ``df`` itself when nothing is missing.
-    """
-    missing = [name for name in ANALYTIC if f"power_{name}" not in df]
-    if not missing:
-        return df
-    df = df.copy()
-    base = preset("figure9")
-    for name in missing:
-        method = ANALYTIC[name][0]
-        df[f"power_{name}"] = [
-            float(expected_power(base.updated(k3=r.k3, fc=r.fc), r.psd, method))
-            for r in df.itertuples()
-        ]
-    return errors_against_mc(df)
 
 
 def time_methods(k3s, repeats: int = 3) -> dict:
@@ -374,6 +346,35 @@ def reading(df: pd.DataFrame, timings: dict | None = None) -> str:
     return " ".join(parts)
 
 
+# ----------------------------------------------------------------- the points of a sweep
+def method_errors(result, base, methods=("linearisation", "averaging")) -> pd.DataFrame:
+    """A sweep's table with each method's error against Monte Carlo at every point.
+
+    For each method m the columns of :func:`randvib.linearisation_verdicts`
+    (``m_rel_error``, ``m_rel_error_ci95``, ``m_consistent``: the method
+    inside the Monte Carlo 95 % interval); with averaging, also
+    ``averaging_zeta_friction``, the friction damping ratio of each point's
+    device (zeta_f > 0.5: outside the method's stated validity, where it warns).
+
+    Parameters
+    ----------
+    result : SweepResult
+        Of :func:`randvib.run_sweep` on ``base``, whose table holds each
+        method's ``m_power`` (every method but the slow reference).
+    base : Harvester
+    methods : sequence of str
+    """
+    table = result.table
+    for method in methods:
+        table = linearisation_verdicts(table, method)
+    if "averaging" in methods:
+        table["averaging_zeta_friction"] = [
+            float(averaging_statistics(point_device(base, p), p["psd"], warn=False).zeta_friction)
+            for p in result.points
+        ]
+    return table
+
+
 # ----------------------------------------------------------------- the cases of a paired run
 def relative_error(value, reference, ci95):
     """(value / reference - 1, its 95 % half-width): a prediction against a Monte Carlo estimate.
@@ -430,6 +431,17 @@ def methods_against_monte_carlo(result, methods, *, resolved: float = 0.25) -> p
                 row[f"{q}_rel_error"], row[f"{q}_rel_error_ci95"] = error
             rows.append(row)
     return pd.DataFrame(rows)
+
+
+def methods_shown(methods: pd.DataFrame, labels) -> pd.DataFrame:
+    """:func:`methods_against_monte_carlo`'s table for a report: the case's ``labels``, the
+    method, each error ± its half-width in % (blank where not compared) and the refusal."""
+    shown = methods[[*labels, "method"]].copy()
+    for q in ("power", "exceedance"):
+        cells = plus_minus(methods[f"{q}_rel_error"], methods[f"{q}_rel_error_ci95"])
+        shown[f"{q} error (%)"] = ["" if "nan" in c else c for c in cells]
+    shown["refused"] = methods.refused.fillna("").str.slice(0, 60)
+    return shown
 
 
 def method_accuracy(methods: pd.DataFrame, where: str, by: str) -> dict:

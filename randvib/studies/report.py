@@ -23,6 +23,7 @@ import pandas as pd
 from randvib._io import dumps, prepare_output_dir, write_tracked
 
 __all__ = [
+    "ensembles_text",
     "fc_levels",
     "format_number",
     "format_percent",
@@ -273,3 +274,19 @@ def fc_levels(rows: pd.DataFrame) -> str:
         fcs = ", ".join(f"{1e3 * f:.3g}" for f in sorted(sub.fc))
         parts.append(f"S = {psd:g}, k3 = {k3:g}: Fc = {fcs} mN")
     return "; ".join(parts)
+
+
+def ensembles_text(settings, quick: bool, wall: float, *, paired: str, how: str = "",
+                   start: str = "") -> str:  # fmt: skip
+    """How a study's paired ensembles ran (:func:`randvib.run_ensembles`), in words.
+
+    ``settings`` (:class:`randvib.SweepSettings` of a fixed size), the run's
+    wall time ``wall`` (s); ``paired`` says which cases share a seed, ``how``
+    and ``start`` what is integrated beside the device and from where.
+    """
+    return (
+        f"Monte Carlo: Heun{how}, dt = {settings.dt:g} s, {settings.min_paths} paths x "
+        f"{settings.window:g} s after {settings.burn_in:g} s burn-in{start}, seed "
+        f"{settings.seed} ({paired}: paired). {'Quick mode. ' if quick else ''}"
+        f"Wall time {wall:.0f} s."
+    )

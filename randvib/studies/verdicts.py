@@ -328,3 +328,29 @@ def scaling_sentence(inter: pd.DataFrame) -> str:
         f"; the {len(groups)} such groups here differ by up to {100 * diff:.3g} % of P(Fc, 0), "
         "more than rounding: the exact scaling does not hold in these results."
     )
+
+
+def contrast_range(sub: pd.DataFrame, where: str = "{centre}, zeta = {zeta:g}") -> dict:
+    """The contrasts of one family in numbers: breaks, range, the smallest in magnitude.
+
+    ``sub`` holds ``relative_contrast``, ``relative_ci95`` and
+    ``breaks_no_interaction`` (detectable after Holm and practically large);
+    ``where`` names the smallest's row (formatted with its columns).
+    """
+    small = sub.loc[sub.relative_contrast.abs().idxmin()]
+    return {"n_breaks": int(sub.breaks_no_interaction.sum()), "n_points": int(len(sub)),
+            "min_relative_contrast": float(sub.relative_contrast.min()),
+            "max_relative_contrast": float(sub.relative_contrast.max()),
+            "smallest_abs": float(small.relative_contrast),
+            "smallest_abs_ci95": float(small.relative_ci95),
+            "smallest_abs_where": where.format(**small)}  # fmt: skip
+
+
+def holds_down_to(sub: pd.DataFrame, along: str = "zeta") -> float | None:
+    """The smallest value of ``along``, from the largest down, before the first row that
+    ``breaks_no_interaction``; None when the first one already breaks it (e.g. the
+    narrowest band down to which no interaction holds, from the broadest)."""
+    ordered = sub.sort_values(along, ascending=False)
+    breaks = ordered.breaks_no_interaction.to_numpy(dtype=bool)
+    held = len(breaks) if not breaks.any() else int(np.argmax(breaks))
+    return float(ordered[along].iloc[held - 1]) if held else None
