@@ -1,19 +1,17 @@
-"""How results show themselves: compact reprs, HTML tables for Jupyter, pandas.
+"""How results show themselves: plain-text and HTML (Jupyter) tables, and pandas.
 
 The result classes (:class:`~randvib.montecarlo.results.SimulationResult`,
 :class:`~randvib.analytic.power_prediction.PowerPrediction`,
 :class:`~randvib.analytic.statistical_linearisation.LinearisationResult`,
 :class:`~randvib.identification.result.IdentificationResult`) build a list of
-rows ``(name, value, unit)`` and hand it here, so that the terminal, the
-notebook and the tables agree on what is shown and to what precision.
+rows ``(name, value, unit)``, the values written by :mod:`randvib.formatting`
+and the units from :mod:`randvib.quantities`, and hand it here, so that the
+terminal and the notebook show the same table.
 """
 
 from __future__ import annotations
 
 import html
-import math
-
-import numpy as np
 
 
 def pandas():
@@ -25,102 +23,6 @@ def pandas():
             "to_frame() needs pandas: pip install pandas (or pip install -e . in a checkout)"
         ) from error
     return pd
-
-
-def number(value, digits: int = 5) -> str:
-    """A number to ``digits`` significant figures; arrays by their shape and range."""
-    if value is None:
-        return "-"
-    array = np.asarray(value)
-    if array.ndim > 0:
-        if array.size == 0:
-            return f"array{array.shape}"
-        return f"array{array.shape} {number(array.min(), 3)} .. {number(array.max(), 3)}"
-    x = float(array)
-    if x == 0 or not math.isfinite(x):
-        return f"{x:g}"
-    return f"{x:.{digits}g}"
-
-
-def estimate(mean: float, ci95: float) -> str:
-    """``mean ± ci95`` with the mean to the precision its interval supports.
-
-    The half-width keeps two significant figures and the mean is written to
-    the same decimal place (``0.00246461 ± 0.00000055``): the last digit shown is
-    the interval's second. See :func:`estimate_parts`.
-    """
-    if not (_finite(mean) and _finite(ci95)) or ci95 <= 0:
-        return number(mean, 6)
-    return " ± ".join(estimate_parts(mean, ci95))
-
-
-#: Below this magnitude the leading zeros hide the digits: 9.29e-06, not 0.00000929.
-PLAIN_BELOW = 1e-4
-
-#: Most significant digits shown of an estimate (a noise-free fit's interval
-#: may support more; eight say all a reader can use).
-MAX_FIGURES = 8
-
-
-def estimate_parts(mean, half_width) -> tuple[str, str]:
-    """A Monte Carlo mean and its 95 % half-width, as the half-width allows.
-
-    The half-width is shown to two significant digits and the mean to the same
-    decimal place (``0.0024619 +- 0.00027`` -> ``0.00246``, ``0.00027``), both
-    in one notation, chosen by the mean's size; a mean known to more than
-    :data:`MAX_FIGURES` digits is shown to that many. A zero or missing half-width
-    leaves the mean at six significant digits; non-finite values are ``n/a``.
-    One rule for the terminal tables, the reprs and the notebook.
-
-    Examples
-    --------
-    >>> estimate_parts(0.0024619412547950926, 0.000272784)
-    ('0.00246', '0.00027')
-    >>> estimate_parts(12345.678, 140.0)
-    ('12350', '140')
-    >>> estimate_parts(9.2912e-06, 9.81e-07)
-    ('9.29e-06', '9.8e-07')
-    >>> estimate_parts(0.0490000000112, 2.09e-12)
-    ('0.049000000', '2.1e-12')
-    """
-    if not (_finite(mean) and _finite(half_width) and half_width > 0):
-        return _cell(mean), _cell(half_width)
-    decimals = 1 - math.floor(math.log10(half_width))  # the 2nd significant digit's place
-    half = round(half_width, decimals)
-    if half > 0 and math.floor(math.log10(half)) > math.floor(math.log10(half_width)):
-        decimals -= 1  # 0.0996 rounded up to 0.10: two digits are now one place earlier
-    shown = decimals
-    if mean != 0:  # no more than MAX_FIGURES digits, however small the interval
-        shown = min(decimals, MAX_FIGURES - 1 - math.floor(math.log10(abs(mean))))
-    # the pair in one notation, chosen by the mean: 0.000722 and 0.000042;
-    # a half-width past the eighth decimal in exponent notation (2.1e-12)
-    plain = round(mean, shown) == 0 or abs(mean) >= PLAIN_BELOW
-    return _fixed(mean, shown, plain), _fixed(half_width, decimals, plain and decimals <= 8)
-
-
-def _finite(value) -> bool:
-    return isinstance(value, int | float | np.floating) and math.isfinite(value)
-
-
-def _cell(value) -> str:
-    """A value without an interval: six significant digits, ``n/a`` if not a number."""
-    if value is None:
-        return ""
-    if isinstance(value, float | np.floating) and not math.isfinite(value):
-        return "n/a"
-    return f"{value + 0.0:.6g}" if _finite(value) else str(value)
-
-
-def _fixed(value: float, decimals: int, plain: bool) -> str:
-    """``value`` rounded to ``decimals`` places (negative: tens, hundreds...), in plain
-    notation if ``plain``, else in exponent notation with the same digits."""
-    rounded = round(value, decimals) + 0.0  # + 0.0: never "-0"
-    if decimals >= 0 and plain:
-        return f"{rounded:.{decimals}f}"
-    if decimals < 0 and abs(rounded) < 1e9:
-        return f"{rounded:.0f}"
-    digits = max(1, math.floor(math.log10(abs(rounded))) + decimals + 1) if rounded else 1
-    return f"{rounded:.{digits - 1}e}"
 
 
 def text_table(title: str, rows, note: str = "") -> str:

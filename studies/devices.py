@@ -48,6 +48,7 @@ import numpy as np
 import pandas as pd
 
 import randvib as rv
+from randvib.formatting import plus_minus
 from randvib.studies import budget, figures, report, script_main
 from randvib.studies.grids import fixed_paths, response_matched
 from randvib.studies.methods import accuracy_sentences, method_accuracy, methods_against_monte_carlo
@@ -198,7 +199,7 @@ def setup_section(axes, results, settings, quick, wall) -> str:
 
 def power_section(results, v, figure) -> str:
     shown = results[["input", "g", "device"]].copy()
-    pm = report.plus_minus
+    pm = plus_minus
     shown["E[P_e] (mW)"] = pm(results.power_mc, results.power_mc_ci95, 1e3, ".4f")
     shown["/ linear (paired)"] = pm(results.power_ratio_to_linear, results.power_ratio_ci95, 1.0,
                                     ".3f")  # fmt: skip
@@ -243,7 +244,7 @@ def budget_section(results, v) -> str:
 def methods_section(methods, v, figure) -> str:
     shown = methods[["input", "g", "device", "method"]].copy()
     for q in ("power", "exceedance"):
-        cells = report.plus_minus(methods[f"{q}_rel_error"], methods[f"{q}_rel_error_ci95"])
+        cells = plus_minus(methods[f"{q}_rel_error"], methods[f"{q}_rel_error_ci95"])
         shown[f"{q} error (%)"] = ["" if "nan" in c else c for c in cells]  # not compared
     shown["refused"] = methods.refused.fillna("").str.slice(0, 60)
     return (

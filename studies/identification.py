@@ -148,8 +148,6 @@ def figure8(fits, electrical, common, out: Path) -> pd.DataFrame:
             figure = figure_fit(
                 pred,
                 window=(0, 2),
-                scale=1e3,
-                unit="mm",
                 title=f"{label} ({level:g} m s$^{{-2}}$ RMS), coil with R$_L$ = {R_LOAD:g} Ω: "
                 f"{model} model identified on test 3",
             )

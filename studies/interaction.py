@@ -33,6 +33,7 @@ import numpy as np
 import pandas as pd
 
 import randvib as rv
+from randvib.formatting import plus_minus
 from randvib.montecarlo.sweep import SweepSettings, linearisation_verdicts
 from randvib.studies import figures, script_main
 from randvib.studies.contrasts import (
@@ -50,7 +51,6 @@ from randvib.studies.grids import (
 from randvib.studies.half_step import check_step_bias, half_step_verdict, sweep_with_half_step
 from randvib.studies.report import (
     markdown_table,
-    plus_minus,
     prepare_output_dir,
     readable_table,
     write_report,

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import randvib as rv
-from randvib import _display
+from randvib import formatting
 from randvib.identification.result import IdentificationResult
 
 
@@ -24,12 +24,12 @@ def simulation():
 
 def test_estimate_shows_the_digits_its_interval_supports():
     # one notation for the pair, chosen by the mean (as in the CLI's tables)
-    assert _display.estimate(0.0024646123, 5.4568e-7) == "0.00246461 ± 0.00000055"
-    assert _display.estimate(9.2912e-06, 9.81e-07) == "9.29e-06 ± 9.8e-07"
-    assert _display.estimate(12.3456, 0.25) == "12.35 ± 0.25"
-    assert _display.estimate(0.001346, 0.000295) == "0.00135 ± 0.00030"  # zeros kept
-    assert _display.estimate(134.55, 29.5) == "135 ± 30"
-    assert _display.estimate(1e-3, 0.0) == "0.001"  # no interval: six figures at most
+    assert formatting.estimate(0.0024646123, 5.4568e-7) == "0.00246461 ± 0.00000055"
+    assert formatting.estimate(9.2912e-06, 9.81e-07) == "9.29e-06 ± 9.8e-07"
+    assert formatting.estimate(12.3456, 0.25) == "12.35 ± 0.25"
+    assert formatting.estimate(0.001346, 0.000295) == "0.00135 ± 0.00030"  # zeros kept
+    assert formatting.estimate(134.55, 29.5) == "135 ± 30"
+    assert formatting.estimate(1e-3, 0.0) == "0.001"  # no interval: six figures at most
 
 
 def test_simulation_frame_holds_the_statistics(simulation):

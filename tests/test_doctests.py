@@ -18,7 +18,7 @@ MODULES = (
     "randvib.analytic.linearisation",
     "randvib.analytic.prediction",
     "randvib.analytic.statistical_linearisation",
-    "randvib._display",
+    "randvib.formatting",
     "randvib.identification.prediction",
     "randvib.identification.record_response",
     "randvib.identification.synthetic",
@@ -29,6 +29,7 @@ MODULES = (
     "randvib.models.record",
     "randvib.montecarlo.simulation",
     "randvib.montecarlo.sweep",
+    "randvib.quantities",
 )
 
 FLAGS = doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE

@@ -26,10 +26,10 @@ from study_checks import check_study_run, contrast_zscores
 import randvib as rv
 from randvib.analytic.prediction import expected_power
 from randvib.cli import main
+from randvib.formatting import plus_minus
 from randvib.montecarlo.sweep import SweepSettings
 from randvib.studies import STUDIES, load
 from randvib.studies.grids import fc_at_friction_level, fc_where_power_halves, friction_level
-from randvib.studies.report import plus_minus
 from randvib.studies.verdicts import interaction_summary
 
 interaction = load("interaction")  # the script studies/interaction.py

@@ -17,12 +17,13 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import special  # Student t quantile; lighter than scipy.stats
 
-from randvib import _display
+from randvib import _display, formatting
 from randvib._validation import check_choice
 from randvib.analytic import exact_solutions as exact
 from randvib.models.excitation import Excitation, as_excitation
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import kernel
+from randvib.quantities import unit
 from randvib.statistics import FirstPassage, Statistic, estimate
 
 
@@ -362,19 +363,19 @@ class SimulationResult:
 
     def _statistics(self) -> list[tuple[str, Statistic, str]]:
         """(name, Statistic, unit) of every statistic this run has."""
-        circuit_unit = "V^2" if self.harvester.coupling_name == "piezo" else "A^2"
         named = (
-            ("power_electrical", "W"),
-            ("power_load", "W"),
-            ("velocity_variance", "(m/s)^2"),
-            ("displacement_variance", "m^2"),
-            ("mean_abs_velocity", "m/s"),
-            ("friction_power", "W"),
-            ("circuit_mean_square", circuit_unit),
-            ("stroke_exceedance", "fraction of time"),
+            "power_electrical",
+            "power_load",
+            "velocity_variance",
+            "displacement_variance",
+            "mean_abs_velocity",
+            "friction_power",
+            "circuit_mean_square",
+            "stroke_exceedance",
         )
-        out = [(name, getattr(self, name), unit) for name, unit in named]
-        return [(name, stat, unit) for name, stat, unit in out if stat is not None]
+        out = [(name, getattr(self, name)) for name in named]
+        electrical = self.harvester.electrical
+        return [(name, stat, unit(name, electrical)) for name, stat in out if stat is not None]
 
     def _settings_line(self) -> str:
         if self.is_white:
@@ -384,7 +385,7 @@ class SimulationResult:
             excitation = f"{self.excitation.name}{level}"
         cv = ", control variates" if self.control_variates else ""
         return (
-            f"{self.n_paths} paths x {_display.number(self.averaging_time, 4)} s averaged, "
+            f"{self.n_paths} paths x {formatting.compact(self.averaging_time, 4)} s averaged, "
             f"dt {self.dt:g} s, {self.scheme}, seed {self.seed}, {excitation}{cv}"
         )
 
@@ -401,20 +402,20 @@ class SimulationResult:
                 "ci95": stat.ci95,
                 "std_error": stat.std_error,
                 "n_paths": stat.n_paths,
-                "unit": unit,
+                "unit": units,
             }
-            for name, stat, unit in self._statistics()
+            for name, stat, units in self._statistics()
         }
         return pd.DataFrame.from_dict(rows, orient="index").rename_axis("statistic")
 
     def _rows(self):
-        return [(n, _display.estimate(s.mean, s.ci95), u) for n, s, u in self._statistics()]
+        return [(n, formatting.estimate(s.mean, s.ci95), u) for n, s, u in self._statistics()]
 
     def __repr__(self) -> str:
         power = self.power_electrical
         return (
             f"{type(self).__name__}({self._settings_line()}; power_electrical = "
-            f"{_display.estimate(power.mean, power.ci95)} W)"
+            f"{formatting.estimate(power.mean, power.ci95)} W)"
         )
 
     def __str__(self) -> str:
