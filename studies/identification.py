@@ -325,7 +325,7 @@ def run_study(
     table = parameter_table(fits, MODELS, TRAINING_TESTS, TRUTH)
     write_table(out, "table2_identified.csv", table)
     write_table(out, "noise_free_recovery.csv", recovery)
-    electrical = rv.ElectricalCoupling(ALPHA, R_LOAD, R_COIL)
+    electrical = rv.Resistive(ALPHA, R_LOAD, R_COIL)
     fig8 = figure8(fits, electrical, common, out)
     elapsed = time.perf_counter() - start
     write_table(out, "figure8.csv", fig8)

@@ -22,7 +22,7 @@ from randvib.models.excitation import (
     White,
 )
 
-DEVICE = ["--preset", "section5"]
+DEVICE = ["--preset", "figure9"]
 COLOURED = [
     (BandPass(1.0, 10.0, 0.2), ["--excitation", "band-pass", "--f0", "10", "--zeta", "0.2"]),
     (KanaiTajimi(1.0, 10.0, 0.3), ["--excitation", "kanai-tajimi", "--f0", "10", "--zeta", "0.3"]),
@@ -37,7 +37,7 @@ def power_error(capsys, argv, fragment):
 
 @pytest.fixture(scope="module")
 def harvester():
-    return rv.preset("section5")
+    return rv.preset("figure9")
 
 
 # ------------------------------------------------------------------ Python API

@@ -35,5 +35,5 @@ def test_linear_recursions_are_the_schemes_written_out():
 
 
 def test_unknown_method_is_refused_by_name():
-    with pytest.raises(ValueError, match="method"):
+    with pytest.raises(ValueError, match="`scheme`"):
         integrator("runge-kutta")

@@ -689,14 +689,12 @@ def test_too_large_step_refused_with_bound():
         ({"t_end": -1.0}, "`t_end`"),
         ({"dt": 0.0}, "`dt`"),
         ({"burn_in": 2.0}, "`burn_in`"),
-        ({"method": "rk4"}, "`method`"),
         ({"scheme": "rk4"}, "`scheme`"),
         ({"dW": np.zeros((3, 3))}, "`dW` must have shape"),
         ({"initial": "somewhere"}, "`initial`"),
         ({"seed": -1}, "`seed`"),
     ],
 )
-@pytest.mark.filterwarnings("ignore:`method=`:DeprecationWarning")  # the alias row
 def test_bad_arguments(kwargs, fragment):
     base = dict(t_end=1.0, dt=1e-4, n_paths=4)
     with pytest.raises(ValueError, match=fragment):
@@ -705,17 +703,15 @@ def test_bad_arguments(kwargs, fragment):
         simulate(LINEAR, -1.0, **base)
 
 
-def test_method_is_a_deprecated_alias_of_scheme():
+def test_the_integrator_is_named_scheme_only():
+    """``scheme`` names the integrator; ``method`` (the analytic methods' word) is no alias."""
     base = dict(t_end=0.05, dt=1e-4, n_paths=4, seed=2, check_step=False, progress=False)
-    new = simulate(LINEAR, 1.0, scheme="euler-maruyama", **base)
-    with pytest.warns(DeprecationWarning, match="scheme="):
-        old = simulate(LINEAR, 1.0, method="euler-maruyama", **base)
-    np.testing.assert_array_equal(old.per_path, new.per_path)
-    assert new.scheme == "euler-maruyama" and new.summary()["method"] == "euler-maruyama"
-    with pytest.warns(DeprecationWarning):
-        assert old.method == "euler-maruyama"
-    with pytest.raises(TypeError, match="`scheme` only"):
-        simulate(LINEAR, 1.0, scheme="heun", method="heun", **base)
+    result = simulate(LINEAR, 1.0, scheme="euler-maruyama", **base)
+    # the JSON key stays `method`, as the CLI's --method
+    assert result.scheme == "euler-maruyama" and result.summary()["method"] == "euler-maruyama"
+    assert not hasattr(result, "method")
+    with pytest.raises(TypeError, match="method"):
+        simulate(LINEAR, 1.0, method="heun", **base)
 
 
 def test_cli_simulate_json(capsys):

@@ -207,7 +207,7 @@ def device_from_parameters(
 
     The identified damping ``c`` becomes the Harvester's c_m: a record taken
     in open circuit holds no electrical damping. ``electrical`` (a coupling,
-    e.g. ``ElectricalCoupling(alpha, r_load, r_coil)``) wires the device, its
+    e.g. ``Resistive(alpha, r_load, r_coil)``) wires the device, its
     c_e added to c (:meth:`~randvib.models.harvester.Harvester.with_coupling`).
     """
     law = check_model(model)

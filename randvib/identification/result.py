@@ -171,7 +171,7 @@ class IdentificationResult:
         electrical : Coupling, optional
             A coupling to wire the device with (its c_e is added to the
             identified c, which a record taken in open circuit does not hold),
-            e.g. ``randvib.ElectricalCoupling(alpha, r_load, r_coil)``.
+            e.g. ``randvib.Resistive(alpha, r_load, r_coil)``.
         """
         return device_from_parameters(self.model, self.parameters, electrical)[0]
 

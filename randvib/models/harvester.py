@@ -15,7 +15,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from randvib._validation import check_finite, check_nonnegative, check_positive, scalar_or_array
-from randvib.models.coupling import COUPLINGS, Coupling, ElectricalCoupling, Resistive
+from randvib.models.coupling import COUPLINGS, Coupling, Resistive
 from randvib.models.friction import FrictionModel
 from randvib.models.potential import Potential
 from randvib.quantities import unit
@@ -26,7 +26,7 @@ def _check_real(name, value, _unit):
     return check_finite(name, value)
 
 
-__all__ = ["ElectricalCoupling", "Harvester"]  # ElectricalCoupling: re-exported, historical home
+__all__ = ["Harvester"]
 
 
 class ElectricalDampingOverflow(ValueError):
@@ -185,7 +185,7 @@ class Harvester:
         r_load, r_coil : float
             Load and coil resistances (ohm).
         """
-        electrical = ElectricalCoupling(alpha, r_load, r_coil)
+        electrical = Resistive(alpha, r_load, r_coil)
         return cls.with_coupling(m, c_m, k, electrical, k3=k3, friction=friction, stroke=stroke)
 
     # ----------------------------------------------------------------- derived

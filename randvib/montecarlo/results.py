@@ -11,7 +11,6 @@ recorded paths. Numbers are computed here; tables and reprs are drawn by
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -163,16 +162,6 @@ class SimulationResult:
     @property
     def n_paths(self) -> int:
         return self.per_path.shape[0]
-
-    @property
-    def method(self) -> str:
-        """Deprecated alias of :attr:`scheme` (the integrator's name)."""
-        warnings.warn(
-            "SimulationResult.method is deprecated; use SimulationResult.scheme",
-            DeprecationWarning,
-            stacklevel=2,
-        )
-        return self.scheme
 
     @property
     def averaging_time(self) -> float:
@@ -346,7 +335,7 @@ class SimulationResult:
             dt=self.dt,
             t_end=self.t_end,
             burn_in=self.burn_in,
-            method=self.scheme,  # the JSON key predates the name `scheme`
+            method=self.scheme,  # the JSON key is the CLI's: `--method`
             seed=self.seed,
             psd=self.psd,
             control_variates=self.control_variates,

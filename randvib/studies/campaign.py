@@ -44,7 +44,7 @@ def synthetic_record(
     displacement, with white sensor noise of RMS ``noise`` = (base (m),
     relative (m), voltage (V)) (the LVDT's 1 um, the laser's 2 um, 0.1 mV),
     or none with ``noise=None``. ``electrical`` (a
-    :class:`randvib.ElectricalCoupling`) adds its damping c_e to the truth's
+    :class:`randvib.Resistive`) adds its damping c_e to the truth's
     c and records the load voltage. ``rng`` draws the excitation, then the
     noise.
 
