@@ -1,4 +1,4 @@
-"""One set of conventions for every command, and output for people (issue 12, command line).
+"""One set of conventions for every command, and output for people (the command line).
 
 The parser walk below runs over every registered subcommand, so that a new
 command keeps the conventions: defaults shown in ``--help``, the shared flags

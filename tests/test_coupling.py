@@ -1,4 +1,4 @@
-"""Electrical couplings: resistive, inductive (coil inductance) and piezo (issue 11).
+"""Electrical couplings: resistive, inductive (coil inductance) and piezo.
 
 Exact references:
 

@@ -120,7 +120,7 @@ def test_white_output_is_unchanged(capsys):
         assert code == 0
         got = json.loads(out)
         # the same keys, values and order; keys are only ever added after them
-        # (power_mechanical: c_m E[v^2] + friction power, issue 12)
+        # (power_mechanical: c_m E[v^2] + friction power)
         assert {key: got[key] for key in before} == before
         assert list(got)[: len(before)] == list(before)
         assert set(got) - set(before) == {"power_mechanical"}

@@ -1,4 +1,4 @@
-"""A friction law defined only here runs through every consumer (issue 9).
+"""A friction law defined only here runs through every consumer.
 
 ``Stribeck`` below is declared in this file and nowhere in the package:
 Coulomb friction plus a static peak that decays with speed,

@@ -1,4 +1,4 @@
-"""Fuzzing the command line and the public functions (issue 13).
+"""Fuzzing the command line and the public functions.
 
 Hypothesis draws arguments, ordinary and extreme (0, +-1e308, 1e-308, NaN,
 inf, huge integers), and each test asserts the contract: a command ends with
@@ -179,7 +179,7 @@ def test_predict_refuses_or_is_finite(p, method):
     assert result.velocity_variance > 0, result
 
 
-# ------------------------------------------------------------------ issues 10 and 11 options
+# ---------------------------------------------------------- excitation and coupling options
 #: Each excitation with the options it takes, and the ordinary range of each.
 EXCITATION_OPTIONS = {
     "white": {},

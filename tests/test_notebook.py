@@ -1,4 +1,4 @@
-"""Results and progress bars in a real Jupyter kernel (issue 12: notebooks).
+"""Results and progress bars in a real Jupyter kernel (notebooks).
 
 The notebooks below are executed by nbclient in a fresh IPython kernel, as a
 user's notebook is: what they check is the cell output Jupyter would show

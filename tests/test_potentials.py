@@ -1,4 +1,4 @@
-"""Potentials of any shape (issue 11): bistable, pure cubic, free mass, and the stroke limit.
+"""Potentials of any shape: bistable, pure cubic, free mass, and the stroke limit.
 
 Exact references: the Gibbs density exp(-H/T), T = S m^2/(4c), of any confining
 potential without friction (velocity Gaussian with E[v^2] = S m/(4c), so the

@@ -15,7 +15,7 @@ study = load("silverbox")  # the script studies/silverbox.py
 
 
 def test_quick_study_meets_the_arrow_head_target(tmp_path):
-    """Issue 15's target: arrow-head RMS <= 0.5 mV with the physical model
+    """The study's target (TARGET_MV): arrow-head RMS <= 0.5 mV with the physical model
     (measured: 0.388 mV quick, 0.39 mV full)."""
     study.run_study(tmp_path / "sb", quick=True, progress=False)
     table = pd.read_csv(tmp_path / "sb" / "results.csv")

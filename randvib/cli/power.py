@@ -177,7 +177,7 @@ def _point(args) -> tuple[dict, object, object]:
     }
     if result.power_load is None:
         out.pop("power_load")
-    if harvester.electrical is not None:  # added with the couplings (issue 11)
+    if harvester.electrical is not None:
         out["coupling"] = harvester.coupling_name
     else:
         # what is not converted: c_m E[v^2] + friction power, c_eq E[v^2] being all
