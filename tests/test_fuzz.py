@@ -329,15 +329,11 @@ def _excitations():
 
 
 def _refused(build):
-    """``build()``, or None when it is refused with a ValueError, or with the
-    RuntimeError that says statistical linearisation did not converge (both allowed)."""
+    """``build()``, or None when it is refused with a ValueError (statistical
+    linearisation that did not converge included)."""
     try:
         return build()
     except ValueError:
-        return None
-    except RuntimeError as exc:
-        if "did not converge" not in str(exc):
-            raise
         return None
 
 

@@ -414,12 +414,11 @@ def _typical_level(excitation) -> float:
     return float(level)
 
 
-class LinearisationDidNotConverge(ValueError, RuntimeError):
+class LinearisationDidNotConverge(ValueError):
     """No fixed point of the statistical linearisation was found.
 
-    A ValueError (the device and excitation admit no Gaussian linearisation
-    the solver can find: callers report it as a refusal, one line), and a
-    RuntimeError as before.
+    A ValueError: the device and excitation admit no Gaussian linearisation
+    the solver can find, and callers report it as a refusal, one line.
     """
 
 

@@ -1,10 +1,9 @@
 """``randvib power``: analytic expected power (paper Eq. 19-32 and beyond).
 
 Under white noise (the default) every method of
-:data:`randvib.analytic.prediction.METHODS` applies and the output is what
-it was before excitations existed; under another excitation only the methods
-that declare they accept it (statistical linearisation) do, and the JSON
-gains an ``excitation`` object describing it. The ``--method`` choices, their
+:data:`randvib.analytic.prediction.METHODS` applies; under another excitation
+only the methods that declare they accept it (statistical linearisation) do,
+and the JSON gains an ``excitation`` object describing it. The ``--method`` choices, their
 help and the refusals come from the methods' declarations
 (:mod:`randvib.analytic.method`).
 

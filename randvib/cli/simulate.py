@@ -1,11 +1,12 @@
-"""``randvib simulate``: Monte Carlo ensemble of the harvester under white or filtered noise.
+"""``randvib simulate``: Monte Carlo ensemble under white, coloured or recorded base acceleration.
 
-White noise as before; ``--excitation band-pass|kanai-tajimi`` integrates the
-shaping filter with the device, ``band-limited`` and ``--psd-file`` are
-synthesised path by path (the options of :mod:`randvib.cli._excitation`,
-shared with ``randvib power``); ``--record FILE`` simulates the device on the
-record itself (:func:`randvib.monte_carlo_on_record`), ``--segments`` windows
-giving the interval.
+White noise by default (``--psd``); ``--excitation band-pass|kanai-tajimi``
+integrates the shaping filter with the device, ``band-limited`` and
+``--psd-file`` are synthesised path by path (the options of
+:mod:`randvib.cli._excitation`, shared with ``randvib power``); ``--record
+FILE`` simulates the device on the record itself
+(:func:`randvib.monte_carlo_on_record`), ``--segments`` windows giving the
+interval.
 """
 
 from __future__ import annotations

@@ -6,7 +6,8 @@ and computes every statistic from them with its interval
 (:mod:`randvib.statistics`); :class:`Histogram` holds the stationary
 histograms of z and v counted per group of paths, :class:`Histories` the
 recorded paths. Numbers are computed here; tables and reprs are drawn by
-:mod:`randvib._display`.
+:mod:`randvib._display`, with the units of :mod:`randvib.quantities` and the
+digits of :mod:`randvib.formatting`.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Monte Carlo simulation of the harvester under white or rational noise: ``simulate``.
+"""Monte Carlo simulation of the harvester under white or coloured base excitation: ``simulate``.
 
 The SDE (docs/conventions.md, paper Eq. 1 and 15-17) for the state (z, v = z') and,
 for LuGre friction, the bristle state theta:
