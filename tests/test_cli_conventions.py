@@ -3,6 +3,10 @@
 The parser walk below runs over every registered subcommand, so that a new
 command keeps the conventions: defaults shown in ``--help``, the shared flags
 present with one meaning, choices declared as choices.
+
+Covers :mod:`randvib.cli` (the parser, shared flags, one-line errors, the options named
+differently from the API), the tables and device lines of :mod:`randvib.cli._output` and
+:mod:`randvib.cli._device`, and the digits they print (:mod:`randvib.formatting`).
 """
 
 import argparse

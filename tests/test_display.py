@@ -1,4 +1,11 @@
-"""Results in notebooks and pandas: compact reprs, HTML tables, to_frame/to_dict."""
+"""Results in notebooks and pandas: compact reprs, HTML tables, to_frame/to_dict.
+
+Covers :mod:`randvib._display` (plain-text and HTML tables, pandas) through the result
+types (:mod:`randvib.montecarlo.results`, :mod:`randvib.analytic.power_prediction`,
+:mod:`randvib.analytic.statistical_linearisation`,
+:mod:`randvib.identification.result`), the digits they show (:mod:`randvib.formatting`)
+and their units (:mod:`randvib.quantities`).
+"""
 
 import numpy as np
 import pytest
@@ -145,3 +152,23 @@ def test_tables_records_and_spectra_have_compact_reprs(simulation):
         f"SampledSpectra({spectra.frequency.size} frequencies, 0-500 Hz, 2 paths"
     )
     assert len(text) < 200
+
+
+def test_units_come_from_one_vocabulary():
+    """Result types take a quantity's unit from randvib.quantities: a circuit state's
+    mean square in its coupling's unit squared, and one unit per name everywhere."""
+    from randvib.quantities import unit
+
+    piezo = rv.Harvester.with_coupling(
+        0.0226, 0.05, 57.4, rv.Piezo(theta=2e-3, capacitance=1e-7, r_load=1e5)
+    )
+    coil = rv.Inductive(alpha=0.1992, r_load=0.5, r_coil=0.48, inductance=2e-3)
+    assert unit("circuit_mean_square", coil) == "A^2"
+    assert unit("circuit_variance", piezo.electrical) == "V^2"
+    assert unit("circuit_mean_square") == "A^2 or V^2"  # the device unknown (a PowerPrediction)
+    lin = rv.statistical_linearisation(piezo, rv.BandPass(1.0, 8.0, 0.2))
+    assert {name: u for name, _, u in lin._rows()}["circuit_variance"] == "V^2"
+    prediction = rv.predict(rv.preset("figure9"), 1.0)
+    assert all(u == unit(name) for name, _, u in prediction._quantities())
+    with pytest.raises(KeyError, match="not a reported quantity"):
+        unit("power")

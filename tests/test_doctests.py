@@ -4,6 +4,10 @@ Every module of the package whose source holds a ``>>>`` example is listed in
 ``MODULES`` (a test checks the list is complete), and each runs under
 :mod:`doctest` with the usual numpy-friendly flags. The examples print
 rounded numbers, so they state what the code computes at fixed seeds.
+
+Covers the examples of the modules in ``MODULES`` (:mod:`randvib.models.presets`,
+:mod:`randvib.montecarlo.simulation`, :mod:`randvib.formatting`,
+:mod:`randvib.quantities`, ...).
 """
 
 import doctest

@@ -6,6 +6,9 @@ exit 0 and finite numbers in valid JSON, or exit 2 with one line on stderr;
 never a traceback, an internal error (exit 1) or a non-finite number with
 exit 0. Sizes are bounded so that no legitimate run is long (a hang would
 show as the test's own timeout).
+
+Covers every command of :mod:`randvib.cli` and
+:func:`randvib.analytic.prediction.predict`.
 """
 
 import json

@@ -2,6 +2,11 @@
 
 Covers randvib.identification.identify (the driver), .cost (Eq. 11), .bounds,
 .settings, .models, .result and .prediction (predict_record, validate).
+
+Covers :func:`randvib.identify` and its parts: :mod:`randvib.identification.identify`,
+:mod:`randvib.identification.cost`, :mod:`randvib.identification.bounds`,
+:mod:`randvib.identification.settings`, :mod:`randvib.identification.result` and
+:mod:`randvib.identification.prediction`.
 """
 
 import json

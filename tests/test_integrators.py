@@ -3,6 +3,8 @@
 The compiled step and the exact linear recursions both read the weights; the
 hand-written recursions below are the independent check that the table says
 what the schemes are.
+
+Covers :mod:`randvib.montecarlo.integrators`.
 """
 
 import numpy as np

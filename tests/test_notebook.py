@@ -3,6 +3,9 @@
 The notebooks below are executed by nbclient in a fresh IPython kernel, as a
 user's notebook is: what they check is the cell output Jupyter would show
 (the widget bar, the HTML table), not our own idea of it.
+
+Covers :mod:`randvib._progress` (the bars in a kernel) and :mod:`randvib._display` (the
+HTML tables).
 """
 
 from __future__ import annotations

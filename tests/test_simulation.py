@@ -13,6 +13,14 @@ The statistics are functions of the seed (``case_*`` below) so that
 ``tests/calibration/simulation.py`` can rerun them over many seeds; each test's
 docstring records the resulting z-scores (number of seeds, mean, standard
 deviation, largest |z|).
+
+Covers :func:`randvib.simulate` and the parts it orchestrates:
+:mod:`randvib.montecarlo.simulation`, :mod:`randvib.montecarlo.validation`,
+:mod:`randvib.montecarlo.options`, :mod:`randvib.montecarlo.kernel_setup`,
+:mod:`randvib.montecarlo.kernel`, :mod:`randvib.montecarlo.batches`,
+:mod:`randvib.montecarlo.results` and the step check of
+:mod:`randvib.montecarlo.step_check`. The estimators themselves:
+tests/test_statistics.py.
 """
 
 import json

@@ -8,6 +8,10 @@ the CSV tables, the interaction contrast against the FPK grids, resuming,
 refusing another run's folder (through the private ``_grid``/``_settings``
 overrides) and the exact scaling laws; the verdict wording itself is checked
 on synthetic tables below.
+
+Covers the studies' building blocks :mod:`randvib.studies.grids`,
+:mod:`randvib.studies.contrasts`, :mod:`randvib.studies.accuracy`,
+:mod:`randvib.studies.verdicts` and :mod:`randvib.studies.report`.
 """
 
 import json

@@ -4,6 +4,10 @@ Every study figure of the tests' tiny runs goes through
 :func:`randvib.figure_style.save_figure`, whose layout check is an error
 in the tests (``filterwarnings`` in pyproject.toml); these tests show the
 check itself catches what it must.
+
+Covers :mod:`randvib.figure_style`, the report's Markdown tables
+(:mod:`randvib.studies.report`), the numbers they print (:mod:`randvib.formatting`) and
+:mod:`randvib.studies.evidence`.
 """
 
 import matplotlib

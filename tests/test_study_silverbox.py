@@ -3,6 +3,9 @@
 The quick study fits the Duffing model on the first 20,000 multisine samples
 only (SaDE 12 x 10, then the least-squares polish) and is scored on the
 held-out multisine test and the full arrow-head, which nothing was tuned on.
+
+Covers the shipped record (:mod:`randvib.datasets`) and its identification
+(:mod:`randvib.identification.identify`) as the study runs them.
 """
 
 import json

@@ -1,4 +1,7 @@
-"""Sweeps: grids, precision targets, common random numbers, resumable output, executors."""
+"""Sweeps: grids, precision targets, common random numbers, resumable output, executors.
+
+Covers :mod:`randvib.montecarlo.sweep`.
+"""
 
 import json
 
