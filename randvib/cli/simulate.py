@@ -19,6 +19,7 @@ from randvib.cli._excitation import add_excitation_arguments, excitation_from_ar
 from randvib.cli._output import describe_device, describe_excitation, print_table
 from randvib.formatting import cell, estimate_parts
 from randvib.montecarlo.integrators import INTEGRATORS
+from randvib.montecarlo.results import STATISTICS
 from randvib.quantities import unit
 
 
@@ -127,17 +128,7 @@ def run(args) -> int:
         except ValueError:  # e.g. no zero-mean Gaussian solution for this double well
             analytic = None
     rows = []
-    for name in (
-        "power_electrical",
-        "power_load",
-        "velocity_variance",
-        "displacement_variance",
-        "mean_abs_velocity",
-        "friction_power",
-        "circuit_mean_square",
-        "stroke_exceedance",
-        "stroke_first_passage_time",
-    ):
+    for name in (*STATISTICS, "stroke_first_passage_time"):
         if summary.get(name) is None:
             continue
         s = summary[name]

@@ -26,6 +26,19 @@ from randvib.montecarlo import kernel
 from randvib.quantities import unit
 from randvib.statistics import FirstPassage, Statistic, estimate
 
+#: The statistics of a :class:`SimulationResult` that are shown, in order (their
+#: units: :mod:`randvib.quantities`).
+STATISTICS = (
+    "power_electrical",
+    "power_load",
+    "velocity_variance",
+    "displacement_variance",
+    "mean_abs_velocity",
+    "friction_power",
+    "circuit_mean_square",
+    "stroke_exceedance",
+)
+
 
 @dataclass(frozen=True)
 class Histogram:
@@ -353,17 +366,7 @@ class SimulationResult:
 
     def _statistics(self) -> list[tuple[str, Statistic, str]]:
         """(name, Statistic, unit) of every statistic this run has."""
-        named = (
-            "power_electrical",
-            "power_load",
-            "velocity_variance",
-            "displacement_variance",
-            "mean_abs_velocity",
-            "friction_power",
-            "circuit_mean_square",
-            "stroke_exceedance",
-        )
-        out = [(name, getattr(self, name)) for name in named]
+        out = [(name, getattr(self, name)) for name in STATISTICS]
         electrical = self.harvester.electrical
         return [(name, stat, unit(name, electrical)) for name, stat in out if stat is not None]
 
