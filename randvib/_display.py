@@ -13,6 +13,9 @@ from __future__ import annotations
 
 import html
 
+from randvib.formatting import compact
+from randvib.quantities import QUANTITIES, unit
+
 
 def pandas():
     """The pandas module, or an ImportError that says how to get it."""
@@ -50,4 +53,61 @@ def html_table(title: str, rows, note: str = "") -> str:
         f"<table><caption style='text-align:left'>{caption}</caption>"
         "<thead><tr><th>quantity</th><th>value</th><th>unit</th></tr></thead>"
         f"<tbody>{body}</tbody></table>"
+    )
+
+
+def time_series(result, names) -> list[tuple]:
+    """(name, values, unit) of the quantities ``names`` that ``result`` has (not None);
+    units from :mod:`randvib.quantities` (a circuit's mean square: its coupling's)."""
+    electrical = result.harvester.electrical
+    out = []
+    for name in names:
+        values = getattr(result, name)
+        if values is not None:
+            out.append((name, values, unit(name, electrical) if name in QUANTITIES else ""))
+    return out
+
+
+def time_header(name: str, units: str) -> str:
+    """A time table's header: the quantity's symbol (:mod:`randvib.quantities`) and unit."""
+    quantity = QUANTITIES.get(name)
+    label = quantity.symbol if quantity is not None and quantity.symbol else name
+    return f"{label} ({units})" if units else label
+
+
+def time_rows(times, series, cell) -> tuple[list, list]:
+    """(headers, rows) of a time table: ``series`` (name, values, unit), ``cell(values, i)``."""
+    headers = ["time (s)"] + [time_header(name, unit) for name, _, unit in series]
+    rows = [
+        [compact(t)] + [cell(values, i) for _, values, _ in series] for i, t in enumerate(times)
+    ]
+    return headers, rows
+
+
+def time_table(title: str, headers, rows, note: str = "") -> str:
+    """A time-resolved table (one row per time, cells already text) under ``title``."""
+    from tabulate import tabulate
+
+    body = tabulate(rows, headers=headers, disable_numparse=True, stralign="right")
+    lines = [title, body]
+    if note:
+        lines.append(f"({note})")
+    return "\n".join(lines)
+
+
+def time_html_table(title: str, headers, rows, note: str = "") -> str:
+    """:func:`time_table` as a small HTML table (Jupyter's ``_repr_html_``)."""
+    head = "".join(f"<th>{html.escape(h)}</th>" for h in headers)
+    body = "".join(
+        "<tr>"
+        + "".join(f"<td style='text-align:right'>{html.escape(c)}</td>" for c in row)
+        + "</tr>"
+        for row in rows
+    )
+    caption = f"<b>{html.escape(title)}</b>"
+    if note:
+        caption += f"<br><small>{html.escape(note)}</small>"
+    return (
+        f"<table><caption style='text-align:left'>{caption}</caption>"
+        f"<thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
     )

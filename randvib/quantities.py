@@ -39,7 +39,7 @@ class Quantity(NamedTuple):
 
     unit: str
     description: str
-    #: How a report's header names it (paper notation); None: by its name.
+    #: How a report's or a time table's header names it; None: by its name.
     symbol: str | None = None
 
 
@@ -80,22 +80,37 @@ QUANTITIES: dict[str, Quantity] = {
     "input_offset": Quantity("input unit", "offset of the input channel"),
     "output_offset": Quantity("m", "offset of the measured displacement"),
     # ------------------------------------------------ statistics, predicted or estimated
-    "power_electrical": Quantity("W", "expected electrical power E[P_e] = c_e E[z'^2] (Eq. 32)"),
-    "power_load": Quantity("W", "expected power into the load E[i^2 R_L]"),
+    "power_electrical": Quantity(
+        "W", "expected electrical power E[P_e] = c_e E[z'^2] (Eq. 32)", "E[P_e]"
+    ),
+    "power_load": Quantity("W", "expected power into the load E[i^2 R_L]", "E[P_L]"),
     "power_mechanical": Quantity("W", "power dissipated mechanically: c_m E[z'^2] + friction"),
     "friction_power": Quantity("W", "power dissipated by friction E[z' F]"),
-    "c_eq": Quantity("Ns/m", "equivalent viscous damping (Eq. 19, 30)"),
-    "k_eq": Quantity("N/m", "equivalent linear stiffness"),
-    "velocity_variance": Quantity("(m/s)^2", "velocity variance E[z'^2] (Eq. 20)"),
-    "displacement_variance": Quantity("m^2", "displacement variance E[z^2]"),
+    "c_eq": Quantity("Ns/m", "equivalent viscous damping (Eq. 19, 30)", "c_eq"),
+    "k_eq": Quantity("N/m", "equivalent linear stiffness", "k_eq"),
+    "velocity_variance": Quantity("(m/s)^2", "velocity variance E[z'^2] (Eq. 20)", "E[v^2]"),
+    "displacement_variance": Quantity("m^2", "displacement variance E[z^2]", "E[z^2]"),
     "mean_abs_velocity": Quantity("m/s", "mean absolute velocity E|z'|"),
     # A circuit state's unit is its coupling's (current A, voltage V): see unit().
-    "circuit_mean_square": Quantity("A^2 or V^2", "mean square of the circuit state"),
+    "circuit_mean_square": Quantity("A^2 or V^2", "mean square of the circuit state", "E[x^2]"),
     "circuit_variance": Quantity("A^2 or V^2", "variance of the circuit state"),
     "stroke_exceedance": Quantity(
-        "", "P(|z| > stroke): stationary probability (Monte Carlo: fraction of time)"
+        "",
+        "P(|z| > stroke): stationary probability (Monte Carlo: fraction of time)",
+        "P(|z| > stroke)",
     ),
     "stroke_first_passage_time": Quantity("s", "mean first time |z| reaches the stroke"),
+    # ------------------------------------------------ events (time-resolved, from t = 0)
+    "cumulative_energy": Quantity(
+        "J", "electrical energy from t = 0: int_0^t E[P_e] dt", "energy to t"
+    ),
+    "stroke_reached": Quantity("", "probability that |z| reached the stroke by t", "P(reached)"),
+    "stroke_reached_poisson": Quantity(
+        "", "P(reached) by the Poisson crossing approximation", "reached, Poisson*"
+    ),
+    "stroke_reached_vanmarcke": Quantity(
+        "", "P(reached) by Vanmarcke's approximation", "reached, Vanmarcke*"
+    ),
     "r_load_optimal": Quantity("ohm", "load resistance of the largest load power"),
     "power_load_optimal": Quantity("W", "load power at the optimal load resistance"),
 }

@@ -14,7 +14,8 @@ the sweeps, the response spectra and every study:
 - :func:`two_sided_p_value` and :func:`holm_significant`: a test of a zero
   mean and Holm's step-down correction for a family of them;
 - :class:`FirstPassage` and :func:`median_first_passage`: first-passage times
-  censored at the end of the run.
+  censored at the end of the run;
+- :class:`TimeStatistics`: one estimate per time of a transient ensemble.
 """
 
 from __future__ import annotations
@@ -169,6 +170,50 @@ class FirstPassage:
             "horizon": self.horizon,
             "restricted_mean": self.restricted_mean.to_dict(),
         }
+
+
+@dataclass(frozen=True)
+class TimeStatistics:
+    """Monte Carlo estimates at several times, each with its 95 % half-width.
+
+    The estimate at each time is the mean over independent paths of that
+    path's value at that time (a snapshot of a transient ensemble), with the
+    Student-t interval of :func:`estimate`; ``self[i]`` is time i's
+    :class:`Statistic`.
+
+    Attributes
+    ----------
+    mean, ci95, std_error : ndarray
+        One value per time.
+    n_paths : int
+    """
+
+    mean: np.ndarray
+    ci95: np.ndarray
+    std_error: np.ndarray
+    n_paths: int
+
+    @classmethod
+    def from_paths(cls, per_path) -> TimeStatistics:
+        """From values of shape (n_paths, n_times), one row per independent path."""
+        per_path = np.asarray(per_path, dtype=float)
+        n = per_path.shape[0]
+        if n < 2:
+            raise ValueError(f"need at least 2 paths for a confidence interval, got {n}")
+        mean, half = mean_and_half_width(per_path)
+        return cls(mean, half, per_path.std(axis=0, ddof=1) / np.sqrt(n), n)
+
+    def __len__(self) -> int:
+        return self.mean.size
+
+    def __getitem__(self, i) -> Statistic:
+        return Statistic(
+            float(self.mean[i]), float(self.ci95[i]), float(self.std_error[i]), self.n_paths
+        )
+
+    def to_list(self) -> list:
+        """[[mean, 95 % half-width], ...] over the times, ready for JSON."""
+        return [[float(m), float(h)] for m, h in zip(self.mean, self.ci95, strict=True)]
 
 
 def mean_and_half_width(per_path: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -107,3 +107,13 @@ def calibrate(name: str, case, seeds, widths=(24, 20)) -> dict:
             flush=True,
         )
     return zs
+
+
+def seeds_and_names(argv, default_seeds: int = 40, first: int = 1000):
+    """(seeds, names or None) from a calibration script's ``[n_seeds] [--first=SEED] [name ...]``."""
+    args = list(argv)
+    for arg in [a for a in args if a.startswith("--first=")]:
+        first = int(arg.split("=", 1)[1])
+        args.remove(arg)
+    n = int(args[0]) if args else default_seeds
+    return range(first, first + n), (args[1:] or None)

@@ -446,6 +446,48 @@ MUTATIONS: tuple[Mutation, ...] = (
         "mechanical + electrical must equal the injected m S / 4 to 1e-12 under white noise "
         "(energy balance, c_eq = S m / (4 E[v^2])).",
     ),
+    Mutation(
+        name="event-noise-gain",
+        path="randvib/montecarlo/kernel.py",
+        edits=(("noise = noise * gain", "noise = noise * gain * 1.05"),),
+        tests=("tests/test_transient_simulation.py::test_monte_carlo_matches_the_exact_transient",),
+        why="An event's white noise is 5 % too strong in the kernel (10 % too much injected "
+        "variance); the ensemble's energy is compared with the Lyapunov solution, the "
+        "scheme's exact bias removed, powered for 6 %.",
+    ),
+    Mutation(
+        name="event-filter-coupling",
+        path="randvib/analytic/transient.py",
+        edits=(
+            (
+                "a[self.iv, : self.n_filter] = e * self._coupling",
+                "a[self.iv, : self.n_filter] = e * e * self._coupling",
+            ),
+        ),
+        tests=(
+            "tests/test_transient_analytic.py::"
+            "test_enveloped_filtered_noise_against_the_evolutionary_spectrum",
+        ),
+        why="The transient Lyapunov equation applies the envelope's square to a filtered "
+        "input's coupling (a step hides it); Priestley's evolutionary spectrum of the "
+        "modulated process, an independent route, sees it.",
+    ),
+    Mutation(
+        name="caughey-stumpf-phase",
+        path="randvib/analytic/exact_solutions.py",
+        edits=(
+            (
+                "(1.0 - decay * (1.0 + r * sin2 + 2 * r * r * square))",
+                "(1.0 - decay * (1.0 - r * sin2 + 2 * r * r * square))",
+            ),
+        ),
+        tests=(
+            "tests/test_transient_analytic.py::"
+            "test_caughey_stumpf_closed_form_against_its_own_derivative_and_integral",
+        ),
+        why="The reference itself: Caughey and Stumpf's E[z^2] with the phase term's sign "
+        "flipped; its derivative must be twice the closed-form E[z z'].",
+    ),
 )
 
 

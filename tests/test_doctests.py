@@ -23,10 +23,12 @@ MODULES = (
     "randvib.analytic.prediction",
     "randvib.analytic.statistical_linearisation",
     "randvib.formatting",
+    "randvib.analytic.transient",
     "randvib.identification.prediction",
     "randvib.identification.record_response",
     "randvib.identification.synthetic",
     "randvib.models.coupling",
+    "randvib.models.event",
     "randvib.models.excitation",
     "randvib.models.harvester",
     "randvib.models.presets",
@@ -34,6 +36,7 @@ MODULES = (
     "randvib.montecarlo.simulation",
     "randvib.montecarlo.sweep",
     "randvib.quantities",
+    "randvib.montecarlo.transient",
 )
 
 FLAGS = doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE

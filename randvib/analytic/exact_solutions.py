@@ -13,6 +13,9 @@
   and has the Caughey-Dienes density exp(-(4/(S m))(c v^2/2 + Fc |v|)).
 * Stationary energy balance (Ito's rule on the mechanical energy, any
   stiffness, any memoryless friction): c E[v^2] + E[v F(v)] = S m / 4.
+* The linear oscillator from rest under white noise switched on at t = 0
+  (Caughey and Stumpf 1961): its second moments at every time and the
+  integral of E[v^2] over an event, in closed form.
 """
 
 from __future__ import annotations
@@ -141,3 +144,85 @@ def caughey_dienes_moments(m, c, fc, psd) -> tuple[float, float]:
     mean = ratio - mu  # E[u | u > mu] - mu = E|v|
     second = s2 + mu * ratio - 2.0 * mu * ratio + mu * mu  # E[(u - mu)^2 | u > mu]
     return float(second), float(mean)
+
+
+def _underdamped(m, c, k):
+    """(omega_n (rad/s), zeta, omega_d (rad/s)) of an underdamped linear oscillator."""
+    m, c, k = (float(check_positive(n, x)) for n, x in (("m", m), ("c", c), ("k", k)))
+    omega = np.sqrt(k / m)
+    zeta = c / (2.0 * np.sqrt(k * m))
+    if not zeta < 1.0:
+        raise ValueError(
+            f"the closed form is for an underdamped oscillator: zeta = c / (2 sqrt(k m)) = "
+            f"{zeta:.6g} must be < 1"
+        )
+    return omega, zeta, omega * np.sqrt(1.0 - zeta * zeta)
+
+
+def caughey_stumpf_moments(m, c, k, psd, t):
+    """Second moments of the linear oscillator from rest under white noise switched on at t = 0.
+
+    ``m z'' + c z' + k z = -m a`` with E[a(t1) a(t2)] = (S/2) delta(t2 - t1)
+    for t >= 0 and z(0) = z'(0) = 0 (Caughey and Stumpf 1961, "Transient
+    response of a dynamic system under random excitation", J. Appl. Mech.
+    28, 563-566). With omega_n^2 = k/m, 2 zeta omega_n = c/m,
+    omega_d = omega_n sqrt(1 - zeta^2) and r = zeta omega_n / omega_d::
+
+        E[z^2] = S/(8 zeta omega_n^3) {1 - e^(-2 zeta omega_n t) [1 + r sin(2 omega_d t) + 2 r^2 sin^2(omega_d t)]}
+        E[v^2] = S/(8 zeta omega_n) {1 - e^(-2 zeta omega_n t) [1 - r sin(2 omega_d t) + 2 r^2 sin^2(omega_d t)]}
+        E[z v] = (S/4) e^(-2 zeta omega_n t) sin^2(omega_d t) / omega_d^2
+
+    (E[z v] = d E[z^2]/dt / 2), tending to the stationary S m^2/(4 c k) and
+    S m/(4 c). Underdamped oscillators (zeta < 1) only.
+
+    Parameters
+    ----------
+    m, c, k : float
+        Mass (kg), damping (Ns/m), stiffness (N/m), all > 0, zeta < 1.
+    psd : float
+        One-sided PSD S of the base acceleration ((m/s^2)^2/Hz).
+    t : array_like
+        Times since the noise was switched on (s), >= 0.
+
+    Returns
+    -------
+    z2, zv, v2 : ndarray
+        E[z^2] (m^2), E[z z'] (m^2/s) and E[z'^2] ((m/s)^2) at ``t``.
+    """
+    omega, zeta, omega_d = _underdamped(m, c, k)
+    psd = float(check_positive("psd", psd, "(m/s^2)^2/Hz"))
+    t = check_nonnegative("t", t, "s")
+    r = zeta * omega / omega_d
+    decay = np.exp(-2.0 * zeta * omega * t)
+    sin2 = np.sin(2.0 * omega_d * t)
+    square = np.sin(omega_d * t) ** 2
+    z2 = psd / (8.0 * zeta * omega**3) * (1.0 - decay * (1.0 + r * sin2 + 2 * r * r * square))
+    v2 = psd / (8.0 * zeta * omega) * (1.0 - decay * (1.0 - r * sin2 + 2 * r * r * square))
+    zv = 0.25 * psd * decay * square / omega_d**2
+    return z2, zv, v2
+
+
+def caughey_stumpf_velocity_integral(m, c, k, psd, t_end):
+    """int_0^T E[z'^2(t)] dt ((m/s)^2 s) of :func:`caughey_stumpf_moments`, in closed form.
+
+    With a = 2 zeta omega_n, Omega = 2 omega_d and r = zeta omega_n / omega_d,
+    E[v^2] = sigma_v^2 {1 - e^(-a t) [(1 + r^2) - r sin(Omega t) - r^2 cos(Omega t)]}
+    integrates term by term; times c_e it is the expected electrical energy
+    harvested from t = 0 to T (J).
+    """
+    omega, zeta, omega_d = _underdamped(m, c, k)
+    psd = float(check_positive("psd", psd, "(m/s^2)^2/Hz"))
+    big_t = check_nonnegative("t_end", t_end, "s")
+    r = zeta * omega / omega_d
+    a, big_omega = 2.0 * zeta * omega, 2.0 * omega_d
+    decay = np.exp(-a * big_t)
+    norm = a * a + big_omega * big_omega
+    plain = -np.expm1(-a * big_t) / a
+    sine = big_omega - decay * (
+        a * np.sin(big_omega * big_t) + big_omega * np.cos(big_omega * big_t)
+    )
+    sine /= norm
+    cosine = a + decay * (big_omega * np.sin(big_omega * big_t) - a * np.cos(big_omega * big_t))
+    cosine /= norm
+    sigma_v2 = psd / (8.0 * zeta * omega)
+    return sigma_v2 * (big_t - ((1.0 + r * r) * plain - r * sine - r * r * cosine))

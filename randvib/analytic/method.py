@@ -12,7 +12,9 @@ described by its class in :mod:`randvib.models.friction`). It declares
   ``potentials`` (kinds of :mod:`randvib.models.potential`) and
   ``friction_form`` (a key of :data:`FRICTION_FORMS`: any memoryless law, or
   the form Fc tanh(beta v));
-* what it gives: ``stroke_exceedance`` (P(|z| > stroke));
+* what it gives: ``stroke_exceedance`` (P(|z| > stroke)); ``transient``
+  (the moments through an event, :meth:`AnalyticMethod.solve_transient`,
+  for :func:`randvib.transient_response`);
 * ``reference`` - a slow reference solver, not one to run at every point of
   a sweep; ``validity`` - its :class:`Validity` limits, beyond which it warns
   or refuses;
@@ -95,6 +97,8 @@ class Validity:
 
 #: Named as the alternative of every refusal.
 MONTE_CARLO = "Monte Carlo (randvib.simulate)"
+#: Named as the alternative of every refusal of an event.
+MONTE_CARLO_EVENT = "Monte Carlo (randvib.simulate_transient)"
 
 
 class AnalyticMethod:
@@ -121,6 +125,9 @@ class AnalyticMethod:
     friction_form: str = "memoryless"
     #: Gives P(|z| > stroke) for a harvester with a stroke.
     stroke_exceedance: bool = False
+    #: Solves an event's transient moments (randvib.transient_response); the
+    #: others are stationary and refuse an event.
+    transient: bool = False
     #: A slow reference solver (about half a second a point): not for every sweep point.
     reference: bool = False
     #: Its declared validity limits.
@@ -175,11 +182,16 @@ class AnalyticMethod:
     def _reason(self, harvester, psd, who, alternatives: bool = False) -> str | None:
         """The first declaration the case fails, in words (with the alternatives), or None."""
         potential = harvester.potential
+        if getattr(psd, "is_event", False) and not self.transient:
+            return (
+                f"{who} is stationary; the {psd.name} event's transient response needs "
+                f"{self._transient_alternatives()}"
+            )
         if not potential.velocity_is_stationary:  # no method treats it: no alternatives
             return _potential_refusal(potential, who, CONFINING + ("free",))
 
         def others() -> str:
-            return self._alternatives(harvester, psd) if alternatives else MONTE_CARLO
+            return self._alternatives(harvester, psd) if alternatives else _monte_carlo(psd)
 
         if harvester.has_circuit and not self.circuit:
             return (
@@ -209,7 +221,14 @@ class AnalyticMethod:
             for name, method in METHODS.items()
             if name != self.name and method.accepts(harvester, psd)
         ]
-        return " or ".join([f"method={name!r}" for name in names] + [MONTE_CARLO])
+        return " or ".join([f"method={name!r}" for name in names] + [_monte_carlo(psd)])
+
+    def _transient_alternatives(self) -> str:
+        """The registered transient methods, then Monte Carlo of an event, in words."""
+        from randvib.analytic.prediction import METHODS
+
+        names = [f"method={name!r}" for name, method in METHODS.items() if method.transient]
+        return " or ".join(names + [MONTE_CARLO_EVENT])
 
     # ------------------------------------------------------------ computing
     def solve(self, harvester: Harvester, psd):  # pragma: no cover - abstract
@@ -221,6 +240,20 @@ class AnalyticMethod:
         :func:`randvib.predict` checks the case and the answer.
         """
         raise NotImplementedError
+
+    def solve_transient(self, harvester: Harvester, event, times, t_end, start):
+        """The :class:`~randvib.analytic.transient.TransientPrediction` of an accepted event.
+
+        For a method that declares ``transient``; :func:`randvib.transient_response`
+        checks the case and gives the report ``times`` (s), ``t_end`` (s) and
+        the :class:`~randvib.models.event.EventStart`.
+        """
+        raise NotImplementedError(f"{self.called} is stationary: it has no transient solution")
+
+
+def _monte_carlo(psd) -> str:
+    """The Monte Carlo alternative for ``psd``: of an event, or stationary."""
+    return MONTE_CARLO_EVENT if getattr(psd, "is_event", False) else MONTE_CARLO
 
 
 def _potential_refusal(potential, who, kinds, alternatives: str = "") -> str | None:

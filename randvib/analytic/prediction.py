@@ -118,6 +118,11 @@ def predict(harvester: Harvester, psd, method="linearisation") -> PowerPredictio
     >>> rv.METHODS["averaging"].accepts(rv.preset("figure9"), rv.BandPass(1.0, 8.0, 0.1))
     False
     """
+    if getattr(psd, "is_event", False):
+        raise ValueError(
+            f"randvib.predict gives stationary statistics; the {psd.name} event's transient "
+            "response is randvib.transient_response (or Monte Carlo, randvib.simulate_transient)"
+        )
     solver = method_named(method)
     solver.require(harvester, psd)
     _refuse_undamped(harvester)

@@ -56,6 +56,7 @@ from randvib.analytic.linearisation import (
 )
 from randvib.analytic.method import AnalyticMethod, non_white, white_level
 from randvib.analytic.power_prediction import PowerPrediction, gaussian_exceedance
+from randvib.analytic.transient import solve_transient
 from randvib.models.excitation import Excitation, as_excitation
 from randvib.models.harvester import Harvester
 from randvib.models.potential import CONFINING
@@ -351,6 +352,7 @@ class Linearisation(AnalyticMethod):
     coloured = True
     circuit = True
     stroke_exceedance = True
+    transient = True
 
     def potentials_under(self, harvester: Harvester, psd) -> tuple[str, ...]:
         # The free mass has no stationary z for the fixed point's linear device;
@@ -377,6 +379,15 @@ class Linearisation(AnalyticMethod):
             circuit_mean_square=lin.circuit_variance,
             stroke_exceedance=None if exceedance is None else float(exceedance),
         )
+
+    def solve_transient(self, harvester: Harvester, event, times, t_end, start):
+        """Time-dependent statistical linearisation (:mod:`randvib.analytic.transient`).
+
+        The Lyapunov differential equation of the linear(ised) system with
+        k_eq(t), c_eq(t) from the Gaussian closure at each time: exact for the
+        linear device.
+        """
+        return solve_transient(self.name, harvester, event, times, t_end, start)
 
 
 #: The method's declaration (:data:`randvib.analytic.prediction.METHODS` holds it).

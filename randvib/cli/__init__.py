@@ -167,6 +167,8 @@ def _show_warning(message, category, filename, lineno, file=None, line=None):
 #: ``randvib.NAME(`` in the library's messages -> the command that does it here.
 _API_TO_COMMAND = {
     "simulate": "randvib simulate",
+    "simulate_transient": "randvib simulate --envelope",
+    "transient_response": "randvib power --envelope",
     "predict": "randvib power",
     "expected_power": "randvib power",
     "identify": "randvib identify",

@@ -15,6 +15,10 @@ combination. A sweep prints one row per point (``--json``: a list of the
 single-point objects; ``--csv FILE``: all their keys, one row per point).
 ``--optimal-load`` adds the load resistance that maximises the load power
 (:func:`randvib.optimal_load_resistance`) and that power.
+
+``--envelope`` makes the input an event from t = 0 (:mod:`randvib.cli._event`):
+the moments at ``--times`` and the energy to ``--t-end`` by the Lyapunov
+equation (:func:`randvib.transient_response`), one point at a time.
 """
 
 from __future__ import annotations
@@ -27,6 +31,7 @@ import math
 from randvib._io import check_output_file, dumps
 from randvib.analytic.prediction import METHODS, optimal_load_resistance, predict
 from randvib.cli._device import add_device_arguments, harvester_from_args, option_flag
+from randvib.cli._event import add_event_arguments, power_event, wants_event
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
 from randvib.cli._output import describe_device, describe_excitation, print_table
 from randvib.formatting import cell
@@ -43,6 +48,7 @@ def register(sub) -> None:
     )
     add_device_arguments(p)
     add_excitation_arguments(p)
+    add_event_arguments(p, t_end=True)
     p.add_argument(
         "--method",
         default="linearisation",
@@ -80,7 +86,7 @@ def _method_help() -> str:
 
 
 #: The options that take a single value even in ``power`` (not physical numbers).
-NOT_SWEPT = ("psd_file", "record")
+NOT_SWEPT = ("psd_file", "record", "t_end")
 
 
 def _allow_sweeps(parser) -> None:
@@ -140,6 +146,8 @@ def run(args) -> int:
         None if args.csv is None else check_output_file(args.csv, "--csv", overwrite=args.force)
     )
     swept, points = _sweep(args)
+    if wants_event(args):
+        return power_event(args, swept, points)
     results = [_point(point) for point in points]
     if csv_file is not None:
         _write_csv(csv_file, [out for out, _, _ in results])

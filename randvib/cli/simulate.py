@@ -1,5 +1,8 @@
 """``randvib simulate``: Monte Carlo ensemble under white, coloured or recorded base acceleration.
 
+``--envelope`` makes the input an event from t = 0 (:mod:`randvib.cli._event`,
+:func:`randvib.simulate_transient`): a time-resolved table at ``--times``.
+
 White noise by default (``--psd``); ``--excitation band-pass|kanai-tajimi``
 integrates the shaping filter with the device, ``band-limited`` and
 ``--psd-file`` are synthesised path by path (the options of
@@ -15,6 +18,7 @@ from randvib._io import dumps
 from randvib._validation import MAX_SEED, integer_option
 from randvib.analytic.prediction import METHODS, predict
 from randvib.cli._device import add_device_arguments, harvester_from_args
+from randvib.cli._event import add_event_arguments, simulate_event, wants_event
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
 from randvib.cli._output import describe_device, describe_excitation, print_table
 from randvib.formatting import cell, estimate_parts
@@ -33,6 +37,7 @@ def register(sub) -> None:
     )
     add_device_arguments(p)
     add_excitation_arguments(p)
+    add_event_arguments(p)
     g = p.add_argument_group("simulation")
     g.add_argument(
         "--paths",
@@ -44,7 +49,8 @@ def register(sub) -> None:
         "--t-end",
         type=float,
         default=None,
-        help="time per path incl. burn-in (s) (default: 20; not with --record, whose length it is)",
+        help="time per path incl. burn-in (s) (default: 20; not with --record, whose length "
+        "it is; with --envelope the end of the event window, by default the last of --times)",
     )
     g.add_argument(
         "--dt",
@@ -58,7 +64,13 @@ def register(sub) -> None:
         default=None,
         help="with --record: windows of the record that make the paths (default 10)",
     )
-    g.add_argument("--burn-in", type=float, default=2.0, help="discarded initial time (s)")
+    g.add_argument(
+        "--burn-in",
+        type=float,
+        default=None,
+        help="discarded initial time (s) (default: 2; not with --envelope: an event starts "
+        "at t = 0)",
+    )
     g.add_argument(
         "--method",
         default="heun",
@@ -88,6 +100,9 @@ def run(args) -> int:
 
     harvester = harvester_from_args(args)
     psd = excitation_from_args(args)
+    if wants_event(args):
+        return simulate_event(args, harvester, psd)
+    burn_in = 2.0 if args.burn_in is None else args.burn_in
     white = isinstance(psd, float | int)
     if args.control_variates and not white and psd.shaping_filter() is None:
         raise ValueError(
@@ -96,7 +111,7 @@ def run(args) -> int:
             "has a known mean"
         )
     if args.record is not None:
-        result = _on_record(harvester, psd, args)
+        result = _on_record(harvester, psd, args, burn_in)
     else:
         if args.segments is not None:
             raise ValueError("`--segments` cuts a record into paths; it needs `--record`")
@@ -106,7 +121,7 @@ def run(args) -> int:
             t_end=20.0 if args.t_end is None else args.t_end,
             dt=1e-4 if args.dt is None else args.dt,
             n_paths=1000 if args.paths is None else args.paths,
-            burn_in=args.burn_in,
+            burn_in=burn_in,
             scheme=args.method,  # the CLI keeps its option name `--method`
             seed=args.seed,
             threads=args.threads,
@@ -164,7 +179,7 @@ def run(args) -> int:
     return 0
 
 
-def _on_record(harvester, record, args):
+def _on_record(harvester, record, args, burn_in):
     """``--record``: :func:`randvib.monte_carlo_on_record`, the options checked one line each."""
     from randvib.montecarlo.on_record import monte_carlo_on_record
 
@@ -191,7 +206,7 @@ def _on_record(harvester, record, args):
             harvester,
             record,
             segments=10 if args.segments is None else args.segments,
-            burn_in=args.burn_in,
+            burn_in=burn_in,
             substeps=substeps,
             scheme=args.method,
             seed=args.seed,

@@ -46,7 +46,7 @@ acceleration: a :class:`~randvib.models.record.Record` with a
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 from scipy import signal
@@ -252,6 +252,11 @@ class Excitation:
         """Stationary Gaussian paths of the base acceleration (m/s^2), see :func:`synthesise`."""
         return synthesise(self, duration, dt, n_paths, seed)
 
+    def scaled(self, factor: float) -> Excitation:
+        """The same spectrum with its PSD multiplied by ``factor`` (> 0): the level times it."""
+        factor = float(check_positive("factor", factor))
+        return replace(self, level=self.level * factor)
+
     def parameters(self) -> dict:
         """The excitation's name and parameters (SI units), ready for JSON."""
         out = {"excitation": self.name}
@@ -268,6 +273,11 @@ def as_excitation(value) -> Excitation:
     """An :class:`Excitation` as is; a number S as white noise ``White(S)``."""
     if isinstance(value, Excitation):
         return value
+    if getattr(value, "is_event", False):
+        raise ValueError(
+            f"the {value.name} event is not stationary: its transient response is computed by "
+            "randvib.simulate_transient (Monte Carlo) and randvib.transient_response (analytic)"
+        )
     # an array of levels is refused by name here (float() would fail with numpy's
     # own words); predict, expected_power and equivalent_damping take arrays
     value = check_scalar("psd", value, f"a white-noise level S in {_PSD_UNIT}", BROADCASTING)
@@ -525,10 +535,14 @@ class Tabulated(Excitation):
         object.__setattr__(self, "frequency", f)
         object.__setattr__(self, "density", p)
 
+    def scaled(self, factor: float) -> Tabulated:
+        factor = float(check_positive("factor", factor))
+        return Tabulated(self.frequency, self.density * factor)
+
     @classmethod
     def from_csv(cls, path) -> Tabulated:
         """Read a table with the columns ``frequency`` (Hz) and ``psd`` ((m/s^2)^2/Hz)."""
-        frame = _read_columns(path, ("frequency", "psd"))
+        frame = read_columns(path, ("frequency", "psd"))
         return cls(frame["frequency"], frame["psd"])
 
     def psd(self, frequency):
@@ -652,6 +666,12 @@ class Measured(Excitation):
         object.__setattr__(self, "segment_length", length)
         object.__setattr__(self, "spectrum", Tabulated(f, p))
 
+    def scaled(self, factor: float) -> Measured:
+        """The record's acceleration times sqrt(factor): its PSD times ``factor``."""
+        factor = float(check_positive("factor", factor))
+        scaled = Record(time=self.time, base_acceleration=self.acceleration * np.sqrt(factor))
+        return Measured(scaled, self.segment_length)
+
     @classmethod
     def from_csv(cls, path, segment_length: int | None = None) -> Measured:
         """Read a record with the columns ``time`` (s) and ``base_acceleration`` (m/s^2)."""
@@ -719,8 +739,9 @@ class Measured(Excitation):
         )
 
 
-def _read_columns(path, columns) -> dict:
-    """The named columns of a CSV file (:func:`~randvib.models.record.read_csv`) as floats."""
+def read_columns(path, columns) -> dict:
+    """The named ``columns`` of a CSV file (:func:`~randvib.models.record.read_csv`) as floats;
+    a missing one is named."""
     frame = read_csv(path, "file")
     missing = [c for c in columns if c not in frame.columns]
     if missing:

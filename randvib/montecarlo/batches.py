@@ -67,7 +67,7 @@ def run_batches(run: Run, setup: KernelSetup, batches, progress: bool):
             acc, failed, hist, rec = interruptible(
                 kernel.run_ensemble, **setup.arguments(run, lo, hi)
             )
-            _raise_if_diverged(run, lo, failed)
+            raise_if_diverged(run, lo, failed)
             per_path[lo:hi] = acc
             if run.record.histogram_bins > 0:
                 hist_groups.append(hist)
@@ -86,7 +86,8 @@ def run_batches(run: Run, setup: KernelSetup, batches, progress: bool):
     return per_path, histogram, histories
 
 
-def _raise_if_diverged(run: Run, lo: int, failed: np.ndarray) -> None:
+def raise_if_diverged(run: Run, lo: int, failed: np.ndarray) -> None:
+    """Refuse a batch (its first path ``lo``) in which a path became non-finite, naming it."""
     bad = np.flatnonzero(failed >= 0)
     if bad.size:
         p = bad[0]

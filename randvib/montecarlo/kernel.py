@@ -253,6 +253,58 @@ class Noise(NamedTuple):
     fi: np.ndarray
 
 
+class Transient(NamedTuple):
+    """An event's envelope per step, its start, and what is kept of each path at given times.
+
+    For :func:`randvib.simulate_transient`: step n's input is multiplied by
+    ``gain[n]`` (the envelope over the step, :mod:`randvib.montecarlo.transient`),
+    either the noise increment itself (``scale_noise``: white noise, whose
+    gain is the step's RMS envelope, and synthesised input) or the shaping
+    filter's output where it enters the device's acceleration (the C entries
+    marked by ``filter_mask``; the filter itself runs stationary). The device
+    starts from the fixed :class:`Start`, the first ``n_start`` auxiliary
+    (filter) states from N(0, L L^T), L = ``start``. The kernel writes, per
+    path of the batch, (z, v, P x, max |z| so far) at the state indices
+    ``snap_steps`` (state j is at t = j dt) into ``snapshots``, and the peak
+    |z| over the run, int v^2 dt and int (P x)^2 dt (trapezoid rule) into
+    ``event``. Build it with :func:`transient_group`, which fixes the types.
+    """
+
+    gain: np.ndarray  #: float64[n_steps]
+    scale_noise: bool
+    filter_mask: np.ndarray  #: float64[N_AUX]: 1.0 where the state's C entry carries e(t)
+    n_start: int
+    start: np.ndarray  #: float64[N_AUX, N_AUX]
+    snap_steps: np.ndarray  #: int64[n_times], increasing
+    snapshots: np.ndarray  #: float64[count, n_times, N_SNAP] (written)
+    event: np.ndarray  #: float64[count, N_EVENT] (written)
+
+
+#: Columns of :attr:`Transient.snapshots`: z (m), v (m/s), P x (A or V; 0 without a
+#: circuit), max |z| from t = 0 (m).
+SNAP_Z, SNAP_V, SNAP_X, SNAP_PEAK = 0, 1, 2, 3
+N_SNAP = 4
+#: Columns of :attr:`Transient.event`: peak |z| over the run (m), int v^2 dt
+#: ((m/s)^2 s), int (P x)^2 dt (A^2 s or V^2 s).
+EVENT_PEAK, EVENT_V2, EVENT_X2 = 0, 1, 2
+N_EVENT = 3
+
+
+def transient_group(gain, scale_noise, filter_mask, n_start, start, snap_steps, count):
+    """A :class:`Transient` with its output arrays for ``count`` paths, each field typed."""
+    snap_steps = np.ascontiguousarray(snap_steps, dtype=np.int64)
+    return Transient(
+        np.ascontiguousarray(gain, dtype=float),
+        bool(scale_noise),
+        np.ascontiguousarray(filter_mask, dtype=float),
+        int(n_start),
+        np.ascontiguousarray(start, dtype=float),
+        snap_steps,
+        np.zeros((count, snap_steps.size, N_SNAP)),
+        np.zeros((count, N_EVENT)),
+    )
+
+
 def pack(group, *values):
     """``group(*values)`` with each value cast to its field's declared type.
 
@@ -448,9 +500,65 @@ def filter_step(z, v, theta, x1, x2, dt, noise, weights, drift, kind, p, fn, blo
     )
 
 
+@numba.njit(cache=True, inline="always")
+def _scaled_block(block, mask, gain):
+    """The auxiliary block with the masked (filter) C entries times ``gain``: e(t) C x_f."""
+    return (
+        block[0], block[1], block[2], block[3], block[4], block[5], block[6], block[7],
+        block[8], block[9], block[10], block[11], block[12], block[13], block[14],
+        block[15] * (1.0 + mask[0] * (gain - 1.0)),
+        block[16] * (1.0 + mask[1] * (gain - 1.0)),
+        block[17] * (1.0 + mask[2] * (gain - 1.0)),
+        block[18],
+    )  # fmt: skip
+
+
+@numba.njit(cache=True, inline="always")
+def _drawn_states(rng, j, ki, wi, fi, chol, n):
+    """(x1, x2, x3) = L (n1, n2, n3) for the first ``n`` states, from lane j's stream."""
+    x1 = x2 = x3 = 0.0
+    if n > 0:
+        n1 = standard_normal(rng, j, ki, wi, fi)
+        x1 = chol[0, 0] * n1
+        if n > 1:
+            n2 = standard_normal(rng, j, ki, wi, fi)
+            x2 = chol[1, 0] * n1 + chol[1, 1] * n2
+            if n > 2:
+                n3 = standard_normal(rng, j, ki, wi, fi)
+                x3 = chol[2, 0] * n1 + chol[2, 1] * n2 + chol[2, 2] * n3
+    return x1, x2, x3
+
+
+@numba.njit(cache=True, inline="always")
+def _snapshots(snapshots, snap, k, state, start, lanes, z, v, square, peak):
+    """Write the lanes' (z, v, P x, peak) for every snapshot k, k + 1, ... at ``state``.
+
+    Returns the index of the next snapshot to take.
+    """
+    while k < snap.shape[0] and snap[k] == state:
+        for j in range(lanes):
+            snapshots[start + j, k, SNAP_Z] = z[j]
+            snapshots[start + j, k, SNAP_V] = v[j]
+            snapshots[start + j, k, SNAP_X] = square[j]
+            snapshots[start + j, k, SNAP_PEAK] = peak[j]
+        k += 1
+    return k
+
+
 @numba.njit(cache=True, parallel=True, nogil=True)
 def run_ensemble(
-    scheme, device, friction, timing, paths, initial, companion, recording, noise, auxiliary, stop
+    scheme,
+    device,
+    friction,
+    timing,
+    paths,
+    initial,
+    companion,
+    recording,
+    noise,
+    auxiliary,
+    stop,
+    transient=None,
 ):
     """Integrate ``paths.count`` paths and return per-path time averages.
 
@@ -485,6 +593,10 @@ def run_ensemble(
         next check (every CHECK_EVERY steps); the results are then partial
         and the caller discards them. The loop releases the GIL (nogil) so
         that the caller's thread can watch for the interrupt.
+    transient : Transient or None
+        An event (:class:`Transient`): the per-step envelope, the filter's
+        random start and the snapshots, written into its arrays. None (the
+        stationary runs) compiles the loop without any of it.
 
     Returns
     -------
@@ -528,6 +640,15 @@ def run_ensemble(
             and ac[18] == 0.0
         )
         chol = auxiliary.start
+    if transient is not None:
+        gains = transient.gain
+        snap = transient.snap_steps
+        snapshots = transient.snapshots
+        event_out = transient.event  # outputs and inputs read once, outside the parallel loop
+        scale_noise = transient.scale_noise
+        filter_mask = transient.filter_mask
+        n_start = transient.n_start
+        filter_start = transient.start
     n_chunks = (n_paths + LANES - 1) // LANES
     acc = np.zeros((n_paths, N_ACC))
     failed = np.full(n_paths, -1, dtype=np.int64)
@@ -557,6 +678,12 @@ def run_ensemble(
         x3 = np.zeros(LANES)
         a = np.zeros((LANES, N_ACC))
         a[:, ACC_FIRST_HIT] = -1.0
+        if auxiliary is not None:
+            step_block = block
+        if transient is not None:
+            peak = np.zeros(LANES)
+            square = np.zeros(LANES)  # P x of the circuit state, for int (P x)^2 dt
+            integrals = np.zeros((LANES, 2))
         for j in range(lanes):
             seed_path_state(seed, first_path + start + j, rng, j)
             if init_random:
@@ -580,18 +707,33 @@ def run_ensemble(
                 v[j] = init_v
                 zc[j] = comp_init_z
                 vc[j] = comp_init_v
+            if transient is not None:
+                x1[j], x2[j], x3[j] = _drawn_states(rng, j, ki, wi, fi, filter_start, n_start)
+                peak[j] = abs(z[j])
+                if auxiliary is not None:
+                    square[j] = p1 * x1[j] + p2 * x2[j] + p3 * x3[j]
             if start + j < n_record:
                 records[start + j, 0, 0] = z[j]
                 records[start + j, 0, 1] = v[j]
         stopped = False
+        if transient is not None:
+            next_snap = _snapshots(snapshots, snap, 0, 0, start, lanes, z, v, square, peak)
         for n in range(n_steps):
             in_window = n >= n_burn
+            if transient is not None:
+                gain = gains[n]
+                if auxiliary is not None:
+                    if not scale_noise:
+                        step_block = _scaled_block(block, filter_mask, gain)
             for j in range(lanes):
                 if given_noise:
                     dwj = dw[start + j, n]
                 else:
                     dwj = sqdt * standard_normal(rng, j, ki, wi, fi)
                 noise = noise_amp * dwj
+                if transient is not None:
+                    if scale_noise:
+                        noise = noise * gain
                 zj = z[j]
                 vj = v[j]
                 tj = th[j]
@@ -609,7 +751,7 @@ def run_ensemble(
                         fr_kind,
                         fr_p,
                         fr_fn,
-                        block,
+                        step_block,
                     )
                 elif auxiliary is not None:
                     x1j = x1[j]
@@ -632,7 +774,7 @@ def run_ensemble(
                         fr_kind,
                         fr_p,
                         fr_fn,
-                        block,
+                        step_block,
                     )
                 else:
                     zn, vn, tn, f1 = scheme_step(
@@ -661,6 +803,13 @@ def run_ensemble(
                 z[j] = zn
                 v[j] = vn
                 th[j] = tn
+                if transient is not None:
+                    peak[j] = max(peak[j], abs(zn))
+                    integrals[j, 0] += 0.5 * dt * (vj * vj + vn * vn)
+                    if auxiliary is not None:
+                        sq = p1 * x1[j] + p2 * x2[j] + p3 * x3[j]
+                        integrals[j, 1] += 0.5 * dt * (square[j] * square[j] + sq * sq)
+                        square[j] = sq
                 if with_companion:
                     zcj = zc[j]
                     vcj = vc[j]
@@ -675,6 +824,10 @@ def run_ensemble(
                     records[start + j, r, 0] = z[j]
                     records[start + j, r, 1] = v[j]
                     records[start + j, r, 2] = th[j]
+            if transient is not None:
+                next_snap = _snapshots(
+                    snapshots, snap, next_snap, n + 1, start, lanes, z, v, square, peak
+                )
             if (n + 1) % CHECK_EVERY == 0 or n == n_steps - 1:
                 for j in range(lanes):
                     if not (np.isfinite(z[j]) and np.isfinite(v[j]) and np.isfinite(th[j])):
@@ -689,6 +842,10 @@ def run_ensemble(
             a[j, ACC_H1] = 0.5 * m * vj * vj + 0.5 * k * zj * zj + 0.25 * k3 * zj**4
             if abs(zj) > stroke and a[j, ACC_FIRST_HIT] < 0.0:
                 a[j, ACC_FIRST_HIT] = n_steps * dt  # the final state
+            if transient is not None:
+                event_out[p, EVENT_PEAK] = peak[j]
+                event_out[p, EVENT_V2] = integrals[j, 0]
+                event_out[p, EVENT_X2] = integrals[j, 1]
             for q in range(N_ACC):
                 if q == ACC_H0 or q == ACC_H1 or q == ACC_FIRST_HIT:
                     acc[p, q] = a[j, q]

@@ -66,6 +66,7 @@ STUDIES = (
     "silverbox",
     "excitation",
     "devices",
+    "events",
 )
 
 
