@@ -1,4 +1,4 @@
-"""Speed of the fast power predictors (issue 6), with ratios to linearisation.
+"""Speed of the fast power predictors, with ratios to linearisation.
 
 Run:  python -m pytest benchmarks/bench_averaging.py --benchmark-only -s
 
@@ -19,7 +19,7 @@ import randvib as rv
 DEVICE = rv.preset("figure9").updated(k3=5e5)
 PSD = 1.0
 SWEEP = DEVICE.updated(fc=np.linspace(0.0, 0.06, 100))
-#: The methods held to issue 6's speed bars.
+#: The methods held to the speed targets above.
 FAST = ("averaging", "fpk-fast")
 
 

@@ -1,4 +1,4 @@
-"""Engine speed and memory (issue 3), as ratios to baselines measured in the same run.
+"""Engine speed and memory, as ratios to baselines measured in the same run.
 
 Run:  python -m pytest benchmarks/bench_engine.py --benchmark-only -s
 
@@ -8,10 +8,10 @@ Device: figure9 preset with k3 = 5e5 N/m^3 (Duffing + Coulomb), dt = 1e-4 s,
   of standard normals, one generator per core, in threads;
 * sdeint.itoEuler on one path;
 * a plain vectorised numpy Euler-Maruyama loop over all paths.
-* the same engine under band-pass input (issue 10): the kernel then
+* the same engine under band-pass input: the kernel then
   integrates the shaping filter's 2 states with the device; the target is at
   most 1.5x the white-noise kernel per path-step (``filter_over_white``).
-* the same engine with a coil inductance (issue 11): the kernel integrates the
+* the same engine with a coil inductance: the kernel integrates the
   circuit's current as an auxiliary state (the same compiled block as the
   filter's), reported as ``circuit_over_white`` per path-step.
 * the same engine under band-limited input (4-20 Hz), synthesised per path

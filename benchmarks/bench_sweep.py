@@ -1,4 +1,4 @@
-"""Sweep benchmarks (issue 4): variance reduction and the full figure9 study.
+"""Sweep benchmarks: variance reduction and the full figure9 study.
 
 Run:  python -m pytest benchmarks/bench_sweep.py --benchmark-only -s
 

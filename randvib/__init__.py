@@ -51,7 +51,7 @@ _EXPORTS = {
     "randvib.analytic.transient": ("transient_response", "TransientPrediction"),
     "randvib.analytic.fokker_planck": ("fast_fpk_statistics", "fpk_statistics", "solve_fpk"),
     "randvib.models.friction": ("Coulomb", "FrictionModel", "LuGre", "Tanh"),
-    "randvib.models.harvester": ("ElectricalCoupling", "Harvester"),
+    "randvib.models.harvester": ("Harvester",),
     "randvib.models.coupling": ("Coupling", "COUPLINGS", "Inductive", "Piezo", "Resistive"),
     "randvib.identification.cost": ("normalised_cost",),
     "randvib.identification.models": ("MeasurementModel",),

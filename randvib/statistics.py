@@ -78,7 +78,7 @@ def estimate(samples, controls=None, folds: int = 4) -> Statistic:
         the same paths under-reports the error (in-sample overfitting). The
         empirical coverage of the 95 % interval, and the under-coverage of
         in-sample fitting, are checked over thousands of repeated estimations
-        in ``tests/test_simulation.py::test_cross_fitted_intervals_cover_at_95_percent``.
+        in ``tests/test_statistics.py::test_cross_fitted_intervals_cover_at_95_percent``.
     folds : int
         Number of cross-fitting groups (>= 2).
     """

@@ -47,6 +47,7 @@ import numpy as np
 import pandas as pd
 
 import randvib as rv
+from randvib.formatting import plus_minus
 from randvib.studies import budget, figures, report, script_main
 from randvib.studies.grids import fixed_paths, matched_band
 from randvib.studies.methods import (
@@ -178,7 +179,7 @@ def setup_section(axes, results, settings, quick, wall) -> str:
 
 def power_section(results, v, figure) -> str:
     shown = results[["input", "g", "device"]].copy()
-    pm = report.plus_minus
+    pm = plus_minus
     shown["E[P_e] (mW)"] = pm(results.power_mc, results.power_mc_ci95, 1e3, ".4f")
     shown["/ linear (paired)"] = pm(results.power_ratio_to_linear, results.power_ratio_ci95, 1.0,
                                     ".3f")  # fmt: skip

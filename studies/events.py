@@ -42,6 +42,7 @@ import pandas as pd
 
 import randvib as rv
 from randvib.figure_style import PALETTE, new_figure, panel_letters, save_figure, styled
+from randvib.formatting import percent, plus_minus
 from randvib.statistics import paired_ratio
 from randvib.studies import report, script_main
 
@@ -252,8 +253,7 @@ def sentences(v: dict) -> list[str]:
     ratios = e["bistable_over_paper"]
     lo, hi = min(r[0] for r in ratios.values()), max(r[0] for r in ratios.values())
     stationary = "; ".join(
-        f"{name} {report.format_percent(x['min_error'], 1, True)} to "
-        f"{report.format_percent(x['max_error'], 1, True)}"
+        f"{name} {percent(x['min_error'], 1, True)} to {percent(x['max_error'], 1, True)}"
         for name, x in st.items()
     )
     worst_linear = max(abs(st["linear"]["min_error"]), abs(st["linear"]["max_error"]))
@@ -262,9 +262,9 @@ def sentences(v: dict) -> list[str]:
     decay = 2 * v["setup"]["m"] / v["setup"]["c"]
     holds = "holds" if worst_linear <= 0.05 else "does not hold"
     reading = (f"it {holds} for the linear device (within "
-               f"{report.format_percent(worst_linear, 1)}; its decay time 2 m / c = {decay:.2f} s "
+               f"{percent(worst_linear, 1)}; its decay time 2 m / c = {decay:.2f} s "
                f"against the envelope's {ENVELOPE.equivalent_duration(T_END):.1f} s), and errs by "
-               f"up to {report.format_percent(worst_other, 0)} for the nonlinear devices, whose "
+               f"up to {percent(worst_other, 0)} for the nonlinear devices, whose "
                "power is not proportional to the intensity")  # fmt: skip
     half = ", ".join(
         f"{n} {'beyond the largest S' if s is None else f'S = {s:.3g}'}"
@@ -277,8 +277,8 @@ def sentences(v: dict) -> list[str]:
         f"Stationary power at the envelope's peak times the event's power-equivalent duration "
         f"misses the event's energy by {stationary}: {reading}.",
         f"Time-dependent statistical linearisation of the paper's device gives the event energy "
-        f"within {report.format_percent(lin['energy_error_min'], 1, True)} to "
-        f"{report.format_percent(lin['energy_error_max'], 1, True)} of Monte Carlo; its largest "
+        f"within {percent(lin['energy_error_min'], 1, True)} to "
+        f"{percent(lin['energy_error_max'], 1, True)} of Monte Carlo; its largest "
         f"error in E[P_e](t) is at {lin['largest_time_error_where']}.",
         f"The 5 mm stroke is reached in half of the events at {half}. For the linear device "
         f"Poisson's out-crossing approximation over-estimates P(stroke reached) by up to "
@@ -339,7 +339,7 @@ def setup_section(axes, seed, quick, wall) -> str:
 
 def results_section(results: pd.DataFrame, lines: list[str], figure: Path) -> str:
     shown = results[["device", "level"]].rename(columns={"level": "S"})
-    shown["energy MC (mJ)"] = report.plus_minus(results.energy_mc, results.energy_mc_ci95,
+    shown["energy MC (mJ)"] = plus_minus(results.energy_mc, results.energy_mc_ci95,
                                                 1e3, ".4g")  # fmt: skip
     shown["transient lin. (mJ)"] = 1e3 * results.energy_lin
     shown["stationary x duration (mJ)"] = 1e3 * results.energy_stationary
@@ -348,7 +348,7 @@ def results_section(results: pd.DataFrame, lines: list[str], figure: Path) -> st
         else f"{r.energy_over_paper:.3f} ± {r.energy_over_paper_ci95:.3f}"
         for r in results.itertuples()
     ]  # fmt: skip
-    shown["P(stroke)"] = report.plus_minus(results.stroke_reached_mc,
+    shown["P(stroke)"] = plus_minus(results.stroke_reached_mc,
                                            results.stroke_reached_mc_ci95, 1, ".3f")  # fmt: skip
     shown["Poisson*"] = results.stroke_poisson
     shown["Vanmarcke*"] = results.stroke_vanmarcke

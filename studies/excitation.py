@@ -38,6 +38,7 @@ from scipy import special
 
 import randvib as rv
 from randvib.figure_style import num_tex
+from randvib.formatting import plus_minus
 from randvib.statistics import holm_significant
 from randvib.studies import figures, report, script_main
 from randvib.studies.contrasts import paired_interactions
@@ -154,9 +155,9 @@ def setup_section(axes, results, settings, quick, wall) -> str:
 def linearisation_section(results, v, figure) -> str:
     lin = v["linearisation"]
     shown = results[["centre", "zeta"]].assign(**{"Fc (mN)": 1e3 * results.fc, "k3": results.k3})
-    shown["P_MC (mW)"] = report.plus_minus(results.power_mc, results.power_mc_ci95, 1e3, ".4f")
+    shown["P_MC (mW)"] = plus_minus(results.power_mc, results.power_mc_ci95, 1e3, ".4f")
     shown["P_lin (mW)"] = [f"{1e3 * p:.4f}" for p in results.power_linearisation]
-    shown["lin. error (%)"] = report.plus_minus(results.linearisation_rel_error,
+    shown["lin. error (%)"] = plus_minus(results.linearisation_rel_error,
                                          results.linearisation_rel_error_ci95)  # fmt: skip
     shown["k_eq / k"] = results.k_eq / 57.4
     by_zeta = ", ".join(f"{100 * e:.1f} % at zeta = {z}"
@@ -186,7 +187,7 @@ def interaction_section(inter, v, figure) -> str:
     holds = "; ".join(f"{key}: {'none' if z is None else f'zeta >= {z:g}'}"
                       for key, z in it["no_interaction_holds_down_to_zeta"].items())  # fmt: skip
     shown = inter[["centre", "zeta", "k3"]].copy()
-    shown["contrast / P(Fc,0) (%)"] = report.plus_minus(inter.relative_contrast,
+    shown["contrast / P(Fc,0) (%)"] = plus_minus(inter.relative_contrast,
                                                         inter.relative_ci95)  # fmt: skip
     shown["linearisation (%)"] = [f"{100 * x:+.2f}" for x in inter.linearisation_relative_contrast]
     shown["spring alone, Fc = 0 (%)"] = [f"{100 * x:+.2f}" for x in inter.spring_alone_relative]

@@ -32,6 +32,7 @@ import sys
 import numpy as np
 
 import randvib as rv
+from randvib.formatting import plus_minus
 from randvib.studies import figures, script_main
 from randvib.studies.contrasts import (
     interaction_contrasts,
@@ -55,7 +56,6 @@ from randvib.studies.half_step import (
 from randvib.studies.methods import method_errors
 from randvib.studies.report import (
     markdown_table,
-    plus_minus,
     prepare_output_dir,
     write_report,
     write_table,

@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 import randvib as rv
+from randvib.formatting import plus_minus
 from randvib.studies import figures, script_main
 from randvib.studies.accuracy import (
     TOLERANCES,
@@ -59,7 +60,6 @@ from randvib.studies.half_step import (
 from randvib.studies.methods import method_errors
 from randvib.studies.report import (
     markdown_table,
-    plus_minus,
     prepare_output_dir,
     write_report,
     write_table,

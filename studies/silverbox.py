@@ -68,8 +68,8 @@ ABLATION = {
 ABLATION_LAST = "+ band-limited input instead of the spline (the Duffing model)"
 #: RMS error (mV) a physical model should reach on both test parts.
 TARGET_MV = 0.5
-#: Published RMS errors (mV) on the same record, as quoted in issue 15 (their
-#: multisine test split may differ from this study's).
+#: RMS errors (mV) published for the same record (their multisine test split
+#: may differ from this study's).
 PUBLISHED = [
     ("best black-box (Beintema, Toth & Schoukens 2021)", 1.4, 0.36),
     ("polynomial NARX", 4.0, None),

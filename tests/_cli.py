@@ -16,3 +16,9 @@ def one_line_error(capsys, argv, fragment):
     assert code == 2, (out, err)
     assert fragment in err, err
     assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+
+
+def fit_args(path, *extra):
+    """``randvib identify PATH`` with a tiny, fast search (the output-path and message tests)."""
+    return ["identify", path, "--model", "coulomb", "--m", "0.0226", "--popsize", "8",
+            "--generations", "2", "--no-progress", "--no-polish", *extra]  # fmt: skip

@@ -21,3 +21,29 @@ def _nothing_written_into_the_checkout():
     yield
     new = sorted(_visible_entries(ROOT) - before - {"__pycache__"})
     assert not new, f"the tests wrote {new} into {ROOT}; write under tmp_path"
+
+
+@pytest.fixture(scope="module")
+def record_csv(tmp_path_factory):
+    """A 2 s synthetic record of the Coulomb TD1 device, and its fitted-parameter file."""
+    import json
+
+    import randvib as rv
+
+    folder = tmp_path_factory.mktemp("records")
+    path = folder / "rec.csv"
+    record = rv.synthetic_record(
+        rv.preset("coulomb-td1"), 2.0, duration=2.0, sample_rate=1000.0, seed=1
+    )
+    record.to_csv(path, float_format=None)
+    params = folder / "params.json"
+    params.write_text(
+        json.dumps(
+            {
+                "model": "coulomb",
+                "parameters": {"m": 0.0226, "c": 0.049, "k": 57.4, "k3": 70742.0, "fc": 0.0058},
+                "settings": {"substeps": 4},
+            }
+        )
+    )
+    return path, params

@@ -384,7 +384,7 @@ MUTATIONS: tuple[Mutation, ...] = (
                 'if _row_checksum(row) == "trusted":',
             ),
         ),
-        tests=("tests/test_trust.py::test_corrupted_point_is_named_and_recomputed",),
+        tests=("tests/test_resume.py::test_corrupted_point_is_named_and_recomputed",),
         why="A resumed sweep trusts each stored row without its checksum, so a stored power "
         "changed on disk (doubled) flows into the table and the verdicts; the test doubles "
         "one and requires it to be recomputed.",

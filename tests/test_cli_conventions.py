@@ -1,8 +1,12 @@
-"""One set of conventions for every command, and output for people (issue 12, command line).
+"""One set of conventions for every command, and output for people (the command line).
 
 The parser walk below runs over every registered subcommand, so that a new
 command keeps the conventions: defaults shown in ``--help``, the shared flags
 present with one meaning, choices declared as choices.
+
+Covers :mod:`randvib.cli` (the parser, shared flags, one-line errors, the options named
+differently from the API), the tables and device lines of :mod:`randvib.cli._output` and
+:mod:`randvib.cli._device`, and the digits they print (:mod:`randvib.formatting`).
 """
 
 import argparse
@@ -18,7 +22,6 @@ import numpy as np
 import pytest
 
 import randvib as rv
-from randvib._display import estimate_parts as format_estimate
 from randvib.cli import (
     API_NAMES,
     COMPILING,
@@ -29,6 +32,8 @@ from randvib.cli import (
     one_line_choice_error,
 )
 from randvib.cli.power import sweep_values
+from randvib.formatting import estimate_parts as format_estimate
+from randvib.formatting import with_standard_error
 from randvib.models.excitation import BandLimited
 from tests._cli import one_line_error, run
 
@@ -369,10 +374,8 @@ def test_table_columns_of_words_are_flush_left_and_named(capsys):
 
 
 def test_identify_table_shows_the_digits_the_standard_error_supports():
-    from randvib.cli.identify import _with_precision
-
-    row = _with_precision(57.4001412, 0.00014079, (57.3998653, 57.4004171))
+    row = with_standard_error(57.4001412, 0.00014079, (57.3998653, 57.4004171))
     assert row == ["57.40014", "0.00014", "[57.39987, 57.40042]"]
     # a noise-free fit: eight significant digits, the tiny error in exponent form
-    assert _with_precision(0.0490000000112, 2.09e-12, None) == ["0.049000000", "2.1e-12", ""]
-    assert _with_precision(0.0226, None, None) == [0.0226, "", ""]  # a fixed parameter
+    assert with_standard_error(0.0490000000112, 2.09e-12, None) == ["0.049000000", "2.1e-12", ""]
+    assert with_standard_error(0.0226, None, None) == ["0.0226", "", ""]  # a fixed parameter

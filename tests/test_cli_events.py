@@ -6,6 +6,8 @@ Lyapunov equation, itself checked against independent routes in
 tests/test_transient_analytic.py), at several times and over the event:
 ``power`` to 1e-6, ``simulate`` within its 95 % intervals widened to 4
 standard errors.
+
+Covers the event options of both commands (:mod:`randvib.cli._event`).
 """
 
 import json

@@ -2,6 +2,10 @@
 study from the command line (sizes shrunk by monkeypatching the study's grid), and the
 error branches. Every user error must end with exit status 2 and one line naming the
 argument.
+
+Covers the commands' modules :mod:`randvib.cli.simulate`, :mod:`randvib.cli.identify`,
+:mod:`randvib.cli.validate` and :mod:`randvib.cli.study`, with the identification
+figures of ``--plot`` (:mod:`randvib.identification.plots`).
 """
 
 import json

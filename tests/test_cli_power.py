@@ -1,3 +1,10 @@
+"""``randvib power`` (:mod:`randvib.cli.power`): JSON and table output, circuits, errors.
+
+Values given on the command line override a preset's; a circuit adds the load
+power; bad input ends with one line and exit status 2; the installed console
+script and ``python -m randvib`` (:mod:`randvib.__main__`) exit as ``main`` does.
+"""
+
 import json
 import subprocess
 import sys

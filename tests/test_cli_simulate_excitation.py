@@ -1,9 +1,13 @@
 """``randvib simulate`` under filtered excitation: the CLI runs what the Python API runs.
 
-White noise must stay exactly as before; band-pass and Kanai-Tajimi input
+White noise gives what the API gives; band-pass and Kanai-Tajimi input
 give the same numbers as :func:`randvib.simulate` with the same excitation
 object (band-limited and tabulated input synthesised, a record simulated on
 itself); what Monte Carlo cannot take is refused with one line (exit 2).
+
+Covers :mod:`randvib.cli.simulate` with the excitation options of
+:mod:`randvib.cli._excitation`, and the record simulated on itself
+(:mod:`randvib.montecarlo.on_record`).
 """
 
 import json

@@ -1,4 +1,4 @@
-"""Electrical couplings: resistive, inductive (coil inductance) and piezo (issue 11).
+"""Electrical couplings: resistive, inductive (coil inductance) and piezo.
 
 Exact references:
 
@@ -14,6 +14,10 @@ Exact references:
   stiffness), with the *declared* circuit and friction parameters.
 
 Every Monte Carlo comparison goes through ``assert_matches`` (tests/_stats.py).
+
+Covers :mod:`randvib.models.coupling`, the circuit state in the linear response
+(:mod:`randvib.analytic.linear_response`) and in the Monte Carlo kernel
+(:mod:`randvib.montecarlo.kernel_setup`, :mod:`randvib.montecarlo.kernel`).
 """
 
 import json

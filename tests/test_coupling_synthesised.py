@@ -15,6 +15,9 @@ Calibration (``NUMBA_NUM_THREADS=1 python tests/calibration/coupling_synthesised
 inductive P_e -0.04 / 0.92 / 2.66 (6.27), E[v^2] -0.04 / 0.92 / 2.68 (6.35),
 E[z^2] -0.04 / 0.92 / 2.64 (6.31); piezo P_e -0.11 / 0.94 / 2.19 (9.25),
 E[v^2] -0.11 / 0.94 / 2.18 (9.42), E[z^2] -0.11 / 0.94 / 2.18 (9.28).
+
+Covers a circuit state of :mod:`randvib.models.coupling` driven by the synthesised input
+of :mod:`randvib.montecarlo.driven`.
 """
 
 import pytest

@@ -1,10 +1,17 @@
-"""Results in notebooks and pandas: compact reprs, HTML tables, to_frame/to_dict."""
+"""Results in notebooks and pandas: compact reprs, HTML tables, to_frame/to_dict.
+
+Covers :mod:`randvib._display` (plain-text and HTML tables, pandas) through the result
+types (:mod:`randvib.montecarlo.results`, :mod:`randvib.analytic.power_prediction`,
+:mod:`randvib.analytic.statistical_linearisation`,
+:mod:`randvib.identification.result`), the digits they show (:mod:`randvib.formatting`)
+and their units (:mod:`randvib.quantities`).
+"""
 
 import numpy as np
 import pytest
 
 import randvib as rv
-from randvib import _display
+from randvib import formatting
 from randvib.identification.result import IdentificationResult
 
 
@@ -24,12 +31,12 @@ def simulation():
 
 def test_estimate_shows_the_digits_its_interval_supports():
     # one notation for the pair, chosen by the mean (as in the CLI's tables)
-    assert _display.estimate(0.0024646123, 5.4568e-7) == "0.00246461 ± 0.00000055"
-    assert _display.estimate(9.2912e-06, 9.81e-07) == "9.29e-06 ± 9.8e-07"
-    assert _display.estimate(12.3456, 0.25) == "12.35 ± 0.25"
-    assert _display.estimate(0.001346, 0.000295) == "0.00135 ± 0.00030"  # zeros kept
-    assert _display.estimate(134.55, 29.5) == "135 ± 30"
-    assert _display.estimate(1e-3, 0.0) == "0.001"  # no interval: six figures at most
+    assert formatting.estimate(0.0024646123, 5.4568e-7) == "0.00246461 ± 0.00000055"
+    assert formatting.estimate(9.2912e-06, 9.81e-07) == "9.29e-06 ± 9.8e-07"
+    assert formatting.estimate(12.3456, 0.25) == "12.35 ± 0.25"
+    assert formatting.estimate(0.001346, 0.000295) == "0.00135 ± 0.00030"  # zeros kept
+    assert formatting.estimate(134.55, 29.5) == "135 ± 30"
+    assert formatting.estimate(1e-3, 0.0) == "0.001"  # no interval: six figures at most
 
 
 def test_simulation_frame_holds_the_statistics(simulation):
@@ -145,3 +152,23 @@ def test_tables_records_and_spectra_have_compact_reprs(simulation):
         f"SampledSpectra({spectra.frequency.size} frequencies, 0-500 Hz, 2 paths"
     )
     assert len(text) < 200
+
+
+def test_units_come_from_one_vocabulary():
+    """Result types take a quantity's unit from randvib.quantities: a circuit state's
+    mean square in its coupling's unit squared, and one unit per name everywhere."""
+    from randvib.quantities import unit
+
+    piezo = rv.Harvester.with_coupling(
+        0.0226, 0.05, 57.4, rv.Piezo(theta=2e-3, capacitance=1e-7, r_load=1e5)
+    )
+    coil = rv.Inductive(alpha=0.1992, r_load=0.5, r_coil=0.48, inductance=2e-3)
+    assert unit("circuit_mean_square", coil) == "A^2"
+    assert unit("circuit_variance", piezo.electrical) == "V^2"
+    assert unit("circuit_mean_square") == "A^2 or V^2"  # the device unknown (a PowerPrediction)
+    lin = rv.statistical_linearisation(piezo, rv.BandPass(1.0, 8.0, 0.2))
+    assert {name: u for name, _, u in lin._rows()}["circuit_variance"] == "V^2"
+    prediction = rv.predict(rv.preset("figure9"), 1.0)
+    assert all(u == unit(name) for name, _, u in prediction._quantities())
+    with pytest.raises(KeyError, match="not a reported quantity"):
+        unit("power")

@@ -4,6 +4,9 @@ The build (``python -m sphinx -W --keep-going -b html docs OUT``) runs the
 examples of the gallery, so a failing example, a malformed docstring section
 or a broken cross-reference fails here. It builds a copy of ``docs/`` so that
 the generated pages never land in the checkout.
+
+Covers the docstrings of every module (the API reference of the names re-exported by
+``randvib/__init__.py`` and the Modules section) and docs/.
 """
 
 import html as html_module

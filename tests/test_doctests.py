@@ -4,6 +4,10 @@ Every module of the package whose source holds a ``>>>`` example is listed in
 ``MODULES`` (a test checks the list is complete), and each runs under
 :mod:`doctest` with the usual numpy-friendly flags. The examples print
 rounded numbers, so they state what the code computes at fixed seeds.
+
+Covers the examples of the modules in ``MODULES`` (:mod:`randvib.models.presets`,
+:mod:`randvib.montecarlo.simulation`, :mod:`randvib.formatting`,
+:mod:`randvib.quantities`, ...).
 """
 
 import doctest
@@ -18,8 +22,8 @@ MODULES = (
     "randvib.analytic.linearisation",
     "randvib.analytic.prediction",
     "randvib.analytic.statistical_linearisation",
+    "randvib.formatting",
     "randvib.analytic.transient",
-    "randvib._display",
     "randvib.identification.prediction",
     "randvib.identification.record_response",
     "randvib.identification.synthetic",
@@ -31,6 +35,7 @@ MODULES = (
     "randvib.models.record",
     "randvib.montecarlo.simulation",
     "randvib.montecarlo.sweep",
+    "randvib.quantities",
     "randvib.montecarlo.transient",
 )
 

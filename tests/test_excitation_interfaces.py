@@ -22,7 +22,7 @@ from randvib.models.excitation import (
     White,
 )
 
-DEVICE = ["--preset", "section5"]
+DEVICE = ["--preset", "figure9"]
 COLOURED = [
     (BandPass(1.0, 10.0, 0.2), ["--excitation", "band-pass", "--f0", "10", "--zeta", "0.2"]),
     (KanaiTajimi(1.0, 10.0, 0.3), ["--excitation", "kanai-tajimi", "--f0", "10", "--zeta", "0.3"]),
@@ -37,7 +37,7 @@ def power_error(capsys, argv, fragment):
 
 @pytest.fixture(scope="module")
 def harvester():
-    return rv.preset("section5")
+    return rv.preset("figure9")
 
 
 # ------------------------------------------------------------------ Python API
@@ -120,7 +120,7 @@ def test_white_output_is_unchanged(capsys):
         assert code == 0
         got = json.loads(out)
         # the same keys, values and order; keys are only ever added after them
-        # (power_mechanical: c_m E[v^2] + friction power, issue 12)
+        # (power_mechanical: c_m E[v^2] + friction power)
         assert {key: got[key] for key in before} == before
         assert list(got)[: len(before)] == list(before)
         assert set(got) - set(before) == {"power_mechanical"}

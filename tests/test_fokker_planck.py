@@ -1,6 +1,9 @@
 """FPK reference solver: convergence study, exact limits, agreement with averaging.
 
 Agreement with Monte Carlo over a grid of points: tests/test_claims.py.
+
+Covers :mod:`randvib.analytic.fokker_planck`, checked against the exact references of
+:mod:`randvib.analytic.exact_solutions` and against :mod:`randvib.analytic.averaging`.
 """
 
 import warnings

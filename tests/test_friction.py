@@ -1,3 +1,11 @@
+"""Friction laws of paper Eq. 4-10 (:mod:`randvib.models.friction`).
+
+The sign convention (Coulomb's force zero at rest), E[v F(v)] in closed form
+against Gaussian quadrature (:mod:`randvib._quadrature`), tanh tending to
+Coulomb, LuGre's steady state, the compiled force against the numpy law, and
+bad parameters named.
+"""
+
 import numpy as np
 import pytest
 from hypothesis import given

@@ -1,4 +1,4 @@
-"""A friction law defined only here runs through every consumer (issue 9).
+"""A friction law defined only here runs through every consumer.
 
 ``Stribeck`` below is declared in this file and nowhere in the package:
 Coulomb friction plus a static peak that decays with speed,
@@ -26,6 +26,12 @@ with a speed-dependent sliding force and a separate breakaway level (Fs) is
 not of that form, so it is integrated with plain RK4, which needs the force
 smooth on the scale of the step. Monte Carlo (Euler-Maruyama/Heun) and the
 Gaussian quadrature of linearisation take the discontinuous law as it is.
+
+Covers the friction family's declarations (:mod:`randvib.models.friction`,
+:mod:`randvib.models.parameters`) as every consumer reads them: the CLI's options
+(:mod:`randvib.cli._device`), identification (:mod:`randvib.identification.models`,
+:mod:`randvib.identification.bounds`, :mod:`randvib.identification.record_integrator`)
+and the Monte Carlo kernel.
 """
 
 from dataclasses import dataclass

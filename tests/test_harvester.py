@@ -1,3 +1,10 @@
+"""The device of paper Eq. 1-3 (:mod:`randvib.models.harvester`) and the presets (:mod:`randvib.models.presets`).
+
+The electrical constructor (c_e from Eq. 3), the load's share of the power,
+immutable devices and their updated copies, parameters refused by name, and
+the presets of paper Table 2 with the assumed magnet mass.
+"""
+
 import numpy as np
 import pytest
 

@@ -2,6 +2,11 @@
 
 Covers randvib.identification.identify (the driver), .cost (Eq. 11), .bounds,
 .settings, .models, .result and .prediction (predict_record, validate).
+
+Covers :func:`randvib.identify` and its parts: :mod:`randvib.identification.identify`,
+:mod:`randvib.identification.cost`, :mod:`randvib.identification.bounds`,
+:mod:`randvib.identification.settings`, :mod:`randvib.identification.result` and
+:mod:`randvib.identification.prediction`.
 """
 
 import json
@@ -351,7 +356,7 @@ def test_result_is_a_harvester_and_its_measurement_model(record):
     direct = predict_record(device, record, measurement=offsets, simulation=res.simulation)
     assert res.predict(record).cost == direct.cost
     # wired: c_e of the coil added to the identified c, the load voltage simulated
-    coil = rv.ElectricalCoupling(0.1992, 10.0, 0.48)
+    coil = rv.Resistive(0.1992, 10.0, 0.48)
     wired = res.harvester(coil)
     assert wired.c == p["c"] + coil.electrical_damping and wired.c_m == p["c"]
     assert res.predict(record, electrical=coil).voltage is not None

@@ -1,4 +1,8 @@
-"""The identification study's cheap guarantees (the full run belongs to the study itself)."""
+"""The identification study's cheap guarantees (the full run belongs to the study itself).
+
+Covers the identification campaign's pieces (:mod:`randvib.studies.campaign`) as the
+study script uses them, through :mod:`randvib.cli.study`.
+"""
 
 import numpy as np
 import pytest

@@ -3,6 +3,8 @@
 The compiled step and the exact linear recursions both read the weights; the
 hand-written recursions below are the independent check that the table says
 what the schemes are.
+
+Covers :mod:`randvib.montecarlo.integrators`.
 """
 
 import numpy as np
@@ -35,5 +37,5 @@ def test_linear_recursions_are_the_schemes_written_out():
 
 
 def test_unknown_method_is_refused_by_name():
-    with pytest.raises(ValueError, match="method"):
+    with pytest.raises(ValueError, match="`scheme`"):
         integrator("runge-kutta")

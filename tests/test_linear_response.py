@@ -3,6 +3,10 @@
 References: the white-noise results of docs/conventions.md (E[v^2] = S m/(4c),
 Eq. 30/32 through ``randvib.expected_power``) and two independent routes to
 the linear device's variances (Lyapunov equation, spectral integral).
+
+Covers :mod:`randvib.analytic.linear_response`,
+:mod:`randvib.analytic.statistical_linearisation` and the linear blocks of
+:mod:`randvib.models.state_space`.
 """
 
 import numpy as np

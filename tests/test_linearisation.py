@@ -1,3 +1,11 @@
+"""Equivalent linearisation under white noise (:mod:`randvib.analytic.linearisation`, paper Eq. 19-32).
+
+Eq. 30 by hand, the general fixed point of Eq. 19-20 with Gaussian expectations
+by quadrature (:mod:`randvib._quadrature`), broadcasting over parameters and
+levels, the energy balance, and the optimal load of
+:mod:`randvib.analytic.prediction` against its closed form.
+"""
+
 import numpy as np
 import pytest
 from hypothesis import given, settings

@@ -3,6 +3,10 @@
 For each curated mutation, a copy of the project is mutated and the tests
 named in its entry must fail. The table of mutations, with what each models
 and which test catches it, is ``python tests/mutation_check.py --list``.
+
+Covers the suite itself: each mutant edits one module of randvib
+(:mod:`randvib.montecarlo.kernel`, :mod:`randvib.statistics`,
+:mod:`randvib.models.friction`, ...; the list is in tests/mutation_check.py).
 """
 
 from concurrent.futures import ThreadPoolExecutor

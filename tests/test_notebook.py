@@ -1,8 +1,11 @@
-"""Results and progress bars in a real Jupyter kernel (issue 12: notebooks).
+"""Results and progress bars in a real Jupyter kernel (notebooks).
 
 The notebooks below are executed by nbclient in a fresh IPython kernel, as a
 user's notebook is: what they check is the cell output Jupyter would show
 (the widget bar, the HTML table), not our own idea of it.
+
+Covers :mod:`randvib._progress` (the bars in a kernel) and :mod:`randvib._display` (the
+HTML tables).
 """
 
 from __future__ import annotations

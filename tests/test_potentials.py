@@ -1,4 +1,4 @@
-"""Potentials of any shape (issue 11): bistable, pure cubic, free mass, and the stroke limit.
+"""Potentials of any shape: bistable, pure cubic, free mass, and the stroke limit.
 
 Exact references: the Gibbs density exp(-H/T), T = S m^2/(4c), of any confining
 potential without friction (velocity Gaussian with E[v^2] = S m/(4c), so the
@@ -9,6 +9,11 @@ the kernel's stroke accumulators against recorded paths.
 Monte Carlo z-scores were calibrated over seeds with
 ``NUMBA_NUM_THREADS=1 python tests/calibration/potentials.py 40`` (numbers in
 each test's docstring).
+
+Covers :mod:`randvib.models.potential`, the references of
+:mod:`randvib.analytic.exact_solutions`, the stroke statistics of the Monte Carlo kernel
+(:mod:`randvib.montecarlo.kernel`) and the linearised step check of the free mass
+(:mod:`randvib.montecarlo.step_check`).
 """
 
 import json

@@ -7,6 +7,8 @@ estimate is then exact: (2 D / sum w^2) sum_tau c_w(tau) R(tau) cos(2 pi f tau D
 c_w the Hann window's autocorrelation and D the recorded step, so the
 comparison has neither time-step nor leakage tolerance; the Monte Carlo
 interval is over independent paths.
+
+Covers :mod:`randvib.montecarlo.spectra`.
 """
 
 import numpy as np

@@ -4,6 +4,8 @@ Thresholds are 4 standard errors of each sample statistic (exact for the
 moments of 1.28 million normals), or a Bonferroni bound for the maximum over
 many path pairs; ``rng_z_scores`` computes them as a function of the seed so
 that tests/calibration/simulation.py can check their spread over seeds.
+
+Covers :mod:`randvib.montecarlo.rng`.
 """
 
 import numpy as np

@@ -13,6 +13,14 @@ The statistics are functions of the seed (``case_*`` below) so that
 ``tests/calibration/simulation.py`` can rerun them over many seeds; each test's
 docstring records the resulting z-scores (number of seeds, mean, standard
 deviation, largest |z|).
+
+Covers :func:`randvib.simulate` and the parts it orchestrates:
+:mod:`randvib.montecarlo.simulation`, :mod:`randvib.montecarlo.validation`,
+:mod:`randvib.montecarlo.options`, :mod:`randvib.montecarlo.kernel_setup`,
+:mod:`randvib.montecarlo.kernel`, :mod:`randvib.montecarlo.batches`,
+:mod:`randvib.montecarlo.results` and the step check of
+:mod:`randvib.montecarlo.step_check`. The estimators themselves:
+tests/test_statistics.py.
 """
 
 import json
@@ -26,7 +34,6 @@ import numpy as np
 import pytest
 import sdeint
 from _stats import assert_matches
-from scipy import special, stats
 
 import randvib as rv
 from randvib.analytic import exact_solutions as exact
@@ -345,100 +352,6 @@ def test_lugre_against_independent_fine_step_reference():
     _check(case_lugre_fine_reference(seed=1))
 
 
-# ------------------------------------------------ confidence-interval coverage
-def binomial_acceptance(n, p=0.95, false_failure=1e-3):
-    """[lo, hi] holding Binomial(n, p) with probability >= 1 - false_failure."""
-    lo = int(stats.binom.ppf(false_failure / 2, n, p))  # P(X < lo) <= false_failure / 2
-    hi = int(stats.binom.isf(false_failure / 2, n, p))  # P(X > hi) <= false_failure / 2
-    return lo, hi
-
-
-def _in_sample_estimate(y, x):
-    """Controlled mean with beta fitted on the same paths (what ``estimate`` avoids)."""
-    n = y.size
-    coef, *_ = np.linalg.lstsq(np.column_stack([np.ones(n), x]), y, rcond=None)
-    r = y - x @ coef[1:]
-    return r.mean(), special.stdtrit(n - 1, 0.975) * np.sqrt(np.var(r, ddof=1) / n)
-
-
-def synthetic_coverage(seed, reps, n, p, in_sample=False):
-    """Hits of the 95 % interval over ``reps`` data sets y = 3 + X beta + eps.
-
-    X has p equicorrelated (rho = 0.5) standard normal controls; R^2 is about 0.97.
-    """
-    rng = np.random.default_rng(seed)
-    chol = np.linalg.cholesky(np.full((p, p), 0.5) + 0.5 * np.eye(p))
-    beta = np.linspace(1.0, 2.0, p)
-    hits = 0
-    for _ in range(reps):
-        x = rng.standard_normal((n, p)) @ chol.T
-        y = 3.0 + x @ beta + rng.standard_normal(n)
-        if in_sample:
-            mean, half = _in_sample_estimate(y, x)
-        else:
-            s = estimate(y, x)
-            mean, half = s.mean, s.ci95
-        hits += abs(mean - 3.0) <= half
-    return hits
-
-
-def simulation_coverage(seed, groups=600, group_size=24):
-    """Hits of the controlled 95 % interval of E[v_n^2] over independent groups of paths.
-
-    One run of the coarse linear scheme device, split into ``groups`` groups of
-    ``group_size`` paths; the reference is the exact discrete stationary value.
-    """
-    dt, psd = 0.05, 2.0
-    cov = integrators.scheme_stationary_covariance("heun", 1.0, 1.0, 4.0, psd, dt)
-    r = simulate(
-        SCHEME_DEVICE,
-        psd,
-        t_end=30.0,
-        dt=dt,
-        n_paths=groups * group_size,
-        burn_in=10.0,
-        seed=seed,
-        check_step=False,
-    )
-    y, x = r.column(0), r.controls()
-    hits = 0
-    for g in range(groups):
-        s = estimate(
-            y[g * group_size : (g + 1) * group_size], x[g * group_size : (g + 1) * group_size]
-        )
-        hits += abs(s.mean - cov[1, 1]) <= s.ci95
-    return hits
-
-
-def test_cross_fitted_intervals_cover_at_95_percent():
-    """Empirical coverage of ``estimate``'s 95 % interval with cross-fitted controls.
-
-    Synthetic data (known mean, 4 correlated controls, 100 paths, 3000 data
-    sets) and real simulation output (600 independent groups of 24 paths, 2
-    controls, exact discrete reference): the number of hits must lie in the
-    exact Binomial(N, 0.95) acceptance region of false-failure rate 1e-3.
-    In-sample fitting (6 controls, 24 paths) is shown to under-cover: its hits
-    fall below that region. Calibration (20 seeds each): synthetic hits
-    0.9437-0.9553 (mean 0.9503; 40 000 data sets at one seed: 0.9496 +-
-    0.0011), region [0.9363, 0.9627]; simulation groups 0.9383-0.9600 (mean
-    0.9500), region [0.9183, 0.9767]; in-sample 0.830-0.869 (mean 0.855),
-    region from 0.9335: all 20 seeds detected.
-    """
-    reps = 3000
-    lo, hi = binomial_acceptance(reps)
-    hits = synthetic_coverage(seed=1, reps=reps, n=100, p=4)
-    assert lo <= hits <= hi, (hits / reps, lo / reps, hi / reps)
-    groups = 600
-    lo, hi = binomial_acceptance(groups)
-    hits = simulation_coverage(seed=2, groups=groups)
-    assert lo <= hits <= hi, (hits / groups, lo / groups, hi / groups)
-    # without cross-fitting the interval is too short: detectably under-covers
-    reps = 2000
-    lo, _ = binomial_acceptance(reps)
-    hits = synthetic_coverage(seed=3, reps=reps, n=24, p=6, in_sample=True)
-    assert hits < lo, (hits / reps, lo / reps)
-
-
 def _sde_functions(device, psd):
     m, c, k, k3 = device.m, device.c, device.k, device.k3
     fr = device.friction
@@ -689,14 +602,12 @@ def test_too_large_step_refused_with_bound():
         ({"t_end": -1.0}, "`t_end`"),
         ({"dt": 0.0}, "`dt`"),
         ({"burn_in": 2.0}, "`burn_in`"),
-        ({"method": "rk4"}, "`method`"),
         ({"scheme": "rk4"}, "`scheme`"),
         ({"dW": np.zeros((3, 3))}, "`dW` must have shape"),
         ({"initial": "somewhere"}, "`initial`"),
         ({"seed": -1}, "`seed`"),
     ],
 )
-@pytest.mark.filterwarnings("ignore:`method=`:DeprecationWarning")  # the alias row
 def test_bad_arguments(kwargs, fragment):
     base = dict(t_end=1.0, dt=1e-4, n_paths=4)
     with pytest.raises(ValueError, match=fragment):
@@ -705,17 +616,15 @@ def test_bad_arguments(kwargs, fragment):
         simulate(LINEAR, -1.0, **base)
 
 
-def test_method_is_a_deprecated_alias_of_scheme():
+def test_the_integrator_is_named_scheme_only():
+    """``scheme`` names the integrator; ``method`` (the analytic methods' word) is no alias."""
     base = dict(t_end=0.05, dt=1e-4, n_paths=4, seed=2, check_step=False, progress=False)
-    new = simulate(LINEAR, 1.0, scheme="euler-maruyama", **base)
-    with pytest.warns(DeprecationWarning, match="scheme="):
-        old = simulate(LINEAR, 1.0, method="euler-maruyama", **base)
-    np.testing.assert_array_equal(old.per_path, new.per_path)
-    assert new.scheme == "euler-maruyama" and new.summary()["method"] == "euler-maruyama"
-    with pytest.warns(DeprecationWarning):
-        assert old.method == "euler-maruyama"
-    with pytest.raises(TypeError, match="`scheme` only"):
-        simulate(LINEAR, 1.0, scheme="heun", method="heun", **base)
+    result = simulate(LINEAR, 1.0, scheme="euler-maruyama", **base)
+    # the JSON key stays `method`, as the CLI's --method
+    assert result.scheme == "euler-maruyama" and result.summary()["method"] == "euler-maruyama"
+    assert not hasattr(result, "method")
+    with pytest.raises(TypeError, match="method"):
+        simulate(LINEAR, 1.0, method="heun", **base)
 
 
 def test_cli_simulate_json(capsys):

@@ -1,7 +1,7 @@
 """Monte Carlo under rational spectra: the device with its shaping filter's states.
 
 ``simulate(harvester, BandPass(...) or KanaiTajimi(...))`` integrates the
-filter's two states with the device by the same scheme (issue 10). The exact
+filter's two states with the device by the same scheme. The exact
 checks use the linear device (k3 = 0, no friction): driven through a linear
 filter it is a linear Gaussian system whose stationary covariance is known
 
@@ -148,8 +148,8 @@ def test_fine_step_continuous_lyapunov(name):
     2.7 (7.4), E[z^2] -0.42 / 1.07 / 2.8 (8.3) (the two cases share their
     random numbers, so their z-scores are correlated). Seeds 2000-2029,
     band-pass E[v^2]: -0.33 / 0.82 / 2.5. Over those 60 seeds the mean z was
-    -0.44 +- 0.13, a possible bias of 0.07 % of E[v^2]. Investigated (issue
-    10) and found to be a fluctuation, not a bias:
+    -0.44 +- 0.13, a possible bias of 0.07 % of E[v^2]. Investigated and
+    found to be a fluctuation, not a bias:
 
     * every part of the estimator's expectation is exact: the kernel equals
       the scheme's linear recursion on device + filter path by path (given

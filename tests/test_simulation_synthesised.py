@@ -11,6 +11,9 @@ velocity increments (randvib.montecarlo.driven). Exact checks:
 * the device on a measured record: a sine record against the exact harmonic
   response, a long Gaussian record against the spectral integral with the
   segments' interval.
+
+Covers :mod:`randvib.montecarlo.driven` in :func:`randvib.simulate` and in
+:mod:`randvib.montecarlo.on_record`.
 """
 
 import numpy as np

@@ -8,6 +8,10 @@ the CSV tables, the interaction contrast against the FPK grids, resuming,
 refusing another run's folder (another grid or seed) and the exact scaling
 laws; the verdict wording itself is checked
 on synthetic tables below.
+
+Covers the studies' building blocks :mod:`randvib.studies.grids`,
+:mod:`randvib.studies.contrasts`, :mod:`randvib.studies.accuracy`,
+:mod:`randvib.studies.verdicts` and :mod:`randvib.studies.report`.
 """
 
 import json
@@ -26,6 +30,7 @@ from study_checks import check_study_run, contrast_zscores
 import randvib as rv
 from randvib.analytic.prediction import expected_power
 from randvib.cli import main
+from randvib.formatting import plus_minus
 from randvib.montecarlo.sweep import SweepSettings
 from randvib.studies import STUDIES, load
 from randvib.studies.accuracy import trusted_limit
@@ -37,7 +42,6 @@ from randvib.studies.grids import (
     friction_level_points,
     power_ratio,
 )
-from randvib.studies.report import plus_minus
 from randvib.studies.verdicts import (
     interaction_counts,
     interaction_summary,

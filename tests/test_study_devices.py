@@ -10,6 +10,10 @@ ratios and the censored first-passage columns are consistent, the budget
 interpolation (randvib/studies/budget.py) is exact on a power law, the
 verdicts are recomputed from the CSVs, and a second run resumes from the
 stored cases (randvib.run_ensembles) without recomputing them.
+
+Covers the study script with the building blocks it uses:
+:mod:`randvib.studies.budget`, :mod:`randvib.studies.methods` (the analytic
+methods against Monte Carlo) and :mod:`randvib.montecarlo.ensembles`.
 """
 
 import json

@@ -6,6 +6,8 @@ the transient linearisation of the linear device is that exact solution, the
 stationary-times-duration estimate is the stationary power at the peak times
 int e^2 dt, the paired ratio of the paper's device to itself is 1, the
 verdicts are recomputed from the CSV, and the report and figures exist.
+
+Covers the study script with its figures (:mod:`randvib.studies.transient_figure`).
 """
 
 import json

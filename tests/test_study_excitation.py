@@ -7,6 +7,10 @@ it within its interval, the paired contrast is the combination of the four
 devices' powers (same paths) and narrower than unpaired, the verdicts are
 recomputed from the CSVs, and a second run resumes from the stored cases
 (randvib.run_ensembles) without recomputing them.
+
+Covers the study script with the building blocks it uses: :mod:`randvib.studies.grids`
+(response-matched levels), :mod:`randvib.studies.contrasts` (paired interactions),
+:mod:`randvib.studies.spectra_figure`.
 """
 
 import json

@@ -5,6 +5,10 @@ checked against the corrected FPK grids (``tests/study_checks.py``), which
 solve the same stationary problem without sampling. Calibration
 (``tests/calibration/studies.py``, seeds 0-19 of the quick study) is quoted in
 each test's docstring.
+
+Covers the study script with the building blocks it uses:
+:mod:`randvib.studies.verdicts`, :mod:`randvib.studies.half_step` (the half-step re-
+runs) and :mod:`randvib.studies.figures`.
 """
 
 import json

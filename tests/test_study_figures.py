@@ -4,6 +4,10 @@ Every study figure of the tests' tiny runs goes through
 :func:`randvib.figure_style.save_figure`, whose layout check is an error
 in the tests (``filterwarnings`` in pyproject.toml); these tests show the
 check itself catches what it must.
+
+Covers :mod:`randvib.figure_style`, the report's Markdown tables
+(:mod:`randvib.studies.report`), the numbers they print (:mod:`randvib.formatting`) and
+:mod:`randvib.studies.evidence`.
 """
 
 import matplotlib
@@ -23,10 +27,9 @@ from randvib.figure_style import (  # noqa: E402
     save_figure,
     text_overlaps,
 )
+from randvib.formatting import percent, significant  # noqa: E402
 from randvib.studies.evidence import independent_count, rescaling_groups  # noqa: E402
 from randvib.studies.report import (  # noqa: E402
-    format_number,
-    format_percent,
     markdown_table,
     readable_table,
     verdict_lines,
@@ -65,9 +68,10 @@ def test_save_figure_refuses_layout_without_constrained_engine(tmp_path):
 
 
 def test_number_formats_have_no_nan_or_negative_zero():
-    assert format_number(float("nan")) == "n/a" and format_number(None) == "n/a"
-    assert format_number(-1e-9, 3) == "-1e-09" and format_number(-0.0) == "0"
-    assert format_percent(-0.00001) == "0.00 %" and format_percent(0.0123, sign=True) == "+1.23 %"
+    assert significant(float("nan"), 4) == "n/a" and significant(None, 4) == "n/a"
+    assert significant(-1e-9, 3) == "-1e-09" and significant(-0.0, 4) == "0"
+    assert significant(float("inf"), 4) == "∞"
+    assert percent(-0.00001) == "0.00 %" and percent(0.0123, sign=True) == "+1.23 %"
     assert num_tex(5e5) == "5 × 10$^{5}$" and num_tex(1e7) == "10$^{7}$" and num_tex(0.5) == "0.5"
     table = markdown_table(pd.DataFrame({"x": [np.nan, -0.00001, 2.5], "y": ["a", "b", "c"]}))
     assert unclean_tokens(table) == {} and "n/a" in table

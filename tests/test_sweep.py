@@ -1,4 +1,7 @@
-"""Sweeps: grids, precision targets, common random numbers, resumable output, executors."""
+"""Sweeps: grids, precision targets, common random numbers, resumable output, executors.
+
+Covers :mod:`randvib.montecarlo.sweep`.
+"""
 
 import json
 
@@ -16,7 +19,7 @@ from randvib.montecarlo.sweep import (
     paired_contrast,
     run_sweep,
 )
-from randvib.statistics import Statistic, holm_significant
+from randvib.statistics import Statistic
 
 BASE = rv.preset("figure9")
 FAST = SweepSettings(
@@ -246,11 +249,6 @@ def test_paired_interaction_is_tighter_than_unpaired():
     t = res.table
     unpaired = np.sqrt(np.sum(t.power_electrical_ci95**2))
     assert inter.ci95 < unpaired / 2
-
-
-def test_holm():
-    assert list(holm_significant([0.001, 0.04, 0.2])) == [True, False, False]
-    assert list(holm_significant([0.01, 0.02])) == [True, True]
 
 
 def test_resume_interrupted_sweep_without_recomputing(tmp_path, monkeypatch):

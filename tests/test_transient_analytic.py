@@ -17,6 +17,9 @@ References, each computed by a route independent of the moment equations:
 
 The moments must agree to 1e-6 relative (the issue's bar; measured: about
 1e-10 against the closed form).
+
+Covers :mod:`randvib.analytic.transient` and the first-passage approximations of
+:mod:`randvib.analytic.first_passage`.
 """
 
 import numpy as np

@@ -10,6 +10,9 @@ A_n or B_n). The difference of the two is the scheme's known bias, removed
 before comparing (``known_bias`` of tests/_stats.py); the tolerance is the
 ensemble's own standard error (4 sigma), and each comparison must be able
 to see a 15 % error (power check). The paths and seeds are fixed.
+
+Covers :mod:`randvib.montecarlo.transient` and its results
+(:mod:`randvib.montecarlo.transient_results`).
 """
 
 import numpy as np

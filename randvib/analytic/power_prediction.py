@@ -13,9 +13,10 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from scipy import special
 
-from randvib import _display
+from randvib import _display, formatting
 from randvib._validation import scalar_or_array
 from randvib.models.harvester import Harvester
+from randvib.quantities import unit
 
 
 @dataclass(frozen=True)
@@ -118,8 +119,8 @@ class PowerPrediction:
 
     def _quantities(self) -> list[tuple[str, object, str]]:
         """(name, value, unit) of every field with a value."""
-        out = [(name, getattr(self, name), unit) for name, unit in UNITS.items()]
-        return [(name, value, unit) for name, value, unit in out if value is not None]
+        out = [(name, getattr(self, name)) for name in SHOWN]
+        return [(name, value, unit(name)) for name, value in out if value is not None]
 
     def to_frame(self):
         """The prediction as a :class:`pandas.DataFrame`.
@@ -139,11 +140,13 @@ class PowerPrediction:
         return frame
 
     def _rows(self):
-        return [(name, _display.number(value), unit) for name, value, unit in self._quantities()]
+        return [
+            (name, formatting.compact(value), units) for name, value, units in self._quantities()
+        ]
 
     def __repr__(self) -> str:
         fields = ", ".join(
-            f"{name}={_display.number(value)}" for name, value, _ in self._quantities()
+            f"{name}={formatting.compact(value)}" for name, value, _ in self._quantities()
         )
         return f"PowerPrediction(method={self.method!r}, {fields})"
 
@@ -151,17 +154,17 @@ class PowerPrediction:
         return _display.html_table(f"Prediction ({self.method})", self._rows())
 
 
-#: Units of the fields of :class:`PowerPrediction`, in the order they are shown.
-UNITS = {
-    "power_electrical": "W",
-    "power_load": "W",
-    "c_eq": "Ns/m",
-    "velocity_variance": "(m/s)^2",
-    "displacement_variance": "m^2",
-    "mean_abs_velocity": "m/s",
-    "circuit_mean_square": "A^2 or V^2",
-    "stroke_exceedance": "probability",
-}
+#: The fields of :class:`PowerPrediction` shown, in order (their units: :mod:`randvib.quantities`).
+SHOWN = (
+    "power_electrical",
+    "power_load",
+    "c_eq",
+    "velocity_variance",
+    "displacement_variance",
+    "mean_abs_velocity",
+    "circuit_mean_square",
+    "stroke_exceedance",
+)
 
 
 def gaussian_exceedance(stroke, displacement_variance):

@@ -46,7 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import optimize
 
-from randvib import _display
+from randvib import _display, formatting
 from randvib._validation import check_scalar_device
 from randvib.analytic.linear_response import device_block, output_variances, response_spectra
 from randvib.analytic.linearisation import (
@@ -60,6 +60,7 @@ from randvib.analytic.transient import solve_transient
 from randvib.models.excitation import Excitation, as_excitation
 from randvib.models.harvester import Harvester
 from randvib.models.potential import CONFINING
+from randvib.quantities import unit
 
 #: Largest |log residual| accepted as converged.
 _TOLERANCE = 1e-10
@@ -141,19 +142,18 @@ class LinearisationResult(LinearisedDevice):
         return out
 
     def _rows(self):
-        circuit_unit = "V^2" if self.harvester.coupling_name == "piezo" else "A^2"
         named = (
-            ("power_electrical", "W"),
-            ("power_load", "W"),
-            ("c_eq", "Ns/m"),
-            ("k_eq", "N/m"),
-            ("velocity_variance", "(m/s)^2"),
-            ("displacement_variance", "m^2"),
-            ("circuit_variance", circuit_unit),
+            "power_electrical",
+            "power_load",
+            "c_eq",
+            "k_eq",
+            "velocity_variance",
+            "displacement_variance",
+            "circuit_variance",
         )
         return [
-            (name, _display.number(getattr(self, name)), unit)
-            for name, unit in named
+            (name, formatting.compact(getattr(self, name)), unit(name, self.harvester.electrical))
+            for name in named
             if getattr(self, name) is not None
         ]
 
@@ -425,12 +425,11 @@ def _typical_level(excitation) -> float:
     return float(level)
 
 
-class LinearisationDidNotConverge(ValueError, RuntimeError):
+class LinearisationDidNotConverge(ValueError):
     """No fixed point of the statistical linearisation was found.
 
-    A ValueError (the device and excitation admit no Gaussian linearisation
-    the solver can find: callers report it as a refusal, one line), and a
-    RuntimeError as before.
+    A ValueError: the device and excitation admit no Gaussian linearisation
+    the solver can find, and callers report it as a refusal, one line.
     """
 
 

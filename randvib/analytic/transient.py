@@ -54,7 +54,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import integrate, linalg, special
 
-from randvib import _display
+from randvib import _display, formatting
 from randvib._validation import check_finite, check_scalar_device
 from randvib.analytic.first_passage import (
     outcrossing_rate,
@@ -584,19 +584,19 @@ class TransientPrediction:
         approximate = "; * approximate" if self.stroke_reached_poisson is not None else ""
         return (
             f"{self.method}, {how}, {self.event.name}, start {self.start.describe()}; energy "
-            f"int_0^{self.t_end:g} E[P_e] dt = {_display.number(self.energy_electrical)} J"
+            f"int_0^{self.t_end:g} E[P_e] dt = {formatting.compact(self.energy_electrical)} J"
             f"{approximate}"
         )
 
     def _table(self):
         return _display.time_rows(
-            self.times, self._series(), lambda values, i: _display.number(values[i])
+            self.times, self._series(), lambda values, i: formatting.compact(values[i])
         )
 
     def __repr__(self) -> str:
         return (
             f"TransientPrediction({self.method}, exact={self.exact}, {self.event.name}, {self.times.size} times to "
-            f"{self.t_end:g} s; energy_electrical = {_display.number(self.energy_electrical)} J)"
+            f"{self.t_end:g} s; energy_electrical = {formatting.compact(self.energy_electrical)} J)"
         )
 
     def __str__(self) -> str:

@@ -299,8 +299,8 @@ def _analytic_beside(harvester, event, times, t_end, start):
 
 
 def _print_simulated(harvester, psd, event, start, result, analytic) -> None:
-    from randvib._display import estimate_parts
-    from randvib.cli._output import describe_device, describe_excitation, format_value, print_table
+    from randvib.cli._output import describe_device, describe_excitation, print_table
+    from randvib.formatting import cell, estimate_parts
 
     print(describe_device(harvester))
     print(describe_excitation(psd))
@@ -316,17 +316,17 @@ def _print_simulated(harvester, psd, event, start, result, analytic) -> None:
         headers.append("E[P_e] analytic (W)")
     rows = []
     for i, t in enumerate(result.times):
-        row = [format_value(float(t))]
+        row = [cell(float(t))]
         for stat in columns:
             row += list(estimate_parts(float(stat.mean[i]), float(stat.ci95[i])))
         if analytic is not None:
-            row.append(format_value(float(analytic.power_electrical[i])))
+            row.append(cell(float(analytic.power_electrical[i])))
         rows.append(row)
     print_table(rows, headers)
     energy = result.energy_electrical
     line = f"energy from t = 0 to {result.t_end:g} s: {' ± '.join(estimate_parts(energy.mean, energy.ci95))} J"
     if analytic is not None:
-        line += f" (analytic {format_value(analytic.energy_electrical)} J)"
+        line += f" (analytic {cell(analytic.energy_electrical)} J)"
     print(line)
     quantiles = ", ".join(f"{100 * q:g} % {v:.4g} m" for q, v in result.peak_quantiles().items())
     print(f"peak |z| over the event: {quantiles}")
@@ -377,7 +377,8 @@ def power_event(args, swept: list, points: list) -> int:
 
 
 def _print_predicted(harvester, psd, event, start, result) -> None:
-    from randvib.cli._output import describe_device, describe_excitation, format_value, print_table
+    from randvib.cli._output import describe_device, describe_excitation, print_table
+    from randvib.formatting import cell
 
     print(describe_device(harvester))
     print(describe_excitation(psd))
@@ -395,13 +396,13 @@ def _print_predicted(harvester, psd, event, start, result) -> None:
     shown = [(label, getattr(result, name)) for name, label in names.items()]
     shown = [(label, values) for label, values in shown if values is not None]
     rows = [
-        [format_value(float(t))] + [format_value(float(values[i])) for _, values in shown]
+        [cell(float(t))] + [cell(float(values[i])) for _, values in shown]
         for i, t in enumerate(result.times)
     ]
     print_table(rows, ["time (s)"] + [label for label, _ in shown])
     how = "exact: linear device" if result.exact else "time-dependent statistical linearisation"
     print(
-        f"energy from t = 0 to {result.t_end:g} s: {format_value(result.energy_electrical)} J "
+        f"energy from t = 0 to {result.t_end:g} s: {cell(result.energy_electrical)} J "
         f"({result.method}, {how})"
     )
     if result.stroke_reached_poisson is not None:

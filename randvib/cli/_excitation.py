@@ -89,8 +89,8 @@ def excitation_from_args(args):
     Returns
     -------
     float or Excitation
-        ``--psd`` itself for white noise (checked downstream exactly as
-        before excitations existed), else the excitation object.
+        ``--psd`` itself for white noise (a number, checked downstream as
+        every white-noise level is), else the excitation object.
 
     Raises
     ------

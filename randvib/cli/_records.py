@@ -8,6 +8,7 @@ from randvib._validation import integer_option
 from randvib.identification.input_reconstruction import HOLDS
 from randvib.identification.settings import INITIAL_STATES, SimulationSettings
 from randvib.models.record import INPUT_KINDS, OUTPUT_CHANNEL, TIME_COLUMN, read_record
+from randvib.quantities import unit
 
 
 def add_record_arguments(parser: argparse.ArgumentParser) -> None:
@@ -129,16 +130,18 @@ def parse_bounds(items) -> dict:
 
 def output_unit(args) -> str:
     """The unit of the output column: m for the relative displacement, else the column's own."""
-    return "m" if args.output_column == OUTPUT_CHANNEL else f"{args.output_column} units"
+    if args.output_column == OUTPUT_CHANNEL:
+        return unit(OUTPUT_CHANNEL)
+    return f"{args.output_column} units"
 
 
 def plot_units(args) -> dict:
-    """``scale`` and ``unit`` of the displacement in ``--plot`` figures.
+    """``scale`` and ``unit`` of the output in ``--plot`` figures.
 
-    The default output column is the relative displacement in m, shown in mm
-    as in the paper; a column the user named (``--output-column``) is shown
-    as it is, in the record's own units.
+    The default output column is the relative displacement in m, which the
+    figures show in mm (their default); a column the user named
+    (``--output-column``) is shown as it is, in the record's own units.
     """
     if args.output_column == OUTPUT_CHANNEL:
-        return dict(scale=1e3, unit="mm")
+        return {}
     return dict(scale=1.0, unit=output_unit(args))

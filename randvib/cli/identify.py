@@ -5,9 +5,6 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-import numpy as np
-
-from randvib._display import estimate_parts
 from randvib._io import check_output_file, dumps, write_or_keep
 from randvib._validation import MAX_SEED, integer_option
 from randvib.cli._output import print_table
@@ -20,10 +17,11 @@ from randvib.cli._records import (
     record_from_args,
     simulation_settings,
 )
+from randvib.formatting import with_standard_error
 from randvib.identification.identify import identify
-from randvib.identification.models import MODELS, UNITS
+from randvib.identification.models import MODELS, unit_of
 from randvib.identification.settings import SearchSettings
-from randvib.models.record import CHANNELS
+from randvib.quantities import unit
 
 DEFAULT = SearchSettings()
 
@@ -146,23 +144,6 @@ def run(args) -> int:
     return 0
 
 
-def _with_precision(value, se, interval) -> list:
-    """Value, standard error and interval to the digits the standard error supports.
-
-    The standard error keeps two significant digits and the value and the
-    interval's ends are written to its decimal place, as Monte Carlo means are
-    (:func:`randvib._display.estimate_parts`); without a standard error the
-    value keeps six digits.
-    """
-    if se is None or not np.isfinite(se) or se <= 0:
-        return [value, "" if se is None else se, ""]
-    shown, se_shown = estimate_parts(value, se)
-    if interval is None:
-        return [shown, se_shown, ""]
-    lo, hi = (estimate_parts(end, se)[0] for end in interval)
-    return [shown, se_shown, f"[{lo}, {hi}]"]
-
-
 def print_report(result, record, output_unit: str = "m") -> None:
     """The parameters with standard errors and 95 % intervals, J, the correlations.
 
@@ -170,12 +151,12 @@ def print_report(result, record, output_unit: str = "m") -> None:
     relative displacement; a named ``--output-column`` keeps its own).
     """
     se, ci = result.standard_errors, result.confidence_intervals
-    units = {**UNITS, "output_offset": output_unit, "input_offset": CHANNELS[record.input_kind][0]}
+    offsets = {"output_offset": output_unit, "input_offset": unit(record.input_kind)}
     rows = [
         [
             name,
-            *_with_precision(value, se.get(name), ci.get(name)),
-            units[name],
+            *with_standard_error(value, se.get(name), ci.get(name)),
+            offsets[name] if name in offsets else unit_of(result.model, name),
             "identified" if name in se or name in result.free else "fixed",
         ]
         for name, value in result.parameters.items()

@@ -1,10 +1,9 @@
 """``randvib power``: analytic expected power (paper Eq. 19-32 and beyond).
 
 Under white noise (the default) every method of
-:data:`randvib.analytic.prediction.METHODS` applies and the output is what
-it was before excitations existed; under another excitation only the methods
-that declare they accept it (statistical linearisation) do, and the JSON
-gains an ``excitation`` object describing it. The ``--method`` choices, their
+:data:`randvib.analytic.prediction.METHODS` applies; under another excitation
+only the methods that declare they accept it (statistical linearisation) do,
+and the JSON gains an ``excitation`` object describing it. The ``--method`` choices, their
 help and the refusals come from the methods' declarations
 (:mod:`randvib.analytic.method`).
 
@@ -34,13 +33,10 @@ from randvib.analytic.prediction import METHODS, optimal_load_resistance, predic
 from randvib.cli._device import add_device_arguments, harvester_from_args, option_flag
 from randvib.cli._event import add_event_arguments, power_event, wants_event
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
-from randvib.cli._output import (
-    describe_device,
-    describe_excitation,
-    format_value,
-    print_table,
-)
-from randvib.models.excitation import PARAMETER_UNITS, Excitation
+from randvib.cli._output import describe_device, describe_excitation, print_table
+from randvib.formatting import cell
+from randvib.models.excitation import Excitation
+from randvib.quantities import QUANTITIES, unit
 
 
 def register(sub) -> None:
@@ -188,7 +184,7 @@ def _point(args) -> tuple[dict, object, object]:
     }
     if result.power_load is None:
         out.pop("power_load")
-    if harvester.electrical is not None:  # added with the couplings (issue 11)
+    if harvester.electrical is not None:
         out["coupling"] = harvester.coupling_name
     else:
         # what is not converted: c_m E[v^2] + friction power, c_eq E[v^2] being all
@@ -225,35 +221,23 @@ def _check_method(name: str, harvester, psd) -> None:
         )
 
 
-UNITS = {
-    "psd": "(m/s^2)^2/Hz",
-    "c_eq": "Ns/m",
-    "velocity_variance": "(m/s)^2",
-    "displacement_variance": "m^2",
-    "mean_abs_velocity": "m/s",
-    "power_electrical": "W",
-    "power_load": "W",
-    "power_mechanical": "W",
-    "r_load_optimal": "ohm",
-    "power_load_optimal": "W",
-    "circuit_mean_square": "A^2 or V^2",
-    "stroke": "m",
-    **PARAMETER_UNITS,  # the excitation's parameters
-}
+def _unit(key: str, harvester) -> str:
+    """The unit of a key of the JSON object (none for words: method, friction...)."""
+    return unit(key, harvester.electrical) if key in QUANTITIES else ""
 
 
 def _print_point(out: dict, harvester, psd) -> None:
     """One point: the device and excitation used, then quantity / value / unit."""
     print(describe_device(harvester))
     print(describe_excitation(psd))
-    rows = [(k, v, UNITS.get(k, "")) for k, v in out.items() if k != "excitation"]
-    rows += [(k, v, UNITS.get(k, "")) for k, v in out.get("excitation", {}).items()]
+    rows = [(k, v, _unit(k, harvester)) for k, v in out.items() if k != "excitation"]
+    rows += [(k, v, _unit(k, harvester)) for k, v in out.get("excitation", {}).items()]
     print_table(rows, ("quantity", "value", "unit"))
     if harvester.electrical is None and harvester.c_e == 0:
         print(
             "note: this device has no electrical damping (c_e = 0, as the presets identified "
             "without the coil), so the power it delivers is 0 W; give --alpha/--r-load/--r-coil "
-            f"or --c-e. It dissipates {format_value(out['power_mechanical'], 4)} W mechanically "
+            f"or --c-e. It dissipates {cell(out['power_mechanical'], 4)} W mechanically "
             "(c_m E[v^2] + friction)."
         )
 
@@ -280,8 +264,9 @@ def _print_sweep(swept: list[str], points, results) -> None:
         [getattr(point, dest) for dest in swept] + [out.get(c) for c in columns]
         for point, (out, _, _) in zip(points, results, strict=True)
     ]
+    harvester = results[0][1]
     headers = [option_flag(d) for d in swept] + [
-        f"{c} ({UNITS[c]})" if UNITS.get(c) else c for c in columns
+        f"{c} ({_unit(c, harvester)})" if _unit(c, harvester) else c for c in columns
     ]
     print_table(rows, headers)
 

@@ -1,32 +1,30 @@
-"""``randvib simulate``: Monte Carlo ensemble of the harvester under white or filtered noise.
+"""``randvib simulate``: Monte Carlo ensemble under white, coloured or recorded base acceleration.
 
 ``--envelope`` makes the input an event from t = 0 (:mod:`randvib.cli._event`,
 :func:`randvib.simulate_transient`): a time-resolved table at ``--times``.
 
-White noise as before; ``--excitation band-pass|kanai-tajimi`` integrates the
-shaping filter with the device, ``band-limited`` and ``--psd-file`` are
-synthesised path by path (the options of :mod:`randvib.cli._excitation`,
-shared with ``randvib power``); ``--record FILE`` simulates the device on the
-record itself (:func:`randvib.monte_carlo_on_record`), ``--segments`` windows
-giving the interval.
+White noise by default (``--psd``); ``--excitation band-pass|kanai-tajimi``
+integrates the shaping filter with the device, ``band-limited`` and
+``--psd-file`` are synthesised path by path (the options of
+:mod:`randvib.cli._excitation`, shared with ``randvib power``); ``--record
+FILE`` simulates the device on the record itself
+(:func:`randvib.monte_carlo_on_record`), ``--segments`` windows giving the
+interval.
 """
 
 from __future__ import annotations
 
-from randvib._display import estimate_parts
 from randvib._io import dumps
 from randvib._validation import MAX_SEED, integer_option
 from randvib.analytic.prediction import METHODS, predict
 from randvib.cli._device import add_device_arguments, harvester_from_args
 from randvib.cli._event import add_event_arguments, simulate_event, wants_event
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
-from randvib.cli._output import (
-    describe_device,
-    describe_excitation,
-    format_value,
-    print_table,
-)
+from randvib.cli._output import describe_device, describe_excitation, print_table
+from randvib.formatting import cell, estimate_parts
 from randvib.montecarlo.integrators import INTEGRATORS
+from randvib.montecarlo.results import STATISTICS
+from randvib.quantities import unit
 
 
 def register(sub) -> None:
@@ -145,22 +143,19 @@ def run(args) -> int:
         except ValueError:  # e.g. no zero-mean Gaussian solution for this double well
             analytic = None
     rows = []
-    units = {
-        "power_electrical": "W",
-        "power_load": "W",
-        "velocity_variance": "(m/s)^2",
-        "displacement_variance": "m^2",
-        "mean_abs_velocity": "m/s",
-        "friction_power": "W",
-        "circuit_mean_square": "A^2 or V^2",
-    }
-    units.update(stroke_exceedance="", stroke_first_passage_time="s")
-    for name, unit in units.items():
+    for name in (*STATISTICS, "stroke_first_passage_time"):
         if summary.get(name) is None:
             continue
         s = summary[name]
         lin = getattr(analytic, name, None) if analytic is not None else None
-        rows.append((name, *estimate_parts(s["mean"], s["ci95"]), format_value(lin), unit))
+        rows.append(
+            (
+                name,
+                *estimate_parts(s["mean"], s["ci95"]),
+                cell(lin),
+                unit(name, harvester.electrical),
+            )
+        )
     first = summary.get("stroke_first_passage")
     if first is not None and first["mean"] is None:
         restricted = first["restricted_mean"]
@@ -169,7 +164,7 @@ def run(args) -> int:
                 f"E[min(first passage, {first['horizon']:g} s)]",
                 *estimate_parts(restricted["mean"], restricted["ci95"]),
                 f"{first['paths_reached']}/{first['n_paths']} paths reached the stroke",
-                "s",
+                unit("stroke_first_passage_time"),
             )
         )
     print(describe_device(harvester))

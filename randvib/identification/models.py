@@ -11,7 +11,7 @@ must be given; with a force input it may be left free and is identified.
 
 This module holds the declarations every part of the identification reads:
 the device's own parameters (:data:`DEVICE_SPECS`), the models
-(:data:`MODELS`, :data:`MODEL_PARAMETERS`), the units (:data:`UNITS`) and
+(:data:`MODELS`, :data:`MODEL_PARAMETERS`), their units (:func:`unit_of`) and
 the one check of a parameter's value (:func:`check_parameter`).
 
 **One device.** Outside the search, a model's parameter values are a
@@ -25,7 +25,6 @@ pair into the named parameters the compiled simulation takes,
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from dataclasses import dataclass
 
 from randvib._validation import (
@@ -39,14 +38,15 @@ from randvib.identification.record_integrator import EXTRA_PARAMETERS
 from randvib.models.friction import FRICTION_MODELS, RegistryView
 from randvib.models.harvester import Harvester
 from randvib.models.parameters import Parameter
+from randvib.quantities import unit
 
 #: The device's own parameters (Eq. 1; friction laws declare theirs): unit,
 #: default bounds from the record's scales, log scale (k3 may be zero).
 DEVICE_SPECS = {
-    "m": Parameter("kg", True, lambda s: (0.1 * s.m, 10 * s.m)),
-    "c": Parameter("Ns/m", False, lambda s: (1e-4 * s.c_ref, 2 * s.c_ref)),
-    "k": Parameter("N/m", True, lambda s: (0.1 * s.k_ref, 10 * s.k_ref)),
-    "k3": Parameter("N/m^3", False, lambda s: (0.0, 2 * s.k_ref / s.z_max**2), log=False),
+    "m": Parameter(unit("m"), True, lambda s: (0.1 * s.m, 10 * s.m)),
+    "c": Parameter(unit("c"), False, lambda s: (1e-4 * s.c_ref, 2 * s.c_ref)),
+    "k": Parameter(unit("k"), True, lambda s: (0.1 * s.k_ref, 10 * s.k_ref)),
+    "k3": Parameter(unit("k3"), False, lambda s: (0.0, 2 * s.k_ref / s.z_max**2), log=False),
 }
 
 
@@ -68,36 +68,11 @@ def parameter_specs(model) -> dict[str, Parameter]:
     return {**DEVICE_SPECS, **({} if law is None else law.parameter_specs())}
 
 
-#: Units of the quadratic stiffness and the sensor offsets.
-EXTRA_UNITS = {"k2": "N/m^2", "input_offset": "input unit", "output_offset": "m"}
-
-
 def unit_of(model, name):
-    """The unit of parameter ``name`` of ``model`` (a law's own declaration wins)."""
-    return EXTRA_UNITS[name] if name in EXTRA_UNITS else parameter_specs(model)[name].unit
-
-
-class _Units(Mapping):
-    """Parameter name -> unit, from the device's and the laws' declarations."""
-
-    def _table(self):
-        out = {name: spec.unit for name, spec in DEVICE_SPECS.items()} | EXTRA_UNITS
-        for law in FRICTION_MODELS.values():
-            out.update({name: spec.unit for name, spec in law.parameter_specs().items()})
-        return out
-
-    def __getitem__(self, key):
-        return self._table()[key]
-
-    def __iter__(self):
-        return iter(self._table())
-
-    def __len__(self):
-        return len(self._table())
-
-
-#: Parameter name -> SI unit (live view; a law's own units win in its results).
-UNITS = _Units()
+    """The unit of parameter ``name`` of ``model``: a law's own declaration, else
+    :func:`randvib.quantities.unit` (``m``, ``c``, ``k``, ``k3``, ``k2``, the offsets)."""
+    specs = parameter_specs(model)
+    return specs[name].unit if name in specs else unit(name)
 
 
 def check_model(model):
@@ -232,7 +207,7 @@ def device_from_parameters(
 
     The identified damping ``c`` becomes the Harvester's c_m: a record taken
     in open circuit holds no electrical damping. ``electrical`` (a coupling,
-    e.g. ``ElectricalCoupling(alpha, r_load, r_coil)``) wires the device, its
+    e.g. ``Resistive(alpha, r_load, r_coil)``) wires the device, its
     c_e added to c (:meth:`~randvib.models.harvester.Harvester.with_coupling`).
     """
     law = check_model(model)

@@ -23,6 +23,9 @@ MODEL_STYLE = {
     "lugre": dict(color=PALETTE[2], marker="D", ms=4, ls=":", label="LuGre"),
 }
 
+#: The figures show displacements (m) in mm and voltages (V) in mV, as the paper does.
+MILLI = 1e3
+
 #: Measured data in black, the model's simulation dashed in vermilion.
 MEASURED = dict(color="black", lw=1.0, label="measured")
 SIMULATED = dict(color=PALETTE[1], lw=1.0, ls="--", label="simulated")
@@ -34,7 +37,7 @@ def _finish(fig, path):
     return fig
 
 
-def plot_time_history(prediction, ax=None, *, window=None, scale=1.0, unit="m"):
+def plot_time_history(prediction, ax=None, *, window=None, scale=MILLI, unit="mm"):
     """Measured (solid black) and simulated (dashed) relative displacement.
 
     Parameters
@@ -45,7 +48,8 @@ def plot_time_history(prediction, ax=None, *, window=None, scale=1.0, unit="m"):
     window : (t0, t1), optional
         Time window (s) to show; default :func:`default_window`.
     scale, unit : float, str
-        Display scaling, e.g. ``1e3, "mm"``.
+        Display scaling of the record's output, by default from m to mm; a
+        record whose output is not a displacement in m gives its own.
     """
     if ax is None:
         _, axes = new_figure(figsize=(7.0, 2.6))
@@ -79,7 +83,7 @@ def default_window(record, cycles: float = 30.0, longest: float = 2.0) -> float:
     return min(duration, longest, cycles / (crossings / 2.0 / duration))
 
 
-def plot_histograms(prediction, axes=None, *, bins=81, scale=1.0, unit="m", legend=True):
+def plot_histograms(prediction, axes=None, *, bins=81, scale=MILLI, unit="mm", legend=True):
     """Densities of the measured and simulated displacement and, with a coil, load voltage.
 
     With a circuit the voltage histogram shows the spike at zero volts caused
@@ -89,8 +93,8 @@ def plot_histograms(prediction, axes=None, *, bins=81, scale=1.0, unit="m", lege
     rec = prediction.record
     panels = [(rec.z * scale, prediction.z * scale, "z", unit)]
     if prediction.voltage is not None:
-        measured = None if rec.voltage is None else rec.voltage * 1e3
-        panels.append((measured, prediction.voltage * 1e3, "load voltage V", "mV"))
+        measured = None if rec.voltage is None else rec.voltage * MILLI
+        panels.append((measured, prediction.voltage * MILLI, "load voltage V", "mV"))
     if axes is None:
         _, grid = new_figure(1, len(panels), figsize=(3.5 * len(panels), 2.6))
         axes = grid[0]
@@ -111,7 +115,7 @@ def plot_histograms(prediction, axes=None, *, bins=81, scale=1.0, unit="m", lege
 
 
 @styled
-def figure_fit(prediction, path=None, *, window=None, scale=1.0, unit="m", title=None):
+def figure_fit(prediction, path=None, *, window=None, scale=MILLI, unit="mm", title=None):
     """Paper Figure 8 analogue: (a) time history, (b) displacement and (c) voltage densities.
 
     ``title`` defaults to the record's name.

@@ -6,13 +6,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from randvib import _display
-from randvib.identification.models import (
-    MeasurementModel,
-    device_from_parameters,
-    parameter_specs,
-    unit_of,
-)
+from randvib import _display, formatting
+from randvib.identification.models import MeasurementModel, device_from_parameters, unit_of
 from randvib.identification.prediction import Prediction, predict_record
 from randvib.identification.settings import SimulationSettings
 from randvib.models.harvester import Harvester
@@ -131,11 +126,10 @@ class IdentificationResult:
         cost and the search's summary are in :meth:`to_dict`.
         """
         pd = _display.pandas()
-        specs = parameter_specs(self.model)
         rows = {
             name: {
                 "value": float(value),
-                "unit": specs[name].unit,
+                "unit": unit_of(self.model, name),
                 "free": name in self.free,
                 "lower": float(self.bounds[name][0]) if name in self.bounds else np.nan,
                 "upper": float(self.bounds[name][1]) if name in self.bounds else np.nan,
@@ -145,11 +139,10 @@ class IdentificationResult:
         return pd.DataFrame.from_dict(rows, orient="index").rename_axis("parameter")
 
     def _rows(self):
-        specs = parameter_specs(self.model)
-        rows = [("cost J (Eq. 11)", _display.number(self.cost, 4), "")]
+        rows = [("cost J (Eq. 11)", formatting.compact(self.cost, 4), "")]
         for name, value in self.parameters.items():
             fixed = "" if name in self.free else " (fixed)"
-            rows.append((name + fixed, _display.number(value), specs[name].unit))
+            rows.append((name + fixed, formatting.compact(value), unit_of(self.model, name)))
         return rows
 
     def _search_line(self) -> str:
@@ -161,9 +154,9 @@ class IdentificationResult:
 
     def __repr__(self) -> str:
         # compact: the per-generation history stays in .history, not on the screen
-        values = ", ".join(f"{name}={_display.number(v)}" for name, v in self.parameters.items())
+        values = ", ".join(f"{name}={formatting.compact(v)}" for name, v in self.parameters.items())
         return (
-            f"IdentificationResult(model={self.model!r}, cost={_display.number(self.cost, 4)}, "
+            f"IdentificationResult(model={self.model!r}, cost={formatting.compact(self.cost, 4)}, "
             f"{values}; {self.nfev} simulations, {self.generations} generations)"
         )
 
@@ -178,7 +171,7 @@ class IdentificationResult:
         electrical : Coupling, optional
             A coupling to wire the device with (its c_e is added to the
             identified c, which a record taken in open circuit does not hold),
-            e.g. ``randvib.ElectricalCoupling(alpha, r_load, r_coil)``.
+            e.g. ``randvib.Resistive(alpha, r_load, r_coil)``.
         """
         return device_from_parameters(self.model, self.parameters, electrical)[0]
 

@@ -1,10 +1,10 @@
 """Synthetic records: a device simulated under a band-limited shaker test, as a sensor sees it.
 
-One call, :func:`synthetic_record`, replaces the four steps a user needed
-before (realise the excitation, pick the input channel, simulate the device
-with :func:`~randvib.identification.record_response.record_response`,
-wrap a :class:`~randvib.models.record.Record`) and adds what a real
-measurement adds: Gaussian sensor noise and constant offsets on each channel.
+One call, :func:`synthetic_record`, takes the four steps of a synthetic test
+(realise the excitation, pick the input channel, simulate the device with
+:func:`~randvib.identification.record_response.record_response`, wrap a
+:class:`~randvib.models.record.Record`) and adds what a real measurement
+adds: Gaussian sensor noise and constant offsets on each channel.
 An offset is what the sensor adds: measured value = true value + offset.
 
 The excitation follows the paper's shaker tests (Sec. 3): a Gaussian base

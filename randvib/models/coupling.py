@@ -163,10 +163,6 @@ class Resistive(Coupling):
         return np.sqrt(self.r_coil**2 + self.r_coil * self.alpha**2 / c_m)
 
 
-#: The paper's circuit under its historical name.
-ElectricalCoupling = Resistive
-
-
 @dataclass(frozen=True, eq=False)
 class Inductive(Coupling):
     """Electromagnetic transducer with a coil inductance.

@@ -59,6 +59,7 @@ from randvib._validation import (
 )
 from randvib.models.record import Record, read_csv, read_record
 from randvib.models.state_space import StateSpace
+from randvib.quantities import unit
 
 
 class BaseMotionOverflow(ValueError):
@@ -151,7 +152,7 @@ def band_limited_excitation(
 #: Name -> excitation class; filled by :class:`Excitation` subclasses.
 EXCITATIONS: dict[str, type] = {}
 
-_PSD_UNIT = "(m/s^2)^2/Hz"
+_PSD_UNIT = unit("psd")
 
 #: The functions that take an array of white-noise levels S (named in refusals).
 BROADCASTING = "randvib.predict, randvib.expected_power and randvib.equivalent_damping"
@@ -261,20 +262,6 @@ class Excitation:
         out = {"excitation": self.name}
         out.update({f.name: getattr(self, f.name) for f in fields(self)})
         return out
-
-
-#: SI units of the numbers :meth:`Excitation.parameters` reports, for tables and messages.
-PARAMETER_UNITS = {
-    "level": "(m/s^2)^2/Hz",
-    "f0": "Hz",
-    "zeta": "",
-    "f_lo": "Hz",
-    "f_hi": "Hz",
-    "variance": "(m/s^2)^2",
-    "duration": "s",
-    "dt": "s",
-    "segment_length": "samples",
-}
 
 
 def _one(name: str, value):

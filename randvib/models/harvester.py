@@ -15,17 +15,18 @@ from dataclasses import dataclass, fields
 import numpy as np
 
 from randvib._validation import check_finite, check_nonnegative, check_positive, scalar_or_array
-from randvib.models.coupling import COUPLINGS, Coupling, ElectricalCoupling, Resistive
+from randvib.models.coupling import COUPLINGS, Coupling, Resistive
 from randvib.models.friction import FrictionModel
 from randvib.models.potential import Potential
+from randvib.quantities import unit
 
 
-def _check_real(name, value, unit):
-    """Any finite value: the potential's kind is the methods' business (issue 11)."""
+def _check_real(name, value, _unit):
+    """Any finite value: the potential it makes (double well, free mass) is the methods' business."""
     return check_finite(name, value)
 
 
-__all__ = ["ElectricalCoupling", "Harvester"]  # ElectricalCoupling: re-exported, historical home
+__all__ = ["Harvester"]
 
 
 class ElectricalDampingOverflow(ValueError):
@@ -96,14 +97,15 @@ class Harvester:
     stroke: float | None = None
 
     def __post_init__(self):
-        for name, check, unit in (
-            ("m", check_positive, "kg"),
-            ("c_m", check_nonnegative, "Ns/m"),
-            ("c_e", check_nonnegative, "Ns/m"),
-            ("k", _check_real, "N/m"),
-            ("k3", _check_real, "N/m^3"),
+        for name, check in (
+            ("m", check_positive),
+            ("c_m", check_nonnegative),
+            ("c_e", check_nonnegative),
+            ("k", _check_real),
+            ("k3", _check_real),
         ):
-            object.__setattr__(self, name, scalar_or_array(check(name, getattr(self, name), unit)))
+            value = check(name, getattr(self, name), unit(name))
+            object.__setattr__(self, name, scalar_or_array(value))
         if self.stroke is not None:
             stroke = check_positive("stroke", self.stroke, "m")
             if np.ndim(stroke):
@@ -183,7 +185,7 @@ class Harvester:
         r_load, r_coil : float
             Load and coil resistances (ohm).
         """
-        electrical = ElectricalCoupling(alpha, r_load, r_coil)
+        electrical = Resistive(alpha, r_load, r_coil)
         return cls.with_coupling(m, c_m, k, electrical, k3=k3, friction=friction, stroke=stroke)
 
     # ----------------------------------------------------------------- derived

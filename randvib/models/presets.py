@@ -9,9 +9,9 @@ by m leaves c/m, k/m, k3/m, Fc/m), so this is an assumption, not a result.
 Table 2 presets (``<model>-td1``, ``<model>-td2`` for training data 1 = test 3
 and 2 = test 8) were identified with no coil attached: the identified viscous
 damping is all mechanical (``c_m = c``, ``c_e = 0``), so their electrical power
-is zero until a circuit or ``c_e`` is given. ``figure9`` (alias
-``section5``) is the paper's Section 5 / Figure 9 device: Coulomb training-data-1
-parameters with c_m = c_e = 0.1 Ns/m.
+is zero until a circuit or ``c_e`` is given. ``figure9`` is the paper's
+Section 5 / Figure 9 device: Coulomb training-data-1 parameters with
+c_m = c_e = 0.1 Ns/m.
 """
 
 from __future__ import annotations
@@ -50,7 +50,6 @@ PRESETS: dict[str, Harvester] = {
     f"{model}-td{n}": _table2(model, n) for model in _TABLE2 for n in (1, 2)
 }
 PRESETS["figure9"] = PRESETS["coulomb-td1"].updated(c_m=0.1, c_e=0.1)
-PRESETS["section5"] = PRESETS["figure9"]
 
 PRESET_DESCRIPTIONS = {
     **{
@@ -59,7 +58,6 @@ PRESET_DESCRIPTIONS = {
         for n in (1, 2)
     },
     "figure9": "Section 5 / Figure 9: Coulomb training data 1 with c_m = c_e = 0.1 Ns/m",
-    "section5": "alias of figure9",
 }
 
 

@@ -38,15 +38,20 @@ import numpy as np
 
 from randvib._io import existing_file
 from randvib._validation import check_positive
+from randvib.quantities import QUANTITIES
 
-#: Channel name -> (SI unit, what it holds); the CSV column names of a record.
+#: Channel name -> its :class:`~randvib.quantities.Quantity` (SI unit, what it
+#: holds); the CSV column names of a record.
 CHANNELS = {
-    "base_acceleration": ("m/s^2", "base acceleration y''"),
-    "base_velocity": ("m/s", "base velocity y'"),
-    "base_displacement": ("m", "base (shaker) displacement y"),
-    "force": ("N", "force u on the mass"),
-    "relative_displacement": ("m", "displacement z of the mass relative to the base"),
-    "voltage": ("V", "load voltage"),
+    name: QUANTITIES[name]
+    for name in (
+        "base_acceleration",
+        "base_velocity",
+        "base_displacement",
+        "force",
+        "relative_displacement",
+        "voltage",
+    )
 }
 #: The channels that can drive the device (paper Eq. 1: -m y'' or a force u).
 INPUT_KINDS = ("base_displacement", "base_acceleration", "force")

@@ -14,7 +14,6 @@ orders.
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -110,44 +109,13 @@ HEUN = Integrator("heun", 1.0, 2.0, "stratonovich", (0.5, 0.5))
 INTEGRATORS = {i.name: i for i in (EULER_MARUYAMA, HEUN)}
 
 
-#: The integrator used when none is named.
-DEFAULT_SCHEME = "heun"
-
-
-def integrator(name: str, argument: str = "method") -> Integrator:
+def integrator(name: str, argument: str = "scheme") -> Integrator:
     """Look up an integrator by name (``euler-maruyama`` or ``heun``).
 
     ``argument`` is the keyword named in the error message for an unknown name.
     """
     check_choice(argument, name, tuple(INTEGRATORS))
     return INTEGRATORS[name]
-
-
-def scheme_argument(scheme: str | None, method: str | None, stacklevel: int = 3):
-    """The integrator's name from ``scheme=`` or its deprecated alias ``method=``.
-
-    ``method`` means several things in randvib (analytic method, optimiser);
-    the integrator is called ``scheme``. Functions that took ``method=`` for
-    it keep accepting it with a :class:`DeprecationWarning` (pointing
-    ``stacklevel`` frames up: 3 is the caller of the function calling this).
-
-    Returns
-    -------
-    name : str
-        The integrator's name (:data:`DEFAULT_SCHEME` when neither is given).
-    argument : str
-        The keyword it came by, for error messages.
-    """
-    if method is None:
-        return (DEFAULT_SCHEME if scheme is None else scheme), "scheme"
-    if scheme is not None:
-        raise TypeError("give the integrator as `scheme` only; `method` is its deprecated alias")
-    warnings.warn(
-        "`method=` for the integrator is deprecated; use `scheme=`",
-        DeprecationWarning,
-        stacklevel=stacklevel,
-    )
-    return method, "method"
 
 
 def scheme_matrices(scheme: str, m, c, k, psd, dt):

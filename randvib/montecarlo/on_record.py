@@ -39,7 +39,7 @@ import numpy as np
 from randvib._validation import check_int, check_positive
 from randvib.models.excitation import Measured
 from randvib.models.harvester import Harvester
-from randvib.montecarlo import driven, integrators
+from randvib.montecarlo import driven
 from randvib.montecarlo.results import SimulationResult
 from randvib.montecarlo.simulation import execute
 from randvib.montecarlo.validation import validated
@@ -106,7 +106,7 @@ def monte_carlo_on_record(
     run = validated(
         harvester,
         record.spectrum,  # validated as a spectrum; the record replaces it below
-        integrators.scheme_argument(scheme, None),
+        scheme,
         t_end=source.n_steps * dt,
         dt=dt,
         burn_in=source.n_burn * substeps * dt,

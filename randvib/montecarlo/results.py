@@ -6,24 +6,38 @@ and computes every statistic from them with its interval
 (:mod:`randvib.statistics`); :class:`Histogram` holds the stationary
 histograms of z and v counted per group of paths, :class:`Histories` the
 recorded paths. Numbers are computed here; tables and reprs are drawn by
-:mod:`randvib._display`.
+:mod:`randvib._display`, with the units of :mod:`randvib.quantities` and the
+digits of :mod:`randvib.formatting`.
 """
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import special  # Student t quantile; lighter than scipy.stats
 
-from randvib import _display
+from randvib import _display, formatting
 from randvib._validation import check_choice
 from randvib.analytic import exact_solutions as exact
 from randvib.models.excitation import Excitation, as_excitation
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import kernel
+from randvib.quantities import unit
 from randvib.statistics import FirstPassage, Statistic, estimate
+
+#: The statistics of a :class:`SimulationResult` that are shown, in order (their
+#: units: :mod:`randvib.quantities`).
+STATISTICS = (
+    "power_electrical",
+    "power_load",
+    "velocity_variance",
+    "displacement_variance",
+    "mean_abs_velocity",
+    "friction_power",
+    "circuit_mean_square",
+    "stroke_exceedance",
+)
 
 
 @dataclass(frozen=True)
@@ -162,16 +176,6 @@ class SimulationResult:
     @property
     def n_paths(self) -> int:
         return self.per_path.shape[0]
-
-    @property
-    def method(self) -> str:
-        """Deprecated alias of :attr:`scheme` (the integrator's name)."""
-        warnings.warn(
-            "SimulationResult.method is deprecated; use SimulationResult.scheme",
-            DeprecationWarning,
-            stacklevel=2,
-        )
-        return self.scheme
 
     @property
     def averaging_time(self) -> float:
@@ -345,7 +349,7 @@ class SimulationResult:
             dt=self.dt,
             t_end=self.t_end,
             burn_in=self.burn_in,
-            method=self.scheme,  # the JSON key predates the name `scheme`
+            method=self.scheme,  # the JSON key is the CLI's: `--method`
             seed=self.seed,
             psd=self.psd,
             control_variates=self.control_variates,
@@ -362,19 +366,9 @@ class SimulationResult:
 
     def _statistics(self) -> list[tuple[str, Statistic, str]]:
         """(name, Statistic, unit) of every statistic this run has."""
-        circuit_unit = "V^2" if self.harvester.coupling_name == "piezo" else "A^2"
-        named = (
-            ("power_electrical", "W"),
-            ("power_load", "W"),
-            ("velocity_variance", "(m/s)^2"),
-            ("displacement_variance", "m^2"),
-            ("mean_abs_velocity", "m/s"),
-            ("friction_power", "W"),
-            ("circuit_mean_square", circuit_unit),
-            ("stroke_exceedance", "fraction of time"),
-        )
-        out = [(name, getattr(self, name), unit) for name, unit in named]
-        return [(name, stat, unit) for name, stat, unit in out if stat is not None]
+        out = [(name, getattr(self, name)) for name in STATISTICS]
+        electrical = self.harvester.electrical
+        return [(name, stat, unit(name, electrical)) for name, stat in out if stat is not None]
 
     def _settings_line(self) -> str:
         if self.is_white:
@@ -384,7 +378,7 @@ class SimulationResult:
             excitation = f"{self.excitation.name}{level}"
         cv = ", control variates" if self.control_variates else ""
         return (
-            f"{self.n_paths} paths x {_display.number(self.averaging_time, 4)} s averaged, "
+            f"{self.n_paths} paths x {formatting.compact(self.averaging_time, 4)} s averaged, "
             f"dt {self.dt:g} s, {self.scheme}, seed {self.seed}, {excitation}{cv}"
         )
 
@@ -401,20 +395,20 @@ class SimulationResult:
                 "ci95": stat.ci95,
                 "std_error": stat.std_error,
                 "n_paths": stat.n_paths,
-                "unit": unit,
+                "unit": units,
             }
-            for name, stat, unit in self._statistics()
+            for name, stat, units in self._statistics()
         }
         return pd.DataFrame.from_dict(rows, orient="index").rename_axis("statistic")
 
     def _rows(self):
-        return [(n, _display.estimate(s.mean, s.ci95), u) for n, s, u in self._statistics()]
+        return [(n, formatting.estimate(s.mean, s.ci95), u) for n, s, u in self._statistics()]
 
     def __repr__(self) -> str:
         power = self.power_electrical
         return (
             f"{type(self).__name__}({self._settings_line()}; power_electrical = "
-            f"{_display.estimate(power.mean, power.ci95)} W)"
+            f"{formatting.estimate(power.mean, power.ci95)} W)"
         )
 
     def __str__(self) -> str:

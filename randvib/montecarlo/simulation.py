@@ -1,4 +1,4 @@
-"""Monte Carlo simulation of the harvester under white or rational noise: ``simulate``.
+"""Monte Carlo simulation of the harvester under white or coloured base excitation: ``simulate``.
 
 The SDE (docs/conventions.md, paper Eq. 1 and 15-17) for the state (z, v = z') and,
 for LuGre friction, the bristle state theta:
@@ -54,7 +54,7 @@ from randvib._progress import progress_wanted
 from randvib._validation import check_int
 from randvib.models.excitation import Excitation
 from randvib.models.harvester import Harvester
-from randvib.montecarlo import driven, integrators
+from randvib.montecarlo import driven
 from randvib.montecarlo.batches import batch_bounds, run_batches
 from randvib.montecarlo.kernel_setup import KernelSetup
 from randvib.montecarlo.resources import announce_long_run, check_resources
@@ -71,7 +71,7 @@ def simulate(
     dt: float,
     n_paths: int,
     burn_in: float = 0.0,
-    scheme: str | None = None,
+    scheme: str = "heun",
     seed: int = 0,
     dW=None,
     initial="stationary",
@@ -86,7 +86,6 @@ def simulate(
     batch_paths: int | None = None,
     progress: bool | None = None,
     check_step: bool = True,
-    method: str | None = None,
 ) -> SimulationResult:
     """Simulate an ensemble of the harvester under white or coloured base excitation.
 
@@ -166,8 +165,6 @@ def simulate(
         off in CI and in logs).
     check_step : bool
         Refuse steps that are too large (default True).
-    method : str, optional
-        Deprecated alias of ``scheme``.
 
     Returns
     -------
@@ -190,7 +187,7 @@ def simulate(
     run = validated(
         harvester,
         psd,
-        integrators.scheme_argument(scheme, method),
+        scheme,
         t_end=t_end,
         dt=dt,
         burn_in=burn_in,

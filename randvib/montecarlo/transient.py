@@ -44,7 +44,7 @@ from randvib._resources import check_memory
 from randvib._validation import check_finite, check_int
 from randvib.models.event import Enveloped, EventStart
 from randvib.models.harvester import Harvester
-from randvib.montecarlo import driven, integrators, kernel
+from randvib.montecarlo import driven, kernel
 from randvib.montecarlo.batches import batch_bounds, raise_if_diverged
 from randvib.montecarlo.kernel_setup import KernelSetup
 from randvib.montecarlo.resources import check_resources
@@ -65,7 +65,7 @@ def simulate_transient(
     n_paths: int,
     times=None,
     start="rest",
-    scheme: str | None = None,
+    scheme: str = "heun",
     seed: int = 0,
     dW=None,
     first_path: int = 0,
@@ -143,7 +143,7 @@ def simulate_transient(
     run = validated(
         harvester,
         event.excitation,
-        integrators.scheme_argument(scheme, None),
+        scheme,
         t_end=t_end,
         dt=dt,
         burn_in=0.0,

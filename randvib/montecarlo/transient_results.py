@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from randvib import _display
+from randvib import _display, formatting
 from randvib.models.event import Enveloped, EventStart
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import kernel
@@ -242,14 +242,14 @@ class TransientResult:
         return (
             f"{self.n_paths} paths, dt {self.dt:g} s, {self.scheme}, seed {self.seed}, "
             f"{self.event.name}, start {self.start.describe()}; energy int_0^{self.t_end:g} "
-            f"P_e dt = {_display.estimate(energy.mean, energy.ci95)} J"
+            f"P_e dt = {formatting.estimate(energy.mean, energy.ci95)} J"
         )
 
     def _table(self):
         return _display.time_rows(
             self.times,
             self._series(),
-            lambda stat, i: _display.estimate(stat.mean[i], stat.ci95[i]),
+            lambda stat, i: formatting.estimate(stat.mean[i], stat.ci95[i]),
         )
 
     def __repr__(self) -> str:
@@ -257,7 +257,7 @@ class TransientResult:
         return (
             f"TransientResult({self.n_paths} paths, {self.times.size} times to {self.t_end:g} s, "
             f"{self.event.name}; energy_electrical = "
-            f"{_display.estimate(energy.mean, energy.ci95)} J)"
+            f"{formatting.estimate(energy.mean, energy.ci95)} J)"
         )
 
     def __str__(self) -> str:

@@ -52,7 +52,7 @@ class Run:
 def validated(
     harvester,
     psd,
-    scheme_argument,
+    scheme,
     *,
     t_end,
     dt,
@@ -67,8 +67,8 @@ def validated(
 ) -> Run:
     """:func:`randvib.simulate`'s arguments checked, in one place; messages name the argument.
 
-    ``scheme_argument`` is (scheme name, keyword it came by) and ``record``
-    (histogram_bins, histogram_range, record_paths, record_every).
+    ``scheme`` is the integrator's name and ``record`` (histogram_bins,
+    histogram_range, record_paths, record_every).
     """
     if not isinstance(harvester, Harvester):
         raise ValueError(f"`harvester` must be a randvib.Harvester, got {type(harvester).__name__}")
@@ -81,7 +81,7 @@ def validated(
             "`companion` needs a confining potential: the friction-free companion's exact "
             "E[z^2] (Gibbs) does not exist for the free mass (k = k3 = 0)"
         )
-    scheme = integrator(*scheme_argument)
+    scheme = integrator(scheme)
     excitation = _simulated_excitation(psd)
     grid = TimeGrid.from_times(t_end, dt, burn_in)
     n_paths = check_int("n_paths", n_paths, 1)

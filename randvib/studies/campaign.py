@@ -31,8 +31,8 @@ from randvib.identification.models import MODEL_PARAMETERS, device_from_paramete
 from randvib.identification.plots import figure_costs, figure_fit
 from randvib.identification.record_response import record_response
 from randvib.identification.result import IdentificationResult
+from randvib.models.coupling import Resistive
 from randvib.models.excitation import band_limited_excitation
-from randvib.models.harvester import ElectricalCoupling
 from randvib.models.presets import ALPHA, R_COIL
 from randvib.models.record import Record
 
@@ -43,9 +43,9 @@ PARAMETER_ORDER = ("c", "k", "k3", "fc", "beta", "sigma0", "sigma1", "fs", "vs")
 SIMULATED, MEASURED = "share |V| < 0.5 mV, simulated", "share |V| < 0.5 mV, measured"
 
 
-def paper_coil(r_load: float) -> ElectricalCoupling:
+def paper_coil(r_load: float) -> Resistive:
     """The paper's coil (alpha = 0.1992 Wb/m, R_C = 0.48 ohm, measured) with load ``r_load`` (ohm)."""
-    return ElectricalCoupling(ALPHA, r_load, R_COIL)
+    return Resistive(ALPHA, r_load, R_COIL)
 
 
 def synthetic_record(
@@ -62,7 +62,7 @@ def synthetic_record(
     displacement, with white sensor noise of RMS ``noise`` = (base (m),
     relative (m), voltage (V)) (the LVDT's 1 um, the laser's 2 um, 0.1 mV),
     or none with ``noise=None``. ``electrical`` (a
-    :class:`randvib.ElectricalCoupling`) adds its damping c_e to the truth's
+    :class:`randvib.Resistive`) adds its damping c_e to the truth's
     c and records the load voltage. ``rng`` draws the excitation, then the
     noise.
 
@@ -281,7 +281,7 @@ def voltage_figures(fits: dict, wired, electrical, out: Path, *, trained_on: str
     wired : sequence of (tag, label, rms, Record)
         Records with the load voltage: a file tag, words and the RMS base
         acceleration (m/s^2) for the title and the table.
-    electrical : ElectricalCoupling
+    electrical : Resistive
     out : Path
         Folder of the figures ``figure8_{tag}_{model}.png`` (time history and
         densities, :func:`randvib.identification.plots.figure_fit`).

@@ -45,11 +45,12 @@ from randvib.analytic.fokker_planck import fast_fpk_statistics, fpk_statistics
 from randvib.analytic.linearisation import equivalent_damping
 from randvib.analytic.prediction import expected_power, predict
 from randvib.analytic.statistical_linearisation import statistical_linearisation
+from randvib.formatting import plus_minus
 from randvib.models.presets import preset
 from randvib.montecarlo.ensembles import Case
 from randvib.montecarlo.step_check import step_bias
 from randvib.montecarlo.sweep import linearisation_verdicts, point_device
-from randvib.studies.report import markdown_table, plus_minus
+from randvib.studies.report import markdown_table
 
 #: Analytic methods: column suffix -> (method name in randvib.METHODS, label).
 ANALYTIC = {

@@ -17,18 +17,16 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
 
 from randvib._io import dumps, prepare_output_dir, write_tracked
+from randvib.formatting import formatted, significant, unsigned_zeros
+from randvib.quantities import report_header
 
 __all__ = [
     "ensembles_text",
     "fc_levels",
-    "format_number",
-    "format_percent",
     "markdown_table",
-    "plus_minus",
     "print_verdicts",
     "readable_table",
     "prepare_output_dir",
@@ -38,14 +36,6 @@ __all__ = [
     "write_table",
     "write_verdicts",
 ]
-
-
-def plus_minus(value, ci, scale: float = 100.0, fmt: str = "+.2f") -> list[str]:
-    """'value ± ci' strings (default: fractions as percent) for report tables."""
-    return [
-        f"{scale * v:{fmt}} ± {scale * c:{fmt.lstrip('+')}}"
-        for v, c in zip(np.atleast_1d(value), np.atleast_1d(ci), strict=True)
-    ]
 
 
 def markdown_table(df: pd.DataFrame, floatfmt: str = ".4g", numparse: bool = True) -> str:
@@ -64,10 +54,10 @@ def markdown_table(df: pd.DataFrame, floatfmt: str = ".4g", numparse: bool = Tru
         if pd.api.types.is_bool_dtype(df[column]):
             df[column] = df[column].map(lambda v: "yes" if v else "no")
         if pd.api.types.is_float_dtype(df[column]):
-            df[column] = [_float_cell(v, floatfmt) for v in df[column]]
+            df[column] = [formatted(v, floatfmt) for v in df[column]]
         elif pd.api.types.is_object_dtype(df[column]) or pd.api.types.is_string_dtype(df[column]):
-            df[column] = [_float_cell(v, floatfmt) if isinstance(v, float)
-                          else _unsigned_zeros(v) if isinstance(v, str) else v
+            df[column] = [formatted(v, floatfmt) if isinstance(v, float)
+                          else unsigned_zeros(v) if isinstance(v, str) else v
                           for v in df[column]]  # fmt: skip
     return tabulate(
         df,
@@ -82,43 +72,21 @@ def markdown_table(df: pd.DataFrame, floatfmt: str = ".4g", numparse: bool = Tru
 #: Bare column names a report table may still carry, and their headers with units (the
 #: quantities are stored in these units; Fc is not here: stored in N, shown in mN).
 _BARE_HEADERS = {
-    "psd": "S ((m/s²)²/Hz)",
-    "k3": "k3 (N/m³)",
+    **{name: report_header(name) for name in ("psd", "k3", "zeta", "f0")},
     "phi": "φ",
     "kappa": "κ",
-    "zeta": "ζ",
-    "f0": "f0 (Hz)",
     "n_paths": "paths",
     "p": "p-value",
 }
 
 
-def _unsigned_zeros(text: str) -> str:
-    """``text`` with every signed zero ('-0', '+0.000') written unsigned ('0', '0.000')."""
-    import re
-
-    return re.sub(r"(?<![\w.])[-+](0(?:\.0+)?)(?![\d.])", r"\1", text)
-
-
-def _float_cell(value: float, floatfmt: str) -> str:
-    """One number of a report table: 'n/a' for NaN, no '-0'."""
-    if value != value:
-        return "n/a"
-    text = format(value, floatfmt)
-    try:
-        zero = float(text) == 0
-    except ValueError:
-        return text
-    return text.lstrip("-") if zero else text
-
-
 #: Raw result columns and how a report shows them: (header with its unit, scale factor).
 READABLE_COLUMNS = {
-    "psd": ("S ((m/s²)²/Hz)", 1.0),
-    "k3": ("k3 (N/m³)", 1.0),
+    "psd": (report_header("psd"), 1.0),
+    "k3": (report_header("k3"), 1.0),
     "fc": ("Fc (mN)", 1e3),
     "phi": ("φ", 1.0),
-    "zeta": ("ζ", 1.0),
+    "zeta": (report_header("zeta"), 1.0),
     "linearisation_power": ("P Eq. 32 (mW)", 1e3),
     "power_electrical": ("P Monte Carlo (mW)", 1e3),
     "power_electrical_ci95": ("95 % half-width (mW)", 1e3),
@@ -199,7 +167,7 @@ def verdict_lines(out_dir: Path, max_items: int = 40) -> list[str]:
             # a verdict sentence stored beside its numbers: shown with the sentences
             lines.append(f"- {prefix}: {value.strip().lstrip(';').strip()}")
         elif isinstance(value, float):
-            flat.append(f"{prefix}: {format_number(value)}")
+            flat.append(f"{prefix}: {significant(value, 4)}")
         else:
             flat.append(f"{prefix}: {value}")
 
@@ -217,32 +185,6 @@ def print_verdicts(report: Path) -> None:
     if lines:
         print(f"verdicts ({report.parent / 'verdicts.json'}):")
         print("\n".join(lines))
-
-
-def format_number(value, digits: int = 4) -> str:
-    """``value`` for a report: ``digits`` significant figures, 'n/a' for NaN or None, no '-0'."""
-    if value is None:
-        return "n/a"
-    value = float(value)
-    if value != value:
-        return "n/a"
-    if value == float("inf"):
-        return "∞"
-    if value == float("-inf"):
-        return "-∞"
-    text = f"{value:.{digits}g}"
-    # a negative value that rounds to zero is written as 0
-    return text[1:] if text.startswith("-") and float(text) == 0 else text
-
-
-def format_percent(fraction, digits: int = 2, sign: bool = False) -> str:
-    """A fraction written as a percentage ('1.23 %'), 'n/a' for NaN, no '-0.00 %'."""
-    if fraction is None or float(fraction) != float(fraction):
-        return "n/a"
-    text = f"{100 * float(fraction):{'+' if sign else ''}.{digits}f}"
-    if float(text) == 0:
-        text = f"{0:.{digits}f}"
-    return f"{text} %"
 
 
 def write_report(

@@ -11,8 +11,9 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from randvib.formatting import plus_minus
 from randvib.studies.evidence import rescaling_groups
-from randvib.studies.report import fc_levels, plus_minus, sign_word
+from randvib.studies.report import fc_levels, sign_word
 
 
 def linearisation_verdict(table: pd.DataFrame) -> tuple[dict, str]:

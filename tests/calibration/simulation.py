@@ -1,4 +1,4 @@
-"""Seed calibration of the Monte Carlo assertions in tests/test_simulation.py.
+"""Seed calibration of the Monte Carlo assertions in tests/test_simulation.py and test_statistics.py.
 
 Run by hand (not collected by pytest), from the repository root:
 
@@ -70,13 +70,15 @@ def main():
             f"gain         seeds {len(gains)}  smallest ratio {min(gains):.2f}  median {np.median(gains):.2f}"
         )
     if not only or "coverage" in only:
+        import test_statistics as ts
+
         k = max(20, n // 5)
         for label, reps, fn in (
-            ("synthetic n=100 p=4", 3000, lambda s: t.synthetic_coverage(s, 3000, 100, 4)),
-            ("simulation groups", 600, lambda s: t.simulation_coverage(s, 600)),
-            ("in-sample n=24 p=6", 2000, lambda s: t.synthetic_coverage(s, 2000, 24, 6, True)),
+            ("synthetic n=100 p=4", 3000, lambda s: ts.synthetic_coverage(s, 3000, 100, 4)),
+            ("simulation groups", 600, lambda s: ts.simulation_coverage(s, 600)),
+            ("in-sample n=24 p=6", 2000, lambda s: ts.synthetic_coverage(s, 2000, 24, 6, True)),
         ):
-            lo, hi = t.binomial_acceptance(reps)
+            lo, hi = ts.binomial_acceptance(reps)
             hits = np.array([fn(s) for s in range(1000, 1000 + k)])
             inside = np.sum((hits >= lo) & (hits <= hi))
             print(

@@ -1,0 +1,298 @@
+"""Interrupts that interrupt: Ctrl-C and SIGTERM stop a run, keep what finished, end its workers.
+
+Covers :mod:`randvib._interrupts` as the package uses it: the compiled Monte
+Carlo loop (:func:`randvib.simulate`), the command line's exit statuses
+(:mod:`randvib.cli`: 130 for Ctrl-C, 143 for SIGTERM, one line), a sweep's
+worker processes (:func:`randvib.montecarlo.sweep.make_executor`: they ignore
+Ctrl-C while starting and end with a killed parent), a study's folder lock
+released, and the study scripts' entry point
+(:func:`randvib.studies.script_main`).
+"""
+
+import _thread
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import threading
+import time
+from pathlib import Path
+
+import pytest
+from _cli import run
+
+import randvib as rv
+from randvib import _io
+from randvib.montecarlo.simulation import simulate
+
+ROOT = Path(__file__).resolve().parents[1]
+BASE = rv.preset("figure9")
+
+
+def _interrupt_after(seconds):
+    timer = threading.Timer(seconds, _thread.interrupt_main)
+    timer.start()
+    return timer
+
+
+def test_ctrl_c_stops_a_running_simulation():
+    # compiled first, so that the interrupt lands inside the compiled loop
+    simulate(BASE, 1.0, t_end=0.01, dt=1e-4, n_paths=2, progress=False)
+    # 4e9 path-steps: minutes at the least on any machine; Ctrl-C after 1 s
+    kwargs = dict(t_end=2000.0, dt=1e-4, n_paths=200, progress=False)
+    timer = _interrupt_after(1.0)
+    started = time.perf_counter()
+    with pytest.raises(KeyboardInterrupt):
+        simulate(BASE, 1.0, **kwargs)
+    timer.cancel()
+    assert time.perf_counter() - started < 60  # stopped, not run to the end
+
+
+def test_ctrl_c_in_the_cli_exits_130(capsys):
+    simulate(BASE, 1.0, t_end=0.01, dt=1e-4, n_paths=2, progress=False)
+    timer = _interrupt_after(1.0)
+    code, out, err = run(capsys, "simulate", "--preset", "figure9", "--psd", "1",
+                         "--paths", "200", "--t-end", "2000", "--dt", "1e-4")  # fmt: skip
+    timer.cancel()
+    assert code == 130 and "interrupted" in err and "Traceback" not in err
+
+
+def test_ctrl_c_in_a_study_exits_130_and_releases_its_folder(capsys, tmp_path, monkeypatch):
+    simulate(BASE, 1.0, t_end=0.01, dt=1e-4, n_paths=2, progress=False)
+
+    def long_study(out_dir, *, quick, seed, workers, scheduler, progress):
+        out = _io.prepare_output_dir(out_dir, {"study": "long"})
+        _io.write_tracked(out / "first.csv", "finished part\n")
+        simulate(BASE, 1.0, t_end=2000.0, dt=1e-4, n_paths=200, progress=False)
+
+    monkeypatch.setattr("randvib.cli.study.load_study", lambda name: long_study)
+    timer = _interrupt_after(1.0)
+    code, out, err = run(capsys, "study", "interaction", "--out", tmp_path / "s")
+    timer.cancel()
+    assert code == 130 and "Traceback" not in err
+    assert (tmp_path / "s" / "first.csv").read_text() == "finished part\n"  # kept
+    assert not (tmp_path / "s" / _io.LOCK_FILE).exists()
+
+
+def _subprocess_env():
+    return {
+        **os.environ,
+        "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]),
+        "NUMBA_NUM_THREADS": "1",
+    }
+
+
+def test_sigterm_stops_simulate_and_exits_143():
+    simulate(BASE, 1.0, t_end=0.01, dt=1e-4, n_paths=2, progress=False)  # numba cache warm
+    # 4e10 path-steps: its LongRunWarning is printed once the run starts
+    argv = ["simulate", "--preset", "figure9", "--psd", "1", "--paths", "200",
+            "--t-end", "20000", "--dt", "1e-4"]  # fmt: skip
+    child = subprocess.Popen(
+        [sys.executable, "-m", "randvib", *argv],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=_subprocess_env(),
+    )
+    assert "will take about" in child.stderr.readline()
+    time.sleep(0.5)
+    child.send_signal(signal.SIGTERM)
+    out, err = child.communicate(timeout=60)
+    assert child.returncode == 143, err
+    assert "terminated" in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize(
+    "stop, code",
+    [(KeyboardInterrupt, 130), ("sigterm", 143)],
+)
+def test_study_script_main_stops_with_one_line(capsys, tmp_path, stop, code):
+    """``python studies/NAME.py OUT``: Ctrl-C and SIGTERM end with 130 / 143 and
+    one line (they printed a KeyboardInterrupt traceback)."""
+    from randvib.studies import script_main
+
+    def run_study(out_dir, *, quick, seed, workers, scheduler, progress):
+        """A study stopped while it runs."""
+        if stop == "sigterm":
+            os.kill(os.getpid(), signal.SIGTERM)  # handled: raises Terminated here
+            time.sleep(5)
+        raise stop()
+
+    run_study.__module__ = __name__
+    assert script_main(run_study, [str(tmp_path / "o")]) == code
+    err = capsys.readouterr().err
+    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+
+
+def test_sweep_workers_end_when_the_sweep_is_killed(tmp_path):
+    script = textwrap.dedent(
+        """
+        import os, sys, time
+        sys.path.insert(0, sys.argv[1])
+        from trust_worker import pid
+        from randvib.montecarlo.sweep import make_executor
+        if __name__ == "__main__":
+            pool, close = make_executor(workers=2)
+            print(" ".join(map(str, set(pool.map(pid, range(16))))), flush=True)
+            time.sleep(120)
+        """
+    )
+    (tmp_path / "trust_worker.py").write_text(
+        "import os, time\ndef pid(_):\n    time.sleep(0.2)\n    return os.getpid()\n"
+    )
+    (tmp_path / "main.py").write_text(script)
+    parent = subprocess.Popen(
+        [sys.executable, str(tmp_path / "main.py"), str(tmp_path)],
+        stdout=subprocess.PIPE,
+        text=True,
+        env={
+            **os.environ,
+            "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")]),
+        },
+    )
+    workers = [int(p) for p in parent.stdout.readline().split()]
+    assert workers
+    parent.send_signal(signal.SIGKILL)
+    parent.wait()
+    deadline = time.monotonic() + 30
+    alive = workers
+    while alive and time.monotonic() < deadline:
+        time.sleep(0.2)
+        alive = [p for p in workers if _alive(p)]
+    assert alive == []
+
+
+def test_sweep_workers_ignore_ctrl_c_while_they_are_still_starting(tmp_path):
+    """Found by CI: a Ctrl-C that reached a worker while it was still importing
+    (before its initializer could ignore SIGINT) printed a KeyboardInterrupt
+    traceback from multiprocessing's spawn_main. SIGINT sent to every worker
+    the moment they are spawned, long before any has imported randvib: the pool
+    still works and nothing is written to stderr."""
+    script = textwrap.dedent(
+        """
+        import os, signal
+        from randvib.montecarlo.sweep import make_executor
+        if __name__ == "__main__":
+            pool, close = make_executor(workers=2)
+            futures = [pool.submit(abs, i) for i in range(-8, 0)]  # spawns both workers
+            pids = [p.pid for p in pool._processes.values()]
+            for pid in pids:
+                os.kill(pid, signal.SIGINT)
+            print(len(pids), sum(f.result() for f in futures), flush=True)
+            close()
+        """
+    )
+    (tmp_path / "main.py").write_text(script)
+    done = subprocess.run(
+        [sys.executable, str(tmp_path / "main.py")],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env=_subprocess_env(),
+    )
+    assert (done.returncode, done.stdout.split(), done.stderr) == (0, ["2", "36"], "")
+
+
+def _alive(pid):
+    try:
+        os.waitpid(pid, os.WNOHANG)  # reap if it happens to be our child
+    except ChildProcessError:
+        pass
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    status = Path(f"/proc/{pid}/status")
+    return not (status.exists() and "zombie" in status.read_text())
+
+
+def test_readme_sweep_example_has_the_main_guard():
+    readme = (ROOT / "README.md").read_text()
+    block = readme[readme.index("from randvib.montecarlo.sweep import SweepSettings") :]
+    block = block[: block.index("```")]
+    assert 'if __name__ == "__main__":' in block
+    assert block.index("__main__") < block.index("run_sweep(")
+    assert "trust" in readme[readme.index("scheduler=` (and `--scheduler`)") :][:300]
+
+
+SWEEP_STUDY = """
+import sys
+import randvib as rv
+import randvib.cli.study
+from randvib.cli import main
+from randvib.montecarlo.sweep import SweepSettings, cartesian, run_sweep
+
+
+def sweep_study(out_dir, *, quick, seed, workers, scheduler, progress):
+    # 2000 small points on 2 worker processes: minutes, far longer than the test waits
+    settings = SweepSettings(dt=2e-4, window=1.0, burn_in=0.05, target_rel_ci=0.5,
+                             min_paths=8, batch_paths=8, max_paths=8)
+    points = cartesian(psd=[1.0 + i / 1000 for i in range(2000)])
+    run_sweep(rv.preset("figure9"), points, settings, out_dir=out_dir, workers=workers,
+              progress=False)
+
+
+if __name__ == "__main__":
+    randvib.cli.study.load_study = lambda name: sweep_study
+    sys.exit(main(["study", "interaction", "--out", sys.argv[1], "--workers", "2"]))
+"""
+
+
+def _children(pid):
+    """Process ids whose parent is ``pid`` (Linux /proc)."""
+    found = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid:
+            found.append(int(stat.parent.name))
+    return found
+
+
+@pytest.mark.parametrize(
+    "how, code",
+    [("ctrl-c", 130), ("sigterm", 143)],
+)
+def test_interrupted_process_pool_sweep_keeps_points_and_ends_workers(tmp_path, how, code):
+    """Ctrl-C (SIGINT to the whole process group, as a terminal sends it) or
+    SIGTERM (to the parent only) on a sweep over 2 worker processes: exit
+    130 / 143, no worker left, the finished points kept and valid, the lock gone."""
+    simulate(BASE, 1.0, t_end=0.01, dt=2e-4, n_paths=2, progress=False)  # numba cache warm
+    script, out = tmp_path / "sweep_study.py", tmp_path / "out"
+    script.write_text(SWEEP_STUDY)
+    child = subprocess.Popen(
+        [sys.executable, str(script), str(out)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=_subprocess_env(),
+        start_new_session=True,  # its own process group, as a shell job
+    )
+    deadline = time.monotonic() + 120
+    while not list(out.glob("points/*.json")) and time.monotonic() < deadline:
+        assert child.poll() is None, child.communicate()
+        time.sleep(0.1)
+    workers = _children(child.pid)
+    assert len(workers) >= 2  # the two workers (and spawn's resource tracker)
+    if how == "ctrl-c":
+        os.killpg(child.pid, signal.SIGINT)
+    else:
+        child.send_signal(signal.SIGTERM)
+    _, err = child.communicate(timeout=60)
+    assert child.returncode == code, err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+    deadline = time.monotonic() + 30
+    while any(_alive(p) for p in workers) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not [p for p in workers if _alive(p)]
+    assert not (out / _io.LOCK_FILE).exists()
+    points = sorted(out.glob("points/*.json"))
+    assert 1 <= len(points) < 2000
+    for p in points:
+        stored = json.loads(p.read_text())
+        assert math.isfinite(stored["row"]["power_electrical"])

@@ -1,0 +1,157 @@
+"""Output files and folders: nothing a user saved is lost or overwritten silently.
+
+Covers :mod:`randvib._io` (output paths checked before computing, a result
+that cannot be written kept beside, atomic writes, ``metadata.json``, files
+edited since randvib wrote them) as the commands use it
+(:mod:`randvib.cli.identify`, :mod:`randvib.cli.validate`, :mod:`randvib.cli.record`,
+:mod:`randvib.cli.study`) and the studies' report writer
+(:mod:`randvib.studies.report`). Folder locks: tests/test_locks.py.
+"""
+
+import json
+import threading
+from pathlib import Path
+
+import pytest
+from _cli import fit_args, one_line_error, run
+
+import randvib as rv
+from randvib import _io
+
+
+@pytest.mark.parametrize(
+    "option, target, fragment",
+    [
+        ("--save", "missing/x.json", "does not exist"),
+        ("--plot", "missing/x.png", "does not exist"),
+        ("--save", "a_file/x.json", "is not a folder"),
+        ("--plot", "a_file/x.png", "is not a folder"),
+        ("--save", "a_folder", "is a folder"),
+    ],
+)
+def test_identify_output_paths_checked_before_fitting(
+    capsys, tmp_path, monkeypatch, record_csv, option, target, fragment
+):
+    (tmp_path / "a_file").write_text("x")
+    (tmp_path / "a_folder").mkdir()
+    monkeypatch.chdir(tmp_path)
+    fitted = []
+    monkeypatch.setattr("randvib.cli.identify.identify", lambda *a, **k: fitted.append(1))
+    one_line_error(capsys, fit_args(record_csv[0], option, target), fragment)
+    assert fitted == []  # refused before the fit
+
+
+@pytest.mark.parametrize(
+    "argv, fragment",
+    [
+        (["validate", "{params}", "{rec}", "--plot", "a_file/sub"], "is a file"),
+        (["record", "--preset", "figure9", "--rms", "2", "--out", "a_file/x.csv"], "not a folder"),
+        (["record", "--preset", "figure9", "--rms", "2", "--out", "a_folder"], "is a folder"),
+        (["study", "interaction", "--quick", "--out", "a_file/x"], "is a file"),
+    ],
+)
+def test_other_output_paths_under_a_file_or_a_folder(
+    capsys, tmp_path, monkeypatch, record_csv, argv, fragment
+):
+    (tmp_path / "a_file").write_text("x")
+    (tmp_path / "a_folder").mkdir()
+    monkeypatch.chdir(tmp_path)
+    argv = [a.format(params=record_csv[1], rec=record_csv[0]) for a in argv]
+    one_line_error(capsys, argv, fragment)
+
+
+def test_result_that_cannot_be_written_is_kept_beside(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    where = _io.write_or_keep(tmp_path / "gone" / "fit.json", '{"J": 1}', "--save")
+    assert where is not None and where.read_text() == '{"J": 1}'
+    assert where.parent == Path(".") or where.parent.resolve() == tmp_path
+    assert "could not write `--save`" in capsys.readouterr().err
+
+
+def test_identify_save_failing_after_the_fit_keeps_the_result(
+    capsys, tmp_path, monkeypatch, record_csv
+):
+    # The folder disappears during the fit: the result must still exist somewhere.
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "out").mkdir()
+    real = rv.identify
+
+    def fit_then_remove_folder(*args, **kwargs):
+        result = real(*args, **kwargs)
+        (tmp_path / "out").rmdir()
+        return result
+
+    monkeypatch.setattr("randvib.cli.identify.identify", fit_then_remove_folder)
+    code, out, err = run(capsys, *fit_args(record_csv[0], "--save", "out/fit.json", "--json"))
+    assert code == 0
+    kept = list(tmp_path.glob("randvib-unsaved-*.json"))
+    assert len(kept) == 1 and json.loads(kept[0].read_text())["model"] == "coulomb"
+    assert str(kept[0].name) in err
+
+
+def test_atomic_writes_from_many_writers_share_no_temporary_file(tmp_path):
+    target = tmp_path / "results.csv"
+    errors = []
+
+    def writer(i):
+        try:
+            for _ in range(50):
+                _io.atomic_write_text(target, f"writer {i}\n" * 100)
+        except Exception as exc:  # a shared temporary name crashes here
+            errors.append(exc)
+
+    threads = [threading.Thread(target=writer, args=(i,)) for i in range(8)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert errors == []
+    lines = set(target.read_text().splitlines())
+    assert len(lines) == 1  # one writer's whole file, never a mixture
+    assert list(tmp_path.iterdir()) == [target]  # no temporary left behind
+
+
+def test_edited_report_is_not_overwritten_without_force(tmp_path):
+    from randvib.studies.report import write_report
+
+    report = write_report(tmp_path, "T", [("A", "body")])
+    write_report(tmp_path, "T", [("A", "body")])  # a rerun may rewrite its own file
+    report.write_text(report.read_text() + "\nmy notes\n")
+    with pytest.raises(FileExistsError, match="changed since randvib wrote it"):
+        write_report(tmp_path, "T", [("A", "new body")])
+    assert "my notes" in report.read_text()
+    with _io.overwrite_edited():
+        write_report(tmp_path, "T", [("A", "new body")])
+    assert "new body" in report.read_text() and "my notes" not in report.read_text()
+
+
+def test_study_rerun_refuses_edited_figure_and_force_allows(capsys, tmp_path, monkeypatch):
+    from randvib.studies import report
+
+    def fake_study(out_dir, *, quick, seed, workers, scheduler, progress):
+        out = _io.prepare_output_dir(out_dir, {"study": "fake"})
+        from randvib.figure_style import new_figure, save_figure
+
+        save_figure(new_figure()[0], out / "figure.png")  # a study's figure style
+        return report.write_report(out, "fake", [])
+
+    monkeypatch.setattr("randvib.cli.study.load_study", lambda name: fake_study)
+    out = tmp_path / "study"
+    assert run(capsys, "study", "interaction", "--out", out)[0] == 0
+    (out / "figure.png").write_bytes(b"edited by hand")
+    one_line_error(capsys, ["study", "interaction", "--out", out], "--force")
+    assert (out / "figure.png").read_bytes() == b"edited by hand"
+    assert run(capsys, "study", "interaction", "--out", out, "--force")[0] == 0
+    assert (out / "figure.png").read_bytes().startswith(b"\x89PNG")
+    assert not (out / _io.LOCK_FILE).exists()  # released when the study ends
+
+
+@pytest.mark.parametrize("bad", ["list", "folder"])
+def test_metadata_that_is_a_list_or_a_folder_is_named(capsys, tmp_path, bad):
+    meta = tmp_path / _io.METADATA_FILE
+    if bad == "list":
+        meta.write_text("[1, 2]")
+    else:
+        meta.mkdir()
+    with pytest.raises(FileExistsError, match="not a randvib metadata file"):
+        _io.prepare_output_dir(tmp_path, {"grid": 1})
