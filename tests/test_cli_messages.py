@@ -14,7 +14,7 @@ import json
 import math
 
 import pytest
-from _cli import fit_args, one_line_error, run
+from _cli import error_lines, fit_args, one_line_error, run
 
 import randvib.montecarlo.sweep as sweep_module
 
@@ -143,7 +143,7 @@ def test_unexpected_exception_is_one_line_exit_1(capsys, monkeypatch):
     monkeypatch.delenv("RANDVIB_TRACEBACK", raising=False)
     code, out, err = run(capsys, "power", "--preset", "figure9", "--psd", "1")
     assert code == 1 and "internal error: ZeroDivisionError" in err
-    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert len(error_lines(err)) == 1 and "Traceback" not in err
 
 
 def test_unreachable_scheduler_fails_fast_with_a_message(monkeypatch):

@@ -10,7 +10,7 @@ import subprocess
 import sys
 
 import pytest
-from _cli import run
+from _cli import error_lines, run
 
 import randvib as rv
 
@@ -104,7 +104,7 @@ def test_bad_input_one_line_exit_2(capsys, argv, fragment):
     code, out, err = run(capsys, "power", *argv)
     assert code == 2
     assert fragment in err
-    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert len(error_lines(err)) == 1 and "Traceback" not in err
 
 
 def test_console_script_exit_code():

@@ -16,6 +16,7 @@ import math
 
 import numpy as np
 import pytest
+from _cli import error_lines
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -62,7 +63,7 @@ def _check_contract(code, out, err, json_out: bool):
     assert code in (0, 2), (code, err)
     assert "Traceback" not in err
     if code == 2:
-        assert len(err.strip().splitlines()) == 1, err
+        assert len(error_lines(err)) == 1, err
         return
     if json_out:
         data = json.loads(out, parse_constant=lambda c: pytest.fail(f"{c} in JSON output"))

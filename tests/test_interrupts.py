@@ -22,7 +22,7 @@ import time
 from pathlib import Path
 
 import pytest
-from _cli import run
+from _cli import error_lines, run
 
 import randvib as rv
 from randvib import _io
@@ -102,7 +102,7 @@ def test_sigterm_stops_simulate_and_exits_143():
     child.send_signal(signal.SIGTERM)
     out, err = child.communicate(timeout=60)
     assert child.returncode == 143, err
-    assert "terminated" in err and "Traceback" not in err and len(err.strip().splitlines()) == 1
+    assert "terminated" in err and "Traceback" not in err and len(error_lines(err)) == 1
 
 
 @pytest.mark.parametrize(
@@ -124,7 +124,7 @@ def test_study_script_main_stops_with_one_line(capsys, tmp_path, stop, code):
     run_study.__module__ = __name__
     assert script_main(run_study, [str(tmp_path / "o")]) == code
     err = capsys.readouterr().err
-    assert len(err.strip().splitlines()) == 1 and "Traceback" not in err
+    assert len(error_lines(err)) == 1 and "Traceback" not in err
 
 
 def test_sweep_workers_end_when_the_sweep_is_killed(tmp_path):
@@ -285,7 +285,7 @@ def test_interrupted_process_pool_sweep_keeps_points_and_ends_workers(tmp_path, 
         child.send_signal(signal.SIGTERM)
     _, err = child.communicate(timeout=60)
     assert child.returncode == code, err
-    assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+    assert "Traceback" not in err and len(error_lines(err)) == 1, err
     deadline = time.monotonic() + 30
     while any(_alive(p) for p in workers) and time.monotonic() < deadline:
         time.sleep(0.1)

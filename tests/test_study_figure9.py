@@ -16,6 +16,7 @@ import json
 import numpy as np
 import pandas as pd
 import pytest
+from _cli import error_lines
 from _stats import assert_matches
 from study_checks import contrast_zscores, power_zscores, step_zscores, unclean_tokens
 
@@ -135,7 +136,7 @@ def test_figure9_resumes_and_refuses_another_run(figure9_quick, capsys):
     capsys.readouterr()
     assert main(["study", "figure9", "--out", str(out), "--workers", "1", "--no-progress"]) == 2
     err = capsys.readouterr().err
-    assert "different run" in err and len(err.strip().splitlines()) == 1
+    assert "different run" in err and len(error_lines(err)) == 1
 
 
 def _table(errors, consistent, fcs=(0.01, 0.02, 0.03, 0.04)):
