@@ -78,6 +78,7 @@ _EXPORTS = {
     "randvib.montecarlo.spectra": ("SampledSpectra",),
     "randvib.montecarlo.sweep": ("linearisation_verdicts", "run_sweep", "SweepSettings"),
     "randvib.montecarlo.ensembles": ("Case", "EnsembleResult", "run_ensembles"),
+    "randvib.montecarlo.event_cases": ("EventSettings",),
     "randvib.studies.spectra_figure": ("plot_response_spectra",),
     "randvib.studies.transient_figure": ("plot_transient",),
     "randvib.identification.sade": ("sade", "SADEResult"),

@@ -7,7 +7,13 @@ stationary-times-duration estimate is the stationary power at the peak times
 int e^2 dt, the paired ratio of the paper's device to itself is 1, the
 verdicts are recomputed from the CSV, and the report and figures exist.
 
-Covers the study script with its figures (:mod:`randvib.studies.transient_figure`).
+A rerun into the same folder resumes every case from its checksummed store
+(the same tables, bit for bit), and an event run of the paired-ensemble
+runner is :func:`randvib.simulate_transient` on the group's seed.
+
+Covers the study script with its figures (:mod:`randvib.studies.transient_figure`),
+its building block :mod:`randvib.studies.events` and the runner's event cases
+(:mod:`randvib.montecarlo.event_cases`).
 """
 
 import json
@@ -21,6 +27,7 @@ from study_checks import check_study_run, statistic
 import randvib as rv
 from randvib.cli import main
 from randvib.studies import load
+from randvib.studies.events import event_cases, half_level
 
 events = load("events")
 TINY = {"levels": (0.2, 1.0), "n_paths": 160, "dt": 2.5e-4}
@@ -29,7 +36,7 @@ TINY = {"levels": (0.2, 1.0), "n_paths": 160, "dt": 2.5e-4}
 def test_events_study_end_to_end(tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(events, "grid", lambda quick: dict(TINY))
     out = tmp_path / "events"
-    argv = ["study", "events", "--quick", "--out", str(out), "--no-progress", "--threads", "1"]
+    argv = ["study", "events", "--quick", "--out", str(out), "--no-progress", "--workers", "1"]
     assert main(argv) == 0
     text = check_study_run(capsys.readouterr().out, out)
     results = pd.read_csv(out / "results.csv")
@@ -58,9 +65,44 @@ def test_events_study_end_to_end(tmp_path, monkeypatch, capsys):
     assert sentences[0] in text and "Poisson" in text and "| bistable |" in text
     for figure in ("energy_and_stroke.png", "transient.png"):
         assert (out / figure).stat().st_size > 10_000
+    # a rerun loads every case from the store: the same tables, bit for bit
+    stored = sorted((out / "ensembles" / "points").glob("*.npy"))
+    assert len(stored) == len(results)
+    stamps = [p.stat().st_mtime_ns for p in stored]
+    assert main(argv) == 0
+    capsys.readouterr()
+    assert [p.stat().st_mtime_ns for p in stored] == stamps
+    pd.testing.assert_frame_equal(pd.read_csv(out / "results.csv"), results)
+    pd.testing.assert_frame_equal(pd.read_csv(out / "transient.csv"), series)
+
+
+def test_an_event_run_is_simulate_transient_on_the_group_seed():
+    """Group j of a run with seed s is simulate_transient at seed 1000 s + j, path by path."""
+    settings = rv.EventSettings(1.0, 5e-4, 8, times=(0.0, 0.5, 1.0), seed=3)
+    devices = {name: events.devices()[name] for name in ("linear", "paper")}
+    cases = event_cases(devices, events.event, (0.5, 2.0))
+    run = rv.run_ensembles(cases, settings, workers=1, progress=False)
+    assert run.groups == [0, 0, 1, 1]
+    i = run.find(1, device="paper")
+    direct = rv.simulate_transient(
+        devices["paper"][0], events.event(2.0), t_end=1.0, dt=5e-4, n_paths=8,
+        times=(0.0, 0.5, 1.0), seed=3001, progress=False,
+    )  # fmt: skip
+    got = run.transient(i)
+    np.testing.assert_array_equal(got.snapshots, direct.snapshots)
+    np.testing.assert_array_equal(got.path_energies, direct.path_energies)
+    np.testing.assert_array_equal(got.first_hit, direct.first_hit)
+    np.testing.assert_array_equal(got.times, direct.times)
+    assert run.table.energy_electrical[i] == direct.energy_electrical.mean
+    with pytest.raises(ValueError, match="events run with randvib.EventSettings"):
+        rv.run_ensembles([rv.Case({"x": 1}, devices["paper"][0], 1.0)], settings, progress=False)
+    with pytest.raises(ValueError, match="events run with randvib.EventSettings"):
+        rv.run_ensembles(cases, rv.SweepSettings(), progress=False)
+    with pytest.raises(ValueError, match="times"):
+        rv.EventSettings(1.0, 5e-4, 8, times=(0.0, 2.0))
 
 
 def test_half_level_interpolates_in_log_intensity():
     sub = pd.DataFrame({"level": [0.1, 1.0, 10.0], "stroke_reached_mc": [0.0, 0.25, 0.75]})
-    assert events._half_level(sub) == pytest.approx(np.sqrt(10.0))
-    assert events._half_level(sub.assign(stroke_reached_mc=[0.0, 0.1, 0.2])) is None
+    assert half_level(sub) == pytest.approx(np.sqrt(10.0))
+    assert half_level(sub.assign(stroke_reached_mc=[0.0, 0.1, 0.2])) is None

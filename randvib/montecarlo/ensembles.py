@@ -19,6 +19,13 @@ resumes where it stopped and a corrupted case is named and recomputed
 (:func:`~randvib.montecarlo.sweep.run_sweep`) is the special case of one
 device's parameter points, all on one seed.
 
+An *event run* (settings :class:`~randvib.montecarlo.event_cases.EventSettings`,
+every case's excitation an :class:`randvib.Enveloped` event) simulates each
+case from t = 0 through the event (:func:`randvib.simulate_transient`) and
+stores every path's snapshots (:mod:`randvib.montecarlo.event_cases`);
+:meth:`EnsembleResult.transient` gives a case's
+:class:`~randvib.TransientResult`.
+
 Seeds: the groups are numbered in the order in which their first case comes
 (j = 0, 1, ...), and group j runs on the seed ``GROUP_SEEDS * settings.seed + j``:
 for fewer than :data:`GROUP_SEEDS` groups, runs with different settings seeds
@@ -38,8 +45,10 @@ import numpy as np
 import pandas as pd
 
 from randvib._validation import MAX_SEED
+from randvib.models.event import Enveloped
 from randvib.models.excitation import Excitation, as_excitation
 from randvib.models.harvester import Harvester
+from randvib.montecarlo import event_cases
 from randvib.montecarlo.sweep import PointStore, SweepSettings, run_stored, simulate_to_precision
 from randvib.statistics import Statistic, estimate, median_first_passage, paired_ratio
 
@@ -67,14 +76,16 @@ class Case:
     device : Harvester
         Scalar parameters; any friction, coupling and potential that
         :func:`randvib.simulate` takes.
-    excitation : float or Excitation
+    excitation : float, Excitation or Enveloped
         The base acceleration: a white-noise level S ((m/s^2)^2/Hz) or an
-        excitation, as :func:`randvib.simulate` takes it.
+        excitation, as :func:`randvib.simulate` takes it; or an event, as
+        :func:`randvib.simulate_transient` takes it (an event run).
     group : hashable, optional
         Cases with equal groups run on one seed (common random numbers:
         paired). None: a group of its own.
-    initial : "stationary", "rest" or (z0, v0)
-        The start of every path (:func:`randvib.simulate`).
+    initial : "stationary", "rest", "unexcited" or (z0, v0)
+        The start of every path (:func:`randvib.simulate`; an event starts
+        from "rest", "unexcited" or (z0, v0), :class:`randvib.EventStart`).
     """
 
     labels: Mapping
@@ -93,7 +104,8 @@ class Case:
                 )
         if not isinstance(self.device, Harvester):
             raise ValueError(f"`device` must be a Harvester, got {type(self.device).__name__}")
-        as_excitation(self.excitation)  # a bad level or excitation is refused here, by name
+        if not isinstance(self.excitation, Enveloped):
+            as_excitation(self.excitation)  # a bad level or excitation is refused here, by name
 
     def key(self, seed: int) -> dict:
         """What this case is, JSON-ready: stored with its result and checked on resume."""
@@ -101,9 +113,14 @@ class Case:
             "labels": dict(self.labels),
             "seed": seed,
             "device": self.device.parameters(),
-            "excitation": as_excitation(self.excitation).parameters(),
+            "excitation": self._excitation().parameters(),
             "initial": self.initial,
         })  # fmt: skip
+
+    def _excitation(self):
+        if isinstance(self.excitation, Enveloped):
+            return self.excitation
+        return as_excitation(self.excitation)
 
 
 def run_case(case: Case, settings: SweepSettings, seed: int, threads: int | None = 1):
@@ -206,6 +223,17 @@ class EnsembleResult:
             excitation=excitation,
         )  # fmt: skip
 
+    def transient(self, index: int):
+        """Case ``index`` of an event run as :func:`randvib.simulate_transient` returned it.
+
+        A :class:`~randvib.TransientResult` of the stored paths (every
+        statistic through the event, the paths' energies for paired ratios).
+        """
+        if not isinstance(self.settings, event_cases.EventSettings):
+            raise ValueError("only the cases of an event run (EventSettings) have a transient")
+        seed = GROUP_SEEDS * self.settings.seed + self.groups[index]
+        return event_cases.unpack(self.per_path[index], self.cases[index], self.settings, seed)
+
     def power_samples(self, index: int) -> np.ndarray:
         """Each path's time-averaged electrical power (W) in case ``index``.
 
@@ -294,7 +322,7 @@ class EnsembleResult:
 
 def run_ensembles(
     cases,
-    settings: SweepSettings | None = None,
+    settings: SweepSettings | event_cases.EventSettings | None = None,
     *,
     out_dir=None,
     executor: Executor | None = None,
@@ -310,10 +338,12 @@ def run_ensembles(
     cases : iterable of Case
         The ensembles, each with its labels and group (see the module
         docstring for the seeds).
-    settings : SweepSettings
+    settings : SweepSettings or EventSettings
         Time step, window, burn-in, scheme, paths (a precision target, or
         min_paths = max_paths for a fixed size), the seed of the run and the
-        control variates (white noise only).
+        control variates (white noise only); or, for cases under events,
+        :class:`~randvib.montecarlo.event_cases.EventSettings` (the window
+        from t = 0, step, paths, report times and seed).
     out_dir : path-like, optional
         Folder for ``metadata.json`` and ``points/`` (one JSON row and one
         ``.npy`` per case, with checksums). Finished cases found there are
@@ -345,6 +375,7 @@ def run_ensembles(
         if key in keys:
             raise ValueError(f"two cases have the labels {dict(case.labels)}; each needs its own")
         keys.add(key)
+        event_cases.check_event_case(case, settings)
     groups = _group_numbers(cases)
     if max(groups) >= GROUP_SEEDS or GROUP_SEEDS * settings.seed + max(groups) > MAX_SEED:
         raise ValueError(
@@ -352,6 +383,8 @@ def run_ensembles(
             f"and GROUP_SEEDS * seed + groups at most {MAX_SEED}"
         )
     seeds = [GROUP_SEEDS * settings.seed + j for j in groups]
+    events = isinstance(settings, event_cases.EventSettings)
+    runner = event_cases.run_event_case if events else run_case
     store = None
     if out_dir is not None:
         identity = {
@@ -359,10 +392,11 @@ def run_ensembles(
             "cases": [case.key(seed) for case, seed in zip(cases, seeds, strict=True)],
             "settings": settings.to_dict(),
         }
-        store = PointStore(out_dir, identity, required=("power_electrical", "n_paths"),
-                           table=None, what="case")  # fmt: skip
+        required = ("energy_electrical" if events else "power_electrical", "n_paths")
+        store = PointStore(out_dir, identity, required=required, table=None, what="case",
+                           columns=settings.columns() if events else None)  # fmt: skip
     rows, per_path = run_stored(
-        [(run_case, (case, settings, seed)) for case, seed in zip(cases, seeds, strict=True)],
+        [(runner, (case, settings, seed)) for case, seed in zip(cases, seeds, strict=True)],
         [case.key(seed) for case, seed in zip(cases, seeds, strict=True)],
         store,
         executor=executor,

@@ -401,6 +401,9 @@ class PointStore:
         File name of the CSV of the rows, or None for none.
     what : str
         What a point is called in a warning ("sweep point", "case").
+    columns : int, optional
+        Columns of a point's per-path array; default the stationary
+        kernel's per-path averages (``N_ACC``).
     """
 
     FORMAT = 2
@@ -413,10 +416,12 @@ class PointStore:
         required: tuple = (*STATISTICS, "n_paths"),
         table: str | None = "results.csv",
         what: str = "sweep point",
+        columns: int | None = None,
     ):
         self.out = prepare_output_dir(out_dir, identity)
         (self.out / "points").mkdir(exist_ok=True)
         self.required, self.table, self.what = tuple(required), table, what
+        self.columns = columns
 
     def _paths(self, index: int) -> Path:
         return self.out / "points" / f"{index:05d}.npy"
@@ -469,7 +474,7 @@ class PointStore:
             paths = np.load(io.BytesIO(data), allow_pickle=False)
         except (OSError, ValueError) as exc:
             raise _BadPoint(f"{npy_file.name}: {exc}") from None
-        if list(paths.shape) != shape or shape != [row["n_paths"], N_ACC]:
+        if list(paths.shape) != shape or shape != [row["n_paths"], self.columns or N_ACC]:
             raise _BadPoint(f"{npy_file.name} has shape {paths.shape}, expected {shape}")
         if not np.all(np.isfinite(paths)):
             raise _BadPoint(f"{npy_file.name} holds non-finite values")
