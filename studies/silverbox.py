@@ -16,7 +16,8 @@ near 60 Hz): linear (k3 = 0), Duffing, and Duffing with a quadratic term.
 An ablation adds the measurement model's pieces one at a time to the
 Duffing fit, from none (linear interpolation, start from the first samples,
 no offsets). Writes ``report.md``, ``results.csv``, ``ablation.csv`` and each
-fit as JSON. The same fit from the command line::
+fit as JSON (a rerun loads the fits found there:
+:mod:`randvib.studies.benchmark`). The same fit from the command line::
 
     randvib identify SNLS80mV.csv --input-column V1 --input-kind force \\
         --output-column V2 --sample-rate 610.3515625 --rows 40700:121072 \\
@@ -31,11 +32,9 @@ import sys
 
 import pandas as pd
 
-from randvib._io import dumps, write_tracked
 from randvib.datasets import silverbox
-from randvib.identification.identify import identify
-from randvib.identification.prediction import predict_record
 from randvib.studies import script_main
+from randvib.studies.benchmark import ablation_table, fit_and_score, parameter_listing
 from randvib.studies.report import (
     markdown_table,
     prepare_output_dir,
@@ -51,18 +50,19 @@ HOLD = "bandlimited"
 NO_OFFSETS = {"input_offset": 0.0, "output_offset": 0.0}
 #: label -> identify options of the models compared.
 MODELS = {
-    "linear (k3 = 0)": dict(fixed={"k3": 0.0}, hold=HOLD),
-    "Duffing": dict(hold=HOLD),
-    "Duffing + k2": dict(hold=HOLD, quadratic=True),
+    "linear (k3 = 0)": ("linear", dict(fixed={"k3": 0.0}, hold=HOLD)),
+    "Duffing": ("duffing", dict(hold=HOLD)),
+    "Duffing + k2": ("duffing_k2", dict(hold=HOLD, quadratic=True)),
 }
 #: The Duffing fit with the measurement model's pieces added one at a time.
 ABLATION = {
-    "none: linear interpolation, start from the record, no offsets": dict(
-        hold="linear", initial_state="record", fixed=NO_OFFSETS
+    "none: linear interpolation, start from the record, no offsets": (
+        "ablation_none",
+        dict(hold="linear", initial_state="record", fixed=NO_OFFSETS),
     ),
-    "+ offsets": dict(hold="linear", initial_state="record"),
-    "+ estimated initial state": dict(hold="linear"),
-    "+ cubic-spline input": dict(hold="cubic"),
+    "+ offsets": ("ablation_offsets", dict(hold="linear", initial_state="record")),
+    "+ estimated initial state": ("ablation_start", dict(hold="linear")),
+    "+ cubic-spline input": ("ablation_spline", dict(hold="cubic")),
 }
 #: The ablation's last row: the Duffing model itself (band-limited input).
 ABLATION_LAST = "+ band-limited input instead of the spline (the Duffing model)"
@@ -85,25 +85,6 @@ def parts(quick):
     return estimation, test, silverbox("arrow-head")
 
 
-def fit_and_score(records, label, options, search, progress):
-    """One fit on ``records[0]``; its J and RMS error on each record."""
-    options = dict(options)
-    res = identify(records[0], "viscous", substeps=SUBSTEPS, progress=progress, **search, **options)
-    sim = {k: res.settings[k] for k in ("substeps", "hold", "initial_state")}
-    rows = []
-    for rec in records:
-        pred = predict_record(res.harvester(), rec, measurement=res.measurement, **sim)
-        rows.append(
-            {
-                "model": label,
-                "record": rec.name,
-                "J (Eq. 11)": pred.cost,
-                "RMS error (mV)": 1e3 * pred.rms_error,
-            }
-        )
-    return res, rows
-
-
 def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, progress=True):
     """Fit and validate the Silverbox models; write ``report.md`` and the fits into ``out_dir``.
 
@@ -113,20 +94,13 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
     out = prepare_output_dir(out_dir, {"study": "silverbox", "quick": quick, "seed": seed})
     records = parts(quick)
     models = {"Duffing": MODELS["Duffing"]} if quick else MODELS
-    rows, fits = [], {}
-    for label, options in models.items():
-        res, fit_rows = fit_and_score(records, label, options, search, progress)
-        name = label.split()[0].lower() + ("_k2" if "k2" in label else "")
-        write_tracked(out / f"{name}.json", dumps(res.to_dict(), indent=2))
-        rows += fit_rows
-        fits[label] = res
-    table = pd.DataFrame(rows)
+    options = dict(substeps=SUBSTEPS, progress=progress, **search)
+    table, fits = fit_and_score(records, models, out, **options)
     write_table(out, "results.csv", table)
     ablation = pd.DataFrame()
     if not quick:
-        duffing = [r for r in rows if r["model"] == "Duffing"]
-        ablation = run_ablation(records, search, progress, duffing)
-    if not quick:
+        duffing = (ABLATION_LAST, table[table["model"] == "Duffing"])
+        ablation = ablation_table(records, ABLATION, out, duffing, **options)
         write_table(out, "ablation.csv", ablation)
     data, sentences = silverbox_verdicts(table, ablation, records[1].name, records[2].name)
     write_verdicts(out, data, sentences)
@@ -195,19 +169,6 @@ def _relation(ours: float, theirs: float) -> str:
     return f"{ours / theirs:.3g} times larger than"
 
 
-def run_ablation(records, search, progress, duffing_rows):
-    rows = []
-    for label, options in ABLATION.items():
-        _, fit_rows = fit_and_score(records, label, options, search, progress)
-        rows.append({"measurement model": label, **_rms_by_record(fit_rows)})
-    rows.append({"measurement model": ABLATION_LAST, **_rms_by_record(duffing_rows)})
-    return pd.DataFrame(rows)
-
-
-def _rms_by_record(fit_rows):
-    return {f"{r['record']} RMS (mV)": r["RMS error (mV)"] for r in fit_rows}
-
-
 def report_sections(records, table, ablation, fits, seed, quick):
     estimation, test, arrow = records
     setup = (
@@ -243,25 +204,13 @@ def report_sections(records, table, ablation, fits, seed, quick):
                 + markdown_table(ablation),
             )
         )
-    sections.append(("Parameters (per unit force gain; mass free)", _listing(fits)))
+    sections.append(("Parameters (per unit force gain; mass free)", parameter_listing(fits)))
     return sections
 
 
 def _rms(table, label, record):
     row = table[(table["model"] == label) & (table["record"] == record)]
     return float(row["RMS error (mV)"].iloc[0])
-
-
-def _listing(fits):
-    lines = []
-    for label, res in fits.items():
-        se = res.standard_errors
-        items = [
-            f"{k} = {v:.6g}" + (f" +- {se[k]:.2g}" if k in se else "")
-            for k, v in res.parameters.items()
-        ]
-        lines.append(f"- {label}: " + ", ".join(items))
-    return "\n".join(lines)
 
 
 if __name__ == "__main__":

@@ -106,10 +106,6 @@ def test_a_wheel_ships_the_study_scripts(tmp_path):
     assert not any(n.startswith("studies/") for n in names)
 
 
-#: Scripts not yet written over the public API alone.
-NOT_YET_PUBLIC = {"silverbox"}
-
-
 def _public_module(module: str) -> bool:
     """What a study script may import from randvib: the package (its exports), the studies'
     building blocks (randvib.studies.*) and the package's top-level public modules
@@ -123,7 +119,7 @@ def _public_module(module: str) -> bool:
     return len(parts) == 2 and (ROOT / "randvib" / f"{parts[1]}.py").is_file()
 
 
-@pytest.mark.parametrize("name", sorted(set(STUDIES) - NOT_YET_PUBLIC))
+@pytest.mark.parametrize("name", STUDIES)
 def test_study_scripts_use_the_public_api(name):
     """A study reads as a user's script: what it needs is exported (``import randvib as rv``)
     or a randvib.studies building block; no engine module, no private module or name."""

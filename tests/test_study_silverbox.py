@@ -4,8 +4,10 @@ The quick study fits the Duffing model on the first 20,000 multisine samples
 only (SaDE 12 x 10, then the least-squares polish) and is scored on the
 held-out multisine test and the full arrow-head, which nothing was tuned on.
 
-Covers the shipped record (:mod:`randvib.datasets`) and its identification
-(:mod:`randvib.identification.identify`) as the study runs them.
+Covers the shipped record (:mod:`randvib.datasets`), its identification
+(:mod:`randvib.identification.identify`) and the benchmark's building block
+(:mod:`randvib.studies.benchmark`: fits kept in the study's folder, a rerun
+loads them) as the study runs them.
 """
 
 import json
@@ -30,6 +32,12 @@ def test_quick_study_meets_the_arrow_head_target(tmp_path):
     assert verdicts["arrow_head_rms_mV"] == rms["arrow-head"]
     assert verdicts["best_model"] == "Duffing" and len(verdicts["verdicts"]) == 1
     assert verdicts["meets_target"] is (max(rms.values()) <= 0.5)
+    # a rerun loads the fit kept in the folder: the same table, the fit not rewritten
+    fit = tmp_path / "sb" / "duffing.json"
+    stamp = fit.stat().st_mtime_ns
+    study.run_study(tmp_path / "sb", quick=True, progress=False)
+    assert fit.stat().st_mtime_ns == stamp
+    pd.testing.assert_frame_equal(pd.read_csv(tmp_path / "sb" / "results.csv"), table)
 
 
 def test_verdicts_follow_from_the_tables():
