@@ -24,3 +24,33 @@ def test_silverbox_parts_have_the_documented_lengths_and_sampling():
 def test_unknown_part_is_refused_by_name():
     with pytest.raises(ValueError, match="part must be one of"):
         datasets.silverbox("training")
+
+
+def test_silverbox_split_is_the_benchmark_loaders():
+    """The indices of nonlinear_benchmarks.Silverbox(): arrow-head data[100:40575] and its first
+    32,000 samples; multisines data[40650:127400], their first int(0.75 n) samples training."""
+    assert datasets.SILVERBOX_SPLIT == {
+        "multisine train": (40_650, 40_650 + 65_062),
+        "multisine test": (105_712, 127_400),
+        "arrow-head full": (100, 40_575),
+        "arrow-head no extrapolation": (100, 32_100),
+    }
+    assert 65_062 == int(0.75 * (127_400 - 40_650))
+    assert datasets.SILVERBOX_INITIALISATION == 50
+    split = datasets.silverbox_split()
+    arrow, multisine = datasets.silverbox("arrow-head"), datasets.silverbox("multisine")
+    whole_u = np.concatenate([arrow.input, multisine.input])
+    whole_z = np.concatenate([arrow.z, multisine.z])
+    for name, (start, stop) in datasets.SILVERBOX_SPLIT.items():
+        assert split[name].name == name
+        np.testing.assert_array_equal(split[name].input, whole_u[start:stop])
+        np.testing.assert_array_equal(split[name].z, whole_z[start:stop])
+    # training and tests do not overlap
+    assert (
+        datasets.SILVERBOX_SPLIT["multisine train"][1]
+        <= datasets.SILVERBOX_SPLIT["multisine test"][0]
+    )
+    assert (
+        datasets.SILVERBOX_SPLIT["arrow-head full"][1]
+        <= datasets.SILVERBOX_SPLIT["multisine train"][0]
+    )
