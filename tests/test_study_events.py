@@ -94,6 +94,8 @@ def test_an_event_run_is_simulate_transient_on_the_group_seed():
     np.testing.assert_array_equal(got.first_hit, direct.first_hit)
     np.testing.assert_array_equal(got.times, direct.times)
     assert run.table.energy_electrical[i] == direct.energy_electrical.mean
+    with pytest.raises(ValueError, match="event run have no time averages"):
+        run.paired_ratios(device="linear")
     with pytest.raises(ValueError, match="events run with randvib.EventSettings"):
         rv.run_ensembles([rv.Case({"x": 1}, devices["paper"][0], 1.0)], settings, progress=False)
     with pytest.raises(ValueError, match="events run with randvib.EventSettings"):

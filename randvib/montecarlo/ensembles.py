@@ -197,6 +197,7 @@ class EnsembleResult:
         """The per-path averages of case ``index`` by name (:class:`~randvib.montecarlo.kernel.PathAverages`)."""
         from randvib.montecarlo.kernel import PathAverages
 
+        self._stationary()
         return PathAverages(self.per_path[index])
 
     def simulation(self, index: int):
@@ -210,6 +211,7 @@ class EnsembleResult:
         from randvib.montecarlo.options import TimeGrid
         from randvib.montecarlo.results import SimulationResult
 
+        self._stationary()
         case, settings = self.cases[index], self.settings
         excitation = as_excitation(case.excitation)
         grid = TimeGrid.from_times(
@@ -310,6 +312,13 @@ class EnsembleResult:
             n = min(self.per_path[i].shape[0], self.per_path[j].shape[0])
             rows.append(paired_ratio(self.power_samples(i)[:n], self.power_samples(j)[:n]))
         return pd.DataFrame(rows, columns=["ratio", "ratio_ci95"], index=self.table.index)
+
+    def _stationary(self) -> None:
+        if isinstance(self.settings, event_cases.EventSettings):
+            raise ValueError(
+                "the cases of an event run have no time averages: use transient(index), a "
+                "randvib.TransientResult (path_energies for paired ratios)"
+            )
 
     def _one_group(self, indices) -> None:
         groups = {self.groups[i] for i in indices}
