@@ -68,3 +68,16 @@ def test_verdicts_follow_from_the_tables():
     _, sentences = study.silverbox_verdicts(worse, pd.DataFrame(), "multisine test", "arrow-head")
     assert "2.14 times larger than the 1.31 mV" in sentences[0] and len(sentences) == 3
     assert "It misses the physical model's target of 0.5 mV" in sentences[0]
+
+
+def test_rms_beyond_a_first_part_is_the_rms_of_the_rest():
+    import numpy as np
+    import pytest
+
+    from randvib.studies.benchmark import rms_beyond
+
+    e = np.random.default_rng(0).normal(size=1000) * np.linspace(1.0, 3.0, 1000)
+    full, part = np.sqrt(np.mean(e**2)), np.sqrt(np.mean(e[:700] ** 2))
+    assert rms_beyond(full, 1000, part, 700) == pytest.approx(np.sqrt(np.mean(e[700:] ** 2)))
+    with pytest.raises(ValueError, match="`n_part` must lie in"):
+        rms_beyond(full, 1000, part, 1000)

@@ -8,7 +8,8 @@ Eq. 11) and the RMS simulation error. :func:`fit_and_score` runs the fits
 resumes) and tabulates the scores; :func:`ablation_table` does so for the
 steps of an ablation (one fit per step, its RMS error per record);
 :func:`parameter_listing` lists the fitted parameters with their standard
-errors.
+errors; :func:`rms_beyond` gives the error over the samples of a record
+beyond its first part (the arrow-head's extrapolated amplitudes).
 
 A record is scored as the benchmark scores it: ``score`` (the options of
 :func:`randvib.predict_record`, e.g. ``skip`` for the samples left out of
@@ -26,7 +27,7 @@ import pandas as pd
 from randvib.identification.prediction import predict_record
 from randvib.studies.campaign import identify_cached
 
-__all__ = ["ablation_table", "fit_and_score", "parameter_listing", "score_fit"]
+__all__ = ["ablation_table", "fit_and_score", "parameter_listing", "rms_beyond", "score_fit"]
 
 #: The column of the RMS simulation error (mV) in :func:`fit_and_score`'s table.
 RMS = "RMS error (mV)"
@@ -74,6 +75,18 @@ def fit_and_score(records, fits: dict, folder, *, model="viscous", score=None, *
             scored = score_fit(fit, rec, **((score or {}) if i else {}))
             rows.append({"model": label, "record": rec.name, **scored})
     return pd.DataFrame(rows), results
+
+
+def rms_beyond(full_rms: float, n_full: int, part_rms: float, n_part: int) -> float:
+    """The RMS error over the samples of a record beyond its first part (same units).
+
+    ``full_rms`` over the ``n_full`` scored samples of the record, ``part_rms``
+    over the ``n_part`` scored samples of its first part (both scored from the
+    same start): the mean squares add, weighted by the sample counts.
+    """
+    if not 0 < n_part < n_full:
+        raise ValueError(f"`n_part` must lie in (0, n_full = {n_full}), got {n_part!r}")
+    return float(((full_rms**2 * n_full - part_rms**2 * n_part) / (n_full - n_part)) ** 0.5)
 
 
 def ablation_table(records, steps: dict, folder, last: tuple, **kwargs) -> pd.DataFrame:
