@@ -64,6 +64,13 @@ def test_verdicts_follow_from_the_tables():
     assert "not below 0.3 mV" in sentences[1] and data["below_aim"] is False
     assert "20 times the Duffing model's" in sentences[2]
     assert "divides the Duffing model's arrow-head error by 5 (2 -> 0.4 mV)" in sentences[3]
+    k2 = [("Duffing + k2", "arrow-head", 0.38), ("Duffing + k2", "multisine test", 0.3)]
+    with_k2 = pd.concat([table, pd.DataFrame(k2, columns=table.columns)])
+    data, sentences = study.silverbox_verdicts(
+        with_k2, pd.DataFrame(), "multisine test", "arrow-head"
+    )
+    assert data["best_model"] == "Duffing + k2" and data["k2_change_arrow_head"] == 0.38 / 0.4 - 1
+    assert "changes the arrow-head error by -5 %" in sentences[3]
     worse = table.assign(**{"RMS error (mV)": [8.0, 4.0, 2.8, 0.72]})
     _, sentences = study.silverbox_verdicts(worse, pd.DataFrame(), "multisine test", "arrow-head")
     assert "2.14 times larger than the 1.31 mV" in sentences[0] and len(sentences) == 3
