@@ -36,6 +36,7 @@ import sys
 import pandas as pd
 
 from randvib.datasets import SILVERBOX_INITIALISATION, silverbox_split
+from randvib.formatting import percent
 from randvib.studies import script_main
 from randvib.studies.benchmark import ablation_table, fit_and_score, parameter_listing, rms_beyond
 from randvib.studies.report import (
@@ -174,7 +175,7 @@ def silverbox_verdicts(table, ablation, test_name, arrow_name) -> tuple[dict, li
         data["k2_change_arrow_head"] = change
         sentences.append(
             f"A quadratic spring term (fitted on the training data, with both offsets) changes "
-            f"the arrow-head error by {100 * change:+.2g} %."
+            f"the arrow-head error by {percent(change, 3, True)}."
         )
     if not ablation.empty:
         column = f"{arrow_name} RMS (mV)"

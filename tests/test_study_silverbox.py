@@ -70,7 +70,7 @@ def test_verdicts_follow_from_the_tables():
         with_k2, pd.DataFrame(), "multisine test", "arrow-head"
     )
     assert data["best_model"] == "Duffing + k2" and data["k2_change_arrow_head"] == 0.38 / 0.4 - 1
-    assert "changes the arrow-head error by -5 %" in sentences[3]
+    assert "changes the arrow-head error by -5.000 %" in sentences[3]
     worse = table.assign(**{"RMS error (mV)": [8.0, 4.0, 2.8, 0.72]})
     _, sentences = study.silverbox_verdicts(worse, pd.DataFrame(), "multisine test", "arrow-head")
     assert "2.14 times larger than the 1.31 mV" in sentences[0] and len(sentences) == 3
