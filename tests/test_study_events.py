@@ -100,6 +100,9 @@ def test_an_event_run_is_simulate_transient_on_the_group_seed():
         rv.run_ensembles([rv.Case({"x": 1}, devices["paper"][0], 1.0)], settings, progress=False)
     with pytest.raises(ValueError, match="events run with randvib.EventSettings"):
         rv.run_ensembles(cases, rv.SweepSettings(), progress=False)
+    stationary_start = rv.Case({"x": 1}, devices["paper"][0], events.event(1.0))
+    with pytest.raises(ValueError, match="an event starts from `initial` 'rest'"):
+        rv.run_ensembles([stationary_start], settings, progress=False)
     with pytest.raises(ValueError, match="times"):
         rv.EventSettings(1.0, 5e-4, 8, times=(0.0, 2.0))
 

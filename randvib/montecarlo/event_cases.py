@@ -144,7 +144,8 @@ def unpack(per_path: np.ndarray, case, settings: EventSettings, seed: int) -> Tr
 
 
 def check_event_case(case, settings) -> None:
-    """Refuse a stationary case in an event run and an event case in a stationary one."""
+    """Refuse a stationary case in an event run, an event case in a stationary one, and an
+    event case whose ``initial`` is not an event's start."""
     is_event = isinstance(case.excitation, Enveloped)
     if is_event != isinstance(settings, EventSettings):
         raise ValueError(
@@ -153,3 +154,11 @@ def check_event_case(case, settings) -> None:
             + f" but the settings are {type(settings).__name__}: events run with "
             "randvib.EventSettings, stationary excitations with randvib.SweepSettings"
         )
+    if is_event:
+        try:
+            EventStart.of(case.initial, case.device)
+        except ValueError:
+            raise ValueError(
+                f"case {dict(case.labels)}: an event starts from `initial` 'rest', "
+                f"'unexcited' or a state (z0, v0); got {case.initial!r}"
+            ) from None
