@@ -53,7 +53,7 @@ from randvib.studies.report import (
 #: How the benchmark scores a test part: its first samples only start the simulation.
 SCORE = {"skip": SILVERBOX_INITIALISATION, "initial_state": "record"}
 MULTISINE_TEST, ARROW_HEAD = "multisine test", "arrow-head full"
-SUBSTEPS = 4  # 8 changes the arrow-head RMS by 1e-4 mV (measured on the Duffing fit)
+SUBSTEPS = 4  # 8 changes the training RMS by 1e-4 mV (the Duffing fit, training data only)
 HOLD = "bandlimited"
 NO_OFFSETS = {"input_offset": 0.0, "output_offset": 0.0}
 #: label -> identify options of the models compared.
