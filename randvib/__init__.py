@@ -53,6 +53,7 @@ _EXPORTS = {
     "randvib.models.friction": ("Coulomb", "FrictionModel", "LuGre", "Tanh"),
     "randvib.models.harvester": ("Harvester",),
     "randvib.models.coupling": ("Coupling", "COUPLINGS", "Inductive", "Piezo", "Resistive"),
+    "randvib.models.rectifier": ("BridgeCoil", "BridgePiezo", "RECTIFIED", "Rectified"),
     "randvib.identification.cost": ("normalised_cost",),
     "randvib.identification.models": ("MeasurementModel",),
     "randvib.identification.identify": ("identify",),

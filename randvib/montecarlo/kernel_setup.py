@@ -43,6 +43,7 @@ class KernelSetup:
     companion: kernel.Companion
     recording: kernel.Recording
     auxiliary: kernel.Auxiliary | None
+    rectifier: kernel.Rectifier | None = None
 
     @classmethod
     def prepare(cls, run: Run, linear) -> KernelSetup:
@@ -62,6 +63,7 @@ class KernelSetup:
             companion=companion,
             recording=_recording(run, linear),
             auxiliary=_auxiliary(run, linear),
+            rectifier=_rectifier(h),
         )
 
     def arguments(self, run: Run, lo: int, hi: int) -> dict:
@@ -83,6 +85,7 @@ class KernelSetup:
             recording=self.recording._replace(n_record=n_record),
             noise=kernel.Noise(dw, ZIG_KI, ZIG_WI, ZIG_FI),
             auxiliary=self.auxiliary,
+            rectifier=self.rectifier,
         )
 
 
@@ -134,6 +137,19 @@ def _auxiliary(run: Run, linear) -> kernel.Auxiliary | None:
     gain = 1.0 if excitation.is_white or driven_input else 0.0
     coefficients = np.concatenate([a.ravel(), b, g, c, [gain]])
     return kernel.pack(kernel.Auxiliary, n_states, coefficients, square, chol)
+
+
+def _rectifier(harvester: Harvester) -> kernel.Rectifier | None:
+    """The kernel's bridge (:class:`randvib.montecarlo.kernel.Rectifier`); None without one.
+
+    The storage capacitor starts empty (V_C = 0): the burn-in must cover its
+    charging (:func:`randvib.montecarlo.validation.check_options` warns when
+    it is shorter than a few R_L C).
+    """
+    if not harvester.is_rectified:
+        return None
+    code, output, p = harvester.electrical.kernel_parameters()
+    return kernel.pack(kernel.Rectifier, code, output, p, 0.0)
 
 
 def _driven_circuit_variance(harvester: Harvester, excitation: Excitation) -> float:

@@ -221,7 +221,10 @@ def execute(run: Run, *, control_variates, check_step, threads, batch_paths, pro
     # One linear test system per run, built when first needed (a fixed start
     # without a step check may need none): the step check, the random start,
     # the default histogram ranges and the circuit's start all use it.
-    linear = functools.cache(lambda: LinearTestSystem.of(run.harvester, run.excitation))
+    # A bridge is checked on its linear surrogate (the conducting bridge's damping).
+    linear = functools.cache(
+        lambda: LinearTestSystem.of(run.harvester.linear_surrogate(), run.excitation)
+    )
     if check_step or run.initial.kind == "stationary":
         check_scales(run, linear)
     if check_step:
