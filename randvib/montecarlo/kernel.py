@@ -48,7 +48,8 @@ ACC_FIRST_HIT = 11  # time (s) of the first state with |z| > stroke from t = 0; 
 ACC_STORED = 12  # mean power into the bridge's output, battery or storage load (W); 0 without
 ACC_COIL_LOSS = 13  # mean R_C i^2 of a rectified coil (W); 0 without
 ACC_DIODE_LOSS = 14  # mean 2 V_d |i| of a bridge (W); 0 without
-N_ACC = 15
+ACC_V_OUT = 15  # mean output voltage of a bridge, V_b or V_C (V); 0 without
+N_ACC = 16
 
 
 class PathAverages:
@@ -137,6 +138,11 @@ class PathAverages:
     def diode_loss(self):
         """Time average of 2 V_d |i| of a bridge per path (W); 0 without one."""
         return self._col(ACC_DIODE_LOSS)
+
+    @property
+    def output_voltage(self):
+        """Time average of a bridge's output voltage per path, V_b or V_C (V); 0 without one."""
+        return self._col(ACC_V_OUT)
 
     def energy_balance_controls(self, window):
         """The two zero-mean controls of the energy balance: Ito integral, energy change."""
@@ -840,6 +846,7 @@ def run_ensemble(
         half_cp = 0.5 * rp[1] if rectifier.kind == 2 else 0.0
         half_c = 0.5 * rp[4] if rectifier.output == 1 else 0.0
         v_c0 = rectifier.v_c0
+        v_out_b = rp[3]
         if auxiliary is not None:
             rblock = block
         else:  # white or given input: no filter, the noise drives the velocity (g_v = 1)
@@ -942,6 +949,7 @@ def run_ensemble(
                 if rectifier is not None:
                     if in_window and n == n_burn:
                         a[j, ACC_H0] = half_cp * s1[j] * s1[j] + half_c * s2[j] * s2[j]
+                    v_out = v_out_b if rect[1] == 0 else s2[j]  # at the step's start
                     zn, vn, tn, x1[j], x2[j], x3[j], s1[j], s2[j], f1, e_s, e_c, e_d = (
                         rectified_step(
                             zj, vj, tj, x1[j], x2[j], x3[j], s1[j], s2[j], dt, noise,
@@ -952,6 +960,7 @@ def run_ensemble(
                         a[j, ACC_STORED] += e_s * inv_dt
                         a[j, ACC_COIL_LOSS] += e_c * inv_dt
                         a[j, ACC_DIODE_LOSS] += e_d * inv_dt
+                        a[j, ACC_V_OUT] += v_out
                 elif auxiliary is not None and filter_only:
                     zn, vn, tn, x1[j], x2[j], f1 = filter_step(
                         zj,

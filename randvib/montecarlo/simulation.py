@@ -56,6 +56,7 @@ from randvib.models.excitation import Excitation
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import driven
 from randvib.montecarlo.batches import batch_bounds, run_batches
+from randvib.montecarlo.bridge_step import check_bridge_step
 from randvib.montecarlo.kernel_setup import KernelSetup
 from randvib.montecarlo.resources import announce_long_run, check_resources
 from randvib.montecarlo.results import SimulationResult
@@ -229,6 +230,8 @@ def execute(run: Run, *, control_variates, check_step, threads, batch_paths, pro
         check_scales(run, linear)
     if check_step:
         linear().check_step(run.scheme.name, run.grid.dt)
+        if run.harvester.is_rectified:  # the switching, which the linear check cannot see
+            check_bridge_step(run)
     setup = KernelSetup.prepare(run, linear)
     if threads is not None:
         threads = check_int("threads", threads, 1)

@@ -1,0 +1,213 @@
+"""Rectified couplings: a coil or a piezo into a full-wave bridge, battery or storage capacitor.
+
+Exact references and limits (docs/conventions.md, "Full-wave bridge"):
+
+* a coil bridge with V_d = 0 into a battery at V_b = 0 is the resistive
+  coil with c_e = alpha^2 / R_C: E[v^2] = S m / (4 (c_m + c_e)) exactly under
+  white noise, the coil loss c_e E[v^2]; and on the same noise the kernel's
+  paths are those of the resistive device;
+* V_d = 0 and a large storage capacitor: V_C hardly ripples, so the circuit
+  is the ideal rectifier into a battery at V_C's level sqrt(P R_L);
+* energy balance per path: with the given increments dW, c_m v^2 + v F +
+  stored + coil + diode losses + (change of the device's and capacitors'
+  energy) = m (S/2) QV / 2 + m sqrt(S/2) sum v dW / T, QV = sum dW^2 / T,
+  up to the scheme's accounting error, whose order of convergence is
+  measured (about 1); and in the mean, sum of the powers = m S / 4 (white
+  noise) within its interval;
+* the half-step check of the switching warns with the step to use.
+
+Covers :mod:`randvib.models.rectifier`, the bridge in the kernel
+(:mod:`randvib.montecarlo.kernel`, :mod:`randvib.montecarlo.kernel_setup`), its
+statistics (:mod:`randvib.montecarlo.results`) and its step check
+(:mod:`randvib.montecarlo.bridge_step`).
+"""
+
+import warnings
+
+import numpy as np
+import pytest
+from _stats import assert_matches
+
+import randvib as rv
+from randvib.montecarlo.bridge_step import BridgeStepWarning
+from randvib.montecarlo.step_check import step_bias
+from randvib.statistics import estimate
+
+M, C_M, K = 0.0226, 0.05, 57.4  # docs/conventions.md: the paper's device, m assumed
+ALPHA, R_COIL = 0.1992, 0.48  # the paper's coil
+S = 1.0
+
+
+def device(coupling, **kw):
+    return rv.Harvester.with_coupling(M, C_M, K, coupling, **kw)
+
+
+def quiet_simulate(h, psd, **kw):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return rv.simulate(h, psd, progress=False, **kw)
+
+
+# ------------------------------------------------------------------ declarations
+@pytest.mark.parametrize(
+    "kwargs, words",
+    [
+        (dict(), "either `battery`"),
+        (dict(battery=0.1, storage_capacitance=1e-3, r_load=10.0), "not both"),
+        (dict(storage_capacitance=1e-3), "`r_load`"),
+        (dict(battery=-0.1), "`battery` must be >= 0"),
+        (dict(battery=0.1, v_diode=-0.2), "`v_diode` must be >= 0"),
+        (dict(storage_capacitance=0.0, r_load=10.0), "`storage_capacitance` must be > 0"),
+    ],
+)
+def test_bridge_declaration_refuses_impossible_outputs(kwargs, words):
+    with pytest.raises(ValueError, match=words) as info:
+        rv.BridgeCoil(ALPHA, R_COIL, **kwargs)
+    assert "\n" not in str(info.value)
+
+
+def test_bridge_refuses_zero_coil_resistance_and_methods_that_do_not_take_it():
+    with pytest.raises(ValueError, match="`r_coil` must be > 0"):
+        rv.BridgeCoil(ALPHA, 0.0, battery=0.1)
+    h = device(rv.BridgeCoil(ALPHA, R_COIL, battery=0.1))
+    assert h.c_e == 0.0 and h.is_rectified and not h.has_circuit
+    with pytest.raises(ValueError, match="switching diodes need"):
+        rv.predict(h, S)
+    with pytest.raises(ValueError, match="companion"):
+        rv.simulate(h, S, t_end=1.0, dt=1e-4, n_paths=2, companion=True, progress=False)
+
+
+# ------------------------------------------------------------------ limits
+def test_dead_zone_free_coil_bridge_is_the_resistive_coil():
+    """V_d = V_b = 0: the exact linear result, and the resistive device's paths."""
+    dt, kw = 2e-4, dict(t_end=12.0, burn_in=2.0, n_paths=64, seed=5)
+    bridge = device(rv.BridgeCoil(ALPHA, R_COIL, battery=0.0))
+    # the energy-balance controls (Ito sum, energy change) narrow the interval
+    result = quiet_simulate(bridge, S, dt=dt, control_variates=True, **kw)
+    c_e = ALPHA**2 / R_COIL
+    exact_v2 = S * M / (4.0 * (C_M + c_e))  # docs/conventions.md Eq. 20
+    # the scheme's exact stationary-variance bias on this linear device
+    bias = step_bias("heun", rv.Harvester(M, C_M, c_e, K), S, dt)
+    assert_matches(
+        result.velocity_variance, exact_v2, detect=0.05, known_bias=bias * exact_v2, what="E[v^2]"
+    )
+    assert_matches(
+        result.power_coil_loss, c_e * exact_v2, detect=0.05, known_bias=bias * c_e * exact_v2
+    )
+    assert result.power_stored.mean == 0.0 and result.power_diode_loss.mean == 0.0
+    resistive = quiet_simulate(rv.Harvester(M, C_M, c_e, K), S, dt=dt, **kw)
+    # the same noise and the same arithmetic up to rounding: the same paths
+    np.testing.assert_allclose(result.averages.v2, resistive.averages.v2, rtol=1e-8)
+
+
+def test_large_storage_capacitor_is_the_ideal_rectifier_into_its_level():
+    """V_d = 0, R_L C = 1 s >> the 0.125 s period: a battery at V_C's mean level.
+
+    With V_C constant the two circuits are the same; what separates them is
+    V_C's fluctuation: stored E[V_C^2]/R_L = (E[V_C]^2 + var V_C)/R_L, so the
+    gap is bounded by the measured relative variance of V_C (plus the paired
+    difference's 95 % interval), and it shrinks as C grows.
+    """
+    kw = dict(t_end=16.0, burn_in=6.0, dt=2e-4, n_paths=48, seed=11)
+    r_load, cap = 2.0, 0.5
+    with_cap = quiet_simulate(device(rv.BridgeCoil(ALPHA, R_COIL, 0.0, None, cap, r_load)), S, **kw)
+    stored, mean_v = with_cap.power_stored, with_cap.averages.output_voltage
+    level = float(np.mean(mean_v))
+    relative_variance = stored.mean * r_load / level**2 - 1.0
+    assert 0.0 < relative_variance < 0.1  # a nearly constant V_C: the limit is approached
+    battery = quiet_simulate(device(rv.BridgeCoil(ALPHA, R_COIL, 0.0, level)), S, **kw)
+    np.testing.assert_allclose(battery.averages.output_voltage, level)
+    diff = estimate(battery.averages.stored_power - with_cap.averages.stored_power)
+    assert abs(diff.mean) <= diff.ci95 + relative_variance * stored.mean, (diff, stored)
+    # and a battery at half that level stores measurably less: the comparison can fail
+    half = quiet_simulate(device(rv.BridgeCoil(ALPHA, R_COIL, 0.0, level / 2)), S, **kw)
+    off = estimate(half.averages.stored_power - with_cap.averages.stored_power)
+    assert off.mean + off.ci95 < 0 and abs(off.mean) > abs(diff.mean) + diff.ci95, (off, diff)
+
+
+# ------------------------------------------------------------------ energy balance
+CIRCUITS = {
+    "coil-battery": rv.BridgeCoil(ALPHA, R_COIL, v_diode=0.01, battery=0.03),
+    "coil-capacitor": rv.BridgeCoil(ALPHA, R_COIL, 0.01, None, 1e-2, 10.0),
+    "piezo-battery": rv.BridgePiezo(1e-3, 1e-7, v_diode=0.1, battery=2.0),
+    "piezo-capacitor": rv.BridgePiezo(1e-3, 1e-7, 0.1, None, 1e-6, 1e6),
+}
+
+
+def _path_residuals(h, dW, dt, burn_in):
+    """Per-path energy-balance residuals (W) on the given increments (module docstring)."""
+    n_paths, n_steps = dW.shape
+    r = rv.simulate(
+        h, S, t_end=n_steps * dt, burn_in=burn_in, dt=dt, n_paths=n_paths, dW=dW,
+        initial=(0.0, 0.0), progress=False, check_step=False,
+    )  # fmt: skip
+    a, window = r.averages, r.averaging_time
+    n_burn = int(round(burn_in / dt))
+    qv = (dW[:, n_burn:] ** 2).sum(axis=1) / window
+    dissipated = h.c * a.v2 + a.friction_power + a.stored_power + a.coil_loss + a.diode_loss
+    supplied = M * (S / 2.0) * qv / 2.0 + M * np.sqrt(S / 2.0) * a.ito_integral
+    return dissipated + a.energy_change(window) - supplied, r
+
+
+@pytest.mark.filterwarnings("ignore::randvib.montecarlo.validation.BridgeStartWarning")
+@pytest.mark.parametrize("name", list(CIRCUITS))
+def test_energy_balance_per_path_converges_at_first_order(name):
+    """Same Brownian path at dt, dt/2, dt/4: the residual's order, measured, is about 1."""
+    h = device(CIRCUITS[name], k3=5e4, friction=rv.Coulomb(0.005))
+    fine_dt, n_paths, t = 5e-5, 8, 2.0
+    dW = np.random.default_rng(7).normal(0.0, np.sqrt(fine_dt), (n_paths, int(t / fine_dt)))
+    sizes = []
+    for factor in (4, 2, 1):
+        coarse = dW.reshape(n_paths, -1, factor).sum(axis=2)
+        res, _ = _path_residuals(h, coarse, fine_dt * factor, 0.5)
+        sizes.append(np.mean(np.abs(res)) / (M * S / 4))
+    orders = np.log2(np.array(sizes[:-1]) / np.array(sizes[1:]))
+    # the trapezoidal scheme's accounting error is O(dt) for a Lipschitz drift
+    # and for the projection of the piezo's clamp; 0.7 .. 1.3 separates it from
+    # the order 1/2 of an unaccounted quadratic variation and from order 2
+    assert np.all((orders > 0.7) & (orders < 1.3)), (name, sizes, orders)
+    assert sizes[-1] < 2e-3, sizes  # at 5e-5 s the balance closes to 0.2 % per path
+
+
+@pytest.mark.filterwarnings("ignore::randvib.montecarlo.validation.BridgeStartWarning")
+@pytest.mark.parametrize("name", ["coil-battery", "piezo-capacitor"])
+def test_white_noise_powers_sum_to_m_s_over_4(name):
+    """c_m E[v^2] + E[vF] + stored + coil + diode = m S / 4 within its interval."""
+    h = device(CIRCUITS[name], k3=5e4, friction=rv.Coulomb(0.005))
+    dt, n_paths, t = 2e-4, 48, 8.0
+    dW = np.random.default_rng(3).normal(0.0, np.sqrt(dt), (n_paths, int(t / dt)))
+    per_path, result = _path_residuals(h, dW, dt, 2.0)
+    residual = result.energy_balance_residual()
+    # the mean residual = the per-path accounting error (O(dt), bounded by its
+    # largest value) + the zero-mean noise terms, whose interval it carries
+    bound = residual.ci95 + np.max(np.abs(per_path))
+    assert abs(residual.mean) <= bound, (residual, bound)
+    mechanical, stored = result.power_mechanical, result.power_stored
+    assert stored.mean > 5 * stored.ci95 and mechanical.mean > 0  # a real, stored power
+    total = result.power_electrical.mean + mechanical.mean
+    assert total == pytest.approx(M * S / 4, rel=0.1)
+
+
+def test_bridge_under_band_pass_input_follows_the_resistive_device():
+    """The filter's states with the bridge: V_d = V_b = 0 gives the resistive device's paths."""
+    excitation = rv.BandPass(1.0, 8.0, 0.3)
+    kw = dict(t_end=6.0, burn_in=1.0, dt=2e-4, n_paths=16, seed=2)
+    bridge = quiet_simulate(device(rv.BridgeCoil(ALPHA, R_COIL, battery=0.0)), excitation, **kw)
+    c_e = ALPHA**2 / R_COIL
+    resistive = quiet_simulate(rv.Harvester(M, C_M, c_e, K), excitation, **kw)
+    np.testing.assert_allclose(bridge.averages.v2, resistive.averages.v2, rtol=1e-8)
+    drop = quiet_simulate(
+        device(rv.BridgeCoil(ALPHA, R_COIL, v_diode=0.02, battery=0.02)), excitation, **kw
+    )
+    assert 0 < drop.power_stored.mean < bridge.power_coil_loss.mean
+
+
+def test_half_step_check_warns_with_the_step_to_use():
+    h = device(rv.BridgeCoil(ALPHA, R_COIL, v_diode=0.01, battery=0.03))
+    with pytest.warns(BridgeStepWarning, match=r"use dt <= .* s for less than 1%"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", rv.StepSizeWarning)
+            rv.simulate(h, S, t_end=8.0, dt=6e-3, n_paths=2, progress=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", BridgeStepWarning)
+        rv.simulate(h, S, t_end=4.0, dt=2e-4, n_paths=2, progress=False)
