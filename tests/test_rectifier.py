@@ -18,18 +18,27 @@ Exact references and limits (docs/conventions.md, "Full-wave bridge"):
 
 Covers :mod:`randvib.models.rectifier`, the bridge in the kernel
 (:mod:`randvib.montecarlo.kernel`, :mod:`randvib.montecarlo.kernel_setup`), its
-statistics (:mod:`randvib.montecarlo.results`) and its step check
-(:mod:`randvib.montecarlo.bridge_step`).
+statistics (:mod:`randvib.montecarlo.results`), its step check
+(:mod:`randvib.montecarlo.bridge_step`) and its command-line options
+(:mod:`randvib.cli._device`, ``randvib simulate``).
 """
 
+import dataclasses
+import json
 import warnings
 
 import numpy as np
 import pytest
+from _cli import one_line_error, run
 from _stats import assert_matches
 
 import randvib as rv
-from randvib.montecarlo.bridge_step import BridgeStepWarning
+from randvib.montecarlo.bridge_step import (
+    BridgeStepWarning,
+    EnergyBalanceWarning,
+    check_bridge_balance,
+)
+from randvib.montecarlo.kernel import ACC_STORED
 from randvib.montecarlo.step_check import step_bias
 from randvib.statistics import estimate
 
@@ -150,6 +159,7 @@ def _path_residuals(h, dW, dt, burn_in):
 
 
 @pytest.mark.filterwarnings("ignore::randvib.montecarlo.validation.BridgeStartWarning")
+@pytest.mark.filterwarnings("ignore::randvib.montecarlo.bridge_step.EnergyBalanceWarning")
 @pytest.mark.parametrize("name", list(CIRCUITS))
 def test_energy_balance_per_path_converges_at_first_order(name):
     """Same Brownian path at dt, dt/2, dt/4: the residual's order, measured, is about 1."""
@@ -202,6 +212,18 @@ def test_bridge_under_band_pass_input_follows_the_resistive_device():
     assert 0 < drop.power_stored.mean < bridge.power_coil_loss.mean
 
 
+def test_per_run_identity_check_warns_when_the_powers_miss_the_input():
+    """Quiet on a converged run; a stored power counted twice is caught by the same check."""
+    h = device(rv.BridgeCoil(ALPHA, R_COIL, v_diode=0.01, battery=0.03))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", EnergyBalanceWarning)
+        result = rv.simulate(h, S, t_end=10.0, burn_in=2.0, dt=2e-4, n_paths=32, progress=False)
+    per_path = result.per_path.copy()
+    per_path[:, ACC_STORED] *= 2.0
+    with pytest.warns(EnergyBalanceWarning, match="reduce dt"):
+        check_bridge_balance(dataclasses.replace(result, per_path=per_path))
+
+
 def test_half_step_check_warns_with_the_step_to_use():
     h = device(rv.BridgeCoil(ALPHA, R_COIL, v_diode=0.01, battery=0.03))
     with pytest.warns(BridgeStepWarning, match=r"use dt <= .* s for less than 1%"):
@@ -211,3 +233,49 @@ def test_half_step_check_warns_with_the_step_to_use():
     with warnings.catch_warnings():
         warnings.simplefilter("error", BridgeStepWarning)
         rv.simulate(h, S, t_end=4.0, dt=2e-4, n_paths=2, progress=False)
+
+
+# ------------------------------------------------------------------ command line
+BRIDGE_ARGS = ("--m", "0.0226", "--c-m", "0.05", "--k", "57.4", "--psd", "1")
+
+
+def test_cli_simulate_reports_the_bridge_powers_as_the_python_api(capsys):
+    argv = (
+        "simulate", *BRIDGE_ARGS, "--coupling", "inductive", "--rectifier", "bridge",
+        "--alpha", "0.1992", "--r-coil", "0.48", "--v-diode", "0.01", "--battery", "0.03",
+        "--t-end", "4", "--burn-in", "1", "--dt", "2e-4", "--paths", "16", "--seed", "4", "--json",
+    )  # fmt: skip
+    code, out, _ = run(capsys, *argv)
+    assert code == 0
+    data = json.loads(out)
+    bridge = rv.BridgeCoil(ALPHA, R_COIL, v_diode=0.01, battery=0.03)
+    result = quiet_simulate(device(bridge), S, t_end=4.0, burn_in=1.0, dt=2e-4, n_paths=16, seed=4)
+    for key in ("power_stored", "power_coil_loss", "power_diode_loss", "power_mechanical"):
+        assert data[key] == getattr(result, key).to_dict(), key
+        assert set(data[key]) == {"mean", "ci95"}
+
+
+@pytest.mark.parametrize(
+    "extra, fragment",
+    [
+        (("--battery", "1"), "`--battery` needs `--rectifier bridge`"),
+        (("--coupling", "resistive", "--rectifier", "bridge"), "needs `--coupling inductive|piezo`"),
+        (
+            ("--coupling", "inductive", "--rectifier", "bridge", "--alpha", "0.2", "--r-coil",
+             "0.5", "--battery", "1", "--inductance", "1e-3"),
+            "`--inductance` must be 0",
+        ),
+        (
+            ("--coupling", "piezo", "--rectifier", "bridge", "--theta", "1e-3", "--capacitance",
+             "1e-7", "--v-diode", "-0.1", "--battery", "1"),
+            "`--v-diode` must be >= 0",
+        ),
+        (
+            ("--coupling", "inductive", "--rectifier", "bridge", "--alpha", "0.2", "--r-coil",
+             "0.5", "--storage-capacitance", "1e-3"),
+            "`--storage-capacitance` needs `--r-load`",
+        ),
+    ],
+)  # fmt: skip
+def test_cli_bridge_errors_are_one_line(capsys, extra, fragment):
+    one_line_error(capsys, ("simulate", *BRIDGE_ARGS, *extra, "--paths", "4"), fragment)

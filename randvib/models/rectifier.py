@@ -108,6 +108,10 @@ class Rectified(Coupling):
                 raise ValueError(f"`{name}` must be > 0 ({unit}), got {getattr(self, name)!r}")
 
     # -------------------------------------------------------- what it is
+    def parameters(self) -> dict:
+        """The bridge's parameters by name (SI units), the output left out omitted."""
+        return {k: v for k, v in super().parameters().items() if v is not None}
+
     @property
     def has_battery(self) -> bool:
         """True for a battery output, False for a storage capacitor with its load."""

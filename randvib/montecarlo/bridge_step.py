@@ -86,3 +86,29 @@ def check_bridge_step(run) -> None:
             BridgeStepWarning,
             stacklevel=4,
         )
+
+
+class EnergyBalanceWarning(RuntimeWarning):
+    """A bridge's powers do not sum to the white-noise input m S / 4."""
+
+
+def check_bridge_balance(result) -> None:
+    """Warn when a white-noise bridge run's powers miss m S / 4 beyond their interval.
+
+    Every dissipation path (mechanical, stored, coil, diodes) sums to the
+    input m S / 4 (docs/conventions.md); the check allows the residual's 95 %
+    half-width plus :data:`BRIDGE_STEP_TOLERANCE` of m S / 4 for the step's
+    accounting error, which the half-step check keeps below that.
+    """
+    if not (result.harvester.is_rectified and result.is_white) or result.n_paths < 2:
+        return
+    residual = result.energy_balance_residual()
+    supplied = result.psd * result.harvester.m / 4.0
+    if abs(residual.mean) > residual.ci95 + BRIDGE_STEP_TOLERANCE * supplied:
+        warnings.warn(
+            f"the bridge's powers miss the white-noise input m S / 4 = {supplied:.4g} W by "
+            f"{residual.mean:+.3g} W (+- {residual.ci95:.2g}): lengthen the burn-in (the "
+            "storage capacitor's charging) or reduce dt (the switching)",
+            EnergyBalanceWarning,
+            stacklevel=3,
+        )

@@ -56,7 +56,7 @@ from randvib.models.excitation import Excitation
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import driven
 from randvib.montecarlo.batches import batch_bounds, run_batches
-from randvib.montecarlo.bridge_step import check_bridge_step
+from randvib.montecarlo.bridge_step import check_bridge_balance, check_bridge_step
 from randvib.montecarlo.kernel_setup import KernelSetup
 from randvib.montecarlo.resources import announce_long_run, check_resources
 from randvib.montecarlo.results import SimulationResult
@@ -247,7 +247,7 @@ def execute(run: Run, *, control_variates, check_step, threads, batch_paths, pro
     started = time.perf_counter()
     per_path, histogram, histories = run_batches(run, setup, batches, progress)
     wall = time.perf_counter() - started
-    return SimulationResult(
+    result = SimulationResult(
         harvester=run.harvester,
         psd=run.psd,
         scheme=run.scheme.name,
@@ -263,3 +263,6 @@ def execute(run: Run, *, control_variates, check_step, threads, batch_paths, pro
         wall_time=wall,
         excitation=run.excitation,
     )
+    if check_step:  # the per-run identity: every path sums to m S / 4
+        check_bridge_balance(result)
+    return result
