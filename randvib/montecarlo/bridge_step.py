@@ -97,12 +97,13 @@ def check_bridge_balance(result) -> None:
 
     Every dissipation path (mechanical, stored, coil, diodes) sums to the
     input m S / 4 (docs/conventions.md); the check allows the residual's 95 %
-    half-width plus :data:`BRIDGE_STEP_TOLERANCE` of m S / 4 for the step's
-    accounting error, which the half-step check keeps below that.
+    half-width (narrowed by the energy-balance control variates, which hold
+    for any white-noise run) plus :data:`BRIDGE_STEP_TOLERANCE` of m S / 4 for
+    the step's accounting error, which the half-step check keeps below that.
     """
     if not (result.harvester.is_rectified and result.is_white) or result.n_paths < 2:
         return
-    residual = result.energy_balance_residual()
+    residual = result.energy_balance_residual(control_variates=True)
     supplied = result.psd * result.harvester.m / 4.0
     if abs(residual.mean) > residual.ci95 + BRIDGE_STEP_TOLERANCE * supplied:
         warnings.warn(

@@ -344,13 +344,14 @@ class SimulationResult:
             return self.statistic(self._circuit_power("power_load"))
         return self.statistic(self.harvester.c_e * e.load_fraction * self.averages.v2)
 
-    def energy_balance_residual(self) -> Statistic:
+    def energy_balance_residual(self, control_variates: bool | None = None) -> Statistic:
         """c E[v^2] + E[v F] + P_x - S m / 4 (W): zero up to O(dt) and noise (white only).
 
         ``P_x`` is the power of a circuit state ((R_L + R_C) i^2 or V^2 / R_L;
         docs/conventions.md: the coupling's force f x does the work
         f x v = R x^2 + d/dt(stored energy)) or of a bridge (stored, coil and
-        diode losses); without one, c holds c_e.
+        diode losses); without one, c holds c_e. ``control_variates`` (default:
+        the result's setting) narrows the interval with :meth:`controls`.
         """
         self._require_white("the energy-balance residual and its S m / 4")
         h = self.harvester
@@ -360,7 +361,7 @@ class SimulationResult:
             samples = samples + avg.stored_power + avg.coil_loss + avg.diode_loss
         elif h.has_circuit:
             samples = samples + self._circuit_power("power_electrical")
-        return self.statistic(samples)
+        return self.statistic(samples, control_variates)
 
     def response_spectra(self, segment_duration: float | None = None):
         """Welch PSDs of z, v and c_e S_v from the recorded paths (:mod:`.spectra`)."""
