@@ -506,13 +506,13 @@ def _bridge_current(v, v_c, rect):
     ``i = sgn(e) max(0, |e| - V_out - 2 V_d) / R_C``, ``e = alpha v``; V_out is
     V_b (battery) or ``v_c``.
     """
-    _, output, gain, r_coil, v_d, v_b, _, _ = rect
+    output, gain, v_d, v_b, inv_r_coil = rect[1], rect[2], rect[4], rect[5], rect[8]
     v_out = v_b if output == 0 else v_c
     e = gain * v
     over = abs(e) - v_out - 2.0 * v_d
     if over <= 0.0:
         return 0.0
-    return over / r_coil if e > 0.0 else -over / r_coil
+    return over * inv_r_coil if e > 0.0 else -over * inv_r_coil
 
 
 @numba.njit(cache=True, inline="always")
@@ -523,7 +523,7 @@ def _piezo_clamp(v_p, v_c, rect):
     shared between C_p and the storage capacitor C, which then move together
     (charge conserved: ``C_p (|V_p| - 2 V_d) + C V_C`` before and after).
     """
-    _, output, _, c_p, v_d, v_b, cap, _ = rect
+    output, c_p, v_d, v_b, cap = rect[1], rect[3], rect[4], rect[5], rect[6]
     a = abs(v_p)
     if output == 0:
         limit = v_b + 2.0 * v_d
@@ -534,7 +534,7 @@ def _piezo_clamp(v_p, v_c, rect):
     limit = v_c + 2.0 * v_d
     if a <= limit:
         return v_p, v_c, 0.0
-    v_c_new = (c_p * (a - 2.0 * v_d) + cap * v_c) / (c_p + cap)
+    v_c_new = rect[12] * (a - 2.0 * v_d) + rect[13] * v_c  # weights C_p, C over C_p + C
     clamped = v_c_new + 2.0 * v_d
     return (clamped if v_p > 0.0 else -clamped), v_c_new, cap * (v_c_new - v_c)
 
@@ -566,7 +566,7 @@ def rectified_step(
     b1, b2 = weights
     a11, a12, a13, a21, a22, a23, a31, a32, a33 = block[0:9]
     bv1, bv2, bv3, g1, g2, g3, c1, c2, c3, gv = block[9:19]
-    rkind, output, gain, second, v_d, v_b, cap, r_load = rect
+    rkind, output, second, v_d, v_b, r_load = rect[0], rect[1], rect[3], rect[4], rect[5], rect[7]
     inv_m = drift[0]
     acc1, rate1, force = _acceleration(z, v, theta, drift, kind, p, fn)
     acc1 -= c1 * x1 + c2 * x2 + c3 * x3
@@ -574,16 +574,8 @@ def rectified_step(
     d2 = a21 * x1 + a22 * x2 + a23 * x3 + bv2 * v
     d3 = a31 * x1 + a32 * x2 + a33 * x3 + bv3 * v
     nv = gv * noise
-    if rkind == 1:
-        i1 = _bridge_current(v, s2, rect)
-        acc1 -= gain * i1 * inv_m
-        ds1 = 0.0
-        ds2 = (abs(i1) - s2 / r_load) / cap if output == 1 else 0.0
-    else:
-        i1 = 0.0
-        acc1 -= gain * s1 * inv_m
-        ds1 = gain / second * v
-        ds2 = -s2 / (r_load * cap) if output == 1 else 0.0
+    f1, ds1, ds2, i1 = _bridge_rates(v, s1, s2, rect, inv_m)
+    acc1 += f1
     if b2 == 0.0:
         zn = z + b1 * v * dt
         vn = v + b1 * acc1 * dt + nv
@@ -612,16 +604,8 @@ def rectified_step(
         e1 = a11 * x1p + a12 * x2p + a13 * x3p + bv1 * vp
         e2 = a21 * x1p + a22 * x2p + a23 * x3p + bv2 * vp
         e3 = a31 * x1p + a32 * x2p + a33 * x3p + bv3 * vp
-        if rkind == 1:
-            i2 = _bridge_current(vp, s2p, rect)
-            acc2 -= gain * i2 * inv_m
-            es1 = 0.0
-            es2 = (abs(i2) - s2p / r_load) / cap if output == 1 else 0.0
-        else:
-            i2 = 0.0
-            acc2 -= gain * s1p * inv_m
-            es1 = gain / second * vp
-            es2 = -s2p / (r_load * cap) if output == 1 else 0.0
+        f2, es1, es2, i2 = _bridge_rates(vp, s1p, s2p, rect, inv_m)
+        acc2 += f2
         zn = z + (b1 * v + b2 * vp) * dt
         vn = v + (b1 * acc1 + b2 * acc2) * dt + nv
         tn = theta + (b1 * rate1 + b2 * rate2) * dt
@@ -640,6 +624,65 @@ def rectified_step(
         charge = current * dt
     stored = v_b * charge if output == 0 else load / r_load * dt
     return zn, vn, tn, x1n, x2n, x3n, s1n, s2n, force, stored, coil * dt, 2.0 * v_d * charge
+
+
+@numba.njit(cache=True, inline="always")
+def _bridge_rates(v, s1, s2, rect, inv_m):
+    """(acceleration (m/s^2), V_p', V_C', current (A)) of the bridge at (v, V_p, V_C)."""
+    rkind, output, gain = rect[0], rect[1], rect[2]
+    inv_cap, inv_rc = rect[10], rect[11]
+    if rkind == 1:
+        i = _bridge_current(v, s2, rect)
+        ds2 = abs(i) * inv_cap - s2 * inv_rc if output == 1 else 0.0
+        return -gain * i * inv_m, 0.0, ds2, i
+    ds2 = -s2 * inv_rc if output == 1 else 0.0
+    return -gain * s1 * inv_m, rect[9] * v, ds2, 0.0
+
+
+@numba.njit(cache=True, inline="always")
+def rectified_white_step(z, v, theta, s1, s2, dt, noise, weights, drift, kind, p, fn, rect):
+    """:func:`rectified_step` without a shaping filter (white or given input): the same
+    operations less the filter's exact zeros."""
+    b1, b2 = weights
+    rkind, output, second, v_d, v_b, r_load = rect[0], rect[1], rect[3], rect[4], rect[5], rect[7]
+    inv_m = drift[0]
+    acc1, rate1, force = _acceleration(z, v, theta, drift, kind, p, fn)
+    f1, ds1, ds2, i1 = _bridge_rates(v, s1, s2, rect, inv_m)
+    acc1 += f1
+    if b2 == 0.0:
+        zn = z + b1 * v * dt
+        vn = v + b1 * acc1 * dt + noise
+        tn = theta + b1 * rate1 * dt
+        s1n = s1 + b1 * ds1 * dt
+        s2n = s2 + b1 * ds2 * dt
+        current = b1 * abs(i1)
+        coil = b1 * i1 * i1
+        load = b1 * s2 * s2
+    else:
+        zp = z + v * dt
+        vp = v + acc1 * dt + noise
+        tp = theta + rate1 * dt
+        s1p = s1 + ds1 * dt
+        s2p = s2 + ds2 * dt
+        if rkind == 2:
+            s1p, s2p, _ = _piezo_clamp(s1p, s2p, rect)
+        acc2, rate2, _ = _acceleration(zp, vp, tp, drift, kind, p, fn)
+        f2, es1, es2, i2 = _bridge_rates(vp, s1p, s2p, rect, inv_m)
+        acc2 += f2
+        zn = z + (b1 * v + b2 * vp) * dt
+        vn = v + (b1 * acc1 + b2 * acc2) * dt + noise
+        tn = theta + (b1 * rate1 + b2 * rate2) * dt
+        s1n = s1 + (b1 * ds1 + b2 * es1) * dt
+        s2n = s2 + (b1 * ds2 + b2 * es2) * dt
+        current = b1 * abs(i1) + b2 * abs(i2)
+        coil = b1 * i1 * i1 + b2 * i2 * i2
+        load = b1 * s2 * s2 + b2 * s2p * s2p
+    if rkind == 2:
+        s1n, s2n, charge = _piezo_clamp(s1n, s2n, rect)
+    else:
+        charge = current * dt
+    stored = v_b * charge if output == 0 else load / r_load * dt
+    return zn, vn, tn, s1n, s2n, force, stored, coil * second * dt, 2.0 * v_d * charge
 
 
 @numba.njit(cache=True, inline="always")
@@ -841,7 +884,13 @@ def run_ensemble(
         filter_start = transient.start
     if rectifier is not None:
         rp = rectifier.p
-        rect = (rectifier.kind, rectifier.output, rp[0], rp[1], rp[2], rp[3], rp[4], rp[5])
+        # (kind, output, gain, R_C or C_p, V_d, V_b, C, R_L) and, to spare divisions
+        # per step: 1/R_C, theta/C_p, 1/C, 1/(R_L C), C_p/(C_p + C), C/(C_p + C)
+        rect = (
+            rectifier.kind, rectifier.output, rp[0], rp[1], rp[2], rp[3], rp[4], rp[5],
+            1.0 / rp[1], rp[0] / rp[1], 1.0 / rp[4], 1.0 / (rp[5] * rp[4]),
+            rp[1] / (rp[1] + rp[4]), rp[4] / (rp[1] + rp[4]),
+        )  # fmt: skip
         # energy held by the piezo's and the storage capacitor's voltages: C_p/2, C/2
         half_cp = 0.5 * rp[1] if rectifier.kind == 2 else 0.0
         half_c = 0.5 * rp[4] if rectifier.output == 1 else 0.0
@@ -950,12 +999,18 @@ def run_ensemble(
                     if in_window and n == n_burn:
                         a[j, ACC_H0] = half_cp * s1[j] * s1[j] + half_c * s2[j] * s2[j]
                     v_out = v_out_b if rect[1] == 0 else s2[j]  # at the step's start
-                    zn, vn, tn, x1[j], x2[j], x3[j], s1[j], s2[j], f1, e_s, e_c, e_d = (
-                        rectified_step(
-                            zj, vj, tj, x1[j], x2[j], x3[j], s1[j], s2[j], dt, noise,
-                            scheme, drift, fr_kind, fr_p, fr_fn, rblock, rect,
-                        )
-                    )  # fmt: skip
+                    if auxiliary is not None:
+                        zn, vn, tn, x1[j], x2[j], x3[j], s1[j], s2[j], f1, e_s, e_c, e_d = (
+                            rectified_step(
+                                zj, vj, tj, x1[j], x2[j], x3[j], s1[j], s2[j], dt, noise,
+                                scheme, drift, fr_kind, fr_p, fr_fn, rblock, rect,
+                            )
+                        )  # fmt: skip
+                    else:
+                        zn, vn, tn, s1[j], s2[j], f1, e_s, e_c, e_d = rectified_white_step(
+                            zj, vj, tj, s1[j], s2[j], dt, noise, scheme, drift, fr_kind,
+                            fr_p, fr_fn, rect,
+                        )  # fmt: skip
                     if in_window:
                         a[j, ACC_STORED] += e_s * inv_dt
                         a[j, ACC_COIL_LOSS] += e_c * inv_dt
