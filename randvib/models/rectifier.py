@@ -9,19 +9,16 @@ Carlo integrates them in the compiled kernel (:class:`kernel.Rectifier
 <randvib.montecarlo.kernel.Rectifier>`), and an analytic method must declare
 that it takes them (:attr:`randvib.analytic.method.AnalyticMethod.rectifier`).
 
-==================  ==============================================  ======================
-coupling            equations (docs/conventions.md)                  stored power
-==================  ==============================================  ======================
-:class:`BridgeCoil`  e = alpha z', V_th = V_out + 2 V_d;                battery V_b E|i|,
-                    i = sgn(e) max(0, |e| - V_th) / R_C (L = 0);    capacitor E[V_C^2]/R_L
-                    force alpha i on the magnet
-:class:`BridgePiezo` C_p V_p' = theta z' - i_b, |V_p| <= V_th;          as for the coil
-                    the bridge current i_b flows only while
-                    |V_p| = V_th; force theta V_p on the mass
-==================  ==============================================  ======================
+* :class:`BridgeCoil`: back-EMF ``e = alpha z'``, threshold
+  ``V_th = V_out + 2 V_d``; ``i = sgn(e) max(0, |e| - V_th) / R_C`` (L = 0);
+  force ``alpha i`` on the magnet.
+* :class:`BridgePiezo`: ``C_p V_p' = theta z' - i_b`` with ``|V_p| <= V_th``;
+  the bridge current ``i_b`` flows only while ``|V_p| = V_th``; force
+  ``theta V_p`` on the mass.
 
-Storage capacitor: ``C V_C' = |i| - V_C / R_L`` with ``V_out = V_C``. Every
-dissipation path is a mean power: stored (above), coil ``R_C E[i^2]``,
+Storage capacitor: ``C V_C' = |i| - V_C / R_L`` with ``V_out = V_C``. Stored
+power: ``V_b E|i|`` into a battery, ``E[V_C^2] / R_L`` from a storage
+capacitor. Every dissipation path is a mean power: stored (above), coil ``R_C E[i^2]``,
 diodes ``2 V_d E|i|``; under white noise they and the mechanical dissipation
 ``c_m E[z'^2] + E[z' F]`` sum to ``m S / 4`` (docs/conventions.md).
 """
