@@ -23,10 +23,13 @@ closed at its mean level: ``V_C`` constant with the charge balance
 Validity. The closure's error is the velocity's departure from a Gaussian,
 which grows with the dead zone: the velocity's tails beyond ``u0`` are
 where all the bridge's power is, and the bridge cuts them. The declared
-limit is on ``a = u0 / s``; beyond it the method refuses (its error against
-Monte Carlo is measured over a grid in ``examples/bridge_closure_accuracy.py``
-and quoted in :attr:`BridgeClosure.summary`). The piezo bridge (hysteretic
-clamp), coloured input and friction with memory are refused.
+limit is on ``a = u0 / s``: up to 1.25 the stored power was within 6.5 % of
+Monte Carlo over the grid of tests/calibration/bridge_closure.py (S 0.25 and
+1, Coulomb friction or none, V_d 0 and 20 mV, batteries to 0.1 V and a
+capacitor of R_L C = 8 periods), beyond it off by up to 33 % and more; the
+method refuses there, and for a storage capacitor of R_L C below 8 natural
+periods (its ripple, neglected, grows). The piezo bridge (hysteretic clamp),
+coloured input and friction with memory are refused.
 """
 
 from __future__ import annotations
@@ -40,8 +43,14 @@ from randvib.analytic.power_prediction import PowerPrediction
 from randvib.models.harvester import Harvester
 from randvib.models.rectifier import BridgeCoil
 
-#: Largest u0 / sigma_v (threshold over velocity spread) the closure is offered at.
-MAX_THRESHOLD_RATIO = 2.0
+#: Largest u0 / sigma_v (threshold over velocity spread) the closure is offered at:
+#: up to it the stored power was within 6.5 % of Monte Carlo over the grid of
+#: tests/calibration/bridge_closure.py (largest |error| 6.3 %), beyond it off by
+#: up to 33 % (2x near u0 / sigma_v = 3).
+MAX_THRESHOLD_RATIO = 1.25
+#: Smallest R_L C of a storage capacitor, in linear natural periods 2 pi / omega_n,
+#: the closure is offered at (its ripple neglected; the grid's capacitor had 8).
+MIN_CAPACITOR_PERIODS = 8.0
 
 
 def _tail(a):
@@ -104,7 +113,8 @@ class BridgeClosure(AnalyticMethod):
     title = "the bridge's Gaussian closure"
     summary = (
         "Gaussian closure of a coil's diode bridge (white noise, battery or capacitor at its "
-        "mean level), microseconds; refused where the threshold exceeds 2 velocity std"
+        "mean level), milliseconds, stored power within 6.5 %; refused where the threshold "
+        "exceeds 1.25 velocity std"
     )
     rectifier = True
     validity = (
@@ -138,6 +148,16 @@ class BridgeClosure(AnalyticMethod):
         psd = float(psd)
         if np.ndim(harvester.m) or np.ndim(harvester.k):
             raise ValueError(f"{self.called} takes scalar device parameters")
+        if not coil.has_battery:
+            periods = coil.r_load * coil.storage_capacitance * harvester.natural_frequency
+            if not periods / (2.0 * np.pi) >= MIN_CAPACITOR_PERIODS:
+                raise self.beyond_validity(
+                    harvester,
+                    psd,
+                    f"is not offered for a storage capacitor of R_L C = "
+                    f"{coil.r_load * coil.storage_capacitance:.3g} s (below "
+                    f"{MIN_CAPACITOR_PERIODS:g} natural periods its ripple is not negligible)",
+                )
         v_out = coil.battery if coil.has_battery else capacitor_level(harvester, psd)
         s = _velocity_std(harvester, psd, v_out)
         ratio = (v_out + 2.0 * coil.v_diode) / coil.alpha / s
