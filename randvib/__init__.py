@@ -65,6 +65,7 @@ _EXPORTS = {
     "randvib.analytic.linearisation": ("coulomb_equivalent_damping", "equivalent_damping"),
     "randvib.analytic.method": ("AnalyticMethod",),
     "randvib.analytic.power_prediction": ("PowerPrediction",),
+    "randvib.analytic.bridge": ("DcOptimum", "optimal_dc_output"),
     "randvib.analytic.prediction": (
         "expected_power",
         "METHODS",

@@ -118,6 +118,8 @@ QUANTITIES: dict[str, Quantity] = {
     ),
     "r_load_optimal": Quantity("ohm", "load resistance of the largest load power"),
     "power_load_optimal": Quantity("W", "load power at the optimal load resistance"),
+    "battery_optimal": Quantity("V", "battery voltage of the largest stored power"),
+    "power_stored_optimal": Quantity("W", "stored power at the optimal bridge output"),
 }
 
 #: Quantities measured in the unit of a coupling's circuit state, squared.

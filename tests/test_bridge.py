@@ -5,9 +5,13 @@ resistive coil c_e = alpha^2 / R_C, for which the Gaussian closure is exact),
 the closure's own energy identity (its powers sum to m S / 4), Monte Carlo
 within the declared error bound (6.5 % of the stored power up to
 u0 / sigma_v = 1.25, measured by tests/calibration/bridge_closure.py) plus the
-Monte Carlo interval, and the refusals beyond the declared validity.
+Monte Carlo interval, and the refusals beyond the declared validity. The
+optimal bridge output (``randvib.optimal_dc_output``, ``randvib power
+--optimal-load``, :mod:`randvib.cli.power`): interior or at a bound, said so,
+and checked against paired Monte Carlo on either side of it.
 """
 
+import json
 import warnings
 
 import pytest
@@ -82,3 +86,48 @@ def test_other_methods_refuse_a_bridge_and_name_the_closure():
         rv.predict(h, 1.0, "linearisation")
     assert BRIDGE_CLOSURE.accepts(h, 1.0)
     assert not BRIDGE_CLOSURE.accepts(h, rv.BandPass(1.0, 8.0, 0.3))
+
+
+def test_optimal_battery_voltage_is_interior_and_monte_carlo_agrees():
+    """V_b* from the closure; Monte Carlo (paired, same noise) stores no more at 0.6 and 1.3 V_b*."""
+    h = device(rv.BridgeCoil(ALPHA, R_COIL, v_diode=0.01, battery=0.03))
+    best = rv.optimal_dc_output(h, 1.0)
+    assert best.where == "interior" and best.lower < best.value < best.upper
+    assert best.to_dict()["battery_optimal"] == best.value
+    kw = dict(t_end=8.0, burn_in=1.0, dt=2e-4, n_paths=32, seed=4, control_variates=True)
+    stored = {}
+    for factor in (0.6, 1.0, 1.3):
+        coil = rv.BridgeCoil(ALPHA, R_COIL, v_diode=0.01, battery=factor * best.value)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            stored[factor] = rv.simulate(device(coil), 1.0, progress=False, **kw).power_stored
+    for factor in (0.6, 1.3):
+        margin = stored[1.0].ci95 + stored[factor].ci95
+        assert stored[1.0].mean + margin > stored[factor].mean, (factor, stored)
+    # the closure's power at its optimum is within its declared error of Monte Carlo
+    assert abs(best.power_stored - stored[1.0].mean) <= 0.065 * stored[1.0].mean + stored[1.0].ci95
+
+
+def test_optimum_at_the_validity_limit_says_so():
+    h = device(rv.BridgeCoil(ALPHA, R_COIL, v_diode=0.01, battery=0.03))
+    best = rv.optimal_dc_output(h, 0.25)
+    assert best.where.startswith("upper bound") and "validity" in best.where
+    assert best.value == pytest.approx(best.upper)
+
+
+def test_cli_power_optimal_load_of_a_bridge(capsys):
+    from _cli import run
+
+    code, out, _ = run(
+        capsys, "power", "--m", "0.0226", "--c-m", "0.05", "--k", "57.4", "--psd", "1",
+        "--coupling", "inductive", "--rectifier", "bridge", "--alpha", "0.1992",
+        "--r-coil", "0.48", "--v-diode", "0.01", "--battery", "0.03",
+        "--method", "bridge-closure", "--optimal-load", "--json",
+    )  # fmt: skip
+    assert code == 0
+    data = json.loads(out)
+    h = device(rv.BridgeCoil(ALPHA, R_COIL, v_diode=0.01, battery=0.03))
+    assert data["battery_optimal"] == rv.optimal_dc_output(h, 1.0).value
+    assert data["optimum"] == "interior"
+    for key in ("power_stored", "power_coil_loss", "power_diode_loss", "power_mechanical"):
+        assert data[key] == getattr(rv.predict(h, 1.0, "bridge-closure"), key)

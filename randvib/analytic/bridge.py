@@ -34,6 +34,8 @@ coloured input and friction with memory are refused.
 
 from __future__ import annotations
 
+from dataclasses import dataclass, replace
+
 import numpy as np
 from scipy import optimize, special
 
@@ -190,3 +192,139 @@ class BridgeClosure(AnalyticMethod):
 
 
 BRIDGE_CLOSURE = BridgeClosure()
+
+
+@dataclass(frozen=True)
+class DcOptimum:
+    """The bridge's output that maximises the stored power (:func:`optimal_dc_output`).
+
+    Attributes
+    ----------
+    parameter : str
+        ``"battery"`` (V_b, V) or ``"r_load"`` (R_L across the storage capacitor, ohm).
+    value : float
+        Its optimal value (V or ohm).
+    power_stored : float
+        The stored power there (W).
+    where : str
+        ``"interior"`` (a maximum inside the range searched), or which bound
+        the maximum sits on and why that bound: ``"lower bound (...)"``,
+        ``"upper bound (...)"``. Never silently a bound.
+    lower, upper : float
+        The range searched (V or ohm).
+    """
+
+    parameter: str
+    value: float
+    power_stored: float
+    where: str
+    lower: float
+    upper: float
+
+    def to_dict(self) -> dict:
+        return {
+            f"{self.parameter}_optimal": self.value,
+            "power_stored_optimal": self.power_stored,
+            "optimum": self.where,
+        }
+
+
+def _stored(harvester: Harvester, psd: float) -> tuple[float, float]:
+    """(stored power (W), u0 / sigma_v) of the closure, without its validity refusal."""
+    coil = harvester.electrical
+    v_out = coil.battery if coil.has_battery else capacitor_level(harvester, psd)
+    s = _velocity_std(harvester, psd, v_out)
+    _, mean_abs_i, _ = bridge_moments(coil, s, v_out)
+    stored = v_out * mean_abs_i if coil.has_battery else v_out**2 / coil.r_load
+    return stored, (v_out + 2.0 * coil.v_diode) / coil.alpha / s
+
+
+def optimal_dc_output(harvester: Harvester, psd: float) -> DcOptimum:
+    """The battery voltage, or the storage capacitor's load, that maximises the stored power.
+
+    Searched with ``method='bridge-closure'`` (white noise, a coil's bridge,
+    any memoryless friction and confining potential) over the range where
+    the closure is offered: V_b from 0 up to the voltage at which the
+    threshold reaches 1.25 velocity std; R_L from the 8 natural periods of
+    R_L C up to the same threshold limit. A bounded scalar search (Brent);
+    the answer says whether the maximum is interior or at a bound, and which.
+
+    Examples
+    --------
+    >>> import randvib as rv
+    >>> coil = rv.BridgeCoil(alpha=0.1992, r_coil=0.48, v_diode=0.01, battery=0.03)
+    >>> h = rv.Harvester.with_coupling(0.0226, 0.05, 57.4, coil)
+    >>> best = rv.optimal_dc_output(h, 1.0)
+    >>> print(f"V_b* = {best.value:.4f} V, {best.power_stored:.4e} W, {best.where}")
+    V_b* = 0.0410 V, 6.5536e-04 W, interior
+    """
+    BRIDGE_CLOSURE.require(harvester, psd, who="optimal_dc_output")
+    psd = float(psd)
+    coil = harvester.electrical
+    if coil.has_battery:
+        parameter, log = "battery", False
+
+        def build(x):
+            return replace(coil, battery=float(x))
+
+        lower = 0.0
+        low_words = "no battery voltage: V_b = 0"
+    else:
+        parameter, log = "r_load", True
+
+        def build(x):
+            return replace(coil, r_load=float(x))
+
+        periods = MIN_CAPACITOR_PERIODS * 2.0 * np.pi / harvester.natural_frequency
+        lower = periods / coil.storage_capacitance
+        low_words = f"R_L C = {MIN_CAPACITOR_PERIODS:g} natural periods, the closure's limit"
+
+    def device(x):
+        return _with(harvester, build(x))
+
+    def ratio_excess(x):
+        return _stored(device(x), psd)[1] - MAX_THRESHOLD_RATIO
+
+    if ratio_excess(lower) >= 0.0:
+        raise BRIDGE_CLOSURE.beyond_validity(
+            harvester, psd, f"has no {parameter} within its validity at this level"
+        )
+    upper = max(lower, 1e-6) * 2.0
+    while ratio_excess(upper) < 0.0:
+        upper *= 2.0
+    if log:
+        upper = float(
+            np.exp(optimize.brentq(lambda y: ratio_excess(np.exp(y)), np.log(lower), np.log(upper)))
+        )
+    else:
+        upper = float(optimize.brentq(ratio_excess, lower, upper, xtol=1e-12))
+
+    def loss(y):
+        return -_stored(device(np.exp(y) if log else y), psd)[0]
+
+    a, b = (np.log(lower), np.log(upper)) if log else (lower, upper)
+    found = optimize.minimize_scalar(
+        loss, bounds=(a, b), method="bounded", options={"xatol": 1e-6 * (b - a)}
+    )
+    best = float(np.exp(found.x) if log else found.x)
+    power = -float(found.fun)
+    for edge in (lower, upper):  # Brent's bounded search never evaluates the bounds
+        if -loss(np.log(edge) if log else edge) >= power:
+            best, power = edge, -loss(np.log(edge) if log else edge)
+    span = (b - a) * 1e-4
+    y = np.log(best) if log else best
+    if y <= a + span:
+        where = f"lower bound ({low_words})"
+    elif y >= b - span:
+        where = "upper bound (the closure's validity limit: u0 = 1.25 sigma_v)"
+    else:
+        where = "interior"
+    return DcOptimum(parameter, float(best), float(power), where, float(lower), float(upper))
+
+
+def _with(harvester: Harvester, coupling) -> Harvester:
+    """The harvester with another bridge."""
+    return Harvester.with_coupling(
+        harvester.m, harvester.c_m, harvester.k, coupling, k3=harvester.k3,
+        friction=harvester.friction, stroke=harvester.stroke,
+    )  # fmt: skip

@@ -14,7 +14,10 @@ ends included, as :func:`numpy.linspace`); several swept options give every
 combination. A sweep prints one row per point (``--json``: a list of the
 single-point objects; ``--csv FILE``: all their keys, one row per point).
 ``--optimal-load`` adds the load resistance that maximises the load power
-(:func:`randvib.optimal_load_resistance`) and that power.
+(:func:`randvib.optimal_load_resistance`) and that power; with a diode
+bridge, the battery voltage or the storage capacitor's load that maximises
+the stored power (:func:`randvib.optimal_dc_output`), that power, and whether
+the optimum is interior or at a bound (``optimum``).
 
 ``--envelope`` makes the input an event from t = 0 (:mod:`randvib.cli._event`):
 the moments at ``--times`` and the energy to ``--t-end`` by the Lyapunov
@@ -29,6 +32,7 @@ import itertools
 import math
 
 from randvib._io import check_output_file, dumps
+from randvib.analytic.bridge import optimal_dc_output
 from randvib.analytic.prediction import METHODS, optimal_load_resistance, predict
 from randvib.cli._device import add_device_arguments, harvester_from_args, option_flag
 from randvib.cli._event import add_event_arguments, power_event, wants_event
@@ -194,7 +198,10 @@ def _point(args) -> tuple[dict, object, object]:
         out["stroke"] = harvester.stroke
         # null where not stationary (the free mass)
         out["stroke_exceedance"] = result.stroke_exceedance
-    if args.optimal_load:
+    if args.optimal_load and harvester.is_rectified:
+        # the battery voltage or the capacitor's load maximising the stored power
+        out.update(optimal_dc_output(harvester, psd).to_dict())
+    elif args.optimal_load:
         out["r_load_optimal"], out["power_load_optimal"] = optimal_load_resistance(
             harvester, psd, method=args.method
         )

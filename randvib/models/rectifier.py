@@ -135,7 +135,9 @@ class Rectified(Coupling):
     power_load = power_electrical
 
     def white_noise_optimal_load(self, m, c_m, k):
-        raise ValueError(f"the {self.name} has no closed-form optimum: use randvib.optimal_dc_load")
+        raise ValueError(
+            f"the {self.name} has no closed-form optimum: use randvib.optimal_dc_output"
+        )
 
     # ------------------------------------------------------ for the kernel
     def kernel_parameters(self) -> tuple[int, int, np.ndarray]:
