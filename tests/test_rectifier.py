@@ -84,6 +84,9 @@ def test_bridge_refuses_zero_coil_resistance_and_methods_that_do_not_take_it():
         rv.predict(h, S)
     with pytest.raises(ValueError, match="companion"):
         rv.simulate(h, S, t_end=1.0, dt=1e-4, n_paths=2, companion=True, progress=False)
+    event = rv.Enveloped(rv.White(1.0), rv.Step())
+    with pytest.raises(ValueError, match="events are not implemented"):
+        rv.simulate_transient(h, event, t_end=1.0, dt=1e-4, n_paths=2)
 
 
 # ------------------------------------------------------------------ limits
