@@ -208,7 +208,8 @@ def simulate_to_precision(
         scheme=settings.scheme,
         seed=seed,
         initial=initial,
-        companion=settings.control_variates,
+        # the companion's exact moments need a viscous c_e (no circuit state, no bridge)
+        companion=settings.control_variates and not (device.has_circuit or device.is_rectified),
         control_variates=settings.control_variates,
         threads=threads,
         progress=False,
