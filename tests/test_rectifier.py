@@ -215,6 +215,29 @@ def test_bridge_under_band_pass_input_follows_the_resistive_device():
     assert 0 < drop.power_stored.mean < bridge.power_coil_loss.mean
 
 
+def test_bridge_under_synthesised_input_follows_the_resistive_device():
+    """Band-limited input (given increments): V_d = V_b = 0 gives the resistive device's paths."""
+    excitation = rv.BandLimited(1.0, 4.0, 20.0)
+    kw = dict(t_end=3.0, burn_in=0.5, dt=2e-4, n_paths=8, seed=6)
+    bridge = quiet_simulate(device(rv.BridgeCoil(ALPHA, R_COIL, battery=0.0)), excitation, **kw)
+    resistive = quiet_simulate(rv.Harvester(M, C_M, ALPHA**2 / R_COIL, K), excitation, **kw)
+    np.testing.assert_allclose(bridge.averages.v2, resistive.averages.v2, rtol=1e-8)
+
+
+def test_bridge_with_lugre_friction_and_a_double_well_balances():
+    """LuGre (a friction state) and k < 0 < k3: the powers sum to m S / 4 within the check."""
+    lugre = rv.LuGre(1.98, 0.18, 0.0008, 0.008, 0.007)  # paper Table 2, training data 1
+    h = rv.Harvester.with_coupling(
+        M, C_M, -30.0, rv.BridgeCoil(ALPHA, R_COIL, 0.01, battery=0.03), k3=3e5, friction=lugre
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", EnergyBalanceWarning)
+        result = rv.simulate(h, S, t_end=6.0, burn_in=1.0, dt=2e-4, n_paths=32, progress=False)
+    residual = result.energy_balance_residual(control_variates=True)
+    assert abs(residual.mean) <= residual.ci95 + 0.01 * M * S / 4
+    assert result.power_stored.mean > 3 * result.power_stored.ci95
+
+
 def test_per_run_identity_check_warns_when_the_step_breaks_the_balance():
     """Quiet at dt = 0.2 ms; at 6 ms (three steps per conduction pulse) the powers miss m S / 4."""
     h = device(rv.BridgeCoil(ALPHA, R_COIL, v_diode=0.01, battery=0.03))
