@@ -55,7 +55,7 @@ def register(sub) -> None:
     add_event_arguments(p, t_end=True)
     p.add_argument(
         "--method",
-        default="linearisation",
+        default=None,
         choices=tuple(METHODS),
         metavar="METHOD",
         help=_method_help(),
@@ -84,7 +84,8 @@ def _method_help() -> str:
     circuit = " or ".join(name for name, method in METHODS.items() if method.circuit)
     text = (
         f"analytic method ({each}); a non-white excitation: {coloured} only; a coil "
-        f"inductance or piezo capacitance: {circuit} only"
+        f"inductance or piezo capacitance: {circuit} only; default linearisation, or "
+        "bridge-closure with --rectifier"
     )
     return text.replace("%", "%%")  # argparse formats help with %
 
@@ -149,6 +150,8 @@ def run(args) -> int:
     csv_file = (
         None if args.csv is None else check_output_file(args.csv, "--csv", overwrite=args.force)
     )
+    if args.method is None:  # a bridge's own method, else statistical linearisation
+        args.method = "bridge-closure" if args.rectifier is not None else "linearisation"
     swept, points = _sweep(args)
     if wants_event(args):
         return power_event(args, swept, points)
