@@ -256,6 +256,9 @@ def _print_point(out: dict, harvester, psd) -> None:
 SWEEP_COLUMNS = (
     "power_electrical",
     "power_load",
+    "power_stored",
+    "battery_optimal",
+    "power_stored_optimal",
     "power_mechanical",
     "r_load_optimal",
     "power_load_optimal",
