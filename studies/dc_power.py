@@ -67,12 +67,18 @@ def sentences(v: dict) -> list[str]:
         f"S = {s:g}: {b['ratio']:.3f} ± {b['ratio_ci95']:.3f} (V_d = {b['v_diode']:g} V, "
         f"V_b = {b['battery']:g} V)" for s, b in v["best_by_level"].items()
     )  # fmt: skip
+    drops = "; ".join(
+        f"V_d = {d:g} V: {b['ratio']:.3g} (S = {b['psd']:g}, V_b = {b['battery']:g} V)"
+        for d, b in v["best_by_drop"].items()
+    )  # fmt: skip
+    factor = "n/a" if v["largest_factor"] is None else f"{v['largest_factor']:.3g}"
     return [
         f"The resistive figure overstates the stored power (paired 95 %) in "
-        f"{v['n_overstated']} of {v['n_cases']} bridge cases, by up to a factor "
-        f"{v['largest_factor']:.3g} among the cases that store anything; "
-        f"{v['never_conducts']} of them never conduct(s) at all.",
+        f"{v['n_overstated']} of {v['n_cases']} bridge cases, by up to a factor {factor} "
+        f"where the stored power is resolved; in {v['never_conducts']} cases the bridge "
+        "never conducts.",
         f"Best stored / resistive ratio on the grid by level: {best}.",
+        f"Best by diode drop: {drops}.",
     ]
 
 

@@ -103,6 +103,7 @@ def overstatement(stored: pd.DataFrame) -> dict:
     resistive figure overstates it by the factor 1 / ratio.
     """
     over = stored[stored.ratio + stored.ratio_ci95 < 1.0]
+    resolved = stored[stored.power_stored > 2.0 * stored.power_stored_ci95]
     best = stored.loc[stored.groupby("psd").ratio.idxmax()]
     return {
         "n_cases": int(len(stored)),
@@ -117,8 +118,10 @@ def overstatement(stored: pd.DataFrame) -> dict:
             }
             for r in best.itertuples()
         },  # fmt: skip
-        "largest_factor": float(1.0 / stored.ratio[stored.ratio > 0].min())
-        if (stored.ratio > 0).any()
-        else float("inf"),
+        # over the cases whose stored power is resolved (mean beyond two half-widths)
+        "largest_factor": float(1.0 / resolved.ratio.min()) if len(resolved) else None,
         "never_conducts": int((stored.power_stored == 0).sum()),
-    }
+        "best_by_drop": {float(r.v_diode): {"ratio": float(r.ratio), "psd": float(r.psd),
+                                            "battery": float(r.battery)}
+                         for r in stored.loc[stored.groupby("v_diode").ratio.idxmax()].itertuples()},
+    }  # fmt: skip
