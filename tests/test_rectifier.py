@@ -143,6 +143,8 @@ CIRCUITS = {
     "coil-capacitor": rv.BridgeCoil(ALPHA, R_COIL, 0.01, None, 1e-2, 10.0),
     "piezo-battery": rv.BridgePiezo(1e-3, 1e-7, v_diode=0.1, battery=2.0),
     "piezo-capacitor": rv.BridgePiezo(1e-3, 1e-7, 0.1, None, 1e-6, 1e6),
+    # Shockley diodes: drop 2 n V_T ln(1 + |i| / I_s), about 60 mV at 10 mA
+    "coil-shockley": rv.BridgeCoil(ALPHA, R_COIL, battery=0.01, saturation_current=1e-3),
 }
 
 
@@ -213,6 +215,30 @@ def test_bridge_under_band_pass_input_follows_the_resistive_device():
         device(rv.BridgeCoil(ALPHA, R_COIL, v_diode=0.02, battery=0.02)), excitation, **kw
     )
     assert 0 < drop.power_stored.mean < bridge.power_coil_loss.mean
+
+
+def test_shockley_diodes_limits_and_refusals(capsys):
+    """I_s -> inf: ideal diodes (drop 2 n V_T |i| / I_s -> 0); a drop and I_s together refused."""
+    kw = dict(t_end=4.0, burn_in=1.0, dt=2e-4, n_paths=16, seed=2)
+    ideal = quiet_simulate(device(rv.BridgeCoil(ALPHA, R_COIL, battery=0.01)), S, **kw)
+    wide = rv.BridgeCoil(ALPHA, R_COIL, battery=0.01, saturation_current=1e3)
+    shockley = quiet_simulate(device(wide), S, **kw)
+    # |i| < 1 A here, so the drop is below 2 V_T 1e-3 = 52 uV of a 10 mV battery's threshold
+    np.testing.assert_allclose(
+        shockley.averages.stored_power, ideal.averages.stored_power, rtol=2e-2
+    )
+    assert 0 < shockley.power_diode_loss.mean < 1e-3 * shockley.power_stored.mean
+    with pytest.raises(ValueError, match="not both"):
+        rv.BridgeCoil(ALPHA, R_COIL, v_diode=0.1, battery=0.01, saturation_current=1e-6)
+    with pytest.raises(ValueError, match="constant-drop"):
+        rv.predict(device(wide), S, "bridge-closure")
+    one_line_error(
+        capsys,
+        ("simulate", *BRIDGE_ARGS, "--coupling", "piezo", "--rectifier", "bridge", "--theta",
+         "1e-3", "--capacitance", "1e-7", "--battery", "1", "--saturation-current", "1e-6",
+         "--paths", "4"),
+        "`--saturation-current` applies to the inductive bridge",
+    )  # fmt: skip
 
 
 def test_bridge_under_synthesised_input_follows_the_resistive_device():

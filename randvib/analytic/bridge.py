@@ -136,14 +136,16 @@ class BridgeClosure(AnalyticMethod):
         reason = super().refusal(harvester, psd, who)
         if reason is None and not self._coil(harvester):
             return (
-                f"{who or self.called} treats a coil into a diode bridge (BridgeCoil) only; "
+                f"{who or self.called} treats a coil into a bridge of constant-drop diodes "
+                "(BridgeCoil without saturation_current) only; "
                 f"use {self._alternatives(harvester, psd)}"
             )
         return reason
 
     @staticmethod
     def _coil(harvester) -> bool:
-        return isinstance(harvester.electrical, BridgeCoil)
+        coil = harvester.electrical
+        return isinstance(coil, BridgeCoil) and not coil.is_shockley
 
     def solve(self, harvester: Harvester, psd) -> PowerPrediction:
         coil = harvester.electrical

@@ -11,7 +11,10 @@ from randvib.models.presets import PRESETS, preset
 from randvib.models.rectifier import RECTIFIED
 
 #: The bridge's own options (the transducer's come from its coupling's declaration).
-BRIDGE_OPTIONS = ("v_diode", "battery", "storage_capacitance")
+BRIDGE_OPTIONS = (
+    "v_diode", "battery", "storage_capacitance", "saturation_current", "ideality",
+    "thermal_voltage",
+)  # fmt: skip
 
 #: ``--friction`` choices: ``none`` and every registered law (live view).
 FRICTION_CHOICES = RegistryView(lambda law: law)
@@ -123,6 +126,15 @@ def add_device_arguments(parser: argparse.ArgumentParser) -> None:
         "--storage-capacitance", type=float, help="storage capacitor C (F), with --r-load; bridge"
     )
     g.add_argument(
+        "--saturation-current",
+        type=float,
+        help="Shockley diodes' saturation current I_s (A) instead of --v-diode; inductive bridge",
+    )
+    g.add_argument("--ideality", type=float, help="Shockley diodes' ideality factor n (default 1)")
+    g.add_argument(
+        "--thermal-voltage", type=float, help="Shockley diodes' k T / q (V, default 0.025852)"
+    )
+    g.add_argument(
         "--psd", type=float, default=None, help="one-sided base-acceleration PSD S ((m/s^2)^2/Hz)"
     )
 
@@ -187,6 +199,8 @@ def _bridge_from_args(args):
         )
     own = cls.parameter_names()
     owners = {name: [c.name for c in couplings] for name, couplings in options.items()}
+    for name in BRIDGE_OPTIONS:  # the bridges' own options, by the bridges that declare them
+        owners[name] = [c.name for c in RECTIFIED.values() if name in c.parameter_names()]
     refuse_foreign_options(given, own, owners, "the {owners} coupling", cls.name)
     required = [n for n in transducer.parameter_names() if n in own and n != "r_load"]
     missing = [n for n in required if n not in given]

@@ -37,6 +37,9 @@ from randvib.models.parameters import Parameter, parameter
 #: CLI's ``--coupling`` with ``--rectifier bridge``).
 RECTIFIED: dict[str, type] = {}
 
+#: Thermal voltage k T / q at 300 K (V), the Shockley diodes' default.
+THERMAL_VOLTAGE = 0.025852
+
 #: Kernel codes of the transducer and of the output (:class:`randvib.montecarlo.kernel.Rectifier`).
 COIL, PIEZO = 1, 2
 BATTERY, CAPACITOR = 0, 1
@@ -143,9 +146,10 @@ class Rectified(Coupling):
     def kernel_parameters(self) -> tuple[int, int, np.ndarray]:
         """(transducer code, output code, p) of :class:`randvib.montecarlo.kernel.Rectifier`.
 
-        ``p = (gain, r_or_cp, V_d, V_b, C, R_L)``: alpha (Wb/m) and R_C (ohm)
-        for the coil, theta (N/V) and C_p (F) for the piezo; V_b is 0 and
-        C, R_L are 1 where the output does not use them.
+        ``p = (gain, r_or_cp, V_d, V_b, C, R_L, I_s, n V_T)``: alpha (Wb/m)
+        and R_C (ohm) for the coil, theta (N/V) and C_p (F) for the piezo; V_b
+        is 0 and C, R_L are 1 where the output does not use them; I_s (A) and
+        n V_T (V) of Shockley diodes, I_s = 0 for a constant drop.
         """
         output = BATTERY if self.has_battery else CAPACITOR
         gain, second = self._transducer_parameters()
@@ -157,12 +161,19 @@ class Rectified(Coupling):
                 self.battery if self.has_battery else 0.0,
                 1.0 if self.has_battery else self.storage_capacitance,
                 1.0 if self.has_battery else self.r_load,
+                self._shockley[0],
+                self._shockley[1],
             ]
         )
         return self._code, output, p
 
     def _transducer_parameters(self):  # pragma: no cover - abstract
         raise NotImplementedError
+
+    @property
+    def _shockley(self) -> tuple[float, float]:
+        """(I_s (A), n V_T (V)) of Shockley diodes; (0, 0) for a constant drop."""
+        return 0.0, 0.0
 
     def threshold(self, v_out: float = 0.0) -> float:
         """V_out + 2 V_d (V): the transducer voltage at which the bridge conducts."""
@@ -202,6 +213,13 @@ class BridgeCoil(Rectified):
     storage_capacitance, r_load : float, optional
         Storage capacitor C (F) and its load R_L (ohm), both > 0; stored
         power E[V_C^2] / R_L.
+    saturation_current : float, optional
+        Shockley diodes instead of a constant drop (then ``v_diode`` = 0):
+        each conducting diode drops ``n V_T ln(1 + |i| / I_s)``, so
+        ``|e| - V_out = R_C |i| + 2 n V_T ln(1 + |i| / I_s)``. I_s (A), > 0.
+    ideality, thermal_voltage : float
+        The Shockley law's n (default 1) and V_T = k T / q (V, default
+        0.025852, 300 K).
 
     Examples
     --------
@@ -217,10 +235,38 @@ class BridgeCoil(Rectified):
     battery: float | None = _optional("V", "battery voltage V_b")
     storage_capacitance: float | None = _optional("F", "storage capacitance C", True)
     r_load: float | None = _optional("ohm", "load resistance R_L across C", True)
+    saturation_current: float | None = _optional("A", "Shockley diodes' I_s", True)
+    ideality: float = _with_default("", 1.0, "Shockley diodes' ideality factor n")
+    thermal_voltage: float = _with_default("V", THERMAL_VOLTAGE, "thermal voltage k T / q")
 
     transducer = "inductive"
     name = "inductive bridge"
     _code = COIL
+
+    def __post_init__(self):
+        super().__post_init__()
+        if self.saturation_current is not None:
+            if self.v_diode != 0.0:
+                raise ValueError(
+                    "give either `v_diode` (a constant drop) or `saturation_current` "
+                    f"(Shockley diodes), not both; got v_diode = {self.v_diode!r}"
+                )
+            if not (self.ideality > 0 and self.thermal_voltage > 0):
+                raise ValueError(
+                    f"`ideality` and `thermal_voltage` must be > 0 for Shockley diodes; got "
+                    f"{self.ideality!r} and {self.thermal_voltage!r}"
+                )
+
+    @property
+    def is_shockley(self) -> bool:
+        """True for Shockley diodes (``saturation_current`` given), False for a constant drop."""
+        return self.saturation_current is not None
+
+    @property
+    def _shockley(self) -> tuple[float, float]:
+        if not self.is_shockley:
+            return 0.0, 0.0
+        return self.saturation_current, self.ideality * self.thermal_voltage
 
     def _transducer_parameters(self):
         return self.alpha, self.r_coil

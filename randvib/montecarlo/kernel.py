@@ -311,7 +311,8 @@ class Rectifier(NamedTuple):
 
     ``kind`` 1: a coil (algebraic current, L = 0), 2: a piezo element (state
     V_p); ``output`` 0: a battery, 1: a storage capacitor with its load (state
-    V_C). ``p = (gain, r_or_cp, V_d, V_b, C, R_L)``:
+    V_C). ``p = (gain, r_or_cp, V_d, V_b, C, R_L, I_s, n V_T)`` (I_s = 0: a
+    constant drop V_d; I_s > 0: Shockley diodes):
     :meth:`randvib.models.rectifier.Rectified.kernel_parameters`.
     ``v_c0`` (V): the storage capacitor's voltage at t = 0.
     """
@@ -501,18 +502,37 @@ def auxiliary_step(z, v, theta, x1, x2, x3, dt, noise, weights, drift, kind, p, 
 
 @numba.njit(cache=True, inline="always")
 def _bridge_current(v, v_c, rect):
-    """Current (A) of the rectified coil at velocity ``v`` with storage voltage ``v_c``.
+    """(current (A), drop of the two conducting diodes (V)) of the coil's bridge.
 
-    ``i = sgn(e) max(0, |e| - V_out - 2 V_d) / R_C``, ``e = alpha v``; V_out is
-    V_b (battery) or ``v_c``.
+    ``e = alpha v``; V_out is V_b (battery) or ``v_c``. Constant drop:
+    ``i = sgn(e) max(0, |e| - V_out - 2 V_d) / R_C``. Shockley diodes (I_s > 0,
+    ``rect[14]``; ``rect[15]`` = 2 n V_T): ``|e| - V_out = R_C |i| + 2 n V_T
+    ln(1 + |i| / I_s)``, solved by Newton's method in y = ln(1 + |i| / I_s),
+    where the equation is convex and increasing: from an upper bound the
+    iterates fall monotonically to the root.
     """
     output, gain, v_d, v_b, inv_r_coil = rect[1], rect[2], rect[4], rect[5], rect[8]
     v_out = v_b if output == 0 else v_c
     e = gain * v
+    i_s = rect[14]
+    if i_s > 0.0:
+        over = abs(e) - v_out
+        if over <= 0.0:
+            return 0.0, 0.0
+        r_is, c = rect[3] * i_s, rect[15]
+        y = min(over / c, np.log1p(over / r_is))
+        for _ in range(60):
+            ey = np.exp(y)
+            step = (r_is * (ey - 1.0) + c * y - over) / (r_is * ey + c)
+            y -= step
+            if step <= 1e-13 * y:
+                break
+        i = i_s * np.expm1(y)
+        return (i if e > 0.0 else -i), c * y
     over = abs(e) - v_out - 2.0 * v_d
     if over <= 0.0:
-        return 0.0
-    return over * inv_r_coil if e > 0.0 else -over * inv_r_coil
+        return 0.0, 0.0
+    return (over * inv_r_coil if e > 0.0 else -over * inv_r_coil), 2.0 * v_d
 
 
 @numba.njit(cache=True, inline="always")
@@ -574,7 +594,7 @@ def rectified_step(
     d2 = a21 * x1 + a22 * x2 + a23 * x3 + bv2 * v
     d3 = a31 * x1 + a32 * x2 + a33 * x3 + bv3 * v
     nv = gv * noise
-    f1, ds1, ds2, i1 = _bridge_rates(v, s1, s2, rect, inv_m)
+    f1, ds1, ds2, i1, drop1 = _bridge_rates(v, s1, s2, rect, inv_m)
     acc1 += f1
     if b2 == 0.0:
         zn = z + b1 * v * dt
@@ -587,6 +607,7 @@ def rectified_step(
         s2n = s2 + b1 * ds2 * dt
         current = b1 * abs(i1)
         coil = b1 * i1 * i1 * second if rkind == 1 else 0.0
+        diodes = b1 * drop1 * abs(i1)
         load = b1 * s2 * s2
     else:
         zp = z + v * dt
@@ -604,7 +625,7 @@ def rectified_step(
         e1 = a11 * x1p + a12 * x2p + a13 * x3p + bv1 * vp
         e2 = a21 * x1p + a22 * x2p + a23 * x3p + bv2 * vp
         e3 = a31 * x1p + a32 * x2p + a33 * x3p + bv3 * vp
-        f2, es1, es2, i2 = _bridge_rates(vp, s1p, s2p, rect, inv_m)
+        f2, es1, es2, i2, drop2 = _bridge_rates(vp, s1p, s2p, rect, inv_m)
         acc2 += f2
         zn = z + (b1 * v + b2 * vp) * dt
         vn = v + (b1 * acc1 + b2 * acc2) * dt + nv
@@ -616,6 +637,7 @@ def rectified_step(
         s2n = s2 + (b1 * ds2 + b2 * es2) * dt
         current = b1 * abs(i1) + b2 * abs(i2)
         coil = (b1 * i1 * i1 + b2 * i2 * i2) * second if rkind == 1 else 0.0
+        diodes = b1 * drop1 * abs(i1) + b2 * drop2 * abs(i2)
         load = b1 * s2 * s2 + b2 * s2p * s2p
     if rkind == 2:
         s1n, s2n, dq = _piezo_clamp(s1n, s2n, rect)
@@ -623,20 +645,22 @@ def rectified_step(
     else:
         charge = current * dt
     stored = v_b * charge if output == 0 else load / r_load * dt
-    return zn, vn, tn, x1n, x2n, x3n, s1n, s2n, force, stored, coil * dt, 2.0 * v_d * charge
+    # the coil's diodes: their drop times the current at each stage; the piezo's: the charge
+    diode = diodes * dt if rkind == 1 else 2.0 * v_d * charge
+    return zn, vn, tn, x1n, x2n, x3n, s1n, s2n, force, stored, coil * dt, diode
 
 
 @numba.njit(cache=True, inline="always")
 def _bridge_rates(v, s1, s2, rect, inv_m):
-    """(acceleration (m/s^2), V_p', V_C', current (A)) of the bridge at (v, V_p, V_C)."""
+    """(acceleration (m/s^2), V_p', V_C', current (A), diodes' drop (V)) at (v, V_p, V_C)."""
     rkind, output, gain = rect[0], rect[1], rect[2]
     inv_cap, inv_rc = rect[10], rect[11]
     if rkind == 1:
-        i = _bridge_current(v, s2, rect)
+        i, drop = _bridge_current(v, s2, rect)
         ds2 = abs(i) * inv_cap - s2 * inv_rc if output == 1 else 0.0
-        return -gain * i * inv_m, 0.0, ds2, i
+        return -gain * i * inv_m, 0.0, ds2, i, drop
     ds2 = -s2 * inv_rc if output == 1 else 0.0
-    return -gain * s1 * inv_m, rect[9] * v, ds2, 0.0
+    return -gain * s1 * inv_m, rect[9] * v, ds2, 0.0, 0.0
 
 
 @numba.njit(cache=True, inline="always")
@@ -647,7 +671,7 @@ def rectified_white_step(z, v, theta, s1, s2, dt, noise, weights, drift, kind, p
     rkind, output, second, v_d, v_b, r_load = rect[0], rect[1], rect[3], rect[4], rect[5], rect[7]
     inv_m = drift[0]
     acc1, rate1, force = _acceleration(z, v, theta, drift, kind, p, fn)
-    f1, ds1, ds2, i1 = _bridge_rates(v, s1, s2, rect, inv_m)
+    f1, ds1, ds2, i1, drop1 = _bridge_rates(v, s1, s2, rect, inv_m)
     acc1 += f1
     if b2 == 0.0:
         zn = z + b1 * v * dt
@@ -657,6 +681,7 @@ def rectified_white_step(z, v, theta, s1, s2, dt, noise, weights, drift, kind, p
         s2n = s2 + b1 * ds2 * dt
         current = b1 * abs(i1)
         coil = b1 * i1 * i1
+        diodes = b1 * drop1 * abs(i1)
         load = b1 * s2 * s2
     else:
         zp = z + v * dt
@@ -667,7 +692,7 @@ def rectified_white_step(z, v, theta, s1, s2, dt, noise, weights, drift, kind, p
         if rkind == 2:
             s1p, s2p, _ = _piezo_clamp(s1p, s2p, rect)
         acc2, rate2, _ = _acceleration(zp, vp, tp, drift, kind, p, fn)
-        f2, es1, es2, i2 = _bridge_rates(vp, s1p, s2p, rect, inv_m)
+        f2, es1, es2, i2, drop2 = _bridge_rates(vp, s1p, s2p, rect, inv_m)
         acc2 += f2
         zn = z + (b1 * v + b2 * vp) * dt
         vn = v + (b1 * acc1 + b2 * acc2) * dt + noise
@@ -676,13 +701,16 @@ def rectified_white_step(z, v, theta, s1, s2, dt, noise, weights, drift, kind, p
         s2n = s2 + (b1 * ds2 + b2 * es2) * dt
         current = b1 * abs(i1) + b2 * abs(i2)
         coil = b1 * i1 * i1 + b2 * i2 * i2
+        diodes = b1 * drop1 * abs(i1) + b2 * drop2 * abs(i2)
         load = b1 * s2 * s2 + b2 * s2p * s2p
     if rkind == 2:
         s1n, s2n, charge = _piezo_clamp(s1n, s2n, rect)
     else:
         charge = current * dt
     stored = v_b * charge if output == 0 else load / r_load * dt
-    return zn, vn, tn, s1n, s2n, force, stored, coil * second * dt, 2.0 * v_d * charge
+    # the coil's diodes: their drop times the current at each stage; the piezo's: the charge
+    diode = diodes * dt if rkind == 1 else 2.0 * v_d * charge
+    return zn, vn, tn, s1n, s2n, force, stored, coil * second * dt, diode
 
 
 @numba.njit(cache=True, inline="always")
@@ -885,11 +913,12 @@ def run_ensemble(
     if rectifier is not None:
         rp = rectifier.p
         # (kind, output, gain, R_C or C_p, V_d, V_b, C, R_L) and, to spare divisions
-        # per step: 1/R_C, theta/C_p, 1/C, 1/(R_L C), C_p/(C_p + C), C/(C_p + C)
+        # per step: 1/R_C, theta/C_p, 1/C, 1/(R_L C), C_p/(C_p + C), C/(C_p + C);
+        # then the Shockley diodes' I_s (0: a constant drop) and 2 n V_T
         rect = (
             rectifier.kind, rectifier.output, rp[0], rp[1], rp[2], rp[3], rp[4], rp[5],
             1.0 / rp[1], rp[0] / rp[1], 1.0 / rp[4], 1.0 / (rp[5] * rp[4]),
-            rp[1] / (rp[1] + rp[4]), rp[4] / (rp[1] + rp[4]),
+            rp[1] / (rp[1] + rp[4]), rp[4] / (rp[1] + rp[4]), rp[6], 2.0 * rp[7],
         )  # fmt: skip
         # energy held by the piezo's and the storage capacitor's voltages: C_p/2, C/2
         half_cp = 0.5 * rp[1] if rectifier.kind == 2 else 0.0

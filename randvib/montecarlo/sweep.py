@@ -158,6 +158,8 @@ def _analytic(device: Harvester, psd: float) -> dict:
     for name, method in METHODS.items():
         if method.reference:  # too slow to run at every sweep point
             continue
+        if method.rectifier and not device.is_rectified:  # a diode bridge's method only
+            continue
         try:
             out[f"{name}_power"] = float(predict(device, psd, name).power_electrical)
         except (ValueError, NotImplementedError):
