@@ -70,7 +70,7 @@ def test_closure_within_its_declared_error_of_monte_carlo(output, fc):
     [
         (rv.BridgeCoil(ALPHA, R_COIL, battery=0.1), 0.25, "velocity std"),
         (rv.BridgeCoil(ALPHA, R_COIL, 0.01, None, 0.01, 2.0), 1.0, "natural periods"),
-        (rv.BridgePiezo(1e-3, 1e-7, battery=2.0), 1.0, "coil into a bridge of constant-drop"),
+        (rv.BridgePiezo(1e-3, 1e-7, battery=2.0), 1.0, "coil without inductance into a bridge"),
         (rv.BridgeCoil(ALPHA, R_COIL, battery=0.03), rv.BandPass(1.0, 8.0, 0.3), "white noise"),
     ],
 )

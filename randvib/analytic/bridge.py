@@ -136,8 +136,8 @@ class BridgeClosure(AnalyticMethod):
         reason = super().refusal(harvester, psd, who)
         if reason is None and not self._coil(harvester):
             return (
-                f"{who or self.called} treats a coil into a bridge of constant-drop diodes "
-                "(BridgeCoil without saturation_current) only; "
+                f"{who or self.called} treats a coil without inductance into a bridge of "
+                "constant-drop diodes (BridgeCoil without saturation_current) only; "
                 f"use {self._alternatives(harvester, psd)}"
             )
         return reason
@@ -145,7 +145,7 @@ class BridgeClosure(AnalyticMethod):
     @staticmethod
     def _coil(harvester) -> bool:
         coil = harvester.electrical
-        return isinstance(coil, BridgeCoil) and not coil.is_shockley
+        return isinstance(coil, BridgeCoil) and not coil.is_shockley and coil.inductance == 0
 
     def solve(self, harvester: Harvester, psd) -> PowerPrediction:
         coil = harvester.electrical

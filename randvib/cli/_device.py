@@ -192,17 +192,13 @@ def _bridge_from_args(args):
     options = _coupling_options()
     given = {n: getattr(args, n) for n in options if getattr(args, n, None) is not None}
     given.update({n: getattr(args, n) for n in BRIDGE_OPTIONS if getattr(args, n) is not None})
-    if given.pop("inductance", 0.0) != 0.0:
-        raise ValueError(
-            f"`--inductance` must be 0 with `--rectifier bridge` (the algebraic-current "
-            f"coil); got {args.inductance!r}"
-        )
     own = cls.parameter_names()
     owners = {name: [c.name for c in couplings] for name, couplings in options.items()}
     for name in BRIDGE_OPTIONS:  # the bridges' own options, by the bridges that declare them
         owners[name] = [c.name for c in RECTIFIED.values() if name in c.parameter_names()]
     refuse_foreign_options(given, own, owners, "the {owners} coupling", cls.name)
-    required = [n for n in transducer.parameter_names() if n in own and n != "r_load"]
+    optional = ("r_load", "inductance")  # the storage load; L defaults to 0
+    required = [n for n in transducer.parameter_names() if n in own and n not in optional]
     missing = [n for n in required if n not in given]
     if missing:
         raise ValueError(

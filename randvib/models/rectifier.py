@@ -30,7 +30,7 @@ from dataclasses import MISSING, dataclass, field, fields
 import numpy as np
 
 from randvib._validation import check_nonnegative, check_positive
-from randvib.models.coupling import Coupling, Piezo, Resistive
+from randvib.models.coupling import Coupling, Inductive, Piezo, Resistive
 from randvib.models.parameters import Parameter, parameter
 
 #: The rectified couplings by the name of the transducer they rectify (the
@@ -41,7 +41,7 @@ RECTIFIED: dict[str, type] = {}
 THERMAL_VOLTAGE = 0.025852
 
 #: Kernel codes of the transducer and of the output (:class:`randvib.montecarlo.kernel.Rectifier`).
-COIL, PIEZO = 1, 2
+COIL, PIEZO, INDUCTIVE_COIL = 1, 2, 3
 BATTERY, CAPACITOR = 0, 1
 
 
@@ -163,9 +163,14 @@ class Rectified(Coupling):
                 1.0 if self.has_battery else self.r_load,
                 self._shockley[0],
                 self._shockley[1],
+                getattr(self, "inductance", 0.0),
             ]
         )
-        return self._code, output, p
+        return self._kernel_code, output, p
+
+    @property
+    def _kernel_code(self) -> int:
+        return self._code
 
     def _transducer_parameters(self):  # pragma: no cover - abstract
         raise NotImplementedError
@@ -193,12 +198,15 @@ class Rectified(Coupling):
 
 @dataclass(frozen=True, eq=False)
 class BridgeCoil(Rectified):
-    """Electromagnetic coil into a full-wave bridge (inductance neglected, L = 0).
+    """Electromagnetic coil into a full-wave bridge.
 
     Back-EMF ``e = alpha z'``; the bridge conducts when ``|e| > V_out + 2 V_d``
     and then ``i = sgn(e) (|e| - V_out - 2 V_d) / R_C``, else ``i = 0``; force
     ``alpha i`` on the magnet (opposing its motion). ``V_out`` is the battery's
     ``V_b``, or the storage capacitor's ``V_C`` with ``C V_C' = |i| - V_C / R_L``.
+    With an inductance L > 0 the current is a state:
+    ``L i' = e - R_C i - sgn(i) (V_out + 2 V_d)`` while it flows; the diodes
+    hold it at 0 when it would reverse, until ``|e|`` exceeds the threshold.
 
     Parameters
     ----------
@@ -220,6 +228,8 @@ class BridgeCoil(Rectified):
     ideality, thermal_voltage : float
         The Shockley law's n (default 1) and V_T = k T / q (V, default
         0.025852, 300 K).
+    inductance : float
+        Coil inductance L (H), >= 0 (default 0: the algebraic current).
 
     Examples
     --------
@@ -238,6 +248,7 @@ class BridgeCoil(Rectified):
     saturation_current: float | None = _optional("A", "Shockley diodes' I_s", True)
     ideality: float = _with_default("", 1.0, "Shockley diodes' ideality factor n")
     thermal_voltage: float = _with_default("V", THERMAL_VOLTAGE, "thermal voltage k T / q")
+    inductance: float = _with_default("H", 0.0, "coil inductance L")
 
     transducer = "inductive"
     name = "inductive bridge"
@@ -250,6 +261,11 @@ class BridgeCoil(Rectified):
                 raise ValueError(
                     "give either `v_diode` (a constant drop) or `saturation_current` "
                     f"(Shockley diodes), not both; got v_diode = {self.v_diode!r}"
+                )
+            if self.inductance > 0:
+                raise ValueError(
+                    "Shockley diodes are implemented for the algebraic-current coil only: give "
+                    f"`inductance` = 0 with `saturation_current`; got {self.inductance!r} H"
                 )
             if not (self.ideality > 0 and self.thermal_voltage > 0):
                 raise ValueError(
@@ -271,8 +287,14 @@ class BridgeCoil(Rectified):
     def _transducer_parameters(self):
         return self.alpha, self.r_coil
 
+    @property
+    def _kernel_code(self) -> int:
+        return INDUCTIVE_COIL if self.inductance > 0 else COIL
+
     def linear_surrogate(self) -> Coupling:
-        """The conducting bridge's damper alpha^2 / R_C (the largest slope of the force)."""
+        """The conducting bridge: the damper alpha^2 / R_C, or the coil with its L > 0."""
+        if self.inductance > 0:
+            return Inductive(self.alpha, self.r_coil, 0.0, self.inductance)
         return Resistive(self.alpha, self.r_coil, 0.0)
 
     def fastest_rate(self) -> float:

@@ -310,9 +310,9 @@ class Rectifier(NamedTuple):
     """A full-wave bridge and its output (:mod:`randvib.models.rectifier`).
 
     ``kind`` 1: a coil (algebraic current, L = 0), 2: a piezo element (state
-    V_p); ``output`` 0: a battery, 1: a storage capacitor with its load (state
-    V_C). ``p = (gain, r_or_cp, V_d, V_b, C, R_L, I_s, n V_T)`` (I_s = 0: a
-    constant drop V_d; I_s > 0: Shockley diodes):
+    V_p), 3: a coil with inductance (state i); ``output`` 0: a battery, 1: a storage capacitor with its load (state
+    V_C). ``p = (gain, r_or_cp, V_d, V_b, C, R_L, I_s, n V_T, L)`` (I_s = 0: a
+    constant drop V_d; I_s > 0: Shockley diodes; L the coil's inductance):
     :meth:`randvib.models.rectifier.Rectified.kernel_parameters`.
     ``v_c0`` (V): the storage capacitor's voltage at t = 0.
     """
@@ -569,7 +569,9 @@ def rectified_step(
     auxiliary step; the bridge adds its force and its states: ``s2`` = V_C
     of a storage capacitor (C V_C' = |i| - V_C / R_L), ``s1`` = V_p of a
     piezo element (C_p V_p' = theta v, clamped by :func:`_piezo_clamp` after
-    each stage, the excess charge through the bridge). The bridge's current
+    each stage, the excess charge through the bridge) or the current i of a
+    coil with inductance (L i' = e - R_C i - sgn(i) V_th; held at 0 when the
+    diodes would let it reverse, until |e| exceeds V_th). The bridge's current
     is continuous in the state for the coil (a dead zone) and the clamp a
     projection for the piezo, so the scheme keeps its form but not its
     smooth-problem order (docs/conventions.md; the tests measure it).
@@ -606,7 +608,7 @@ def rectified_step(
         s1n = s1 + b1 * ds1 * dt
         s2n = s2 + b1 * ds2 * dt
         current = b1 * abs(i1)
-        coil = b1 * i1 * i1 * second if rkind == 1 else 0.0
+        coil = b1 * i1 * i1 * second if rkind != 2 else 0.0
         diodes = b1 * drop1 * abs(i1)
         load = b1 * s2 * s2
     else:
@@ -620,6 +622,8 @@ def rectified_step(
         s2p = s2 + ds2 * dt
         if rkind == 2:
             s1p, s2p, _ = _piezo_clamp(s1p, s2p, rect)
+        elif rkind == 3 and s1p * s1 < 0.0:  # the diodes block the reverse current
+            s1p = 0.0
         acc2, rate2, _ = _acceleration(zp, vp, tp, drift, kind, p, fn)
         acc2 -= c1 * x1p + c2 * x2p + c3 * x3p
         e1 = a11 * x1p + a12 * x2p + a13 * x3p + bv1 * vp
@@ -636,7 +640,7 @@ def rectified_step(
         s1n = s1 + (b1 * ds1 + b2 * es1) * dt
         s2n = s2 + (b1 * ds2 + b2 * es2) * dt
         current = b1 * abs(i1) + b2 * abs(i2)
-        coil = (b1 * i1 * i1 + b2 * i2 * i2) * second if rkind == 1 else 0.0
+        coil = (b1 * i1 * i1 + b2 * i2 * i2) * second if rkind != 2 else 0.0
         diodes = b1 * drop1 * abs(i1) + b2 * drop2 * abs(i2)
         load = b1 * s2 * s2 + b2 * s2p * s2p
     if rkind == 2:
@@ -644,9 +648,11 @@ def rectified_step(
         charge = dq  # the piezo's bridge charge of the step (C)
     else:
         charge = current * dt
+        if rkind == 3 and s1n * s1 < 0.0:  # the diodes block the reverse current
+            s1n = 0.0
     stored = v_b * charge if output == 0 else load / r_load * dt
     # the coil's diodes: their drop times the current at each stage; the piezo's: the charge
-    diode = diodes * dt if rkind == 1 else 2.0 * v_d * charge
+    diode = diodes * dt if rkind != 2 else 2.0 * v_d * charge
     return zn, vn, tn, x1n, x2n, x3n, s1n, s2n, force, stored, coil * dt, diode
 
 
@@ -659,6 +665,19 @@ def _bridge_rates(v, s1, s2, rect, inv_m):
         i, drop = _bridge_current(v, s2, rect)
         ds2 = abs(i) * inv_cap - s2 * inv_rc if output == 1 else 0.0
         return -gain * i * inv_m, 0.0, ds2, i, drop
+    if rkind == 3:  # a coil with inductance: the current s1 is a state
+        i = s1
+        v_th = (rect[5] if output == 0 else s2) + 2.0 * rect[4]
+        e = gain * v
+        if i > 0.0:
+            di = (e - rect[3] * i - v_th) * rect[16]
+        elif i < 0.0:
+            di = (e - rect[3] * i + v_th) * rect[16]
+        else:  # blocked: the bridge opens once |e| exceeds the threshold
+            over = abs(e) - v_th
+            di = 0.0 if over <= 0.0 else (over if e > 0.0 else -over) * rect[16]
+        ds2 = abs(i) * inv_cap - s2 * inv_rc if output == 1 else 0.0
+        return -gain * i * inv_m, di, ds2, i, 2.0 * rect[4]
     ds2 = -s2 * inv_rc if output == 1 else 0.0
     return -gain * s1 * inv_m, rect[9] * v, ds2, 0.0, 0.0
 
@@ -691,6 +710,8 @@ def rectified_white_step(z, v, theta, s1, s2, dt, noise, weights, drift, kind, p
         s2p = s2 + ds2 * dt
         if rkind == 2:
             s1p, s2p, _ = _piezo_clamp(s1p, s2p, rect)
+        elif rkind == 3 and s1p * s1 < 0.0:  # the diodes block the reverse current
+            s1p = 0.0
         acc2, rate2, _ = _acceleration(zp, vp, tp, drift, kind, p, fn)
         f2, es1, es2, i2, drop2 = _bridge_rates(vp, s1p, s2p, rect, inv_m)
         acc2 += f2
@@ -707,9 +728,11 @@ def rectified_white_step(z, v, theta, s1, s2, dt, noise, weights, drift, kind, p
         s1n, s2n, charge = _piezo_clamp(s1n, s2n, rect)
     else:
         charge = current * dt
+        if rkind == 3 and s1n * s1 < 0.0:  # the diodes block the reverse current
+            s1n = 0.0
     stored = v_b * charge if output == 0 else load / r_load * dt
     # the coil's diodes: their drop times the current at each stage; the piezo's: the charge
-    diode = diodes * dt if rkind == 1 else 2.0 * v_d * charge
+    diode = diodes * dt if rkind != 2 else 2.0 * v_d * charge
     return zn, vn, tn, s1n, s2n, force, stored, coil * second * dt, diode
 
 
@@ -914,14 +937,16 @@ def run_ensemble(
         rp = rectifier.p
         # (kind, output, gain, R_C or C_p, V_d, V_b, C, R_L) and, to spare divisions
         # per step: 1/R_C, theta/C_p, 1/C, 1/(R_L C), C_p/(C_p + C), C/(C_p + C);
-        # then the Shockley diodes' I_s (0: a constant drop) and 2 n V_T
+        # then the Shockley diodes' I_s (0: a constant drop) and 2 n V_T, and 1/L
         rect = (
             rectifier.kind, rectifier.output, rp[0], rp[1], rp[2], rp[3], rp[4], rp[5],
             1.0 / rp[1], rp[0] / rp[1], 1.0 / rp[4], 1.0 / (rp[5] * rp[4]),
             rp[1] / (rp[1] + rp[4]), rp[4] / (rp[1] + rp[4]), rp[6], 2.0 * rp[7],
+            1.0 / rp[8] if rp[8] > 0.0 else 0.0,
         )  # fmt: skip
         # energy held by the piezo's and the storage capacitor's voltages: C_p/2, C/2
-        half_cp = 0.5 * rp[1] if rectifier.kind == 2 else 0.0
+        # the piezo's C_p V_p^2 / 2, or the coil's L i^2 / 2 (s1 is V_p or i)
+        half_cp = 0.5 * rp[1] if rectifier.kind == 2 else 0.5 * rp[8]
         half_c = 0.5 * rp[4] if rectifier.output == 1 else 0.0
         v_c0 = rectifier.v_c0
         v_out_b = rp[3]
@@ -962,7 +987,7 @@ def run_ensemble(
         a = np.zeros((LANES, N_ACC))
         a[:, ACC_FIRST_HIT] = -1.0
         if rectifier is not None:
-            s1 = np.zeros(LANES)  # piezo voltage V_p (V)
+            s1 = np.zeros(LANES)  # piezo voltage V_p (V), or the inductive coil's current (A)
             s2 = np.full(LANES, v_c0)  # storage capacitor voltage V_C (V)
             inv_dt = 1.0 / dt
         if auxiliary is not None:
