@@ -989,7 +989,6 @@ def run_ensemble(
         if rectifier is not None:
             s1 = np.zeros(LANES)  # piezo voltage V_p (V), or the inductive coil's current (A)
             s2 = np.full(LANES, v_c0)  # storage capacitor voltage V_C (V)
-            inv_dt = 1.0 / dt
         if auxiliary is not None:
             step_block = block
         if transient is not None:
@@ -1066,9 +1065,10 @@ def run_ensemble(
                             fr_p, fr_fn, rect,
                         )  # fmt: skip
                     if in_window:
-                        a[j, ACC_STORED] += e_s * inv_dt
-                        a[j, ACC_COIL_LOSS] += e_c * inv_dt
-                        a[j, ACC_DIODE_LOSS] += e_d * inv_dt
+                        # energies (J); divided by the window (s) at the end
+                        a[j, ACC_STORED] += e_s
+                        a[j, ACC_COIL_LOSS] += e_c
+                        a[j, ACC_DIODE_LOSS] += e_d
                         a[j, ACC_V_OUT] += v_out
                 elif auxiliary is not None and filter_only:
                     zn, vn, tn, x1[j], x2[j], f1 = filter_step(
@@ -1184,7 +1184,7 @@ def run_ensemble(
             for q in range(N_ACC):
                 if q == ACC_H0 or q == ACC_H1 or q == ACC_FIRST_HIT:
                     acc[p, q] = a[j, q]
-                elif q == ACC_VDW:
+                elif q == ACC_VDW or q == ACC_STORED or q == ACC_COIL_LOSS or q == ACC_DIODE_LOSS:
                     acc[p, q] = a[j, q] / window
                 else:
                     acc[p, q] = a[j, q] * inv_window_steps
