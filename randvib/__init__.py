@@ -66,6 +66,7 @@ _EXPORTS = {
     "randvib.analytic.method": ("AnalyticMethod",),
     "randvib.analytic.power_prediction": ("PowerPrediction",),
     "randvib.analytic.bridge": ("DcOptimum", "optimal_dc_output"),
+    "randvib.montecarlo.bridge_optimum": ("simulated_dc_optimum",),
     "randvib.analytic.prediction": (
         "expected_power",
         "METHODS",

@@ -19,7 +19,8 @@ Exact references and limits (docs/conventions.md, "Full-wave bridge"):
 Covers :mod:`randvib.models.rectifier`, the bridge in the kernel
 (:mod:`randvib.montecarlo.kernel`, :mod:`randvib.montecarlo.kernel_setup`), its
 statistics (:mod:`randvib.montecarlo.results`), its step check
-(:mod:`randvib.montecarlo.bridge_step`) and its command-line options
+(:mod:`randvib.montecarlo.bridge_step`), the best output by Monte Carlo
+(:mod:`randvib.montecarlo.bridge_optimum`) and its command-line options
 (:mod:`randvib.cli._device`, ``randvib simulate``).
 """
 
@@ -258,6 +259,22 @@ def test_coil_inductance_tends_to_the_algebraic_current():
         device(rv.BridgeCoil(ALPHA, R_COIL, 0.005, 0.01, inductance=1e-2)), S, **kw
     )
     assert slow.power_stored.mean < 0.95 * stored[0.0]
+
+
+def test_simulated_optimum_agrees_with_the_closure_and_takes_any_bridge():
+    """Coil, white: the grid's optimum within one grid step (10 mV) of the closure's.
+
+    Piezo under band-pass input (no analytic method takes it): an interior maximum.
+    """
+    coil = device(rv.BridgeCoil(ALPHA, R_COIL, v_diode=0.01, battery=0.03))
+    mc = rv.simulated_dc_optimum(coil, S, (0.0, 0.08), n_paths=32, t_end=8.0)
+    assert mc.where == "interior" and mc.parameter == "battery"
+    assert abs(mc.value - rv.optimal_dc_output(coil, S).value) <= 0.01
+    piezo = device(rv.BridgePiezo(1e-3, 1e-7, v_diode=0.1, battery=2.0))
+    best = rv.simulated_dc_optimum(piezo, rv.BandPass(1.0, 8.0, 0.3), (0.5, 60.0), n_paths=16)
+    assert best.where == "interior" and 0.5 < best.value < 60.0
+    with pytest.raises(ValueError, match="`bounds` must be"):
+        rv.simulated_dc_optimum(coil, S, (0.05, 0.01))
 
 
 def test_bridge_under_synthesised_input_follows_the_resistive_device():
