@@ -10,8 +10,9 @@ Carlo integrates them in the compiled kernel (:class:`kernel.Rectifier
 that it takes them (:attr:`randvib.analytic.method.AnalyticMethod.rectifier`).
 
 * :class:`BridgeCoil`: back-EMF ``e = alpha z'``, threshold
-  ``V_th = V_out + 2 V_d``; ``i = sgn(e) max(0, |e| - V_th) / R_C`` (L = 0);
-  force ``alpha i`` on the magnet.
+  ``V_th = V_out + 2 V_d``; ``i = sgn(e) max(0, |e| - V_th) / R_C`` (L = 0;
+  with an inductance the current is a state, and Shockley diodes replace
+  the constant drop); force ``alpha i`` on the magnet.
 * :class:`BridgePiezo`: ``C_p V_p' = theta z' - i_b`` with ``|V_p| <= V_th``;
   the bridge current ``i_b`` flows only while ``|V_p| = V_th``; force
   ``theta V_p`` on the mass.

@@ -13,7 +13,10 @@ resistive (viscous) circuit, the compile-time fast path, and
 :func:`auxiliary_step` for the device with up to :data:`N_AUX` linear
 auxiliary states (:class:`Auxiliary`: an excitation's shaping filter and/or a
 circuit's current or voltage), one compiled path for every excitation x
-coupling combination.
+coupling combination. A diode bridge (:class:`Rectifier`) has its own
+steps, :func:`rectified_white_step` (white or given input) and
+:func:`rectified_step` (with a shaping filter), compiled only when a bridge
+is simulated.
 
 Memory is O(n_paths): per-path running sums only, unless histograms or
 recorded histories are requested.

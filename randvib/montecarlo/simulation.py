@@ -22,6 +22,12 @@ A coupling with a circuit state (coil inductance, piezo capacitance;
 force ``f x`` on the magnet, to the same linear auxiliary block; the kernel
 averages x^2 per path, so the circuit's power comes with its interval.
 
+A diode bridge (:mod:`randvib.models.rectifier`) is integrated by the
+kernel's rectified steps, with its stored power, coil and diode losses per
+path; a run checks its step by halving it on a pilot ensemble
+(:mod:`randvib.montecarlo.bridge_step`) and, under white noise, that every
+dissipation path sums to m S / 4.
+
 Each path is an independent realisation; statistics are time averages over
 the window [burn_in, t_end) on each path, and their confidence intervals come
 from the spread between paths (independent by construction), so they do not
