@@ -22,6 +22,7 @@ from randvib.models.excitation import Excitation
 from randvib.models.friction import kernel_arguments
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import kernel
+from randvib.montecarlo.bridge_step import storage_start
 from randvib.montecarlo.rng import ZIG_FI, ZIG_KI, ZIG_WI
 from randvib.montecarlo.step_check import coarsened
 from randvib.montecarlo.validation import Run
@@ -63,7 +64,7 @@ class KernelSetup:
             companion=companion,
             recording=_recording(run, linear),
             auxiliary=_auxiliary(run, linear),
-            rectifier=_rectifier(h),
+            rectifier=_rectifier(run),
         )
 
     def arguments(self, run: Run, lo: int, hi: int) -> dict:
@@ -139,17 +140,18 @@ def _auxiliary(run: Run, linear) -> kernel.Auxiliary | None:
     return kernel.pack(kernel.Auxiliary, n_states, coefficients, square, chol)
 
 
-def _rectifier(harvester: Harvester) -> kernel.Rectifier | None:
+def _rectifier(run: Run) -> kernel.Rectifier | None:
     """The kernel's bridge (:class:`randvib.montecarlo.kernel.Rectifier`); None without one.
 
-    The storage capacitor starts empty (V_C = 0): the burn-in must cover its
-    charging (:func:`randvib.montecarlo.validation.check_options` warns when
-    it is shorter than a few R_L C).
+    The storage capacitor starts at :func:`~randvib.montecarlo.bridge_step.storage_start`
+    (its charge-balance level where the closure gives one, else empty: then
+    :func:`randvib.montecarlo.validation.check_options` warns when the
+    burn-in is shorter than a few R_L C).
     """
-    if not harvester.is_rectified:
+    if not run.harvester.is_rectified:
         return None
-    code, output, p = harvester.electrical.kernel_parameters()
-    return kernel.pack(kernel.Rectifier, code, output, p, 0.0)
+    code, output, p = run.harvester.electrical.kernel_parameters()
+    return kernel.pack(kernel.Rectifier, code, output, p, storage_start(run))
 
 
 def _driven_circuit_variance(harvester: Harvester, excitation: Excitation) -> float:

@@ -21,6 +21,7 @@ from randvib.models.excitation import Excitation, as_excitation
 from randvib.models.harvester import Harvester
 from randvib.models.potential import CONFINING
 from randvib.montecarlo import driven
+from randvib.montecarlo.bridge_step import storage_start
 from randvib.montecarlo.integrators import Integrator, integrator
 from randvib.montecarlo.options import InitialState, RecordOptions, TimeGrid
 
@@ -201,8 +202,9 @@ class BridgeStartWarning(RuntimeWarning):
 def _check_bridge(run: Run) -> None:
     """A bridge's options: no companion; a step that resolves its output's RC rate.
 
-    The storage capacitor starts empty, so a burn-in shorter than
-    3 R_L C (about 95 % of its charging) is warned about; a step above
+    A storage capacitor that starts empty
+    (:func:`~randvib.montecarlo.bridge_step.storage_start`) makes a burn-in
+    shorter than 3 R_L C (about 95 % of its charging) warned about; a step above
     0.2 / rate (the charging and load rate 1/(R_C C) + 1/(R_L C) of a coil,
     1/(R_L C) of a piezo) would make the explicit scheme's V_C step
     inaccurate or unstable and is refused.
@@ -219,7 +221,7 @@ def _check_bridge(run: Run) -> None:
             f"`dt` = {run.grid.dt!r} s is too large for the {bridge.name}'s storage "
             f"capacitor (its fastest rate {rate:.3g} 1/s): use dt <= {0.2 / rate:.3g} s"
         )
-    if not bridge.has_battery:
+    if not bridge.has_battery and storage_start(run) == 0.0:  # it starts empty
         settle = 3.0 * bridge.r_load * bridge.storage_capacitance
         if run.grid.burn_in < settle:
             warnings.warn(
