@@ -39,7 +39,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy import optimize, special
 
-from randvib.analytic.linearisation import _solve_velocity_std, linear_displacement_variance
+from randvib.analytic.linearisation import linear_displacement_variance
 from randvib.analytic.method import AnalyticMethod, Validity
 from randvib.analytic.power_prediction import PowerPrediction
 from randvib.models.harvester import Harvester
@@ -79,15 +79,25 @@ def bridge_moments(coil: BridgeCoil, sigma_v: float, v_out: float):
 
 
 def _velocity_std(harvester: Harvester, psd: float, v_out: float) -> float:
-    """sigma_v of the white-noise energy identity with the bridge at output voltage ``v_out``."""
+    """sigma_v of the white-noise energy identity with the bridge at output voltage ``v_out``.
+
+    ``c_m s^2 + E_s[v F] + E_s[v F_e] = S m / 4`` is increasing in s (every
+    term is), so Brent's method in log s on a bracket where it changes sign
+    finds its one root (to float64 precision).
+    """
     coil, law = harvester.electrical, harvester.friction
+    c_m, target = float(harvester.c_m), psd * float(harvester.m) / 4.0
 
-    def mean_velocity_force(s):
-        s = np.asarray(s, dtype=float)
-        bridge = np.vectorize(lambda x: bridge_moments(coil, float(x), v_out)[0])(s)
-        return bridge + (0.0 if law is None else law.mean_velocity_force(s))
+    def excess(log_s):
+        s = float(np.exp(log_s))
+        friction = 0.0 if law is None else float(law.mean_velocity_force(s))
+        return c_m * s * s + friction + bridge_moments(coil, s, v_out)[0] - target
 
-    return float(_solve_velocity_std(harvester.c_m, harvester.m, psd, mean_velocity_force))
+    hi = np.sqrt(target / c_m) if c_m > 0 else np.sqrt(target)
+    while excess(np.log(hi)) < 0.0:  # without c_m: grow until the dissipation exceeds the input
+        hi *= 4.0
+    lo = hi * 1e-12
+    return float(np.exp(optimize.brentq(excess, np.log(lo), np.log(hi), xtol=1e-14, rtol=1e-15)))
 
 
 def capacitor_level(harvester: Harvester, psd: float) -> float:
