@@ -53,6 +53,7 @@ _EXPORTS = {
     "randvib.models.friction": ("Coulomb", "FrictionModel", "LuGre", "Tanh"),
     "randvib.models.harvester": ("Harvester",),
     "randvib.models.coupling": ("Coupling", "COUPLINGS", "Inductive", "Piezo", "Resistive"),
+    "randvib.models.rectifier": ("BridgeCoil", "BridgePiezo", "RECTIFIED", "Rectified"),
     "randvib.identification.cost": ("normalised_cost",),
     "randvib.identification.models": ("MeasurementModel",),
     "randvib.identification.identify": ("identify",),
@@ -64,6 +65,8 @@ _EXPORTS = {
     "randvib.analytic.linearisation": ("coulomb_equivalent_damping", "equivalent_damping"),
     "randvib.analytic.method": ("AnalyticMethod",),
     "randvib.analytic.power_prediction": ("PowerPrediction",),
+    "randvib.analytic.bridge": ("DcOptimum", "optimal_dc_output"),
+    "randvib.montecarlo.bridge_optimum": ("simulated_dc_optimum",),
     "randvib.analytic.prediction": (
         "expected_power",
         "METHODS",

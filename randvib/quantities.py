@@ -86,6 +86,11 @@ QUANTITIES: dict[str, Quantity] = {
     "power_load": Quantity("W", "expected power into the load E[i^2 R_L]", "E[P_L]"),
     "power_mechanical": Quantity("W", "power dissipated mechanically: c_m E[z'^2] + friction"),
     "friction_power": Quantity("W", "power dissipated by friction E[z' F]"),
+    "power_stored": Quantity(
+        "W", "power stored through a bridge: V_b E|i| or E[V_C^2] / R_L", "E[P_stored]"
+    ),
+    "power_coil_loss": Quantity("W", "power lost in the coil's resistance R_C E[i^2]"),
+    "power_diode_loss": Quantity("W", "power lost in the bridge's diodes 2 V_d E|i|"),
     "c_eq": Quantity("Ns/m", "equivalent viscous damping (Eq. 19, 30)", "c_eq"),
     "k_eq": Quantity("N/m", "equivalent linear stiffness", "k_eq"),
     "velocity_variance": Quantity("(m/s)^2", "velocity variance E[z'^2] (Eq. 20)", "E[v^2]"),
@@ -113,6 +118,8 @@ QUANTITIES: dict[str, Quantity] = {
     ),
     "r_load_optimal": Quantity("ohm", "load resistance of the largest load power"),
     "power_load_optimal": Quantity("W", "load power at the optimal load resistance"),
+    "battery_optimal": Quantity("V", "battery voltage of the largest stored power"),
+    "power_stored_optimal": Quantity("W", "stored power at the optimal bridge output"),
 }
 
 #: Quantities measured in the unit of a coupling's circuit state, squared.

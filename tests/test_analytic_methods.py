@@ -89,13 +89,17 @@ ACCEPTED = {
 }
 
 
-def test_the_registry_lists_the_four_methods_in_order():
-    assert list(rv.METHODS) == ["linearisation", "averaging", "fpk-fast", "fpk"]
+def test_the_registry_lists_the_methods_in_order():
+    assert list(rv.METHODS) == ["linearisation", "averaging", "fpk-fast", "fpk", "bridge-closure"]
     for name, method in rv.METHODS.items():
         assert isinstance(method, rv.AnalyticMethod) and method.name == name
         assert method.summary and method.title
     assert [n for n, m in rv.METHODS.items() if m.coloured or m.circuit] == ["linearisation"]
-    assert [n for n, m in rv.METHODS.items() if not m.stroke_exceedance] == ["averaging"]
+    assert [n for n, m in rv.METHODS.items() if not m.stroke_exceedance] == [
+        "averaging",
+        "bridge-closure",
+    ]
+    assert [n for n, m in rv.METHODS.items() if m.rectifier] == ["bridge-closure"]
     assert [n for n, m in rv.METHODS.items() if m.reference] == ["fpk"]
 
 

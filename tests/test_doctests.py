@@ -19,6 +19,7 @@ import pytest
 PACKAGE = Path(__file__).resolve().parents[1] / "randvib"
 
 MODULES = (
+    "randvib.analytic.bridge",
     "randvib.analytic.linearisation",
     "randvib.analytic.prediction",
     "randvib.analytic.statistical_linearisation",
@@ -33,6 +34,7 @@ MODULES = (
     "randvib.models.harvester",
     "randvib.models.presets",
     "randvib.models.record",
+    "randvib.models.rectifier",
     "randvib.montecarlo.simulation",
     "randvib.montecarlo.sweep",
     "randvib.quantities",

@@ -121,7 +121,7 @@ def test_the_law_is_registered_everywhere_from_its_class():
     law = Stribeck(FC, 2 * FC, 0.02, 0.0)
     # memoryless but not of the form Fc tanh(beta v): linearisation's alone, by the declarations
     accepting = [name for name, method in rv.METHODS.items() if method.accepts_friction(law)]
-    assert accepting == ["linearisation"]
+    assert accepting == ["linearisation", "bridge-closure"]  # the bridge's closure: any memoryless
     refusal = "form Fc tanh.*'stribeck-test' is not of that form: use method='linearisation' or"
     with pytest.raises(ValueError, match=refusal):
         rv.predict(_with(law), 0.5, "fpk-fast")

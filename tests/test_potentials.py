@@ -177,6 +177,8 @@ def test_power_without_friction_is_independent_of_the_potential(k, k3):
     exact = h.c_e * S * M / (4 * C)
     tolerance = {"linearisation": 1e-14, "fpk": 1e-5, "fpk-fast": 1e-4, "averaging": 1e-6}
     for method in rv.METHODS:
+        if rv.METHODS[method].rectifier:  # a diode bridge's method: no bridge here
+            continue
         if method == "averaging" and h.potential.kind != "monostable":
             with pytest.raises(ValueError, match="fpk-fast"):
                 rv.predict(h, S, method)

@@ -119,6 +119,8 @@ class AnalyticMethod:
     coloured: bool = False
     #: Accepts a coupling with a circuit state (the others assume a viscous c_e).
     circuit: bool = False
+    #: Accepts a coupling through a diode bridge (:mod:`randvib.models.rectifier`).
+    rectifier: bool = False
     #: Potential kinds it treats (see :data:`randvib.models.potential.KINDS`).
     potentials: tuple[str, ...] = CONFINING + ("free",)
     #: The friction laws it treats: a key of :data:`FRICTION_FORMS`.
@@ -197,6 +199,11 @@ class AnalyticMethod:
             return (
                 f"{who} assumes resistive coupling (a viscous electrical damper); the "
                 f"{harvester.electrical.name} coupling's circuit state needs {others()}"
+            )
+        if harvester.is_rectified and not self.rectifier:
+            return (
+                f"{who} assumes a linear coupling; the {harvester.electrical.name}'s "
+                f"switching diodes need {others()}"
             )
         if non_white(psd) and not self.coloured:
             return f"{who} assumes white noise; the {psd.name} excitation needs {others()}"

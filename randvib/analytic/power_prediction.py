@@ -47,7 +47,11 @@ class PowerPrediction:
         P(|z| > stroke), the stationary fraction of time beyond the
         harvester's stroke; None without a stroke, for the free mass and for
         methods that do not give it (their ``stroke_exceedance`` declaration
-        is False). Linearisation's is the Gaussian estimate
+        is False).
+    power_stored, power_coil_loss, power_diode_loss, power_mechanical : float or None
+        With a diode bridge (:mod:`randvib.models.rectifier`): the stored
+        power, the coil's and the diodes' losses and c_m E[z'^2] + E[z' F]
+        (W); None otherwise (and left out of :meth:`to_dict`). Linearisation's is the Gaussian estimate
         erfc(stroke / sqrt(2 E[z^2])) (approximate; far off for a double
         well, see :mod:`randvib.analytic.linearisation`).
 
@@ -64,6 +68,10 @@ class PowerPrediction:
     power_load: object = None
     circuit_mean_square: object = None
     stroke_exceedance: object = None
+    power_stored: object = None
+    power_coil_loss: object = None
+    power_diode_loss: object = None
+    power_mechanical: object = None
 
     @classmethod
     def from_white_noise(
@@ -112,7 +120,7 @@ class PowerPrediction:
         ``circuit_mean_square`` and ``stroke_exceedance`` only when given.
         """
         out = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()}
-        for optional in ("circuit_mean_square", "stroke_exceedance"):
+        for optional in ("circuit_mean_square", "stroke_exceedance", *BRIDGE_POWERS):
             if out[optional] is None:
                 del out[optional]
         return out
@@ -164,7 +172,14 @@ SHOWN = (
     "mean_abs_velocity",
     "circuit_mean_square",
     "stroke_exceedance",
+    "power_stored",
+    "power_coil_loss",
+    "power_diode_loss",
+    "power_mechanical",
 )
+
+#: A bridge's powers (:mod:`randvib.analytic.bridge`), None without one.
+BRIDGE_POWERS = ("power_stored", "power_coil_loss", "power_diode_loss", "power_mechanical")
 
 
 def gaussian_exceedance(stroke, displacement_variance):

@@ -30,6 +30,7 @@ from randvib._validation import (
     check_scalar_device,
 )
 from randvib.analytic.averaging import AVERAGING
+from randvib.analytic.bridge import BRIDGE_CLOSURE
 from randvib.analytic.fokker_planck import FAST_FOKKER_PLANCK, FOKKER_PLANCK
 from randvib.analytic.method import AnalyticMethod, non_white, white_level
 from randvib.analytic.power_prediction import PowerPrediction
@@ -48,7 +49,8 @@ from randvib.models.harvester import Harvester
 #: and Richardson extrapolation, fast enough for sweeps; ``"fpk"``: the same
 #: equation on fine grids, the slow reference (:mod:`randvib.analytic.fokker_planck`).
 METHODS: dict[str, AnalyticMethod] = {
-    method.name: method for method in (LINEARISATION, AVERAGING, FAST_FOKKER_PLANCK, FOKKER_PLANCK)
+    method.name: method
+    for method in (LINEARISATION, AVERAGING, FAST_FOKKER_PLANCK, FOKKER_PLANCK, BRIDGE_CLOSURE)
 }
 
 
@@ -138,7 +140,7 @@ def _refuse_undamped(harvester: Harvester) -> None:
     """
     c = np.asarray(harvester.c_m + harvester.c_e, dtype=float)
     friction = harvester.friction
-    if harvester.has_circuit:
+    if harvester.has_circuit or harvester.is_rectified:
         return
     if np.any(c == 0) and (friction is None or friction.vanishes):
         raise ValueError(

@@ -8,6 +8,13 @@ from randvib.models.coupling import COUPLINGS, coupling_class
 from randvib.models.friction import FRICTION_MODELS, RegistryView
 from randvib.models.harvester import ElectricalDampingOverflow, Harvester
 from randvib.models.presets import PRESETS, preset
+from randvib.models.rectifier import RECTIFIED
+
+#: The bridge's own options (the transducer's come from its coupling's declaration).
+BRIDGE_OPTIONS = (
+    "v_diode", "battery", "storage_capacitance", "saturation_current", "ideality",
+    "thermal_voltage",
+)  # fmt: skip
 
 #: ``--friction`` choices: ``none`` and every registered law (live view).
 FRICTION_CHOICES = RegistryView(lambda law: law)
@@ -107,6 +114,27 @@ def add_device_arguments(parser: argparse.ArgumentParser) -> None:
             help=f"{spec.description} ({spec.unit}); {', '.join(c.name for c in couplings)}",
         )
     g.add_argument(
+        "--rectifier",
+        choices=("bridge",),
+        help="rectify the inductive or piezo coupling's output with a full-wave diode bridge "
+        "into --battery or --storage-capacitance with --r-load (--inductance then defaults "
+        "to 0, the algebraic-current case)",
+    )
+    g.add_argument("--v-diode", type=float, help="forward drop of each diode V_d (V); bridge")
+    g.add_argument("--battery", type=float, help="battery voltage V_b (V); bridge")
+    g.add_argument(
+        "--storage-capacitance", type=float, help="storage capacitor C (F), with --r-load; bridge"
+    )
+    g.add_argument(
+        "--saturation-current",
+        type=float,
+        help="Shockley diodes' saturation current I_s (A) instead of --v-diode; inductive bridge",
+    )
+    g.add_argument("--ideality", type=float, help="Shockley diodes' ideality factor n (default 1)")
+    g.add_argument(
+        "--thermal-voltage", type=float, help="Shockley diodes' k T / q (V, default 0.025852)"
+    )
+    g.add_argument(
         "--psd", type=float, default=None, help="one-sided base-acceleration PSD S ((m/s^2)^2/Hz)"
     )
 
@@ -151,8 +179,47 @@ def harvester_from_args(args) -> Harvester:
     return Harvester(friction=friction, stroke=args.stroke, **values)
 
 
+def _bridge_from_args(args):
+    """The rectified coupling of ``--rectifier bridge`` (:mod:`randvib.models.rectifier`)."""
+    if args.c_e is not None:
+        raise ValueError("give either `--c-e` or `--rectifier bridge`, not both")
+    if args.coupling not in RECTIFIED:
+        raise ValueError(
+            f"`--rectifier bridge` needs `--coupling {'|'.join(RECTIFIED)}`; got {args.coupling!r}"
+        )
+    cls = RECTIFIED[args.coupling]
+    transducer = COUPLINGS[args.coupling]
+    options = _coupling_options()
+    given = {n: getattr(args, n) for n in options if getattr(args, n, None) is not None}
+    given.update({n: getattr(args, n) for n in BRIDGE_OPTIONS if getattr(args, n) is not None})
+    own = cls.parameter_names()
+    owners = {name: [c.name for c in couplings] for name, couplings in options.items()}
+    for name in BRIDGE_OPTIONS:  # the bridges' own options, by the bridges that declare them
+        owners[name] = [c.name for c in RECTIFIED.values() if name in c.parameter_names()]
+    refuse_foreign_options(given, own, owners, "the {owners} coupling", cls.name)
+    optional = ("r_load", "inductance")  # the storage load; L defaults to 0
+    required = [n for n in transducer.parameter_names() if n in own and n not in optional]
+    missing = [n for n in required if n not in given]
+    if missing:
+        raise ValueError(
+            f"the {cls.name} needs {', '.join(f'`{option_flag(n)}`' for n in missing)}"
+        )
+    try:
+        return cls(**given)
+    except ValueError as exc:  # name the flag, not the parameter
+        message = str(exc)
+        for name in own:
+            message = message.replace(f"`{name}`", f"`{option_flag(name)}`")
+        raise ValueError(message) from None
+
+
 def _coupling_from_args(args):
     """The coupling from ``--coupling`` and its parameter options, or None (``--c-e``)."""
+    if getattr(args, "rectifier", None) is not None:
+        return _bridge_from_args(args)
+    bridge = [n for n in BRIDGE_OPTIONS if getattr(args, n, None) is not None]
+    if bridge:
+        raise ValueError(f"`{option_flag(bridge[0])}` needs `--rectifier bridge`")
     options = _coupling_options()
     given = {n: getattr(args, n) for n in options if getattr(args, n, None) is not None}
     if args.coupling is None and not given:

@@ -14,7 +14,10 @@ ends included, as :func:`numpy.linspace`); several swept options give every
 combination. A sweep prints one row per point (``--json``: a list of the
 single-point objects; ``--csv FILE``: all their keys, one row per point).
 ``--optimal-load`` adds the load resistance that maximises the load power
-(:func:`randvib.optimal_load_resistance`) and that power.
+(:func:`randvib.optimal_load_resistance`) and that power; with a diode
+bridge, the battery voltage or the storage capacitor's load that maximises
+the stored power (:func:`randvib.optimal_dc_output`), that power, and whether
+the optimum is interior or at a bound (``optimum``).
 
 ``--envelope`` makes the input an event from t = 0 (:mod:`randvib.cli._event`):
 the moments at ``--times`` and the energy to ``--t-end`` by the Lyapunov
@@ -29,6 +32,7 @@ import itertools
 import math
 
 from randvib._io import check_output_file, dumps
+from randvib.analytic.bridge import optimal_dc_output
 from randvib.analytic.prediction import METHODS, optimal_load_resistance, predict
 from randvib.cli._device import add_device_arguments, harvester_from_args, option_flag
 from randvib.cli._event import add_event_arguments, power_event, wants_event
@@ -51,7 +55,7 @@ def register(sub) -> None:
     add_event_arguments(p, t_end=True)
     p.add_argument(
         "--method",
-        default="linearisation",
+        default=None,
         choices=tuple(METHODS),
         metavar="METHOD",
         help=_method_help(),
@@ -80,7 +84,8 @@ def _method_help() -> str:
     circuit = " or ".join(name for name, method in METHODS.items() if method.circuit)
     text = (
         f"analytic method ({each}); a non-white excitation: {coloured} only; a coil "
-        f"inductance or piezo capacitance: {circuit} only"
+        f"inductance or piezo capacitance: {circuit} only; default linearisation, or "
+        "bridge-closure with --rectifier"
     )
     return text.replace("%", "%%")  # argparse formats help with %
 
@@ -145,6 +150,8 @@ def run(args) -> int:
     csv_file = (
         None if args.csv is None else check_output_file(args.csv, "--csv", overwrite=args.force)
     )
+    if args.method is None:  # a bridge's own method, else statistical linearisation
+        args.method = "bridge-closure" if args.rectifier is not None else "linearisation"
     swept, points = _sweep(args)
     if wants_event(args):
         return power_event(args, swept, points)
@@ -194,7 +201,10 @@ def _point(args) -> tuple[dict, object, object]:
         out["stroke"] = harvester.stroke
         # null where not stationary (the free mass)
         out["stroke_exceedance"] = result.stroke_exceedance
-    if args.optimal_load:
+    if args.optimal_load and harvester.is_rectified:
+        # the battery voltage or the capacitor's load maximising the stored power
+        out.update(optimal_dc_output(harvester, psd).to_dict())
+    elif args.optimal_load:
         out["r_load_optimal"], out["power_load_optimal"] = optimal_load_resistance(
             harvester, psd, method=args.method
         )
@@ -246,6 +256,9 @@ def _print_point(out: dict, harvester, psd) -> None:
 SWEEP_COLUMNS = (
     "power_electrical",
     "power_load",
+    "power_stored",
+    "battery_optimal",
+    "power_stored_optimal",
     "power_mechanical",
     "r_load_optimal",
     "power_load_optimal",

@@ -129,7 +129,9 @@ def run(args) -> int:
             # the friction-free companion's exact moments hold under white noise
             # and the resistive coupling only; the energy-balance controls hold
             # for every coupling
-            companion=args.control_variates and white and not harvester.has_circuit,
+            companion=args.control_variates
+            and white
+            and not (harvester.has_circuit or harvester.is_rectified),
             control_variates=args.control_variates,
         )
     summary = result.summary()

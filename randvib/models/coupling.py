@@ -57,6 +57,8 @@ class Coupling(DeclaredParameters):
 
     #: Short name used by the CLI and in messages.
     name: str = "coupling"
+    #: True for a coupling through a diode bridge (:mod:`randvib.models.rectifier`).
+    rectified: bool = False
     #: Name and unit of the circuit state of a dynamic coupling.
     state_name: str = ""
     state_unit: str = ""

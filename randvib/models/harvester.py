@@ -118,7 +118,8 @@ class Harvester:
             )
         if self.electrical is not None:
             self._check_coupling()
-        if np.any(self.c_m + self.c_e <= 0) and self.friction is None and not self.has_circuit:
+        undamped_allowed = self.has_circuit or self.is_rectified
+        if np.any(self.c_m + self.c_e <= 0) and self.friction is None and not undamped_allowed:
             raise ValueError(
                 "total damping `c_m + c_e` must be > 0 without friction, got "
                 f"{self.c_m!r} + {self.c_e!r}; the undamped oscillator has no stationary state"
@@ -209,6 +210,25 @@ class Harvester:
     def has_circuit(self) -> bool:
         """True when the coupling carries a circuit state (inductance or capacitance > 0)."""
         return self.electrical is not None and self.electrical.is_dynamic
+
+    @property
+    def is_rectified(self) -> bool:
+        """True when the coupling goes through a diode bridge (:mod:`randvib.models.rectifier`)."""
+        return self.electrical is not None and self.electrical.rectified
+
+    def linear_surrogate(self) -> Harvester:
+        """The device with a rectified coupling replaced by its linear surrogate.
+
+        The surrogate (:meth:`randvib.models.rectifier.Rectified.linear_surrogate`)
+        has the conducting bridge's damping: Monte Carlo checks its step and
+        draws its random start on it. Any other device is returned as it is.
+        """
+        if not self.is_rectified:
+            return self
+        return Harvester.with_coupling(
+            self.m, self.c_m, self.k, self.electrical.linear_surrogate(), k3=self.k3,
+            friction=self.friction, stroke=self.stroke,
+        )  # fmt: skip
 
     @property
     def coupling_name(self) -> str:

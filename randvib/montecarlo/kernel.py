@@ -13,7 +13,10 @@ resistive (viscous) circuit, the compile-time fast path, and
 :func:`auxiliary_step` for the device with up to :data:`N_AUX` linear
 auxiliary states (:class:`Auxiliary`: an excitation's shaping filter and/or a
 circuit's current or voltage), one compiled path for every excitation x
-coupling combination.
+coupling combination. A diode bridge (:class:`Rectifier`) has its own
+steps, :func:`rectified_white_step` (white or given input) and
+:func:`rectified_step` (with a shaping filter), compiled only when a bridge
+is simulated.
 
 Memory is O(n_paths): per-path running sums only, unless histograms or
 recorded histories are requested.
@@ -45,7 +48,11 @@ ACC_COMP_Z2 = 8  # companion mean z^2
 ACC_CIRCUIT2 = 9  # mean x^2 of the circuit state (A^2 or V^2); 0 without one
 ACC_BEYOND = 10  # fraction of the window's steps with |z| > stroke
 ACC_FIRST_HIT = 11  # time (s) of the first state with |z| > stroke from t = 0; -1: none
-N_ACC = 12
+ACC_STORED = 12  # mean power into the bridge's output, battery or storage load (W); 0 without
+ACC_COIL_LOSS = 13  # mean R_C i^2 of a rectified coil (W); 0 without
+ACC_DIODE_LOSS = 14  # mean 2 V_d |i| of a bridge (W); 0 without
+ACC_V_OUT = 15  # mean output voltage of a bridge, V_b or V_C (V); 0 without
+N_ACC = 16
 
 
 class PathAverages:
@@ -119,6 +126,26 @@ class PathAverages:
     def first_hit_time(self):
         """Time (s) of the first state with |z| > stroke, from t = 0; -1 where none was."""
         return self._col(ACC_FIRST_HIT)
+
+    @property
+    def stored_power(self):
+        """Time average of the power into a bridge's output per path (W); 0 without one."""
+        return self._col(ACC_STORED)
+
+    @property
+    def coil_loss(self):
+        """Time average of R_C i^2 of a rectified coil per path (W); 0 without one."""
+        return self._col(ACC_COIL_LOSS)
+
+    @property
+    def diode_loss(self):
+        """Time average of 2 V_d |i| of a bridge per path (W); 0 without one."""
+        return self._col(ACC_DIODE_LOSS)
+
+    @property
+    def output_voltage(self):
+        """Time average of a bridge's output voltage per path, V_b or V_C (V); 0 without one."""
+        return self._col(ACC_V_OUT)
 
     def energy_balance_controls(self, window):
         """The two zero-mean controls of the energy balance: Ito integral, energy change."""
@@ -282,6 +309,23 @@ class Transient(NamedTuple):
 
 #: Columns of :attr:`Transient.snapshots`: z (m), v (m/s), P x (A or V; 0 without a
 #: circuit), max |z| from t = 0 (m).
+class Rectifier(NamedTuple):
+    """A full-wave bridge and its output (:mod:`randvib.models.rectifier`).
+
+    ``kind`` 1: a coil (algebraic current, L = 0), 2: a piezo element (state
+    V_p), 3: a coil with inductance (state i); ``output`` 0: a battery, 1: a storage capacitor with its load (state
+    V_C). ``p = (gain, r_or_cp, V_d, V_b, C, R_L, I_s, n V_T, L)`` (I_s = 0: a
+    constant drop V_d; I_s > 0: Shockley diodes; L the coil's inductance):
+    :meth:`randvib.models.rectifier.Rectified.kernel_parameters`.
+    ``v_c0`` (V): the storage capacitor's voltage at t = 0.
+    """
+
+    kind: int
+    output: int
+    p: np.ndarray
+    v_c0: float
+
+
 SNAP_Z, SNAP_V, SNAP_X, SNAP_PEAK = 0, 1, 2, 3
 N_SNAP = 4
 #: Columns of :attr:`Transient.event`: peak |z| over the run (m), int v^2 dt
@@ -460,6 +504,242 @@ def auxiliary_step(z, v, theta, x1, x2, x3, dt, noise, weights, drift, kind, p, 
 
 
 @numba.njit(cache=True, inline="always")
+def _bridge_current(v, v_c, rect):
+    """(current (A), drop of the two conducting diodes (V)) of the coil's bridge.
+
+    ``e = alpha v``; V_out is V_b (battery) or ``v_c``. Constant drop:
+    ``i = sgn(e) max(0, |e| - V_out - 2 V_d) / R_C``. Shockley diodes (I_s > 0,
+    ``rect[14]``; ``rect[15]`` = 2 n V_T): ``|e| - V_out = R_C |i| + 2 n V_T
+    ln(1 + |i| / I_s)``, solved by Newton's method in y = ln(1 + |i| / I_s),
+    where the equation is convex and increasing: from an upper bound the
+    iterates fall monotonically to the root.
+    """
+    output, gain, v_d, v_b, inv_r_coil = rect[1], rect[2], rect[4], rect[5], rect[8]
+    v_out = v_b if output == 0 else v_c
+    e = gain * v
+    i_s = rect[14]
+    if i_s > 0.0:
+        over = abs(e) - v_out
+        if over <= 0.0:
+            return 0.0, 0.0
+        r_is, c = rect[3] * i_s, rect[15]
+        y = min(over / c, np.log1p(over / r_is))
+        for _ in range(60):
+            ey = np.exp(y)
+            step = (r_is * (ey - 1.0) + c * y - over) / (r_is * ey + c)
+            y -= step
+            if step <= 1e-13 * y:
+                break
+        i = i_s * np.expm1(y)
+        return (i if e > 0.0 else -i), c * y
+    over = abs(e) - v_out - 2.0 * v_d
+    if over <= 0.0:
+        return 0.0, 0.0
+    return (over * inv_r_coil if e > 0.0 else -over * inv_r_coil), 2.0 * v_d
+
+
+@numba.njit(cache=True, inline="always")
+def _piezo_clamp(v_p, v_c, rect):
+    """Clamp |V_p| at V_out + 2 V_d: (V_p, V_C, charge through the bridge (C)).
+
+    The charge beyond the clamp goes through the bridge: into the battery, or
+    shared between C_p and the storage capacitor C, which then move together
+    (charge conserved: ``C_p (|V_p| - 2 V_d) + C V_C`` before and after).
+    """
+    output, c_p, v_d, v_b, cap = rect[1], rect[3], rect[4], rect[5], rect[6]
+    a = abs(v_p)
+    if output == 0:
+        limit = v_b + 2.0 * v_d
+        if a <= limit:
+            return v_p, v_c, 0.0
+        dq = c_p * (a - limit)
+        return (limit if v_p > 0.0 else -limit), v_c, dq
+    limit = v_c + 2.0 * v_d
+    if a <= limit:
+        return v_p, v_c, 0.0
+    v_c_new = rect[12] * (a - 2.0 * v_d) + rect[13] * v_c  # weights C_p, C over C_p + C
+    clamped = v_c_new + 2.0 * v_d
+    return (clamped if v_p > 0.0 else -clamped), v_c_new, cap * (v_c_new - v_c)
+
+
+@numba.njit(cache=True, inline="always")
+def rectified_step(
+    z, v, theta, x1, x2, x3, s1, s2, dt, noise, weights, drift, kind, p, fn, block, rect
+):
+    """:func:`auxiliary_step` for the device with a full-wave bridge (:class:`Rectifier`).
+
+    The filter's states (x1, x2, x3; ``block`` without a circuit) take the
+    auxiliary step; the bridge adds its force and its states: ``s2`` = V_C
+    of a storage capacitor (C V_C' = |i| - V_C / R_L), ``s1`` = V_p of a
+    piezo element (C_p V_p' = theta v, clamped by :func:`_piezo_clamp` after
+    each stage, the excess charge through the bridge) or the current i of a
+    coil with inductance (L i' = e - R_C i - sgn(i) V_th; held at 0 when the
+    diodes would let it reverse, until |e| exceeds V_th). The bridge's current
+    is continuous in the state for the coil (a dead zone) and the clamp a
+    projection for the piezo, so the scheme keeps its form but not its
+    smooth-problem order (docs/conventions.md; the tests measure it).
+
+    Returns
+    -------
+    z, v, theta, x1, x2, x3, s1, s2 : float
+        State after the step.
+    force : float
+        Friction force at the start of the step (N).
+    stored, coil, diode : float
+        Energy (J) of the step into the output, the coil's resistance and the diodes.
+    """
+    b1, b2 = weights
+    a11, a12, a13, a21, a22, a23, a31, a32, a33 = block[0:9]
+    bv1, bv2, bv3, g1, g2, g3, c1, c2, c3, gv = block[9:19]
+    rkind, output, second, v_d, v_b, r_load = rect[0], rect[1], rect[3], rect[4], rect[5], rect[7]
+    inv_m = drift[0]
+    acc1, rate1, force = _acceleration(z, v, theta, drift, kind, p, fn)
+    acc1 -= c1 * x1 + c2 * x2 + c3 * x3
+    d1 = a11 * x1 + a12 * x2 + a13 * x3 + bv1 * v
+    d2 = a21 * x1 + a22 * x2 + a23 * x3 + bv2 * v
+    d3 = a31 * x1 + a32 * x2 + a33 * x3 + bv3 * v
+    nv = gv * noise
+    f1, ds1, ds2, i1, drop1 = _bridge_rates(v, s1, s2, rect, inv_m)
+    acc1 += f1
+    if b2 == 0.0:
+        zn = z + b1 * v * dt
+        vn = v + b1 * acc1 * dt + nv
+        tn = theta + b1 * rate1 * dt
+        x1n = x1 + b1 * d1 * dt + g1 * noise
+        x2n = x2 + b1 * d2 * dt + g2 * noise
+        x3n = x3 + b1 * d3 * dt + g3 * noise
+        s1n = s1 + b1 * ds1 * dt
+        s2n = s2 + b1 * ds2 * dt
+        current = b1 * abs(i1)
+        coil = b1 * i1 * i1 * second if rkind != 2 else 0.0
+        diodes = b1 * drop1 * abs(i1)
+        load = b1 * s2 * s2
+    else:
+        zp = z + v * dt
+        vp = v + acc1 * dt + nv
+        tp = theta + rate1 * dt
+        x1p = x1 + d1 * dt + g1 * noise
+        x2p = x2 + d2 * dt + g2 * noise
+        x3p = x3 + d3 * dt + g3 * noise
+        s1p = s1 + ds1 * dt
+        s2p = s2 + ds2 * dt
+        if rkind == 2:
+            s1p, s2p, _ = _piezo_clamp(s1p, s2p, rect)
+        elif rkind == 3 and s1p * s1 < 0.0:  # the diodes block the reverse current
+            s1p = 0.0
+        acc2, rate2, _ = _acceleration(zp, vp, tp, drift, kind, p, fn)
+        acc2 -= c1 * x1p + c2 * x2p + c3 * x3p
+        e1 = a11 * x1p + a12 * x2p + a13 * x3p + bv1 * vp
+        e2 = a21 * x1p + a22 * x2p + a23 * x3p + bv2 * vp
+        e3 = a31 * x1p + a32 * x2p + a33 * x3p + bv3 * vp
+        f2, es1, es2, i2, drop2 = _bridge_rates(vp, s1p, s2p, rect, inv_m)
+        acc2 += f2
+        zn = z + (b1 * v + b2 * vp) * dt
+        vn = v + (b1 * acc1 + b2 * acc2) * dt + nv
+        tn = theta + (b1 * rate1 + b2 * rate2) * dt
+        x1n = x1 + (b1 * d1 + b2 * e1) * dt + g1 * noise
+        x2n = x2 + (b1 * d2 + b2 * e2) * dt + g2 * noise
+        x3n = x3 + (b1 * d3 + b2 * e3) * dt + g3 * noise
+        s1n = s1 + (b1 * ds1 + b2 * es1) * dt
+        s2n = s2 + (b1 * ds2 + b2 * es2) * dt
+        current = b1 * abs(i1) + b2 * abs(i2)
+        coil = (b1 * i1 * i1 + b2 * i2 * i2) * second if rkind != 2 else 0.0
+        diodes = b1 * drop1 * abs(i1) + b2 * drop2 * abs(i2)
+        load = b1 * s2 * s2 + b2 * s2p * s2p
+    if rkind == 2:
+        s1n, s2n, dq = _piezo_clamp(s1n, s2n, rect)
+        charge = dq  # the piezo's bridge charge of the step (C)
+    else:
+        charge = current * dt
+        if rkind == 3 and s1n * s1 < 0.0:  # the diodes block the reverse current
+            s1n = 0.0
+    stored = v_b * charge if output == 0 else load / r_load * dt
+    # the coil's diodes: their drop times the current at each stage; the piezo's: the charge
+    diode = diodes * dt if rkind != 2 else 2.0 * v_d * charge
+    return zn, vn, tn, x1n, x2n, x3n, s1n, s2n, force, stored, coil * dt, diode
+
+
+@numba.njit(cache=True, inline="always")
+def _bridge_rates(v, s1, s2, rect, inv_m):
+    """(acceleration (m/s^2), V_p', V_C', current (A), diodes' drop (V)) at (v, V_p, V_C)."""
+    rkind, output, gain = rect[0], rect[1], rect[2]
+    inv_cap, inv_rc = rect[10], rect[11]
+    if rkind == 1:
+        i, drop = _bridge_current(v, s2, rect)
+        ds2 = abs(i) * inv_cap - s2 * inv_rc if output == 1 else 0.0
+        return -gain * i * inv_m, 0.0, ds2, i, drop
+    if rkind == 3:  # a coil with inductance: the current s1 is a state
+        i = s1
+        v_th = (rect[5] if output == 0 else s2) + 2.0 * rect[4]
+        e = gain * v
+        if i > 0.0:
+            di = (e - rect[3] * i - v_th) * rect[16]
+        elif i < 0.0:
+            di = (e - rect[3] * i + v_th) * rect[16]
+        else:  # blocked: the bridge opens once |e| exceeds the threshold
+            over = abs(e) - v_th
+            di = 0.0 if over <= 0.0 else (over if e > 0.0 else -over) * rect[16]
+        ds2 = abs(i) * inv_cap - s2 * inv_rc if output == 1 else 0.0
+        return -gain * i * inv_m, di, ds2, i, 2.0 * rect[4]
+    ds2 = -s2 * inv_rc if output == 1 else 0.0
+    return -gain * s1 * inv_m, rect[9] * v, ds2, 0.0, 0.0
+
+
+@numba.njit(cache=True, inline="always")
+def rectified_white_step(z, v, theta, s1, s2, dt, noise, weights, drift, kind, p, fn, rect):
+    """:func:`rectified_step` without a shaping filter (white or given input): the same
+    operations less the filter's exact zeros."""
+    b1, b2 = weights
+    rkind, output, second, v_d, v_b, r_load = rect[0], rect[1], rect[3], rect[4], rect[5], rect[7]
+    inv_m = drift[0]
+    acc1, rate1, force = _acceleration(z, v, theta, drift, kind, p, fn)
+    f1, ds1, ds2, i1, drop1 = _bridge_rates(v, s1, s2, rect, inv_m)
+    acc1 += f1
+    if b2 == 0.0:
+        zn = z + b1 * v * dt
+        vn = v + b1 * acc1 * dt + noise
+        tn = theta + b1 * rate1 * dt
+        s1n = s1 + b1 * ds1 * dt
+        s2n = s2 + b1 * ds2 * dt
+        current = b1 * abs(i1)
+        coil = b1 * i1 * i1
+        diodes = b1 * drop1 * abs(i1)
+        load = b1 * s2 * s2
+    else:
+        zp = z + v * dt
+        vp = v + acc1 * dt + noise
+        tp = theta + rate1 * dt
+        s1p = s1 + ds1 * dt
+        s2p = s2 + ds2 * dt
+        if rkind == 2:
+            s1p, s2p, _ = _piezo_clamp(s1p, s2p, rect)
+        elif rkind == 3 and s1p * s1 < 0.0:  # the diodes block the reverse current
+            s1p = 0.0
+        acc2, rate2, _ = _acceleration(zp, vp, tp, drift, kind, p, fn)
+        f2, es1, es2, i2, drop2 = _bridge_rates(vp, s1p, s2p, rect, inv_m)
+        acc2 += f2
+        zn = z + (b1 * v + b2 * vp) * dt
+        vn = v + (b1 * acc1 + b2 * acc2) * dt + noise
+        tn = theta + (b1 * rate1 + b2 * rate2) * dt
+        s1n = s1 + (b1 * ds1 + b2 * es1) * dt
+        s2n = s2 + (b1 * ds2 + b2 * es2) * dt
+        current = b1 * abs(i1) + b2 * abs(i2)
+        coil = b1 * i1 * i1 + b2 * i2 * i2
+        diodes = b1 * drop1 * abs(i1) + b2 * drop2 * abs(i2)
+        load = b1 * s2 * s2 + b2 * s2p * s2p
+    if rkind == 2:
+        s1n, s2n, charge = _piezo_clamp(s1n, s2n, rect)
+    else:
+        charge = current * dt
+        if rkind == 3 and s1n * s1 < 0.0:  # the diodes block the reverse current
+            s1n = 0.0
+    stored = v_b * charge if output == 0 else load / r_load * dt
+    # the coil's diodes: their drop times the current at each stage; the piezo's: the charge
+    diode = diodes * dt if rkind != 2 else 2.0 * v_d * charge
+    return zn, vn, tn, s1n, s2n, force, stored, coil * second * dt, diode
+
+
+@numba.njit(cache=True, inline="always")
 def filter_step(z, v, theta, x1, x2, dt, noise, weights, drift, kind, p, fn, block):
     """:func:`auxiliary_step` for a 2-state shaping filter alone (no circuit, g_v = 0).
 
@@ -559,6 +839,7 @@ def run_ensemble(
     auxiliary,
     stop,
     transient=None,
+    rectifier=None,
 ):
     """Integrate ``paths.count`` paths and return per-path time averages.
 
@@ -597,6 +878,12 @@ def run_ensemble(
         An event (:class:`Transient`): the per-step envelope, the filter's
         random start and the snapshots, written into its arrays. None (the
         stationary runs) compiles the loop without any of it.
+    rectifier : Rectifier or None
+        A full-wave bridge (:class:`Rectifier`), stepped by
+        :func:`rectified_step` with the filter's states of ``auxiliary``
+        (None: white or given input); its stored power and losses go to
+        ``ACC_STORED``, ``ACC_COIL_LOSS``, ``ACC_DIODE_LOSS``, its capacitors'
+        energy into ``ACC_H0``/``ACC_H1``. None compiles the loop without it.
 
     Returns
     -------
@@ -649,6 +936,30 @@ def run_ensemble(
         filter_mask = transient.filter_mask
         n_start = transient.n_start
         filter_start = transient.start
+    if rectifier is not None:
+        rp = rectifier.p
+        # (kind, output, gain, R_C or C_p, V_d, V_b, C, R_L) and, to spare divisions
+        # per step: 1/R_C, theta/C_p, 1/C, 1/(R_L C), C_p/(C_p + C), C/(C_p + C);
+        # then the Shockley diodes' I_s (0: a constant drop) and 2 n V_T, and 1/L
+        rect = (
+            rectifier.kind, rectifier.output, rp[0], rp[1], rp[2], rp[3], rp[4], rp[5],
+            1.0 / rp[1], rp[0] / rp[1], 1.0 / rp[4], 1.0 / (rp[5] * rp[4]),
+            rp[1] / (rp[1] + rp[4]), rp[4] / (rp[1] + rp[4]), rp[6], 2.0 * rp[7],
+            1.0 / rp[8] if rp[8] > 0.0 else 0.0,
+        )  # fmt: skip
+        # energy held by the piezo's and the storage capacitor's voltages: C_p/2, C/2
+        # the piezo's C_p V_p^2 / 2, or the coil's L i^2 / 2 (s1 is V_p or i)
+        half_cp = 0.5 * rp[1] if rectifier.kind == 2 else 0.5 * rp[8]
+        half_c = 0.5 * rp[4] if rectifier.output == 1 else 0.0
+        v_c0 = rectifier.v_c0
+        v_out_b = rp[3]
+        if auxiliary is not None:
+            rblock = block
+        else:  # white or given input: no filter, the noise drives the velocity (g_v = 1)
+            rblock = (
+                0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+                0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0,
+            )  # fmt: skip
     n_chunks = (n_paths + LANES - 1) // LANES
     acc = np.zeros((n_paths, N_ACC))
     failed = np.full(n_paths, -1, dtype=np.int64)
@@ -678,6 +989,9 @@ def run_ensemble(
         x3 = np.zeros(LANES)
         a = np.zeros((LANES, N_ACC))
         a[:, ACC_FIRST_HIT] = -1.0
+        if rectifier is not None:
+            s1 = np.zeros(LANES)  # piezo voltage V_p (V), or the inductive coil's current (A)
+            s2 = np.full(LANES, v_c0)  # storage capacitor voltage V_C (V)
         if auxiliary is not None:
             step_block = block
         if transient is not None:
@@ -737,7 +1051,29 @@ def run_ensemble(
                 zj = z[j]
                 vj = v[j]
                 tj = th[j]
-                if auxiliary is not None and filter_only:
+                if rectifier is not None:
+                    if in_window and n == n_burn:
+                        a[j, ACC_H0] = half_cp * s1[j] * s1[j] + half_c * s2[j] * s2[j]
+                    v_out = v_out_b if rect[1] == 0 else s2[j]  # at the step's start
+                    if auxiliary is not None:
+                        zn, vn, tn, x1[j], x2[j], x3[j], s1[j], s2[j], f1, e_s, e_c, e_d = (
+                            rectified_step(
+                                zj, vj, tj, x1[j], x2[j], x3[j], s1[j], s2[j], dt, noise,
+                                scheme, drift, fr_kind, fr_p, fr_fn, rblock, rect,
+                            )
+                        )  # fmt: skip
+                    else:
+                        zn, vn, tn, s1[j], s2[j], f1, e_s, e_c, e_d = rectified_white_step(
+                            zj, vj, tj, s1[j], s2[j], dt, noise, scheme, drift, fr_kind,
+                            fr_p, fr_fn, rect,
+                        )  # fmt: skip
+                    if in_window:
+                        # energies (J); divided by the window (s) at the end
+                        a[j, ACC_STORED] += e_s
+                        a[j, ACC_COIL_LOSS] += e_c
+                        a[j, ACC_DIODE_LOSS] += e_d
+                        a[j, ACC_V_OUT] += v_out
+                elif auxiliary is not None and filter_only:
                     zn, vn, tn, x1[j], x2[j], f1 = filter_step(
                         zj,
                         vj,
@@ -787,7 +1123,7 @@ def run_ensemble(
                         a[j, ACC_BEYOND] += 1.0
                 if in_window:
                     if n == n_burn:
-                        a[j, ACC_H0] = 0.5 * m * vj * vj + 0.5 * k * zj * zj + 0.25 * k3 * zj**4
+                        a[j, ACC_H0] += 0.5 * m * vj * vj + 0.5 * k * zj * zj + 0.25 * k3 * zj**4
                     a[j, ACC_V2] += vj * vj
                     a[j, ACC_Z2] += zj * zj
                     a[j, ACC_ABS_V] += abs(vj)
@@ -840,6 +1176,8 @@ def run_ensemble(
             zj = z[j]
             vj = v[j]
             a[j, ACC_H1] = 0.5 * m * vj * vj + 0.5 * k * zj * zj + 0.25 * k3 * zj**4
+            if rectifier is not None:
+                a[j, ACC_H1] += half_cp * s1[j] * s1[j] + half_c * s2[j] * s2[j]
             if abs(zj) > stroke and a[j, ACC_FIRST_HIT] < 0.0:
                 a[j, ACC_FIRST_HIT] = n_steps * dt  # the final state
             if transient is not None:
@@ -849,7 +1187,7 @@ def run_ensemble(
             for q in range(N_ACC):
                 if q == ACC_H0 or q == ACC_H1 or q == ACC_FIRST_HIT:
                     acc[p, q] = a[j, q]
-                elif q == ACC_VDW:
+                elif q == ACC_VDW or q == ACC_STORED or q == ACC_COIL_LOSS or q == ACC_DIODE_LOSS:
                     acc[p, q] = a[j, q] / window
                 else:
                     acc[p, q] = a[j, q] * inv_window_steps

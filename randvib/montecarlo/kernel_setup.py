@@ -22,6 +22,7 @@ from randvib.models.excitation import Excitation
 from randvib.models.friction import kernel_arguments
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import kernel
+from randvib.montecarlo.bridge_step import storage_start
 from randvib.montecarlo.rng import ZIG_FI, ZIG_KI, ZIG_WI
 from randvib.montecarlo.step_check import coarsened
 from randvib.montecarlo.validation import Run
@@ -43,6 +44,7 @@ class KernelSetup:
     companion: kernel.Companion
     recording: kernel.Recording
     auxiliary: kernel.Auxiliary | None
+    rectifier: kernel.Rectifier | None = None
 
     @classmethod
     def prepare(cls, run: Run, linear) -> KernelSetup:
@@ -62,6 +64,7 @@ class KernelSetup:
             companion=companion,
             recording=_recording(run, linear),
             auxiliary=_auxiliary(run, linear),
+            rectifier=_rectifier(run),
         )
 
     def arguments(self, run: Run, lo: int, hi: int) -> dict:
@@ -83,6 +86,7 @@ class KernelSetup:
             recording=self.recording._replace(n_record=n_record),
             noise=kernel.Noise(dw, ZIG_KI, ZIG_WI, ZIG_FI),
             auxiliary=self.auxiliary,
+            rectifier=self.rectifier,
         )
 
 
@@ -134,6 +138,20 @@ def _auxiliary(run: Run, linear) -> kernel.Auxiliary | None:
     gain = 1.0 if excitation.is_white or driven_input else 0.0
     coefficients = np.concatenate([a.ravel(), b, g, c, [gain]])
     return kernel.pack(kernel.Auxiliary, n_states, coefficients, square, chol)
+
+
+def _rectifier(run: Run) -> kernel.Rectifier | None:
+    """The kernel's bridge (:class:`randvib.montecarlo.kernel.Rectifier`); None without one.
+
+    The storage capacitor starts at :func:`~randvib.montecarlo.bridge_step.storage_start`
+    (its charge-balance level where the closure gives one, else empty: then
+    :func:`randvib.montecarlo.validation.check_options` warns when the
+    burn-in is shorter than a few R_L C).
+    """
+    if not run.harvester.is_rectified:
+        return None
+    code, output, p = run.harvester.electrical.kernel_parameters()
+    return kernel.pack(kernel.Rectifier, code, output, p, storage_start(run))
 
 
 def _driven_circuit_variance(harvester: Harvester, excitation: Excitation) -> float:

@@ -36,8 +36,15 @@ STATISTICS = (
     "mean_abs_velocity",
     "friction_power",
     "circuit_mean_square",
+    "power_stored",
+    "power_coil_loss",
+    "power_diode_loss",
+    "power_mechanical",
     "stroke_exceedance",
 )
+
+#: The statistics of a bridge (:mod:`randvib.models.rectifier`), None without one.
+BRIDGE_STATISTICS = ("power_stored", "power_coil_loss", "power_diode_loss", "power_mechanical")
 
 
 @dataclass(frozen=True)
@@ -268,7 +275,11 @@ class SimulationResult:
         """E[P_e] (W): c_e E[z'^2] (paper Eq. 31), or from the circuit state.
 
         With a circuit state: (R_L + R_C) E[i^2] (inductive), E[V^2] / R_L (piezo).
+        With a bridge: everything the circuit takes, stored plus coil and diode losses.
         """
+        if self.harvester.is_rectified:
+            avg = self.averages
+            return self.statistic(avg.stored_power + avg.coil_loss + avg.diode_loss)
         if self.harvester.has_circuit:
             return self.statistic(self._circuit_power("power_electrical"))
         return self.statistic(self.harvester.c_e * self.averages.v2)
@@ -291,28 +302,66 @@ class SimulationResult:
         return self.statistic(self.averages.friction_power)
 
     @property
+    def power_stored(self) -> Statistic | None:
+        """Power stored through a bridge (W): V_b E|i| (battery), E[V_C^2] / R_L (capacitor).
+
+        None without a bridge.
+        """
+        if not self.harvester.is_rectified:
+            return None
+        return self.statistic(self.averages.stored_power)
+
+    @property
+    def power_coil_loss(self) -> Statistic | None:
+        """R_C E[i^2] (W) of a rectified coil (0 for a piezo bridge); None without a bridge."""
+        if not self.harvester.is_rectified:
+            return None
+        return self.statistic(self.averages.coil_loss)
+
+    @property
+    def power_diode_loss(self) -> Statistic | None:
+        """2 V_d E|i| (W) of a bridge; None without one."""
+        if not self.harvester.is_rectified:
+            return None
+        return self.statistic(self.averages.diode_loss)
+
+    @property
+    def power_mechanical(self) -> Statistic | None:
+        """Mechanical dissipation c_m E[z'^2] + E[z' F] (W) beside a bridge; None without one."""
+        if not self.harvester.is_rectified:
+            return None
+        return self.statistic(self.harvester.c * self.averages.v2 + self.averages.friction_power)
+
+    @property
     def power_load(self) -> Statistic | None:
-        """E[i^2 R_L] (W), with a circuit; else None."""
+        """E[i^2 R_L] (W), with a circuit; the stored power with a bridge; else None."""
         e = self.harvester.electrical
         if e is None:
             return None
+        if self.harvester.is_rectified:
+            return self.power_stored
         if self.harvester.has_circuit:
             return self.statistic(self._circuit_power("power_load"))
         return self.statistic(self.harvester.c_e * e.load_fraction * self.averages.v2)
 
-    def energy_balance_residual(self) -> Statistic:
+    def energy_balance_residual(self, control_variates: bool | None = None) -> Statistic:
         """c E[v^2] + E[v F] + P_x - S m / 4 (W): zero up to O(dt) and noise (white only).
 
         ``P_x`` is the power of a circuit state ((R_L + R_C) i^2 or V^2 / R_L;
         docs/conventions.md: the coupling's force f x does the work
-        f x v = R x^2 + d/dt(stored energy)); without one, c holds c_e.
+        f x v = R x^2 + d/dt(stored energy)) or of a bridge (stored, coil and
+        diode losses); without one, c holds c_e. ``control_variates`` (default:
+        the result's setting) narrows the interval with :meth:`controls`.
         """
         self._require_white("the energy-balance residual and its S m / 4")
         h = self.harvester
         samples = h.c * self.averages.v2 + self.averages.friction_power - self.psd * h.m / 4.0
-        if h.has_circuit:
+        if h.is_rectified:
+            avg = self.averages
+            samples = samples + avg.stored_power + avg.coil_loss + avg.diode_loss
+        elif h.has_circuit:
             samples = samples + self._circuit_power("power_electrical")
-        return self.statistic(samples)
+        return self.statistic(samples, control_variates)
 
     def response_spectra(self, segment_duration: float | None = None):
         """Welch PSDs of z, v and c_e S_v from the recorded paths (:mod:`.spectra`)."""
@@ -338,6 +387,8 @@ class SimulationResult:
             out["power_load"] = self.power_load.to_dict()
         if self.harvester.has_circuit:
             out["circuit_mean_square"] = self.circuit_mean_square.to_dict()
+        if self.harvester.is_rectified:
+            out.update({name: getattr(self, name).to_dict() for name in BRIDGE_STATISTICS})
         if self.harvester.stroke is not None:
             out["stroke"] = self.harvester.stroke
             out["stroke_exceedance"] = self.stroke_exceedance.to_dict()

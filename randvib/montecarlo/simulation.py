@@ -22,6 +22,12 @@ A coupling with a circuit state (coil inductance, piezo capacitance;
 force ``f x`` on the magnet, to the same linear auxiliary block; the kernel
 averages x^2 per path, so the circuit's power comes with its interval.
 
+A diode bridge (:mod:`randvib.models.rectifier`) is integrated by the
+kernel's rectified steps, with its stored power, coil and diode losses per
+path; a run checks its step by halving it on a pilot ensemble
+(:mod:`randvib.montecarlo.bridge_step`) and, under white noise, that every
+dissipation path sums to m S / 4.
+
 Each path is an independent realisation; statistics are time averages over
 the window [burn_in, t_end) on each path, and their confidence intervals come
 from the spread between paths (independent by construction), so they do not
@@ -56,6 +62,7 @@ from randvib.models.excitation import Excitation
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import driven
 from randvib.montecarlo.batches import batch_bounds, run_batches
+from randvib.montecarlo.bridge_step import check_bridge_balance, check_bridge_step
 from randvib.montecarlo.kernel_setup import KernelSetup
 from randvib.montecarlo.resources import announce_long_run, check_resources
 from randvib.montecarlo.results import SimulationResult
@@ -221,11 +228,16 @@ def execute(run: Run, *, control_variates, check_step, threads, batch_paths, pro
     # One linear test system per run, built when first needed (a fixed start
     # without a step check may need none): the step check, the random start,
     # the default histogram ranges and the circuit's start all use it.
-    linear = functools.cache(lambda: LinearTestSystem.of(run.harvester, run.excitation))
+    # A bridge is checked on its linear surrogate (the conducting bridge's damping).
+    linear = functools.cache(
+        lambda: LinearTestSystem.of(run.harvester.linear_surrogate(), run.excitation)
+    )
     if check_step or run.initial.kind == "stationary":
         check_scales(run, linear)
     if check_step:
         linear().check_step(run.scheme.name, run.grid.dt)
+        if run.harvester.is_rectified:  # the switching, which the linear check cannot see
+            check_bridge_step(run)
     setup = KernelSetup.prepare(run, linear)
     if threads is not None:
         threads = check_int("threads", threads, 1)
@@ -241,7 +253,7 @@ def execute(run: Run, *, control_variates, check_step, threads, batch_paths, pro
     started = time.perf_counter()
     per_path, histogram, histories = run_batches(run, setup, batches, progress)
     wall = time.perf_counter() - started
-    return SimulationResult(
+    result = SimulationResult(
         harvester=run.harvester,
         psd=run.psd,
         scheme=run.scheme.name,
@@ -257,3 +269,6 @@ def execute(run: Run, *, control_variates, check_step, threads, batch_paths, pro
         wall_time=wall,
         excitation=run.excitation,
     )
+    if check_step:  # the per-run identity: every path sums to m S / 4
+        check_bridge_balance(result)
+    return result

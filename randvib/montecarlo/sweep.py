@@ -158,6 +158,8 @@ def _analytic(device: Harvester, psd: float) -> dict:
     for name, method in METHODS.items():
         if method.reference:  # too slow to run at every sweep point
             continue
+        if method.rectifier and not device.is_rectified:  # a diode bridge's method only
+            continue
         try:
             out[f"{name}_power"] = float(predict(device, psd, name).power_electrical)
         except (ValueError, NotImplementedError):
@@ -208,7 +210,8 @@ def simulate_to_precision(
         scheme=settings.scheme,
         seed=seed,
         initial=initial,
-        companion=settings.control_variates,
+        # the companion's exact moments need a viscous c_e (no circuit state, no bridge)
+        companion=settings.control_variates and not (device.has_circuit or device.is_rectified),
         control_variates=settings.control_variates,
         threads=threads,
         progress=False,

@@ -139,6 +139,12 @@ def simulate_transient(
         )
     if not isinstance(harvester, Harvester):
         raise ValueError(f"`harvester` must be a randvib.Harvester, got {type(harvester).__name__}")
+    if harvester.is_rectified:
+        raise ValueError(
+            f"simulate_transient does not take the {harvester.electrical.name} coupling: "
+            "a bridge's events are not implemented; simulate its stationary response "
+            "with randvib.simulate"
+        )
     start = EventStart.of(start, harvester)
     run = validated(
         harvester,

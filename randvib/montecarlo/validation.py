@@ -21,6 +21,7 @@ from randvib.models.excitation import Excitation, as_excitation
 from randvib.models.harvester import Harvester
 from randvib.models.potential import CONFINING
 from randvib.montecarlo import driven
+from randvib.montecarlo.bridge_step import storage_start
 from randvib.montecarlo.integrators import Integrator, integrator
 from randvib.montecarlo.options import InitialState, RecordOptions, TimeGrid
 
@@ -157,6 +158,8 @@ def check_options(run: Run, control_variates: bool) -> None:
     """Refuse the options that this run's input or circuit cannot honour, saying why."""
     _check_coloured_options(run.excitation, run.companion, control_variates)
     _check_circuit_options(run.harvester, run.companion)
+    if run.harvester.is_rectified:
+        _check_bridge(run)
 
 
 def _check_coloured_options(excitation: Excitation, companion: bool, control_variates: bool):
@@ -190,6 +193,44 @@ def _check_circuit_options(harvester: Harvester, companion: bool):
             f"E[z^2]) assume a viscous c_e, not the {harvester.electrical.name} coupling's "
             "circuit state; use companion=False"
         )
+
+
+class BridgeStartWarning(RuntimeWarning):
+    """The burn-in is short against the storage capacitor's charging time."""
+
+
+def _check_bridge(run: Run) -> None:
+    """A bridge's options: no companion; a step that resolves its output's RC rate.
+
+    A storage capacitor that starts empty
+    (:func:`~randvib.montecarlo.bridge_step.storage_start`) makes a burn-in
+    shorter than 3 R_L C (about 95 % of its charging) warned about; a step above
+    0.2 / rate (the charging and load rate 1/(R_C C) + 1/(R_L C) of a coil,
+    1/(R_L C) of a piezo) would make the explicit scheme's V_C step
+    inaccurate or unstable and is refused.
+    """
+    bridge = run.harvester.electrical
+    if run.companion:
+        raise ValueError(
+            "`companion` needs the resistive coupling: its exact moments assume a viscous "
+            f"c_e, not the {bridge.name}; use companion=False"
+        )
+    rate = bridge.fastest_rate()
+    if rate * run.grid.dt > 0.2:
+        raise ValueError(
+            f"`dt` = {run.grid.dt!r} s is too large for the {bridge.name}'s storage "
+            f"capacitor (its fastest rate {rate:.3g} 1/s): use dt <= {0.2 / rate:.3g} s"
+        )
+    if not bridge.has_battery and storage_start(run) == 0.0:  # it starts empty
+        settle = 3.0 * bridge.r_load * bridge.storage_capacitance
+        if run.grid.burn_in < settle:
+            warnings.warn(
+                f"burn_in = {run.grid.burn_in:g} s is shorter than 3 R_L C = {settle:.3g} s: "
+                "the storage capacitor starts empty and its charging biases the stored "
+                f"power low; use burn_in >= {settle:.3g} s",
+                BridgeStartWarning,
+                stacklevel=4,
+            )
 
 
 def check_scales(run: Run, linear) -> None:

@@ -28,6 +28,8 @@ such scripts share lives here:
 - :mod:`~randvib.studies.evidence`: rows that repeat one experiment (exact rescalings);
 - :mod:`~randvib.studies.figures`: figures of power and contrasts against Fc or the
   bandwidth, power against stroke exceedance, methods' errors against the level;
+- :mod:`~randvib.studies.bridge`: a coil's bridge against its resistive figure (paired
+  cases, stored-power tables, the optimum's table, where the resistive figure overstates);
 - :mod:`~randvib.studies.report`: CSV, ``verdicts.json``, Markdown tables, ``report.md``.
 
 A script imports only ``randvib`` (its exports), these building blocks and the
@@ -74,6 +76,7 @@ STUDIES = (
     "excitation",
     "devices",
     "events",
+    "dc-power",
 )
 
 
