@@ -23,7 +23,7 @@ import numpy as np
 from scipy import optimize
 
 from randvib.analytic.prediction import METHODS, predict
-from randvib.design.space import DesignSpace
+from randvib.harvester_design.space import DesignSpace
 
 __all__ = ["Candidate", "SearchOutcome", "analytic_search", "predictor_for"]
 
@@ -97,7 +97,7 @@ def predictor_for(harvester, excitation):
     return None
 
 
-class _Evaluator:
+class Evaluator:
     """Predictions at box points, cached, counted."""
 
     def __init__(self, space: DesignSpace, excitation, objective):
@@ -163,7 +163,7 @@ def analytic_search(space: DesignSpace, excitation, budget: float, objective, ru
     InfeasibleBudget
         No predicted device meets the budget: says the best reachable exceedance and where.
     """
-    evaluate = _Evaluator(space, excitation, objective)
+    evaluate = Evaluator(space, excitation, objective)
     per = GRID.get(space.dimension, GRID_MANY)
     grid = [c for c in map(evaluate, space.grid(per)) if c is not None]
     if not grid:

@@ -1,0 +1,311 @@
+"""``randvib.design``: the harvester that harvests most from a vibration under a stroke budget.
+
+The user fixes what is fixed (a :class:`~randvib.Harvester` with its mass,
+mechanical damping, friction, coupling and stroke) and the excitation, and
+names the parameters to choose with their ranges. The design
+
+1. searches with the analytic predictors where they take the candidate
+   (:mod:`randvib.harvester_design.search`; exact for a linear device under a rational
+   spectrum);
+2. confirms the optimum and the runners-up by Monte Carlo, all on one seed
+   (common random numbers, :func:`randvib.run_ensembles`; a Dask cluster and
+   resume as for every sweep);
+3. where Monte Carlo disagrees with the ranking (a runner-up significantly
+   better, paired; or the optimum significantly beyond the budget), refines
+   by Monte Carlo on shrinking local grids around the best confirmed
+   feasible candidate, and reports what the analytic answer would have cost;
+4. reports the power the excitation delivers (m S / 4 under white noise),
+   the efficiency, and the fraction of the limit
+   (:func:`randvib.analytic.harvesting_limit.harvesting_limit`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+
+import numpy as np
+
+from randvib.analytic.harvesting_limit import gaussian_displacement_budget, harvesting_limit
+from randvib.harvester_design.objectives import objective_named
+from randvib.harvester_design.result import DesignResult
+from randvib.harvester_design.search import Candidate, analytic_search
+from randvib.harvester_design.space import DesignSpace
+from randvib.models.excitation import as_excitation
+from randvib.models.harvester import Harvester
+from randvib.montecarlo.ensembles import Case, run_ensembles
+from randvib.montecarlo.sweep import SweepSettings
+from randvib.statistics import Statistic, estimate
+
+__all__ = ["design"]
+
+#: Monte Carlo refinement: rounds, and the half-width of the first local grid (unit box).
+REFINE_ROUNDS = 2
+REFINE_STEP = 0.15
+
+
+def design(
+    harvester: Harvester,
+    excitation,
+    vary: Mapping,
+    *,
+    stroke: float | None = None,
+    exceedance: float = 0.01,
+    objective="electrical",
+    monte_carlo: bool = True,
+    settings: SweepSettings | None = None,
+    runners_up: int = 2,
+    refine: bool = True,
+    out_dir=None,
+    executor=None,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    progress: bool = False,
+) -> DesignResult:
+    """Choose the varied parameters that maximise the power with P(|z| > stroke) <= exceedance.
+
+    Parameters
+    ----------
+    harvester : Harvester
+        What is fixed: mass (kg), mechanical damping (Ns/m), friction,
+        coupling; the varied parameters' values in it are ignored.
+    excitation : float or Excitation
+        White-noise level S ((m/s^2)^2/Hz) or any excitation (a band-pass,
+        Kanai-Tajimi, tabulated or measured spectrum).
+    vary : mapping of str to (low, high)
+        The parameters to choose and their ranges (SI): ``k``, ``k3`` (any
+        sign; k < 0 < k3 is bistable), ``c_e``, ``c_m``, a friction law's
+        or the coupling's parameters (``alpha``, ``r_load``, ``theta``, ...).
+    stroke : float, optional
+        Stroke d (m), > 0; default the harvester's.
+    exceedance : float
+        The budget eps: the stationary fraction of time with |z| > d, in (0, 1).
+    objective : str or Objective
+        ``"electrical"`` (E[P_e]) or ``"load"`` (E[i^2 R_L]); see
+        :data:`randvib.harvester_design.objectives.OBJECTIVES`.
+    monte_carlo : bool
+        Confirm (and refine) by Monte Carlo; False: the analytic answer only.
+    settings : SweepSettings, optional
+        Monte Carlo settings; default a 1 % precision target on the power
+        (``target_rel_ci=0.01``), control variates under white noise.
+    runners_up : int
+        Candidates confirmed beside the optimum.
+    refine : bool
+        Refine by Monte Carlo where it disagrees with the analytic ranking.
+    out_dir, executor, workers, scheduler, progress
+        As for :func:`randvib.run_ensembles` (resumable in ``out_dir``, a
+        Dask cluster at ``scheduler``).
+
+    Returns
+    -------
+    DesignResult
+
+    Raises
+    ------
+    ValueError
+        One line for an unknown parameter, an empty range, no stroke, a bad
+        budget or objective, or an infeasible budget
+        (:class:`~randvib.harvester_design.search.InfeasibleBudget`: the best reachable exceedance).
+
+    Examples
+    --------
+    >>> import randvib as rv
+    >>> fixed = rv.Harvester(m=0.0226, c_m=0.049, c_e=0.1, k=57.4, stroke=0.003)
+    >>> result = rv.design(fixed, rv.BandPass(1.0, 8.0, 0.1), {"k": (20, 120), "c_e": (0.01, 1)},
+    ...                    exceedance=0.01, monte_carlo=False)
+    >>> print(f"k = {result.optimum['k']:.1f} N/m, c_e = {result.optimum['c_e']:.3f} Ns/m")
+    k = 59.1 N/m, c_e = 0.456 Ns/m
+    """
+    stroke = harvester.stroke if stroke is None else stroke
+    if stroke is None:
+        raise ValueError("`stroke` is needed: the design's budget is on P(|z| > stroke)")
+    sigma_budget = gaussian_displacement_budget(stroke, exceedance)
+    fixed = harvester.updated(stroke=stroke)
+    goal = objective_named(objective)
+    refusal = goal.requires(fixed)
+    if refusal:
+        raise ValueError(refusal)
+    excitation = as_excitation(excitation)
+    space = DesignSpace(fixed, vary)
+    search = analytic_search(space, excitation, exceedance, goal, runners_up)
+    best = search.optimum
+    limit = harvesting_limit(fixed.m, fixed.c_m, excitation, sigma_budget)
+
+    common = dict(optimum=best.values, objective=goal.name, stroke=float(stroke),
+                  exceedance_budget=float(exceedance), method=best.method,
+                  analytic_optimum=best.values, evaluations=search.evaluations)  # fmt: skip
+    if not monte_carlo:
+        return DesignResult(
+            device=space.device(best.u),
+            power_predicted=best.power,
+            exceedance_predicted=best.exceedance,
+            power_monte_carlo=None,
+            stroke_exceedance_monte_carlo=None,
+            input_power=best.input_power,
+            efficiency=best.power / best.input_power,
+            limit=limit,
+            fraction_of_limit=None if limit is None else best.power / limit,
+            runners_up=[_runner(c) for c in search.runners_up],
+            **common,
+        )
+    settings = settings or SweepSettings(
+        target_rel_ci=0.01, control_variates=excitation.is_white, max_paths=2048
+    )
+    run = dict(settings=settings, out_dir=out_dir, executor=executor, workers=workers,
+               scheduler=scheduler, progress=progress)  # fmt: skip
+    confirmed = _Confirmed(space, excitation, goal, run)
+    candidates = [best, *search.runners_up]
+    confirmed.add(candidates)
+    chosen = confirmed.best(exceedance, candidates)
+    refined = False
+    if refine and confirmed.disagrees(best, chosen, candidates, exceedance):
+        step = REFINE_STEP
+        for _ in range(REFINE_ROUNDS):
+            local = _neighbours(space, chosen.u, step)
+            confirmed.add([c for c in map(confirmed.point, local) if c is not None])
+            chosen = confirmed.best(exceedance, confirmed.candidates)
+            step /= 3.0
+        refined = chosen is not best
+    power = confirmed.power(chosen)
+    input_power = confirmed.input_power(chosen)
+    cost = confirmed.difference(chosen, best)
+    best_x = confirmed.exceedance(best)
+    return DesignResult(
+        device=space.device(chosen.u),
+        power_predicted=chosen.power,
+        exceedance_predicted=chosen.exceedance,
+        power_monte_carlo=power,
+        stroke_exceedance_monte_carlo=confirmed.exceedance(chosen),
+        input_power=input_power,
+        efficiency=power.mean / input_power.mean,
+        limit=limit,
+        fraction_of_limit=None if limit is None else power.mean / limit,
+        runners_up=[
+            {
+                **_runner(c),
+                "power_monte_carlo": confirmed.power(c),
+                "stroke_exceedance_monte_carlo": confirmed.exceedance(c),
+                "difference_to_optimum": confirmed.difference(c, chosen),
+            }
+            for c in candidates
+            if c is not chosen
+        ],
+        analytic_cost=cost,
+        analytic_feasible=_within(best_x, exceedance),
+        refined=refined,
+        monte_carlo_cases=len(confirmed.candidates),
+        **{**common, "optimum": chosen.values},
+    )
+
+
+def _runner(c: Candidate) -> dict:
+    return {"values": c.values, "power_predicted": c.power, "exceedance_predicted": c.exceedance}
+
+
+def _neighbours(space: DesignSpace, u, step: float) -> list:
+    """The 3^d points of a local grid of half-width ``step`` around ``u``, inside the box."""
+    offsets = np.stack(
+        [a.ravel() for a in np.meshgrid(*[[-step, 0.0, step]] * space.dimension, indexing="ij")],
+        axis=-1,
+    )
+    return [np.clip(u + o, 0.0, 1.0) for o in offsets]
+
+
+class _Confirmed:
+    """Monte Carlo of candidates, every run on group 0 of one seed: path i is common to all."""
+
+    def __init__(self, space, excitation, goal, run):
+        self.space, self.excitation, self.goal, self.run = space, excitation, goal, run
+        self.candidates: list = []
+        self.where: dict = {}  # candidate id -> (EnsembleResult, index)
+
+    def point(self, u) -> Candidate | None:
+        """A candidate at ``u``: predicted where a method takes it, else unpredicted (nan)."""
+        from randvib.harvester_design.search import Evaluator
+
+        known = Evaluator(self.space, self.excitation, self.goal)(u)
+        if known is not None:
+            return known
+        try:
+            self.space.device(u)
+        except ValueError:
+            return None
+        return Candidate(u, self.space.values(u), math.nan, math.nan, "none", math.nan)
+
+    def add(self, candidates) -> None:
+        new = [
+            c for c in candidates if all(np.max(np.abs(c.u - o.u)) > 1e-9 for o in self.candidates)
+        ]
+        if not new:
+            return
+        cases = [
+            Case(labels={"candidate": len(self.candidates) + i}, device=self.space.device(c.u),
+                 excitation=self.excitation, group=0)
+            for i, c in enumerate(new)
+        ]  # fmt: skip
+        run = self.run
+        out_dir = run["out_dir"]
+        if out_dir is not None:  # one resumable folder per batch of candidates
+            from pathlib import Path
+
+            out_dir = Path(out_dir) / f"batch{len(self.candidates)}"
+        result = run_ensembles(cases, **{**run, "out_dir": out_dir}, name="design")
+        for i, c in enumerate(new):
+            self.where[id(c)] = (result, i)
+        self.candidates += new
+
+    def _samples(self, c) -> np.ndarray:
+        result, i = self.where[id(c)]
+        return self.goal.monte_carlo(result, i)
+
+    def power(self, c) -> Statistic:
+        return estimate(self._samples(c))
+
+    def exceedance(self, c) -> Statistic:
+        result, i = self.where[id(c)]
+        return estimate(result.averages(i).beyond_stroke)
+
+    def input_power(self, c) -> Statistic:
+        """c_m E[z'^2] + E[z' F] + electrical power, path by path (every dissipation)."""
+        result, i = self.where[id(c)]
+        averages, device = result.averages(i), result.cases[i].device
+        return estimate(
+            device.c_m * averages.v2 + averages.friction_power + result.power_samples(i)
+        )
+
+    def difference(self, a, b) -> Statistic:
+        """Power of ``a`` minus that of ``b`` on their common paths (paired, W)."""
+        x, y = self._samples(a), self._samples(b)
+        n = min(len(x), len(y))
+        return estimate(x[:n] - y[:n])
+
+    def best(self, budget: float, among) -> Candidate:
+        """The highest Monte Carlo power among those the budget does not reject.
+
+        A candidate is rejected when its Monte Carlo exceedance is significantly
+        above the budget (the 95 % interval lies above it): an optimum on the
+        budget's boundary has an estimate on either side of it by chance. If
+        every candidate is rejected, the one with the least exceedance.
+        """
+        feasible = [c for c in among if _within(self.exceedance(c), budget)]
+        if not feasible:
+            return min(among, key=lambda c: self.exceedance(c).mean)
+        return max(feasible, key=lambda c: self.power(c).mean)
+
+    def disagrees(self, best, chosen, candidates, budget: float) -> bool:
+        """Monte Carlo contradicts the analytic choice: another candidate is significantly
+        better (paired 95 % interval above 0) or the optimum is significantly beyond the budget."""
+        if not _within(self.exceedance(best), budget):
+            return True
+        for c in candidates:
+            if c is best:
+                continue
+            d = self.difference(c, best)
+            if d.mean - d.ci95 > 0 and _within(self.exceedance(c), budget):
+                return True
+        return False
+
+
+def _within(x: Statistic, budget: float) -> bool:
+    """The budget is not significantly exceeded: the 95 % interval reaches down to it."""
+    return x.mean - x.ci95 <= budget
