@@ -89,8 +89,12 @@ class SearchOutcome:
 
 
 def predictor_for(harvester, excitation):
-    """The first method of :data:`PREFERENCE` that takes the case and gives the exceedance, or None."""
-    for name in PREFERENCE:
+    """The first method of :data:`PREFERENCE` that takes the case and gives the exceedance, or None.
+
+    A linear device without friction is linearisation's: exact there (Lyapunov).
+    """
+    linear = harvester.friction is None and np.all(harvester.k3 == 0) and np.all(harvester.k > 0)
+    for name in ("linearisation",) if linear else PREFERENCE:
         method = METHODS[name]
         if method.stroke_exceedance and method.accepts(harvester, excitation):
             return method
