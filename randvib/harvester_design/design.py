@@ -29,7 +29,14 @@ import numpy as np
 from randvib.analytic.harvesting_limit import gaussian_displacement_budget, harvesting_limit
 from randvib.harvester_design.objectives import objective_named
 from randvib.harvester_design.result import DesignResult
-from randvib.harvester_design.search import Candidate, analytic_search
+from randvib.harvester_design.search import (
+    COARSE,
+    Candidate,
+    Evaluator,
+    InfeasibleBudget,
+    NothingPredicted,
+    analytic_search,
+)
 from randvib.harvester_design.space import DesignSpace
 from randvib.models.excitation import as_excitation
 from randvib.models.harvester import Harvester
@@ -127,15 +134,23 @@ def design(
         raise ValueError(refusal)
     excitation = as_excitation(excitation)
     space = DesignSpace(fixed, vary)
-    search = analytic_search(space, excitation, exceedance, goal, runners_up)
-    best = search.optimum
     limit = harvesting_limit(fixed.m, fixed.c_m, excitation, sigma_budget)
-
-    common = dict(optimum=best.values, objective=goal.name, stroke=float(stroke),
-                  exceedance_budget=float(exceedance), method=best.method,
-                  analytic_optimum=best.values, evaluations=search.evaluations)  # fmt: skip
+    try:
+        search = analytic_search(space, excitation, exceedance, goal, runners_up)
+    except NothingPredicted as exc:
+        if not monte_carlo:
+            raise ValueError(
+                f"{exc}: only Monte Carlo can search them (monte_carlo=True)"
+            ) from None
+        search = None
+    common = dict(objective=goal.name, stroke=float(stroke), exceedance_budget=float(exceedance),
+                  evaluations=0 if search is None else search.evaluations)  # fmt: skip
     if not monte_carlo:
+        best = search.optimum
         return DesignResult(
+            optimum=best.values,
+            analytic_optimum=best.values,
+            method=best.method,
             device=space.device(best.u),
             power_predicted=best.power,
             exceedance_predicted=best.exceedance,
@@ -154,28 +169,47 @@ def design(
     run = dict(settings=settings, out_dir=out_dir, executor=executor, workers=workers,
                scheduler=scheduler, progress=progress)  # fmt: skip
     confirmed = _Confirmed(space, excitation, goal, run)
-    candidates = [best, *search.runners_up]
-    confirmed.add(candidates)
-    chosen = confirmed.best(exceedance, candidates)
-    refined = False
-    if refine and confirmed.disagrees(best, chosen, candidates, exceedance):
+    if search is None:  # Monte Carlo searches a coarse grid, then refines
+        best = None
+        candidates = [confirmed.point(u) for u in space.grid(COARSE if space.dimension > 1 else 5)]
+        candidates = [c for c in candidates if c is not None]
+        confirmed.add(candidates)
+        disagrees = True
+    else:
+        best = search.optimum
+        candidates = [best, *search.runners_up]
+        # the devices no method predicts are candidates only Monte Carlo can judge
+        unpredicted = [c for c in map(confirmed.point, search.unpredicted) if c is not None]
+        confirmed.add(candidates + unpredicted)
+        candidates += unpredicted
+        disagrees = confirmed.disagrees(best, candidates, exceedance)
+    chosen = confirmed.best(exceedance, confirmed.candidates)
+    if refine and disagrees:
         step = REFINE_STEP
         for _ in range(REFINE_ROUNDS):
             local = _neighbours(space, chosen.u, step)
             confirmed.add([c for c in map(confirmed.point, local) if c is not None])
             chosen = confirmed.best(exceedance, confirmed.candidates)
             step /= 3.0
-        refined = chosen is not best
+    x = confirmed.exceedance(chosen)
+    if not _within(x, exceedance):
+        where = ", ".join(f"{k} = {v:.6g}" for k, v in chosen.values.items())
+        raise InfeasibleBudget(
+            f"the stroke budget P(|z| > {stroke:g} m) <= {exceedance:g} cannot be met in the "
+            f"ranges given: the best reachable exceedance (Monte Carlo) is {x.mean:.3g} "
+            f"± {x.ci95:.2g} (at {where})"
+        )
     power = confirmed.power(chosen)
     input_power = confirmed.input_power(chosen)
-    cost = confirmed.difference(chosen, best)
-    best_x = confirmed.exceedance(best)
     return DesignResult(
+        optimum=chosen.values,
+        analytic_optimum={} if best is None else best.values,
+        method="monte-carlo" if best is None else best.method,
         device=space.device(chosen.u),
         power_predicted=chosen.power,
         exceedance_predicted=chosen.exceedance,
         power_monte_carlo=power,
-        stroke_exceedance_monte_carlo=confirmed.exceedance(chosen),
+        stroke_exceedance_monte_carlo=x,
         input_power=input_power,
         efficiency=power.mean / input_power.mean,
         limit=limit,
@@ -190,11 +224,11 @@ def design(
             for c in candidates
             if c is not chosen
         ],
-        analytic_cost=cost,
-        analytic_feasible=_within(best_x, exceedance),
-        refined=refined,
+        analytic_cost=None if best is None else confirmed.difference(chosen, best),
+        analytic_feasible=None if best is None else _within(confirmed.exceedance(best), exceedance),
+        refined=best is not None and chosen is not best,
         monte_carlo_cases=len(confirmed.candidates),
-        **{**common, "optimum": chosen.values},
+        **common,
     )
 
 
@@ -221,8 +255,6 @@ class _Confirmed:
 
     def point(self, u) -> Candidate | None:
         """A candidate at ``u``: predicted where a method takes it, else unpredicted (nan)."""
-        from randvib.harvester_design.search import Evaluator
-
         known = Evaluator(self.space, self.excitation, self.goal)(u)
         if known is not None:
             return known
@@ -292,7 +324,7 @@ class _Confirmed:
             return min(among, key=lambda c: self.exceedance(c).mean)
         return max(feasible, key=lambda c: self.power(c).mean)
 
-    def disagrees(self, best, chosen, candidates, budget: float) -> bool:
+    def disagrees(self, best, candidates, budget: float) -> bool:
         """Monte Carlo contradicts the analytic choice: another candidate is significantly
         better (paired 95 % interval above 0) or the optimum is significantly beyond the budget."""
         if not _within(self.exceedance(best), budget):

@@ -46,6 +46,14 @@ class InfeasibleBudget(ValueError):
     """No device in the ranges meets the stroke budget (the message says the best reachable)."""
 
 
+class NothingPredicted(ValueError):
+    """No analytic method predicts any device of the ranges (Monte Carlo must search them)."""
+
+
+#: Grid points per dimension of the coarse look at the devices no method predicts.
+COARSE = 3
+
+
 @dataclass(frozen=True)
 class Candidate:
     """One predicted device of the design space.
@@ -80,12 +88,18 @@ class Candidate:
 
 @dataclass(frozen=True)
 class SearchOutcome:
-    """What the analytic search found."""
+    """What the analytic search found.
+
+    ``unpredicted`` holds the points of a coarse grid (:data:`COARSE` per
+    dimension) that no method predicts (refused: a bistable device beyond
+    linearisation's reach, say): candidates only Monte Carlo can judge.
+    """
 
     optimum: Candidate
     runners_up: list
     evaluations: int
     grid: list = field(repr=False)
+    unpredicted: list = field(default_factory=list, repr=False)
 
 
 def predictor_for(harvester, excitation):
@@ -170,10 +184,10 @@ def analytic_search(space: DesignSpace, excitation, budget: float, objective, ru
     evaluate = Evaluator(space, excitation, objective)
     per = GRID.get(space.dimension, GRID_MANY)
     grid = [c for c in map(evaluate, space.grid(per)) if c is not None]
+    unpredicted = [u for u in space.grid(COARSE) if evaluate(u) is None and space.builds(u)]
     if not grid:
-        raise InfeasibleBudget(
-            "no analytic method predicts any device in the ranges given (every point was "
-            "refused); search them by Monte Carlo (design(..., search='monte-carlo'))"
+        raise NothingPredicted(
+            "no analytic method predicts any device in the ranges given (every point was refused)"
         )
     feasible = sorted((c for c in grid if c.exceedance <= budget), key=lambda c: -c.power)
     if not feasible:
@@ -199,7 +213,7 @@ def analytic_search(space: DesignSpace, excitation, budget: float, objective, ru
             break
         if all(np.max(np.abs(c.u - o.u)) > 3 * SAME_POINT for o in [optima[0], *others]):
             others.append(c)
-    return SearchOutcome(optima[0], others[:runners_up], len(evaluate.cache), grid)
+    return SearchOutcome(optima[0], others[:runners_up], len(evaluate.cache), grid, unpredicted)
 
 
 def _local(evaluate, start: Candidate, budget: float, scale: float) -> Candidate:

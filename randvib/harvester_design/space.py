@@ -143,6 +143,14 @@ class DesignSpace:
         """The harvester at the box point ``u``."""
         return self.harvester.updated(**self.values(u))
 
+    def builds(self, u) -> bool:
+        """Whether the point ``u`` makes a device (damping, coupling values allowed)."""
+        try:
+            self.device(u)
+        except ValueError:
+            return False
+        return True
+
     def grid(self, per_dimension: int) -> np.ndarray:
         """Every point of a regular grid of the box, shape (per_dimension^d, d)."""
         axes = [np.linspace(0.0, 1.0, per_dimension)] * self.dimension
