@@ -99,7 +99,7 @@ def design(
         Candidates confirmed beside the optimum.
     refine : bool
         Refine by Monte Carlo where it disagrees with the analytic ranking.
-    out_dir, executor, workers, scheduler, progress
+    out_dir, executor, workers, scheduler, progress : optional
         As for :func:`randvib.run_ensembles` (resumable in ``out_dir``, a
         Dask cluster at ``scheduler``).
 
