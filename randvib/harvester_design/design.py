@@ -38,7 +38,7 @@ from randvib.harvester_design.search import (
     analytic_search,
 )
 from randvib.harvester_design.space import DesignSpace
-from randvib.models.excitation import as_excitation
+from randvib.models.excitation import Measured, as_excitation
 from randvib.models.harvester import Harvester
 from randvib.montecarlo.ensembles import Case, run_ensembles
 from randvib.montecarlo.sweep import SweepSettings
@@ -78,7 +78,9 @@ def design(
         coupling; the varied parameters' values in it are ignored.
     excitation : float or Excitation
         White-noise level S ((m/s^2)^2/Hz) or any excitation (a band-pass,
-        Kanai-Tajimi, tabulated or measured spectrum).
+        Kanai-Tajimi, tabulated or measured spectrum). A measured record's
+        Monte Carlo runs on Gaussian paths synthesised from its Welch PSD
+        (:attr:`randvib.Measured.spectrum`), not on the record itself.
     vary : mapping of str to (low, high)
         The parameters to choose and their ranges (SI): ``k``, ``k3`` (any
         sign; k < 0 < k3 is bistable), ``c_e``, ``c_m``, a friction law's
@@ -250,6 +252,9 @@ class _Confirmed:
 
     def __init__(self, space, excitation, goal, run):
         self.space, self.excitation, self.goal, self.run = space, excitation, goal, run
+        # A record drives Monte Carlo as Gaussian paths of its Welch spectrum (the same
+        # PSD the analytic search used), so that every candidate sees the same paths.
+        self.simulated = excitation.spectrum if isinstance(excitation, Measured) else excitation
         self.candidates: list = []
         self.where: dict = {}  # candidate id -> (EnsembleResult, index)
 
@@ -272,7 +277,7 @@ class _Confirmed:
             return
         cases = [
             Case(labels={"candidate": len(self.candidates) + i}, device=self.space.device(c.u),
-                 excitation=self.excitation, group=0)
+                 excitation=self.simulated, group=0)
             for i, c in enumerate(new)
         ]  # fmt: skip
         run = self.run

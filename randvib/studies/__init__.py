@@ -74,6 +74,7 @@ STUDIES = (
     "excitation",
     "devices",
     "events",
+    "design",
 )
 
 
