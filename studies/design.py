@@ -71,12 +71,12 @@ def inputs(quick: bool) -> dict:
     return {name: x.scaled(1.0 / x.variance) for name, x in out.items()}
 
 
-def one_design(family: str, excitation, stroke: float, settings) -> dict:
-    """The row of one family's design under one input and stroke."""
+def one_design(family: str, excitation, stroke: float, settings, where: dict) -> dict:
+    """The row of one family's design under one input and stroke (``where``: workers, scheduler)."""
     k3, vary = FAMILIES[family]
     try:
         r = rv.design(FIXED.updated(k3=k3), excitation, vary, stroke=stroke, exceedance=EPS,
-                      settings=settings, progress=False)  # fmt: skip
+                      settings=settings, progress=False, **where)  # fmt: skip
     except ValueError as refusal:  # an infeasible budget: the row says so
         return {"family": family, "stroke": stroke, "feasible": False, "note": str(refusal)}
     return {"family": family, "stroke": stroke, "feasible": True, "method": r.method,
@@ -89,13 +89,13 @@ def one_design(family: str, excitation, stroke: float, settings) -> dict:
             "refined": r.refined, "note": ""}  # fmt: skip
 
 
-def compute(quick: bool, settings) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
+def compute(quick: bool, settings, where: dict) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
     """results (every input and family), budget (power vs stroke), bandwidth (optimum vs zeta)."""
     xs = inputs(quick)
-    results = pd.DataFrame([{"input": name, **one_design(f, x, STROKE, settings)}
+    results = pd.DataFrame([{"input": name, **one_design(f, x, STROKE, settings, where)}
                             for name, x in xs.items() for f in FAMILIES])  # fmt: skip
     reference = next(iter(xs.values()))
-    budget = pd.DataFrame([one_design(f, reference, s, settings) for s in STROKES[quick]
+    budget = pd.DataFrame([one_design(f, reference, s, settings, where) for s in STROKES[quick]
                            for f in FAMILIES])  # fmt: skip
     budget = pd.concat([budget, results[results.input == next(iter(xs))].drop(columns="input")])
     bandwidth = pd.DataFrame([
@@ -160,7 +160,9 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
                                 control_variates=False)  # fmt: skip
     out = report.prepare_output_dir(out_dir, {"study": NAME, "quick": quick, "seed": seed})
     started = time.perf_counter()
-    results, budget, bandwidth = compute(quick, settings)
+    results, budget, bandwidth = compute(
+        quick, settings, {"workers": workers, "scheduler": scheduler}
+    )
     for name, table in (("results.csv", results), ("budget.csv", budget),
                         ("bandwidth.csv", bandwidth)):  # fmt: skip
         report.write_table(out, name, table)

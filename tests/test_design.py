@@ -165,7 +165,7 @@ def test_hardening_design_confirmed_by_independent_simulation():
     bp = rv.BandPass(1.0, 8.0, 0.1)
     result = rv.design(
         fixed(), bp, {"k3": (1e4, 1e6), "c_e": (0.02, 1.0)}, exceedance=0.02,
-        settings=settings, runners_up=1, refine=False,
+        settings=settings, runners_up=1, refine=False, workers=1,
     )  # fmt: skip
     other = rv.simulate(result.device, bp, t_end=1.5, burn_in=0.5, dt=2e-4, n_paths=64, seed=99)
     a, b = result.power_monte_carlo, other.power_electrical
@@ -248,7 +248,9 @@ def test_bistable_range_no_method_predicts_is_searched_by_monte_carlo():
     bp = rv.BandPass(0.3, 3.0, 0.05)
     with pytest.raises(ValueError, match="only Monte Carlo"):
         rv.design(device, bp, {"k": (-80.0, -40.0)}, monte_carlo=False)
-    result = rv.design(device, bp, {"k": (-80.0, -40.0)}, exceedance=0.05, settings=settings)
+    result = rv.design(
+        device, bp, {"k": (-80.0, -40.0)}, exceedance=0.05, settings=settings, workers=1
+    )
     assert result.method == "monte-carlo" and result.analytic_cost is None
     assert math.isnan(result.power_predicted)
     assert -80.0 <= result.optimum["k"] <= -40.0

@@ -27,7 +27,10 @@ def test_design_study_quick_end_to_end(tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(study, "QUICK_MC", {"dt": 2e-4, "window": 1.0, "burn_in": 0.3,
                                             "min_paths": 24, "max_paths": 24})  # fmt: skip
     out = tmp_path / "design"
-    assert main(["study", "design", "--quick", "--out", str(out), "--no-progress"]) == 0
+    assert (
+        main(["study", "design", "--quick", "--out", str(out), "--no-progress", "--workers", "1"])
+        == 0
+    )
     for name in ("report.md", "results.csv", "budget.csv", "bandwidth.csv", "design.png"):
         assert (out / name).is_file(), name
     results = pd.read_csv(out / "results.csv")
