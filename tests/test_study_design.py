@@ -21,7 +21,9 @@ study = load("design")
 
 def test_design_study_quick_end_to_end(tmp_path, monkeypatch, capsys):
     band = rv.BandPass(1.0, 8.0, 0.3)
-    monkeypatch.setattr(study, "inputs", lambda quick: {"band": band.scaled(1 / band.variance)})
+    monkeypatch.setattr(
+        study, "inputs", lambda quick: {"band": band.scaled(study.LEVEL / band.variance)}
+    )
     monkeypatch.setattr(study, "STROKES", {True: (0.002,)})
     monkeypatch.setattr(study, "ZETAS", {True: (0.3, 0.05)})
     monkeypatch.setattr(study, "QUICK_MC", {"dt": 2e-4, "window": 1.0, "burn_in": 0.3,
@@ -41,7 +43,7 @@ def test_design_study_quick_end_to_end(tmp_path, monkeypatch, capsys):
     lin = results[results.family == "linear"].iloc[0]
     half = np.hypot(nonlinear.power_mc_ci95, lin.power_mc_ci95)
     assert v["nonlinear_pays"] == int(((nonlinear.power_mc - lin.power_mc) > half).sum())
-    exact = rv.design(study.FIXED, band.scaled(1 / band.variance), study.FAMILIES["linear"][1],
+    exact = rv.design(study.FIXED, band.scaled(study.LEVEL / band.variance), study.FAMILIES["linear"][1],
                       exceedance=study.EPS, monte_carlo=False)  # fmt: skip
     assert lin.power_predicted == pytest.approx(exact.power_predicted, rel=1e-9)
     assert lin.opt_k == pytest.approx(exact.optimum["k"], rel=1e-9)
