@@ -71,6 +71,11 @@ def brute_force_linear(excitation, sigma, k_range, ce_range):
         (rv.BandPass(1.0, 8.0, 0.1), 0.003, 0.01),
         (rv.BandPass(0.5, 12.0, 0.3), 0.002, 0.05),
         (rv.BandPass(2.0, 6.0, 0.05), 0.004, 0.01),
+        (
+            rv.BandPass(1.0, 8.0, 0.03).scaled(9.0 / rv.BandPass(1.0, 8.0, 0.03).variance),
+            0.003,
+            0.01,
+        ),  # narrow and strong: SLSQP ends on the budget's boundary
     ],
 )
 def test_linear_optimum_is_exact(excitation, stroke, eps):

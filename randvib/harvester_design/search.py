@@ -237,10 +237,19 @@ def _local(evaluate, start: Candidate, budget: float, scale: float) -> Candidate
         options={"ftol": 1e-12, "maxiter": 200, "eps": 1e-7},
     )
     end = evaluate(result.x)
-    # a hair inside the boundary is feasible: the constraint's tolerance is 1e-10 in log
-    if end is not None and end.exceedance <= budget * (1 + 1e-8) and end.power > start.power:
-        return end
-    return start
+    if end is None or end.exceedance > budget * (1 + 1e-8):
+        # SLSQP may stop a hair outside the budget (or on an unpredicted point): the
+        # feasible point nearest to it on the segment from the start, by bisection
+        lo, hi = 0.0, 1.0
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            c = evaluate(start.u + mid * (result.x - start.u))
+            if c is not None and c.exceedance <= budget:
+                lo = mid
+            else:
+                hi = mid
+        end = evaluate(start.u + lo * (result.x - start.u))
+    return end if end is not None and end.power > start.power else start
 
 
 def _least_exceedance(evaluate, start: Candidate, space: DesignSpace) -> Candidate:
