@@ -268,3 +268,17 @@ def test_bistable_range_no_method_predicts_is_searched_by_monte_carlo():
             <= 0.05
         ):
             assert other["power_monte_carlo"].mean <= best
+
+
+def test_monte_carlo_resumes_from_out_dir(tmp_path):
+    # The confirmation is run_ensembles with a PointStore: a second run loads every case.
+    settings = SweepSettings(dt=2e-4, window=0.5, burn_in=0.2, min_paths=16, max_paths=16,
+                             control_variates=False)  # fmt: skip
+    bp = rv.BandPass(1.0, 8.0, 0.1)
+    args = (fixed(), bp, {"k": (20.0, 120.0), "c_e": (0.01, 1.0)})
+    first = rv.design(*args, settings=settings, out_dir=tmp_path, workers=1)
+    stored = {p: p.stat().st_mtime_ns for p in tmp_path.rglob("*.npy")}
+    assert stored
+    again = rv.design(*args, settings=settings, out_dir=tmp_path, workers=1)
+    assert {p: p.stat().st_mtime_ns for p in tmp_path.rglob("*.npy")} == stored
+    assert again.power_monte_carlo == first.power_monte_carlo
