@@ -90,6 +90,9 @@ _EXPORTS = {
     "randvib.montecarlo.transient_results": ("TransientResult",),
     "randvib.montecarlo.batches": ("SimulationDivergedError",),
     "randvib.montecarlo.results": ("SimulationResult",),
+    "randvib.harvester_design.design": ("design",),
+    "randvib.harvester_design.result": ("DesignResult",),
+    "randvib.analytic.harvesting_limit": ("gaussian_displacement_budget", "harvesting_limit"),
     "randvib.statistics": ("FirstPassage", "Statistic", "estimate", "TimeStatistics"),
     "randvib.montecarlo.step_check": ("StepSizeWarning",),
 }

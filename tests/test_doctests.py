@@ -39,6 +39,7 @@ MODULES = (
     "randvib.montecarlo.sweep",
     "randvib.quantities",
     "randvib.montecarlo.transient",
+    "randvib.harvester_design.design",
 )
 
 FLAGS = doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE

@@ -24,7 +24,7 @@ import warnings
 from randvib._interrupts import interrupted_exit, sigterm_stops
 
 #: Command modules under randvib.cli, in the order shown by --help.
-COMMANDS = ["power", "simulate", "study", "record", "identify", "validate"]
+COMMANDS = ["power", "design", "simulate", "study", "record", "identify", "validate"]
 
 #: Options whose name differs from the Python API's argument (README's table).
 API_NAMES = {

@@ -77,6 +77,7 @@ STUDIES = (
     "devices",
     "events",
     "dc-power",
+    "design",
 )
 
 

@@ -1,0 +1,177 @@
+"""``randvib design``: the harvester that harvests most from a vibration under a stroke budget.
+
+The device and excitation options of ``randvib power`` fix what is fixed;
+``--vary NAME=LOW:HIGH`` (repeatable) names each parameter to choose and its
+range; ``--stroke`` and ``--exceedance`` set the budget P(|z| > stroke) <=
+exceedance. The analytic search's optimum is confirmed (and, where Monte
+Carlo contradicts it, refined) by Monte Carlo with common random numbers
+(:func:`randvib.design`). ``--json`` prints one object with the keys
+``optimum``, ``power_predicted``, ``power_monte_carlo``,
+``stroke_exceedance_monte_carlo`` (each ``{"mean", "ci95"}``),
+``input_power``, ``limit`` and the rest of :meth:`randvib.DesignResult.to_dict`.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+from randvib._io import dumps
+from randvib._validation import MAX_SEED, integer_option
+from randvib.cli._device import add_device_arguments, harvester_from_args
+from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
+from randvib.cli._output import describe_device, describe_excitation, print_table
+from randvib.formatting import cell
+from randvib.harvester_design.design import design
+from randvib.harvester_design.objectives import OBJECTIVES
+from randvib.models.coupling import COUPLINGS
+from randvib.models.friction import FRICTION_MODELS
+from randvib.montecarlo.sweep import SweepSettings
+
+
+def register(sub) -> None:
+    p = sub.add_parser(
+        "design",
+        help="choose device parameters for the most power under a stroke budget",
+        description="Search the ranges given for the device that harvests most from the "
+        "excitation with P(|z| > --stroke) <= --exceedance: analytic search, Monte Carlo "
+        "confirmation with common random numbers, and the limit for a mass of this size.",
+    )
+    add_device_arguments(p)
+    add_excitation_arguments(p)
+    g = p.add_argument_group("design")
+    g.add_argument(
+        "--vary",
+        action="append",
+        metavar="NAME=LOW:HIGH",
+        type=vary_option,
+        required=True,
+        help="a parameter to choose and its range (SI; repeatable): k, k3 (negative k "
+        "with k3 > 0 is bistable), c_e, c_m, a friction or coupling parameter (alpha, "
+        "r_load, theta, ...)",
+    )
+    g.add_argument(
+        "--exceedance",
+        type=float,
+        default=0.01,
+        help="budget on the fraction of time with abs(z) > --stroke (default 0.01)",
+    )
+    g.add_argument(
+        "--objective",
+        default="electrical",
+        choices=tuple(OBJECTIVES),
+        help="the power to maximise: "
+        + "; ".join(f"{name}: {o.description}" for name, o in OBJECTIVES.items()),
+    )
+    g.add_argument(
+        "--no-monte-carlo", action="store_true", help="the analytic search's answer only"
+    )
+    g.add_argument(
+        "--precision",
+        type=float,
+        default=0.01,
+        help="Monte Carlo target: 95 %% half-width of the power over the power (default 0.01)",
+    )
+    g.add_argument(
+        "--max-paths",
+        type=integer_option(2),
+        default=2048,
+        help="most Monte Carlo paths per candidate (default 2048)",
+    )
+    g.add_argument(
+        "--seed", type=integer_option(0, MAX_SEED // 1000), default=0, help="random seed"
+    )
+    g.add_argument("--out-dir", help="folder to keep the Monte Carlo cases in and resume from")
+    g.add_argument("--scheduler", help="address of a Dask scheduler to run the cases on")
+    g.add_argument("--no-progress", action="store_true", help="no progress bar")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.set_defaults(handler=run)
+
+
+def vary_option(text: str) -> tuple[str, float, float]:
+    """``NAME=LOW:HIGH`` -> (name, low, high)."""
+    name, _, bounds = text.partition("=")
+    parts = bounds.split(":")
+    try:
+        if name and len(parts) == 2:
+            return name.strip(), float(parts[0]), float(parts[1])
+    except ValueError:
+        pass
+    raise argparse.ArgumentTypeError(f"{text!r} is not NAME=LOW:HIGH (for example k=20:120)")
+
+
+def _known_names() -> tuple[str, ...]:
+    """Every parameter some device can vary: the device's, every friction law's and coupling's."""
+    names = ["c_m", "c_e", "k", "k3"]
+    for family in (FRICTION_MODELS, COUPLINGS):
+        for member in family.values():
+            names += list(member.parameter_names())
+    return tuple(dict.fromkeys(names))
+
+
+def run(args) -> int:
+    vary = {}
+    known = _known_names()
+    for name, low, high in args.vary:
+        if name in vary:
+            raise ValueError(f"`--vary {name}` is given twice")
+        if name not in known:
+            raise ValueError(
+                f"`--vary` names unknown parameter {name!r}; allowed: {', '.join(known)}"
+            )
+        if not low < high:
+            raise ValueError(f"`--vary {name}={low:g}:{high:g}` is an empty range: need LOW < HIGH")
+        vary[name] = (low, high)
+        # the device needs a value for a varied parameter it has no other value for
+        if getattr(args, name, 0) is None:
+            setattr(args, name, 0.5 * (low + high))
+    if args.stroke is None:
+        raise ValueError("`--stroke` is needed: the budget is on P(|z| > stroke)")
+    harvester = harvester_from_args(args)
+    excitation = excitation_from_args(args)
+    settings = SweepSettings(
+        target_rel_ci=args.precision,
+        max_paths=args.max_paths,
+        seed=args.seed,
+        control_variates=not hasattr(excitation, "is_white") or excitation.is_white,
+    )
+    result = design(
+        harvester,
+        excitation,
+        vary,
+        exceedance=args.exceedance,
+        objective=args.objective,
+        monte_carlo=not args.no_monte_carlo,
+        settings=settings,
+        out_dir=args.out_dir,
+        scheduler=args.scheduler,
+        progress=not args.no_progress and not args.json,
+    )
+    if args.json:
+        print(dumps(result.to_dict()))
+        return 0
+    print(describe_device(harvester))
+    print(describe_excitation(excitation))
+    out = result.to_dict()
+    rows = [(f"optimum {k}", cell(v), "") for k, v in result.optimum.items()]
+    for key in ("power_predicted", "stroke_exceedance_predicted"):
+        rows.append((key, cell(out[key]), "W" if key.startswith("power") else ""))
+    for key in ("power_monte_carlo", "stroke_exceedance_monte_carlo", "input_power"):
+        value = out[key]
+        if value is None:
+            continue
+        if isinstance(value, dict):
+            value = f"{cell(value['mean'])} ± {cell(value['ci95'])}"
+        rows.append(
+            (key, value if isinstance(value, str) else cell(value), "" if "exceed" in key else "W")
+        )
+    rows.append(("efficiency", cell(out["efficiency"]), ""))
+    rows.append(
+        ("limit", "none (white noise)" if out["limit"] is None else cell(out["limit"]), "W")
+    )
+    if out["fraction_of_limit"] is not None:
+        rows.append(("fraction_of_limit", cell(out["fraction_of_limit"]), ""))
+    if result.refined:
+        cost = result.analytic_cost
+        rows.append(("analytic optimum's cost", f"{cell(cost.mean)} ± {cell(cost.ci95)}", "W"))
+    print_table(rows, ("quantity", "value", "unit"))
+    return 0

@@ -1,0 +1,369 @@
+"""``randvib.design``: the harvester that harvests most from a vibration under a stroke budget.
+
+The user fixes what is fixed (a :class:`~randvib.Harvester` with its mass,
+mechanical damping, friction, coupling and stroke) and the excitation, and
+names the parameters to choose with their ranges. The design
+
+1. searches with the analytic predictors where they take the candidate
+   (:mod:`randvib.harvester_design.search`; exact for a linear device under a rational
+   spectrum);
+2. confirms the optimum and the runners-up by Monte Carlo, all on one seed
+   (common random numbers, :func:`randvib.run_ensembles`; a Dask cluster and
+   resume as for every sweep);
+3. where Monte Carlo disagrees with the analytic answer (a runner-up
+   significantly better, paired; the optimum significantly beyond the budget;
+   or its prediction off by more than :data:`PREDICTION_TOLERANCE`), refines
+   by Monte Carlo on shrinking local grids around the best confirmed
+   feasible candidate, and reports what the analytic answer would have cost;
+4. reports the power the excitation delivers (m S / 4 under white noise),
+   the efficiency, and the fraction of the limit
+   (:func:`randvib.analytic.harvesting_limit.harvesting_limit`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+
+import numpy as np
+
+from randvib.analytic.harvesting_limit import gaussian_displacement_budget, harvesting_limit
+from randvib.harvester_design.objectives import objective_named
+from randvib.harvester_design.result import DesignResult
+from randvib.harvester_design.search import (
+    COARSE,
+    Candidate,
+    Evaluator,
+    InfeasibleBudget,
+    NothingPredicted,
+    analytic_search,
+)
+from randvib.harvester_design.space import DesignSpace
+from randvib.models.excitation import Measured, as_excitation
+from randvib.models.harvester import Harvester
+from randvib.montecarlo.ensembles import Case, run_ensembles
+from randvib.montecarlo.sweep import SweepSettings
+from randvib.statistics import Statistic, estimate
+
+__all__ = ["design"]
+
+#: Monte Carlo refinement: rounds, and the half-width of the first local grid (unit box).
+REFINE_ROUNDS = 2
+REFINE_STEP = 0.15
+#: A prediction further than this fraction (beyond the 95 % interval) from Monte Carlo
+#: is off, and Monte Carlo refines: linearisation's error under white noise is within
+#: a few per cent (README), so a larger gap means the analytic ranking is not reliable.
+PREDICTION_TOLERANCE = 0.02
+
+
+def design(
+    harvester: Harvester,
+    excitation,
+    vary: Mapping,
+    *,
+    stroke: float | None = None,
+    exceedance: float = 0.01,
+    objective="electrical",
+    monte_carlo: bool = True,
+    settings: SweepSettings | None = None,
+    runners_up: int = 2,
+    refine: bool = True,
+    out_dir=None,
+    executor=None,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    progress: bool = False,
+) -> DesignResult:
+    """Choose the varied parameters that maximise the power with P(|z| > stroke) <= exceedance.
+
+    Parameters
+    ----------
+    harvester : Harvester
+        What is fixed: mass (kg), mechanical damping (Ns/m), friction,
+        coupling; the varied parameters' values in it are ignored.
+    excitation : float or Excitation
+        White-noise level S ((m/s^2)^2/Hz) or any excitation (a band-pass,
+        Kanai-Tajimi, tabulated or measured spectrum). A measured record's
+        Monte Carlo runs on Gaussian paths synthesised from its Welch PSD
+        (:attr:`randvib.Measured.spectrum`), not on the record itself.
+    vary : mapping of str to (low, high)
+        The parameters to choose and their ranges (SI): ``k``, ``k3`` (any
+        sign; k < 0 < k3 is bistable), ``c_e``, ``c_m``, a friction law's
+        or the coupling's parameters (``alpha``, ``r_load``, ``theta``, ...).
+    stroke : float, optional
+        Stroke d (m), > 0; default the harvester's.
+    exceedance : float
+        The budget eps: the stationary fraction of time with |z| > d, in (0, 1).
+    objective : str or Objective
+        ``"electrical"`` (E[P_e]) or ``"load"`` (E[i^2 R_L]); see
+        :data:`randvib.harvester_design.objectives.OBJECTIVES`.
+    monte_carlo : bool
+        Confirm (and refine) by Monte Carlo; False: the analytic answer only.
+    settings : SweepSettings, optional
+        Monte Carlo settings; default a 1 % precision target on the power
+        (``target_rel_ci=0.01``), control variates under white noise.
+    runners_up : int
+        Candidates confirmed beside the optimum.
+    refine : bool
+        Refine by Monte Carlo where it disagrees with the analytic ranking.
+    out_dir, executor, workers, scheduler, progress : optional
+        As for :func:`randvib.run_ensembles` (resumable in ``out_dir``, a
+        Dask cluster at ``scheduler``).
+
+    Returns
+    -------
+    DesignResult
+
+    Raises
+    ------
+    ValueError
+        One line for an unknown parameter, an empty range, no stroke, a bad
+        budget or objective, or an infeasible budget
+        (:class:`~randvib.harvester_design.search.InfeasibleBudget`: the best reachable exceedance).
+
+    Examples
+    --------
+    >>> import randvib as rv
+    >>> fixed = rv.Harvester(m=0.0226, c_m=0.049, c_e=0.1, k=57.4, stroke=0.003)
+    >>> result = rv.design(fixed, rv.BandPass(1.0, 8.0, 0.1), {"k": (20, 120), "c_e": (0.01, 1)},
+    ...                    exceedance=0.01, monte_carlo=False)
+    >>> print(f"k = {result.optimum['k']:.1f} N/m, c_e = {result.optimum['c_e']:.3f} Ns/m")
+    k = 59.1 N/m, c_e = 0.456 Ns/m
+    """
+    stroke = harvester.stroke if stroke is None else stroke
+    if stroke is None:
+        raise ValueError("`stroke` is needed: the design's budget is on P(|z| > stroke)")
+    sigma_budget = gaussian_displacement_budget(stroke, exceedance)
+    fixed = harvester.updated(stroke=stroke)
+    goal = objective_named(objective)
+    refusal = goal.requires(fixed)
+    if refusal:
+        raise ValueError(refusal)
+    excitation = as_excitation(excitation)
+    space = DesignSpace(fixed, vary)
+    limit = harvesting_limit(fixed.m, fixed.c_m, excitation, sigma_budget)
+    try:
+        search = analytic_search(space, excitation, exceedance, goal, runners_up)
+    except NothingPredicted as exc:
+        if not monte_carlo:
+            raise ValueError(
+                f"{exc}: only Monte Carlo can search them (monte_carlo=True)"
+            ) from None
+        search = None
+    common = dict(objective=goal.name, stroke=float(stroke), exceedance_budget=float(exceedance),
+                  evaluations=0 if search is None else search.evaluations)  # fmt: skip
+    if not monte_carlo:
+        best = search.optimum
+        return DesignResult(
+            optimum=best.values,
+            analytic_optimum=best.values,
+            method=best.method,
+            device=space.device(best.u),
+            power_predicted=best.power,
+            exceedance_predicted=best.exceedance,
+            power_monte_carlo=None,
+            stroke_exceedance_monte_carlo=None,
+            input_power=best.input_power,
+            efficiency=best.power / best.input_power,
+            limit=limit,
+            fraction_of_limit=None if limit is None else best.power / limit,
+            runners_up=[_runner(c) for c in search.runners_up],
+            **common,
+        )
+    settings = settings or SweepSettings(
+        target_rel_ci=0.01, control_variates=excitation.is_white, max_paths=2048
+    )
+    run = dict(settings=settings, out_dir=out_dir, executor=executor, workers=workers,
+               scheduler=scheduler, progress=progress)  # fmt: skip
+    confirmed = _Confirmed(space, excitation, goal, run)
+    if search is None:  # Monte Carlo searches a coarse grid, then refines
+        best = None
+        candidates = [confirmed.point(u) for u in space.grid(COARSE if space.dimension > 1 else 5)]
+        candidates = [c for c in candidates if c is not None]
+        confirmed.add(candidates)
+        disagrees = True
+    else:
+        best = search.optimum
+        candidates = [best, *search.runners_up]
+        # the devices no method predicts are candidates only Monte Carlo can judge
+        unpredicted = [c for c in map(confirmed.point, search.unpredicted) if c is not None]
+        confirmed.add(candidates + unpredicted)
+        candidates += unpredicted
+        disagrees = confirmed.disagrees(best, candidates, exceedance)
+    chosen = confirmed.best(exceedance, confirmed.candidates)
+    if refine and disagrees:
+        step = REFINE_STEP
+        for _ in range(REFINE_ROUNDS):
+            local = _neighbours(space, chosen.u, step)
+            confirmed.add([c for c in map(confirmed.point, local) if c is not None])
+            chosen = confirmed.best(exceedance, confirmed.candidates)
+            step /= 3.0
+    if best is not None and chosen is not best and not confirmed.better(chosen, best, exceedance):
+        chosen = best  # Monte Carlo's maximum is not significantly better: keep the analytic one
+    x = confirmed.exceedance(chosen)
+    if not _within(x, exceedance):
+        where = ", ".join(f"{k} = {v:.6g}" for k, v in chosen.values.items())
+        raise InfeasibleBudget(
+            f"the stroke budget P(|z| > {stroke:g} m) <= {exceedance:g} cannot be met in the "
+            f"ranges given: the best reachable exceedance (Monte Carlo) is {x.mean:.3g} "
+            f"± {x.ci95:.2g} (at {where})"
+        )
+    power = confirmed.power(chosen)
+    input_power = confirmed.input_power(chosen)
+    return DesignResult(
+        optimum=chosen.values,
+        analytic_optimum={} if best is None else best.values,
+        method="monte-carlo" if best is None else best.method,
+        device=space.device(chosen.u),
+        power_predicted=chosen.power,
+        exceedance_predicted=chosen.exceedance,
+        power_monte_carlo=power,
+        stroke_exceedance_monte_carlo=x,
+        input_power=input_power,
+        efficiency=power.mean / input_power.mean,
+        limit=limit,
+        fraction_of_limit=None if limit is None else power.mean / limit,
+        runners_up=[
+            {
+                **_runner(c),
+                "power_monte_carlo": confirmed.power(c),
+                "stroke_exceedance_monte_carlo": confirmed.exceedance(c),
+                "difference_to_optimum": confirmed.difference(c, chosen),
+            }
+            for c in candidates
+            if c is not chosen
+        ],
+        analytic_cost=None if best is None else confirmed.difference(chosen, best),
+        analytic_feasible=None if best is None else _within(confirmed.exceedance(best), exceedance),
+        refined=best is not None and chosen is not best,
+        monte_carlo_cases=len(confirmed.candidates),
+        **common,
+    )
+
+
+def _runner(c: Candidate) -> dict:
+    return {"values": c.values, "power_predicted": c.power, "exceedance_predicted": c.exceedance}
+
+
+def _neighbours(space: DesignSpace, u, step: float) -> list:
+    """The 3^d points of a local grid of half-width ``step`` around ``u``, inside the box."""
+    offsets = np.stack(
+        [a.ravel() for a in np.meshgrid(*[[-step, 0.0, step]] * space.dimension, indexing="ij")],
+        axis=-1,
+    )
+    return [np.clip(u + o, 0.0, 1.0) for o in offsets]
+
+
+class _Confirmed:
+    """Monte Carlo of candidates, every run on group 0 of one seed: path i is common to all."""
+
+    def __init__(self, space, excitation, goal, run):
+        self.space, self.excitation, self.goal, self.run = space, excitation, goal, run
+        # A record drives Monte Carlo as Gaussian paths of its Welch spectrum (the same
+        # PSD the analytic search used), so that every candidate sees the same paths.
+        self.simulated = excitation.spectrum if isinstance(excitation, Measured) else excitation
+        self.candidates: list = []
+        self.where: dict = {}  # candidate id -> (EnsembleResult, index)
+
+    def point(self, u) -> Candidate | None:
+        """A candidate at ``u``: predicted where a method takes it, else unpredicted (nan)."""
+        known = Evaluator(self.space, self.excitation, self.goal)(u)
+        if known is not None:
+            return known
+        try:
+            self.space.device(u)
+        except ValueError:
+            return None
+        return Candidate(u, self.space.values(u), math.nan, math.nan, "none", math.nan)
+
+    def add(self, candidates) -> None:
+        new = [
+            c for c in candidates if all(np.max(np.abs(c.u - o.u)) > 1e-9 for o in self.candidates)
+        ]
+        if not new:
+            return
+        cases = [
+            Case(labels={"candidate": len(self.candidates) + i}, device=self.space.device(c.u),
+                 excitation=self.simulated, group=0)
+            for i, c in enumerate(new)
+        ]  # fmt: skip
+        run = self.run
+        out_dir = run["out_dir"]
+        if out_dir is not None:  # one resumable folder per batch of candidates
+            from pathlib import Path
+
+            out_dir = Path(out_dir) / f"batch{len(self.candidates)}"
+        result = run_ensembles(cases, **{**run, "out_dir": out_dir}, name="design")
+        for i, c in enumerate(new):
+            self.where[id(c)] = (result, i)
+        self.candidates += new
+
+    def _samples(self, c) -> np.ndarray:
+        result, i = self.where[id(c)]
+        return self.goal.monte_carlo(result, i)
+
+    def _controls(self, c):
+        """The case's zero-mean control variates per path (white noise), or None."""
+        result, i = self.where[id(c)]
+        return result.simulation(i).controls() if result.settings.control_variates else None
+
+    def power(self, c) -> Statistic:
+        return estimate(self._samples(c), self._controls(c))
+
+    def exceedance(self, c) -> Statistic:
+        result, i = self.where[id(c)]
+        return estimate(result.averages(i).beyond_stroke)
+
+    def input_power(self, c) -> Statistic:
+        """c_m E[z'^2] + E[z' F] + electrical power, path by path (every dissipation)."""
+        result, i = self.where[id(c)]
+        averages, device = result.averages(i), result.cases[i].device
+        samples = device.c_m * averages.v2 + averages.friction_power + result.power_samples(i)
+        return estimate(samples, self._controls(c))
+
+    def difference(self, a, b) -> Statistic:
+        """Power of ``a`` minus that of ``b`` on their common paths (paired, W)."""
+        x, y = self._samples(a), self._samples(b)
+        n = min(len(x), len(y))
+        controls = None
+        if self._controls(a) is not None:
+            controls = np.hstack([self._controls(a)[:n], self._controls(b)[:n]])
+        return estimate(x[:n] - y[:n], controls)
+
+    def best(self, budget: float, among) -> Candidate:
+        """The highest Monte Carlo power among those the budget does not reject.
+
+        A candidate is rejected when its Monte Carlo exceedance is significantly
+        above the budget (the 95 % interval lies above it): an optimum on the
+        budget's boundary has an estimate on either side of it by chance. If
+        every candidate is rejected, the one with the least exceedance.
+        """
+        feasible = [c for c in among if _within(self.exceedance(c), budget)]
+        if not feasible:
+            return min(among, key=lambda c: self.exceedance(c).mean)
+        return max(feasible, key=lambda c: self.power(c).mean)
+
+    def disagrees(self, best, candidates, budget: float) -> bool:
+        """Monte Carlo contradicts the analytic choice: the optimum is significantly beyond
+        the budget, its prediction lies outside its Monte Carlo interval by more than
+        :data:`PREDICTION_TOLERANCE`, or another candidate is significantly better (paired
+        95 % interval above 0)."""
+        if not _within(self.exceedance(best), budget):
+            return True
+        power = self.power(best)
+        if abs(power.mean - best.power) > power.ci95 + PREDICTION_TOLERANCE * best.power:
+            return True  # the predictor is off here: its ranking is not to be trusted
+        return any(self.better(c, best, budget) for c in candidates if c is not best)
+
+    def better(self, a, b, budget: float) -> bool:
+        """``a`` meets the budget and harvests significantly more than ``b`` on the common
+        paths (paired 95 % interval above 0, and above rounding: 1e-9 of the power)."""
+        if not _within(self.exceedance(a), budget):
+            return False
+        d = self.difference(a, b)
+        return d.mean - d.ci95 > 1e-9 * abs(self.power(b).mean)
+
+
+def _within(x: Statistic, budget: float) -> bool:
+    """The budget is not significantly exceeded: the 95 % interval reaches down to it."""
+    return x.mean - x.ci95 <= budget

@@ -1,0 +1,176 @@
+"""What a design returns: :class:`DesignResult`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from randvib import _display, formatting
+from randvib.statistics import Statistic
+
+__all__ = ["DesignResult"]
+
+
+def _stat(s: Statistic | None):
+    return None if s is None else s.to_dict()
+
+
+@dataclass(frozen=True)
+class DesignResult:
+    """The chosen device, its predicted and confirmed power, and the limit (SI units).
+
+    Attributes
+    ----------
+    optimum : dict
+        Varied parameter name -> chosen value.
+    device : Harvester
+        The fixed harvester with the chosen values.
+    objective : str
+        The maximised power (:data:`randvib.harvester_design.objectives.OBJECTIVES`).
+    stroke, exceedance_budget : float
+        The stroke d (m) and the budget eps on P(|z| > d).
+    method : str
+        The analytic method of the search.
+    power_predicted : float
+        The analytic prediction of the objective at ``optimum`` (W).
+    exceedance_predicted : float
+        The predicted P(|z| > d) at ``optimum``.
+    power_monte_carlo, stroke_exceedance_monte_carlo : Statistic or None
+        Monte Carlo mean and 95 % half-width at ``optimum`` (None without Monte Carlo).
+    input_power : Statistic or float
+        Power the excitation delivers to the device (W): c_m E[z'^2] + E[z' F]
+        + electrical power, from Monte Carlo (else the prediction). m S / 4
+        under white noise.
+    efficiency : float
+        Objective power over input power (mean values).
+    limit : float or None
+        :func:`randvib.analytic.harvesting_limit.harvesting_limit` at the
+        Gaussian displacement RMS of the budget (W); None where no finite bound exists.
+    fraction_of_limit : float or None
+        The optimum's power (Monte Carlo mean, else predicted) over ``limit``.
+    runners_up : list of dict
+        Other candidates: ``values``, ``power_predicted``, ``exceedance_predicted``
+        and, with Monte Carlo, ``power_monte_carlo``, ``stroke_exceedance_monte_carlo``
+        and ``difference_to_optimum`` (paired, W).
+    analytic_optimum : dict
+        The analytic search's optimum (equal to ``optimum`` unless Monte Carlo refined it).
+    analytic_cost : Statistic or None
+        Monte Carlo power of ``optimum`` minus that of ``analytic_optimum``,
+        paired (W): what the analytic answer would have cost (0 when equal).
+    analytic_feasible : bool or None
+        Whether the analytic optimum met the budget in Monte Carlo (its 95 %
+        interval on the exceedance reaches down to the budget).
+    refined : bool
+        Monte Carlo moved the optimum.
+    evaluations : int
+        Analytic predictions made.
+    monte_carlo_cases : int
+        Ensembles simulated.
+    """
+
+    optimum: dict
+    device: object = field(repr=False)
+    objective: str
+    stroke: float
+    exceedance_budget: float
+    method: str
+    power_predicted: float
+    exceedance_predicted: float
+    power_monte_carlo: Statistic | None
+    stroke_exceedance_monte_carlo: Statistic | None
+    input_power: object
+    efficiency: float
+    limit: float | None
+    fraction_of_limit: float | None
+    runners_up: list = field(repr=False)
+    analytic_optimum: dict = field(repr=False)
+    analytic_cost: Statistic | None = None
+    analytic_feasible: bool | None = None
+    refined: bool = False
+    evaluations: int = 0
+    monte_carlo_cases: int = 0
+
+    def to_dict(self) -> dict:
+        """JSON-ready: the keys of ``randvib design --json``."""
+        input_power = self.input_power
+        return {
+            "optimum": dict(self.optimum),
+            "objective": self.objective,
+            "stroke": self.stroke,
+            "exceedance": self.exceedance_budget,
+            "method": self.method,
+            "power_predicted": self.power_predicted,
+            "stroke_exceedance_predicted": self.exceedance_predicted,
+            "power_monte_carlo": _stat(self.power_monte_carlo),
+            "stroke_exceedance_monte_carlo": _stat(self.stroke_exceedance_monte_carlo),
+            "input_power": input_power.to_dict()
+            if isinstance(input_power, Statistic)
+            else input_power,
+            "efficiency": self.efficiency,
+            "limit": self.limit,
+            "fraction_of_limit": self.fraction_of_limit,
+            "runners_up": [
+                {k: (_stat(v) if isinstance(v, Statistic) else v) for k, v in r.items()}
+                for r in self.runners_up
+            ],
+            "analytic_optimum": dict(self.analytic_optimum),
+            "analytic_cost": _stat(self.analytic_cost),
+            "analytic_feasible": self.analytic_feasible,
+            "refined": self.refined,
+            "evaluations": self.evaluations,
+            "monte_carlo_cases": self.monte_carlo_cases,
+        }
+
+    def to_frame(self):
+        """One row per candidate (the optimum first): parameters, powers and exceedances."""
+        pd = _display.pandas()
+        rows = [
+            {
+                "candidate": "optimum",
+                **self.optimum,
+                "power_predicted": self.power_predicted,
+                "stroke_exceedance_predicted": self.exceedance_predicted,
+                **_columns("power_monte_carlo", self.power_monte_carlo),
+                **_columns("stroke_exceedance_monte_carlo", self.stroke_exceedance_monte_carlo),
+            }
+        ]
+        for i, r in enumerate(self.runners_up, 1):
+            rows.append({
+                "candidate": f"runner-up {i}",
+                **r["values"],
+                "power_predicted": r["power_predicted"],
+                "stroke_exceedance_predicted": r["exceedance_predicted"],
+                **_columns("power_monte_carlo", r.get("power_monte_carlo")),
+                **_columns(
+                    "stroke_exceedance_monte_carlo", r.get("stroke_exceedance_monte_carlo")
+                ),
+            })  # fmt: skip
+        return pd.DataFrame(rows)
+
+    def _rows(self):
+        rows = [(name, formatting.compact(v), "") for name, v in self.optimum.items()]
+        rows.append(("power_predicted", formatting.compact(self.power_predicted), "W"))
+        if self.power_monte_carlo is not None:
+            rows.append(("power_monte_carlo", f"{self.power_monte_carlo}", "W"))
+            rows.append(
+                ("stroke_exceedance_monte_carlo", f"{self.stroke_exceedance_monte_carlo}", "")
+            )
+        if self.limit is not None:
+            rows.append(("limit", formatting.compact(self.limit), "W"))
+        return rows
+
+    def __repr__(self) -> str:
+        chosen = ", ".join(f"{k}={formatting.compact(v)}" for k, v in self.optimum.items())
+        mc = "" if self.power_monte_carlo is None else f", monte_carlo={self.power_monte_carlo}"
+        return (
+            f"DesignResult({chosen}, power_predicted={formatting.compact(self.power_predicted)}"
+            f"{mc})"
+        )
+
+    def _repr_html_(self) -> str:
+        return _display.html_table("Design", self._rows())
+
+
+def _columns(name: str, s: Statistic | None) -> dict:
+    if s is None:
+        return {name: float("nan"), f"{name}_ci95": float("nan")}
+    return {name: s.mean, f"{name}_ci95": s.ci95}

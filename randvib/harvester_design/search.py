@@ -1,0 +1,266 @@
+"""The analytic search of a design: the best predicted device within a stroke budget.
+
+Every candidate is predicted by the most accurate analytic method of
+:data:`randvib.analytic.prediction.METHODS` that takes it (the methods'
+declarations: coloured input, potential kind, friction law; a method that
+refuses a point beyond its declared validity leaves it unpredicted) and gives
+a stroke exceedance. The search evaluates a regular grid of the design box,
+then maximises the objective from the best feasible grid points by SLSQP with
+the budget as a smooth constraint, log(eps) - log P(|z| > d) >= 0. For a
+linear device with a rational spectrum the prediction is the exact Lyapunov
+solution (:mod:`randvib.analytic.linear_response`) and the constraint is
+sigma_z <= d / Phi^-1(1 - eps/2), so the optimum found is the exact one
+(to the optimiser's tolerance, 1e-10 relative in the objective).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import optimize
+
+from randvib.analytic.prediction import METHODS, predict
+from randvib.harvester_design.space import DesignSpace
+
+__all__ = ["Candidate", "SearchOutcome", "analytic_search", "predictor_for"]
+
+#: The analytic methods a design may use, most accurate first (never the
+#: slow reference solver, which the methods declare).
+PREFERENCE = ("fpk-fast", "linearisation")
+#: Grid points per dimension of the first look, by the number of varied parameters.
+GRID = {1: 41, 2: 15, 3: 7}
+#: Grid points per dimension beyond three parameters.
+GRID_MANY = 4
+#: Local optimisations started from the best feasible grid points.
+STARTS = 4
+#: Two local optima closer than this in the unit box are one.
+SAME_POINT = 0.05
+#: Exceedances below this are taken as this (log of the constraint).
+TINY = 1e-300
+
+
+class InfeasibleBudget(ValueError):
+    """No device in the ranges meets the stroke budget (the message says the best reachable)."""
+
+
+class NothingPredicted(ValueError):
+    """No analytic method predicts any device of the ranges (Monte Carlo must search them)."""
+
+
+#: Grid points per dimension of the coarse look at the devices no method predicts.
+COARSE = 3
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One predicted device of the design space.
+
+    Attributes
+    ----------
+    u : ndarray
+        Its point of the unit box.
+    values : dict
+        Parameter name -> value (SI).
+    power : float
+        The objective's predicted power (W).
+    exceedance : float
+        Predicted P(|z| > stroke).
+    method : str
+        The analytic method that predicted it.
+    input_power : float
+        Predicted power the excitation delivers, c_eq E[z'^2] (W): the
+        stationary sum of every dissipation.
+    warned : bool
+        The method warned (beyond a declared validity limit it warns at).
+    """
+
+    u: np.ndarray = field(repr=False)
+    values: dict
+    power: float
+    exceedance: float
+    method: str
+    input_power: float
+    warned: bool = False
+
+
+@dataclass(frozen=True)
+class SearchOutcome:
+    """What the analytic search found.
+
+    ``unpredicted`` holds the points of a coarse grid (:data:`COARSE` per
+    dimension) that no method predicts (refused: a bistable device beyond
+    linearisation's reach, say): candidates only Monte Carlo can judge.
+    """
+
+    optimum: Candidate
+    runners_up: list
+    evaluations: int
+    grid: list = field(repr=False)
+    unpredicted: list = field(default_factory=list, repr=False)
+
+
+def predictor_for(harvester, excitation):
+    """The first method of :data:`PREFERENCE` that takes the case and gives the exceedance, or None.
+
+    A linear device without friction is linearisation's: exact there (Lyapunov).
+    """
+    linear = harvester.friction is None and np.all(harvester.k3 == 0) and np.all(harvester.k > 0)
+    for name in ("linearisation",) if linear else PREFERENCE:
+        method = METHODS[name]
+        if method.stroke_exceedance and method.accepts(harvester, excitation):
+            return method
+    return None
+
+
+class Evaluator:
+    """Predictions at box points, cached, counted."""
+
+    def __init__(self, space: DesignSpace, excitation, objective):
+        self.space, self.excitation, self.objective = space, excitation, objective
+        self.cache: dict = {}
+
+    def __call__(self, u) -> Candidate | None:
+        u = np.clip(np.asarray(u, dtype=float), 0.0, 1.0)
+        key = tuple(np.round(u, 14))
+        if key not in self.cache:
+            self.cache[key] = self._predict(u)
+        return self.cache[key]
+
+    def _predict(self, u) -> Candidate | None:
+        try:
+            device = self.space.device(u)
+        except ValueError:
+            return None  # e.g. no damping at a corner of the box
+        method = predictor_for(device, self.excitation)
+        if method is None:
+            return None
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            try:
+                prediction = predict(device, self.excitation, method=method)
+            except (ValueError, ArithmeticError):
+                return None  # refused beyond its validity, or no Gaussian solution
+        power = self.objective.analytic(prediction, device)
+        exceedance = prediction.stroke_exceedance
+        if exceedance is None or not math.isfinite(power):
+            return None
+        return Candidate(
+            u=u,
+            values=self.space.values(u),
+            power=power,
+            exceedance=float(exceedance),
+            method=method.name,
+            input_power=float(prediction.c_eq * prediction.velocity_variance),
+            warned=bool(caught),
+        )
+
+
+def analytic_search(space: DesignSpace, excitation, budget: float, objective, runners_up: int = 2):
+    """Maximise the predicted objective over the box with P(|z| > stroke) <= budget.
+
+    Parameters
+    ----------
+    space : DesignSpace
+        The varied parameters; its harvester carries the stroke.
+    excitation : Excitation
+    budget : float
+        The largest allowed exceedance eps.
+    objective : Objective
+    runners_up : int
+        How many other distinct good candidates to return.
+
+    Returns
+    -------
+    SearchOutcome
+
+    Raises
+    ------
+    InfeasibleBudget
+        No predicted device meets the budget: says the best reachable exceedance and where.
+    """
+    evaluate = Evaluator(space, excitation, objective)
+    per = GRID.get(space.dimension, GRID_MANY)
+    grid = [c for c in map(evaluate, space.grid(per)) if c is not None]
+    unpredicted = [u for u in space.grid(COARSE) if evaluate(u) is None and space.builds(u)]
+    if not grid:
+        raise NothingPredicted(
+            "no analytic method predicts any device in the ranges given (every point was refused)"
+        )
+    feasible = sorted((c for c in grid if c.exceedance <= budget), key=lambda c: -c.power)
+    if not feasible:
+        best = _least_exceedance(evaluate, min(grid, key=lambda c: c.exceedance), space)
+        if best.exceedance > budget:
+            where = ", ".join(f"{k} = {v:.6g}" for k, v in best.values.items())
+            raise InfeasibleBudget(
+                f"the stroke budget P(|z| > {space.harvester.stroke:g} m) <= {budget:g} cannot be "
+                f"met in the ranges given: the best reachable exceedance is "
+                f"{best.exceedance:.3g} (at {where})"
+            )
+        feasible = [best]
+    scale = feasible[0].power
+    optima = []
+    for start in feasible[:STARTS]:
+        found = _local(evaluate, start, budget, scale)
+        if all(np.max(np.abs(found.u - o.u)) > SAME_POINT for o in optima):
+            optima.append(found)
+    optima.sort(key=lambda c: -c.power)
+    others = optima[1:]
+    for c in feasible:
+        if len(others) >= runners_up:
+            break
+        if all(np.max(np.abs(c.u - o.u)) > 3 * SAME_POINT for o in [optima[0], *others]):
+            others.append(c)
+    return SearchOutcome(optima[0], others[:runners_up], len(evaluate.cache), grid, unpredicted)
+
+
+def _local(evaluate, start: Candidate, budget: float, scale: float) -> Candidate:
+    """SLSQP from ``start``; the better of the start and the end (both feasible)."""
+    log_budget = math.log(budget)
+
+    def power(u):
+        c = evaluate(u)
+        return 0.0 if c is None else -c.power / scale
+
+    def margin(u):
+        c = evaluate(u)
+        return -50.0 if c is None else log_budget - math.log(max(c.exceedance, TINY))
+
+    result = optimize.minimize(
+        power,
+        start.u,
+        method="SLSQP",
+        bounds=[(0.0, 1.0)] * len(start.u),
+        constraints=[{"type": "ineq", "fun": margin}],
+        options={"ftol": 1e-12, "maxiter": 200, "eps": 1e-7},
+    )
+    end = evaluate(result.x)
+    if end is None or end.exceedance > budget * (1 + 1e-8):
+        # SLSQP may stop a hair outside the budget (or on an unpredicted point): the
+        # feasible point nearest to it on the segment from the start, by bisection
+        lo, hi = 0.0, 1.0
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            c = evaluate(start.u + mid * (result.x - start.u))
+            if c is not None and c.exceedance <= budget:
+                lo = mid
+            else:
+                hi = mid
+        end = evaluate(start.u + lo * (result.x - start.u))
+    return end if end is not None and end.power > start.power else start
+
+
+def _least_exceedance(evaluate, start: Candidate, space: DesignSpace) -> Candidate:
+    """The least predicted exceedance near ``start`` (for the refusal of an infeasible budget)."""
+
+    def objective(u):
+        c = evaluate(u)
+        return 0.0 if c is None else math.log(max(c.exceedance, TINY))
+
+    result = optimize.minimize(
+        objective, start.u, method="L-BFGS-B", bounds=[(0.0, 1.0)] * space.dimension
+    )
+    end = evaluate(result.x)
+    return end if end is not None and end.exceedance < start.exceedance else start

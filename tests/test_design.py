@@ -1,0 +1,284 @@
+"""Design for a vibration (:mod:`randvib.harvester_design.design`) and its parts.
+
+Covers :mod:`randvib.harvester_design.space`, :mod:`randvib.harvester_design.search`,
+:mod:`randvib.harvester_design.objectives`, :mod:`randvib.harvester_design.result`,
+:mod:`randvib.harvester_design.design`, the limit
+(:mod:`randvib.analytic.harvesting_limit`) and ``randvib design``
+(:mod:`randvib.cli.design`). The linear optima are checked against an
+independent computation (the spectral integral instead of the Lyapunov
+solution, a brute-force search instead of SLSQP) and a closed form under white
+noise; the Monte Carlo confirmation against an independent simulation.
+"""
+
+import json
+import math
+
+import numpy as np
+import pytest
+from _cli import one_line_error, run
+from scipy import integrate, optimize
+
+import randvib as rv
+from randvib.analytic.harvesting_limit import gaussian_displacement_budget, harvesting_limit
+from randvib.analytic.linear_response import mechanical_block, spectral_variances
+from randvib.harvester_design.search import InfeasibleBudget
+from randvib.montecarlo.sweep import SweepSettings
+
+M, C_M = 0.0226, 0.049
+
+
+def fixed(**extra):
+    return rv.Harvester(m=M, c_m=C_M, c_e=0.1, k=57.4, stroke=0.003, **extra)
+
+
+def brute_force_linear(excitation, sigma, k_range, ce_range):
+    """max c_e E[v^2] with E[z^2] <= sigma^2 by the spectral integral: a fine k grid, for
+    each k the best c_e on the feasible part of its range (the power is unimodal in c_e
+    and E[z^2] falls with c_e), then a bounded refinement in k."""
+
+    def variances(k, c_e):
+        return spectral_variances(mechanical_block(M, C_M + c_e, k), excitation)
+
+    def best_at(k):
+        lo, hi = ce_range
+        if variances(k, hi)[0] > sigma**2:
+            return -np.inf, hi
+        if variances(k, lo)[0] > sigma**2:
+            lo = optimize.brentq(
+                lambda c: variances(k, c)[0] - sigma**2, lo, hi, xtol=1e-14, rtol=1e-13
+            )
+        res = optimize.minimize_scalar(
+            lambda c: -c * variances(k, c)[1],
+            bounds=(lo, hi),
+            method="bounded",
+            options={"xatol": 1e-10},
+        )
+        return -res.fun, res.x
+
+    ks = np.geomspace(*k_range, 25)
+    powers = [best_at(k)[0] for k in ks]
+    i = int(np.argmax(powers))
+    lo, hi = ks[max(i - 1, 0)], ks[min(i + 1, len(ks) - 1)]
+    res = optimize.minimize_scalar(
+        lambda k: -best_at(k)[0], bounds=(lo, hi), method="bounded", options={"xatol": 1e-9}
+    )
+    return -res.fun, res.x, best_at(res.x)[1]
+
+
+@pytest.mark.parametrize(
+    "excitation, stroke, eps",
+    [
+        (rv.BandPass(1.0, 8.0, 0.1), 0.003, 0.01),
+        (rv.BandPass(0.5, 12.0, 0.3), 0.002, 0.05),
+        (rv.BandPass(2.0, 6.0, 0.05), 0.004, 0.01),
+        (
+            rv.BandPass(1.0, 8.0, 0.03).scaled(9.0 / rv.BandPass(1.0, 8.0, 0.03).variance),
+            0.003,
+            0.01,
+        ),  # narrow and strong: SLSQP ends on the budget's boundary
+    ],
+)
+def test_linear_optimum_is_exact(excitation, stroke, eps):
+    # Both sides are exact computations of the same optimum by different routes;
+    # the issue's bar is 0.1 % in power and 3 % in the parameters (the optimum is flat).
+    ranges = {"k": (10.0, 400.0), "c_e": (0.005, 2.0)}
+    result = rv.design(
+        fixed().updated(stroke=stroke), excitation, ranges, exceedance=eps, monte_carlo=False
+    )
+    sigma = gaussian_displacement_budget(stroke, eps)
+    power, k, c_e = brute_force_linear(excitation, sigma, ranges["k"], ranges["c_e"])
+    assert result.power_predicted == pytest.approx(power, rel=1e-3)
+    assert result.power_predicted <= power * (1 + 1e-6)  # the budget is met: no better than exact
+    assert result.optimum["k"] == pytest.approx(k, rel=0.03)
+    assert result.optimum["c_e"] == pytest.approx(c_e, rel=0.03)
+    assert result.exceedance_predicted <= eps * (1 + 1e-6)
+    assert result.method == "linearisation"
+
+
+def test_white_noise_linear_optimum_closed_form():
+    # White noise: E[v^2] = S m / (4 c) whatever k, so the power c_e m S / (4 (c_m + c_e))
+    # rises with c_e (optimum at the top of its range) and the stroke only asks
+    # k >= m^2 S / (4 c sigma^2): any such k is optimal.
+    S, stroke, eps = 0.5, 0.003, 0.01
+    result = rv.design(
+        fixed(), S, {"k": (20.0, 2000.0), "c_e": (0.01, 0.3)}, exceedance=eps, monte_carlo=False
+    )
+    c_e = 0.3
+    assert result.optimum["c_e"] == pytest.approx(c_e, rel=1e-6)
+    assert result.power_predicted == pytest.approx(c_e * M * S / (4 * (C_M + c_e)), rel=1e-9)
+    sigma = gaussian_displacement_budget(stroke, eps)
+    assert result.optimum["k"] >= M**2 * S / (4 * (C_M + c_e) * sigma**2) * (1 - 1e-6)
+    assert result.input_power == pytest.approx(M * S / 4, rel=1e-9)  # every device: m S / 4
+    assert result.limit is None  # no finite bound under white noise
+
+
+def test_gaussian_budget_inverts_erfc():
+    sigma = gaussian_displacement_budget(0.003, 0.01)
+    assert math.erfc(0.003 / (sigma * math.sqrt(2))) == pytest.approx(0.01, rel=1e-12)
+    with pytest.raises(ValueError, match="exceedance"):
+        gaussian_displacement_budget(0.003, 1.5)
+
+
+def test_limit_unconstrained_and_undamped_closed_forms():
+    bp = rv.BandPass(1.0, 8.0, 0.1)
+    # a loose budget: the unconstrained bound m^2 E[a^2] / (4 c_m)
+    assert harvesting_limit(M, C_M, bp, 1.0) == pytest.approx(M**2 * bp.variance / (4 * C_M), 1e-8)
+    # c_m = 0 and a band: m sigma sqrt(E[a'^2]), E[a'^2] = S int (2 pi f)^2 df over the band
+    band, sigma = rv.BandLimited(0.7, 4.0, 20.0), 1e-3
+    jerk = 0.7 * (2 * math.pi) ** 2 * (20.0**3 - 4.0**3) / 3
+    assert harvesting_limit(M, 0.0, band, sigma) == pytest.approx(M * sigma * math.sqrt(jerk), 1e-8)
+    assert harvesting_limit(M, 0.0, bp, sigma) is None  # 1/f^2 tail: unbounded
+    assert harvesting_limit(M, C_M, rv.White(1.0), sigma) is None
+
+
+def test_limit_is_the_dual_minimum_by_independent_quadrature():
+    # min over lambda of int m^2 w^2 G / (4 (c_m w^2 + lambda)) df + lambda sigma^2, with
+    # scipy's adaptive quadrature and a scalar minimiser instead of the module's rule and root.
+    kt, sigma = rv.KanaiTajimi(1.0, 8.0, 0.3), 1e-3
+
+    def dual(lam):
+        def g(f):
+            w = 2 * math.pi * f
+            return M**2 * w**2 * kt.psd(f) / (4 * (C_M * w**2 + lam))
+
+        parts = [integrate.quad(g, a, b, limit=400, epsrel=1e-11)[0]
+                 for a, b in ((0, 8), (8, 16), (16, 200), (200, np.inf))]  # fmt: skip
+        return sum(parts) + lam * sigma**2
+
+    res = optimize.minimize_scalar(
+        lambda x: dual(math.exp(x)), bounds=(-5, 15), method="bounded", options={"xatol": 1e-10}
+    )
+    assert harvesting_limit(M, C_M, kt, sigma) == pytest.approx(res.fun, rel=1e-6)
+
+
+def test_limit_bounds_the_linear_optimum():
+    bp = rv.BandPass(1.0, 8.0, 0.1)
+    result = rv.design(fixed(), bp, {"k": (10, 400), "c_e": (0.005, 2)}, monte_carlo=False)
+    assert 0.3 < result.fraction_of_limit < 1.0
+    assert result.limit == pytest.approx(
+        harvesting_limit(M, C_M, bp, gaussian_displacement_budget(0.003, 0.01))
+    )
+
+
+def test_hardening_design_confirmed_by_independent_simulation():
+    # A Duffing spring and the damping chosen under band-pass input; its Monte Carlo
+    # power must agree with a simulation of the returned device on another seed:
+    # independent estimates, so within the 95 % half-widths combined in quadrature,
+    # widened to 3 standard errors (two-sided 0.3 % false alarm).
+    settings = SweepSettings(dt=2e-4, window=1.0, burn_in=0.5, min_paths=64, max_paths=64, seed=3,
+                             control_variates=False)  # fmt: skip
+    bp = rv.BandPass(1.0, 8.0, 0.1)
+    result = rv.design(
+        fixed(), bp, {"k3": (1e4, 1e6), "c_e": (0.02, 1.0)}, exceedance=0.02,
+        settings=settings, runners_up=1, refine=False, workers=1,
+    )  # fmt: skip
+    other = rv.simulate(result.device, bp, t_end=1.5, burn_in=0.5, dt=2e-4, n_paths=64, seed=99)
+    a, b = result.power_monte_carlo, other.power_electrical
+    assert abs(a.mean - b.mean) <= 3 * math.hypot(a.std_error, b.std_error)
+    assert result.stroke_exceedance_monte_carlo.mean == pytest.approx(
+        other.stroke_exceedance.mean,
+        abs=3
+        * math.hypot(
+            result.stroke_exceedance_monte_carlo.std_error, other.stroke_exceedance.std_error
+        ),
+    )
+    data = result.to_dict()
+    assert {"optimum", "power_predicted", "power_monte_carlo", "stroke_exceedance_monte_carlo",
+            "input_power", "limit"} <= data.keys()  # fmt: skip
+    assert set(data["power_monte_carlo"]) == {"mean", "ci95"}
+    assert len(result.to_frame()) == 2
+    # every dissipation sums to the input power: the efficiency is below 1
+    assert 0 < result.efficiency < 1
+
+
+def test_refusals_are_one_line_and_name_the_problem():
+    bp = rv.BandPass(1.0, 8.0, 0.1)
+    with pytest.raises(ValueError, match="unknown parameter 'kk'"):
+        rv.design(fixed(), bp, {"kk": (1, 2)}, monte_carlo=False)
+    with pytest.raises(ValueError, match="empty range"):
+        rv.design(fixed(), bp, {"k": (2, 1)}, monte_carlo=False)
+    with pytest.raises(ValueError, match="cannot choose 'm'"):
+        rv.design(fixed(), bp, {"m": (0.01, 0.02)}, monte_carlo=False)
+    with pytest.raises(InfeasibleBudget, match="best reachable exceedance is 0.0"):
+        rv.design(fixed(), bp, {"k": (1, 2)}, exceedance=0.001, monte_carlo=False)
+    with pytest.raises(ValueError, match="objective 'load' needs the circuit"):
+        rv.design(fixed(), bp, {"k": (20, 80)}, objective="load", monte_carlo=False)
+    with pytest.raises(ValueError, match="`stroke` is needed"):
+        rv.design(fixed().updated(stroke=None), bp, {"k": (20, 80)}, monte_carlo=False)
+
+
+def test_load_objective_with_a_coil():
+    # the load's share R_L / (R_L + R_C) of E[P_e]: the optimum balances it against c_e
+    coil = rv.Harvester.from_electrical(m=M, c_m=C_M, k=57.4, alpha=0.1992, r_load=1.0,
+                                        r_coil=0.48, stroke=0.003)  # fmt: skip
+    bp = rv.BandPass(1.0, 8.0, 0.1)
+    load = rv.design(coil, bp, {"k": (20, 200), "r_load": (0.01, 10)}, objective="load",
+                     monte_carlo=False)  # fmt: skip
+    grid = [rv.predict(coil.updated(k=load.optimum["k"], r_load=r), bp).power_load
+            for r in np.geomspace(0.01, 10, 200)]  # fmt: skip
+    feasible_best = max(
+        p
+        for p, r in zip(grid, np.geomspace(0.01, 10, 200), strict=True)
+        if rv.predict(coil.updated(k=load.optimum["k"], r_load=r), bp).stroke_exceedance <= 0.01
+    )
+    assert load.power_predicted >= feasible_best * (1 - 1e-6)
+
+
+def test_cli_design_json_and_errors(capsys):
+    base = ["design", "--m", M, "--c-m", C_M, "--excitation", "band-pass", "--psd", 1,
+            "--f0", 8, "--zeta", 0.1, "--stroke", 0.003]  # fmt: skip
+    code, out, _ = run(capsys, *base, "--vary", "k=20:120", "--vary", "c_e=0.01:1",
+                       "--no-monte-carlo", "--json")  # fmt: skip
+    assert code == 0
+    data = json.loads(out)
+    api = rv.design(fixed(), rv.BandPass(1.0, 8.0, 0.1), {"k": (20, 120), "c_e": (0.01, 1)},
+                    monte_carlo=False)  # fmt: skip
+    assert data["optimum"] == pytest.approx(api.optimum, rel=1e-9)
+    assert data["power_predicted"] == pytest.approx(api.power_predicted, rel=1e-9)
+    assert data["limit"] == pytest.approx(api.limit)
+    one_line_error(capsys, [*base, "--vary", "kk=1:2"], "unknown parameter 'kk'")
+    one_line_error(capsys, [*base, "--vary", "k=3:1"], "empty range")
+    one_line_error(capsys, [*base, "--vary", "k=1:2", "--c-e", 0.01, "--exceedance", 0.001],
+                   "best reachable exceedance")  # fmt: skip
+    one_line_error(capsys, [*base, "--vary", "k"], "NAME=LOW:HIGH")
+
+
+def test_bistable_range_no_method_predicts_is_searched_by_monte_carlo():
+    # Deep wells under weak narrow-band input: linearisation has no zero-mean Gaussian
+    # solution anywhere in the range, so Monte Carlo searches a coarse grid and refines;
+    # the chosen device is the best confirmed one that the budget does not reject.
+    settings = SweepSettings(dt=2e-4, window=1.0, burn_in=0.3, min_paths=32, max_paths=32,
+                             control_variates=False)  # fmt: skip
+    device = rv.Harvester(m=M, c_m=C_M, c_e=0.2, k=-60.0, k3=5e5, stroke=0.02)
+    bp = rv.BandPass(0.3, 3.0, 0.05)
+    with pytest.raises(ValueError, match="only Monte Carlo"):
+        rv.design(device, bp, {"k": (-80.0, -40.0)}, monte_carlo=False)
+    result = rv.design(
+        device, bp, {"k": (-80.0, -40.0)}, exceedance=0.05, settings=settings, workers=1
+    )
+    assert result.method == "monte-carlo" and result.analytic_cost is None
+    assert math.isnan(result.power_predicted)
+    assert -80.0 <= result.optimum["k"] <= -40.0
+    assert result.monte_carlo_cases >= 5
+    best = result.power_monte_carlo.mean
+    for other in result.runners_up:
+        if (
+            other["stroke_exceedance_monte_carlo"].mean
+            - other["stroke_exceedance_monte_carlo"].ci95
+            <= 0.05
+        ):
+            assert other["power_monte_carlo"].mean <= best
+
+
+def test_monte_carlo_resumes_from_out_dir(tmp_path):
+    # The confirmation is run_ensembles with a PointStore: a second run loads every case.
+    settings = SweepSettings(dt=2e-4, window=0.5, burn_in=0.2, min_paths=16, max_paths=16,
+                             control_variates=False)  # fmt: skip
+    bp = rv.BandPass(1.0, 8.0, 0.1)
+    args = (fixed(), bp, {"k": (20.0, 120.0), "c_e": (0.01, 1.0)})
+    first = rv.design(*args, settings=settings, out_dir=tmp_path, workers=1)
+    stored = {p: p.stat().st_mtime_ns for p in tmp_path.rglob("*.npy")}
+    assert stored
+    again = rv.design(*args, settings=settings, out_dir=tmp_path, workers=1)
+    assert {p: p.stat().st_mtime_ns for p in tmp_path.rglob("*.npy")} == stored
+    assert again.power_monte_carlo == first.power_monte_carlo

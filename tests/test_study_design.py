@@ -1,0 +1,50 @@
+"""Study ``design`` (studies/design.py, over :func:`randvib.design`): a tiny end-to-end run.
+
+``randvib study design --quick`` with the inputs, strokes, bandwidths and Monte
+Carlo sizes monkeypatched to a few short runs: the files are written, the
+verdict's counts are recomputed from results.csv, and the linear optima agree
+with an independent analytic design of the same input.
+"""
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import randvib as rv
+from randvib.cli import main
+from randvib.studies import load
+
+study = load("design")
+
+
+def test_design_study_quick_end_to_end(tmp_path, monkeypatch, capsys):
+    band = rv.BandPass(1.0, 8.0, 0.3)
+    monkeypatch.setattr(
+        study, "inputs", lambda quick: {"band": band.scaled(study.LEVEL / band.variance)}
+    )
+    monkeypatch.setattr(study, "STROKES", {True: (0.002,)})
+    monkeypatch.setattr(study, "ZETAS", {True: (0.3, 0.05)})
+    monkeypatch.setattr(study, "QUICK_MC", {"dt": 2e-4, "window": 1.0, "burn_in": 0.3,
+                                            "min_paths": 24, "max_paths": 24})  # fmt: skip
+    out = tmp_path / "design"
+    assert (
+        main(["study", "design", "--quick", "--out", str(out), "--no-progress", "--workers", "1"])
+        == 0
+    )
+    for name in ("report.md", "results.csv", "budget.csv", "bandwidth.csv", "design.png"):
+        assert (out / name).is_file(), name
+    results = pd.read_csv(out / "results.csv")
+    v = json.loads((out / "verdicts.json").read_text())
+    assert set(results.family) == set(study.FAMILIES)
+    nonlinear = results[(results.family != "linear") & results.feasible]
+    assert v["comparisons"] == len(nonlinear)
+    lin = results[results.family == "linear"].iloc[0]
+    half = np.hypot(nonlinear.power_mc_ci95, lin.power_mc_ci95)
+    assert v["nonlinear_pays"] == int(((nonlinear.power_mc - lin.power_mc) > half).sum())
+    exact = rv.design(study.FIXED, band.scaled(study.LEVEL / band.variance), study.FAMILIES["linear"][1],
+                      exceedance=study.EPS, monte_carlo=False)  # fmt: skip
+    assert lin.power_predicted == pytest.approx(exact.power_predicted, rel=1e-9)
+    assert lin.opt_k == pytest.approx(exact.optimum["k"], rel=1e-9)
+    assert "A nonlinear spring" in (out / "report.md").read_text()
