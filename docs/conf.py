@@ -50,10 +50,19 @@ smartquotes_action = "qe"
 # -- API reference ------------------------------------------------------------
 autosummary_generate = True
 autosummary_imported_members = False
+# A module's page lists its public API: ``__all__`` where the module declares
+# one (a driver module keeps its internals out of the reference that way).
+autosummary_ignore_module_all = False
 # The tables' one-line summaries are a docstring's first sentence; the paper's
 # abbreviations ("Eq. 32", "Sec. 5", "Fig. 9") end no sentence.
 _autosummary.WELL_KNOWN_ABBREVIATIONS = (
-    *_autosummary.WELL_KNOWN_ABBREVIATIONS, "Eq.", "Eqs.", "Sec.", "Fig.", "Figs.", "Ref."
+    *_autosummary.WELL_KNOWN_ABBREVIATIONS,
+    "Eq.",
+    "Eqs.",
+    "Sec.",
+    "Fig.",
+    "Figs.",
+    "Ref.",
 )
 autodoc_default_options = {"members": True, "inherited-members": False}
 autodoc_typehints = "none"  # numpydoc's Parameters sections carry the types

@@ -63,6 +63,10 @@ from randvib.montecarlo.step_check import LinearTestSystem
 from randvib.montecarlo.validation import Run, check_options, check_scales, validated
 
 
+#: The public API; ``execute`` is the driver's entry for already validated runs.
+__all__ = ["simulate"]
+
+
 def simulate(
     harvester: Harvester,
     psd: float | Excitation,
