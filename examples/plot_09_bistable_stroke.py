@@ -52,7 +52,7 @@ print(f"Monte Carlo    E[P_e] {1e3 * mc.power_electrical.mean:.4f} "
       f"{mc.stroke_exceedance.mean:.4f} ± {mc.stroke_exceedance.ci95:.4f}")  # fmt: skip
 
 # %%
-# How soon from rest: the mean first time |z| reaches the stroke, reported
+# How soon from rest: the mean first time ``|z|`` reaches the stroke, reported
 # only when every path reached it within the run (otherwise a restricted
 # mean, a lower bound).
 passage = mc.stroke_first_passage
