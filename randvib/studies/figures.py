@@ -444,7 +444,8 @@ def power_against_exceedance(
             sub = results[(results.input == name) & (results.device == dev)].sort_values("g")
             zero = (sub.exceedance_mc <= 0).to_numpy()
             x = np.where(zero, edge, sub.exceedance_mc)
-            ax.plot(x, 1e3 * sub.power_mc, "-", color=colour(i), lw=1.2)
+            # the line joins measured exceedances only: a hollow edge point is no value
+            ax.plot(x[~zero], 1e3 * sub.power_mc[~zero], "-", color=colour(i), lw=1.2)
             for (_, row), at, hollow in zip(sub.iterrows(), x, zero, strict=True):
                 ax.errorbar(at, 1e3 * row.power_mc,
                             xerr=None if hollow else row.exceedance_mc_ci95,

@@ -79,7 +79,7 @@ def plot_response_spectra(
                 ax.fill_between(f[keep], lo[keep], (values + half)[keep], color=colour, alpha=0.2)
             ax.set_ylabel(ylabel)
             ax.set_yscale("log")
-            ax.grid(alpha=0.3, which="both", lw=0.5)
+            ax.grid(alpha=0.3, lw=0.5)  # major only: minor lines crowd a narrow log range
     if f_max is None:
         f_max = min(top, 4.0 * peak) if peak else top
     for ax, lines in zip(axes, drawn, strict=True):
