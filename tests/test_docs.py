@@ -108,7 +108,8 @@ def test_cli_page_keeps_double_dashes(site):
     html, _ = site
     text = _text(html / "cli.html")
     assert re.findall(r"\u2013\w", text) == []
-    assert "with --record" in text or "--record" in text
+    assert "e.g. --fix k3=0" in text  # identify's help for --fix, as typed
+    assert "(a new file unless --force)" in text
 
 
 def test_gallery_pages_show_no_object_reprs(site):
