@@ -16,6 +16,8 @@ sys.path.insert(0, str(ROOT))
 os.environ.setdefault("MPLBACKEND", "Agg")
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 
+import sphinx.ext.autosummary as _autosummary  # noqa: E402
+
 import randvib  # noqa: E402
 
 project = "randvib"
@@ -39,9 +41,29 @@ source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
 exclude_patterns = ["_build", "Thumbs.db", ".DS_Store"]
 templates_path = ["_templates"]
 
+# -- Text -----------------------------------------------------------------------
+# Smart quotes would also turn "--" into an en-dash, so the CLI reference
+# (help texts such as "with --record") would show options that cannot be
+# copied; keep quotes and ellipses only.
+smartquotes_action = "qe"
+
 # -- API reference ------------------------------------------------------------
 autosummary_generate = True
 autosummary_imported_members = False
+# A module's page lists its public API: ``__all__`` where the module declares
+# one (a driver module keeps its internals out of the reference that way).
+autosummary_ignore_module_all = False
+# The tables' one-line summaries are a docstring's first sentence; the paper's
+# abbreviations ("Eq. 32", "Sec. 5", "Fig. 9") end no sentence.
+_autosummary.WELL_KNOWN_ABBREVIATIONS = (
+    *_autosummary.WELL_KNOWN_ABBREVIATIONS,
+    "Eq.",
+    "Eqs.",
+    "Sec.",
+    "Fig.",
+    "Figs.",
+    "Ref.",
+)
 autodoc_default_options = {"members": True, "inherited-members": False}
 autodoc_typehints = "none"  # numpydoc's Parameters sections carry the types
 numpydoc_show_class_members = False
@@ -69,6 +91,9 @@ sphinx_gallery_conf = {
     "within_subsection_order": "FileNameSortKey",
     "reset_modules": ("matplotlib",),
     "plot_gallery": "True",
+    # a script's last expression is shown as its output; the artists that
+    # plotting calls return (a legend, lines, a figure) are not output
+    "ignore_repr_types": r"matplotlib[.](text|axes|legend|lines|figure|collections|image|container)",
 }
 
 # -- HTML ---------------------------------------------------------------------

@@ -1,6 +1,6 @@
-"""README.md's headline accuracy claims, each against Monte Carlo with its standard error.
+"""The documented headline accuracy claims (docs/methods.md, docs/studies.md), each against Monte Carlo with its standard error.
 
-The README quotes, for the figure9 device (c = 0.2 Ns/m, damping ratio 0.088):
+docs/methods.md quotes, for the figure9 device (c = 0.2 Ns/m, damping ratio 0.088):
 
 * Eq. 32 (equivalent linearisation) under-predicts the power, by 2.0-2.1 % at
   the half-power friction level (kappa = 4 Fc^2/(pi S m c) = 0.25) and by
@@ -29,7 +29,7 @@ one point) against a Monte Carlo estimate with the engine's control variates
 The FPK reference (``method="fpk"``, converged to about 1e-5) is the
 independent number the Monte Carlo estimate must match (``assert_matches``,
 4 sigma, powered to see a 0.5 % bias: the Coulomb force off by 1 % moves the
-power by 0.45-1.4 % on this grid). The README's quoted ranges are then asserted
+power by 0.45-1.4 % on this grid). The quoted ranges are then asserted
 for every method as ``lo - 4 se <= error <= hi + 4 se``, the error taken
 against the same Monte Carlo estimate.
 """
@@ -51,7 +51,7 @@ N_SIGMA = 4.0
 
 
 def fc_at_kappa(kappa, psd, device=BASE):
-    """Fc (N) of friction level kappa = 4 Fc^2 / (pi S m c) (README, paper Eq. 30)."""
+    """Fc (N) of friction level kappa = 4 Fc^2 / (pi S m c) (docs/methods.md, paper Eq. 30)."""
     return float(np.sqrt(kappa * np.pi * psd * device.m * device.c / 4))
 
 
@@ -76,7 +76,7 @@ def relative_error(analytic, stat):
 def assert_in_range(name, error, se, lo, hi):
     assert lo - N_SIGMA * se <= error <= hi + N_SIGMA * se, (
         f"{name}: relative error {error:+.3%} (standard error {se:.3%}) outside the "
-        f"README's range [{lo:+.2%}, {hi:+.2%}] widened by {N_SIGMA} standard errors"
+        f"documented range [{lo:+.2%}, {hi:+.2%}] widened by {N_SIGMA} standard errors"
     )
 
 
@@ -90,9 +90,9 @@ def predictions(device, psd):
 
 
 # ------------------------------------------------------------ the accuracy table
-#: README "Accuracy against Monte Carlo": relative error ranges (lo, hi) per
+#: docs/methods.md "Accuracy against Monte Carlo": relative error ranges (lo, hi) per
 #: friction level kappa, over S = 1, 0.5, 0.1 and k3 = 0 ... 7e6 N/m^3.
-README_TABLE = {
+DOCUMENTED_TABLE = {
     0.1: {
         "linearisation": (-0.010, -0.009),
         "averaging": (-0.001, -0.0005),
@@ -127,7 +127,7 @@ README_TABLE = {
 
 #: (psd, k3, kappa, paths): every row of the table, every S and k3 of it at
 #: least once; kappa = 0.25 and 1 on the figure9 device itself (k3 = 5e5 is
-#: the paper's Figure 9b) are the README's "half-power friction level" and
+#: the paper's Figure 9b) are docs/studies.md's "half-power friction level" and
 #: "twice it". Paths give a standard error of about 0.06 % of the power.
 GRID = [
     (0.5, 7.07e4, 0.1, 1024),
@@ -155,7 +155,7 @@ def grid_point(psd, k3, kappa, n_paths, seed):
 
 @pytest.mark.parametrize(("psd", "k3", "kappa", "n_paths"), GRID)
 def test_accuracy_table_against_monte_carlo(psd, k3, kappa, n_paths):
-    """Every method's error at a grid point lies in the README's range.
+    """Every method's error at a grid point lies in the documented range.
 
     First the Monte Carlo estimate must equal the FPK reference within
     4 standard errors, powered to detect a 0.5 % bias (a 1 % error in the
@@ -171,13 +171,13 @@ def test_accuracy_table_against_monte_carlo(psd, k3, kappa, n_paths):
     over those seeds (standard error about 0.013 %): linearisation -0.90,
     -2.07, -3.61, -6.05, -6.11, -9.16, -9.18 %; averaging -0.08, -0.19,
     -0.41, -0.81, -0.66, -1.65, -1.56 %; fpk-fast within 0.04 %, fpk within
-    0.015 %. (At kappa = 2 the README's -9.2 to -9.3 % and fpk-fast's -0.04 to
+    0.015 %. (At kappa = 2 the documented -9.2 to -9.3 % and fpk-fast's -0.04 to
     -0.13 % carry its study's own time-step bias, dt = 2.5e-4 s: about
     +0.05-0.1 % on the Monte Carlo power.) Runtime about 16 s for the 7 points.
     """
     mc, pred = grid_point(psd, k3, kappa, n_paths, GRID_SEED)
     assert_matches(mc, pred["fpk"], detect=0.005, what=f"MC vs FPK at kappa {kappa}")
-    for method, (lo, hi) in README_TABLE[kappa].items():
+    for method, (lo, hi) in DOCUMENTED_TABLE[kappa].items():
         err, se = relative_error(pred[method], mc)
         assert_in_range(f"{method} at S={psd}, k3={k3:g}, kappa={kappa}", err, se, lo, hi)
     err, se = relative_error(pred["linearisation"], mc)
@@ -185,7 +185,7 @@ def test_accuracy_table_against_monte_carlo(psd, k3, kappa, n_paths):
 
 
 # -------------------------------------------------- where Eq. 32 can be trusted
-#: README (linearisation-accuracy): trusted to `tol` for phi <= `phi`; Eq. 32
+#: docs/studies.md (linearisation-accuracy): trusted to `tol` for phi <= `phi`; Eq. 32
 #: then predicts at least `ratio` of the friction-free power.
 TRUST_LIMITS = [(0.51, 0.01, 0.67), (1.47, 0.05, 0.33), (2.7, 0.10, 0.15)]
 TRUST_PATHS = 512
@@ -205,7 +205,7 @@ def trust_point(phi, n_paths, seed, psd=1.0):
 
 @pytest.mark.parametrize(("phi", "tol", "ratio"), TRUST_LIMITS)
 def test_eq32_trusted_up_to_the_quoted_friction_levels(phi, tol, ratio):
-    """|Eq. 32 / MC - 1| <= tol + 4 se at the largest phi the README trusts to tol.
+    """|Eq. 32 / MC - 1| <= tol + 4 se at the largest phi the documentation trusts to tol.
 
     Also negative with significance, and Eq. 32's share of the friction-free
     power as quoted (two digits). The MC estimate (512 paths, standard error

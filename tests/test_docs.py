@@ -97,3 +97,60 @@ def test_api_reference_lists_every_public_name():
         re.findall(r"~randvib\.[\w.]+\.(\w+)$", (ROOT / "docs" / "api.rst").read_text(), re.M)
     )
     assert set(randvib.__all__) <= listed, sorted(set(randvib.__all__) - listed)
+
+
+def _text(page: Path) -> str:
+    return html_module.unescape(re.sub(r"<[^>]+>", "", page.read_text()))
+
+
+def test_cli_page_keeps_double_dashes(site):
+    """An option in a help text reads as typed (no smart en-dash), so it can be copied."""
+    html, _ = site
+    text = _text(html / "cli.html")
+    assert re.findall(r"\u2013\w", text) == []
+    assert "e.g. --fix k3=0" in text  # identify's help for --fix, as typed
+    assert "(a new file unless --force)" in text
+
+
+def test_gallery_pages_show_no_object_reprs(site):
+    """A plotting call's return value (a legend, a figure) is not shown as output."""
+    html, _ = site
+    for stem in EXAMPLES:
+        page = (html / "auto_examples" / f"{stem}.html").read_text()
+        assert "object at 0x" not in page, stem
+
+
+def test_api_summaries_are_whole_sentences(site):
+    """The tables' summaries do not stop at an abbreviation ("Eq.") and none is empty."""
+    html, _ = site
+    page = (html / "api.html").read_text()
+    rows = re.findall(r'<tr class="row-(?:odd|even)"><td>(.*?)</td>\s*<td>(.*?)</td>', page, re.S)
+    assert len(rows) >= len(randvib.__all__)
+    for name, summary in rows:
+        name, summary = (
+            html_module.unescape(re.sub(r"<[^>]+>", "", s)).strip() for s in (name, summary)
+        )
+        assert summary, name
+        assert not re.search(r"\b(Eqs?|Sec|Figs?)\.$", summary), (name, summary)
+
+
+def test_simulate_has_a_page_and_its_module_lists_only_the_public_api(site):
+    html, _ = site
+    assert "def simulate" not in _text(html / "simulate.html")
+    assert "randvib.montecarlo.simulation.simulate(" in _text(html / "simulate.html")
+    module = (html / "generated" / "randvib.montecarlo.simulation.html").read_text()
+    assert 'id="randvib.montecarlo.simulation.simulate"' in module
+    assert 'id="randvib.montecarlo.simulation.execute"' not in module
+
+
+def test_the_manual_is_in_the_site_and_the_readme_is_a_front_page(site):
+    """Every page of the manual is built; the README links to pages that exist, and
+    the site itself never sends a reader to the README."""
+    html, _ = site
+    readme = (ROOT / "README.md").read_text()
+    assert len(readme.splitlines()) <= 200
+    for target in re.findall(r"\]\((docs/[^)#]+)\)", readme):
+        assert (ROOT / target).is_file(), target
+        assert (html / Path(target).relative_to("docs").with_suffix(".html")).is_file(), target
+    for page in ("quickstart", "cli", "command_line", "index"):
+        assert "README" not in _text(html / f"{page}.html"), page

@@ -209,8 +209,8 @@ def _alive(pid):
     return not (status.exists() and "zombie" in status.read_text())
 
 
-def test_readme_sweep_example_has_the_main_guard():
-    readme = (ROOT / "README.md").read_text()
+def test_documented_sweep_example_has_the_main_guard():
+    readme = (ROOT / "docs" / "studies.md").read_text()
     block = readme[readme.index("from randvib.montecarlo.sweep import SweepSettings") :]
     block = block[: block.index("```")]
     assert 'if __name__ == "__main__":' in block

@@ -26,7 +26,7 @@ from randvib._interrupts import interrupted_exit, sigterm_stops
 #: Command modules under randvib.cli, in the order shown by --help.
 COMMANDS = ["power", "design", "simulate", "study", "record", "identify", "validate"]
 
-#: Options whose name differs from the Python API's argument (README's table).
+#: Options whose name differs from the Python API's argument (docs/command_line.md's table).
 API_NAMES = {
     "--paths": "n_paths (randvib.simulate)",
     "--method (simulate)": "scheme (randvib.simulate)",
@@ -211,7 +211,7 @@ class _Running:
     flags: dict = {}
 
 
-#: API arguments whose flag is named differently (README's table of renamed options).
+#: API arguments whose flag is named differently (the table of renamed options in docs/command_line.md).
 _RENAMED = {"n_paths": "--paths", "scheme": "--method", "maxiter": "--generations"}
 
 _QUOTED_NAME = re.compile(r"`([A-Za-z_][\w ()-]*)`")

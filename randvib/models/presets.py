@@ -46,6 +46,9 @@ def _table2(model: str, training_set: int) -> Harvester:
     return Harvester(m=MAGNET_MASS, c_m=c, c_e=0.0, k=k, k3=k3, friction=friction)
 
 
+#: The named devices: ``<model>-td<n>`` for every row of the paper's Table 2
+#: (model viscous, coulomb, tanh or lugre; training data n = 1 or 2; no coil,
+#: c_e = 0) and ``figure9``, the Section 5 device (c_m = c_e = 0.1 Ns/m).
 PRESETS: dict[str, Harvester] = {
     f"{model}-td{n}": _table2(model, n) for model in _TABLE2 for n in (1, 2)
 }

@@ -106,6 +106,7 @@ EULER_MARUYAMA = Integrator("euler-maruyama", 1.0, 1.0, "ito", (1.0,))
 #: Rumelin 1982).
 HEUN = Integrator("heun", 1.0, 2.0, "stratonovich", (0.5, 0.5))
 
+#: The integration schemes by name (``euler-maruyama``, ``heun``), as ``scheme=`` takes them.
 INTEGRATORS = {i.name: i for i in (EULER_MARUYAMA, HEUN)}
 
 

@@ -69,6 +69,9 @@ from randvib.montecarlo.results import SimulationResult
 from randvib.montecarlo.step_check import LinearTestSystem
 from randvib.montecarlo.validation import Run, check_options, check_scales, validated
 
+#: The public API; ``execute`` is the driver's entry for already validated runs.
+__all__ = ["simulate"]
+
 
 def simulate(
     harvester: Harvester,

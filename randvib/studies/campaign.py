@@ -28,7 +28,7 @@ from randvib._io import atomic_write_text, dumps, write_tracked
 from randvib.figure_style import save_figure
 from randvib.identification.identify import identify
 from randvib.identification.models import MODEL_PARAMETERS, device_from_parameters
-from randvib.identification.plots import figure_costs, figure_fit
+from randvib.identification.plots import MODEL_STYLE, figure_costs, figure_fit
 from randvib.identification.record_response import record_response
 from randvib.identification.result import IdentificationResult
 from randvib.models.coupling import Resistive
@@ -298,8 +298,9 @@ def voltage_figures(fits: dict, wired, electrical, out: Path, *, trained_on: str
     for tag, label, rms, record in wired:
         for model, fit in fits.items():
             prediction = fit.predict(record, electrical=electrical)
-            title = (f"{label} ({rms:g} m s$^{{-2}}$ RMS), coil with R$_L$ = {electrical.r_load:g}"
-                     f" Ω: {model} model identified on {trained_on}")  # fmt: skip
+            name = MODEL_STYLE.get(model, {}).get("label", model)  # "Coulomb", as in the legends
+            title = (f"{label} ({rms:g} m/s$^2$ RMS), coil with R$_L$ = {electrical.r_load:g}"
+                     f" Ω: {name} model identified on {trained_on}")  # fmt: skip
             figure = figure_fit(prediction, window=(0, 2), scale=1e3, unit="mm", title=title)
             save_figure(figure, Path(out) / f"figure8_{tag}_{model}.png")
             rows.append({"excitation": f"{label}, {rms:g} m/s^2", "model": model,

@@ -406,6 +406,16 @@ def contrast_against_bandwidth(inter: pd.DataFrame, centres, labels: dict, path:
     return save_figure(fig, path)
 
 
+def _math(label: str) -> str:
+    """A table's label in a figure: the natural frequency f_n typeset as $f_n$."""
+    return label.replace("f_n", "$f_n$")
+
+
+def _level_text(g: float) -> str:
+    """A level factor as written in the tables: 1/16 for 0.0625, 4 for 4."""
+    return f"1/{1 / g:g}" if g < 1 else f"{g:g}"
+
+
 @styled
 def power_against_exceedance(
     results: pd.DataFrame, devices, budget: float, stroke: float, path: Path
@@ -415,30 +425,54 @@ def power_against_exceedance(
     ``results`` holds per ``input``, level ``g`` and ``device`` the Monte
     Carlo ``power_mc`` (W) and ``exceedance_mc`` (fraction of time with
     |z| > ``stroke`` (m)) with their ``_ci95``; the ``budget`` is a
-    vertical line.
+    vertical line. A colour per device joins its levels; a marker shape per
+    level g. A point whose paths never passed the stroke (exceedance 0, off a
+    logarithmic axis) is drawn hollow at the axis' left edge, not dropped.
     """
+    from matplotlib.lines import Line2D
     from matplotlib.ticker import LogLocator
 
     inputs = list(dict.fromkeys(results.input))
-    fig, axes = new_figure(1, len(inputs), figsize=(3.6 * len(inputs), 3.4), sharey=True)
+    levels = sorted(results.g.unique())
+    shapes = dict(zip(levels, "osD^vph*", strict=False))
+    positive = results.exceedance_mc[results.exceedance_mc > 0]
+    # the left edge: a decade below the smallest exceedance seen (or the budget's)
+    edge = 0.1 * min(float(positive.min()) if len(positive) else budget, budget)
+    fig, axes = new_figure(1, len(inputs), figsize=(3.6 * len(inputs), 3.9), sharey=True)
     for ax, name in zip(axes[0], inputs, strict=True):
-        for dev in devices:
+        for i, dev in enumerate(devices):
             sub = results[(results.input == name) & (results.device == dev)].sort_values("g")
-            shown = sub.exceedance_mc > 0
-            ax.errorbar(sub.exceedance_mc[shown], 1e3 * sub.power_mc[shown],
-                        xerr=sub.exceedance_mc_ci95[shown], yerr=1e3 * sub.power_mc_ci95[shown],
-                        marker="o", ms=3, capsize=2, label=dev)  # fmt: skip
-        ax.axvline(budget, color="k", ls=":", lw=1, label=f"budget: {100 * budget:g} % of the time")
+            zero = (sub.exceedance_mc <= 0).to_numpy()
+            x = np.where(zero, edge, sub.exceedance_mc)
+            # the line joins measured exceedances only: a hollow edge point is no value
+            ax.plot(x[~zero], 1e3 * sub.power_mc[~zero], "-", color=colour(i), lw=1.2)
+            for (_, row), at, hollow in zip(sub.iterrows(), x, zero, strict=True):
+                ax.errorbar(at, 1e3 * row.power_mc,
+                            xerr=None if hollow else row.exceedance_mc_ci95,
+                            yerr=1e3 * row.power_mc_ci95, marker=shapes[row.g], ms=4, capsize=2,
+                            color=colour(i), mfc="white" if hollow else colour(i))  # fmt: skip
+        ax.axvline(budget, color="k", ls=":", lw=1)
         ax.set_xscale("log")
         ax.set_yscale("log")
+        ax.set_xlim(left=0.6 * edge)
         for axis in (ax.xaxis, ax.yaxis):
             # minor ticks at 2 and 5 only: on a narrow range all eight minor labels collide
             axis.set_minor_locator(LogLocator(subs=(2.0, 5.0)))
         ax.set_xlabel(f"fraction of time with |z| > {1e3 * stroke:g} mm")
-        ax.set_title(name, fontsize=9)
+        ax.set_title(_math(name), fontsize=9)
         ax.grid(alpha=0.3, lw=0.5)
     axes[0, 0].set_ylabel("E[P$_e$] (mW), Monte Carlo")
-    axes[0, 0].legend(fontsize=7, title="markers: levels g; bars: 95 % CI", title_fontsize=7)
+    handles = [Line2D([], [], color=colour(i), lw=1.2, label=dev) for i, dev in enumerate(devices)]
+    handles += [Line2D([], [], ls="none", marker=shapes[g], ms=4, color="0.3",
+                       label=f"g = {_level_text(g)}") for g in levels]  # fmt: skip
+    handles += [
+        Line2D([], [], ls="none", marker="o", ms=4, color="0.3", mfc="white",
+               label="hollow: never beyond (0), drawn at the left edge"),
+        Line2D([], [], color="k", ls=":", lw=1, label=f"budget: {100 * budget:g} % of the time"),
+    ]  # fmt: skip
+    fig.legend(handles=handles, loc="outside lower center", ncol=4, fontsize=7,
+               title="lines: devices; markers: input level g (95 % CI bars)",
+               title_fontsize=7)  # fmt: skip
     panel_letters(axes)
     return save_figure(fig, path)
 
@@ -471,7 +505,13 @@ def method_errors_against_level(methods: pd.DataFrame, devices, path: Path) -> P
         reach = (methods[f"{q}_rel_error"].abs() + methods[f"{q}_rel_error_ci95"]).max()
         if 100 * reach > 10:
             ax.set_yscale("symlog", linthresh=10)
+            # 1-2-4 steps on both sides: a reader can place -40 % or +200 %
+            ticks = [0.0, 5.0] + [m * 10.0**d for d in range(1, 6) for m in (1, 2, 4)]
+            ticks = sorted({t * sign for t in ticks for sign in (1, -1)})
+            bottom, top = ax.get_ylim()
+            ax.set_yticks([t for t in ticks if bottom <= t <= top])
             ax.yaxis.set_major_formatter(FuncFormatter(lambda y, _: f"{y:g}"))
+            ax.yaxis.set_minor_formatter(NullFormatter())
         ax.set_xlabel("level factor g (all inputs)")
         ax.set_ylabel(f"error in {q} against Monte Carlo (%)")
     handles, labels = {}, []

@@ -59,6 +59,7 @@ def plot_response_spectra(
     axes = axes[:, 0]
     colours = PALETTE
     top, peak = 0.0, None
+    drawn = [[] for _ in _PANELS]  # (frequency, values) per panel, for the axis limits
     for i, (label, spectra) in enumerate(series.items()):
         colour = colours[i % len(colours)]
         sampled = hasattr(spectra, "velocity_ci95")
@@ -71,23 +72,36 @@ def plot_response_spectra(
             keep = values > 0  # log axes
             style = "-" if sampled else "--"
             ax.plot(f[keep], values[keep], style, color=colour, lw=1.2, label=label)
+            drawn[_PANELS.index((name, ylabel))].append((f[keep], values[keep]))
             if sampled:
                 half = np.asarray(getattr(spectra, f"{name}_ci95"))
                 lo = np.maximum(values - half, values * 1e-3)
                 ax.fill_between(f[keep], lo[keep], (values + half)[keep], color=colour, alpha=0.2)
             ax.set_ylabel(ylabel)
             ax.set_yscale("log")
-            ax.grid(alpha=0.3, which="both", lw=0.5)
+            ax.grid(alpha=0.3, lw=0.5)  # major only: minor lines crowd a narrow log range
     if f_max is None:
         f_max = min(top, 4.0 * peak) if peak else top
+    for ax, lines in zip(axes, drawn, strict=True):
+        # the limits are the lines' within the shown band: not the tails beyond
+        # f_max, not the Monte Carlo band's floor
+        shown = np.concatenate([v[(f > 0) & (f <= f_max)] for f, v in lines] or [np.ones(1)])
+        if shown.size:
+            ax.set_ylim(0.5 * shown.min(), 2.0 * shown.max())
+    handles, labels = axes[0].get_legend_handles_labels()
     if excitation is not None:
+        # its own logarithmic axis: a linear twin would read as a scale for the log curves
         twin = axes[2].twinx()
-        f = np.linspace(0.0, f_max, 2000)
-        twin.plot(f, excitation.psd(f), ":", color="0.4", lw=1.0, label="base excitation")
+        f = np.linspace(0.0, f_max, 2000)[1:]
+        density = np.asarray(excitation.psd(f), dtype=float)
+        keep = density > 0
+        handles += twin.plot(f[keep], density[keep], ":", color="0.4", lw=1.0)
+        labels.append("base excitation (right axis)")
+        twin.set_yscale("log")
         twin.set_ylabel("$S_{\\ddot y}$ ((m/s$^2$)$^2$/Hz)", color="0.4")
-        twin.legend(loc="upper right", fontsize=8)
-    axes[0].legend(fontsize=8, title="solid: Monte Carlo (95 % band); dashed: linearisation",
-                   title_fontsize=7)  # fmt: skip
+    fig.legend(handles, labels, loc="outside lower center", ncol=2, fontsize=8,
+               title="solid: Monte Carlo (95 % band); dashed: linearisation",
+               title_fontsize=7)  # fmt: skip
     axes[-1].set_xlabel("frequency (Hz)")
     axes[-1].set_xlim(0.0, f_max)
     panel_letters(axes)

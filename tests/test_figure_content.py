@@ -1,0 +1,127 @@
+"""What the studies' figures show, read from the Axes they draw (a reviewer's checks).
+
+No point is silently dropped from a logarithmic axis, levels and lines are
+named in the legend, the natural frequency is typeset, a symmetric-log axis
+carries ticks a reader can place -40 % by, a second axis over a logarithmic
+one is logarithmic too, and the limits follow the data rather than a legend.
+
+Covers :mod:`randvib.studies.figures` (power against stroke exceedance, method
+errors against the level) and :mod:`randvib.studies.spectra_figure`.
+"""
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+import pytest  # noqa: E402
+
+import randvib as rv  # noqa: E402
+from randvib.studies import figures  # noqa: E402
+
+DEVICES = ("linear", "bistable")
+LEVELS = (1 / 16, 1 / 4, 1.0)
+
+
+@pytest.fixture
+def drawn(monkeypatch):
+    """The figures the functions would save, kept open for inspection."""
+    kept = []
+
+    def keep(fig, path, **_):
+        kept.append(fig)
+        return path
+
+    monkeypatch.setattr(figures, "save_figure", keep)
+    yield kept
+    plt.close("all")
+
+
+def exceedance_table() -> pd.DataFrame:
+    rows = []
+    for name in ("white", "band at f_n"):
+        for d, dev in enumerate(DEVICES):
+            for i, g in enumerate(LEVELS):
+                # the linear device never passes the stroke at the lowest level
+                exceedance = 0.0 if (dev == "linear" and i == 0) else 10.0 ** (i - 4 + d)
+                rows.append({"input": name, "device": dev, "g": g,
+                             "power_mc": 1e-3 * g, "power_mc_ci95": 1e-5 * g,
+                             "exceedance_mc": exceedance,
+                             "exceedance_mc_ci95": 0.1 * exceedance})  # fmt: skip
+    return pd.DataFrame(rows)
+
+
+def marker_points(ax):
+    """(x, y) of every drawn data marker (the joining lines and the caps left out)."""
+    points = []
+    for line in ax.get_lines():
+        caps = ("|", "_", None, "None", "")  # error-bar caps are markers too
+        if line.get_marker() not in caps:
+            points += list(zip(line.get_xdata(), line.get_ydata(), strict=True))
+    return points
+
+
+def test_zero_exceedance_is_marked_at_the_edge_not_dropped(drawn, tmp_path):
+    table = exceedance_table()
+    figures.power_against_exceedance(table, DEVICES, 0.01, 0.012, tmp_path / "x.png")
+    (fig,) = drawn
+    axes = [ax for ax in fig.axes if ax.get_xscale() == "log"]
+    assert len(axes) == 2
+    smallest = table.exceedance_mc[table.exceedance_mc > 0].min()
+    for ax in axes:
+        points = marker_points(ax)
+        assert len(points) == len(DEVICES) * len(LEVELS)  # every level of every device
+        left = min(x for x, _ in points)
+        assert 0 < left < smallest and ax.get_xlim()[0] < left  # inside the axis, left of all
+        assert ax.get_xlim()[0] > 0.01 * smallest  # the axis shows data, not decades of room
+    assert axes[1].get_title() == "band at $f_n$"
+
+
+def test_exceedance_legend_names_devices_levels_and_the_hollow_marker(drawn, tmp_path):
+    figures.power_against_exceedance(exceedance_table(), DEVICES, 0.01, 0.012, tmp_path / "x.png")
+    (fig,) = drawn
+    (legend,) = fig.legends
+    texts = [t.get_text() for t in legend.get_texts()]
+    assert {"linear", "bistable", "g = 1/16", "g = 1/4", "g = 1"} <= set(texts)
+    assert any("never beyond" in t for t in texts) and any("budget" in t for t in texts)
+    assert "lines" in legend.get_title().get_text() and "markers" in legend.get_title().get_text()
+
+
+def test_symlog_error_axis_has_ticks_to_read_minus_forty_percent(drawn, tmp_path):
+    rows = []
+    for dev in DEVICES:
+        for g in LEVELS:
+            for method, err in (("linearisation", -0.45 * g), ("fpk-fast", 0.02 * g)):
+                rows.append({"method": method, "device": dev, "g": g,
+                             "power_rel_error": err, "power_rel_error_ci95": 0.01,
+                             "exceedance_rel_error": err / 2,
+                             "exceedance_rel_error_ci95": 0.02})  # fmt: skip
+    figures.method_errors_against_level(pd.DataFrame(rows), DEVICES, tmp_path / "m.png")
+    (fig,) = drawn
+    power_axis = fig.axes[0]
+    assert power_axis.get_yscale() == "symlog"
+    ticks = set(np.round(power_axis.get_yticks(), 6))
+    assert {-40.0, -20.0, -10.0, 0.0} <= ticks
+    labels = [t.get_text() for t in power_axis.get_yticklabels()]
+    assert "-40" in [label.replace("\u2212", "-") for label in labels]
+
+
+def test_spectra_limits_follow_the_lines_and_the_excitation_axis_is_logarithmic():
+    f = np.linspace(0.0, 200.0, 2001)
+    device = rv.preset("figure9")
+    spectra = rv.statistical_linearisation(device, rv.BandPass(1.0, 8.0, 0.1)).response_spectra(f)
+    fig = rv.plot_response_spectra({"lin.": spectra}, excitation=rv.BandPass(1.0, 8.0, 0.1))
+    try:
+        f_max = fig.axes[0].get_xlim()[1]
+        shown = (f > 0) & (f <= f_max)
+        for ax, name in zip(fig.axes[:3], ("displacement", "velocity", "power"), strict=True):
+            values = np.asarray(getattr(spectra, name))[shown]
+            assert ax.get_ylim() == pytest.approx((0.5 * values.min(), 2.0 * values.max()))
+        twins = [ax for ax in fig.axes[3:] if ax.get_ylabel()]
+        assert len(twins) == 1 and twins[0].get_yscale() == "log"
+        (legend,) = fig.legends
+        assert "base excitation (right axis)" in [t.get_text() for t in legend.get_texts()]
+    finally:
+        plt.close(fig)
