@@ -11,7 +11,9 @@ is simulated in one batched, compiled call
 
 Measurement model (measured = true + offset): constant offsets of the input
 and output channels, the input between samples (linear, cubic spline or
-band-limited reconstruction), the initial state, and an optional quadratic
+band-limited reconstruction; by default chosen from the input's content
+against the sample rate,
+:func:`~randvib.identification.input_reconstruction.choose_hold`), the initial state, and an optional quadratic
 stiffness k2, estimated with the parameters (:func:`identify`). By default
 the initial state (z0, z'0) is estimated with the parameters; with
 ``initial_state='record'`` the simulation starts from the first sample (less
@@ -177,8 +179,8 @@ def identify(
         SaDE and polish settings (popsize 30, maxiter 60, seed 0, tol 1e-6,
         patience 15, polish True).
     simulation : SimulationSettings, optional
-        Record simulation settings (substeps 4, linear hold, no low-pass,
-        skip 0, initial state estimated).
+        Record simulation settings (substeps 4, the input's reconstruction
+        chosen from the record, no low-pass, skip 0, initial state estimated).
     progress : bool
         Progress bar.
     callback : callable, optional
@@ -199,6 +201,8 @@ def identify(
     search, simulation = resolve_settings("identify", options, search=search, simulation=simulation)
     fixed = _resolve_fixed(model, fixed, m, record)
     fixed, reported, notes = _measurement_model(record, fixed, bool(quadratic))
+    simulation, why = simulation.for_record(record)
+    notes += (why,) if why else ()
     space = search_space(record, model, fixed, bounds, simulation.skip)
     cost = _identification_cost(record, model, fixed, space.free, simulation)
     _check_population(search, len(space.free))
