@@ -97,7 +97,9 @@ NO_OFFSETS = {"input_offset": 0.0, "output_offset": 0.0}
 
 
 def identify_classic(rec, model, *, fixed=None, **kwargs):
-    """identify with the start taken from the record and no offsets estimated."""
+    """identify with the start taken from the record and no offsets estimated,
+    the input reconstructed linearly as the records here were simulated."""
+    kwargs.setdefault("hold", "linear")
     return identify(
         rec, model, fixed={**NO_OFFSETS, **(fixed or {})}, initial_state="record", **kwargs
     )

@@ -19,9 +19,8 @@ from randvib.cli._records import (
 )
 from randvib.formatting import with_standard_error
 from randvib.identification.identify import identify
-from randvib.identification.models import MODELS, unit_of
+from randvib.identification.models import MODELS
 from randvib.identification.settings import SearchSettings
-from randvib.quantities import unit
 
 DEFAULT = SearchSettings()
 
@@ -151,12 +150,12 @@ def print_report(result, record, output_unit: str = "m") -> None:
     relative displacement; a named ``--output-column`` keeps its own).
     """
     se, ci = result.standard_errors, result.confidence_intervals
-    offsets = {"output_offset": output_unit, "input_offset": unit(record.input_kind)}
+    offsets = {"output_offset": output_unit}
     rows = [
         [
             name,
             *with_standard_error(value, se.get(name), ci.get(name)),
-            offsets[name] if name in offsets else unit_of(result.model, name),
+            offsets[name] if name in offsets else result.unit(name),
             "identified" if name in se or name in result.free else "fixed",
         ]
         for name, value in result.parameters.items()

@@ -446,4 +446,5 @@ def _identification_result(cost, space, res, refined, elapsed, search, simulatio
         uncertainty=unc,
         initial_state={k: float(v) for k, v in start.items()},
         notes=notes,
+        input_kind=cost.record.input_kind,
     )

@@ -12,6 +12,7 @@ from randvib.identification.prediction import Prediction, predict_record
 from randvib.identification.settings import SimulationSettings
 from randvib.models.harvester import Harvester
 from randvib.models.record import Record
+from randvib.quantities import unit
 
 
 @dataclass
@@ -58,7 +59,12 @@ class IdentificationResult:
     initial_state : dict
         ``z0`` (m) and ``v0`` (m/s) the simulation starts from.
     notes : tuple of str
-        Why a measurement-model parameter was not estimated.
+        Why a measurement-model parameter was not estimated, how the input
+        is reconstructed between samples.
+    input_kind : str
+        What the training record's input channel holds
+        (``base_acceleration``, ``base_displacement`` or ``force``): the unit
+        of ``input_offset`` (:meth:`unit`); empty when not known.
     """
 
     model: str
@@ -77,6 +83,13 @@ class IdentificationResult:
     uncertainty: object = None
     initial_state: dict = field(default_factory=dict)
     notes: tuple = ()
+    input_kind: str = ""
+
+    def unit(self, name: str) -> str:
+        """The SI unit of parameter ``name``; ``input_offset`` is in the input channel's unit."""
+        if name == "input_offset" and self.input_kind:
+            return unit(self.input_kind)
+        return unit_of(self.model, name)
 
     @property
     def standard_errors(self) -> dict:
@@ -98,7 +111,8 @@ class IdentificationResult:
         return {
             "model": self.model,
             "parameters": {k: float(v) for k, v in self.parameters.items()},
-            "units": {k: unit_of(self.model, k) for k in self.parameters},
+            "units": {k: self.unit(k) for k in self.parameters},
+            "input_kind": self.input_kind,
             "cost": float(self.cost),
             "free": list(self.free),
             "bounds": {k: [float(a), float(b)] for k, (a, b) in self.bounds.items()},
@@ -129,7 +143,7 @@ class IdentificationResult:
         rows = {
             name: {
                 "value": float(value),
-                "unit": unit_of(self.model, name),
+                "unit": self.unit(name),
                 "free": name in self.free,
                 "lower": float(self.bounds[name][0]) if name in self.bounds else np.nan,
                 "upper": float(self.bounds[name][1]) if name in self.bounds else np.nan,
@@ -142,7 +156,7 @@ class IdentificationResult:
         rows = [("cost J (Eq. 11)", formatting.compact(self.cost, 4), "")]
         for name, value in self.parameters.items():
             fixed = "" if name in self.free else " (fixed)"
-            rows.append((name + fixed, formatting.compact(value), unit_of(self.model, name)))
+            rows.append((name + fixed, formatting.compact(value), self.unit(name)))
         return rows
 
     def _search_line(self) -> str:
