@@ -335,7 +335,9 @@ def test_settings_objects_are_the_keywords(record):
     ).parameters == by_keyword.parameters  # fmt: skip
     with pytest.raises(TypeError, match="unexpected keyword argument\\(s\\) generations"):
         identify(short, "coulomb", m=TRUE["m"], generations=3)
-    with pytest.raises(ValueError, match="`hold` must be one of auto, linear, zero, cubic, bandlimited"):
+    with pytest.raises(
+        ValueError, match="`hold` must be one of auto, linear, zero, cubic, bandlimited"
+    ):
         SimulationSettings(hold="quintic")
 
 
