@@ -90,6 +90,8 @@ def test_default_identification_of_a_wideband_shaker_record_is_within_5_percent(
     assert any("band-limited" in note and "--hold" in note for note in result.notes)
     for name, true in {**TRUTH, **OFFSETS}.items():
         assert result.parameters[name] == pytest.approx(true, rel=0.05), name
+    assert result.residuals.verdict in ("white", "structured")
+    assert result.to_dict()["residuals"]["verdict"] == result.residuals.verdict
 
 
 def test_linear_hold_on_the_wideband_record_warns_naming_hold(rig):

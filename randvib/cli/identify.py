@@ -170,6 +170,8 @@ def print_report(result, record, output_unit: str = "m") -> None:
     print(
         f"initial state z0 = {start['z0']:.6g} {output_unit}, v0 = {start['v0']:.6g} {output_unit}/s"
     )
+    if result.residuals is not None:
+        print(result.residuals.summary())
     for note in result.notes:
         print(f"note: {note}")
     unc = result.uncertainty

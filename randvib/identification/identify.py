@@ -229,9 +229,12 @@ def identify(
     found = dict(zip(space.free, map(float, res.x), strict=True))
     refined = _polish(cost, space, found, simulation, search) if search.polish else None
     elapsed = time.perf_counter() - start
-    return _identification_result(
+    result = _identification_result(
         cost, space, res, refined, elapsed, search, simulation, reported, notes
     )
+    if np.isfinite(result.cost):
+        result.residuals = result.diagnose(record)
+    return result
 
 
 def _check_population(search: SearchSettings, d: int) -> None:

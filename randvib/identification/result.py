@@ -9,6 +9,7 @@ import numpy as np
 from randvib import _display, formatting
 from randvib.identification.models import MeasurementModel, device_from_parameters, unit_of
 from randvib.identification.prediction import Prediction, predict_record
+from randvib.identification.residuals import MAX_LAG, ResidualDiagnostics, residual_diagnostics
 from randvib.identification.settings import SimulationSettings
 from randvib.models.harvester import Harvester
 from randvib.models.record import Record
@@ -65,6 +66,10 @@ class IdentificationResult:
         What the training record's input channel holds
         (``base_acceleration``, ``base_displacement`` or ``force``): the unit
         of ``input_offset`` (:meth:`unit`); empty when not known.
+    residuals : ResidualDiagnostics or None
+        Whiteness of the training residual and its independence of the input
+        (:func:`~randvib.identification.residuals.residual_diagnostics`), with
+        the verdict ``white`` or ``structured``; None when not computed.
     """
 
     model: str
@@ -84,6 +89,7 @@ class IdentificationResult:
     initial_state: dict = field(default_factory=dict)
     notes: tuple = ()
     input_kind: str = ""
+    residuals: ResidualDiagnostics | None = None
 
     def unit(self, name: str) -> str:
         """The SI unit of parameter ``name``; ``input_offset`` is in the input channel's unit."""
@@ -125,6 +131,7 @@ class IdentificationResult:
             "settings": self.settings,
             "initial_state": dict(self.initial_state),
             "notes": list(self.notes),
+            **({} if self.residuals is None else {"residuals": self.residuals.to_dict()}),
             **(
                 {}
                 if self.uncertainty is None
@@ -198,6 +205,17 @@ class IdentificationResult:
     def simulation(self) -> SimulationSettings:
         """The simulation settings of the fit, as :func:`predict_record` takes them."""
         return SimulationSettings(**{k: v for k, v in self.settings.items() if k in _SIMULATION})
+
+    def diagnose(self, record: Record, max_lag: int = MAX_LAG) -> ResidualDiagnostics:
+        """Residual diagnostics of the fit on ``record`` (the training record or another).
+
+        The residual is the measured less the simulated output (:meth:`predict`)
+        after the ``skip`` samples, tested against the record's input
+        (:func:`~randvib.identification.residuals.residual_diagnostics`).
+        """
+        pred = self.predict(record)
+        skip = int(self.settings.get("skip", 0))
+        return residual_diagnostics(record.z[skip:] - pred.z[skip:], record.input[skip:], max_lag)
 
     def predict(self, record: Record, electrical=None) -> Prediction:
         """``record`` simulated with the identified device and measurement model.
