@@ -19,6 +19,7 @@ from randvib.cli._records import (
 )
 from randvib.formatting import with_standard_error
 from randvib.identification.identify import identify
+from randvib.identification.least_squares import COVARIANCE_METHODS
 from randvib.identification.models import MODELS
 from randvib.identification.settings import SearchSettings
 
@@ -177,6 +178,8 @@ def print_report(result, record, output_unit: str = "m") -> None:
     unc = result.uncertainty
     if unc is not None:
         names = list(unc.names)
+        band = f", bandwidth {unc.bandwidth} samples" if unc.bandwidth else ""
+        print(f"intervals: {COVARIANCE_METHODS[unc.method]}{band}")
         print(f"correlation matrix (residual noise s = {unc.noise_std:.4g}, {unc.dof} dof):")
         print_table(
             [

@@ -102,6 +102,18 @@ class ResidualDiagnostics:
         }
 
 
+def ljung_box(residual, max_lag: int = MAX_LAG) -> tuple[float, float]:
+    """Ljung-Box statistic of ``residual`` over lags 1..M and its chi-squared(M) p-value."""
+    e = np.asarray(residual, dtype=float)
+    n = e.shape[0]
+    m = int(min(max_lag, n // 4))
+    if m < 1 or np.std(e) == 0:
+        return 0.0, 1.0
+    r = _correlation(e, e, m)[m + 1 :]
+    q = float(n * (n + 2) * np.sum(r**2 / (n - np.arange(1, m + 1))))
+    return q, float(stats.chi2.sf(q, m))
+
+
 def _correlation(a, b, max_lag):
     """Biased sample cross-correlation ``sum_i a_{i+k} b_i / (N s_a s_b)``, k = -M..M."""
     n = a.shape[0]
@@ -146,9 +158,7 @@ def residual_diagnostics(residual, input_signal, max_lag: int = MAX_LAG) -> Resi
     r_uu = _correlation(u, u, m)[m:]
     r_eu = _correlation(e, u, m)
     z = stats.norm.ppf(1 - LEVEL / 2)
-    k = np.arange(1, m + 1)
-    q = float(n * (n + 2) * np.sum(r_ee[1:] ** 2 / (n - k)))
-    q_p = float(stats.chi2.sf(q, m))
+    q, q_p = ljung_box(e, m)
     # Bartlett: var r_eu(k) = (1/N) sum_j r_ee(j) r_uu(j) for independent series
     var = max(float(1 + 2 * np.sum(r_ee[1:] * r_uu[1:])), 1e-12) / n
     p_cross = 2 * stats.norm.sf(np.abs(r_eu) / np.sqrt(var))
