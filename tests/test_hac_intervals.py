@@ -57,3 +57,12 @@ def test_auto_chooses_white_for_white_residuals_and_hac_for_correlated():
     assert used == "white" and lag == 0
     _, used, lag = covariance(x, signal.lfilter([1.0], [1.0, -0.9], rng.standard_normal(1000)))
     assert used == "hac" and lag > 10  # Andrews' rule at rho = 0.9, N = 1000: about 40
+
+
+def test_newey_west_bandwidth_follows_andrews_rule():
+    """rho = 0.5, N = 10000: alpha = 4 rho^2 / ((1 - rho)^2 (1 + rho)^2) = 16/9, so
+    L = ceil(1.1447 (alpha N)^(1/3)) = 30; the sample rho's standard error (0.009)
+    moves L by at most 1."""
+    e = signal.lfilter([1.0], [1.0, -0.5], np.random.default_rng(4).standard_normal(10000))
+    assert abs(newey_west_bandwidth(e) - 30) <= 1
+    assert newey_west_bandwidth(np.random.default_rng(5).standard_normal(10000)) <= 3
