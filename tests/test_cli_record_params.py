@@ -74,3 +74,9 @@ def test_input_offset_has_the_input_channels_unit_everywhere(fit):
     assert frame.loc["input_offset", "unit"] == "m/s^2"
     assert frame.loc["output_offset", "unit"] == "m"
     assert list(frame.index) == list(fit.parameters)
+
+
+def test_identify_shows_progress_by_default_in_python():
+    import inspect
+
+    assert inspect.signature(identify).parameters["progress"].default is True

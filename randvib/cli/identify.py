@@ -100,14 +100,16 @@ def _new_file(path, option, overwrite=False):
     return None if path is None else check_output_file(path, option, overwrite=overwrite)
 
 
-def _save_plot(result, record, plot: Path, title: str, units: dict) -> None:
+def _save_plot(result, record, plot: Path, title: str, units: dict, json: bool = False) -> None:
     """The figure; if it cannot be written now, say so and keep going (the result is printed)."""
     from randvib.identification.plots import figure_fit
 
     try:
-        figure_fit(result.predict(record), plot, title=title, **units)
+        figure_fit(result.predict(record), plot, title=title, validation=False, **units)
     except OSError as exc:
         print(f"randvib: could not write `--plot` {str(plot)!r} ({exc})", file=sys.stderr)
+        return
+    print(f"wrote {plot}", file=sys.stderr if json else sys.stdout)
 
 
 def run(args) -> int:
@@ -136,7 +138,14 @@ def run(args) -> int:
     if save is not None:
         write_or_keep(save, dumps(out, indent=2), "--save")
     if plot is not None:
-        _save_plot(result, record, plot, f"{args.model} model on {record.name}", plot_units(args))
+        _save_plot(
+            result,
+            record,
+            plot,
+            f"{args.model} model on {record.name}",
+            plot_units(args),
+            args.json,
+        )
     if args.json:
         print(dumps(out))
         return 0

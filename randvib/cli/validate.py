@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 
 from randvib._io import check_output_folder, dumps, existing_file
 from randvib.cli._output import print_table
@@ -107,7 +108,17 @@ def run(args) -> int:
         for i, record in enumerate(records):
             pred = predict_record(harvester, record, measurement=measurement, simulation=settings)
             path = plot_dir / f"{i:02d}_{record.name}.png"
-            figure_fit(pred, path, title=f"{model} model on {record.name}", **plot_units(args))
+            figure_fit(
+                pred,
+                path,
+                title=f"{model} model on {record.name}",
+                validation=True,
+                **plot_units(args),
+            )
+        print(
+            f"wrote {len(records)} figure(s) into {plot_dir}",
+            file=sys.stderr if args.json else sys.stdout,
+        )
     if args.json:
         print(
             dumps(

@@ -129,7 +129,7 @@ def identify(
     quadratic: bool = False,
     search: SearchSettings | None = None,
     simulation: SimulationSettings | None = None,
-    progress: bool = False,
+    progress: bool = True,
     callback=None,
     **options,
 ) -> IdentificationResult:
@@ -182,7 +182,8 @@ def identify(
         Record simulation settings (substeps 4, the input's reconstruction
         chosen from the record, no low-pass, skip 0, initial state estimated).
     progress : bool
-        Progress bar.
+        Progress bar of the search (default True, as the Monte Carlo runs; the
+        CLI turns it off with --no-progress or --json).
     callback : callable, optional
         ``callback(generation, parameters_dict, cost)``; True stops.
     **options

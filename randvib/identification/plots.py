@@ -37,8 +37,12 @@ def _finish(fig, path):
     return fig
 
 
-def plot_time_history(prediction, ax=None, *, window=None, scale=MILLI, unit="mm"):
+def plot_time_history(
+    prediction, ax=None, *, window=None, scale=MILLI, unit="mm", residual_ax=None
+):
     """Measured (solid black) and simulated (dashed) relative displacement.
+
+    The shown window is stated with the time axis (``t0 to t1 s of T s``).
 
     Parameters
     ----------
@@ -50,6 +54,9 @@ def plot_time_history(prediction, ax=None, *, window=None, scale=MILLI, unit="mm
     scale, unit : float, str
         Display scaling of the record's output, by default from m to mm; a
         record whose output is not a displacement in m gives its own.
+    residual_ax : matplotlib Axes, optional
+        Where to draw the residual, measured less simulated, over the same
+        window (a fit that misses shows there what it misses).
     """
     if ax is None:
         _, axes = new_figure(figsize=(7.0, 2.6))
@@ -60,11 +67,23 @@ def plot_time_history(prediction, ax=None, *, window=None, scale=MILLI, unit="mm
     sel = (t >= t0) & (t <= t1)
     ax.plot(t[sel], rec.z[sel] * scale, **MEASURED)
     ax.plot(t[sel], prediction.z[sel] * scale, **SIMULATED)
-    ax.set_xlabel("time (s)")
     ax.set_ylabel(f"relative displacement z ({unit})")
     ax.set_xlim(t[sel][0], t[sel][-1])
+    # the window shown, stated where the time axis is labelled
+    shown = f"time (s); shown: {t[sel][0]:.3g} to {t[sel][-1]:.3g} s of {float(t[-1] - t[0]):.3g} s"
     ax.set_title(f"J = {prediction.cost:.3g} (Eq. 11)", loc="right")
     ax.legend(loc="upper left", ncols=2, frameon=False)
+    if residual_ax is None:
+        ax.set_xlabel(shown)
+        return ax
+    residual = (rec.z - prediction.z) * scale
+    residual_ax.plot(t[sel], residual[sel], color=PALETTE[2], lw=0.8)
+    residual_ax.axhline(0.0, color="black", lw=0.5)
+    residual_ax.set_xlim(t[sel][0], t[sel][-1])
+    residual_ax.set_xlabel(shown)
+    residual_ax.set_ylabel(f"residual ({unit})")
+    rms = float(np.sqrt(np.mean(residual**2)))
+    residual_ax.set_title(f"measured - simulated, RMS {rms:.3g} {unit}", loc="right")
     return ax
 
 
@@ -83,8 +102,19 @@ def default_window(record, cycles: float = 30.0, longest: float = 2.0) -> float:
     return min(duration, longest, cycles / (crossings / 2.0 / duration))
 
 
-def plot_histograms(prediction, axes=None, *, bins=81, scale=MILLI, unit="mm", legend=True):
+def histogram_bins(n: int) -> int:
+    """Bins of a density histogram of ``n`` samples: ``2 n^(1/3)`` (Rice's rule), 10 to 81.
+
+    Enough bins to show a density's shape, few enough that each holds many
+    samples (81 bins of a 500-sample record would be noise).
+    """
+    return int(np.clip(np.ceil(2.0 * n ** (1.0 / 3.0)), 10, 81))
+
+
+def plot_histograms(prediction, axes=None, *, bins=None, scale=MILLI, unit="mm", legend=True):
     """Densities of the measured and simulated displacement and, with a coil, load voltage.
+
+    ``bins`` defaults to :func:`histogram_bins` of the record's length.
 
     With a circuit the voltage histogram shows the spike at zero volts caused
     by sticking (paper Figure 8b): while the magnet sticks, z' = 0 and so V = 0.
@@ -103,7 +133,7 @@ def plot_histograms(prediction, axes=None, *, bins=81, scale=MILLI, unit="mm", l
         values = [x for x in (meas, sim) if x is not None]
         lo = min(np.min(x) for x in values)
         hi = max(np.max(x) for x in values)
-        edges = np.linspace(lo, hi, bins + 1)
+        edges = np.linspace(lo, hi, (bins or histogram_bins(len(sim))) + 1)
         if meas is not None:
             ax.hist(meas, edges, density=True, histtype="step", **MEASURED)
         ax.hist(sim, edges, density=True, histtype="step", **SIMULATED)
@@ -115,31 +145,37 @@ def plot_histograms(prediction, axes=None, *, bins=81, scale=MILLI, unit="mm", l
 
 
 @styled
-def figure_fit(prediction, path=None, *, window=None, scale=MILLI, unit="mm", title=None):
-    """Paper Figure 8 analogue: (a) time history, (b) displacement and (c) voltage densities.
+def figure_fit(
+    prediction, path=None, *, window=None, scale=MILLI, unit="mm", title=None, validation=None
+):
+    """Paper Figure 8 analogue: (a) time history, (b) residual, (c, d) densities.
 
-    ``title`` defaults to the record's name.
+    ``title`` defaults to the record's name; ``validation=True`` marks the
+    figure as a validation (a record the model was not fitted to) in its
+    title, ``False`` as the fit to its training record, None not at all.
     """
     n_hist = 2 if prediction.voltage is not None else 1
     fig = _fit_layout(n_hist)
-    ax_t, *hist_axes = fig.axes
-    plot_time_history(prediction, ax_t, window=window, scale=scale, unit=unit)
+    ax_t, ax_r, *hist_axes = fig.axes
+    plot_time_history(prediction, ax_t, window=window, scale=scale, unit=unit, residual_ax=ax_r)
     # one legend, in (a): in the densities it would cover a tail
     plot_histograms(prediction, hist_axes, scale=scale, unit=unit, legend=False)
     panel_letters(fig.axes)
-    fig.suptitle(title if title else prediction.record.name)
+    what = {None: "", True: "validation: ", False: "fit to the training record: "}[validation]
+    fig.suptitle(f"{what}{title if title else prediction.record.name}")
     return _finish(fig, path)
 
 
 def _fit_layout(n_hist: int):
-    """A figure with the time history on top and ``n_hist`` histograms below."""
+    """A figure with the time history and its residual on top and ``n_hist`` histograms below."""
     import matplotlib.pyplot as plt
 
-    fig = plt.figure(figsize=(7.0, 4.8), layout="constrained")
-    grid = fig.add_gridspec(2, n_hist)
-    fig.add_subplot(grid[0, :])
+    fig = plt.figure(figsize=(7.0, 6.4), layout="constrained")
+    grid = fig.add_gridspec(3, n_hist, height_ratios=(1.2, 0.8, 1.0))
+    top = fig.add_subplot(grid[0, :])
+    fig.add_subplot(grid[1, :], sharex=top)
     for j in range(n_hist):
-        fig.add_subplot(grid[1, j])
+        fig.add_subplot(grid[2, j])
     return fig
 
 
