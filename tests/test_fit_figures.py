@@ -34,7 +34,7 @@ def test_figure_has_a_residual_panel_the_window_and_its_kind(record):
 
     pred = predict_record(preset("coulomb-td1").updated(fc=0.004), record)
     fig = figure_fit(pred, window=(0.0, 1.0), validation=True)
-    ax_t, ax_r, ax_h = fig.axes
+    ax_t, ax_r, ax_h = fig.axes[:3]
     assert ax_r.get_xlabel() == "time (s); shown: 0 to 1 s of 3 s"
     assert ax_r.get_ylabel() == "residual (mm)" and "RMS" in ax_r.get_title(loc="right")
     assert fig._suptitle.get_text().startswith("validation: ")

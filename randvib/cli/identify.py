@@ -105,7 +105,14 @@ def _save_plot(result, record, plot: Path, title: str, units: dict, json: bool =
     from randvib.identification.plots import figure_fit
 
     try:
-        figure_fit(result.predict(record), plot, title=title, validation=False, **units)
+        figure_fit(
+            result.predict(record),
+            plot,
+            title=title,
+            validation=False,
+            diagnostics=result.residuals,
+            **units,
+        )
     except OSError as exc:
         print(f"randvib: could not write `--plot` {str(plot)!r} ({exc})", file=sys.stderr)
         return

@@ -104,15 +104,19 @@ def run(args) -> int:
     if plot_dir is not None:
         from randvib.identification.plots import figure_fit
         from randvib.identification.prediction import predict_record
+        from randvib.identification.residuals import residual_diagnostics
 
         for i, record in enumerate(records):
             pred = predict_record(harvester, record, measurement=measurement, simulation=settings)
             path = plot_dir / f"{i:02d}_{record.name}.png"
+            skip = settings.skip
+            diagnostics = residual_diagnostics(record.z[skip:] - pred.z[skip:], record.input[skip:])
             figure_fit(
                 pred,
                 path,
                 title=f"{model} model on {record.name}",
                 validation=True,
+                diagnostics=diagnostics,
                 **plot_units(args),
             )
         print(

@@ -144,38 +144,87 @@ def plot_histograms(prediction, axes=None, *, bins=None, scale=MILLI, unit="mm",
     return axes
 
 
+def plot_residual_correlations(diagnostics, axes) -> None:
+    """Residual autocorrelation and its cross-correlation with the input, with bands.
+
+    ``diagnostics`` is a
+    :class:`~randvib.identification.residuals.ResidualDiagnostics`; the dashed
+    lines are its (1 - LEVEL) bands of a white, independent residual.
+    """
+    from randvib.identification.residuals import LEVEL
+
+    ax_a, ax_c = axes
+    band = f"{100 * (1 - LEVEL):g} % band"
+    for ax, lags, r, half, name in (
+        (ax_a, diagnostics.lags[1:], diagnostics.autocorrelation[1:], diagnostics.auto_band,
+         f"residual autocorrelation ({diagnostics.verdict})"),
+        (ax_c, diagnostics.cross_lags, diagnostics.cross_correlation, diagnostics.cross_band,
+         "residual-input cross-correlation"),
+    ):  # fmt: skip
+        ax.vlines(lags, 0.0, r, color=PALETTE[0], lw=1.2)
+        ax.axhline(half, color="black", ls="--", lw=0.8, label=band)
+        ax.axhline(-half, color="black", ls="--", lw=0.8)
+        ax.axhline(0.0, color="black", lw=0.5)
+        ax.set_xlabel("lag (samples)")
+        ax.set_ylabel("correlation")
+        ax.set_title(name, loc="right", fontsize=8)
+    ax_a.legend(loc="upper right", frameon=False)
+
+
 @styled
 def figure_fit(
-    prediction, path=None, *, window=None, scale=MILLI, unit="mm", title=None, validation=None
+    prediction,
+    path=None,
+    *,
+    window=None,
+    scale=MILLI,
+    unit="mm",
+    title=None,
+    validation=None,
+    diagnostics=None,
 ):
-    """Paper Figure 8 analogue: (a) time history, (b) residual, (c, d) densities.
+    """Paper Figure 8 analogue: (a) time history, (b) residual, then densities.
 
     ``title`` defaults to the record's name; ``validation=True`` marks the
     figure as a validation (a record the model was not fitted to) in its
     title, ``False`` as the fit to its training record, None not at all.
+    ``diagnostics`` (a
+    :class:`~randvib.identification.residuals.ResidualDiagnostics`) adds a row
+    with the residual's autocorrelation and its cross-correlation with the
+    input (:func:`plot_residual_correlations`).
     """
     n_hist = 2 if prediction.voltage is not None else 1
-    fig = _fit_layout(n_hist)
-    ax_t, ax_r, *hist_axes = fig.axes
+    fig = _fit_layout(n_hist, diagnostics is not None)
+    ax_t, ax_r, *rest = fig.axes
     plot_time_history(prediction, ax_t, window=window, scale=scale, unit=unit, residual_ax=ax_r)
     # one legend, in (a): in the densities it would cover a tail
-    plot_histograms(prediction, hist_axes, scale=scale, unit=unit, legend=False)
+    plot_histograms(prediction, rest[:n_hist], scale=scale, unit=unit, legend=False)
+    if diagnostics is not None:
+        plot_residual_correlations(diagnostics, rest[n_hist:])
     panel_letters(fig.axes)
     what = {None: "", True: "validation: ", False: "fit to the training record: "}[validation]
     fig.suptitle(f"{what}{title if title else prediction.record.name}")
     return _finish(fig, path)
 
 
-def _fit_layout(n_hist: int):
-    """A figure with the time history and its residual on top and ``n_hist`` histograms below."""
+def _fit_layout(n_hist: int, correlations: bool = False):
+    """The time history and its residual on top, ``n_hist`` histograms below, and
+    with ``correlations`` a row of two residual-correlation panels."""
     import matplotlib.pyplot as plt
 
-    fig = plt.figure(figsize=(7.0, 6.4), layout="constrained")
-    grid = fig.add_gridspec(3, n_hist, height_ratios=(1.2, 0.8, 1.0))
+    rows = 4 if correlations else 3
+    fig = plt.figure(figsize=(7.0, 8.4 if correlations else 6.4), layout="constrained")
+    grid = fig.add_gridspec(rows, 2, height_ratios=(1.2, 0.8, 1.0, 1.0)[:rows])
     top = fig.add_subplot(grid[0, :])
     fig.add_subplot(grid[1, :], sharex=top)
-    for j in range(n_hist):
-        fig.add_subplot(grid[2, j])
+    if n_hist == 1:
+        fig.add_subplot(grid[2, :])
+    else:
+        for j in range(n_hist):
+            fig.add_subplot(grid[2, j])
+    if correlations:
+        fig.add_subplot(grid[3, 0])
+        fig.add_subplot(grid[3, 1])
     return fig
 
 
