@@ -57,9 +57,8 @@ def main(n):
             for name, value in truth.items():
                 lo, hi = res.confidence_intervals[name]
                 hits[name] += lo <= value <= hi
-        print(
-            f"{case}: {n} seeds, covariance used: {dict(zip(*np.unique(methods, return_counts=True)))}"
-        )
+        used = {m: methods.count(m) for m in sorted(set(methods))}
+        print(f"{case}: {n} seeds, covariance used: {used}")
         for name, k in hits.items():
             ci = stats.binomtest(k, n).proportion_ci(0.95)
             print(f"  {name:>13}: {k}/{n} = {k / n:.2f} [{ci.low:.2f}, {ci.high:.2f}]")
