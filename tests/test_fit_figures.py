@@ -58,3 +58,11 @@ def test_identify_and_validate_plot_say_where_they_wrote(record, tmp_path, capsy
     assert main(["validate", str(fit), str(data), "--plot", str(folder)]) == 0
     assert f"wrote 1 figure(s) into {folder}" in capsys.readouterr().out
     assert len(list(folder.glob("*.png"))) == 1
+    # the same kind of argument as identify's: one file for one record, new unless --force
+    single = tmp_path / "validation.png"
+    assert main(["validate", str(fit), str(data), "--plot", str(single)]) == 0
+    assert f"wrote {single}" in capsys.readouterr().out and single.exists()
+    assert main(["validate", str(fit), str(data), "--plot", str(single)]) == 2
+    assert "exists" in capsys.readouterr().err
+    assert main(["validate", str(fit), str(data), str(data), "--plot", str(single)]) == 2
+    assert "one file, for one record" in capsys.readouterr().err
