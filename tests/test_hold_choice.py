@@ -147,13 +147,14 @@ def test_midpoint_error_of_a_cosine_is_exact():
 
 def test_white_input_is_not_band_limited_and_warns():
     """White noise has a tenth of its power above 0.9 x Nyquist (Welch's estimate
-    of that fraction is within a few % of 0.1 on 4000 samples): auto keeps
-    linear and warns, naming --hold."""
+    of that fraction is within a few % of 0.1 on 4000 samples): auto takes the
+    band-limited interpolant (lines differ from it by far more than 1 %) and
+    warns, naming --hold."""
     x = np.random.default_rng(2).standard_normal(4000)
     assert near_nyquist_fraction(x) == pytest.approx(0.1, rel=0.15)
     with pytest.warns(UserWarning, match="--hold zero"):
         hold, why = choose_hold(x, 1e-3)
-    assert hold == "linear" and "not band-limited" in why
+    assert hold == "bandlimited" and "not band-limited" in why
 
 
 def test_unknown_hold_is_refused_naming_the_choices():

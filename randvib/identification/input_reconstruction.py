@@ -223,7 +223,9 @@ def choose_hold(samples, dt: float, hold: str = AUTO_HOLD) -> tuple[str, str]:
     frequency, which straight lines attenuate and alias). An input with more
     than :data:`NYQUIST_POWER_LIMIT` of its power next to the Nyquist frequency
     (:func:`near_nyquist_fraction`) is not band-limited: no interpolation
-    represents it, ``auto`` keeps the linear one and a warning says so. A
+    represents it exactly, ``auto`` chooses as above (an input filtered too
+    gently is closer to its band-limited interpolant than to straight lines)
+    and a warning naming ``--hold`` says so. A
     reconstruction given explicitly is kept, with a warning when it differs
     from the band-limited interpolant of a band-limited input by more than
     the tolerance.
@@ -253,7 +255,12 @@ def choose_hold(samples, dt: float, hold: str = AUTO_HOLD) -> tuple[str, str]:
     near = near_nyquist_fraction(x)
     if near > NYQUIST_POWER_LIMIT:
         if hold in (AUTO_HOLD, "bandlimited", "cubic"):
-            chosen = "linear" if hold == AUTO_HOLD else hold
+            # auto: still the band-limited one if lines would differ from it (an
+            # input filtered too gently is closer to band-limited than to lines)
+            chosen = hold
+            if hold == AUTO_HOLD:
+                lines = midpoint_error(x, "linear") <= HOLD_TOLERANCE
+                chosen = "linear" if lines else "bandlimited"
             why = (
                 f"the input has {100 * near:.2g} % of its power above "
                 f"{NEAR_NYQUIST * nyquist:.4g} Hz (Nyquist {nyquist:.4g} Hz): it is not "
