@@ -70,7 +70,7 @@ def add_device_arguments(parser: argparse.ArgumentParser) -> None:
     )
     g.add_argument("--m", type=float, help="mass (kg)")
     g.add_argument("--c-m", type=float, help="mechanical damping (Ns/m)")
-    g.add_argument("--c-e", type=float, help="electrical damping (Ns/m)")
+    g.add_argument("--c-e", type=float, help="electrical damping (Ns/m), default 0")
     g.add_argument(
         "--k",
         type=float,
@@ -174,7 +174,9 @@ def harvester_from_args(args) -> Harvester:
             raise ValueError(
                 f"{flags}: the {coupling.name} coupling's electrical damping is not a finite number"
             ) from None
-    for name in ("m", "c_m", "c_e", "k"):
+    if values["c_e"] is None:
+        values["c_e"] = 0.0  # no coupling given: no electrical damping, as the identified presets
+    for name in ("m", "c_m", "k"):
         _need(values[name], option_flag(name), "the device (or use --preset)")
     return Harvester(friction=friction, stroke=args.stroke, **values)
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from randvib._validation import integer_option
-from randvib.identification.input_reconstruction import HOLDS
+from randvib.identification.input_reconstruction import AUTO_HOLD, HOLDS
 from randvib.identification.settings import INITIAL_STATES, SimulationSettings
 from randvib.models.record import INPUT_KINDS, OUTPUT_CHANNEL, TIME_COLUMN, read_record
 from randvib.quantities import unit
@@ -43,10 +43,10 @@ def add_record_arguments(parser: argparse.ArgumentParser) -> None:
     )
     s.add_argument(
         "--hold",
-        choices=HOLDS,
+        choices=(AUTO_HOLD,) + HOLDS,
         default=None,
-        help="input between samples (default: linear; bandlimited or cubic for a record "
-        "sampled not far above its bandwidth)",
+        help="input between samples (default: auto, linear or bandlimited chosen from the "
+        "input's content against the sample rate)",
     )
     s.add_argument("--lowpass", type=float, metavar="HZ", help="low-pass the driving signal")
     s.add_argument(

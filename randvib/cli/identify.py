@@ -19,9 +19,9 @@ from randvib.cli._records import (
 )
 from randvib.formatting import with_standard_error
 from randvib.identification.identify import identify
-from randvib.identification.models import MODELS, unit_of
+from randvib.identification.least_squares import COVARIANCE_METHODS
+from randvib.identification.models import MODELS
 from randvib.identification.settings import SearchSettings
-from randvib.quantities import unit
 
 DEFAULT = SearchSettings()
 
@@ -100,14 +100,23 @@ def _new_file(path, option, overwrite=False):
     return None if path is None else check_output_file(path, option, overwrite=overwrite)
 
 
-def _save_plot(result, record, plot: Path, title: str, units: dict) -> None:
+def _save_plot(result, record, plot: Path, title: str, units: dict, json: bool = False) -> None:
     """The figure; if it cannot be written now, say so and keep going (the result is printed)."""
     from randvib.identification.plots import figure_fit
 
     try:
-        figure_fit(result.predict(record), plot, title=title, **units)
+        figure_fit(
+            result.predict(record),
+            plot,
+            title=title,
+            validation=False,
+            diagnostics=result.residuals,
+            **units,
+        )
     except OSError as exc:
         print(f"randvib: could not write `--plot` {str(plot)!r} ({exc})", file=sys.stderr)
+        return
+    print(f"wrote {plot}", file=sys.stderr if json else sys.stdout)
 
 
 def run(args) -> int:
@@ -136,7 +145,14 @@ def run(args) -> int:
     if save is not None:
         write_or_keep(save, dumps(out, indent=2), "--save")
     if plot is not None:
-        _save_plot(result, record, plot, f"{args.model} model on {record.name}", plot_units(args))
+        _save_plot(
+            result,
+            record,
+            plot,
+            f"{args.model} model on {record.name}",
+            plot_units(args),
+            args.json,
+        )
     if args.json:
         print(dumps(out))
         return 0
@@ -151,12 +167,12 @@ def print_report(result, record, output_unit: str = "m") -> None:
     relative displacement; a named ``--output-column`` keeps its own).
     """
     se, ci = result.standard_errors, result.confidence_intervals
-    offsets = {"output_offset": output_unit, "input_offset": unit(record.input_kind)}
+    offsets = {"output_offset": output_unit}
     rows = [
         [
             name,
             *with_standard_error(value, se.get(name), ci.get(name)),
-            offsets[name] if name in offsets else unit_of(result.model, name),
+            offsets[name] if name in offsets else result.unit(name),
             "identified" if name in se or name in result.free else "fixed",
         ]
         for name, value in result.parameters.items()
@@ -171,11 +187,15 @@ def print_report(result, record, output_unit: str = "m") -> None:
     print(
         f"initial state z0 = {start['z0']:.6g} {output_unit}, v0 = {start['v0']:.6g} {output_unit}/s"
     )
+    if result.residuals is not None:
+        print(result.residuals.summary())
     for note in result.notes:
         print(f"note: {note}")
     unc = result.uncertainty
     if unc is not None:
         names = list(unc.names)
+        band = f", bandwidth {unc.bandwidth} samples" if unc.bandwidth else ""
+        print(f"intervals: {COVARIANCE_METHODS[unc.method]}{band}")
         print(f"correlation matrix (residual noise s = {unc.noise_std:.4g}, {unc.dof} dof):")
         print_table(
             [

@@ -3,7 +3,9 @@
 The device options are those of ``simulate`` and ``power``; the excitation is
 the paper's band-limited shaker test (Sec. 3): ``--rms`` (m/s^2, scaled
 exactly) or ``--psd`` (flat level, (m/s^2)^2/Hz) between ``--f-lo`` and
-``--f-hi``. Sensor noise and offsets make it look like a measurement.
+``--f-hi``. Sensor noise and offsets make it look like a measurement. The
+parameters simulated (device, excitation, sensors, seed) are written beside
+the record, ``FILE.json`` next to ``FILE.csv``.
 """
 
 from __future__ import annotations
@@ -11,7 +13,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from randvib._io import check_output_file
+from randvib._io import check_output_file, dumps, write_or_keep
 from randvib._resources import check_memory
 from randvib._validation import MAX_SEED, check_int, integer_option
 from randvib.cli._device import add_device_arguments, harvester_from_args
@@ -61,6 +63,9 @@ def run(args) -> int:
     if out.exists() and not out.is_dir() and not args.force:
         raise FileExistsError(f"`--out` {str(out)!r} exists; choose a new name or give --force")
     check_output_file(out, "--out", overwrite=args.force)
+    sidecar = check_output_file(
+        out.with_suffix(".json"), "--out's parameters", overwrite=args.force
+    )
     check_int("--seed", args.seed, 0, MAX_SEED)
     if (args.rms is None) == (args.psd is None):
         raise ValueError("give exactly one of `--rms` (m/s^2) and `--psd` ((m/s^2)^2/Hz)")
@@ -69,8 +74,9 @@ def run(args) -> int:
         # the excitation, its spectrum, the response and the CSV text, about 12 floats a sample
         check_memory(f"a record of {samples:.3g} samples", 96.0 * samples, "shorten `--duration`")
     excitation = args.rms if args.psd is None else BandLimited(args.psd, args.f_lo, args.f_hi)
+    device = harvester_from_args(args)
     record = synthetic_record(
-        harvester_from_args(args),
+        device,
         excitation,
         duration=args.duration,
         sample_rate=args.sample_rate,
@@ -86,5 +92,24 @@ def run(args) -> int:
     )
     # Full precision, so that identify reads back exactly the simulated samples.
     record.to_csv(out, overwrite=args.force, float_format=None)
+    simulated = {
+        "record": out.name,
+        "device": device.parameters(),
+        "excitation": {"rms": args.rms, "psd": args.psd, "f_lo": args.f_lo, "f_hi": args.f_hi},
+        "duration": args.duration,
+        "sample_rate": args.sample_rate,
+        "input": args.input,
+        "substeps": args.substeps,
+        "seed": args.seed,
+        "sensors": {
+            "noise_z": args.noise_z,
+            "noise_input": args.noise_input,
+            "offset_z": args.offset_z,
+            "offset_input": args.offset_input,
+        },
+    }
+    where = write_or_keep(sidecar, dumps(simulated, indent=2), "--out's parameters")
     print(f"wrote {out} ({record.n} samples at {record.sample_rate:g} Hz, {args.input})")
+    if where is not None:
+        print(f"wrote {where} (the parameters simulated)")
     return 0

@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 
-from randvib._io import check_output_folder, dumps, existing_file
+from randvib._io import check_output_file, check_output_folder, dumps, existing_file
 from randvib.cli._output import print_table
 from randvib.cli._records import (
     add_record_arguments,
@@ -37,10 +38,15 @@ def register(sub) -> None:
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument(
-        "--plot", metavar="DIR", help="write one measured-vs-simulated PNG per record into DIR"
+        "--plot",
+        metavar="FILE.png|DIR",
+        help="measured-vs-simulated figure: FILE.png (a new file) for one record, as identify "
+        "--plot takes; DIR for one PNG per record",
     )
     p.add_argument(
-        "--force", action="store_true", help="write --plot into a folder that is not empty"
+        "--force",
+        action="store_true",
+        help="overwrite an existing --plot file, or write into a folder that is not empty",
     )
     add_record_arguments(p)
     p.set_defaults(handler=run)
@@ -90,8 +96,15 @@ def run(args) -> int:
     parameters.update(_overrides(args.set, model))
     harvester, measurement = device_from_parameters(model, parameters)
     settings = _settings(args, saved, args.params)
-    plot_dir = None
-    if args.plot is not None:
+    plot_dir = plot_file = None
+    if args.plot is not None and str(args.plot).lower().endswith(".png"):
+        if len(args.data) != 1:
+            raise ValueError(
+                f"`--plot` {args.plot!r} is one file, for one record; got {len(args.data)} "
+                "records: give a folder instead"
+            )
+        plot_file = check_output_file(args.plot, "--plot", overwrite=args.force)
+    elif args.plot is not None:
         plot_dir = check_output_folder(args.plot, "--plot")
         if plot_dir.exists() and any(plot_dir.iterdir()) and not args.force:
             raise FileExistsError(
@@ -100,14 +113,30 @@ def run(args) -> int:
         plot_dir.mkdir(parents=True, exist_ok=True)
     records = [record_from_args(path, args) for path in args.data]
     rows = validate(harvester, records, measurement=measurement, simulation=settings)
-    if plot_dir is not None:
+    if plot_dir is not None or plot_file is not None:
         from randvib.identification.plots import figure_fit
         from randvib.identification.prediction import predict_record
+        from randvib.identification.residuals import residual_diagnostics
 
         for i, record in enumerate(records):
             pred = predict_record(harvester, record, measurement=measurement, simulation=settings)
-            path = plot_dir / f"{i:02d}_{record.name}.png"
-            figure_fit(pred, path, title=f"{model} model on {record.name}", **plot_units(args))
+            path = plot_file or plot_dir / f"{i:02d}_{record.name}.png"
+            skip = settings.skip
+            diagnostics = residual_diagnostics(record.z[skip:] - pred.z[skip:], record.input[skip:])
+            figure_fit(
+                pred,
+                path,
+                title=f"{model} model on {record.name}",
+                validation=True,
+                diagnostics=diagnostics,
+                **plot_units(args),
+            )
+        print(
+            f"wrote {plot_file}"
+            if plot_file
+            else f"wrote {len(records)} figure(s) into {plot_dir}",
+            file=sys.stderr if args.json else sys.stdout,
+        )
     if args.json:
         print(
             dumps(

@@ -11,7 +11,9 @@ is simulated in one batched, compiled call
 
 Measurement model (measured = true + offset): constant offsets of the input
 and output channels, the input between samples (linear, cubic spline or
-band-limited reconstruction), the initial state, and an optional quadratic
+band-limited reconstruction; by default chosen from the input's content
+against the sample rate,
+:func:`~randvib.identification.input_reconstruction.choose_hold`), the initial state, and an optional quadratic
 stiffness k2, estimated with the parameters (:func:`identify`). By default
 the initial state (z0, z'0) is estimated with the parameters; with
 ``initial_state='record'`` the simulation starts from the first sample (less
@@ -127,7 +129,7 @@ def identify(
     quadratic: bool = False,
     search: SearchSettings | None = None,
     simulation: SimulationSettings | None = None,
-    progress: bool = False,
+    progress: bool = True,
     callback=None,
     **options,
 ) -> IdentificationResult:
@@ -177,10 +179,11 @@ def identify(
         SaDE and polish settings (popsize 30, maxiter 60, seed 0, tol 1e-6,
         patience 15, polish True).
     simulation : SimulationSettings, optional
-        Record simulation settings (substeps 4, linear hold, no low-pass,
-        skip 0, initial state estimated).
+        Record simulation settings (substeps 4, the input's reconstruction
+        chosen from the record, no low-pass, skip 0, initial state estimated).
     progress : bool
-        Progress bar.
+        Progress bar of the search (default True, as the Monte Carlo runs; the
+        CLI turns it off with --no-progress or --json).
     callback : callable, optional
         ``callback(generation, parameters_dict, cost)``; True stops.
     **options
@@ -199,6 +202,8 @@ def identify(
     search, simulation = resolve_settings("identify", options, search=search, simulation=simulation)
     fixed = _resolve_fixed(model, fixed, m, record)
     fixed, reported, notes = _measurement_model(record, fixed, bool(quadratic))
+    simulation, why = simulation.for_record(record)
+    notes += (why,) if why else ()
     space = search_space(record, model, fixed, bounds, simulation.skip)
     cost = _identification_cost(record, model, fixed, space.free, simulation)
     _check_population(search, len(space.free))
@@ -225,9 +230,12 @@ def identify(
     found = dict(zip(space.free, map(float, res.x), strict=True))
     refined = _polish(cost, space, found, simulation, search) if search.polish else None
     elapsed = time.perf_counter() - start
-    return _identification_result(
+    result = _identification_result(
         cost, space, res, refined, elapsed, search, simulation, reported, notes
     )
+    if np.isfinite(result.cost):
+        result.residuals = result.diagnose(record)
+    return result
 
 
 def _check_population(search: SearchSettings, d: int) -> None:
@@ -442,4 +450,5 @@ def _identification_result(cost, space, res, refined, elapsed, search, simulatio
         uncertainty=unc,
         initial_state={k: float(v) for k, v in start.items()},
         notes=notes,
+        input_kind=cost.record.input_kind,
     )

@@ -3,9 +3,12 @@
 The input is sampled on a uniform grid ``t_i = i dt``. The kernel
 (:mod:`randvib.identification.record_integrator`) is driven by a base
 acceleration (m/s^2) or a force (N) (:func:`driving_signal`); between samples
-the signal is reconstructed (:func:`reconstruct_input`: linear by default;
-cubic spline or band-limited (sinc) interpolation for records sampled not far
-above their bandwidth; a zero-order hold).
+the signal is reconstructed (:func:`reconstruct_input`: linear, cubic spline
+or band-limited (sinc) interpolation; a zero-order hold). By default the
+reconstruction is chosen from the record (:func:`choose_hold`): linear where
+it agrees with the band-limited interpolant to :data:`HOLD_TOLERANCE`, the
+band-limited one where the input has content close to the Nyquist frequency
+that straight lines between samples would misrepresent.
 
 A recorded base displacement is turned into base acceleration by the
 fourth-order central difference
@@ -26,6 +29,18 @@ from randvib.models.record import INPUT_KINDS
 
 #: Reconstructions of the input between samples (see :func:`reconstruct_input`).
 HOLDS = ("linear", "zero", "cubic", "bandlimited")
+#: The reconstruction chosen from the record's input (:func:`choose_hold`).
+AUTO_HOLD = "auto"
+#: Largest relative RMS difference, at the mid-points between samples, between
+#: a reconstruction and the band-limited interpolant that is accepted without a
+#: warning (and below which ``auto`` keeps the linear one).
+HOLD_TOLERANCE = 0.01
+#: Fraction of the input's power above :data:`NEAR_NYQUIST` times the Nyquist
+#: frequency beyond which the input is taken as not band-limited: an
+#: anti-aliased sensor leaves orders of magnitude less there.
+NYQUIST_POWER_LIMIT = 1e-3
+#: Where the band next to the Nyquist frequency starts, as its fraction.
+NEAR_NYQUIST = 0.9
 
 
 def second_derivative(y, dt):
@@ -159,3 +174,119 @@ def _sinc_interpolation(x, up):
     padded = np.zeros(m * up // 2 + 1, dtype=complex)
     padded[: spectrum.shape[0]] = spectrum
     return np.fft.irfft(padded, m * up)[: (n - 1) * up + 1] * up
+
+
+def midpoint_error(samples, hold: str) -> float:
+    """Relative RMS difference between ``hold`` and the band-limited interpolant.
+
+    Both reconstructions are evaluated half-way between samples, where they
+    differ most; the difference is divided by the standard deviation of the
+    samples. A measure of how far ``hold`` misrepresents a band-limited input.
+    """
+    x = np.asarray(samples, dtype=float)
+    scale = float(np.std(x))
+    if x.shape[0] < 3 or scale == 0.0:
+        return 0.0
+    exact = _sinc_interpolation(x, 2)[1::2]
+    if hold == "bandlimited":
+        return 0.0
+    if hold == "zero":
+        mid = x[:-1]
+    else:
+        mid = reconstruct_input(x, 1.0, 1, hold)[1::2]
+    return float(np.sqrt(np.mean((mid - exact) ** 2)) / scale)
+
+
+def near_nyquist_fraction(samples) -> float:
+    """Fraction of the (mean-removed) input's power above :data:`NEAR_NYQUIST` x Nyquist.
+
+    Welch's estimate (Hann window, segments of up to 1024 samples), whose
+    leakage from the band's content is far below :data:`NYQUIST_POWER_LIMIT`.
+    """
+    from scipy import signal
+
+    x = np.asarray(samples, dtype=float)
+    if x.shape[0] < 16 or np.std(x) == 0.0:
+        return 0.0
+    f, p = signal.welch(x - np.mean(x), fs=1.0, nperseg=min(x.shape[0], 1024))
+    total = float(np.sum(p))
+    return float(np.sum(p[f >= 0.5 * NEAR_NYQUIST]) / total) if total > 0 else 0.0
+
+
+def choose_hold(samples, dt: float, hold: str = AUTO_HOLD) -> tuple[str, str]:
+    """The reconstruction of a record's input: ``hold``, or chosen for ``auto``.
+
+    ``auto`` keeps the linear reconstruction where it differs from the
+    band-limited interpolant by at most :data:`HOLD_TOLERANCE` (relative RMS
+    at the mid-points, :func:`midpoint_error`), and chooses the band-limited
+    one where it differs more (content up to a good part of the Nyquist
+    frequency, which straight lines attenuate and alias). An input with more
+    than :data:`NYQUIST_POWER_LIMIT` of its power next to the Nyquist frequency
+    (:func:`near_nyquist_fraction`) is not band-limited: no interpolation
+    represents it exactly, ``auto`` chooses as above (an input filtered too
+    gently is closer to its band-limited interpolant than to straight lines)
+    and a warning naming ``--hold`` says so. A
+    reconstruction given explicitly is kept, with a warning when it differs
+    from the band-limited interpolant of a band-limited input by more than
+    the tolerance.
+
+    Parameters
+    ----------
+    samples : array_like
+        The driving signal (m/s^2 or N) at ``t_i = i dt``.
+    dt : float
+        Sample interval (s).
+    hold : {'auto', 'linear', 'zero', 'cubic', 'bandlimited'}
+
+    Returns
+    -------
+    hold : str
+        One of :data:`HOLDS`.
+    why : str
+        One sentence on the choice (for a result's notes; empty for an
+        explicit ``hold`` that needs no warning).
+    """
+    import warnings
+
+    if hold != AUTO_HOLD and hold not in HOLDS:
+        raise ValueError(f"`hold` must be one of {', '.join((AUTO_HOLD,) + HOLDS)}; got {hold!r}")
+    x = np.asarray(samples, dtype=float)
+    nyquist = 0.5 / dt
+    near = near_nyquist_fraction(x)
+    if near > NYQUIST_POWER_LIMIT:
+        if hold in (AUTO_HOLD, "bandlimited", "cubic"):
+            # auto: still the band-limited one if lines would differ from it (an
+            # input filtered too gently is closer to band-limited than to lines)
+            chosen = hold
+            if hold == AUTO_HOLD:
+                lines = midpoint_error(x, "linear") <= HOLD_TOLERANCE
+                chosen = "linear" if lines else "bandlimited"
+            why = (
+                f"the input has {100 * near:.2g} % of its power above "
+                f"{NEAR_NYQUIST * nyquist:.4g} Hz (Nyquist {nyquist:.4g} Hz): it is not "
+                "band-limited, so no reconstruction between samples is exact; "
+                f"using {chosen!r}; if the input was held constant between samples choose "
+                "--hold zero (hold='zero'), else sample it faster or anti-aliased"
+            )
+            warnings.warn(why, UserWarning, stacklevel=3)
+            return chosen, why
+        return hold, ""
+    errors = {h: midpoint_error(x, h) for h in ("linear", "cubic", "zero")}
+    if hold == AUTO_HOLD:
+        if errors["linear"] <= HOLD_TOLERANCE:
+            return "linear", ""
+        return "bandlimited", (
+            f"input reconstructed band-limited (hold='bandlimited'): straight lines between "
+            f"samples would misrepresent its content by {100 * errors['linear']:.2g} % RMS "
+            "(chosen from the record; --hold sets it)"
+        )
+    if hold != "bandlimited" and errors[hold] > HOLD_TOLERANCE:
+        why = (
+            f"--hold {hold} (hold={hold!r}) misrepresents this input by "
+            f"{100 * errors[hold]:.2g} % RMS between samples (it has content close to the "
+            f"Nyquist frequency {nyquist:.4g} Hz), which biases the fit; use --hold "
+            "bandlimited or leave --hold out (auto)"
+        )
+        warnings.warn(why, UserWarning, stacklevel=3)
+        return hold, why
+    return hold, ""

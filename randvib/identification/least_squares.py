@@ -164,6 +164,13 @@ class Uncertainty:
         Residual standard deviation s (units of z).
     dof : int
         Residual degrees of freedom N - d.
+    method : str
+        How the covariance was estimated: ``white`` (``s^2 (J^T J)^-1``, exact
+        to first order for white noise) or ``hac`` (the sandwich
+        ``(J^T J)^-1 S (J^T J)^-1`` with a Newey-West middle S, used when the
+        residual is not white; :func:`covariance`).
+    bandwidth : int
+        The Newey-West bandwidth L in samples (0 for ``white``).
     """
 
     names: tuple
@@ -173,6 +180,8 @@ class Uncertainty:
     correlation: np.ndarray
     noise_std: float
     dof: int
+    method: str = "white"
+    bandwidth: int = 0
 
     def to_dict(self) -> dict:
         return {
@@ -186,7 +195,80 @@ class Uncertainty:
             },
             "noise_std": float(self.noise_std),
             "dof": int(self.dof),
+            "covariance": self.method,
+            "covariance_description": COVARIANCE_METHODS[self.method],
+            "bandwidth": int(self.bandwidth),
         }
+
+
+#: What each covariance estimate means (the report and the JSON say which was used).
+COVARIANCE_METHODS = {
+    "white": "least squares, white residual assumed: s^2 (J^T J)^-1",
+    "hac": "sandwich with a Newey-West (Bartlett kernel) middle, the residual being "
+    "correlated (Ljung-Box rejects whiteness at 1 %); bandwidth by Andrews' AR(1) rule",
+}
+
+
+def newey_west_bandwidth(residual) -> int:
+    """Andrews' (1991) AR(1) plug-in bandwidth of the Bartlett kernel (samples).
+
+    ``L = 1.1447 (alpha N)^(1/3)`` with ``alpha = 4 rho^2 / ((1 - rho)^2 (1 + rho)^2)``,
+    rho the residual's lag-1 autocorrelation; at most N / 4.
+    """
+    e = np.asarray(residual, dtype=float) - np.mean(residual)
+    n = e.shape[0]
+    denom = float(e @ e)
+    rho = float(e[1:] @ e[:-1]) / denom if denom > 0 else 0.0
+    rho = min(max(rho, -0.999), 0.999)
+    alpha = 4 * rho**2 / ((1 - rho) ** 2 * (1 + rho) ** 2)
+    return int(min(np.ceil(1.1447 * (alpha * n) ** (1 / 3)), n // 4))
+
+
+def covariance(jacobian, residuals, method: str = "auto") -> tuple[np.ndarray, str, int]:
+    """Covariance of least-squares estimates (in the Jacobian's coordinates).
+
+    Parameters
+    ----------
+    jacobian : ndarray, shape (N, d)
+        d e / d u at the optimum.
+    residuals : ndarray, shape (N,)
+    method : {'auto', 'white', 'hac'}
+        ``white``: ``s^2 (J^T J)^-1`` with ``s^2 = |e|^2 / (N - d)``.
+        ``hac``: ``(J^T J)^-1 S (J^T J)^-1`` with
+        ``S = sum_{|l| <= L} (1 - |l| / (L + 1)) sum_i g_i g_{i-l}^T``,
+        ``g_i = J_i e_i`` (Newey and West 1987), L from
+        :func:`newey_west_bandwidth`; consistent for a correlated residual.
+        ``auto``: ``hac`` when the Ljung-Box test rejects whiteness at 1 %
+        (:func:`randvib.identification.residuals.ljung_box`), else ``white``.
+
+    Returns
+    -------
+    cov : ndarray, shape (d, d)
+    method : str
+        ``white`` or ``hac``.
+    bandwidth : int
+    """
+    from randvib.identification.residuals import LEVEL, ljung_box
+
+    j = np.asarray(jacobian, dtype=float)
+    e = np.asarray(residuals, dtype=float)
+    n, d = j.shape
+    bread = np.linalg.pinv(j.T @ j)
+    if method == "auto":
+        method = "hac" if ljung_box(e)[1] < LEVEL else "white"
+    if method == "white":
+        return float(e @ e) / max(n - d, 1) * bread, "white", 0
+    if method != "hac":
+        raise ValueError(f"`method` must be one of auto, white, hac; got {method!r}")
+    g = j * e[:, None]
+    lag = newey_west_bandwidth(e)
+    middle = g.T @ g
+    for k in range(1, lag + 1):
+        gamma = g[k:].T @ g[:-k]
+        middle += (1 - k / (lag + 1)) * (gamma + gamma.T)
+    # small-sample scaling N / (N - d), as s^2 has
+    middle *= n / max(n - d, 1)
+    return bread @ middle @ bread, "hac", lag
 
 
 def uncertainty(problem: SimulationError, u, residuals, jacobian_u) -> Uncertainty:
@@ -202,7 +284,8 @@ def uncertainty(problem: SimulationError, u, residuals, jacobian_u) -> Uncertain
     n, d = jacobian_u.shape
     dof = max(n - d, 1)
     s2 = float(residuals @ residuals) / dof
-    cov = s2 * np.linalg.pinv(jacobian_u.T @ jacobian_u) * np.outer(dtheta_du, dtheta_du)
+    cov_u, method, bandwidth = covariance(jacobian_u, residuals)
+    cov = cov_u * np.outer(dtheta_du, dtheta_du)
     se = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     with np.errstate(invalid="ignore", divide="ignore"):
         corr = cov / np.outer(se, se)
@@ -219,6 +302,8 @@ def uncertainty(problem: SimulationError, u, residuals, jacobian_u) -> Uncertain
         correlation=corr,
         noise_std=float(np.sqrt(s2)),
         dof=dof,
+        method=method,
+        bandwidth=bandwidth,
     )
 
 

@@ -37,8 +37,12 @@ def _finish(fig, path):
     return fig
 
 
-def plot_time_history(prediction, ax=None, *, window=None, scale=MILLI, unit="mm"):
+def plot_time_history(
+    prediction, ax=None, *, window=None, scale=MILLI, unit="mm", residual_ax=None
+):
     """Measured (solid black) and simulated (dashed) relative displacement.
+
+    The shown window is stated with the time axis (``t0 to t1 s of T s``).
 
     Parameters
     ----------
@@ -50,6 +54,9 @@ def plot_time_history(prediction, ax=None, *, window=None, scale=MILLI, unit="mm
     scale, unit : float, str
         Display scaling of the record's output, by default from m to mm; a
         record whose output is not a displacement in m gives its own.
+    residual_ax : matplotlib Axes, optional
+        Where to draw the residual, measured less simulated, over the same
+        window (a fit that misses shows there what it misses).
     """
     if ax is None:
         _, axes = new_figure(figsize=(7.0, 2.6))
@@ -60,11 +67,23 @@ def plot_time_history(prediction, ax=None, *, window=None, scale=MILLI, unit="mm
     sel = (t >= t0) & (t <= t1)
     ax.plot(t[sel], rec.z[sel] * scale, **MEASURED)
     ax.plot(t[sel], prediction.z[sel] * scale, **SIMULATED)
-    ax.set_xlabel("time (s)")
     ax.set_ylabel(f"relative displacement z ({unit})")
     ax.set_xlim(t[sel][0], t[sel][-1])
+    # the window shown, stated where the time axis is labelled
+    shown = f"time (s); shown: {t[sel][0]:.3g} to {t[sel][-1]:.3g} s of {float(t[-1] - t[0]):.3g} s"
     ax.set_title(f"J = {prediction.cost:.3g} (Eq. 11)", loc="right")
     ax.legend(loc="upper left", ncols=2, frameon=False)
+    if residual_ax is None:
+        ax.set_xlabel(shown)
+        return ax
+    residual = (rec.z - prediction.z) * scale
+    residual_ax.plot(t[sel], residual[sel], color=PALETTE[2], lw=0.8)
+    residual_ax.axhline(0.0, color="black", lw=0.5)
+    residual_ax.set_xlim(t[sel][0], t[sel][-1])
+    residual_ax.set_xlabel(shown)
+    residual_ax.set_ylabel(f"residual ({unit})")
+    rms = float(np.sqrt(np.mean(residual**2)))
+    residual_ax.set_title(f"measured - simulated, RMS {rms:.3g} {unit}", loc="right")
     return ax
 
 
@@ -83,8 +102,19 @@ def default_window(record, cycles: float = 30.0, longest: float = 2.0) -> float:
     return min(duration, longest, cycles / (crossings / 2.0 / duration))
 
 
-def plot_histograms(prediction, axes=None, *, bins=81, scale=MILLI, unit="mm", legend=True):
+def histogram_bins(n: int) -> int:
+    """Bins of a density histogram of ``n`` samples: ``2 n^(1/3)`` (Rice's rule), 10 to 81.
+
+    Enough bins to show a density's shape, few enough that each holds many
+    samples (81 bins of a 500-sample record would be noise).
+    """
+    return int(np.clip(np.ceil(2.0 * n ** (1.0 / 3.0)), 10, 81))
+
+
+def plot_histograms(prediction, axes=None, *, bins=None, scale=MILLI, unit="mm", legend=True):
     """Densities of the measured and simulated displacement and, with a coil, load voltage.
+
+    ``bins`` defaults to :func:`histogram_bins` of the record's length.
 
     With a circuit the voltage histogram shows the spike at zero volts caused
     by sticking (paper Figure 8b): while the magnet sticks, z' = 0 and so V = 0.
@@ -103,7 +133,7 @@ def plot_histograms(prediction, axes=None, *, bins=81, scale=MILLI, unit="mm", l
         values = [x for x in (meas, sim) if x is not None]
         lo = min(np.min(x) for x in values)
         hi = max(np.max(x) for x in values)
-        edges = np.linspace(lo, hi, bins + 1)
+        edges = np.linspace(lo, hi, (bins or histogram_bins(len(sim))) + 1)
         if meas is not None:
             ax.hist(meas, edges, density=True, histtype="step", **MEASURED)
         ax.hist(sim, edges, density=True, histtype="step", **SIMULATED)
@@ -114,32 +144,87 @@ def plot_histograms(prediction, axes=None, *, bins=81, scale=MILLI, unit="mm", l
     return axes
 
 
-@styled
-def figure_fit(prediction, path=None, *, window=None, scale=MILLI, unit="mm", title=None):
-    """Paper Figure 8 analogue: (a) time history, (b) displacement and (c) voltage densities.
+def plot_residual_correlations(diagnostics, axes) -> None:
+    """Residual autocorrelation and its cross-correlation with the input, with bands.
 
-    ``title`` defaults to the record's name.
+    ``diagnostics`` is a
+    :class:`~randvib.identification.residuals.ResidualDiagnostics`; the dashed
+    lines are its (1 - LEVEL) bands of a white, independent residual.
+    """
+    from randvib.identification.residuals import LEVEL
+
+    ax_a, ax_c = axes
+    band = f"{100 * (1 - LEVEL):g} % band"
+    for ax, lags, r, half, name in (
+        (ax_a, diagnostics.lags[1:], diagnostics.autocorrelation[1:], diagnostics.auto_band,
+         f"residual autocorrelation ({diagnostics.verdict})"),
+        (ax_c, diagnostics.cross_lags, diagnostics.cross_correlation, diagnostics.cross_band,
+         "residual-input cross-correlation"),
+    ):  # fmt: skip
+        ax.vlines(lags, 0.0, r, color=PALETTE[0], lw=1.2)
+        ax.axhline(half, color="black", ls="--", lw=0.8, label=band)
+        ax.axhline(-half, color="black", ls="--", lw=0.8)
+        ax.axhline(0.0, color="black", lw=0.5)
+        ax.set_xlabel("lag (samples)")
+        ax.set_ylabel("correlation")
+        ax.set_title(name, loc="right", fontsize=8)
+    ax_a.legend(loc="upper right", frameon=False)
+
+
+@styled
+def figure_fit(
+    prediction,
+    path=None,
+    *,
+    window=None,
+    scale=MILLI,
+    unit="mm",
+    title=None,
+    validation=None,
+    diagnostics=None,
+):
+    """Paper Figure 8 analogue: (a) time history, (b) residual, then densities.
+
+    ``title`` defaults to the record's name; ``validation=True`` marks the
+    figure as a validation (a record the model was not fitted to) in its
+    title, ``False`` as the fit to its training record, None not at all.
+    ``diagnostics`` (a
+    :class:`~randvib.identification.residuals.ResidualDiagnostics`) adds a row
+    with the residual's autocorrelation and its cross-correlation with the
+    input (:func:`plot_residual_correlations`).
     """
     n_hist = 2 if prediction.voltage is not None else 1
-    fig = _fit_layout(n_hist)
-    ax_t, *hist_axes = fig.axes
-    plot_time_history(prediction, ax_t, window=window, scale=scale, unit=unit)
+    fig = _fit_layout(n_hist, diagnostics is not None)
+    ax_t, ax_r, *rest = fig.axes
+    plot_time_history(prediction, ax_t, window=window, scale=scale, unit=unit, residual_ax=ax_r)
     # one legend, in (a): in the densities it would cover a tail
-    plot_histograms(prediction, hist_axes, scale=scale, unit=unit, legend=False)
+    plot_histograms(prediction, rest[:n_hist], scale=scale, unit=unit, legend=False)
+    if diagnostics is not None:
+        plot_residual_correlations(diagnostics, rest[n_hist:])
     panel_letters(fig.axes)
-    fig.suptitle(title if title else prediction.record.name)
+    what = {None: "", True: "validation: ", False: "fit to the training record: "}[validation]
+    fig.suptitle(f"{what}{title if title else prediction.record.name}")
     return _finish(fig, path)
 
 
-def _fit_layout(n_hist: int):
-    """A figure with the time history on top and ``n_hist`` histograms below."""
+def _fit_layout(n_hist: int, correlations: bool = False):
+    """The time history and its residual on top, ``n_hist`` histograms below, and
+    with ``correlations`` a row of two residual-correlation panels."""
     import matplotlib.pyplot as plt
 
-    fig = plt.figure(figsize=(7.0, 4.8), layout="constrained")
-    grid = fig.add_gridspec(2, n_hist)
-    fig.add_subplot(grid[0, :])
-    for j in range(n_hist):
-        fig.add_subplot(grid[1, j])
+    rows = 4 if correlations else 3
+    fig = plt.figure(figsize=(7.0, 8.4 if correlations else 6.4), layout="constrained")
+    grid = fig.add_gridspec(rows, 2, height_ratios=(1.2, 0.8, 1.0, 1.0)[:rows])
+    top = fig.add_subplot(grid[0, :])
+    fig.add_subplot(grid[1, :], sharex=top)
+    if n_hist == 1:
+        fig.add_subplot(grid[2, :])
+    else:
+        for j in range(n_hist):
+            fig.add_subplot(grid[2, j])
+    if correlations:
+        fig.add_subplot(grid[3, 0])
+        fig.add_subplot(grid[3, 1])
     return fig
 
 

@@ -130,6 +130,8 @@ def predict_record(
     J = 1.04
     """
     (simulation,) = resolve_settings("predict_record", options, simulation=simulation)
+    if isinstance(record, Record):  # else refused by score
+        simulation, _ = simulation.for_record(record)
     parameters = device_parameters(harvester, measurement, "predict_record")
     model = model_of(harvester.friction_name)
     return score(

@@ -9,9 +9,11 @@ import numpy as np
 from randvib import _display, formatting
 from randvib.identification.models import MeasurementModel, device_from_parameters, unit_of
 from randvib.identification.prediction import Prediction, predict_record
+from randvib.identification.residuals import MAX_LAG, ResidualDiagnostics, residual_diagnostics
 from randvib.identification.settings import SimulationSettings
 from randvib.models.harvester import Harvester
 from randvib.models.record import Record
+from randvib.quantities import unit
 
 
 @dataclass
@@ -58,7 +60,16 @@ class IdentificationResult:
     initial_state : dict
         ``z0`` (m) and ``v0`` (m/s) the simulation starts from.
     notes : tuple of str
-        Why a measurement-model parameter was not estimated.
+        Why a measurement-model parameter was not estimated, how the input
+        is reconstructed between samples.
+    input_kind : str
+        What the training record's input channel holds
+        (``base_acceleration``, ``base_displacement`` or ``force``): the unit
+        of ``input_offset`` (:meth:`unit`); empty when not known.
+    residuals : ResidualDiagnostics or None
+        Whiteness of the training residual and its independence of the input
+        (:func:`~randvib.identification.residuals.residual_diagnostics`), with
+        the verdict ``white`` or ``structured``; None when not computed.
     """
 
     model: str
@@ -77,6 +88,14 @@ class IdentificationResult:
     uncertainty: object = None
     initial_state: dict = field(default_factory=dict)
     notes: tuple = ()
+    input_kind: str = ""
+    residuals: ResidualDiagnostics | None = None
+
+    def unit(self, name: str) -> str:
+        """The SI unit of parameter ``name``; ``input_offset`` is in the input channel's unit."""
+        if name == "input_offset" and self.input_kind:
+            return unit(self.input_kind)
+        return unit_of(self.model, name)
 
     @property
     def standard_errors(self) -> dict:
@@ -98,7 +117,8 @@ class IdentificationResult:
         return {
             "model": self.model,
             "parameters": {k: float(v) for k, v in self.parameters.items()},
-            "units": {k: unit_of(self.model, k) for k in self.parameters},
+            "units": {k: self.unit(k) for k in self.parameters},
+            "input_kind": self.input_kind,
             "cost": float(self.cost),
             "free": list(self.free),
             "bounds": {k: [float(a), float(b)] for k, (a, b) in self.bounds.items()},
@@ -111,6 +131,7 @@ class IdentificationResult:
             "settings": self.settings,
             "initial_state": dict(self.initial_state),
             "notes": list(self.notes),
+            **({} if self.residuals is None else {"residuals": self.residuals.to_dict()}),
             **(
                 {}
                 if self.uncertainty is None
@@ -129,7 +150,7 @@ class IdentificationResult:
         rows = {
             name: {
                 "value": float(value),
-                "unit": unit_of(self.model, name),
+                "unit": self.unit(name),
                 "free": name in self.free,
                 "lower": float(self.bounds[name][0]) if name in self.bounds else np.nan,
                 "upper": float(self.bounds[name][1]) if name in self.bounds else np.nan,
@@ -142,7 +163,7 @@ class IdentificationResult:
         rows = [("cost J (Eq. 11)", formatting.compact(self.cost, 4), "")]
         for name, value in self.parameters.items():
             fixed = "" if name in self.free else " (fixed)"
-            rows.append((name + fixed, formatting.compact(value), unit_of(self.model, name)))
+            rows.append((name + fixed, formatting.compact(value), self.unit(name)))
         return rows
 
     def _search_line(self) -> str:
@@ -184,6 +205,17 @@ class IdentificationResult:
     def simulation(self) -> SimulationSettings:
         """The simulation settings of the fit, as :func:`predict_record` takes them."""
         return SimulationSettings(**{k: v for k, v in self.settings.items() if k in _SIMULATION})
+
+    def diagnose(self, record: Record, max_lag: int = MAX_LAG) -> ResidualDiagnostics:
+        """Residual diagnostics of the fit on ``record`` (the training record or another).
+
+        The residual is the measured less the simulated output (:meth:`predict`)
+        after the ``skip`` samples, tested against the record's input
+        (:func:`~randvib.identification.residuals.residual_diagnostics`).
+        """
+        pred = self.predict(record)
+        skip = int(self.settings.get("skip", 0))
+        return residual_diagnostics(record.z[skip:] - pred.z[skip:], record.input[skip:], max_lag)
 
     def predict(self, record: Record, electrical=None) -> Prediction:
         """``record`` simulated with the identified device and measurement model.

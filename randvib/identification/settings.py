@@ -14,7 +14,12 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 
 from randvib._validation import MAX_SEED, check_int
-from randvib.identification.input_reconstruction import HOLDS
+from randvib.identification.input_reconstruction import (
+    AUTO_HOLD,
+    HOLDS,
+    choose_hold,
+    driving_signal,
+)
 
 #: How the simulation's initial state is obtained (SimulationSettings.initial_state).
 INITIAL_STATES = ("estimate", "record")
@@ -28,8 +33,12 @@ class SimulationSettings:
     ----------
     substeps : int
         Integration steps per sample interval (default 4).
-    hold : {'linear', 'zero'}
-        Interpolation of the input between samples.
+    hold : {'auto', 'linear', 'zero', 'cubic', 'bandlimited'}
+        Reconstruction of the input between samples
+        (:func:`~randvib.identification.input_reconstruction.reconstruct_input`);
+        ``auto`` (default) chooses linear or band-limited from the record's
+        input (:func:`~randvib.identification.input_reconstruction.choose_hold`,
+        :meth:`for_record`).
     lowpass : float or None
         Zero-phase low-pass cut-off (Hz) for the driving signal (useful for a
         base displacement differentiated twice).
@@ -47,7 +56,7 @@ class SimulationSettings:
     """
 
     substeps: int = 4
-    hold: str = "linear"
+    hold: str = AUTO_HOLD
     lowpass: float | None = None
     skip: int = 0
     initial_state: str = "estimate"
@@ -55,8 +64,10 @@ class SimulationSettings:
     def __post_init__(self):
         object.__setattr__(self, "substeps", check_int("substeps", self.substeps, minimum=1))
         object.__setattr__(self, "skip", check_int("skip", self.skip, minimum=0))
-        if self.hold not in HOLDS:
-            raise ValueError(f"`hold` must be one of {', '.join(HOLDS)}; got {self.hold!r}")
+        if self.hold != AUTO_HOLD and self.hold not in HOLDS:
+            raise ValueError(
+                f"`hold` must be one of {', '.join((AUTO_HOLD,) + HOLDS)}; got {self.hold!r}"
+            )
         if self.initial_state not in INITIAL_STATES:
             raise ValueError(
                 f"`initial_state` must be one of {', '.join(INITIAL_STATES)}; "
@@ -65,6 +76,18 @@ class SimulationSettings:
 
     def to_dict(self) -> dict:
         return _fields_of(self)
+
+    def for_record(self, record) -> tuple[SimulationSettings, str]:
+        """These settings with the reconstruction resolved for ``record``'s input.
+
+        Returns the settings with ``hold`` one of the concrete reconstructions
+        and a sentence on the choice ('' when there is nothing to say); warns
+        when the reconstruction cannot represent the input (see
+        :func:`~randvib.identification.input_reconstruction.choose_hold`).
+        """
+        drive, _ = driving_signal(record.input, record.dt, record.input_kind, self.lowpass)
+        hold, why = choose_hold(drive, record.dt, self.hold)
+        return replace(self, hold=hold), why
 
 
 @dataclass(frozen=True)
