@@ -298,16 +298,23 @@ def load_search_bounds(harvester: Harvester) -> tuple[float, float]:
     (:meth:`~randvib.models.coupling.Coupling.white_noise_optimal_load`) where
     it is positive -- with :data:`LOAD_SEARCH_DECADES` decades on each side.
     """
-    coupling, m, c_m, k = harvester.electrical, harvester.m, harvester.c_m, harvester.k
-    loads = []
+    coupling = harvester.electrical
+    m, c_m, k = (np.float64(v) for v in (harvester.m, harvester.c_m, harvester.k))
+    candidates = [lambda: coupling.white_noise_optimal_load(m, c_m, k)]
     if hasattr(coupling, "alpha"):
-        loads.append(coupling.r_coil + coupling.alpha**2 / c_m)
+        candidates.append(lambda: coupling.r_coil + np.float64(coupling.alpha) ** 2 / c_m)
     if hasattr(coupling, "theta"):
-        loads.append(c_m / coupling.theta**2)
-        if coupling.is_dynamic and k != 0:
-            loads.append(1.0 / (np.sqrt(abs(k) / m) * coupling.capacitance))
-    with np.errstate(all="ignore"):
-        loads.append(coupling.white_noise_optimal_load(m, c_m, k))
+        candidates.append(lambda: c_m / np.float64(coupling.theta) ** 2)
+        if coupling.is_dynamic:
+            candidates.append(lambda: 1.0 / (np.sqrt(abs(k) / m) * coupling.capacitance))
+    loads = []
+    for candidate in candidates:
+        # c_m = 0, k = 0 or extreme parameters give inf or nan, dropped below
+        with np.errstate(all="ignore"):
+            try:
+                loads.append(candidate())
+            except (OverflowError, ZeroDivisionError):
+                pass
     loads = [float(r) for r in loads if np.isfinite(r) and r > 0]
     if not loads:
         raise ValueError(
