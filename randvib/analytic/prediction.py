@@ -179,6 +179,7 @@ def _finite(solver: AnalyticMethod, harvester: Harvester, psd) -> PowerPredictio
     ]
     if bad:
         raise ValueError(_out_of_range(method, harvester, psd, ", ".join(bad)))
+    solver.check_answer(harvester, psd, result)
     return result
 
 
