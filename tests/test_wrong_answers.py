@@ -1,13 +1,85 @@
 """Answers that were silently wrong: each case refused or flagged rather than returned.
 
-Covers the refusal of a non-confining potential in
-:mod:`randvib.identification.synthetic` (and ``randvib record``, :mod:`randvib.cli.record`).
+Covers the energy-balance check of the method family (:mod:`randvib.analytic.method`,
+called by :mod:`randvib.analytic.prediction`), fpk's barrier limit
+(:mod:`randvib.analytic.fokker_planck`), and the refusal of a non-confining
+potential in :mod:`randvib.identification.synthetic` (and ``randvib record``,
+:mod:`randvib.cli.record`).
+
+The exact reference is the white-noise energy balance: the base does work
+m S / 4 on the mass, all dissipated, so c_m E[v^2] + P_e = m S / 4 without
+friction and <= m S / 4 with it.
 """
+
+import dataclasses
 
 import pytest
 from _cli import one_line_error
 
 import randvib as rv
+from randvib.analytic.method import ENERGY_BALANCE_TOLERANCE
+from randvib.analytic.prediction import METHODS
+
+M, C_M, C_E = 0.0226, 0.116, 0.05
+
+
+def _balance(h, s, result):
+    """(c_m E[v^2] + P_e) / (m S / 4)."""
+    return (h.c_m * result.velocity_variance + result.power_electrical) / (h.m * s / 4)
+
+
+@pytest.mark.parametrize("fc", [0.0, 0.0058])
+def test_fpk_refuses_the_issues_deep_double_well(fc, capsys):
+    """k = -57.4 N/m, k3 = 5e5 N/m^3, S = 0.005: fpk gave 0.35x the exact power (+360 %
+    against Monte Carlo with Coulomb friction); now refused, naming the alternatives."""
+    argv = ["power", "--m", M, "--c-m", C_M, "--c-e", C_E, "--k=-57.4", "--k3", "5e5",
+            "--psd", "0.005", "--method", "fpk", "--friction", "coulomb", "--fc", fc]  # fmt: skip
+    one_line_error(capsys, argv, "barrier of 32")
+    # the friction-free answer that remains is exact: c_e S m / (4 (c_m + c_e))
+    h = rv.Harvester(m=M, c_m=C_M, c_e=C_E, k=-57.4, k3=5e5)
+    exact = C_E * 0.005 * M / (4 * (C_M + C_E))
+    assert rv.expected_power(h, 0.005) == pytest.approx(exact, rel=1e-12)
+
+
+def test_fpk_is_exact_up_to_its_barrier_limit():
+    """At the declared limit (32 m E[v^2]) the friction-free balance holds to 1e-3:
+    the limit's measured error is 1.5e-4 (fokker_planck.FPK_MAX_BARRIER)."""
+    s = 1.0
+    ev2 = s * M / (4 * C_M)
+    h = rv.Harvester(m=M, c_m=C_M, c_e=0.0, k=-57.4, k3=57.4**2 / (4 * 31.9 * M * ev2))
+    assert _balance(h, s, rv.predict(h, s, "fpk")) == pytest.approx(1.0, abs=1e-3)
+
+
+@pytest.mark.parametrize(("method", "k3"), [("fpk", 1e100), ("fpk-fast", 1e200)])
+def test_huge_k3_answers_are_refused_by_the_energy_balance(method, k3):
+    """fpk gave 17x and fpk-fast 0.97x the exact friction-free power at these k3."""
+    h = rv.Harvester(m=M, c_m=C_M, c_e=C_E, k=57.4, k3=k3)
+    with pytest.raises(ValueError, match="white-noise input power"):
+        rv.predict(h, 1.0, method)
+
+
+@pytest.mark.parametrize("method", list(METHODS))
+@pytest.mark.parametrize("fc", [0.0, 0.0058])
+def test_every_method_meets_the_balance_and_a_broken_answer_is_refused(method, fc):
+    """The family's check passes the methods' answers on the paper's device (their
+    measured balance error is at most 1.6e-5, method.ENERGY_BALANCE_TOLERANCE) and
+    refuses the same answer with E[v^2] raised by 3 % (power 3 % above the balance)."""
+    h = rv.Harvester(m=M, c_m=C_M, c_e=C_E, k=57.4, k3=1e5, friction=rv.Coulomb(fc))
+    solver = METHODS[method]
+    result = rv.predict(h, 1.0, method)
+    ratio = _balance(h, 1.0, result)
+    if fc == 0:
+        assert ratio == pytest.approx(1.0, abs=1e-4)
+    else:
+        assert ratio < 1.0
+    factor = (1 + 3 * ENERGY_BALANCE_TOLERANCE) / ratio
+    broken = dataclasses.replace(
+        result,
+        velocity_variance=result.velocity_variance * factor,
+        power_electrical=result.power_electrical * factor,
+    )
+    with pytest.raises(ValueError, match="white-noise input power"):
+        solver.check_answer(h, 1.0, broken)
 
 
 def test_synthetic_record_refuses_a_non_confining_potential():
