@@ -13,6 +13,7 @@ friction and <= m S / 4 with it.
 
 import dataclasses
 
+import numpy as np
 import pytest
 from _cli import one_line_error
 
@@ -95,3 +96,54 @@ def test_record_command_refuses_a_non_confining_potential(capsys, tmp_path):
             "--out", out]  # fmt: skip
     one_line_error(capsys, argv, "not confining")
     assert not out.exists()
+
+
+def _fit(parameters, bounds, interval):
+    """An IdentificationResult with the given values, boxes and local 95 % intervals."""
+    from randvib.identification.least_squares import Uncertainty
+    from randvib.identification.result import IdentificationResult
+
+    names = tuple(interval)
+    unc = Uncertainty(
+        names=names,
+        estimate={n: parameters[n] for n in names},
+        standard_error={n: (interval[n][1] - interval[n][0]) / 4 for n in names},
+        interval=interval,
+        correlation=np.eye(len(names)),
+        noise_std=1.0,
+        dof=100,
+    )
+    return IdentificationResult(
+        model="coulomb", parameters=parameters, free=names, cost=1.0, bounds=bounds,
+        nfev=1, generations=1, elapsed=1.0, simulations_per_second=1.0, message="",
+        uncertainty=unc,
+    )  # fmt: skip
+
+
+def test_identification_on_a_bound_is_labelled_and_has_no_interval():
+    """k left on its upper bound 2: 'at upper bound', no interval; c inside its box:
+    interval cut at the box; the JSON says the same."""
+    fit = _fit(
+        {"c": 0.05, "k": 2.0},
+        {"c": (0.01, 0.06), "k": (1.0, 2.0)},
+        {"c": (0.04, 0.07), "k": (-22.0, 26.0)},
+    )
+    assert fit.at_bound == {"k": "upper"}
+    assert fit.confidence_intervals == {"c": (0.04, 0.06)}
+    out = fit.to_dict()
+    assert out["at_bound"] == {"k": "upper"}
+    assert out["confidence_intervals_95"] == {"c": [0.04, 0.06]}
+
+
+def test_identify_command_labels_a_parameter_on_its_bound(capsys, tmp_path):
+    """`--bounds k=100:200` on a record of a k = 57 N/m device: k stops at 100."""
+    from _cli import fit_args, run
+
+    path = tmp_path / "r.csv"
+    rv.synthetic_record("coulomb-td1", 1.0, duration=2.0, sample_rate=1000.0, seed=0).to_csv(path)
+    argv = [*fit_args(path, "--bounds", "k=100:200")]
+    argv.remove("--no-polish")  # the polish gives the intervals
+    code, out, err = run(capsys, *argv)
+    assert code == 0, err
+    k_row = next(line for line in out.splitlines() if line.startswith("k "))
+    assert k_row.rstrip().endswith("at lower bound") and "[" not in k_row
