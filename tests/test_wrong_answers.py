@@ -4,7 +4,10 @@ Covers the energy-balance check of the method family (:mod:`randvib.analytic.met
 called by :mod:`randvib.analytic.prediction`), fpk's barrier limit
 (:mod:`randvib.analytic.fokker_planck`), and the refusal of a non-confining
 potential in :mod:`randvib.identification.synthetic` (and ``randvib record``,
-:mod:`randvib.cli.record`).
+:mod:`randvib.cli.record`), identify's labels of a parameter on its bound
+(:mod:`randvib.identification.result`, :mod:`randvib.cli.identify`) and
+validate's per-record offsets (:mod:`randvib.identification.prediction`,
+:mod:`randvib.cli.validate`).
 
 The exact reference is the white-noise energy balance: the base does work
 m S / 4 on the mass, all dissipated, so c_m E[v^2] + P_e = m S / 4 without
@@ -147,3 +150,27 @@ def test_identify_command_labels_a_parameter_on_its_bound(capsys, tmp_path):
     assert code == 0, err
     k_row = next(line for line in out.splitlines() if line.startswith("k "))
     assert k_row.rstrip().endswith("at lower bound") and "[" not in k_row
+
+
+def test_validate_re_estimates_the_offsets_on_each_record(capsys, tmp_path):
+    """The true device with record A's offsets on record B (other offsets, no noise):
+    J far from 0 when A's offsets are reused; ~0 with B's re-estimated (the truth)."""
+
+    from randvib.identification.models import MeasurementModel
+    from randvib.identification.prediction import validate
+
+    device = rv.preset("coulomb-td1")
+    kw = dict(duration=2.0, sample_rate=1000.0)
+    b = rv.synthetic_record(device, 1.0, seed=2, offset_z=-0.003, offset_input=-0.2, **kw)
+    fitted_a = MeasurementModel(input_offset=0.3, output_offset=0.002)
+    (given,) = validate(device, [b], measurement=fitted_a, offsets="given")
+    (own,) = validate(device, [b], measurement=fitted_a)
+    assert given.cost > 1.0
+    # the exact offsets give J = 0 up to the simulation's rounding: 1e-4 is far
+    # below any misfit and far above the offsets' search tolerance (1e-9 of the box)
+    assert own.cost < 1e-4
+    # the two offsets are nearly interchangeable with a weak k3 (a constant input
+    # mostly shifts z): J, not each offset, is what is determined
+    assert own.offsets["output_offset"] == pytest.approx(-0.003, rel=0.1)
+    with pytest.raises(ValueError, match="`offsets` must be one of"):
+        validate(device, [b], measurement=fitted_a, offsets="fitted")
