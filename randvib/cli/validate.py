@@ -22,10 +22,12 @@ from randvib.identification.settings import SimulationSettings
 SIMULATION_FIELDS = tuple(SimulationSettings().to_dict())
 
 #: What validate does with the fitted record's sensor offsets.
-OFFSETS_NOTE = (
-    "the sensor offsets belong to a record, not to the device: they are re-estimated on "
-    "each record (the fitted record's are not reused); the other parameters are the file's"
-)
+OFFSETS_NOTE = {
+    "per-record": "the sensor offsets belong to a record, not to the device: they are "
+    "re-estimated on each record (the fitted record's are not reused; `--offsets given` "
+    "reuses them); the other parameters are the file's",
+    "given": "the file's sensor offsets are used on every record (`--offsets given`)",
+}
 
 
 def register(sub) -> None:
@@ -41,6 +43,13 @@ def register(sub) -> None:
     p.add_argument("data", nargs="+", metavar="DATA.csv", help="records to score")
     p.add_argument(
         "--set", action="append", metavar="NAME=VALUE", help="override a parameter value"
+    )
+    p.add_argument(
+        "--offsets",
+        choices=("per-record", "given"),
+        default="per-record",
+        help="sensor offsets: re-estimated on each record (default; they belong to a "
+        "record) or the file's on every record",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument(
@@ -106,7 +115,9 @@ def run(args) -> int:
             )
         plot_dir.mkdir(parents=True, exist_ok=True)
     records = [record_from_args(path, args) for path in args.data]
-    rows = validate(harvester, records, measurement=measurement, simulation=settings)
+    rows = validate(
+        harvester, records, measurement=measurement, offsets=args.offsets, simulation=settings
+    )
     if plot_dir is not None:
         from randvib.identification.plots import figure_fit
         from randvib.identification.prediction import predict_record
@@ -133,7 +144,7 @@ def run(args) -> int:
                         }
                         for r in rows
                     ],
-                    "offsets": OFFSETS_NOTE,
+                    "offsets": OFFSETS_NOTE[args.offsets],
                 }
             )
         )
@@ -143,5 +154,5 @@ def run(args) -> int:
         [[r.record, r.samples, r.cost, r.rms_error] for r in rows],
         ["record", "samples", "J", "RMS error"],
     )
-    print(f"note: {OFFSETS_NOTE}")
+    print(f"note: {OFFSETS_NOTE[args.offsets]}")
     return 0
