@@ -154,9 +154,15 @@ def _advice_warnings() -> tuple:
     """randvib's warnings that say something about the user's run (a step size, a validity)."""
     from randvib.analytic.averaging import AveragingValidityWarning
     from randvib.analytic.prediction import LoadBoundWarning
+    from randvib.analytic.statistical_linearisation import LinearisationValidityWarning
     from randvib.montecarlo.step_check import StepSizeWarning
 
-    return (StepSizeWarning, AveragingValidityWarning, LoadBoundWarning)
+    return (
+        StepSizeWarning,
+        AveragingValidityWarning,
+        LoadBoundWarning,
+        LinearisationValidityWarning,
+    )
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None):
