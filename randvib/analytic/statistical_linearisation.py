@@ -390,7 +390,7 @@ class Linearisation(AnalyticMethod):
         vv, zz = lin.velocity_variance, lin.displacement_variance
         exceedance = None if zz is None else gaussian_exceedance(harvester.stroke, zz)
         if lin.method == "white-noise":
-            _warn_friction_dominated(harvester, lin.c_eq)
+            _warn_friction_dominated(harvester, lin.c_eq, vv)
             mean_abs = np.sqrt(2.0 / np.pi * np.asarray(vv))  # Gaussian v
             return PowerPrediction.from_white_noise(
                 harvester, self.name, vv, zz, mean_abs, psd, exceedance
@@ -417,11 +417,18 @@ class Linearisation(AnalyticMethod):
         return solve_transient(self.name, harvester, event, times, t_end, start)
 
 
-def _warn_friction_dominated(harvester: Harvester, c_eq) -> None:
-    """LinearisationValidityWarning at the point of largest friction share beyond the limit."""
+def _warn_friction_dominated(harvester: Harvester, c_eq, velocity_variance) -> None:
+    """LinearisationValidityWarning at the point of largest friction share beyond the limit.
+
+    Only at points with a finite positive answer: the others are refused by
+    the driver, which a warning must not precede.
+    """
     with np.errstate(all="ignore"):
-        share = 1.0 - np.asarray(harvester.c_m + harvester.c_e, dtype=float) / np.asarray(c_eq)
-    share = np.where(np.isfinite(share), share, 0.0)
+        c = np.asarray(harvester.c_m + harvester.c_e, dtype=float)
+        share = 1.0 - c / np.asarray(c_eq, dtype=float)
+        vv = np.asarray(velocity_variance, dtype=float)
+        answered = np.isfinite(vv) & (vv > 0) & np.isfinite(c_eq) & np.isfinite(c)
+    share = np.where(np.isfinite(share) & answered, share, 0.0)
     worst = float(np.max(share)) if share.size else 0.0
     if worst > LINEARISATION_FRICTION_SHARE_LIMIT:
         warnings.warn(
