@@ -421,7 +421,9 @@ def optimal_load_resistance(harvester: Harvester, psd, method: str = "linearisat
     # Bracket the optimum on a coarse log grid first (12 points a decade):
     # P_L(R) is unimodal in practice but flat tails make a blind bounded
     # search slow to converge.
-    n = max(61, int(np.ceil(12 * np.log10(hi / lo))) + 1)
+    # (at most 4001: an interval of 330 decades, float64's whole range)
+    decades = np.log10(hi) - np.log10(lo)
+    n = int(min(max(61, np.ceil(12 * decades) + 1), 4001))
     grid = np.linspace(np.log(lo), np.log(hi), n)
     values = [negative_power(g) for g in grid]
     if not min(values) < 0:
