@@ -415,10 +415,16 @@ def test_cli_identify_json_and_validate(tmp_path, capsys, record):
     # offsets are estimated by default and reported with the parameters
     assert set(out["parameters"]) == {"m", "c", "k", "k3", "fc", "input_offset", "output_offset"}
     assert out["cost"] == pytest.approx(json.loads(params.read_text())["cost"])
-    assert main(["validate", str(params), str(data), str(other), "--json"]) == 0
+    argv = ["validate", str(params), str(data), str(other), "--json", "--offsets", "given"]
+    assert main(argv) == 0
     scores = json.loads(capsys.readouterr().out)
     assert [r["record"] for r in scores["records"]] == ["r", "o"]
     assert scores["records"][0]["cost"] == pytest.approx(out["cost"], rel=1e-9)
+    # by default the offsets are re-estimated per record: J on the fitted record
+    # is then at most the fit's (the offsets are optimised again, the rest held)
+    assert main(["validate", str(params), str(data), "--json"]) == 0
+    again = json.loads(capsys.readouterr().out)
+    assert again["records"][0]["cost"] <= out["cost"] * (1 + 1e-9)
 
 
 @pytest.mark.parametrize(

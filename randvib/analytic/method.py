@@ -95,6 +95,26 @@ class Validity:
     meaning: str
 
 
+#: Relative tolerance of the white-noise energy balance every answer is checked
+#: against (:meth:`AnalyticMethod.check_answer`). Without friction the balance
+#: is exact for every potential and coupling; over the presets (friction
+#: removed, S = 0.01 to 10) and double wells of barrier 1 to 8 m E[v^2] the
+#: methods meet it to 7e-16 (linearisation, averaging: by construction),
+#: 1.6e-5 (fpk-fast) and 3e-8 (fpk), and with friction stay below 1 + 3e-8
+#: (tests/test_wrong_answers.py re-measures a subset). 1 % is 600 times the
+#: largest of these and far inside the factors 0.35 to 13.6 it refuses.
+ENERGY_BALANCE_TOLERANCE = 0.01
+
+#: The limit every method is held to: the energy balance under white noise.
+ENERGY_BALANCE = Validity(
+    "energy_balance",
+    ENERGY_BALANCE_TOLERANCE,
+    "refuses",
+    "the power dissipated in the dampers and the circuit, c_m E[v^2] + P_e, over the "
+    "white-noise input power m S / 4: exactly 1 without friction, at most 1 with it "
+    "(friction dissipates too)",
+)
+
 #: Named as the alternative of every refusal.
 MONTE_CARLO = "Monte Carlo (randvib.simulate)"
 #: Named as the alternative of every refusal of an event.
@@ -236,6 +256,54 @@ class AnalyticMethod:
 
         names = [f"method={name!r}" for name, method in METHODS.items() if method.transient]
         return " or ".join(names + [MONTE_CARLO_EVENT])
+
+    # ------------------------------------------------------------ checking
+    def check_answer(self, harvester: Harvester, psd, result) -> None:
+        """Refuse an answer that breaks the white-noise energy balance (:data:`ENERGY_BALANCE`).
+
+        Under white noise of level S the base does work m S / 4 (W) on the
+        mass on average, whatever the potential, and all of it is dissipated:
+        ``c_m E[v^2] + P_e + E[v F(v)] = m S / 4`` (P_e = c_e E[v^2] for a
+        resistive coupling, the circuit resistances' power for a circuit
+        state; E[v F(v)] >= 0 is the friction's). Without friction
+        ``c_m E[v^2] + P_e`` must equal m S / 4, with friction stay below it,
+        both to :data:`ENERGY_BALANCE_TOLERANCE`. Scalar white-noise cases
+        only (an array is a grid a caller inspects point by point; a coloured
+        input's power has no closed form).
+
+        Raises
+        ------
+        ValueError
+            One line: the method, the dissipated and the input power, and the
+            other methods that take the case.
+        """
+        if non_white(psd) or result.velocity_variance is None:
+            return
+        level = white_level(psd)
+        values = (harvester.m, harvester.c_m, level, result.velocity_variance)
+        if any(np.ndim(v) for v in values + (result.power_electrical,)):
+            return
+        input_power = float(harvester.m) * float(level) / 4.0
+        dissipated = float(harvester.c_m) * float(result.velocity_variance) + float(
+            result.power_electrical
+        )
+        if not (np.isfinite(input_power) and input_power > 0 and np.isfinite(dissipated)):
+            return  # out-of-range values are refused by the driver's finiteness check
+        ratio = dissipated / input_power
+        law = harvester.friction
+        frictionless = law is None or law.vanishes
+        tol = ENERGY_BALANCE_TOLERANCE
+        if frictionless and abs(ratio - 1.0) <= tol or not frictionless and ratio <= 1.0 + tol:
+            return
+        need = "equal" if frictionless else "stay below"
+        raise self.beyond_validity(
+            harvester,
+            psd,
+            f"gives a dissipated power c_m E[v^2] + P_e = {dissipated:.4g} W, {ratio:.3g} times "
+            f"the white-noise input power m S / 4 = {input_power:.4g} W, which it must {need}"
+            f"{' without friction' if frictionless else ' (friction dissipates the rest)'}; "
+            "the answer is wrong here",
+        )
 
     # ------------------------------------------------------------ computing
     def solve(self, harvester: Harvester, psd):  # pragma: no cover - abstract

@@ -19,6 +19,8 @@ intervals (about 3 ms a point); ``"fpk"`` as the slow reference.
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 from scipy import optimize
 
@@ -179,6 +181,7 @@ def _finite(solver: AnalyticMethod, harvester: Harvester, psd) -> PowerPredictio
     ]
     if bad:
         raise ValueError(_out_of_range(method, harvester, psd, ", ".join(bad)))
+    solver.check_answer(harvester, psd, result)
     return result
 
 
@@ -279,9 +282,85 @@ def optimal_load_resistance_linear(c_m, alpha, r_coil):
     return np.sqrt(r_coil**2 + r_coil * alpha**2 / c_m)
 
 
-def optimal_load_resistance(
-    harvester: Harvester, psd, method: str = "linearisation", bounds=(1e-6, 1e6)
-):
+class LoadBoundWarning(RuntimeWarning):
+    """The best load of :func:`optimal_load_resistance` lies on a bound of its search: no maximum."""
+
+
+#: Decades searched on each side of the device's characteristic loads.
+LOAD_SEARCH_DECADES = 4.0
+
+
+def load_search_bounds(harvester: Harvester) -> tuple[float, float]:
+    """The interval of R_L (ohm) that :func:`optimal_load_resistance` searches by default.
+
+    Derived from the device, never fixed: the characteristic loads of its
+    coupling -- the matched impedance R_C + alpha^2/c_m of a coil (the load at
+    which c_e = c_m with R_C = 0), 1/(omega_n C_p) of a piezo element (its
+    capacitive impedance at omega_n = sqrt(|k|/m)) or c_m/theta^2 without C_p,
+    and the white-noise optimum of the linear device
+    (:meth:`~randvib.models.coupling.Coupling.white_noise_optimal_load`) where
+    it is positive -- with :data:`LOAD_SEARCH_DECADES` decades on each side.
+    """
+    coupling = harvester.electrical
+    m, c_m, k = (np.float64(v) for v in (harvester.m, harvester.c_m, harvester.k))
+    candidates = [lambda: coupling.white_noise_optimal_load(m, c_m, k)]
+    if hasattr(coupling, "alpha"):
+        candidates.append(lambda: coupling.r_coil + np.float64(coupling.alpha) ** 2 / c_m)
+    if hasattr(coupling, "theta"):
+        candidates.append(lambda: c_m / np.float64(coupling.theta) ** 2)
+        if coupling.is_dynamic:
+            candidates.append(lambda: 1.0 / (np.sqrt(abs(k) / m) * coupling.capacitance))
+    loads = []
+    for candidate in candidates:
+        # c_m = 0, k = 0 or extreme parameters give inf or nan, dropped below
+        with np.errstate(all="ignore"):
+            try:
+                loads.append(candidate())
+            except (OverflowError, ZeroDivisionError):
+                pass
+    loads = [float(r) for r in loads if np.isfinite(r) and r > 0]
+    if not loads:
+        raise ValueError(
+            f"optimal_load_resistance cannot derive a search interval from the coupling "
+            f"{coupling!r}; give `bounds`=(lower, upper) in ohm"
+        )
+    span = 10.0**LOAD_SEARCH_DECADES
+    return min(loads) / span, max(loads) * span
+
+
+class OptimalLoad(tuple):
+    """``(r_load, power)`` of :func:`optimal_load_resistance`, saying where the optimum lies.
+
+    Unpacks as the pair ``r_load, power``; ``location`` is ``"interior"``
+    (a maximum inside ``bounds``), ``"lower bound"`` or ``"upper bound"``
+    (the power still rises towards that end of the interval searched: the
+    true optimum lies beyond it, or is the limit R_L -> 0, as for a coil
+    with R_C = 0); ``bounds`` is the interval searched (ohm).
+    """
+
+    def __new__(cls, r_load: float, power: float, location: str, bounds: tuple):
+        obj = super().__new__(cls, (r_load, power))
+        obj.location = location
+        obj.bounds = bounds
+        return obj
+
+    @property
+    def r_load(self) -> float:
+        """Optimal (or best-in-bounds) load resistance (ohm)."""
+        return self[0]
+
+    @property
+    def power(self) -> float:
+        """Expected load power there (W)."""
+        return self[1]
+
+    @property
+    def interior(self) -> bool:
+        """True when the optimum lies strictly inside the interval searched."""
+        return self.location == "interior"
+
+
+def optimal_load_resistance(harvester: Harvester, psd, method: str = "linearisation", bounds=None):
     """Load resistance R_L (ohm) maximising expected load power (scalar inputs).
 
     The harvester must have a coupling (``Harvester.from_electrical`` or
@@ -294,12 +373,20 @@ def optimal_load_resistance(
     sqrt(R_C^2 + R_C alpha^2/c_m) resistive, its inductive extension, and
     sqrt(m / (C_p (C_p k + theta^2))) piezo).
 
+    Parameters
+    ----------
+    bounds : (float, float), optional
+        Interval of R_L searched (ohm). Default: derived from the device
+        (:func:`load_search_bounds`).
+
     Returns
     -------
-    r_load : float
-        Optimal load resistance (ohm).
-    power : float
-        Expected load power there (W).
+    OptimalLoad
+        The pair ``(r_load, power)``: the load resistance (ohm) and the
+        expected load power there (W), with ``location`` "interior",
+        "lower bound" or "upper bound". An optimum on a bound is not a
+        maximum: it also raises a :class:`LoadBoundWarning` saying so (with
+        R_C = 0 the load power of a coil rises as R_L -> 0).
 
     Examples
     --------
@@ -323,6 +410,8 @@ def optimal_load_resistance(
     if not isinstance(psd, Excitation):
         psd = check_scalar("psd", psd, "a white-noise level S in (m/s^2)^2/Hz", BROADCASTING)
         psd = float(check_positive("psd", psd, "(m/s^2)^2/Hz"))
+    if bounds is None:
+        bounds = load_search_bounds(harvester)
     lo, hi = (float(check_positive("bounds", b, "ohm")) for b in bounds)
     if not lo < hi:
         raise ValueError(f"`bounds` must satisfy lower < upper, got {bounds!r}")
@@ -331,21 +420,47 @@ def optimal_load_resistance(
         device = harvester.updated(r_load=float(np.exp(log_r)))
         return -float(expected_power(device, psd, method, into="load"))
 
-    # Bracket the optimum on a coarse log grid first: P_L(R) is unimodal in
-    # practice but flat tails make a blind bounded search slow to converge.
-    grid = np.linspace(np.log(lo), np.log(hi), 61)
+    # Bracket the optimum on a coarse log grid first (12 points a decade):
+    # P_L(R) is unimodal in practice but flat tails make a blind bounded
+    # search slow to converge.
+    # (at most 4001: an interval of 330 decades, float64's whole range)
+    decades = np.log10(hi) - np.log10(lo)
+    n = int(min(max(61, np.ceil(12 * decades) + 1), 4001))
+    grid = np.linspace(np.log(lo), np.log(hi), n)
     values = [negative_power(g) for g in grid]
     if not min(values) < 0:
         # no load takes any power (a coil whose inductance blocks the current,
         # a power below float64's range): no optimum to report
         raise ValueError(
-            f"no load resistance in `bounds` {bounds!r} ohm takes any power from this device "
-            f"(the load power is {-max(values):g} W at every load tried) under {psd!r}; "
+            f"no load resistance in `bounds` ({lo:g}, {hi:g}) ohm takes any power from this "
+            f"device (the load power is {-max(values):g} W at every load tried) under {psd!r}; "
             f"check the coupling {harvester.electrical!r}"
         )
     i = int(np.argmin(values))
-    a, b = grid[max(i - 1, 0)], grid[min(i + 1, len(grid) - 1)]
+    if i in (0, len(grid) - 1):
+        # the power still rises towards this end: the bound is no maximum
+        location = "lower bound" if i == 0 else "upper bound"
+        r_load, power = float(np.exp(grid[i])), -float(values[i])
+        warnings.warn(
+            f"the load power rises up to the {location} of the search, R_L = {r_load:g} ohm "
+            f"(bounds ({lo:g}, {hi:g}) ohm): the optimum lies beyond it"
+            + (
+                " (R_L -> 0 with r_coil = 0)"
+                if i == 0 and _coil_without_resistance(harvester)
+                else ""
+            )
+            + "; the value returned is the best load inside the bounds, not a maximum",
+            LoadBoundWarning,
+            stacklevel=2,
+        )
+        return OptimalLoad(r_load, power, location, (lo, hi))
+    a, b = grid[i - 1], grid[i + 1]
     res = optimize.minimize_scalar(
         negative_power, bounds=(a, b), method="bounded", options={"xatol": 1e-10}
     )
-    return float(np.exp(res.x)), -float(res.fun)
+    return OptimalLoad(float(np.exp(res.x)), -float(res.fun), "interior", (lo, hi))
+
+
+def _coil_without_resistance(harvester: Harvester) -> bool:
+    """A coil coupling with R_C = 0 (whose load power rises as R_L -> 0)."""
+    return getattr(harvester.electrical, "r_coil", None) == 0

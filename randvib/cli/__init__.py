@@ -153,9 +153,16 @@ def _main_with_warnings(argv) -> int:
 def _advice_warnings() -> tuple:
     """randvib's warnings that say something about the user's run (a step size, a validity)."""
     from randvib.analytic.averaging import AveragingValidityWarning
+    from randvib.analytic.prediction import LoadBoundWarning
+    from randvib.analytic.statistical_linearisation import LinearisationValidityWarning
     from randvib.montecarlo.step_check import StepSizeWarning
 
-    return (StepSizeWarning, AveragingValidityWarning)
+    return (
+        StepSizeWarning,
+        AveragingValidityWarning,
+        LoadBoundWarning,
+        LinearisationValidityWarning,
+    )
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None):

@@ -160,20 +160,27 @@ def run(args) -> int:
     return 0
 
 
+def _status(name, se, free, at_bound) -> str:
+    """``fixed``, ``identified`` or ``at lower/upper bound`` (where the search stopped: no estimate)."""
+    if name in at_bound:
+        return f"at {at_bound[name]} bound"
+    return "identified" if name in se or name in free else "fixed"
+
+
 def print_report(result, record, output_unit: str = "m") -> None:
     """The parameters with standard errors and 95 % intervals, J, the correlations.
 
     ``output_unit``: the unit of the record's output column (m for the
     relative displacement; a named ``--output-column`` keeps its own).
     """
-    se, ci = result.standard_errors, result.confidence_intervals
+    se, ci, at_bound = result.standard_errors, result.confidence_intervals, result.at_bound
     offsets = {"output_offset": output_unit}
     rows = [
         [
             name,
             *with_standard_error(value, se.get(name), ci.get(name)),
             offsets[name] if name in offsets else result.unit(name),
-            "identified" if name in se or name in result.free else "fixed",
+            _status(name, se, result.free, at_bound),
         ]
         for name, value in result.parameters.items()
     ]

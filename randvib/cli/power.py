@@ -205,9 +205,10 @@ def _point(args) -> tuple[dict, object, object]:
         # the battery voltage or the capacitor's load maximising the stored power
         out.update(optimal_dc_output(harvester, psd).to_dict())
     elif args.optimal_load:
-        out["r_load_optimal"], out["power_load_optimal"] = optimal_load_resistance(
-            harvester, psd, method=args.method
-        )
+        best = optimal_load_resistance(harvester, psd, method=args.method)
+        out["r_load_optimal"], out["power_load_optimal"] = best
+        # "interior", or the bound of the device-derived search the power still rises to
+        out["r_load_optimal_location"] = best.location
     if coloured:
         out["excitation"] = psd.parameters()
     return out, harvester, psd

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import sys
 
@@ -21,6 +22,14 @@ from randvib.identification.settings import SimulationSettings
 
 SIMULATION_FIELDS = tuple(SimulationSettings().to_dict())
 
+#: What validate does with the fitted record's sensor offsets.
+OFFSETS_NOTE = {
+    "per-record": "the sensor offsets belong to a record, not to the device: they are "
+    "re-estimated on each record (the fitted record's are not reused; `--offsets given` "
+    "reuses them); the other parameters are the file's",
+    "given": "the file's sensor offsets are used on every record (`--offsets given`)",
+}
+
 
 def register(sub) -> None:
     p = sub.add_parser(
@@ -35,6 +44,13 @@ def register(sub) -> None:
     p.add_argument("data", nargs="+", metavar="DATA.csv", help="records to score")
     p.add_argument(
         "--set", action="append", metavar="NAME=VALUE", help="override a parameter value"
+    )
+    p.add_argument(
+        "--offsets",
+        choices=("per-record", "given"),
+        default="per-record",
+        help="sensor offsets: re-estimated on each record (default; they belong to a "
+        "record) or the file's on every record",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument(
@@ -112,14 +128,18 @@ def run(args) -> int:
             )
         plot_dir.mkdir(parents=True, exist_ok=True)
     records = [record_from_args(path, args) for path in args.data]
-    rows = validate(harvester, records, measurement=measurement, simulation=settings)
+    rows = validate(
+        harvester, records, measurement=measurement, offsets=args.offsets, simulation=settings
+    )
     if plot_dir is not None or plot_file is not None:
         from randvib.identification.plots import figure_fit
         from randvib.identification.prediction import predict_record
         from randvib.identification.residuals import residual_diagnostics
 
-        for i, record in enumerate(records):
-            pred = predict_record(harvester, record, measurement=measurement, simulation=settings)
+        for i, (record, row) in enumerate(zip(records, rows, strict=True)):
+            # the offsets re-estimated on this record, as its J
+            own = dataclasses.replace(measurement, **row.offsets)
+            pred = predict_record(harvester, record, measurement=own, simulation=settings)
             path = plot_file or plot_dir / f"{i:02d}_{record.name}.png"
             skip = settings.skip
             diagnostics = residual_diagnostics(record.z[skip:] - pred.z[skip:], record.input[skip:])
@@ -149,9 +169,11 @@ def run(args) -> int:
                             "cost": r.cost,
                             "rms_error": r.rms_error,
                             "samples": r.samples,
+                            "offsets": r.offsets,
                         }
                         for r in rows
                     ],
+                    "offsets": OFFSETS_NOTE[args.offsets],
                 }
             )
         )
@@ -161,4 +183,5 @@ def run(args) -> int:
         [[r.record, r.samples, r.cost, r.rms_error] for r in rows],
         ["record", "samples", "J", "RMS error"],
     )
+    print(f"note: {OFFSETS_NOTE[args.offsets]}")
     return 0

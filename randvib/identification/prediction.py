@@ -172,20 +172,110 @@ class ValidationRow:
     cost: float
     rms_error: float
     samples: int
+    #: The sensor offsets used on this record (re-estimated on it, or given).
+    offsets: dict = field(default_factory=dict)
+
+
+#: How :func:`validate` treats the sensors' offsets.
+OFFSET_POLICIES = ("per-record", "given")
 
 
 def validate(
-    harvester: Harvester, records, *, measurement: MeasurementModel | None = None, **settings
+    harvester: Harvester,
+    records,
+    *,
+    measurement: MeasurementModel | None = None,
+    offsets: str = "per-record",
+    **settings,
 ) -> list[ValidationRow]:
     """J (Eq. 11) and RMS error of a device on each of several records.
 
     ``settings`` are those of :func:`predict_record` (``simulation=`` or its
-    fields as keywords); ``measurement`` is the sensors' model, the same on
-    every record.
+    fields as keywords); ``measurement`` is the sensors' model (k2 and the
+    offsets).
+
+    Parameters
+    ----------
+    offsets : {"per-record", "given"}
+        ``"per-record"`` (default): the sensor offsets belong to a record, not
+        to the device, so they are re-estimated on each record -- the output
+        offset in closed form (the mean residual, as identify profiles it),
+        the input offset, where ``measurement`` has one, by a bounded scalar
+        search of J over the record's input mean +- half its standard
+        deviation (identify's box). ``"given"``: those of ``measurement`` on
+        every record. Each row's ``offsets`` says which were used.
     """
+    if offsets not in OFFSET_POLICIES:
+        raise ValueError(f"`offsets` must be one of {', '.join(OFFSET_POLICIES)}; got {offsets!r}")
     model = model_of(harvester.friction_name) if isinstance(harvester, Harvester) else None
+    measurement = measurement or MeasurementModel()
     rows = []
     for record in records:
-        pred = predict_record(harvester, record, measurement=measurement, **settings)
-        rows.append(ValidationRow(record.name, model, pred.cost, pred.rms_error, record.n))
+        used = measurement
+        if offsets == "per-record":
+            used = _record_offsets(harvester, record, measurement, settings)
+        pred = predict_record(harvester, record, measurement=used, **settings)
+        rows.append(
+            ValidationRow(
+                record.name,
+                model,
+                pred.cost,
+                pred.rms_error,
+                record.n,
+                {"input_offset": used.input_offset, "output_offset": used.output_offset},
+            )
+        )
     return rows
+
+
+def _record_offsets(harvester, record, measurement, settings) -> MeasurementModel:
+    """``measurement`` with the offsets that minimise J on ``record`` (see :func:`validate`).
+
+    J is identify's: the output offset profiled in closed form, the start
+    z0 taken from the first sample less the record's mean (:class:`CostFunction`).
+    """
+    from dataclasses import replace
+
+    from scipy import optimize
+
+    from randvib.identification.input_reconstruction import driving_signal
+
+    options = dict(settings)
+    (simulation,) = resolve_settings(
+        "validate", options, simulation=options.pop("simulation", None)
+    )
+    parameters = check_parameters(
+        device_parameters(harvester, measurement, "validate"), model_of(harvester.friction_name)
+    )
+    model = model_of(harvester.friction_name)
+    estimate_input = measurement.input_offset != 0.0
+    fixed = {k: v for k, v in parameters.items() if k != "output_offset"}
+    if estimate_input:
+        fixed.pop("input_offset", None)
+    free = ("input_offset",) if estimate_input else ()
+    options = simulation.to_dict()
+    options.pop("initial_state", None)
+    cost = CostFunction(record, model, fixed=fixed, free=free, profile_offset=True, **options)
+    input_offset = 0.0
+    if estimate_input:
+        drive, _ = driving_signal(record.input, record.dt, record.input_kind)
+        mean, half = float(np.mean(drive)), 0.5 * float(np.std(drive))
+        res = optimize.minimize_scalar(
+            lambda x: float(cost(np.array([[x]]))[0]),
+            bounds=(mean - half, mean + half),
+            method="bounded",
+            options={"xatol": 1e-9 * half},
+        )
+        input_offset = float(res.x)
+    values = {**fixed, "input_offset": input_offset} if estimate_input else dict(fixed)
+    skip = simulation.skip
+    output_offset = 0.0
+    # the start z0 = first sample less the offset: a second pass starts from
+    # the offset just estimated instead of the record's mean (its guess)
+    for start in (cost.z0, None):
+        z0 = start if start is not None else float(record.z[0] - output_offset)
+        z, _ = cost.simulate(values, z0=z0)
+        if not np.all(np.isfinite(z)):
+            break
+        output_offset = float(np.mean(record.z[skip:] - z[skip:]))
+    return replace(measurement, input_offset=input_offset, output_offset=output_offset)

@@ -15,6 +15,12 @@ from randvib.models.harvester import Harvester
 from randvib.models.record import Record
 from randvib.quantities import unit
 
+#: Distance from a search bound, as a share of the interval's width, within
+#: which a free parameter counts as on it (the polish's bounded least squares
+#: stops exactly on a bound; 1e-6 is far below any meaningful resolution of
+#: the fit and far above float64 rounding).
+BOUND_TOLERANCE = 1e-6
+
 
 @dataclass
 class IdentificationResult:
@@ -106,11 +112,57 @@ class IdentificationResult:
         return {n: se[n] for n in self.parameters if n in se}
 
     @property
+    def at_bound(self) -> dict:
+        """Free parameters the search left on a bound: name -> ``"lower"`` or ``"upper"``.
+
+        Within :data:`BOUND_TOLERANCE` of the box's width. Such a value is
+        where the search stopped, not an estimate: the cost may fall further
+        beyond the bound, and the local (Gauss-Newton) interval, which assumes
+        an interior minimum, does not apply.
+        """
+        return {
+            name: side for name, (side, _) in self._boxed().items() if side in ("lower", "upper")
+        }
+
+    def _boxed(self) -> dict:
+        """Free parameters inside their search box: name -> (where, (lo, hi)).
+
+        ``where`` is "lower", "upper" or "inside". A value outside its box
+        (an offset, whose box is the search's start only) is not listed.
+        """
+        out = {}
+        for name, (lo, hi) in self.bounds.items():
+            if name not in self.free or name not in self.parameters:
+                continue
+            lo, hi, value = float(lo), float(hi), float(self.parameters[name])
+            tol = BOUND_TOLERANCE * (hi - lo)
+            if not lo - tol <= value <= hi + tol:
+                continue
+            where = "lower" if value <= lo + tol else "upper" if value >= hi - tol else "inside"
+            out[name] = (where, (lo, hi))
+        return out
+
+    @property
     def confidence_intervals(self) -> dict:
-        """95 % confidence interval of each estimated parameter."""
+        """95 % confidence interval of each estimated parameter, inside its search box.
+
+        A parameter on a bound (:attr:`at_bound`) has none: its local interval
+        assumes an interior minimum. A parameter inside its box has the local
+        interval cut at the box (the search cannot return a value beyond it).
+        """
         if self.uncertainty is None:
             return {}
-        return {n: self.uncertainty.interval[n] for n in self.standard_errors}
+        boxed = self._boxed()
+        out = {}
+        for name in self.standard_errors:
+            a, b = self.uncertainty.interval[name]
+            if name in boxed:
+                where, (lo, hi) = boxed[name]
+                if where != "inside":
+                    continue
+                a, b = max(a, lo), min(b, hi)
+            out[name] = (a, b)
+        return out
 
     def to_dict(self) -> dict:
         """JSON-ready summary."""
@@ -132,10 +184,18 @@ class IdentificationResult:
             "initial_state": dict(self.initial_state),
             "notes": list(self.notes),
             **({} if self.residuals is None else {"residuals": self.residuals.to_dict()}),
+            # free parameters left on a search bound: not estimates, no interval
+            "at_bound": self.at_bound,
             **(
                 {}
                 if self.uncertainty is None
-                else {"uncertainty_of": "all estimated quantities", **self.uncertainty.to_dict()}
+                else {
+                    "uncertainty_of": "all estimated quantities",
+                    **self.uncertainty.to_dict(),
+                    "confidence_intervals_95": {
+                        k: [float(a), float(b)] for k, (a, b) in self.confidence_intervals.items()
+                    },
+                }
             ),
         }
 

@@ -31,6 +31,7 @@ from randvib._validation import (
 from randvib.identification.record_response import record_response
 from randvib.models.excitation import BaseMotionOverflow, Excitation, band_limited_excitation
 from randvib.models.harvester import Harvester
+from randvib.models.potential import CONFINING
 from randvib.models.presets import PRESETS, preset
 from randvib.models.record import Record
 
@@ -177,7 +178,11 @@ def _device(device) -> Harvester:
         raise ValueError(
             f"`device` must be a Harvester or a preset name, got {type(device).__name__}"
         )
-    return check_scalar_device(device, "synthetic_record")
+    device = check_scalar_device(device, "synthetic_record")
+    # a non-confining potential sends the mass to infinity within the record
+    # (|z| ~ 1e269 m): refused as simulate refuses it; the free mass drifts but stays finite
+    device.potential.require("a synthetic record", CONFINING + ("free",))
+    return device
 
 
 def _true_input(excitation, kind, duration, sample_rate, band, rng) -> np.ndarray:

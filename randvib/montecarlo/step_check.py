@@ -315,7 +315,7 @@ def _augmented_system(m, k_eff, c_eff, excitation: Excitation, coupling=None):
 
     dx = F x dt + G dW with the states (filter, z, v, circuit); the rows of C
     pick y (the base acceleration; none under white noise), z, v and the
-    circuit state.
+    circuit state. For the free mass (k_eff = 0) z is left out.
     """
     block = device_block(m, c_eff, k_eff, coupling)
     if excitation.is_white:
@@ -327,7 +327,15 @@ def _augmented_system(m, k_eff, c_eff, excitation: Excitation, coupling=None):
         rows = [np.concatenate([shaping.system.c[0], np.zeros(block.n_states)])]
     pick = np.vstack(rows + [np.hstack([np.zeros((block.n_states, n_filter)), block.c])])
     g = np.sqrt(q) * system.b[:, None]
-    return system.a, g, pick
+    a = system.a
+    if k_eff == 0:
+        # the free mass: z is not stationary (no Lyapunov solution) and, with
+        # no spring, feeds back into nothing; the stationary system is
+        # (filter, v, circuit), whose variances the step check compares
+        keep = [i for i in range(a.shape[0]) if i != n_filter]
+        a, g = a[np.ix_(keep, keep)], g[keep]
+        pick = pick[np.abs(pick[:, n_filter]) == 0][:, keep]
+    return a, g, pick
 
 
 def _augmented_bias(scheme, f, g, pick, dt) -> float:
