@@ -24,3 +24,27 @@ def test_unstable_step_is_called_unstable_not_off_by_inf():
     message = str(info.value)
     assert "unstable" in message and "inf" not in message, message
     assert "use dt <=" in message
+
+
+from _cli import one_line_error  # noqa: E402
+
+POWER = ["power", "--preset", "coulomb-td1", "--psd", "0.005"]
+
+
+@pytest.mark.parametrize(
+    "extra, fragment",
+    [
+        (["--excitation", "kanai-tajimi", "--zeta", "0.3", "--f0", "-inf"], "got -inf"),
+        (["--excitation", "kanai-tajimi", "--zeta", "0.3", "--f0", "-Infinity"], "got -inf"),
+        (["--k3", "-5e5:-1e5:2", "--k", "10"], "k3 = -500000.0 N/m^3"),
+    ],
+)
+def test_negative_infinities_and_sweeps_are_values_not_options(capsys, extra, fragment):
+    """`--f0 -inf` is checked as a number, not answered by argparse's "expected one argument"."""
+    one_line_error(capsys, [*POWER, *extra], fragment)
+
+
+def test_sweep_between_huge_ends_is_not_nan(capsys):
+    """START:STOP:COUNT near the float limit: the ends themselves are reported, not "nan"."""
+    one_line_error(capsys, ["power", "--preset", "coulomb-td1", "--psd=-1e308:1e308:3"],
+                   "got -1e+308")  # fmt: skip
