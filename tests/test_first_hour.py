@@ -48,3 +48,20 @@ def test_sweep_between_huge_ends_is_not_nan(capsys):
     """START:STOP:COUNT near the float limit: the ends themselves are reported, not "nan"."""
     one_line_error(capsys, ["power", "--preset", "coulomb-td1", "--psd=-1e308:1e308:3"],
                    "got -1e+308")  # fmt: skip
+
+
+def test_band_edge_at_a_subnormal_frequency_is_the_band_from_zero(capsys):
+    """`--f-lo 5e-324` integrates like `--f-lo 0` (the bands differ by 5e-324 Hz), instead of
+    numpy's "Geometric sequence cannot include zero". Both quadratures are converged far below
+    the 1e-9 allowed here (the composite Gauss-Legendre rule of linear_response)."""
+    import json
+
+    from _cli import run
+
+    band = [*POWER, "--excitation", "band-limited", "--f-hi", "20", "--json"]
+    results = []
+    for f_lo in ("5e-324", "0"):
+        code, out, err = run(capsys, *band, "--f-lo", f_lo)
+        assert code == 0, err
+        results.append(json.loads(out)["velocity_variance"])
+    assert results[0] == pytest.approx(results[1], rel=1e-9)
