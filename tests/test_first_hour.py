@@ -9,6 +9,8 @@ and the refusals of the CLI's option parsing and checks
 import warnings
 
 import pytest
+from _cli import one_line_error
+from _cli import run as run_cli
 
 import randvib as rv
 
@@ -25,8 +27,6 @@ def test_unstable_step_is_called_unstable_not_off_by_inf():
     assert "unstable" in message and "inf" not in message, message
     assert "use dt <=" in message
 
-
-from _cli import one_line_error  # noqa: E402
 
 POWER = ["power", "--preset", "coulomb-td1", "--psd", "0.005"]
 
@@ -56,12 +56,20 @@ def test_band_edge_at_a_subnormal_frequency_is_the_band_from_zero(capsys):
     the 1e-9 allowed here (the composite Gauss-Legendre rule of linear_response)."""
     import json
 
-    from _cli import run
-
     band = [*POWER, "--excitation", "band-limited", "--f-hi", "20", "--json"]
     results = []
     for f_lo in ("5e-324", "0"):
-        code, out, err = run(capsys, *band, "--f-lo", f_lo)
+        code, out, err = run_cli(capsys, *band, "--f-lo", f_lo)
         assert code == 0, err
         results.append(json.loads(out)["velocity_variance"])
     assert results[0] == pytest.approx(results[1], rel=1e-9)
+
+
+def test_tiny_inductance_under_white_noise_blames_the_inductance(capsys):
+    """The refusal names the parameter of extreme magnitude, not "a narrow-band excitation"
+    (the input is white)."""
+    argv = [*POWER, "--coupling", "inductive", "--alpha", "0.2", "--r-load", "10",
+            "--r-coil", "0.48", "--inductance", "1e-300"]  # fmt: skip
+    one_line_error(capsys, argv, "inductance = 1e-300 is beyond the range")
+    code, out, err = run_cli(capsys, *argv)
+    assert "narrow-band" not in err and "array(" not in err, err

@@ -33,7 +33,7 @@ from randvib.analytic.averaging import AVERAGING
 from randvib.analytic.fokker_planck import FAST_FOKKER_PLANCK, FOKKER_PLANCK
 from randvib.analytic.method import AnalyticMethod, non_white, white_level
 from randvib.analytic.power_prediction import PowerPrediction
-from randvib.analytic.statistical_linearisation import LINEARISATION
+from randvib.analytic.statistical_linearisation import LINEARISATION, LinearisationDidNotConverge
 from randvib.models.excitation import BROADCASTING, Excitation
 from randvib.models.harvester import Harvester
 
@@ -156,6 +156,10 @@ def _finite(solver: AnalyticMethod, harvester: Harvester, psd) -> PowerPredictio
             result = solver.solve(harvester, psd)
     except (ArithmeticError, RuntimeError, ValueError) as exc:
         own = _raised_by_randvib(exc) and not isinstance(exc, ArithmeticError)
+        if isinstance(exc, LinearisationDidNotConverge) and _extreme_values(harvester, psd):
+            # a parameter such as inductance = 1e-300 H, not the excitation, broke the search
+            what = "statistical linearisation found no fixed point"
+            raise ValueError(_out_of_range(method, harvester, psd, what)) from None
         if own and isinstance(exc, ValueError):
             raise  # randvib's own explanation (no stationary response, a potential it cannot treat)
         # a library's (scipy: "array must not contain infs or NaNs") after an
@@ -214,6 +218,8 @@ def _extreme_values(harvester: Harvester, psd) -> list[str]:
 def _out_of_range(method, harvester, psd, what, overflow: bool = True) -> str:
     """The refusal of a non-finite result; float64's range is blamed only when it is the cause."""
     level = psd.parameters() if isinstance(psd, Excitation) else psd
+    if np.ndim(level) == 0 and not isinstance(level, dict):
+        level = float(level)  # "psd = 0.005", not "psd = array(0.005)"
     text = f"method {method!r} has no finite result at these values ({what}): psd = {level!r}, "
     extreme = _extreme_values(harvester, psd) if overflow else []
     if not extreme:
