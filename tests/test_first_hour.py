@@ -73,3 +73,20 @@ def test_tiny_inductance_under_white_noise_blames_the_inductance(capsys):
     one_line_error(capsys, argv, "inductance = 1e-300 is beyond the range")
     code, out, err = run_cli(capsys, *argv)
     assert "narrow-band" not in err and "array(" not in err, err
+
+
+def test_predict_broadcasts_over_levels_for_a_piezo_device():
+    """`rv.predict(piezo_device, array)` gives each level's scalar prediction (the same fixed
+    point, so equal to rounding), not numpy's "only 0-dimensional arrays" error."""
+    import numpy as np
+
+    device = rv.Harvester(m=0.0226, c_m=0.049, c_e=0.0, k=57.4, k3=7e4,
+                          electrical=rv.Piezo(theta=1e-3, capacitance=1e-8, r_load=1e5))  # fmt: skip
+    levels = np.array([0.1, 0.5, 1.0])
+    swept = rv.predict(device, levels)
+    assert np.shape(swept.power_load) == (3,)
+    for i, level in enumerate(levels):
+        one = rv.predict(device, float(level))
+        assert swept.power_load[i] == pytest.approx(one.power_load, rel=1e-12)
+        assert swept.circuit_mean_square[i] == pytest.approx(one.circuit_mean_square, rel=1e-12)
+    assert len(swept.to_frame()) == 3

@@ -360,6 +360,12 @@ class Linearisation(AnalyticMethod):
         return self.potentials if takes_fast_path(harvester, psd) else CONFINING
 
     def solve(self, harvester: Harvester, psd) -> PowerPrediction:
+        if not takes_fast_path(harvester, psd) and np.ndim(psd) > 0:
+            # the fixed point takes one white level at a time (a circuit state):
+            # solve each and broadcast the fields over the levels' shape, as the fast path does
+            levels = np.asarray(psd, dtype=float)
+            points = [self.solve(harvester, float(level)) for level in levels.ravel()]
+            return _stacked(points, levels.shape)
         lin = linearise(harvester, psd)
         vv, zz = lin.velocity_variance, lin.displacement_variance
         exceedance = None if zz is None else gaussian_exceedance(harvester.stroke, zz)
@@ -392,6 +398,16 @@ class Linearisation(AnalyticMethod):
 
 #: The method's declaration (:data:`randvib.analytic.prediction.METHODS` holds it).
 LINEARISATION = Linearisation()
+
+
+def _stacked(points: list[PowerPrediction], shape: tuple) -> PowerPrediction:
+    """One prediction whose fields are arrays of ``shape`` over the scalar ``points``."""
+    fields = {}
+    for name in ("c_eq", "velocity_variance", "displacement_variance", "mean_abs_velocity",
+                 "power_electrical", "power_load", "circuit_mean_square", "stroke_exceedance"):  # fmt: skip
+        values = [getattr(point, name) for point in points]
+        fields[name] = None if values[0] is None else np.asarray(values, dtype=float).reshape(shape)
+    return PowerPrediction(method=points[0].method, **fields)
 
 
 def _state(harvester: Harvester, outputs: dict):
