@@ -90,3 +90,20 @@ def test_predict_broadcasts_over_levels_for_a_piezo_device():
         assert swept.power_load[i] == pytest.approx(one.power_load, rel=1e-12)
         assert swept.circuit_mean_square[i] == pytest.approx(one.circuit_mean_square, rel=1e-12)
     assert len(swept.to_frame()) == 3
+
+
+def test_statistic_converts_and_prints_rounded_to_its_interval():
+    """float() gives the mean; scaling/shifting by a number maps mean and interval exactly;
+    two Statistics do not combine (their correlation is unknown); str rounds to the interval."""
+    stat = rv.Statistic(0.0024619412547950926, 0.000272784, 0.000139, 100)
+    assert float(stat) == stat.mean
+    milli = stat * 1e3
+    assert isinstance(milli, rv.Statistic) and milli == 1e3 * stat
+    assert milli.mean == pytest.approx(2.4619412547950926, rel=1e-15)
+    assert milli.ci95 == pytest.approx(0.272784, rel=1e-15)
+    assert (-stat).ci95 == stat.ci95 and (1.0 - stat).mean == pytest.approx(1.0 - stat.mean)
+    assert (stat / 4).std_error == pytest.approx(stat.std_error / 4)
+    with pytest.raises(TypeError):
+        stat * stat
+    assert str(stat) == "0.00246 ± 0.00027" == f"{stat}"
+    assert f"{stat:.2e}" == "2.46e-03 ± 2.73e-04"
