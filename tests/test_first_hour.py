@@ -107,3 +107,25 @@ def test_statistic_converts_and_prints_rounded_to_its_interval():
         stat * stat
     assert str(stat) == "0.00246 ± 0.00027" == f"{stat}"
     assert f"{stat:.2e}" == "2.46e-03 ± 2.73e-04"
+
+
+def test_prediction_prints_its_table_with_the_circuit_unit_and_frames_its_sweep():
+    """print() gives the table (not the repr), E[V^2] of a piezo in V^2; a broadcast
+    to_frame() has a column per swept input so its rows can be told apart."""
+    import numpy as np
+
+    piezo = rv.Harvester(m=0.0226, c_m=0.049, c_e=0.0, k=57.4, k3=7e4,
+                         electrical=rv.Piezo(theta=1e-3, capacitance=1e-8, r_load=1e5))  # fmt: skip
+    text = str(rv.predict(piezo, 1.0))
+    assert text.startswith("Prediction (linearisation)") and "PowerPrediction(" not in text
+    assert "circuit_mean_square" in text and text.rstrip().endswith("V^2")
+    assert "A^2" not in text
+    assert "electrical" not in rv.predict(piezo, 1.0).to_dict()
+
+    device = rv.preset("figure9").updated(c_m=np.array([[0.01], [0.02]]))
+    frame = rv.predict(device, np.array([1.0, 0.5])).to_frame()
+    assert list(frame["psd"]) == [1.0, 0.5, 1.0, 0.5]
+    assert list(frame["c_m"]) == [0.01, 0.01, 0.02, 0.02]
+
+    lin = rv.statistical_linearisation(rv.preset("figure9"), rv.BandPass(1.0, 8.0, 0.1))
+    assert str(lin).startswith("Statistical linearisation") and "k_eq" in str(lin)

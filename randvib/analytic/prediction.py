@@ -19,6 +19,8 @@ intervals (about 3 ms a point); ``"fpk"`` as the slow reference.
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 from scipy import optimize
 
@@ -128,7 +130,20 @@ def predict(harvester: Harvester, psd, method="linearisation") -> PowerPredictio
     _refuse_undamped(harvester)
     if not non_white(psd):  # White(S) runs exactly the code of the number S
         psd = check_positive("psd", white_level(psd), "(m/s^2)^2/Hz")
-    return _finite(solver, harvester, psd)
+    result = _finite(solver, harvester, psd)
+    inputs = _swept_inputs(harvester, psd)
+    return dataclasses.replace(result, inputs=inputs) if inputs else result
+
+
+def _swept_inputs(harvester: Harvester, psd) -> dict:
+    """The array-valued inputs of a broadcast call (``psd``, device parameters), by name."""
+    values = {"psd": psd} if not isinstance(psd, Excitation) else {}
+    values.update(harvester.parameters())
+    return {
+        name: np.asarray(value, dtype=float)
+        for name, value in values.items()
+        if not isinstance(value, str) and np.ndim(value) > 0
+    }
 
 
 def _refuse_undamped(harvester: Harvester) -> None:

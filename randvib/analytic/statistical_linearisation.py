@@ -175,6 +175,11 @@ class LinearisationResult(LinearisedDevice):
         fields = ", ".join(f"{name}={value}" for name, value, _ in self._rows())
         return f"LinearisationResult({self.excitation!r}, {self.method}; {fields})"
 
+    def __str__(self) -> str:
+        """The table of :meth:`_repr_html_` as plain text (``print(result)``)."""
+        title = f"Statistical linearisation ({self.method}) under {self.excitation!r}"
+        return _display.text_table(title, self._rows())
+
     def _repr_html_(self) -> str:
         title = f"Statistical linearisation ({self.method}) under {self.excitation!r}"
         return _display.html_table(title, self._rows())
@@ -384,6 +389,7 @@ class Linearisation(AnalyticMethod):
             power_load=lin.power_load,
             circuit_mean_square=lin.circuit_variance,
             stroke_exceedance=None if exceedance is None else float(exceedance),
+            electrical=harvester.electrical,
         )
 
     def solve_transient(self, harvester: Harvester, event, times, t_end, start):
@@ -407,7 +413,7 @@ def _stacked(points: list[PowerPrediction], shape: tuple) -> PowerPrediction:
                  "power_electrical", "power_load", "circuit_mean_square", "stroke_exceedance"):  # fmt: skip
         values = [getattr(point, name) for point in points]
         fields[name] = None if values[0] is None else np.asarray(values, dtype=float).reshape(shape)
-    return PowerPrediction(method=points[0].method, **fields)
+    return PowerPrediction(method=points[0].method, electrical=points[0].electrical, **fields)
 
 
 def _state(harvester: Harvester, outputs: dict):
