@@ -129,3 +129,45 @@ def test_prediction_prints_its_table_with_the_circuit_unit_and_frames_its_sweep(
 
     lin = rv.statistical_linearisation(rv.preset("figure9"), rv.BandPass(1.0, 8.0, 0.1))
     assert str(lin).startswith("Statistical linearisation") and "k_eq" in str(lin)
+
+
+def test_bistable_device_by_its_wells_and_barrier():
+    """Harvester.bistable / Potential.from_wells invert z_w = sqrt(-k/k3), Delta U = k^2/(4 k3)
+    exactly (to rounding); natural_frequency is the well frequency sqrt(-2k/m), not nan."""
+    import numpy as np
+
+    device = rv.Harvester.bistable(0.002, 1e-4, m=0.0226, c_m=0.049, c_e=0.0)
+    assert device.k == pytest.approx(-100.0, rel=1e-14)
+    assert device.k3 == pytest.approx(2.5e7, rel=1e-14)
+    assert device.potential.wells[1] == pytest.approx(0.002, rel=1e-14)
+    assert device.potential.barrier_height == pytest.approx(1e-4, rel=1e-14)
+    assert device.natural_frequency == pytest.approx(np.sqrt(200.0 / 0.0226), rel=1e-14)
+    with pytest.raises(ValueError, match="`barrier`.*> 0 J"):
+        rv.Harvester.bistable(0.002, -1.0, m=0.0226, c_m=0.049, c_e=0.0)
+    with pytest.raises(ValueError, match="not `k`"):
+        rv.Harvester.bistable(0.002, 1e-4, m=0.0226, c_m=0.049, c_e=0.0, k=1.0)
+
+
+def test_cli_wells_and_barrier_give_the_same_device_and_say_bistable(capsys):
+    """`--wells/--barrier` predicts exactly what the equivalent `--k/--k3` predicts, and the
+    device line says bistable, where the wells are and the well frequency; a piezo device's
+    line has no c_e (it couples through its circuit)."""
+    import json
+
+    base = ["power", "--m", "0.0226", "--c-m", "0.049", "--c-e", "0.01", "--psd", "0.005"]
+    code, by_wells, err = run_cli(capsys, *base, "--wells", "0.002", "--barrier", "1e-4")
+    assert code == 0, err
+    assert "bistable: wells at z = +-0.002 m, barrier 0.0001 J, well frequency" in by_wells
+    code, by_k, err = run_cli(capsys, *base, "--k=-100", "--k3", "2.5e7", "--json")
+    code, by_wells_json, err = run_cli(capsys, *base, "--wells", "0.002", "--barrier", "1e-4",
+                                       "--json")  # fmt: skip
+    a, b = json.loads(by_k), json.loads(by_wells_json)
+    assert a["power_electrical"] == pytest.approx(b["power_electrical"], rel=1e-12)
+    one_line_error(capsys, [*base, "--wells", "0.002"], "`--barrier` is missing")
+    one_line_error(capsys, [*base, "--wells", "0.002", "--barrier", "1", "--k", "3"], "not both")
+
+    piezo = ["power", "--m", "0.0226", "--c-m", "0.049", "--k", "57.4", "--coupling", "piezo",
+             "--theta", "1e-3", "--capacitance", "1e-8", "--r-load", "1e5", "--psd", "1"]  # fmt: skip
+    code, out, err = run_cli(capsys, *piezo)
+    assert code == 0 and "c_e" not in out.splitlines()[0], out
+    assert "circuit_mean_square" in out and "A^2" not in out
