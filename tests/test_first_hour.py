@@ -2,8 +2,13 @@
 
 Covers the step check's refusal (:mod:`randvib.montecarlo.step_check`), file
 modes of written outputs (:mod:`randvib._io`, see also tests/test_output_files.py),
-and the refusals of the CLI's option parsing and checks
-(:mod:`randvib.cli.power`, :mod:`randvib.cli.identify`).
+:class:`randvib.statistics.Statistic`'s conversions, the printed tables and
+frames of :mod:`randvib.analytic.power_prediction`, broadcasting in
+:mod:`randvib.analytic.prediction` and :mod:`randvib.analytic.statistical_linearisation`,
+bistable devices by their wells (:mod:`randvib.models.potential`,
+:mod:`randvib.models.harvester`), and the CLI's options and refusals
+(:mod:`randvib.cli.power`, :mod:`randvib.cli._device`, :mod:`randvib.cli._excitation`,
+:mod:`randvib.cli._output`, :mod:`randvib.cli.validate`).
 """
 
 import warnings
@@ -171,3 +176,33 @@ def test_cli_wells_and_barrier_give_the_same_device_and_say_bistable(capsys):
     code, out, err = run_cli(capsys, *piezo)
     assert code == 0 and "c_e" not in out.splitlines()[0], out
     assert "circuit_mean_square" in out and "A^2" not in out
+
+
+def test_power_record_takes_input_column_and_sample_rate_like_identify(capsys, tmp_path):
+    """`power --record` reads another column name and a file without time column, and gives
+    the same prediction as from the standard file; the options alone are refused."""
+    import json
+
+    record = rv.synthetic_record(rv.preset("coulomb-td1"), 2.0, duration=2.0,
+                                 sample_rate=1000.0, seed=1)  # fmt: skip
+    standard = tmp_path / "standard.csv"
+    record.to_csv(standard, float_format=None)
+    bare = tmp_path / "bare.csv"
+    bare.write_text("acc\n" + "\n".join(repr(float(a)) for a in record["base_acceleration"]))
+    argv = ["power", "--preset", "coulomb-td1", "--c-e", "0.01", "--json", "--record"]
+    code, out, err = run_cli(capsys, *argv, standard)
+    assert code == 0, err
+    code, out_bare, err = run_cli(capsys, *argv, bare, "--input-column", "acc",
+                                  "--sample-rate", "1000")  # fmt: skip
+    assert code == 0, err
+    assert json.loads(out_bare)["power_electrical"] == pytest.approx(
+        json.loads(out)["power_electrical"],
+        rel=1e-9,  # the same samples, the same Welch PSD
+    )
+    one_line_error(capsys, [*POWER, "--sample-rate", "1000"], "needs `--record`")
+
+
+def test_validate_accepts_no_progress(capsys, record_csv):
+    """`randvib validate --no-progress` is accepted as by every other command."""
+    code, out, err = run_cli(capsys, "validate", record_csv[1], record_csv[0], "--no-progress")
+    assert code == 0, err

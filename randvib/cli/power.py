@@ -86,7 +86,7 @@ def _method_help() -> str:
 
 
 #: The options that take a single value even in ``power`` (not physical numbers).
-NOT_SWEPT = ("psd_file", "record", "t_end")
+NOT_SWEPT = ("psd_file", "record", "t_end", "sample_rate")
 
 
 def _allow_sweeps(parser) -> None:

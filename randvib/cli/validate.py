@@ -37,6 +37,11 @@ def register(sub) -> None:
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument(
+        "--no-progress",
+        action="store_true",
+        help="no progress display (validate shows none; accepted as by every command)",
+    )
+    p.add_argument(
         "--plot", metavar="DIR", help="write one measured-vs-simulated PNG per record into DIR"
     )
     p.add_argument(

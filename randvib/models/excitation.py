@@ -673,11 +673,27 @@ class Measured(Excitation):
         return Measured(scaled, self.segment_length)
 
     @classmethod
-    def from_csv(cls, path, segment_length: int | None = None) -> Measured:
-        """Read a record with the columns ``time`` (s) and ``base_acceleration`` (m/s^2)."""
-        return cls(
-            read_record(path, input_kind="base_acceleration", output_column=None), segment_length
+    def from_csv(
+        cls,
+        path,
+        segment_length: int | None = None,
+        *,
+        input_column: str | None = None,
+        sample_rate: float | None = None,
+    ) -> Measured:
+        """Read a record with the columns ``time`` (s) and ``base_acceleration`` (m/s^2).
+
+        ``input_column`` names another acceleration column; ``sample_rate`` (Hz)
+        serves a file without a time column (as :func:`randvib.read_record`).
+        """
+        record = read_record(
+            path,
+            input_column=input_column,
+            input_kind="base_acceleration",
+            output_column=None,
+            sample_rate=sample_rate,
         )
+        return cls(record, segment_length)
 
     @property
     def time(self) -> np.ndarray:
