@@ -206,3 +206,17 @@ def test_validate_accepts_no_progress(capsys, record_csv):
     """`randvib validate --no-progress` is accepted as by every other command."""
     code, out, err = run_cli(capsys, "validate", record_csv[1], record_csv[0], "--no-progress")
     assert code == 0, err
+
+
+def test_measured_record_names_welch_integral_and_record_variance():
+    """A measured excitation reports the integral of its Welch PSD and the samples' variance
+    under their own names, not both as "variance"."""
+    import numpy as np
+
+    record = rv.synthetic_record(rv.preset("coulomb-td1"), 2.0, duration=2.0,
+                                 sample_rate=1000.0, seed=1)  # fmt: skip
+    measured = rv.Measured(record)
+    parameters = measured.parameters()
+    assert "variance" not in parameters
+    assert parameters["record_variance"] == pytest.approx(np.var(record["base_acceleration"]))
+    assert parameters["psd_integral"] == measured.variance

@@ -745,13 +745,21 @@ class Measured(Excitation):
             "duration": self.duration,
             "dt": self.dt,
             "segment_length": self.segment_length,
-            "variance": self.variance,
+            # two numbers, named for what they are: the Welch integral the methods
+            # use and the samples' own variance (they differ by the estimate's error)
+            "psd_integral": self.variance,
+            "record_variance": self.record_variance,
         }
+
+    @property
+    def record_variance(self) -> float:
+        """Variance of the recorded acceleration about its mean ((m/s^2)^2)."""
+        return float(np.var(self.acceleration))
 
     def __repr__(self) -> str:  # the record's size, not its samples
         return (
             f"Measured({self.record.n} samples at {1.0 / self.dt:.6g} Hz, {self.duration:.6g} s, "
-            f"variance {self.variance:.4g} (m/s^2)^2)"
+            f"Welch PSD integral {self.variance:.4g} (m/s^2)^2)"
         )
 
 
