@@ -124,6 +124,10 @@ def test_verdict_lines_show_sentences_then_numbers(tmp_path):
     assert verdict_lines(tmp_path) == ["  a.n: 3"]
     (tmp_path / "report.md").write_text("# T\n\n## S\n\nText.\n\n**Verdict.** It holds\nhere.\n")
     assert verdict_lines(tmp_path)[0] == "- It holds here."
+    (tmp_path / "report.md").write_text("**Verdict.**\n\n- **a**: one.\n- **b**: two.\n")
+    assert verdict_lines(tmp_path) == [
+        "- a: one.", "- b: two.", f"  (1 number behind them in {tmp_path / 'verdicts.json'})"
+    ]  # fmt: skip
 
 
 def test_fit_window_holds_about_thirty_cycles():

@@ -177,7 +177,8 @@ def verdict_lines(out_dir: Path, max_items: int = 40) -> list[str]:
     if not lines:  # no sentence stored with the numbers: the report's own
         lines = [f"- {s}" for s in _report_verdicts(Path(out_dir) / "report.md")]
     if lines:
-        return lines + [f"  ({len(flat)} numbers behind them in {path})"] if flat else lines
+        count = f"{len(flat)} number{'s' * (len(flat) != 1)}"
+        return lines + [f"  ({count} behind them in {path})"] if flat else lines
     if len(flat) > max_items:
         flat = flat[:max_items] + [f"... ({len(flat) - max_items} more in {path})"]
     return [f"  {line}" for line in flat]
@@ -189,9 +190,18 @@ def _report_verdicts(report: Path) -> list[str]:
         text = report.read_text()
     except OSError:
         return []
-    paragraphs = [" ".join(p.split()) for p in text.split("\n\n")]
-    mark = "**Verdict.**"
-    return [p[p.index(mark) + len(mark) :].strip() for p in paragraphs if mark in p]
+    paragraphs = text.split("\n\n")
+    mark, out = "**Verdict.**", []
+    for i, paragraph in enumerate(paragraphs):
+        if mark not in paragraph:
+            continue
+        rest = paragraph[paragraph.index(mark) + len(mark) :].strip()
+        if rest:
+            out.append(" ".join(rest.split()))
+        elif i + 1 < len(paragraphs):  # "**Verdict.**" above a list: its items
+            items = paragraphs[i + 1].strip().split("\n- ")
+            out += [" ".join(item.lstrip("- ").replace("**", "").split()) for item in items]
+    return [sentence for sentence in out if sentence]
 
 
 def print_verdicts(report: Path) -> None:
