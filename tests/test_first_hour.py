@@ -8,7 +8,8 @@ frames of :mod:`randvib.analytic.power_prediction`, broadcasting in
 bistable devices by their wells (:mod:`randvib.models.potential`,
 :mod:`randvib.models.harvester`), and the CLI's options and refusals
 (:mod:`randvib.cli.power`, :mod:`randvib.cli._device`, :mod:`randvib.cli._excitation`,
-:mod:`randvib.cli._output`, :mod:`randvib.cli.validate`).
+:mod:`randvib.cli._output`, :mod:`randvib.cli.validate`); the printed table of
+:mod:`randvib.identification.result`.
 """
 
 import warnings
@@ -220,3 +221,12 @@ def test_measured_record_names_welch_integral_and_record_variance():
     assert "variance" not in parameters
     assert parameters["record_variance"] == pytest.approx(np.var(record["base_acceleration"]))
     assert parameters["psd_integral"] == measured.variance
+
+
+def test_identification_result_prints_its_table(record_csv):
+    """print() of an IdentificationResult is the table of its notebook view, not the repr."""
+    fit = rv.identify(rv.read_record(record_csv[0]), "coulomb", m=0.0226, popsize=8, maxiter=2,
+                      polish=False, fixed={"k3": 70742.0})  # fmt: skip
+    text = str(fit)
+    assert text.startswith("Identification") and "IdentificationResult(" not in text
+    assert "fc" in text and "N" in text
