@@ -226,6 +226,7 @@ def write_or_keep(path, text: str, option: str) -> Path | None:
         reason = exc.strerror or type(exc).__name__
         fd, spare = tempfile.mkstemp(prefix="randvib-unsaved-", suffix=Path(path).suffix, dir=".")
         try:
+            os.fchmod(fd, _new_file_mode())
             with os.fdopen(fd, "w") as f:
                 f.write(text)
         except OSError:
@@ -239,12 +240,24 @@ def write_or_keep(path, text: str, option: str) -> Path | None:
 
 
 # ------------------------------------------------------------------ atomic writes
+def _new_file_mode() -> int:
+    """The mode ``open()`` gives a new file: 0666 less the process umask.
+
+    ``tempfile.mkstemp`` creates its file 0600 whatever the umask; files written
+    through it are set to this mode, so every file randvib writes follows one rule.
+    """
+    mask = os.umask(0)
+    os.umask(mask)
+    return 0o666 & ~mask
+
+
 def atomic_write_bytes(path, data: bytes) -> None:
     """Write a file via a unique temporary name and rename, so a crash never leaves
     half a file and two writers never share a temporary file."""
     path = Path(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
+        os.fchmod(fd, _new_file_mode())
         with os.fdopen(fd, "wb") as f:
             f.write(data)
         os.replace(tmp, path)

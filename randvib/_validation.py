@@ -148,7 +148,8 @@ def check_scalar_device(harvester, function: str):
             raise ValueError(
                 f"{function} needs scalar harvester parameters (one device): `{name}` is an "
                 f"array of shape "
-                f"{np.shape(value)}; loop over its values (randvib.predict and "
-                "randvib.expected_power broadcast over arrays)"
+                f"{np.shape(value)}; loop over its values (only white noise with a resistive "
+                "coupling broadcasts over device arrays, in randvib.predict and "
+                "randvib.expected_power)"
             )
     return harvester

@@ -64,6 +64,10 @@ QUANTITIES: dict[str, Quantity] = {
     "f_lo": Quantity("Hz", "lower band edge"),
     "f_hi": Quantity("Hz", "upper band edge"),
     "variance": Quantity("(m/s^2)^2", "variance of the base acceleration"),
+    "psd_integral": Quantity(
+        "(m/s^2)^2", "integral of the record's Welch PSD (the variance the methods see)"
+    ),
+    "record_variance": Quantity("(m/s^2)^2", "variance of the recorded base acceleration"),
     "duration": Quantity("s", "duration"),
     "dt": Quantity("s", "time step"),
     "segment_length": Quantity("samples", "Welch segment length"),

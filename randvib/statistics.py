@@ -25,6 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import special  # Student t quantile; lighter than scipy.stats
 
+from randvib import formatting
+
 
 @dataclass(frozen=True)
 class Statistic:
@@ -40,6 +42,12 @@ class Statistic:
         Standard error of ``mean``.
     n_paths : int
         Number of independent paths behind it.
+
+    ``float(stat)`` is the mean. Multiplying or dividing by a number, or adding
+    or subtracting one, gives a Statistic with the interval mapped exactly
+    (``stat * 1e3`` for mW); arithmetic between two Statistics is refused, since
+    it needs their correlation (:func:`paired_ratio` for a ratio of paired
+    ensembles). ``str(stat)`` and ``f"{stat}"`` round the mean to its interval.
     """
 
     mean: float
@@ -56,8 +64,56 @@ class Statistic:
         return {"mean": self.mean, "ci95": self.ci95}
 
     def __format__(self, spec):
-        spec = spec or ".6g"
+        """``mean ± ci95``; without a spec the mean is rounded to its interval
+        (:func:`randvib.formatting.estimate`), with one (``f"{stat:.3e}"``) both use it."""
+        if not spec:
+            return formatting.estimate(self.mean, self.ci95)
         return f"{self.mean:{spec}} ± {self.ci95:{spec}}"
+
+    def __str__(self):
+        return format(self, "")
+
+    def __float__(self):
+        """The estimate itself (``float(stat)``); its interval is dropped."""
+        return float(self.mean)
+
+    # Scaling or shifting by a known number maps the interval exactly (a linear map
+    # of the mean), so those return a Statistic; products of two estimates need their
+    # correlation (paired_ratio) and are refused, as is a number divided by one.
+    def _scaled(self, factor: float) -> Statistic:
+        factor = float(factor)
+        return Statistic(self.mean * factor, self.ci95 * abs(factor),
+                         self.std_error * abs(factor), self.n_paths)  # fmt: skip
+
+    def _shifted(self, offset: float) -> Statistic:
+        return Statistic(self.mean + float(offset), self.ci95, self.std_error, self.n_paths)
+
+    def __mul__(self, other):
+        return self._scaled(other) if _is_scalar(other) else NotImplemented
+
+    __rmul__ = __mul__
+
+    def __truediv__(self, other):
+        return self._scaled(1.0 / float(other)) if _is_scalar(other) else NotImplemented
+
+    def __add__(self, other):
+        return self._shifted(other) if _is_scalar(other) else NotImplemented
+
+    __radd__ = __add__
+
+    def __sub__(self, other):
+        return self._shifted(-float(other)) if _is_scalar(other) else NotImplemented
+
+    def __rsub__(self, other):
+        return self._scaled(-1.0)._shifted(other) if _is_scalar(other) else NotImplemented
+
+    def __neg__(self):
+        return self._scaled(-1.0)
+
+
+def _is_scalar(value) -> bool:
+    """A plain real number (not a Statistic, not an array), for Statistic's arithmetic."""
+    return isinstance(value, int | float | np.integer | np.floating) and not isinstance(value, bool)
 
 
 def estimate(samples, controls=None, folds: int = 4) -> Statistic:

@@ -122,14 +122,15 @@ def answer(v: dict) -> str:
     parts, mark = [], budget.bound_mark
     for name, devs in v["fixed_input"].items():
         b, at = devs["bistable"], v["at_budget"][name]["bistable"]
-        more = ", ".join(f"{g:g}" for g in b["levels_more_power"]) or "none"
+        levels = ", ".join(f"{g:g}" for g in b["levels_more_power"])
+        more = f"at g = {levels}" if levels else "at none of the levels"
         within = ", ".join(
             f"g = {w['g']:g} ({w['ratio']:.3f} ± {w['ratio_ci95']:.3f} times, "
             f"{100 * w['exceedance']:.2g} ± {100 * w['exceedance_ci95']:.2g} % beyond)"
             for w in b["more_power_within_budget"]
         )
         parts.append(
-            f"{name}: more power than the linear device (paired, 95 %) at g = {more}; "
+            f"{name}: more power than the linear device (paired, 95 %) {more}; "
             f"of these, within the budget (exceedance and its half-width at most "
             f"{100 * v['budget']:g} %): {within or 'none'}; largest "
             f"ratio {b['largest_ratio']:.3f} ± {b['largest_ratio_ci95']:.3f} at g = "

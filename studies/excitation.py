@@ -38,7 +38,7 @@ from scipy import special
 
 import randvib as rv
 from randvib.figure_style import num_tex
-from randvib.formatting import plus_minus
+from randvib.formatting import plus_minus, significant
 from randvib.statistics import holm_significant
 from randvib.studies import figures, report, script_main
 from randvib.studies.contrasts import paired_interactions
@@ -95,6 +95,11 @@ def compute(base, axes, settings, out, workers, scheduler, progress):
 
 
 # ----------------------------------------------------------------- verdicts
+def where(centre: str) -> str:
+    """'band above resonance (1.25 f_n)': a band's centre in words and as a multiple of f_n."""
+    return f"band {centre} resonance ({CENTRES[centre]:g} f_n)"
+
+
 def verdicts(results: pd.DataFrame, inter: pd.DataFrame) -> dict:
     """The numbers behind the report's verdicts, computed from the two tables."""
     lin = results[(results.fc > 0) & (results.centre != "white")]
@@ -111,10 +116,10 @@ def verdicts(results: pd.DataFrame, inter: pd.DataFrame) -> dict:
         "linearisation": {
             "largest_abs_error_by_zeta": {f"{z:g}": v for z, v in by_zeta.items()},
             "largest_abs_error": float(abs(worst.linearisation_rel_error)),
-            "where_largest": f"{worst.centre} resonance, zeta = {worst.zeta:g}, k3 = {worst.k3:g}",
+            "where_largest": f"{where(worst.centre)}, zeta = {worst.zeta:g}, k3 = {significant(worst.k3, 3)}",
             "largest_ci95": float(worst.linearisation_rel_error_ci95),
             "white_noise_errors": [float(e) for e in white.linearisation_rel_error],
-            "linear_device_exact_max_abs_z": float(np.abs(z_exact).max()),
+            "linear_device_exact_max_abs_score": float(np.abs(z_exact).max()),
         },
         "interaction": {
             "n_contrasts": int(len(band)),
@@ -123,15 +128,17 @@ def verdicts(results: pd.DataFrame, inter: pd.DataFrame) -> dict:
             "practical_threshold": PRACTICAL,
             "breaks": breaks[["centre", "zeta", "k3", "relative_contrast", "relative_ci95"]
                              ].to_dict("records"),
-            "by_k3": {f"{k3:g}": contrast_range(sub) for k3, sub in band.groupby("k3")},
+            "by_k3": {significant(k3, 3): contrast_range(sub, "band {centre} resonance, zeta = {zeta:g}")
+                      for k3, sub in band.groupby("k3")},
             "largest_relative_contrast": float(largest.relative_contrast),
             "largest_relative_ci95": float(largest.relative_ci95),
-            "where_largest": f"{largest.centre}, zeta = {largest.zeta:g}, k3 = {largest.k3:g}",
+            "where_largest": f"{where(largest.centre)}, zeta = {largest.zeta:g}, "
+                             f"k3 = {significant(largest.k3, 3)}",
             "white_relative_contrasts": {
-                f"{r.k3:g}": [float(r.relative_contrast), float(r.relative_ci95)]
+                significant(r.k3, 3): [float(r.relative_contrast), float(r.relative_ci95)]
                 for r in inter[inter.centre == "white"].itertuples()},
             "no_interaction_holds_down_to_zeta": {
-                f"{centre}, k3={k3:g}": holds_down_to(sub)
+                f"{where(centre)}, k3 = {significant(k3, 3)}": holds_down_to(sub)
                 for (centre, k3), sub in band.groupby(["centre", "k3"])},
         },
     }  # fmt: skip
@@ -145,7 +152,7 @@ def setup_section(axes, results, settings, quick, wall) -> str:
     return (
         "Device: preset `figure9` (c_m = c_e = 0.1 Ns/m, k = 57.4 N/m, m = 0.0226 kg assumed; "
         f"linear resonance 8.02 Hz), Coulomb Fc = 0 and {1e3 * FC:g} mN, k3 = "
-        + ", ".join(f"{k:g}" for k in axes["k3s"])
+        + ", ".join(significant(k, 3) for k in axes["k3s"])
         + " N/m^3. Band-pass input (peak S at f0, half-power bandwidth 2 zeta f0), peak level "
         "matched so that the linear device's E[z'^2] equals that under white noise S = 1 "
         "(levels below). " + mc + "\n\n" + report.markdown_table(levels, floatfmt=".4g")
@@ -169,7 +176,8 @@ def linearisation_section(results, v, figure) -> str:
         f" % (± {100 * lin['largest_ci95']:.1f} %, {lin['where_largest']}); largest magnitude per "
         f"band: {by_zeta}. Under white noise (S = 1) the same devices give {white}. The linear "
         "device (no friction, no spring) is exact for both methods, a check of the Monte Carlo: "
-        f"the largest |z| of the difference is {lin['linear_device_exact_max_abs_z']:.2f}.\n\n"
+        "the largest |difference| / standard error is "
+        f"{lin['linear_device_exact_max_abs_score']:.2f}.\n\n"
         + report.markdown_table(shown, floatfmt=".3g")
     )
 

@@ -134,7 +134,7 @@ def test_tables_records_and_spectra_have_compact_reprs(simulation):
             base_acceleration=np.random.default_rng(0).normal(size=4000),
         )
     )
-    assert repr(record).startswith("Measured(4000 samples at 1000 Hz, 4 s, variance ")
+    assert repr(record).startswith("Measured(4000 samples at 1000 Hz, 4 s, Welch PSD integral ")
     statistical = rv.statistical_linearisation(rv.preset("figure9"), table)
     assert "array" not in repr(statistical) and "array" not in statistical._repr_html_()
     spectra = rv.simulate(

@@ -155,3 +155,25 @@ def test_metadata_that_is_a_list_or_a_folder_is_named(capsys, tmp_path, bad):
         meta.mkdir()
     with pytest.raises(FileExistsError, match="not a randvib metadata file"):
         _io.prepare_output_dir(tmp_path, {"grid": 1})
+
+
+@pytest.mark.parametrize("umask", [0o022, 0o077, 0o002])
+def test_written_files_follow_the_umask_like_open(tmp_path, monkeypatch, umask):
+    """Atomic writes and kept-beside results get the mode ``open()`` would give (0666 less
+    the umask), not mkstemp's 0600, so PNG, study and CSV/JSON outputs share one rule."""
+    import os
+    import stat
+
+    old = os.umask(umask)
+    try:
+        _io.atomic_write_bytes(tmp_path / "a.png", b"x")
+        _io.write_tracked(tmp_path / "b.csv", "x\n")
+        monkeypatch.chdir(tmp_path)
+        kept = _io.write_or_keep(tmp_path / "missing" / "c.json", "{}", "--save")
+        (tmp_path / "plain.txt").write_text("x")
+    finally:
+        os.umask(old)
+    expected = stat.S_IMODE((tmp_path / "plain.txt").stat().st_mode)
+    assert expected == 0o666 & ~umask
+    for path in (tmp_path / "a.png", tmp_path / "b.csv", kept):
+        assert stat.S_IMODE(Path(path).stat().st_mode) == expected, path

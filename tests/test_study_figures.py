@@ -117,8 +117,17 @@ def test_rescaled_rows_count_once_and_only_when_the_numbers_rescale():
 def test_verdict_lines_show_sentences_then_numbers(tmp_path):
     write_verdicts(tmp_path, {"a": {"n": 3, "x": 0.123456, "rows": [{"k": 1}]}}, ["It holds."])
     lines = verdict_lines(tmp_path)
-    assert lines == ["- It holds.", "  a.n: 3", "  a.x: 0.1235", "  a.rows: 1 entries"]
+    assert lines == ["- It holds.", f"  (3 numbers behind them in {tmp_path / 'verdicts.json'})"]
     assert verdict_lines(tmp_path / "missing") == []
+    # no sentence stored: the report's verdict paragraphs, else the numbers themselves
+    write_verdicts(tmp_path, {"a": {"n": 3}})
+    assert verdict_lines(tmp_path) == ["  a.n: 3"]
+    (tmp_path / "report.md").write_text("# T\n\n## S\n\nText.\n\n**Verdict.** It holds\nhere.\n")
+    assert verdict_lines(tmp_path)[0] == "- It holds here."
+    (tmp_path / "report.md").write_text("**Verdict.**\n\n- **a**: one.\n- **b**: two.\n")
+    assert verdict_lines(tmp_path) == [
+        "- a: one.", "- b: two.", f"  (1 number behind them in {tmp_path / 'verdicts.json'})"
+    ]  # fmt: skip
 
 
 def test_fit_window_holds_about_thirty_cycles():

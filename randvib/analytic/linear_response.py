@@ -156,6 +156,9 @@ def frequency_rule(block: StateSpace, excitation: Excitation):
         raise ValueError("the block has no mode and the spectrum no feature to integrate over")
     top = min(hi, _TAIL_FACTOR * max(scales))
     small = 1e-3 * min([w for _, w in features] + [b for b in kinks if b > 0])
+    # a band edge at a subnormal frequency (f_lo = 5e-324 Hz) would make the grid
+    # start at 0; below 1e-12 of the top, one panel holds a negligible, bounded integrand
+    small = max(small, 1e-12 * top)
     edges = [lo, top, *kinks, *np.geomspace(small, top, _GRID_POINTS)]
     for fc, w in features:
         offsets = w * 2.0**_PEAK_POWERS

@@ -8,7 +8,7 @@ share), which every method computes the same way.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 from scipy import special
@@ -43,6 +43,13 @@ class PowerPrediction:
     circuit_mean_square : float or None
         E[i^2] (A^2) or E[V^2] (V^2) of a circuit state (inductive or piezo
         coupling); None without one (and left out of :meth:`to_dict`).
+    electrical : Coupling or None
+        The device's coupling, which sets the unit shown for
+        ``circuit_mean_square``; not a result (left out of :meth:`to_dict`).
+    inputs : dict or None
+        For a broadcast prediction, its array-valued inputs by name (``psd``,
+        device parameters such as ``c_m``), which :meth:`to_frame` writes as
+        columns so that its rows can be told apart; not a result.
     stroke_exceedance : float, ndarray or None
         P(|z| > stroke), the stationary fraction of time beyond the
         harvester's stroke; None without a stroke, for the free mass and for
@@ -72,6 +79,10 @@ class PowerPrediction:
     power_coil_loss: object = None
     power_diode_loss: object = None
     power_mechanical: object = None
+    #: the device's coupling, for the circuit state's unit (A^2 for a coil, V^2 for a piezo)
+    electrical: object = field(default=None, repr=False, compare=False)
+    #: the array-valued inputs of a broadcast prediction (name -> values), its sweep's axes
+    inputs: object = field(default=None, repr=False, compare=False)
 
     @classmethod
     def from_white_noise(
@@ -112,6 +123,7 @@ class PowerPrediction:
             power_electrical=clean(power),
             power_load=None if power_load is None else clean(power_load),
             stroke_exceedance=None if stroke_exceedance is None else clean(stroke_exceedance),
+            electrical=harvester.electrical,
         )
 
     def to_dict(self) -> dict:
@@ -119,7 +131,9 @@ class PowerPrediction:
 
         ``circuit_mean_square`` and ``stroke_exceedance`` only when given.
         """
-        out = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in asdict(self).items()}
+        fields = asdict(self)
+        del fields["electrical"], fields["inputs"]  # the device's and the sweep's, not results
+        out = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in fields.items()}
         for optional in ("circuit_mean_square", "stroke_exceedance", *BRIDGE_POWERS):
             if out[optional] is None:
                 del out[optional]
@@ -128,7 +142,9 @@ class PowerPrediction:
     def _quantities(self) -> list[tuple[str, object, str]]:
         """(name, value, unit) of every field with a value."""
         out = [(name, getattr(self, name)) for name in SHOWN]
-        return [(name, value, unit(name)) for name, value in out if value is not None]
+        return [
+            (name, value, unit(name, self.electrical)) for name, value in out if value is not None
+        ]
 
     def to_frame(self):
         """The prediction as a :class:`pandas.DataFrame`.
@@ -136,14 +152,14 @@ class PowerPrediction:
         One row for scalar inputs; for a broadcast sweep one row per point
         (the fields broadcast together and are flattened in C order, so row
         ``i`` is ``numpy.unravel_index(i, shape)`` of the sweep's shape).
-        Columns are the fields (SI units, see the class) and ``method``.
+        Columns are ``method``, the swept inputs (``inputs``: ``psd``, array-valued
+        device parameters) and the fields (SI units, see the class).
         """
         pd = _display.pandas()
-        names = [name for name, _, _ in self._quantities()]
-        values = np.broadcast_arrays(
-            *(np.asarray(v, dtype=float) for _, v, _ in self._quantities())
-        )
-        frame = pd.DataFrame({n: v.ravel() for n, v in zip(names, values, strict=True)})
+        inputs = dict(self.inputs or {})
+        columns = [*inputs.items()] + [(name, v) for name, v, _ in self._quantities()]
+        values = np.broadcast_arrays(*(np.asarray(v, dtype=float) for _, v in columns))
+        frame = pd.DataFrame({n: v.ravel() for (n, _), v in zip(columns, values, strict=True)})
         frame.insert(0, "method", self.method)
         return frame
 
@@ -157,6 +173,10 @@ class PowerPrediction:
             f"{name}={formatting.compact(value)}" for name, value, _ in self._quantities()
         )
         return f"PowerPrediction(method={self.method!r}, {fields})"
+
+    def __str__(self) -> str:
+        """The table of :meth:`_repr_html_` as plain text (``print(prediction)``)."""
+        return _display.text_table(f"Prediction ({self.method})", self._rows())
 
     def _repr_html_(self) -> str:
         return _display.html_table(f"Prediction ({self.method})", self._rows())

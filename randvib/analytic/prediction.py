@@ -19,6 +19,7 @@ intervals (about 3 ms a point); ``"fpk"`` as the slow reference.
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 
 import numpy as np
@@ -36,7 +37,7 @@ from randvib.analytic.bridge import BRIDGE_CLOSURE
 from randvib.analytic.fokker_planck import FAST_FOKKER_PLANCK, FOKKER_PLANCK
 from randvib.analytic.method import AnalyticMethod, non_white, white_level
 from randvib.analytic.power_prediction import PowerPrediction
-from randvib.analytic.statistical_linearisation import LINEARISATION
+from randvib.analytic.statistical_linearisation import LINEARISATION, LinearisationDidNotConverge
 from randvib.models.excitation import BROADCASTING, Excitation
 from randvib.models.harvester import Harvester
 
@@ -132,7 +133,20 @@ def predict(harvester: Harvester, psd, method="linearisation") -> PowerPredictio
     _refuse_undamped(harvester)
     if not non_white(psd):  # White(S) runs exactly the code of the number S
         psd = check_positive("psd", white_level(psd), "(m/s^2)^2/Hz")
-    return _finite(solver, harvester, psd)
+    result = _finite(solver, harvester, psd)
+    inputs = _swept_inputs(harvester, psd)
+    return dataclasses.replace(result, inputs=inputs) if inputs else result
+
+
+def _swept_inputs(harvester: Harvester, psd) -> dict:
+    """The array-valued inputs of a broadcast call (``psd``, device parameters), by name."""
+    values = {"psd": psd} if not isinstance(psd, Excitation) else {}
+    values.update(harvester.parameters())
+    return {
+        name: np.asarray(value, dtype=float)
+        for name, value in values.items()
+        if not isinstance(value, str) and np.ndim(value) > 0
+    }
 
 
 def _refuse_undamped(harvester: Harvester) -> None:
@@ -160,6 +174,10 @@ def _finite(solver: AnalyticMethod, harvester: Harvester, psd) -> PowerPredictio
             result = solver.solve(harvester, psd)
     except (ArithmeticError, RuntimeError, ValueError) as exc:
         own = _raised_by_randvib(exc) and not isinstance(exc, ArithmeticError)
+        if isinstance(exc, LinearisationDidNotConverge) and _extreme_values(harvester, psd):
+            # a parameter such as inductance = 1e-300 H, not the excitation, broke the search
+            what = "statistical linearisation found no fixed point"
+            raise ValueError(_out_of_range(method, harvester, psd, what)) from None
         if own and isinstance(exc, ValueError):
             raise  # randvib's own explanation (no stationary response, a potential it cannot treat)
         # a library's (scipy: "array must not contain infs or NaNs") after an
@@ -219,6 +237,8 @@ def _extreme_values(harvester: Harvester, psd) -> list[str]:
 def _out_of_range(method, harvester, psd, what, overflow: bool = True) -> str:
     """The refusal of a non-finite result; float64's range is blamed only when it is the cause."""
     level = psd.parameters() if isinstance(psd, Excitation) else psd
+    if np.ndim(level) == 0 and not isinstance(level, dict):
+        level = float(level)  # "psd = 0.005", not "psd = array(0.005)"
     text = f"method {method!r} has no finite result at these values ({what}): psd = {level!r}, "
     extreme = _extreme_values(harvester, psd) if overflow else []
     if not extreme:

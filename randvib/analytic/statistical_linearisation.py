@@ -176,6 +176,11 @@ class LinearisationResult(LinearisedDevice):
         fields = ", ".join(f"{name}={value}" for name, value, _ in self._rows())
         return f"LinearisationResult({self.excitation!r}, {self.method}; {fields})"
 
+    def __str__(self) -> str:
+        """The table of :meth:`_repr_html_` as plain text (``print(result)``)."""
+        title = f"Statistical linearisation ({self.method}) under {self.excitation!r}"
+        return _display.text_table(title, self._rows())
+
     def _repr_html_(self) -> str:
         title = f"Statistical linearisation ({self.method}) under {self.excitation!r}"
         return _display.html_table(title, self._rows())
@@ -386,6 +391,12 @@ class Linearisation(AnalyticMethod):
         return self.potentials if takes_fast_path(harvester, psd) else CONFINING
 
     def solve(self, harvester: Harvester, psd) -> PowerPrediction:
+        if not takes_fast_path(harvester, psd) and np.ndim(psd) > 0:
+            # the fixed point takes one white level at a time (a circuit state):
+            # solve each and broadcast the fields over the levels' shape, as the fast path does
+            levels = np.asarray(psd, dtype=float)
+            points = [self.solve(harvester, float(level)) for level in levels.ravel()]
+            return _stacked(points, levels.shape)
         lin = linearise(harvester, psd)
         vv, zz = lin.velocity_variance, lin.displacement_variance
         exceedance = None if zz is None else gaussian_exceedance(harvester.stroke, zz)
@@ -405,6 +416,7 @@ class Linearisation(AnalyticMethod):
             power_load=lin.power_load,
             circuit_mean_square=lin.circuit_variance,
             stroke_exceedance=None if exceedance is None else float(exceedance),
+            electrical=harvester.electrical,
         )
 
     def solve_transient(self, harvester: Harvester, event, times, t_end, start):
@@ -443,6 +455,16 @@ def _warn_friction_dominated(harvester: Harvester, c_eq, velocity_variance) -> N
 
 #: The method's declaration (:data:`randvib.analytic.prediction.METHODS` holds it).
 LINEARISATION = Linearisation()
+
+
+def _stacked(points: list[PowerPrediction], shape: tuple) -> PowerPrediction:
+    """One prediction whose fields are arrays of ``shape`` over the scalar ``points``."""
+    fields = {}
+    for name in ("c_eq", "velocity_variance", "displacement_variance", "mean_abs_velocity",
+                 "power_electrical", "power_load", "circuit_mean_square", "stroke_exceedance"):  # fmt: skip
+        values = [getattr(point, name) for point in points]
+        fields[name] = None if values[0] is None else np.asarray(values, dtype=float).reshape(shape)
+    return PowerPrediction(method=points[0].method, electrical=points[0].electrical, **fields)
 
 
 def _state(harvester: Harvester, outputs: dict):

@@ -47,8 +47,10 @@ class UserError(Exception):
 
 
 #: What argparse takes for a negative number (not an option): its own pattern
-#: misses exponents, so `--k3 -5e5` would be read as a missing value.
-NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
+#: misses exponents, infinities and START:STOP:COUNT sweeps, so `--k3 -5e5` or
+#: `--f0 -inf` would be read as a missing value rather than checked as a number.
+_NUMBER = r"((\d+\.?\d*|\.\d+)([eE][-+]?\d+)?|inf|infinity|nan)"
+NEGATIVE_NUMBER = re.compile(rf"^-{_NUMBER}(:[-+]?{_NUMBER}){{0,2}}$", re.IGNORECASE)
 
 
 #: argparse's refusal of a value outside ``choices`` (Python 3.11 and 3.12+ spellings).

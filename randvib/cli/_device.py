@@ -7,6 +7,7 @@ import argparse
 from randvib.models.coupling import COUPLINGS, coupling_class
 from randvib.models.friction import FRICTION_MODELS, RegistryView
 from randvib.models.harvester import ElectricalDampingOverflow, Harvester
+from randvib.models.potential import Potential
 from randvib.models.presets import PRESETS, preset
 from randvib.models.rectifier import RECTIFIED
 
@@ -79,6 +80,15 @@ def add_device_arguments(parser: argparse.ArgumentParser) -> None:
     )
     g.add_argument("--k3", type=float, help="cubic stiffness (N/m^3)")
     g.add_argument(
+        "--wells",
+        type=float,
+        help="bistable device by its wells at z = +-WELLS (m, > 0), with --barrier; "
+        "instead of --k/--k3 (k = -4 barrier/wells^2, k3 = 4 barrier/wells^4)",
+    )
+    g.add_argument(
+        "--barrier", type=float, help="barrier height between the wells (J, > 0), with --wells"
+    )
+    g.add_argument(
         "--stroke",
         type=float,
         help="stroke limit (m, > 0): report the time fraction with abs(z) beyond it "
@@ -139,6 +149,24 @@ def add_device_arguments(parser: argparse.ArgumentParser) -> None:
     )
 
 
+def _potential_from_wells(args) -> dict:
+    """``{"k": ..., "k3": ...}`` from ``--wells``/``--barrier`` (empty when neither is given)."""
+    wells, barrier = getattr(args, "wells", None), getattr(args, "barrier", None)
+    if wells is None and barrier is None:
+        return {}
+    if wells is None or barrier is None:
+        missing = "--barrier" if barrier is None else "--wells"
+        raise ValueError(f"`--wells` and `--barrier` go together: `{missing}` is missing")
+    if args.k is not None or args.k3 is not None:
+        raise ValueError("give either `--wells/--barrier` or `--k/--k3`, not both")
+    try:
+        potential = Potential.from_wells(wells, barrier)
+    except ValueError as error:
+        text = str(error).replace("`well`", "`--wells`").replace("`barrier`", "`--barrier`")
+        raise ValueError(text) from None
+    return {"k": potential.k, "k3": potential.k3}
+
+
 def harvester_from_args(args) -> Harvester:
     """Build the harvester from a preset and/or explicit options."""
     if args.preset is not None:
@@ -152,6 +180,7 @@ def harvester_from_args(args) -> Harvester:
         given = getattr(args, name)
         if given is not None:
             values[name] = given
+    values.update(_potential_from_wells(args))
 
     friction = _friction_from_args(args, friction)
 

@@ -81,6 +81,17 @@ def add_excitation_arguments(parser: argparse.ArgumentParser) -> None:
         help="measured base acceleration: CSV with the columns time (s, evenly spaced) and "
         "base_acceleration (m/s^2); its PSD by Welch's method",
     )
+    g.add_argument(
+        "--input-column",
+        metavar="NAME",
+        help="with --record: the base-acceleration column (default: base_acceleration)",
+    )
+    g.add_argument(
+        "--sample-rate",
+        type=float,
+        metavar="HZ",
+        help="with --record: sample rate when the file has no time column",
+    )
 
 
 def excitation_from_args(args):
@@ -99,6 +110,11 @@ def excitation_from_args(args):
         bad values, unreadable or invalid files.
     """
     files = {dest: getattr(args, dest) for dest in FILE_OPTIONS if getattr(args, dest) is not None}
+    columns = {"input_column": args.input_column, "sample_rate": args.sample_rate}
+    if "record" not in files:
+        for dest, value in columns.items():
+            if value is not None:
+                raise ValueError(f"`{option_flag(dest)}` reads a record: it needs `--record`")
     options = _parameter_options()
     given = {name: getattr(args, name) for name in options if getattr(args, name) is not None}
     if files:
@@ -110,7 +126,9 @@ def excitation_from_args(args):
         if extra:
             flags = ", ".join(f"`{flag}`" for flag in extra)
             raise ValueError(f"`{option_flag(dest)}` gives the whole spectrum; drop {flags}")
-        return _read(option_flag(dest), FILE_OPTIONS[dest], path)
+        return _read(
+            option_flag(dest), FILE_OPTIONS[dest], path, columns if dest == "record" else {}
+        )
 
     name = args.excitation or "white"
     own = _parameters(name)
@@ -134,15 +152,15 @@ def excitation_from_args(args):
         raise ValueError(message) from None
 
 
-def _read(flag: str, name: str, path: str):
-    """``EXCITATIONS[name].from_csv(path)``, its errors as one line naming ``flag``."""
+def _read(flag: str, name: str, path: str, columns: dict):
+    """``EXCITATIONS[name].from_csv(path, **columns)``, its errors as one line naming ``flag``."""
     file = Path(path)
     if file.is_dir():
         raise ValueError(f"`{flag}` must be a CSV file, got the folder {path}")
     if not file.exists():
         raise ValueError(f"`{flag}`: no such file {path}")
     try:
-        return EXCITATIONS[name].from_csv(file)
+        return EXCITATIONS[name].from_csv(file, **columns)
     except (ValueError, OSError) as exc:  # pandas' parse errors are ValueErrors
         first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
         # names inside the file's message are its columns ('psd'), not options

@@ -10,9 +10,10 @@ printed that the ensemble does not support; units come from
 
 from __future__ import annotations
 
+import numpy as np
 from tabulate import tabulate
 
-from randvib.formatting import cell
+from randvib.formatting import cell, compact
 from randvib.quantities import QUANTITIES, unit
 
 #: Table columns that hold words, not numbers.
@@ -51,7 +52,11 @@ DEVICE_PARAMETERS = ("m", "c_m", "c_e", "k", "k3")
 def describe_device(harvester) -> str:
     """One line: the device actually simulated or predicted (after preset and options)."""
     own = {name: getattr(harvester, name) for name in DEVICE_PARAMETERS}
+    if harvester.has_circuit:
+        del own["c_e"]  # a circuit state couples through the circuit (c_e = 0), shown below
     parts = [_assignments(own, _quantity_units(own))]
+    if np.ndim(harvester.k) == 0 and harvester.potential.kind == "bistable":
+        parts.append(_bistable(harvester))
     friction = harvester.friction
     if friction is None:
         parts.append("no friction")
@@ -70,6 +75,16 @@ def describe_device(harvester) -> str:
         stroke = {"stroke": harvester.stroke}
         parts.append(_assignments(stroke, _quantity_units(stroke)))
     return "device: " + "; ".join(parts)
+
+
+def _bistable(harvester) -> str:
+    """``bistable: wells at z = +-z_w m, barrier ... J, well frequency ... Hz``."""
+    potential = harvester.potential
+    well_hz = harvester.natural_frequency / (2.0 * np.pi)
+    return (
+        f"bistable: wells at z = +-{compact(potential.wells[1])} m, barrier "
+        f"{compact(potential.barrier_height)} J, well frequency {compact(well_hz)} Hz"
+    )
 
 
 def describe_excitation(psd) -> str:

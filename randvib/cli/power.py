@@ -91,7 +91,7 @@ def _method_help() -> str:
 
 
 #: The options that take a single value even in ``power`` (not physical numbers).
-NOT_SWEPT = ("psd_file", "record", "t_end")
+NOT_SWEPT = ("psd_file", "record", "t_end", "sample_rate")
 
 
 def _allow_sweeps(parser) -> None:
@@ -116,7 +116,9 @@ def sweep_values(text: str) -> list[float]:
         if len(parts) == 3:
             start, stop, count = float(parts[0]), float(parts[1]), int(parts[2])
             if count >= 2 and math.isfinite(start) and math.isfinite(stop):
-                return [start + (stop - start) * i / (count - 1) for i in range(count)]
+                # a convex combination: stop - start overflows for ends near the float limit
+                steps = [i / (count - 1) for i in range(count)]
+                return [start * (1.0 - t) + stop * t for t in steps]
     except ValueError:
         pass
     raise argparse.ArgumentTypeError(

@@ -62,7 +62,7 @@ def register(sub) -> None:
         "--segments",
         type=integer_option(2),
         default=None,
-        help="with --record: windows of the record that make the paths (default 10)",
+        help="with --record: windows the record is cut into, one batch mean each (default 10)",
     )
     g.add_argument(
         "--burn-in",
@@ -173,7 +173,13 @@ def run(args) -> int:
     print(describe_excitation(psd) if args.record is None else f"excitation: record {args.record}")
     print_table(rows, ("statistic", "Monte Carlo", "± 95 %", "linearisation", "unit"))
     if args.record is not None:
-        print(f"windows of the record as paths; lag-1 correlation {result.lag1_correlation:+.2f}")
+        # one record is one realisation: its windows are batch means, not independent paths
+        print(
+            f"{result.n_paths} windows of the record x {result.averaging_time:g} s averaged "
+            f"(batch means; lag-1 correlation between windows {result.lag1_correlation:+.2f}; "
+            f"dt {result.dt:g} s, {result.scheme}), {result.wall_time:.2f} s wall"
+        )
+        return 0
     print(
         f"{result.n_paths} paths x {result.averaging_time:g} s averaged (dt {result.dt:g} s, "
         f"{result.scheme}, seed {result.seed}), {result.wall_time:.2f} s wall"

@@ -54,6 +54,11 @@ def register(sub) -> None:
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument(
+        "--no-progress",
+        action="store_true",
+        help="no progress display (validate shows none; accepted as by every command)",
+    )
+    p.add_argument(
         "--plot",
         metavar="FILE.png|DIR",
         help="measured-vs-simulated figure: FILE.png (a new file) for one record, as identify "

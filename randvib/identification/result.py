@@ -241,6 +241,10 @@ class IdentificationResult:
             f"{values}; {self.nfev} simulations, {self.generations} generations)"
         )
 
+    def __str__(self) -> str:
+        """The table of :meth:`_repr_html_` as plain text (``print(result)``)."""
+        return _display.text_table("Identification", self._rows(), self._search_line())
+
     def _repr_html_(self) -> str:
         return _display.html_table("Identification", self._rows(), self._search_line())
 

@@ -673,11 +673,27 @@ class Measured(Excitation):
         return Measured(scaled, self.segment_length)
 
     @classmethod
-    def from_csv(cls, path, segment_length: int | None = None) -> Measured:
-        """Read a record with the columns ``time`` (s) and ``base_acceleration`` (m/s^2)."""
-        return cls(
-            read_record(path, input_kind="base_acceleration", output_column=None), segment_length
+    def from_csv(
+        cls,
+        path,
+        segment_length: int | None = None,
+        *,
+        input_column: str | None = None,
+        sample_rate: float | None = None,
+    ) -> Measured:
+        """Read a record with the columns ``time`` (s) and ``base_acceleration`` (m/s^2).
+
+        ``input_column`` names another acceleration column; ``sample_rate`` (Hz)
+        serves a file without a time column (as :func:`randvib.read_record`).
+        """
+        record = read_record(
+            path,
+            input_column=input_column,
+            input_kind="base_acceleration",
+            output_column=None,
+            sample_rate=sample_rate,
         )
+        return cls(record, segment_length)
 
     @property
     def time(self) -> np.ndarray:
@@ -729,13 +745,21 @@ class Measured(Excitation):
             "duration": self.duration,
             "dt": self.dt,
             "segment_length": self.segment_length,
-            "variance": self.variance,
+            # two numbers, named for what they are: the Welch integral the methods
+            # use and the samples' own variance (they differ by the estimate's error)
+            "psd_integral": self.variance,
+            "record_variance": self.record_variance,
         }
+
+    @property
+    def record_variance(self) -> float:
+        """Variance of the recorded acceleration about its mean ((m/s^2)^2)."""
+        return float(np.var(self.acceleration))
 
     def __repr__(self) -> str:  # the record's size, not its samples
         return (
             f"Measured({self.record.n} samples at {1.0 / self.dt:.6g} Hz, {self.duration:.6g} s, "
-            f"variance {self.variance:.4g} (m/s^2)^2)"
+            f"Welch PSD integral {self.variance:.4g} (m/s^2)^2)"
         )
 
 

@@ -145,6 +145,31 @@ class Harvester:
             )
 
     @classmethod
+    def bistable(cls, well: float, barrier: float, **parameters) -> Harvester:
+        """A bistable device given by its wells at z = +-``well`` (m) and ``barrier`` (J).
+
+        The same device as ``Harvester(k=..., k3=..., ...)`` with
+        k = -4 barrier / well^2 < 0 < k3 = 4 barrier / well^4
+        (:meth:`Potential.from_wells`); ``parameters`` are the others
+        (``m``, ``c_m``, ``c_e``, ``friction``, ``electrical``, ``stroke``).
+
+        Examples
+        --------
+        >>> import randvib as rv
+        >>> d = rv.Harvester.bistable(0.002, 1e-4, m=0.0226, c_m=0.049, c_e=0.0)
+        >>> print(f"k = {d.k:g} N/m, k3 = {d.k3:g} N/m^3, wells at +-{d.potential.wells[1]:g} m")
+        k = -100 N/m, k3 = 2.5e+07 N/m^3, wells at +-0.002 m
+        """
+        for name in ("k", "k3"):
+            if name in parameters:
+                raise ValueError(
+                    f"Harvester.bistable takes the wells and the barrier, not `{name}`: give "
+                    "either well/barrier or k/k3 (Harvester(...))"
+                )
+        potential = Potential.from_wells(well, barrier)
+        return cls(k=potential.k, k3=potential.k3, **parameters)
+
+    @classmethod
     def with_coupling(cls, m, c_m, k, coupling: Coupling, k3=0.0, friction=None, stroke=None):
         """Build a harvester with any electrical coupling (:mod:`randvib.models.coupling`).
 
@@ -197,9 +222,14 @@ class Harvester:
 
     @property
     def natural_frequency(self):
-        """Linear natural frequency omega_n = sqrt(k/m) (rad/s); nan for k < 0."""
+        """Small-oscillation frequency about the stable rest position (rad/s).
+
+        omega_n = sqrt(k/m) for k >= 0; for a bistable device (k < 0 < k3) the
+        frequency in either well, sqrt(-2 k/m) (U'' = -2 k at z = +-sqrt(-k/k3));
+        nan for a non-confining potential. See :attr:`Potential.stiffness_at_rest`.
+        """
         with np.errstate(invalid="ignore"):
-            return np.sqrt(self.k / self.m)
+            return np.sqrt(self.potential.stiffness_at_rest / self.m)
 
     @property
     def potential(self) -> Potential:

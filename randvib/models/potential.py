@@ -57,6 +57,34 @@ class Potential:
         object.__setattr__(self, "k", scalar_or_array(check_finite("k", self.k)))
         object.__setattr__(self, "k3", scalar_or_array(check_finite("k3", self.k3)))
 
+    @classmethod
+    def from_wells(cls, well: float, barrier: float) -> Potential:
+        """The bistable potential with wells at z = +-``well`` (m) and ``barrier`` (J).
+
+        Inverts z_w = sqrt(-k/k3) and Delta U = k^2/(4 k3):
+        k = -4 Delta U / z_w^2 (N/m), k3 = 4 Delta U / z_w^4 (N/m^3).
+
+        Examples
+        --------
+        >>> p = Potential.from_wells(0.002, 1e-4)
+        >>> print(f"{p.k:.6g} N/m, {p.k3:.6g} N/m^3, wells at +-{p.wells[1]:.6g} m")
+        -100 N/m, 2.5e+07 N/m^3, wells at +-0.002 m
+        """
+        well = float(check_finite("well", well))
+        barrier = float(check_finite("barrier", barrier))
+        if not well > 0:
+            raise ValueError(f"`well` (the wells' distance from z = 0) must be > 0 m, got {well!r}")
+        if not barrier > 0:
+            raise ValueError(f"`barrier` (the barrier height) must be > 0 J, got {barrier!r}")
+        with np.errstate(all="ignore"):
+            k, k3 = -4.0 * barrier / well**2, 4.0 * barrier / well**4
+        if not (np.isfinite(k) and np.isfinite(k3) and k < 0 < k3):
+            raise ValueError(
+                f"wells at +-{well!r} m with a barrier of {barrier!r} J give k = {k!r} N/m, "
+                f"k3 = {k3!r} N/m^3, beyond float64"
+            )
+        return cls(float(k), float(k3))
+
     # ------------------------------------------------------------ classification
     @property
     def kind(self):
@@ -118,6 +146,15 @@ class Potential:
                 "beyond float64 (sqrt(-k/k3) overflows)"
             )
         return (-float(z_w), float(z_w))
+
+    @property
+    def stiffness_at_rest(self):
+        """U''(z) at the stable rest position (N/m): k at z = 0, or -2 k in the bistable
+        wells z = +-sqrt(-k/k3); nan for a non-confining potential."""
+        k, k3 = np.broadcast_arrays(np.asarray(self.k, float), np.asarray(self.k3, float))
+        kinds = np.asarray(self.kind)
+        stiffness = np.where(kinds == "bistable", -2.0 * k, k)
+        return scalar_or_array(np.where(kinds == "non-confining", np.nan, stiffness))
 
     @property
     def minimum(self):

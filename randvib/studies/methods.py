@@ -401,7 +401,8 @@ def predictions(device, excitation, methods) -> list[dict]:
             try:
                 p = predict(device, excitation, method)
             except ValueError as err:
-                row["refused"] = str(err).split(";")[0][:160]
+                # the refusal's first clause, whole (its reason); the rest is advice
+                row["refused"] = str(err).split(";")[0]
                 rows.append(row)
                 continue
         row["power"] = float(p.power_electrical)

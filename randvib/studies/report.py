@@ -143,9 +143,11 @@ def write_verdicts(out_dir: Path, verdicts: dict, sentences=()) -> Path:
 def verdict_lines(out_dir: Path, max_items: int = 40) -> list[str]:
     """The verdicts of the study in ``out_dir`` as lines for the terminal.
 
-    The sentences of ``verdicts.json`` first (its ``"verdicts"`` list and any
-    text longer than a line's worth), then every other number and word of the
-    file as ``key.sub: value`` (lists of records counted, not listed), at most
+    The sentences: ``verdicts.json``'s ``"verdicts"`` list and any text in it
+    longer than a line's worth, or else the report's ``**Verdict.**`` paragraphs.
+    With sentences, the numbers behind them are only counted (they are in the
+    file); without any, every number and word of the file is shown as
+    ``key.sub: value`` (lists of records counted, not listed), at most
     ``max_items`` of them.
     """
     import json
@@ -172,9 +174,34 @@ def verdict_lines(out_dir: Path, max_items: int = 40) -> list[str]:
             flat.append(f"{prefix}: {value}")
 
     walk("", data)
+    if not lines:  # no sentence stored with the numbers: the report's own
+        lines = [f"- {s}" for s in _report_verdicts(Path(out_dir) / "report.md")]
+    if lines:
+        count = f"{len(flat)} number{'s' * (len(flat) != 1)}"
+        return lines + [f"  ({count} behind them in {path})"] if flat else lines
     if len(flat) > max_items:
         flat = flat[:max_items] + [f"... ({len(flat) - max_items} more in {path})"]
-    return lines + [f"  {line}" for line in flat]
+    return [f"  {line}" for line in flat]
+
+
+def _report_verdicts(report: Path) -> list[str]:
+    """The ``**Verdict.**`` paragraphs of a study's report, without the mark."""
+    try:
+        text = report.read_text()
+    except OSError:
+        return []
+    paragraphs = text.split("\n\n")
+    mark, out = "**Verdict.**", []
+    for i, paragraph in enumerate(paragraphs):
+        if mark not in paragraph:
+            continue
+        rest = paragraph[paragraph.index(mark) + len(mark) :].strip()
+        if rest:
+            out.append(" ".join(rest.split()))
+        elif i + 1 < len(paragraphs):  # "**Verdict.**" above a list: its items
+            items = paragraphs[i + 1].strip().split("\n- ")
+            out += [" ".join(item.lstrip("- ").replace("**", "").split()) for item in items]
+    return [sentence for sentence in out if sentence]
 
 
 def print_verdicts(report: Path) -> None:
