@@ -25,6 +25,7 @@ from randvib.harvester_design.design import design
 from randvib.harvester_design.objectives import OBJECTIVES
 from randvib.models.coupling import COUPLINGS
 from randvib.models.friction import FRICTION_MODELS
+from randvib.models.rectifier import BridgeCoil, BridgePiezo
 from randvib.montecarlo.sweep import SweepSettings
 
 
@@ -47,7 +48,7 @@ def register(sub) -> None:
         required=True,
         help="a parameter to choose and its range (SI; repeatable): k, k3 (negative k "
         "with k3 > 0 is bistable), c_e, c_m, a friction or coupling parameter (alpha, "
-        "r_load, theta, ...)",
+        "r_load, theta, ...) or of a --rectifier bridge (battery, v_diode, ...)",
     )
     g.add_argument(
         "--exceedance",
@@ -100,9 +101,10 @@ def vary_option(text: str) -> tuple[str, float, float]:
 
 
 def _known_names() -> tuple[str, ...]:
-    """Every parameter some device can vary: the device's, every friction law's and coupling's."""
+    """Every parameter some device can vary: the device's, every friction law's, coupling's
+    and bridge's (``battery``, ``r_load``, ``v_diode``, ...)."""
     names = ["c_m", "c_e", "k", "k3"]
-    for family in (FRICTION_MODELS, COUPLINGS):
+    for family in (FRICTION_MODELS, COUPLINGS, {"coil": BridgeCoil, "piezo": BridgePiezo}):
         for member in family.values():
             names += list(member.parameter_names())
     return tuple(dict.fromkeys(names))

@@ -89,13 +89,17 @@ def design(
     vary : mapping of str to (low, high)
         The parameters to choose and their ranges (SI): ``k``, ``k3`` (any
         sign; k < 0 < k3 is bistable), ``c_e``, ``c_m``, a friction law's
-        or the coupling's parameters (``alpha``, ``r_load``, ``theta``, ...).
+        or the coupling's parameters (``alpha``, ``r_load``, ``theta``, ...;
+        a bridge's ``battery`` V_b (V) or storage load ``r_load``).
     stroke : float, optional
         Stroke d (m), > 0; default the harvester's.
     exceedance : float
         The budget eps: the stationary fraction of time with |z| > d, in (0, 1).
     objective : str or Objective
-        ``"electrical"`` (E[P_e]) or ``"load"`` (E[i^2 R_L]); see
+        ``"electrical"`` (E[P_e]), ``"load"`` (E[i^2 R_L]) or ``"stored"``
+        (the DC power through a diode bridge, V_b E|i| or E[V_C^2] / R_L:
+        searched with ``bridge-closure`` where it is offered, by Monte Carlo
+        elsewhere); see
         :data:`randvib.harvester_design.objectives.OBJECTIVES`.
     monte_carlo : bool
         Confirm (and refine) by Monte Carlo; False: the analytic answer only.
@@ -318,7 +322,11 @@ class _Confirmed:
         """c_m E[z'^2] + E[z' F] + electrical power, path by path (every dissipation)."""
         result, i = self.where[id(c)]
         averages, device = result.averages(i), result.cases[i].device
-        samples = device.c_m * averages.v2 + averages.friction_power + result.power_samples(i)
+        if device.is_rectified:  # what the bridge takes: stored, coil and diode losses
+            electrical = averages.stored_power + averages.coil_loss + averages.diode_loss
+        else:
+            electrical = result.power_samples(i)
+        samples = device.c_m * averages.v2 + averages.friction_power + electrical
         return estimate(samples, self._controls(c))
 
     def difference(self, a, b) -> Statistic:

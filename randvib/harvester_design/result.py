@@ -35,7 +35,8 @@ class DesignResult:
     exceedance_predicted : float
         The predicted P(|z| > d) at ``optimum``.
     power_monte_carlo, stroke_exceedance_monte_carlo : Statistic or None
-        Monte Carlo mean and 95 % half-width at ``optimum`` (None without Monte Carlo).
+        Monte Carlo mean and 95 % half-width at ``optimum`` (None without Monte Carlo);
+        the power is the objective's (the stored power for ``"stored"``).
     input_power : Statistic or float
         Power the excitation delivers to the device (W): c_m E[z'^2] + E[z' F]
         + electrical power, from Monte Carlo (else the prediction). m S / 4

@@ -11,6 +11,12 @@ linear device with a rational spectrum the prediction is the exact Lyapunov
 solution (:mod:`randvib.analytic.linear_response`) and the constraint is
 sigma_z <= d / Phi^-1(1 - eps/2), so the optimum found is the exact one
 (to the optimiser's tolerance, 1e-10 relative in the objective).
+
+A coil into a diode bridge (:mod:`randvib.models.rectifier`) is predicted by
+``bridge-closure`` (white noise, within its declared validity; beyond it the
+point is left to Monte Carlo). The closure takes the response as Gaussian, so
+its exceedance is that of a Gaussian displacement of the closure's variance,
+P(|z| > d) = erfc(d / (sigma_z sqrt 2)); Monte Carlo confirms it.
 """
 
 from __future__ import annotations
@@ -20,7 +26,7 @@ import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import optimize
+from scipy import optimize, special
 
 from randvib.analytic.prediction import METHODS, predict
 from randvib.harvester_design.space import DesignSpace
@@ -30,6 +36,11 @@ __all__ = ["Candidate", "SearchOutcome", "analytic_search", "predictor_for"]
 #: The analytic methods a design may use, most accurate first (never the
 #: slow reference solver, which the methods declare).
 PREFERENCE = ("fpk-fast", "linearisation")
+#: The method of a device behind a diode bridge (the others refuse a rectifier).
+RECTIFIED = "bridge-closure"
+#: Methods whose stroke exceedance is that of their Gaussian displacement: their
+#: closure assumes a Gaussian response, so the exceedance is its consequence.
+GAUSSIAN_DISPLACEMENT = (RECTIFIED,)
 #: Grid points per dimension of the first look, by the number of varied parameters.
 GRID = {1: 41, 2: 15, 3: 7}
 #: Grid points per dimension beyond three parameters.
@@ -106,7 +117,11 @@ def predictor_for(harvester, excitation):
     """The first method of :data:`PREFERENCE` that takes the case and gives the exceedance, or None.
 
     A linear device without friction is linearisation's: exact there (Lyapunov).
+    A device behind a diode bridge is :data:`RECTIFIED`'s where it accepts it.
     """
+    if harvester.is_rectified:
+        method = METHODS[RECTIFIED]
+        return method if method.accepts(harvester, excitation) else None
     linear = harvester.friction is None and np.all(harvester.k3 == 0) and np.all(harvester.k > 0)
     for name in ("linearisation",) if linear else PREFERENCE:
         method = METHODS[name]
@@ -145,6 +160,9 @@ class Evaluator:
                 return None  # refused beyond its validity, or no Gaussian solution
         power = self.objective.analytic(prediction, device)
         exceedance = prediction.stroke_exceedance
+        if exceedance is None and method.name in GAUSSIAN_DISPLACEMENT:
+            sigma = math.sqrt(float(prediction.displacement_variance))
+            exceedance = float(special.erfc(device.stroke / (sigma * math.sqrt(2.0))))
         if exceedance is None or not math.isfinite(power):
             return None
         return Candidate(
