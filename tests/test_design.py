@@ -334,3 +334,67 @@ def test_cli_design_stored_objective_json_and_errors(capsys):
     plain = ["design", "--m", M, "--c-m", C_M, "--k", 57.4, "--psd", 1, "--stroke", 0.003]
     one_line_error(capsys, [*plain, "--vary", "c_e=0.01:1", "--objective", "stored"],
                    "objective 'stored' needs a diode bridge")  # fmt: skip
+
+
+def test_first_passage_bound_is_met_on_its_boundary_by_the_analytic_search():
+    # A linear device under band-pass input: the Gaussian stationary (z, z') of the exact
+    # Lyapunov solution gives Rice's out-crossing rate nu = (sigma_v / sigma_z) / pi
+    # exp(-d^2 / (2 sigma_z^2)) in closed form (E[z z'] = 0), and the predicted mean first
+    # passage (1 - P(|z| > d)) / nu. Asking for twice the unconstrained optimum's makes the
+    # bound active: SLSQP ends on it (1e-8 relative, its constraint tolerance).
+    bp, vary = rv.BandPass(1.0, 8.0, 0.1), {"k": (20, 120), "c_e": (0.01, 1)}
+    free = rv.design(fixed(), bp, vary, monte_carlo=False)
+    bound = 2.0 * free.first_passage_predicted
+    result = rv.design(fixed(), bp, vary, monte_carlo=False, min_first_passage=bound)
+    p = rv.predict(result.device, bp, method="linearisation")
+    sz, sv, d = math.sqrt(p.displacement_variance), math.sqrt(p.velocity_variance), 0.003
+    rate = sv / sz / math.pi * math.exp(-0.5 * d * d / (sz * sz))
+    closed_form = (1 - math.erfc(d / (sz * math.sqrt(2)))) / rate
+    assert result.first_passage_predicted == pytest.approx(closed_form, rel=1e-9)
+    assert result.first_passage_predicted == pytest.approx(bound, rel=1e-6)
+    assert result.first_passage_predicted >= bound * (1 - 1e-8)
+    assert result.exceedance_predicted <= 0.01 * (1 + 1e-8)
+    assert result.power_predicted < free.power_predicted
+    assert result.to_dict()["min_first_passage"] == bound
+    with pytest.raises(InfeasibleBudget, match="first-passage constraint E.tau. >= 1e.30 s"):
+        rv.design(fixed(), bp, vary, monte_carlo=False, min_first_passage=1e30)
+    with pytest.raises(ValueError, match="`min_first_passage` must be a finite time > 0"):
+        rv.design(fixed(), bp, vary, monte_carlo=False, min_first_passage=-1.0)
+
+
+def test_first_passage_bound_is_checked_by_monte_carlo():
+    # A hardening device under white noise: fpk-fast's density is not Gaussian, so no
+    # first passage is predicted and Monte Carlo alone checks the bound. All 32 paths reach
+    # the stroke within the run, so E[tau] is estimated: a bound well below its interval is
+    # confirmed (E[min(tau, t_end)] significantly above it), one well above is refused.
+    settings = SweepSettings(dt=2e-4, window=1.0, burn_in=0.3, min_paths=32, max_paths=32,
+                             seed=4, control_variates=False)  # fmt: skip
+    device = rv.Harvester(m=M, c_m=C_M, c_e=0.1, k=57.4, k3=1e5, stroke=0.003)
+    args = (device, 1.0, {"c_e": (0.05, 0.5)})
+    kw = dict(exceedance=0.2, settings=settings, workers=1, runners_up=1)
+    loose = rv.design(*args, **kw, min_first_passage=0.01)
+    assert math.isnan(loose.first_passage_predicted)
+    first = loose.first_passage_monte_carlo
+    assert first.paths_reached == first.n_paths == 32
+    assert loose.first_passage_confirmed is True
+    assert first.restricted_mean.mean - first.restricted_mean.ci95 >= 0.01
+    assert loose.to_dict()["first_passage_monte_carlo"]["paths_reached"] == 32
+    assert first.mean.mean + first.mean.ci95 < 1.0  # so the bound of 1 s is refused:
+    with pytest.raises(InfeasibleBudget, match="first-passage constraint E.tau. >= 1 s"):
+        rv.design(*args, **kw, min_first_passage=1.0)
+
+
+def test_cli_design_min_first_passage(capsys):
+    base = ["design", "--m", M, "--c-m", C_M, "--excitation", "band-pass", "--psd", 1,
+            "--f0", 8, "--zeta", 0.1, "--stroke", 0.003, "--vary", "k=20:120",
+            "--vary", "c_e=0.01:1", "--no-monte-carlo"]  # fmt: skip
+    code, out, _ = run(capsys, *base, "--min-first-passage", 5, "--json")
+    assert code == 0
+    data = json.loads(out)
+    api = rv.design(fixed(), rv.BandPass(1.0, 8.0, 0.1), {"k": (20, 120), "c_e": (0.01, 1)},
+                    monte_carlo=False, min_first_passage=5.0)  # fmt: skip
+    assert data["min_first_passage"] == 5.0
+    assert data["first_passage_predicted"] == pytest.approx(api.first_passage_predicted)
+    assert data["optimum"] == pytest.approx(api.optimum, rel=1e-9)
+    one_line_error(capsys, [*base, "--min-first-passage", 1e30], "first-passage constraint")
+    one_line_error(capsys, [*base, "--min-first-passage", 0], "`--min-first-passage` must be")

@@ -8,7 +8,8 @@ Carlo contradicts it, refined) by Monte Carlo with common random numbers
 (:func:`randvib.design`). ``--json`` prints one object with the keys
 ``optimum``, ``power_predicted``, ``power_monte_carlo``,
 ``stroke_exceedance_monte_carlo`` (each ``{"mean", "ci95"}``),
-``input_power``, ``limit`` and the rest of :meth:`randvib.DesignResult.to_dict`.
+``input_power``, ``limit``, with ``--min-first-passage`` the first passage
+predicted and by Monte Carlo, and the rest of :meth:`randvib.DesignResult.to_dict`.
 """
 
 from __future__ import annotations
@@ -55,6 +56,13 @@ def register(sub) -> None:
         type=float,
         default=0.01,
         help="budget on the fraction of time with abs(z) > --stroke (default 0.01)",
+    )
+    g.add_argument(
+        "--min-first-passage",
+        type=float,
+        metavar="SECONDS",
+        help="also require a mean first-passage time to --stroke of at least SECONDS "
+        "(predicted where the response is Gaussian, checked by Monte Carlo)",
     )
     g.add_argument(
         "--objective",
@@ -142,6 +150,7 @@ def run(args) -> int:
         vary,
         exceedance=args.exceedance,
         objective=args.objective,
+        min_first_passage=args.min_first_passage,
         monte_carlo=not args.no_monte_carlo,
         settings=settings,
         out_dir=args.out_dir,

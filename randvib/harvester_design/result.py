@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from randvib import _display, formatting
-from randvib.statistics import Statistic
+from randvib.statistics import FirstPassage, Statistic
 
 __all__ = ["DesignResult"]
 
@@ -66,6 +66,18 @@ class DesignResult:
         Analytic predictions made.
     monte_carlo_cases : int
         Ensembles simulated.
+    min_first_passage : float or None
+        The bound T (s) on the mean first-passage time to the stroke, if any.
+    first_passage_predicted : float
+        Predicted mean first-passage time to the stroke (s) from a stationary
+        start; NaN where the method does not give it.
+    first_passage_monte_carlo : FirstPassage or None
+        Monte Carlo time to |z| > stroke from the ensembles' start (censored at
+        the run's end).
+    first_passage_confirmed : bool or None
+        Monte Carlo's verdict on ``min_first_passage``: True (E[min(tau, t_end)]
+        significantly above T), False (E[tau] significantly below T), None
+        (undetermined: paths censored at t_end, or no bound).
     """
 
     optimum: dict
@@ -89,6 +101,10 @@ class DesignResult:
     refined: bool = False
     evaluations: int = 0
     monte_carlo_cases: int = 0
+    min_first_passage: float | None = None
+    first_passage_predicted: float = float("nan")
+    first_passage_monte_carlo: FirstPassage | None = None
+    first_passage_confirmed: bool | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready: the keys of ``randvib design --json``."""
@@ -119,6 +135,12 @@ class DesignResult:
             "refined": self.refined,
             "evaluations": self.evaluations,
             "monte_carlo_cases": self.monte_carlo_cases,
+            "min_first_passage": self.min_first_passage,
+            "first_passage_predicted": self.first_passage_predicted,
+            "first_passage_monte_carlo": None
+            if self.first_passage_monte_carlo is None
+            else self.first_passage_monte_carlo.to_dict(),
+            "first_passage_confirmed": self.first_passage_confirmed,
         }
 
     def to_frame(self):

@@ -17,6 +17,16 @@ A coil into a diode bridge (:mod:`randvib.models.rectifier`) is predicted by
 point is left to Monte Carlo). The closure takes the response as Gaussian, so
 its exceedance is that of a Gaussian displacement of the closure's variance,
 P(|z| > d) = erfc(d / (sigma_z sqrt 2)); Monte Carlo confirms it.
+
+An optional second constraint asks for a mean first-passage time to the
+stroke of at least T. Where the method's response is Gaussian
+(:data:`GAUSSIAN_RESPONSE`) it is predicted from Rice's stationary rate of
+crossings out of |z| < d (:func:`randvib.analytic.first_passage.outcrossing_rate`,
+with E[z z'] = 0) as independent (Poisson) crossings from a stationary start,
+E[tau] = (1 - P(|z| > d)) / nu_d: conservative (too short) for a narrow-band
+response, whose crossings come in clumps. Elsewhere (``fpk-fast``'s
+non-Gaussian density) no first passage is predicted and only Monte Carlo
+checks the constraint.
 """
 
 from __future__ import annotations
@@ -26,8 +36,10 @@ import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import optimize, special
+from scipy import optimize
 
+from randvib.analytic.first_passage import outcrossing_rate
+from randvib.analytic.power_prediction import gaussian_exceedance
 from randvib.analytic.prediction import METHODS, predict
 from randvib.harvester_design.space import DesignSpace
 
@@ -41,6 +53,8 @@ RECTIFIED = "bridge-closure"
 #: Methods whose stroke exceedance is that of their Gaussian displacement: their
 #: closure assumes a Gaussian response, so the exceedance is its consequence.
 GAUSSIAN_DISPLACEMENT = (RECTIFIED,)
+#: Methods whose stationary (z, z') is Gaussian: the first passage is predicted for them.
+GAUSSIAN_RESPONSE = ("linearisation", RECTIFIED)
 #: Grid points per dimension of the first look, by the number of varied parameters.
 GRID = {1: 41, 2: 15, 3: 7}
 #: Grid points per dimension beyond three parameters.
@@ -86,6 +100,9 @@ class Candidate:
         stationary sum of every dissipation.
     warned : bool
         The method warned (beyond a declared validity limit it warns at).
+    first_passage : float
+        Predicted mean first-passage time to the stroke (s) from a stationary
+        start; NaN where the method's response is not Gaussian (module docstring).
     """
 
     u: np.ndarray = field(repr=False)
@@ -95,6 +112,7 @@ class Candidate:
     method: str
     input_power: float
     warned: bool = False
+    first_passage: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -161,8 +179,7 @@ class Evaluator:
         power = self.objective.analytic(prediction, device)
         exceedance = prediction.stroke_exceedance
         if exceedance is None and method.name in GAUSSIAN_DISPLACEMENT:
-            sigma = math.sqrt(float(prediction.displacement_variance))
-            exceedance = float(special.erfc(device.stroke / (sigma * math.sqrt(2.0))))
+            exceedance = float(gaussian_exceedance(device.stroke, prediction.displacement_variance))
         if exceedance is None or not math.isfinite(power):
             return None
         return Candidate(
@@ -173,10 +190,37 @@ class Evaluator:
             method=method.name,
             input_power=float(prediction.c_eq * prediction.velocity_variance),
             warned=bool(caught),
+            first_passage=predicted_first_passage(prediction, method, device.stroke, exceedance),
         )
 
 
-def analytic_search(space: DesignSpace, excitation, budget: float, objective, runners_up: int = 2):
+def predicted_first_passage(prediction, method, stroke: float, exceedance: float) -> float:
+    """E[tau] (s) to |z| > ``stroke`` from a stationary start, Poisson crossings; NaN if not Gaussian."""
+    if method.name not in GAUSSIAN_RESPONSE or prediction.displacement_variance is None:
+        return math.nan
+    rate = float(
+        outcrossing_rate(
+            prediction.displacement_variance, 0.0, prediction.velocity_variance, stroke
+        )
+    )
+    return (1.0 - exceedance) / rate if rate > 0 else math.inf
+
+
+def meets(c: Candidate, budget: float, min_first_passage: float | None) -> bool:
+    """The prediction meets the budget and, where it predicts one, the first-passage bound."""
+    if c.exceedance > budget:
+        return False
+    return min_first_passage is None or not c.first_passage < min_first_passage
+
+
+def analytic_search(
+    space: DesignSpace,
+    excitation,
+    budget: float,
+    objective,
+    runners_up: int = 2,
+    min_first_passage: float | None = None,
+):
     """Maximise the predicted objective over the box with P(|z| > stroke) <= budget.
 
     Parameters
@@ -189,6 +233,9 @@ def analytic_search(space: DesignSpace, excitation, budget: float, objective, ru
     objective : Objective
     runners_up : int
         How many other distinct good candidates to return.
+    min_first_passage : float, optional
+        T (s): also require a predicted mean first passage to the stroke of
+        at least T where the method predicts one (:func:`predicted_first_passage`).
 
     Returns
     -------
@@ -197,7 +244,8 @@ def analytic_search(space: DesignSpace, excitation, budget: float, objective, ru
     Raises
     ------
     InfeasibleBudget
-        No predicted device meets the budget: says the best reachable exceedance and where.
+        No predicted device meets the budget (says the best reachable exceedance and
+        where) or the first-passage bound (says the longest predicted first passage).
     """
     evaluate = Evaluator(space, excitation, objective)
     per = GRID.get(space.dimension, GRID_MANY)
@@ -207,21 +255,27 @@ def analytic_search(space: DesignSpace, excitation, budget: float, objective, ru
         raise NothingPredicted(
             "no analytic method predicts any device in the ranges given (every point was refused)"
         )
-    feasible = sorted((c for c in grid if c.exceedance <= budget), key=lambda c: -c.power)
+    feasible = sorted((c for c in grid if meets(c, budget, min_first_passage)),
+                      key=lambda c: -c.power)  # fmt: skip
     if not feasible:
-        best = _least_exceedance(evaluate, min(grid, key=lambda c: c.exceedance), space)
-        if best.exceedance > budget:
-            where = ", ".join(f"{k} = {v:.6g}" for k, v in best.values.items())
-            raise InfeasibleBudget(
-                f"the stroke budget P(|z| > {space.harvester.stroke:g} m) <= {budget:g} cannot be "
-                f"met in the ranges given: the best reachable exceedance is "
-                f"{best.exceedance:.3g} (at {where})"
-            )
-        feasible = [best]
+        within = [c for c in grid if c.exceedance <= budget]
+        if not within:
+            best = _least_exceedance(evaluate, min(grid, key=lambda c: c.exceedance), space)
+            if best.exceedance > budget:
+                where = ", ".join(f"{k} = {v:.6g}" for k, v in best.values.items())
+                raise InfeasibleBudget(
+                    f"the stroke budget P(|z| > {space.harvester.stroke:g} m) <= {budget:g} "
+                    f"cannot be met in the ranges given: the best reachable exceedance is "
+                    f"{best.exceedance:.3g} (at {where})"
+                )
+            within = [best]
+        feasible = [c for c in within if meets(c, budget, min_first_passage)]
+        if not feasible:
+            feasible = [_longest_first_passage(evaluate, within, budget, min_first_passage, space)]
     scale = feasible[0].power
     optima = []
     for start in feasible[:STARTS]:
-        found = _local(evaluate, start, budget, scale)
+        found = _local(evaluate, start, budget, scale, min_first_passage)
         if all(np.max(np.abs(found.u - o.u)) > SAME_POINT for o in optima):
             optima.append(found)
     optima.sort(key=lambda c: -c.power)
@@ -234,9 +288,24 @@ def analytic_search(space: DesignSpace, excitation, budget: float, objective, ru
     return SearchOutcome(optima[0], others[:runners_up], len(evaluate.cache), grid, unpredicted)
 
 
-def _local(evaluate, start: Candidate, budget: float, scale: float) -> Candidate:
+def _local(
+    evaluate, start: Candidate, budget: float, scale: float, min_first_passage=None
+) -> Candidate:
     """SLSQP from ``start``; the better of the start and the end (both feasible)."""
     log_budget = math.log(budget)
+    constraints = [{"type": "ineq", "fun": lambda u: margin(u)}]
+    if min_first_passage is not None:
+        log_time = math.log(min_first_passage)
+
+        def passage_margin(u):
+            c = evaluate(u)
+            if c is None:
+                return -50.0
+            if math.isnan(c.first_passage):
+                return 0.0  # not predicted here: left to Monte Carlo
+            return min(math.log(max(c.first_passage, TINY)) - log_time, 50.0)
+
+        constraints.append({"type": "ineq", "fun": passage_margin})
 
     def power(u):
         c = evaluate(u)
@@ -251,23 +320,60 @@ def _local(evaluate, start: Candidate, budget: float, scale: float) -> Candidate
         start.u,
         method="SLSQP",
         bounds=[(0.0, 1.0)] * len(start.u),
-        constraints=[{"type": "ineq", "fun": margin}],
+        constraints=constraints,
         options={"ftol": 1e-12, "maxiter": 200, "eps": 1e-7},
     )
     end = evaluate(result.x)
-    if end is None or end.exceedance > budget * (1 + 1e-8):
+    if end is None or not meets(end, budget * (1 + 1e-8), _relaxed(min_first_passage)):
         # SLSQP may stop a hair outside the budget (or on an unpredicted point): the
         # feasible point nearest to it on the segment from the start, by bisection
         lo, hi = 0.0, 1.0
         for _ in range(60):
             mid = 0.5 * (lo + hi)
             c = evaluate(start.u + mid * (result.x - start.u))
-            if c is not None and c.exceedance <= budget:
+            if c is not None and meets(c, budget, min_first_passage):
                 lo = mid
             else:
                 hi = mid
         end = evaluate(start.u + lo * (result.x - start.u))
     return end if end is not None and end.power > start.power else start
+
+
+def _relaxed(min_first_passage):
+    """The first-passage bound less SLSQP's tolerance on the constraint (1e-8 relative)."""
+    return None if min_first_passage is None else min_first_passage * (1 - 1e-8)
+
+
+def _longest_first_passage(evaluate, within, budget, min_first_passage, space) -> Candidate:
+    """The longest predicted first passage among ``within`` and a local ascent from it under
+    the exceedance budget, if it meets ``min_first_passage``; else InfeasibleBudget."""
+    start = max(within, key=lambda c: c.first_passage)
+    log_budget = math.log(budget)
+
+    def objective(u):
+        c = evaluate(u)
+        return 50.0 if c is None else -math.log(max(c.first_passage, TINY))
+
+    def margin(u):
+        c = evaluate(u)
+        return -50.0 if c is None else log_budget - math.log(max(c.exceedance, TINY))
+
+    result = optimize.minimize(
+        objective, start.u, method="SLSQP", bounds=[(0.0, 1.0)] * space.dimension,
+        constraints=[{"type": "ineq", "fun": margin}],
+    )  # fmt: skip
+    end = evaluate(result.x)
+    best = start
+    if end is not None and end.exceedance <= budget and end.first_passage > start.first_passage:
+        best = end
+    if best.first_passage >= min_first_passage:
+        return best  # the grid missed it: the search goes on from there
+    where = ", ".join(f"{k} = {v:.6g}" for k, v in best.values.items())
+    raise InfeasibleBudget(
+        f"the first-passage constraint E[tau] >= {min_first_passage:g} s (mean time to "
+        f"|z| > {space.harvester.stroke:g} m) cannot be met in the ranges given within the "
+        f"stroke budget: the longest predicted is {best.first_passage:.3g} s (at {where})"
+    )
 
 
 def _least_exceedance(evaluate, start: Candidate, space: DesignSpace) -> Candidate:
