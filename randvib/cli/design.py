@@ -175,6 +175,15 @@ def run(args) -> int:
         rows.append(
             (key, value if isinstance(value, str) else cell(value), "" if "exceed" in key else "W")
         )
+    if args.min_first_passage is not None:
+        rows.append(("first_passage_predicted", cell(out["first_passage_predicted"]), "s"))
+        first = result.first_passage_monte_carlo
+        if first is not None:
+            lower = first.restricted_mean
+            rows.append(("first_passage_monte_carlo",
+                         f"{cell(first.mean.mean)} ± {cell(first.mean.ci95)}" if first.mean
+                         else f">= {cell(lower.mean)} ± {cell(lower.ci95)} (censored)", "s"))  # fmt: skip
+            rows.append(("first_passage_confirmed", str(out["first_passage_confirmed"]), ""))
     rows.append(("efficiency", cell(out["efficiency"]), ""))
     rows.append(
         ("limit", "none (white noise)" if out["limit"] is None else cell(out["limit"]), "W")
