@@ -301,6 +301,17 @@ def test_stored_objective_battery_optimum_is_optimal_dc_output():
     assert result.method == "bridge-closure" and result.objective == "stored"
     assert result.optimum["battery"] == pytest.approx(exact.value, rel=1e-3)
     assert result.power_predicted == pytest.approx(exact.power_stored, rel=1e-9)
+    # a storage capacitor: its load r_load varied (its lower end inside the closure's
+    # R_L C >= 8 natural periods), the same agreement
+    cap = rv.BridgeCoil(alpha=0.1992, r_coil=0.48, v_diode=0.01, storage_capacitance=1.0,
+                        r_load=1.0)  # fmt: skip
+    with_cap = rv.Harvester.with_coupling(M, 0.05, 57.4, cap, stroke=0.05)
+    best_load = rv.optimal_dc_output(with_cap, 1.0)
+    assert best_load.where == "interior"
+    loaded = rv.design(with_cap, 1.0, {"r_load": (1.01 * best_load.lower, 100.0)},
+                       objective="stored", monte_carlo=False)  # fmt: skip
+    assert loaded.optimum["r_load"] == pytest.approx(best_load.value, rel=1e-3)
+    assert loaded.power_predicted == pytest.approx(best_load.power_stored, rel=1e-9)
     # Monte Carlo confirms power_stored; the batteries beyond the closure's validity
     # (threshold above 1.25 velocity std) are left to Monte Carlo, not predicted.
     settings = SweepSettings(dt=2e-4, window=1.0, burn_in=0.5, min_paths=32, max_paths=32,
