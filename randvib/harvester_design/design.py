@@ -274,7 +274,7 @@ def design(
             if c is not chosen
         ],
         analytic_cost=None if best is None else confirmed.difference(chosen, best),
-        analytic_feasible=None if best is None else _within(confirmed.exceedance(best), exceedance),
+        analytic_feasible=None if best is None else confirmed.feasible(best, exceedance),
         refined=best is not None and chosen is not best,
         monte_carlo_cases=len(confirmed.candidates),
         first_passage_predicted=chosen.first_passage,

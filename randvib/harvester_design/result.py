@@ -59,7 +59,8 @@ class DesignResult:
         paired (W): what the analytic answer would have cost (0 when equal).
     analytic_feasible : bool or None
         Whether the analytic optimum met the budget in Monte Carlo (its 95 %
-        interval on the exceedance reaches down to the budget).
+        interval on the exceedance reaches down to the budget) and Monte Carlo
+        did not reject its first passage (``min_first_passage``).
     refined : bool
         Monte Carlo moved the optimum.
     evaluations : int
