@@ -282,3 +282,130 @@ def test_monte_carlo_resumes_from_out_dir(tmp_path):
     again = rv.design(*args, settings=settings, out_dir=tmp_path, workers=1)
     assert {p: p.stat().st_mtime_ns for p in tmp_path.rglob("*.npy")} == stored
     assert again.power_monte_carlo == first.power_monte_carlo
+
+
+def bridge_coil(battery=0.03, stroke=0.05):
+    coil = rv.BridgeCoil(alpha=0.1992, r_coil=0.48, v_diode=0.01, battery=battery)
+    return rv.Harvester.with_coupling(M, 0.05, 57.4, coil, stroke=stroke)
+
+
+def test_stored_objective_battery_optimum_is_optimal_dc_output():
+    # A coil into a battery under white noise, the stroke budget inactive: the design's
+    # analytic search (bridge-closure) maximises the same closure as optimal_dc_output,
+    # so they agree to the optimisers' tolerances (SLSQP's 1e-12 in the objective, Brent's
+    # 1e-6 of the range): 1e-3 in the flat optimum's voltage, 1e-9 in its power.
+    exact = rv.optimal_dc_output(bridge_coil(), 1.0)
+    assert exact.where == "interior"
+    result = rv.design(bridge_coil(), 1.0, {"battery": (0.001, 0.2)}, objective="stored",
+                       monte_carlo=False)  # fmt: skip
+    assert result.method == "bridge-closure" and result.objective == "stored"
+    assert result.optimum["battery"] == pytest.approx(exact.value, rel=1e-3)
+    assert result.power_predicted == pytest.approx(exact.power_stored, rel=1e-9)
+    # a storage capacitor: its load r_load varied (its lower end inside the closure's
+    # R_L C >= 8 natural periods), the same agreement
+    cap = rv.BridgeCoil(alpha=0.1992, r_coil=0.48, v_diode=0.01, storage_capacitance=1.0,
+                        r_load=1.0)  # fmt: skip
+    with_cap = rv.Harvester.with_coupling(M, 0.05, 57.4, cap, stroke=0.05)
+    best_load = rv.optimal_dc_output(with_cap, 1.0)
+    assert best_load.where == "interior"
+    loaded = rv.design(with_cap, 1.0, {"r_load": (1.01 * best_load.lower, 100.0)},
+                       objective="stored", monte_carlo=False)  # fmt: skip
+    assert loaded.optimum["r_load"] == pytest.approx(best_load.value, rel=1e-3)
+    assert loaded.power_predicted == pytest.approx(best_load.power_stored, rel=1e-9)
+    # Monte Carlo confirms power_stored; the batteries beyond the closure's validity
+    # (threshold above 1.25 velocity std) are left to Monte Carlo, not predicted.
+    settings = SweepSettings(dt=2e-4, window=1.0, burn_in=0.5, min_paths=32, max_paths=32,
+                             seed=5)  # fmt: skip
+    confirmed = rv.design(bridge_coil(), 1.0, {"battery": (0.001, 0.2)}, objective="stored",
+                          settings=settings, workers=1)  # fmt: skip
+    assert any(math.isnan(r["power_predicted"]) for r in confirmed.runners_up)
+    # independent estimates (another seed): within 3 combined standard errors
+    other = rv.simulate(confirmed.device, 1.0, t_end=1.5, burn_in=0.5, dt=2e-4, n_paths=32,
+                        seed=77)  # fmt: skip
+    a, b = confirmed.power_monte_carlo, other.power_stored
+    assert abs(a.mean - b.mean) <= 3 * math.hypot(a.std_error, b.std_error)
+    # the closure's declared accuracy: stored power within 6.5 % (bridge.py), widened by
+    # the Monte Carlo half-width
+    assert abs(a.mean - confirmed.power_predicted) <= 0.065 * confirmed.power_predicted + a.ci95
+    assert 0 < confirmed.efficiency < 1
+
+
+def test_cli_design_stored_objective_json_and_errors(capsys):
+    base = ["design", "--m", M, "--c-m", 0.05, "--k", 57.4, "--coupling", "inductive",
+            "--alpha", 0.1992, "--r-coil", 0.48, "--rectifier", "bridge", "--v-diode", 0.01,
+            "--psd", 1, "--stroke", 0.05]  # fmt: skip
+    code, out, _ = run(capsys, *base, "--vary", "battery=0.001:0.2", "--objective", "stored",
+                       "--no-monte-carlo", "--json")  # fmt: skip
+    assert code == 0
+    data = json.loads(out)
+    exact = rv.optimal_dc_output(bridge_coil(), 1.0)
+    assert data["objective"] == "stored" and data["method"] == "bridge-closure"
+    assert data["optimum"]["battery"] == pytest.approx(exact.value, rel=1e-3)
+    assert data["power_predicted"] == pytest.approx(exact.power_stored, rel=1e-9)
+    plain = ["design", "--m", M, "--c-m", C_M, "--k", 57.4, "--psd", 1, "--stroke", 0.003]
+    one_line_error(capsys, [*plain, "--vary", "c_e=0.01:1", "--objective", "stored"],
+                   "objective 'stored' needs a diode bridge")  # fmt: skip
+
+
+def test_first_passage_bound_is_met_on_its_boundary_by_the_analytic_search():
+    # A linear device under band-pass input: the Gaussian stationary (z, z') of the exact
+    # Lyapunov solution gives Rice's out-crossing rate nu = (sigma_v / sigma_z) / pi
+    # exp(-d^2 / (2 sigma_z^2)) in closed form (E[z z'] = 0), and the predicted mean first
+    # passage (1 - P(|z| > d)) / nu. Asking for twice the unconstrained optimum's makes the
+    # bound active: SLSQP ends on it (1e-8 relative, its constraint tolerance).
+    bp, vary = rv.BandPass(1.0, 8.0, 0.1), {"k": (20, 120), "c_e": (0.01, 1)}
+    free = rv.design(fixed(), bp, vary, monte_carlo=False)
+    bound = 2.0 * free.first_passage_predicted
+    result = rv.design(fixed(), bp, vary, monte_carlo=False, min_first_passage=bound)
+    p = rv.predict(result.device, bp, method="linearisation")
+    sz, sv, d = math.sqrt(p.displacement_variance), math.sqrt(p.velocity_variance), 0.003
+    rate = sv / sz / math.pi * math.exp(-0.5 * d * d / (sz * sz))
+    closed_form = (1 - math.erfc(d / (sz * math.sqrt(2)))) / rate
+    assert result.first_passage_predicted == pytest.approx(closed_form, rel=1e-9)
+    assert result.first_passage_predicted == pytest.approx(bound, rel=1e-6)
+    assert result.first_passage_predicted >= bound * (1 - 1e-8)
+    assert result.exceedance_predicted <= 0.01 * (1 + 1e-8)
+    assert result.power_predicted < free.power_predicted
+    assert result.to_dict()["min_first_passage"] == bound
+    with pytest.raises(InfeasibleBudget, match="first-passage constraint E.tau. >= 1e.30 s"):
+        rv.design(fixed(), bp, vary, monte_carlo=False, min_first_passage=1e30)
+    with pytest.raises(ValueError, match="`min_first_passage` must be a finite time > 0"):
+        rv.design(fixed(), bp, vary, monte_carlo=False, min_first_passage=-1.0)
+
+
+def test_first_passage_bound_is_checked_by_monte_carlo():
+    # A hardening device under white noise: fpk-fast's density is not Gaussian, so no
+    # first passage is predicted and Monte Carlo alone checks the bound. All 32 paths reach
+    # the stroke within the run, so E[tau] is estimated: a bound well below its interval is
+    # confirmed (E[min(tau, t_end)] significantly above it), one well above is refused.
+    settings = SweepSettings(dt=2e-4, window=1.0, burn_in=0.3, min_paths=32, max_paths=32,
+                             seed=4, control_variates=False)  # fmt: skip
+    device = rv.Harvester(m=M, c_m=C_M, c_e=0.1, k=57.4, k3=1e5, stroke=0.003)
+    args = (device, 1.0, {"c_e": (0.05, 0.5)})
+    kw = dict(exceedance=0.2, settings=settings, workers=1, runners_up=1)
+    loose = rv.design(*args, **kw, min_first_passage=0.01)
+    assert math.isnan(loose.first_passage_predicted)
+    first = loose.first_passage_monte_carlo
+    assert first.paths_reached == first.n_paths == 32
+    assert loose.first_passage_confirmed is True
+    assert first.restricted_mean.mean - first.restricted_mean.ci95 >= 0.01
+    assert loose.to_dict()["first_passage_monte_carlo"]["paths_reached"] == 32
+    assert first.mean.mean + first.mean.ci95 < 1.0  # so the bound of 1 s is refused:
+    with pytest.raises(InfeasibleBudget, match="first-passage constraint E.tau. >= 1 s"):
+        rv.design(*args, **kw, min_first_passage=1.0)
+
+
+def test_cli_design_min_first_passage(capsys):
+    base = ["design", "--m", M, "--c-m", C_M, "--excitation", "band-pass", "--psd", 1,
+            "--f0", 8, "--zeta", 0.1, "--stroke", 0.003, "--vary", "k=20:120",
+            "--vary", "c_e=0.01:1", "--no-monte-carlo"]  # fmt: skip
+    code, out, _ = run(capsys, *base, "--min-first-passage", 5, "--json")
+    assert code == 0
+    data = json.loads(out)
+    api = rv.design(fixed(), rv.BandPass(1.0, 8.0, 0.1), {"k": (20, 120), "c_e": (0.01, 1)},
+                    monte_carlo=False, min_first_passage=5.0)  # fmt: skip
+    assert data["min_first_passage"] == 5.0
+    assert data["first_passage_predicted"] == pytest.approx(api.first_passage_predicted)
+    assert data["optimum"] == pytest.approx(api.optimum, rel=1e-9)
+    one_line_error(capsys, [*base, "--min-first-passage", 1e30], "first-passage constraint")
+    one_line_error(capsys, [*base, "--min-first-passage", 0], "`--min-first-passage` must be")

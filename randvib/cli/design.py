@@ -8,7 +8,8 @@ Carlo contradicts it, refined) by Monte Carlo with common random numbers
 (:func:`randvib.design`). ``--json`` prints one object with the keys
 ``optimum``, ``power_predicted``, ``power_monte_carlo``,
 ``stroke_exceedance_monte_carlo`` (each ``{"mean", "ci95"}``),
-``input_power``, ``limit`` and the rest of :meth:`randvib.DesignResult.to_dict`.
+``input_power``, ``limit``, with ``--min-first-passage`` the first passage
+predicted and by Monte Carlo, and the rest of :meth:`randvib.DesignResult.to_dict`.
 """
 
 from __future__ import annotations
@@ -25,6 +26,7 @@ from randvib.harvester_design.design import design
 from randvib.harvester_design.objectives import OBJECTIVES
 from randvib.models.coupling import COUPLINGS
 from randvib.models.friction import FRICTION_MODELS
+from randvib.models.rectifier import BridgeCoil, BridgePiezo
 from randvib.montecarlo.sweep import SweepSettings
 
 
@@ -47,13 +49,20 @@ def register(sub) -> None:
         required=True,
         help="a parameter to choose and its range (SI; repeatable): k, k3 (negative k "
         "with k3 > 0 is bistable), c_e, c_m, a friction or coupling parameter (alpha, "
-        "r_load, theta, ...)",
+        "r_load, theta, ...) or of a --rectifier bridge (battery, v_diode, ...)",
     )
     g.add_argument(
         "--exceedance",
         type=float,
         default=0.01,
         help="budget on the fraction of time with abs(z) > --stroke (default 0.01)",
+    )
+    g.add_argument(
+        "--min-first-passage",
+        type=float,
+        metavar="SECONDS",
+        help="also require a mean first-passage time to --stroke of at least SECONDS "
+        "(predicted where the response is Gaussian, checked by Monte Carlo)",
     )
     g.add_argument(
         "--objective",
@@ -100,9 +109,10 @@ def vary_option(text: str) -> tuple[str, float, float]:
 
 
 def _known_names() -> tuple[str, ...]:
-    """Every parameter some device can vary: the device's, every friction law's and coupling's."""
+    """Every parameter some device can vary: the device's, every friction law's, coupling's
+    and bridge's (``battery``, ``r_load``, ``v_diode``, ...)."""
     names = ["c_m", "c_e", "k", "k3"]
-    for family in (FRICTION_MODELS, COUPLINGS):
+    for family in (FRICTION_MODELS, COUPLINGS, {"coil": BridgeCoil, "piezo": BridgePiezo}):
         for member in family.values():
             names += list(member.parameter_names())
     return tuple(dict.fromkeys(names))
@@ -140,6 +150,7 @@ def run(args) -> int:
         vary,
         exceedance=args.exceedance,
         objective=args.objective,
+        min_first_passage=args.min_first_passage,
         monte_carlo=not args.no_monte_carlo,
         settings=settings,
         out_dir=args.out_dir,
@@ -164,6 +175,15 @@ def run(args) -> int:
         rows.append(
             (key, value if isinstance(value, str) else cell(value), "" if "exceed" in key else "W")
         )
+    if args.min_first_passage is not None:
+        rows.append(("first_passage_predicted", cell(out["first_passage_predicted"]), "s"))
+        first = result.first_passage_monte_carlo
+        if first is not None:
+            lower = first.restricted_mean
+            rows.append(("first_passage_monte_carlo",
+                         f"{cell(first.mean.mean)} ± {cell(first.mean.ci95)}" if first.mean
+                         else f">= {cell(lower.mean)} ± {cell(lower.ci95)} (censored)", "s"))  # fmt: skip
+            rows.append(("first_passage_confirmed", str(out["first_passage_confirmed"]), ""))
     rows.append(("efficiency", cell(out["efficiency"]), ""))
     rows.append(
         ("limit", "none (white noise)" if out["limit"] is None else cell(out["limit"]), "W")

@@ -15,7 +15,12 @@ names the parameters to choose with their ranges. The design
    or its prediction off by more than :data:`PREDICTION_TOLERANCE`), refines
    by Monte Carlo on shrinking local grids around the best confirmed
    feasible candidate, and reports what the analytic answer would have cost;
-4. reports the power the excitation delivers (m S / 4 under white noise),
+4. with a bound on the mean first-passage time to the stroke
+   (``min_first_passage``), predicts it where the method's response is
+   Gaussian (:func:`randvib.harvester_design.search.predicted_first_passage`) and checks
+   it by Monte Carlo on the confirmed candidates (each path's first time
+   beyond the stroke, :class:`randvib.statistics.FirstPassage`);
+5. reports the power the excitation delivers (m S / 4 under white noise),
    the efficiency, and the fraction of the limit
    (:func:`randvib.analytic.harvesting_limit.harvesting_limit`).
 """
@@ -43,7 +48,7 @@ from randvib.models.excitation import Measured, as_excitation
 from randvib.models.harvester import Harvester
 from randvib.montecarlo.ensembles import Case, run_ensembles
 from randvib.montecarlo.sweep import SweepSettings
-from randvib.statistics import Statistic, estimate
+from randvib.statistics import FirstPassage, Statistic, estimate
 
 __all__ = ["design"]
 
@@ -73,6 +78,7 @@ def design(
     workers: int | None = None,
     scheduler: str | None = None,
     progress: bool = False,
+    min_first_passage: float | None = None,
 ) -> DesignResult:
     """Choose the varied parameters that maximise the power with P(|z| > stroke) <= exceedance.
 
@@ -89,13 +95,17 @@ def design(
     vary : mapping of str to (low, high)
         The parameters to choose and their ranges (SI): ``k``, ``k3`` (any
         sign; k < 0 < k3 is bistable), ``c_e``, ``c_m``, a friction law's
-        or the coupling's parameters (``alpha``, ``r_load``, ``theta``, ...).
+        or the coupling's parameters (``alpha``, ``r_load``, ``theta``, ...;
+        a bridge's ``battery`` V_b (V) or storage load ``r_load``).
     stroke : float, optional
         Stroke d (m), > 0; default the harvester's.
     exceedance : float
         The budget eps: the stationary fraction of time with |z| > d, in (0, 1).
     objective : str or Objective
-        ``"electrical"`` (E[P_e]) or ``"load"`` (E[i^2 R_L]); see
+        ``"electrical"`` (E[P_e]), ``"load"`` (E[i^2 R_L]) or ``"stored"``
+        (the DC power through a diode bridge, V_b E|i| or E[V_C^2] / R_L:
+        searched with ``bridge-closure`` where it is offered, by Monte Carlo
+        elsewhere); see
         :data:`randvib.harvester_design.objectives.OBJECTIVES`.
     monte_carlo : bool
         Confirm (and refine) by Monte Carlo; False: the analytic answer only.
@@ -109,6 +119,17 @@ def design(
     out_dir, executor, workers, scheduler, progress : optional
         As for :func:`randvib.run_ensembles` (resumable in ``out_dir``, a
         Dask cluster at ``scheduler``).
+    min_first_passage : float, optional
+        T (s), > 0: also require a mean first-passage time to the stroke
+        E[tau] >= T, from the ensembles' stationary start. The search uses
+        the prediction where there is one (Gaussian response: Poisson
+        crossings at Rice's rate, conservative for a narrow-band response);
+        Monte Carlo rejects a candidate whose E[tau] is significantly below
+        T (every path reached the stroke and the 95 % interval lies below T)
+        and confirms it when E[min(tau, t_end)], a lower bound, is
+        significantly above T. Paths censored at the run's end t_end
+        (burn-in plus window) leave it undetermined: to confirm T, run
+        longer than T (``settings``).
 
     Returns
     -------
@@ -119,7 +140,8 @@ def design(
     ValueError
         One line for an unknown parameter, an empty range, no stroke, a bad
         budget or objective, or an infeasible budget
-        (:class:`~randvib.harvester_design.search.InfeasibleBudget`: the best reachable exceedance).
+        (:class:`~randvib.harvester_design.search.InfeasibleBudget`: the best reachable
+        exceedance, or the longest first passage), or a bad ``min_first_passage``.
 
     Examples
     --------
@@ -130,6 +152,14 @@ def design(
     >>> print(f"k = {result.optimum['k']:.1f} N/m, c_e = {result.optimum['c_e']:.3f} Ns/m")
     k = 59.1 N/m, c_e = 0.456 Ns/m
     """
+    if min_first_passage is not None and not (
+        isinstance(min_first_passage, (int, float))
+        and math.isfinite(min_first_passage)
+        and min_first_passage > 0
+    ):
+        raise ValueError(
+            f"`min_first_passage` must be a finite time > 0 (s), got {min_first_passage!r}"
+        )
     stroke = harvester.stroke if stroke is None else stroke
     if stroke is None:
         raise ValueError("`stroke` is needed: the design's budget is on P(|z| > stroke)")
@@ -143,7 +173,7 @@ def design(
     space = DesignSpace(fixed, vary)
     limit = harvesting_limit(fixed.m, fixed.c_m, excitation, sigma_budget)
     try:
-        search = analytic_search(space, excitation, exceedance, goal, runners_up)
+        search = analytic_search(space, excitation, exceedance, goal, runners_up, min_first_passage)
     except NothingPredicted as exc:
         if not monte_carlo:
             raise ValueError(
@@ -151,7 +181,8 @@ def design(
             ) from None
         search = None
     common = dict(objective=goal.name, stroke=float(stroke), exceedance_budget=float(exceedance),
-                  evaluations=0 if search is None else search.evaluations)  # fmt: skip
+                  evaluations=0 if search is None else search.evaluations,
+                  min_first_passage=min_first_passage)  # fmt: skip
     if not monte_carlo:
         best = search.optimum
         return DesignResult(
@@ -168,6 +199,7 @@ def design(
             limit=limit,
             fraction_of_limit=None if limit is None else best.power / limit,
             runners_up=[_runner(c) for c in search.runners_up],
+            first_passage_predicted=best.first_passage,
             **common,
         )
     settings = settings or SweepSettings(
@@ -175,7 +207,7 @@ def design(
     )
     run = dict(settings=settings, out_dir=out_dir, executor=executor, workers=workers,
                scheduler=scheduler, progress=progress)  # fmt: skip
-    confirmed = _Confirmed(space, excitation, goal, run)
+    confirmed = _Confirmed(space, excitation, goal, run, min_first_passage)
     if search is None:  # Monte Carlo searches a coarse grid, then refines
         best = None
         candidates = [confirmed.point(u) for u in space.grid(COARSE if space.dimension > 1 else 5)]
@@ -208,6 +240,14 @@ def design(
             f"ranges given: the best reachable exceedance (Monte Carlo) is {x.mean:.3g} "
             f"± {x.ci95:.2g} (at {where})"
         )
+    if confirmed.passage(chosen) is False:
+        first = confirmed.first_passage(chosen).mean
+        where = ", ".join(f"{k} = {v:.6g}" for k, v in chosen.values.items())
+        raise InfeasibleBudget(
+            f"the first-passage constraint E[tau] >= {min_first_passage:g} s (mean time to "
+            f"|z| > {stroke:g} m) is not met by the best device within the stroke budget: "
+            f"Monte Carlo gives {first.mean:.3g} ± {first.ci95:.2g} s (at {where})"
+        )
     power = confirmed.power(chosen)
     input_power = confirmed.input_power(chosen)
     return DesignResult(
@@ -234,15 +274,19 @@ def design(
             if c is not chosen
         ],
         analytic_cost=None if best is None else confirmed.difference(chosen, best),
-        analytic_feasible=None if best is None else _within(confirmed.exceedance(best), exceedance),
+        analytic_feasible=None if best is None else confirmed.feasible(best, exceedance),
         refined=best is not None and chosen is not best,
         monte_carlo_cases=len(confirmed.candidates),
+        first_passage_predicted=chosen.first_passage,
+        first_passage_monte_carlo=confirmed.first_passage(chosen),
+        first_passage_confirmed=confirmed.passage(chosen),
         **common,
     )
 
 
 def _runner(c: Candidate) -> dict:
-    return {"values": c.values, "power_predicted": c.power, "exceedance_predicted": c.exceedance}
+    return {"values": c.values, "power_predicted": c.power, "exceedance_predicted": c.exceedance,
+            "first_passage_predicted": c.first_passage}  # fmt: skip
 
 
 def _neighbours(space: DesignSpace, u, step: float) -> list:
@@ -257,8 +301,9 @@ def _neighbours(space: DesignSpace, u, step: float) -> list:
 class _Confirmed:
     """Monte Carlo of candidates, every run on group 0 of one seed: path i is common to all."""
 
-    def __init__(self, space, excitation, goal, run):
+    def __init__(self, space, excitation, goal, run, min_first_passage=None):
         self.space, self.excitation, self.goal, self.run = space, excitation, goal, run
+        self.min_first_passage = min_first_passage
         # A record drives Monte Carlo as Gaussian paths of its Welch spectrum (the same
         # PSD the analytic search used), so that every candidate sees the same paths.
         self.simulated = excitation.spectrum if isinstance(excitation, Measured) else excitation
@@ -318,8 +363,35 @@ class _Confirmed:
         """c_m E[z'^2] + E[z' F] + electrical power, path by path (every dissipation)."""
         result, i = self.where[id(c)]
         averages, device = result.averages(i), result.cases[i].device
-        samples = device.c_m * averages.v2 + averages.friction_power + result.power_samples(i)
+        if device.is_rectified:  # what the bridge takes: stored, coil and diode losses
+            electrical = averages.stored_power + averages.coil_loss + averages.diode_loss
+        else:
+            electrical = result.power_samples(i)
+        samples = device.c_m * averages.v2 + averages.friction_power + electrical
         return estimate(samples, self._controls(c))
+
+    def first_passage(self, c) -> FirstPassage:
+        """Time to |z| > stroke from each path's (stationary) start, censored at t_end."""
+        result, i = self.where[id(c)]
+        return result.simulation(i).stroke_first_passage
+
+    def passage(self, c) -> bool | None:
+        """The first-passage bound by Monte Carlo: True when E[min(tau, t_end)] (a lower
+        bound of E[tau]) is significantly above it, False when every path reached the
+        stroke and E[tau] is significantly below it, None when undetermined (or no bound)."""
+        if self.min_first_passage is None:
+            return None
+        first = self.first_passage(c)
+        restricted = first.restricted_mean
+        if restricted.mean - restricted.ci95 >= self.min_first_passage:
+            return True
+        if first.mean is not None and first.mean.mean + first.mean.ci95 < self.min_first_passage:
+            return False
+        return None
+
+    def feasible(self, c, budget: float) -> bool:
+        """Monte Carlo rejects neither the stroke budget nor the first-passage bound."""
+        return _within(self.exceedance(c), budget) and self.passage(c) is not False
 
     def difference(self, a, b) -> Statistic:
         """Power of ``a`` minus that of ``b`` on their common paths (paired, W)."""
@@ -338,7 +410,7 @@ class _Confirmed:
         budget's boundary has an estimate on either side of it by chance. If
         every candidate is rejected, the one with the least exceedance.
         """
-        feasible = [c for c in among if _within(self.exceedance(c), budget)]
+        feasible = [c for c in among if self.feasible(c, budget)]
         if not feasible:
             return min(among, key=lambda c: self.exceedance(c).mean)
         return max(feasible, key=lambda c: self.power(c).mean)
@@ -348,7 +420,7 @@ class _Confirmed:
         the budget, its prediction lies outside its Monte Carlo interval by more than
         :data:`PREDICTION_TOLERANCE`, or another candidate is significantly better (paired
         95 % interval above 0)."""
-        if not _within(self.exceedance(best), budget):
+        if not self.feasible(best, budget):
             return True
         power = self.power(best)
         if abs(power.mean - best.power) > power.ci95 + PREDICTION_TOLERANCE * best.power:
@@ -358,7 +430,7 @@ class _Confirmed:
     def better(self, a, b, budget: float) -> bool:
         """``a`` meets the budget and harvests significantly more than ``b`` on the common
         paths (paired 95 % interval above 0, and above rounding: 1e-9 of the power)."""
-        if not _within(self.exceedance(a), budget):
+        if not self.feasible(a, budget):
             return False
         d = self.difference(a, b)
         return d.mean - d.ci95 > 1e-9 * abs(self.power(b).mean)

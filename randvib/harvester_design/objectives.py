@@ -5,8 +5,8 @@ prediction (:class:`~randvib.analytic.power_prediction.PowerPrediction`) and,
 path by path, from a Monte Carlo ensemble
 (:class:`~randvib.montecarlo.ensembles.EnsembleResult`), so that the design's
 search and its confirmation maximise the same thing. :data:`OBJECTIVES`
-lists them by name; a new objective (stored power behind a rectifier) is one
-more instance.
+lists them by name: the electrical power, the load's share of it, and the
+power stored through a diode bridge (:mod:`randvib.models.rectifier`).
 """
 
 from __future__ import annotations
@@ -55,6 +55,15 @@ def _load_refusal(harvester) -> str | None:
     return None
 
 
+def _stored_refusal(harvester) -> str | None:
+    if not harvester.is_rectified:
+        return (
+            "objective 'stored' needs a diode bridge: build the harvester with "
+            "Harvester.with_coupling(m, c_m, k, BridgeCoil(...) or BridgePiezo(...))"
+        )
+    return None
+
+
 def _load_fraction_samples(ensembles, index) -> np.ndarray:
     device = ensembles.cases[index].device
     if device.has_circuit:
@@ -64,7 +73,9 @@ def _load_fraction_samples(ensembles, index) -> np.ndarray:
 
 
 #: The objectives by name: ``electrical`` (E[P_e], the power converted by the
-#: transducer, paper Eq. 31) and ``load`` (the load's share of it, E[i^2 R_L]).
+#: transducer, paper Eq. 31), ``load`` (the load's share of it, E[i^2 R_L]) and
+#: ``stored`` (the DC power a diode bridge delivers: V_b E|i| into a battery,
+#: E[V_C^2] / R_L from a storage capacitor; docs/conventions.md).
 OBJECTIVES: dict[str, Objective] = {
     o.name: o
     for o in (
@@ -81,6 +92,13 @@ OBJECTIVES: dict[str, Objective] = {
             lambda prediction, harvester: float(prediction.power_load),
             _load_fraction_samples,
             _load_refusal,
+        ),
+        Objective(
+            "stored",
+            "power stored through a diode bridge (V_b E|i| or E[V_C^2] / R_L)",
+            lambda prediction, harvester: float(prediction.power_stored),
+            lambda ensembles, index: ensembles.averages(index).stored_power,
+            _stored_refusal,
         ),
     )
 }

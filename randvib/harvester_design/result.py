@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from randvib import _display, formatting
-from randvib.statistics import Statistic
+from randvib.statistics import FirstPassage, Statistic
 
 __all__ = ["DesignResult"]
 
@@ -35,7 +35,8 @@ class DesignResult:
     exceedance_predicted : float
         The predicted P(|z| > d) at ``optimum``.
     power_monte_carlo, stroke_exceedance_monte_carlo : Statistic or None
-        Monte Carlo mean and 95 % half-width at ``optimum`` (None without Monte Carlo).
+        Monte Carlo mean and 95 % half-width at ``optimum`` (None without Monte Carlo);
+        the power is the objective's (the stored power for ``"stored"``).
     input_power : Statistic or float
         Power the excitation delivers to the device (W): c_m E[z'^2] + E[z' F]
         + electrical power, from Monte Carlo (else the prediction). m S / 4
@@ -58,13 +59,26 @@ class DesignResult:
         paired (W): what the analytic answer would have cost (0 when equal).
     analytic_feasible : bool or None
         Whether the analytic optimum met the budget in Monte Carlo (its 95 %
-        interval on the exceedance reaches down to the budget).
+        interval on the exceedance reaches down to the budget) and Monte Carlo
+        did not reject its first passage (``min_first_passage``).
     refined : bool
         Monte Carlo moved the optimum.
     evaluations : int
         Analytic predictions made.
     monte_carlo_cases : int
         Ensembles simulated.
+    min_first_passage : float or None
+        The bound T (s) on the mean first-passage time to the stroke, if any.
+    first_passage_predicted : float
+        Predicted mean first-passage time to the stroke (s) from a stationary
+        start; NaN where the method does not give it.
+    first_passage_monte_carlo : FirstPassage or None
+        Monte Carlo time to |z| > stroke from the ensembles' start (censored at
+        the run's end).
+    first_passage_confirmed : bool or None
+        Monte Carlo's verdict on ``min_first_passage``: True (E[min(tau, t_end)]
+        significantly above T), False (E[tau] significantly below T), None
+        (undetermined: paths censored at t_end, or no bound).
     """
 
     optimum: dict
@@ -88,6 +102,10 @@ class DesignResult:
     refined: bool = False
     evaluations: int = 0
     monte_carlo_cases: int = 0
+    min_first_passage: float | None = None
+    first_passage_predicted: float = float("nan")
+    first_passage_monte_carlo: FirstPassage | None = None
+    first_passage_confirmed: bool | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready: the keys of ``randvib design --json``."""
@@ -118,6 +136,12 @@ class DesignResult:
             "refined": self.refined,
             "evaluations": self.evaluations,
             "monte_carlo_cases": self.monte_carlo_cases,
+            "min_first_passage": self.min_first_passage,
+            "first_passage_predicted": self.first_passage_predicted,
+            "first_passage_monte_carlo": None
+            if self.first_passage_monte_carlo is None
+            else self.first_passage_monte_carlo.to_dict(),
+            "first_passage_confirmed": self.first_passage_confirmed,
         }
 
     def to_frame(self):

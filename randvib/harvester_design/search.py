@@ -11,6 +11,22 @@ linear device with a rational spectrum the prediction is the exact Lyapunov
 solution (:mod:`randvib.analytic.linear_response`) and the constraint is
 sigma_z <= d / Phi^-1(1 - eps/2), so the optimum found is the exact one
 (to the optimiser's tolerance, 1e-10 relative in the objective).
+
+A coil into a diode bridge (:mod:`randvib.models.rectifier`) is predicted by
+``bridge-closure`` (white noise, within its declared validity; beyond it the
+point is left to Monte Carlo). The closure takes the response as Gaussian, so
+its exceedance is that of a Gaussian displacement of the closure's variance,
+P(|z| > d) = erfc(d / (sigma_z sqrt 2)); Monte Carlo confirms it.
+
+An optional second constraint asks for a mean first-passage time to the
+stroke of at least T. Where the method's response is Gaussian
+(:data:`GAUSSIAN_RESPONSE`) it is predicted from Rice's stationary rate of
+crossings out of |z| < d (:func:`randvib.analytic.first_passage.outcrossing_rate`,
+with E[z z'] = 0) as independent (Poisson) crossings from a stationary start,
+E[tau] = (1 - P(|z| > d)) / nu_d: conservative (too short) for a narrow-band
+response, whose crossings come in clumps. Elsewhere (``fpk-fast``'s
+non-Gaussian density) no first passage is predicted and only Monte Carlo
+checks the constraint.
 """
 
 from __future__ import annotations
@@ -22,6 +38,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import optimize
 
+from randvib.analytic.first_passage import outcrossing_rate
+from randvib.analytic.power_prediction import gaussian_exceedance
 from randvib.analytic.prediction import METHODS, predict
 from randvib.harvester_design.space import DesignSpace
 
@@ -30,6 +48,13 @@ __all__ = ["Candidate", "SearchOutcome", "analytic_search", "predictor_for"]
 #: The analytic methods a design may use, most accurate first (never the
 #: slow reference solver, which the methods declare).
 PREFERENCE = ("fpk-fast", "linearisation")
+#: The method of a device behind a diode bridge (the others refuse a rectifier).
+RECTIFIED = "bridge-closure"
+#: Methods whose stroke exceedance is that of their Gaussian displacement: their
+#: closure assumes a Gaussian response, so the exceedance is its consequence.
+GAUSSIAN_DISPLACEMENT = (RECTIFIED,)
+#: Methods whose stationary (z, z') is Gaussian: the first passage is predicted for them.
+GAUSSIAN_RESPONSE = ("linearisation", RECTIFIED)
 #: Grid points per dimension of the first look, by the number of varied parameters.
 GRID = {1: 41, 2: 15, 3: 7}
 #: Grid points per dimension beyond three parameters.
@@ -75,6 +100,9 @@ class Candidate:
         stationary sum of every dissipation.
     warned : bool
         The method warned (beyond a declared validity limit it warns at).
+    first_passage : float
+        Predicted mean first-passage time to the stroke (s) from a stationary
+        start; NaN where the method's response is not Gaussian (module docstring).
     """
 
     u: np.ndarray = field(repr=False)
@@ -84,6 +112,7 @@ class Candidate:
     method: str
     input_power: float
     warned: bool = False
+    first_passage: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -106,7 +135,11 @@ def predictor_for(harvester, excitation):
     """The first method of :data:`PREFERENCE` that takes the case and gives the exceedance, or None.
 
     A linear device without friction is linearisation's: exact there (Lyapunov).
+    A device behind a diode bridge is :data:`RECTIFIED`'s where it accepts it.
     """
+    if harvester.is_rectified:
+        method = METHODS[RECTIFIED]
+        return method if method.accepts(harvester, excitation) else None
     linear = harvester.friction is None and np.all(harvester.k3 == 0) and np.all(harvester.k > 0)
     for name in ("linearisation",) if linear else PREFERENCE:
         method = METHODS[name]
@@ -145,6 +178,8 @@ class Evaluator:
                 return None  # refused beyond its validity, or no Gaussian solution
         power = self.objective.analytic(prediction, device)
         exceedance = prediction.stroke_exceedance
+        if exceedance is None and method.name in GAUSSIAN_DISPLACEMENT:
+            exceedance = float(gaussian_exceedance(device.stroke, prediction.displacement_variance))
         if exceedance is None or not math.isfinite(power):
             return None
         return Candidate(
@@ -155,10 +190,37 @@ class Evaluator:
             method=method.name,
             input_power=float(prediction.c_eq * prediction.velocity_variance),
             warned=bool(caught),
+            first_passage=predicted_first_passage(prediction, method, device.stroke, exceedance),
         )
 
 
-def analytic_search(space: DesignSpace, excitation, budget: float, objective, runners_up: int = 2):
+def predicted_first_passage(prediction, method, stroke: float, exceedance: float) -> float:
+    """E[tau] (s) to |z| > ``stroke`` from a stationary start, Poisson crossings; NaN if not Gaussian."""
+    if method.name not in GAUSSIAN_RESPONSE or prediction.displacement_variance is None:
+        return math.nan
+    rate = float(
+        outcrossing_rate(
+            prediction.displacement_variance, 0.0, prediction.velocity_variance, stroke
+        )
+    )
+    return (1.0 - exceedance) / rate if rate > 0 else math.inf
+
+
+def meets(c: Candidate, budget: float, min_first_passage: float | None) -> bool:
+    """The prediction meets the budget and, where it predicts one, the first-passage bound."""
+    if c.exceedance > budget:
+        return False
+    return min_first_passage is None or not c.first_passage < min_first_passage
+
+
+def analytic_search(
+    space: DesignSpace,
+    excitation,
+    budget: float,
+    objective,
+    runners_up: int = 2,
+    min_first_passage: float | None = None,
+):
     """Maximise the predicted objective over the box with P(|z| > stroke) <= budget.
 
     Parameters
@@ -171,6 +233,9 @@ def analytic_search(space: DesignSpace, excitation, budget: float, objective, ru
     objective : Objective
     runners_up : int
         How many other distinct good candidates to return.
+    min_first_passage : float, optional
+        T (s): also require a predicted mean first passage to the stroke of
+        at least T where the method predicts one (:func:`predicted_first_passage`).
 
     Returns
     -------
@@ -179,7 +244,8 @@ def analytic_search(space: DesignSpace, excitation, budget: float, objective, ru
     Raises
     ------
     InfeasibleBudget
-        No predicted device meets the budget: says the best reachable exceedance and where.
+        No predicted device meets the budget (says the best reachable exceedance and
+        where) or the first-passage bound (says the longest predicted first passage).
     """
     evaluate = Evaluator(space, excitation, objective)
     per = GRID.get(space.dimension, GRID_MANY)
@@ -189,21 +255,27 @@ def analytic_search(space: DesignSpace, excitation, budget: float, objective, ru
         raise NothingPredicted(
             "no analytic method predicts any device in the ranges given (every point was refused)"
         )
-    feasible = sorted((c for c in grid if c.exceedance <= budget), key=lambda c: -c.power)
+    feasible = sorted((c for c in grid if meets(c, budget, min_first_passage)),
+                      key=lambda c: -c.power)  # fmt: skip
     if not feasible:
-        best = _least_exceedance(evaluate, min(grid, key=lambda c: c.exceedance), space)
-        if best.exceedance > budget:
-            where = ", ".join(f"{k} = {v:.6g}" for k, v in best.values.items())
-            raise InfeasibleBudget(
-                f"the stroke budget P(|z| > {space.harvester.stroke:g} m) <= {budget:g} cannot be "
-                f"met in the ranges given: the best reachable exceedance is "
-                f"{best.exceedance:.3g} (at {where})"
-            )
-        feasible = [best]
+        within = [c for c in grid if c.exceedance <= budget]
+        if not within:
+            best = _least_exceedance(evaluate, min(grid, key=lambda c: c.exceedance), space)
+            if best.exceedance > budget:
+                where = ", ".join(f"{k} = {v:.6g}" for k, v in best.values.items())
+                raise InfeasibleBudget(
+                    f"the stroke budget P(|z| > {space.harvester.stroke:g} m) <= {budget:g} "
+                    f"cannot be met in the ranges given: the best reachable exceedance is "
+                    f"{best.exceedance:.3g} (at {where})"
+                )
+            within = [best]
+        feasible = [c for c in within if meets(c, budget, min_first_passage)]
+        if not feasible:
+            feasible = [_longest_first_passage(evaluate, within, budget, min_first_passage, space)]
     scale = feasible[0].power
     optima = []
     for start in feasible[:STARTS]:
-        found = _local(evaluate, start, budget, scale)
+        found = _local(evaluate, start, budget, scale, min_first_passage)
         if all(np.max(np.abs(found.u - o.u)) > SAME_POINT for o in optima):
             optima.append(found)
     optima.sort(key=lambda c: -c.power)
@@ -216,9 +288,24 @@ def analytic_search(space: DesignSpace, excitation, budget: float, objective, ru
     return SearchOutcome(optima[0], others[:runners_up], len(evaluate.cache), grid, unpredicted)
 
 
-def _local(evaluate, start: Candidate, budget: float, scale: float) -> Candidate:
+def _local(
+    evaluate, start: Candidate, budget: float, scale: float, min_first_passage=None
+) -> Candidate:
     """SLSQP from ``start``; the better of the start and the end (both feasible)."""
     log_budget = math.log(budget)
+    constraints = [{"type": "ineq", "fun": lambda u: margin(u)}]
+    if min_first_passage is not None:
+        log_time = math.log(min_first_passage)
+
+        def passage_margin(u):
+            c = evaluate(u)
+            if c is None:
+                return -50.0
+            if math.isnan(c.first_passage):
+                return 0.0  # not predicted here: left to Monte Carlo
+            return min(math.log(max(c.first_passage, TINY)) - log_time, 50.0)
+
+        constraints.append({"type": "ineq", "fun": passage_margin})
 
     def power(u):
         c = evaluate(u)
@@ -233,23 +320,60 @@ def _local(evaluate, start: Candidate, budget: float, scale: float) -> Candidate
         start.u,
         method="SLSQP",
         bounds=[(0.0, 1.0)] * len(start.u),
-        constraints=[{"type": "ineq", "fun": margin}],
+        constraints=constraints,
         options={"ftol": 1e-12, "maxiter": 200, "eps": 1e-7},
     )
     end = evaluate(result.x)
-    if end is None or end.exceedance > budget * (1 + 1e-8):
+    if end is None or not meets(end, budget * (1 + 1e-8), _relaxed(min_first_passage)):
         # SLSQP may stop a hair outside the budget (or on an unpredicted point): the
         # feasible point nearest to it on the segment from the start, by bisection
         lo, hi = 0.0, 1.0
         for _ in range(60):
             mid = 0.5 * (lo + hi)
             c = evaluate(start.u + mid * (result.x - start.u))
-            if c is not None and c.exceedance <= budget:
+            if c is not None and meets(c, budget, min_first_passage):
                 lo = mid
             else:
                 hi = mid
         end = evaluate(start.u + lo * (result.x - start.u))
     return end if end is not None and end.power > start.power else start
+
+
+def _relaxed(min_first_passage):
+    """The first-passage bound less SLSQP's tolerance on the constraint (1e-8 relative)."""
+    return None if min_first_passage is None else min_first_passage * (1 - 1e-8)
+
+
+def _longest_first_passage(evaluate, within, budget, min_first_passage, space) -> Candidate:
+    """The longest predicted first passage among ``within`` and a local ascent from it under
+    the exceedance budget, if it meets ``min_first_passage``; else InfeasibleBudget."""
+    start = max(within, key=lambda c: c.first_passage)
+    log_budget = math.log(budget)
+
+    def objective(u):
+        c = evaluate(u)
+        return 50.0 if c is None else -math.log(max(c.first_passage, TINY))
+
+    def margin(u):
+        c = evaluate(u)
+        return -50.0 if c is None else log_budget - math.log(max(c.exceedance, TINY))
+
+    result = optimize.minimize(
+        objective, start.u, method="SLSQP", bounds=[(0.0, 1.0)] * space.dimension,
+        constraints=[{"type": "ineq", "fun": margin}],
+    )  # fmt: skip
+    end = evaluate(result.x)
+    best = start
+    if end is not None and end.exceedance <= budget and end.first_passage > start.first_passage:
+        best = end
+    if best.first_passage >= min_first_passage:
+        return best  # the grid missed it: the search goes on from there
+    where = ", ".join(f"{k} = {v:.6g}" for k, v in best.values.items())
+    raise InfeasibleBudget(
+        f"the first-passage constraint E[tau] >= {min_first_passage:g} s (mean time to "
+        f"|z| > {space.harvester.stroke:g} m) cannot be met in the ranges given within the "
+        f"stroke budget: the longest predicted is {best.first_passage:.3g} s (at {where})"
+    )
 
 
 def _least_exceedance(evaluate, start: Candidate, space: DesignSpace) -> Candidate:
