@@ -25,10 +25,11 @@ from __future__ import annotations
 
 import argparse
 import csv
+import io
 import itertools
 import math
 
-from randvib._io import check_output_file, dumps
+from randvib._io import claim_output_file, dumps, write_or_keep
 from randvib.analytic.prediction import METHODS, optimal_load_resistance, predict
 from randvib.cli._device import add_device_arguments, harvester_from_args, option_flag
 from randvib.cli._event import add_event_arguments, power_event, wants_event
@@ -143,14 +144,15 @@ def _sweep(args) -> tuple[list[str], list[argparse.Namespace]]:
 
 def run(args) -> int:
     csv_file = (
-        None if args.csv is None else check_output_file(args.csv, "--csv", overwrite=args.force)
+        None if args.csv is None else claim_output_file(args.csv, "--csv", overwrite=args.force)
     )
     swept, points = _sweep(args)
     if wants_event(args):
         return power_event(args, swept, points)
     results = [_point(point) for point in points]
+    saved = None
     if csv_file is not None:
-        _write_csv(csv_file, [out for out, _, _ in results])
+        saved = _write_csv(csv_file, [out for out, _, _ in results], args.force)
     if args.json:
         outs = [out for out, _, _ in results]
         print(dumps(outs[0] if len(outs) == 1 and not swept else outs))
@@ -158,9 +160,10 @@ def run(args) -> int:
         _print_sweep(swept, points, results)
     else:
         _print_point(*results[0])
-    if csv_file is not None and not args.json:
+    if saved is not None and saved == csv_file and not args.json:
         print(f"wrote {csv_file} ({len(results)} points)")
-    return 0
+    # not saved where asked (a full disk): the table is kept elsewhere, and the exit says so
+    return 0 if csv_file is None or saved == csv_file else 1
 
 
 def _point(args) -> tuple[dict, object, object]:
@@ -271,15 +274,20 @@ def _print_sweep(swept: list[str], points, results) -> None:
     print_table(rows, headers)
 
 
-def _write_csv(path, outs: list[dict]) -> None:
-    """Every point's keys (the excitation's as ``excitation.NAME``), one row per point."""
+def _write_csv(path, outs: list[dict], overwrite: bool):
+    """Every point's keys (the excitation's as ``excitation.NAME``), one row per point.
+
+    Written whole or not at all; where it could not be written, the table is
+    kept in an ``randvib-unsaved-*`` file, whose path is returned.
+    """
     rows = []
     for out in outs:
         row = {k: v for k, v in out.items() if k != "excitation"}
         row.update({f"excitation.{k}": v for k, v in out.get("excitation", {}).items()})
         rows.append(row)
     names = list(dict.fromkeys(k for row in rows for k in row))
-    with open(path, "w", newline="") as file:
-        writer = csv.DictWriter(file, fieldnames=names)
-        writer.writeheader()
-        writer.writerows(rows)
+    text = io.StringIO(newline="")
+    writer = csv.DictWriter(text, fieldnames=names)
+    writer.writeheader()
+    writer.writerows(rows)
+    return write_or_keep(path, text.getvalue(), "--csv", overwrite=overwrite)

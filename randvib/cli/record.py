@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from randvib._io import check_output_file
+from randvib._io import claim_output_file, write_or_keep
 from randvib._resources import check_memory
 from randvib._validation import MAX_SEED, check_int, integer_option
 from randvib.cli._device import add_device_arguments, harvester_from_args
@@ -60,7 +60,7 @@ def run(args) -> int:
     out = Path(args.out)
     if out.exists() and not out.is_dir() and not args.force:
         raise FileExistsError(f"`--out` {str(out)!r} exists; choose a new name or give --force")
-    check_output_file(out, "--out", overwrite=args.force)
+    claim_output_file(out, "--out", overwrite=args.force)
     check_int("--seed", args.seed, 0, MAX_SEED)
     if (args.rms is None) == (args.psd is None):
         raise ValueError("give exactly one of `--rms` (m/s^2) and `--psd` ((m/s^2)^2/Hz)")
@@ -85,6 +85,8 @@ def run(args) -> int:
         name=out.stem,
     )
     # Full precision, so that identify reads back exactly the simulated samples.
-    record.to_csv(out, overwrite=args.force, float_format=None)
+    text = record.to_frame().to_csv(index=False, float_format=None)
+    if write_or_keep(out, text, "--out", overwrite=args.force) != out:
+        return 1
     print(f"wrote {out} ({record.n} samples at {record.sample_rate:g} Hz, {args.input})")
     return 0
