@@ -148,6 +148,10 @@ def _main_with_warnings(argv) -> int:
         finally:
             # in-process callers (tests, notebooks) get the API's words back
             _Running.prog, _Running.flags = "randvib", {}
+            # the output files' and folders' locks go with the command, not the process
+            from randvib._locks import release_all
+
+            release_all()
 
 
 def _advice_warnings() -> tuple:
