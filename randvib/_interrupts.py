@@ -104,10 +104,16 @@ def exit_at_once_on_signals() -> None:
 
 
 def interrupted_exit(exc: KeyboardInterrupt) -> tuple[int, str]:
-    """The exit status and the one line to print for a stopped run."""
+    """The exit status and the one line to print for a stopped run.
+
+    A command that knows what it kept (a sweep's finished points, where)
+    says so in the interrupt's ``kept`` attribute, which replaces the
+    generic "finished results were kept".
+    """
+    kept = getattr(exc, "kept", None) or "finished results were kept"
     if isinstance(exc, Terminated):
-        return 128 + signal.SIGTERM, "randvib: terminated (SIGTERM); finished results were kept"
-    return 128 + signal.SIGINT, "randvib: interrupted; finished results were kept"
+        return 128 + signal.SIGTERM, f"randvib: terminated (SIGTERM); {kept}"
+    return 128 + signal.SIGINT, f"randvib: interrupted; {kept}"
 
 
 @contextlib.contextmanager

@@ -255,3 +255,44 @@ def test_identify_full_disk_leaves_no_empty_save(capsys, tmp_path, monkeypatch, 
     assert code == 1 and list((tmp_path / "full").iterdir()) == []
     kept = list(tmp_path.glob("randvib-unsaved-*.json"))
     assert len(kept) == 1 and json.loads(kept[0].read_text())["model"] == "coulomb"
+
+
+# ------------------------------------------------- a stopped or long power sweep
+@pytest.mark.parametrize("stop, code", [(KeyboardInterrupt, 130), ("sigterm", 143)])
+def test_stopped_power_sweep_keeps_its_finished_points_in_the_csv(
+    capsys, tmp_path, monkeypatch, stop, code
+):
+    from randvib._interrupts import Terminated
+    from randvib.cli import power
+
+    monkeypatch.chdir(tmp_path)
+    real, calls = power._point, []
+
+    def stop_at_the_third(args):
+        calls.append(1)
+        if len(calls) == 3:
+            raise Terminated() if stop == "sigterm" else KeyboardInterrupt()
+        return real(args)
+
+    monkeypatch.setattr(power, "_point", stop_at_the_third)
+    argv = ["power", "--preset", "figure9", "--psd", "0.1:1:5", "--csv", "big.csv"]
+    code_, out, err = run(capsys, *argv)
+    assert code_ == code
+    assert "the 2 finished points of 5 were kept in 'big.csv'" in err
+    rows = (tmp_path / "big.csv").read_text().strip().splitlines()
+    assert len(rows) == 3 and rows[0].startswith("method,psd")  # header and 2 points
+    # without --csv, the line does not claim that anything was kept
+    calls.clear()
+    code_, out, err = run(capsys, *argv[:-2])
+    assert code_ == code and "nothing was saved (no --csv)" in err
+
+
+def test_long_power_sweep_says_how_long_first(capsys, tmp_path, monkeypatch):
+    import itertools
+
+    from randvib import _resources
+
+    ticks = itertools.count(step=100.0)  # every point "takes" 100 s on this clock
+    monkeypatch.setattr(_resources, "clock", lambda: next(ticks))
+    code, out, err = run(capsys, "power", "--preset", "figure9", "--psd", "0.1:1:10")
+    assert code == 0 and "this sweep of 10 points will take about 15 minutes" in err

@@ -30,6 +30,7 @@ import itertools
 import math
 
 from randvib._io import claim_output_file, dumps, write_or_keep
+from randvib._resources import announce_duration, timed
 from randvib.analytic.prediction import METHODS, optimal_load_resistance, predict
 from randvib.cli._device import add_device_arguments, harvester_from_args, option_flag
 from randvib.cli._event import add_event_arguments, power_event, wants_event
@@ -149,7 +150,7 @@ def run(args) -> int:
     swept, points = _sweep(args)
     if wants_event(args):
         return power_event(args, swept, points)
-    results = [_point(point) for point in points]
+    results = _points(points, csv_file, args.force)
     saved = None
     if csv_file is not None:
         saved = _write_csv(csv_file, [out for out, _, _ in results], args.force)
@@ -164,6 +165,40 @@ def run(args) -> int:
         print(f"wrote {csv_file} ({len(results)} points)")
     # not saved where asked (a full disk): the table is kept elsewhere, and the exit says so
     return 0 if csv_file is None or saved == csv_file else 1
+
+
+def _points(points, csv_file, overwrite: bool) -> list:
+    """Every point, in order; on Ctrl-C or SIGTERM the finished ones go to ``--csv``.
+
+    A sweep whose first point shows it will take long says so first
+    (:func:`randvib._resources.announce_duration`).
+    """
+    results = []
+    try:
+        for i, point in enumerate(points):
+            result, seconds = timed(lambda point=point: _point(point))
+            results.append(result)
+            if i == 0 and len(points) > 1:
+                announce_duration(
+                    f"this sweep of {len(points)} points",
+                    seconds * (len(points) - 1),
+                    basis="at the speed of its first point",
+                )
+    except KeyboardInterrupt as exc:
+        exc.kept = _keep_finished(results, len(points), csv_file, overwrite)
+        raise
+    return results
+
+
+def _keep_finished(results, n_points: int, csv_file, overwrite: bool) -> str:
+    """Write the finished points of a stopped sweep to ``--csv``; what was kept, in words."""
+    if csv_file is None:
+        return f"{len(results)} of {n_points} points were finished; nothing was saved (no --csv)"
+    if not results:
+        return f"no point was finished; {str(csv_file)!r} was not written"
+    saved = _write_csv(csv_file, [out for out, _, _ in results], overwrite)
+    where = "printed above" if saved is None else repr(str(saved))
+    return f"the {len(results)} finished points of {n_points} were kept in {where}"
 
 
 def _point(args) -> tuple[dict, object, object]:
