@@ -288,9 +288,12 @@ def atomic_write_bytes(path, data: bytes, *, overwrite: bool = True) -> None:
         else:
             os.link(tmp, path)
             os.unlink(tmp)
-    except BaseException:
+    except BaseException as exc:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
+        if isinstance(exc, OSError) and not isinstance(exc, FileExistsError):
+            # name the target, not the temporary file (a full disk: ENOSPC)
+            raise OSError(exc.errno, exc.strerror or type(exc).__name__, str(path)) from None
         raise
 
 
