@@ -206,6 +206,18 @@ def _release(lock: Path) -> None:
                 os.unlink(lock)
 
 
+def release_since(before: set) -> None:
+    """Release every lock taken since ``before`` (a copy of :func:`held`), keeping older ones."""
+    for lock in [lock for lock in _HELD if lock not in before]:
+        _HELD[lock] = 1
+        _release(lock)
+
+
+def held() -> set:
+    """The locks this process holds now (for :func:`release_since`)."""
+    return set(_HELD)
+
+
 @atexit.register
 def release_all() -> None:
     """Release every folder and file lock this process holds (end of a run, and at exit)."""

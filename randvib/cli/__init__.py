@@ -22,6 +22,7 @@ import sys
 import warnings
 
 from randvib._interrupts import interrupted_exit, interrupts_seen, sigterm_stops
+from randvib._locks import held, release_since
 
 #: Command modules under randvib.cli, in the order shown by --help.
 COMMANDS = ["power", "simulate", "study", "record", "identify", "validate"]
@@ -161,15 +162,14 @@ def _main_with_warnings(argv) -> int:
         for advice in _advice_warnings():
             warnings.filterwarnings("default", category=advice)
         warnings.showwarning = _show_warning
+        locks_before = held()
         try:
             return _main(argv)
         finally:
             # in-process callers (tests, notebooks) get the API's words back
             _Running.prog, _Running.flags = "randvib", {}
-            # the output files' and folders' locks go with the command, not the process
-            from randvib._locks import release_all
-
-            release_all()
+            # the locks the command took go with it (an in-process caller keeps its own)
+            release_since(locks_before)
 
 
 def _advice_warnings() -> tuple:
