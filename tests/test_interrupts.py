@@ -67,12 +67,16 @@ def test_ctrl_c_in_a_study_exits_130_and_releases_its_folder(capsys, tmp_path, m
     def long_study(out_dir, *, quick, seed, workers, scheduler, progress):
         out = _io.prepare_output_dir(out_dir, {"study": "long"})
         _io.write_tracked(out / "first.csv", "finished part\n")
+        # Ctrl-C once the first part is on disk (a fixed time from the start raced with
+        # the folder's set-up on a busy machine), while the long part runs
+        timers.append(_interrupt_after(0.5))
         simulate(BASE, 1.0, t_end=2000.0, dt=1e-4, n_paths=200, progress=False)
 
+    timers = []
     monkeypatch.setattr("randvib.cli.study.load_study", lambda name: long_study)
-    timer = _interrupt_after(1.0)
     code, out, err = run(capsys, "study", "interaction", "--out", tmp_path / "s")
-    timer.cancel()
+    for timer in timers:
+        timer.cancel()
     assert code == 130 and "Traceback" not in err
     assert (tmp_path / "s" / "first.csv").read_text() == "finished part\n"  # kept
     assert not (tmp_path / "s" / _io.LOCK_FILE).exists()
