@@ -5,7 +5,13 @@
 * :func:`ctrl_c_blocked` and :func:`worker_ignores_ctrl_c`: a process pool's
   workers leave Ctrl-C to their parent from the moment they are spawned.
 * :func:`sigterm_stops` and :func:`interrupted_exit`: SIGTERM handled as
-  Ctrl-C is, for the command line and the study scripts.
+  Ctrl-C is, for the command line and the study scripts; :func:`interrupts_seen`
+  notices a Ctrl-C that a finaliser or a callback swallowed, so that such a run
+  still ends with a non-zero status.
+* :func:`exit_at_once_on_signals`: while the command line starts (imports)
+  and once it has finished (interpreter shutdown), Ctrl-C and SIGTERM end
+  the process at once with one line and 130 / 143, never a traceback nor an
+  "Exception ignored" note and exit 0.
 
 A run stopped by SIGTERM (``kill``, a batch scheduler's time limit) should
 end as one stopped by Ctrl-C: finished points and fits kept, folder locks
@@ -18,8 +24,12 @@ status (130 = 128 + SIGINT, 143 = 128 + SIGTERM).
 from __future__ import annotations
 
 import contextlib
+import os
 import signal
 import threading
+
+#: The signals received in this process while a command ran (see interrupts_seen).
+_SEEN: list[int] = []
 
 
 class Terminated(KeyboardInterrupt):
@@ -27,27 +37,83 @@ class Terminated(KeyboardInterrupt):
 
 
 def _raise_terminated(signum, frame):
+    _SEEN.append(signum)
     raise Terminated()
+
+
+def _raise_interrupt(signum, frame):
+    _SEEN.append(signum)
+    raise KeyboardInterrupt
 
 
 @contextlib.contextmanager
 def sigterm_stops():
-    """Within the block, SIGTERM raises :class:`Terminated` (main thread only)."""
+    """Within the block, SIGTERM raises :class:`Terminated` and Ctrl-C KeyboardInterrupt.
+
+    Both are noted (:func:`interrupts_seen`), so that one swallowed on its way
+    (raised inside a finaliser or a callback, which Python reports as
+    "Exception ignored" and goes on) is still known when the run ends. Main
+    thread only.
+    """
     if threading.current_thread() is not threading.main_thread():
         yield
         return
+    del _SEEN[:]
     previous = signal.signal(signal.SIGTERM, _raise_terminated)
+    previous_int = signal.signal(signal.SIGINT, _raise_interrupt)
     try:
         yield
     finally:
         signal.signal(signal.SIGTERM, previous)
+        signal.signal(signal.SIGINT, previous_int)
+
+
+def interrupts_seen() -> KeyboardInterrupt | None:
+    """The interrupt received within the last :func:`sigterm_stops` block, if any.
+
+    A run whose interrupt was swallowed by a finaliser finishes normally; its
+    entry point asks here and ends with the interrupt's status all the same.
+    """
+    if not _SEEN:
+        return None
+    return Terminated() if _SEEN[-1] == signal.SIGTERM else KeyboardInterrupt()
+
+
+def _exit_at_once(signum, frame):
+    if signum == signal.SIGTERM:
+        line = b"randvib: terminated (SIGTERM)\n"
+    else:
+        line = b"randvib: interrupted\n"
+    with contextlib.suppress(OSError):
+        os.write(2, line)
+    os._exit(128 + signum)
+
+
+def exit_at_once_on_signals() -> None:
+    """From now on Ctrl-C and SIGTERM end the process at once: one line, 130 or 143.
+
+    For the entry points, before their imports (nothing computed yet, nothing
+    to keep) and after the command returned (its results written, its locks
+    released): the interpreter then runs imports, finalisers and atexit
+    handlers, where a KeyboardInterrupt would print a traceback or be
+    "ignored" with exit 0.
+    """
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGINT, _exit_at_once)
+        signal.signal(signal.SIGTERM, _exit_at_once)
 
 
 def interrupted_exit(exc: KeyboardInterrupt) -> tuple[int, str]:
-    """The exit status and the one line to print for a stopped run."""
+    """The exit status and the one line to print for a stopped run.
+
+    A command that knows what it kept (a sweep's finished points, where)
+    says so in the interrupt's ``kept`` attribute, which replaces the
+    generic "finished results were kept".
+    """
+    kept = getattr(exc, "kept", None) or "finished results were kept"
     if isinstance(exc, Terminated):
-        return 128 + signal.SIGTERM, "randvib: terminated (SIGTERM); finished results were kept"
-    return 128 + signal.SIGINT, "randvib: interrupted; finished results were kept"
+        return 128 + signal.SIGTERM, f"randvib: terminated (SIGTERM); {kept}"
+    return 128 + signal.SIGINT, f"randvib: interrupted; {kept}"
 
 
 @contextlib.contextmanager

@@ -29,6 +29,7 @@ from pathlib import Path
 
 # the folder locks, used here and re-exported for callers of this module
 from randvib._locks import LOCK_FILE as LOCK_FILE
+from randvib._locks import lock_file as lock_file
 from randvib._locks import lock_folder as lock_folder
 from randvib._locks import release_all as release_all
 from randvib._locks import unlock_folder as unlock_folder
@@ -209,30 +210,57 @@ def check_output_folder(path, option: str) -> Path:
     return path
 
 
-def write_or_keep(path, text: str, option: str) -> Path | None:
-    """Write ``text`` to the new file ``path``; if that fails, keep it beside, saying where.
+def claim_output_file(path, option: str, *, overwrite: bool = False) -> Path:
+    """:func:`check_output_file`, then hold the file's lock until the run ends.
 
-    For results of long runs: the path was checked before the run, but the
-    disk may have filled or the folder gone since. On failure the text goes to
+    A second run given the same output file while this one computes is
+    refused at once (one writer per file, as per folder), naming ``option``.
+    """
+    path = check_output_file(path, option, overwrite=overwrite)
+    lock_file(path, option)
+    return path
+
+
+def write_or_keep(path, text: str | bytes, option: str, *, overwrite: bool = False) -> Path | None:
+    """Write ``text`` atomically to ``path``; if that fails, keep it beside, saying where.
+
+    For results of long runs: the path was checked (and locked, see
+    :func:`claim_output_file`) before the run, but the disk may have filled,
+    the folder gone or (without ``overwrite``) a file of that name appeared
+    since. The target is written whole or not at all (:func:`atomic_write_bytes`:
+    never a truncated file, never a 0-byte one); on failure the result goes to
     a new file in the current folder (or, failing that, to stderr) and a note
-    says so; the returned path is where it is (None: printed).
+    naming ``option`` and the file says so; the returned path is where the
+    result is (None: printed). Compare it with ``path`` before saying "wrote".
     """
     import sys
 
+    data = text.encode() if isinstance(text, str) else text
     try:
-        Path(path).write_text(text)
+        atomic_write_bytes(path, data, overwrite=overwrite)
         return Path(path)
     except OSError as exc:
         reason = exc.strerror or type(exc).__name__
-        fd, spare = tempfile.mkstemp(prefix="randvib-unsaved-", suffix=Path(path).suffix, dir=".")
+        if isinstance(exc, FileExistsError):
+            reason = "a file of that name appeared while the run computed"
         try:
-            os.fchmod(fd, _new_file_mode())
-            with os.fdopen(fd, "w") as f:
-                f.write(text)
+            fd, spare = tempfile.mkstemp(
+                prefix="randvib-unsaved-", suffix=Path(path).suffix, dir="."
+            )
+            try:
+                os.fchmod(fd, _new_file_mode())
+                with os.fdopen(fd, "wb") as f:
+                    f.write(data)
+                    f.flush()
+                    os.fsync(f.fileno())
+            except BaseException:
+                with contextlib.suppress(OSError):
+                    os.unlink(spare)
+                raise
         except OSError:
             print(f"randvib: could not write `{option}` {str(path)!r} ({reason}); the result:",
                   file=sys.stderr)  # fmt: skip
-            print(text, file=sys.stderr)
+            print(data.decode(errors="replace"), file=sys.stderr)
             return None
         print(f"randvib: could not write `{option}` {str(path)!r} ({reason}); "
               f"the result is kept in {spare!r}", file=sys.stderr)  # fmt: skip
@@ -251,19 +279,34 @@ def _new_file_mode() -> int:
     return 0o666 & ~mask
 
 
-def atomic_write_bytes(path, data: bytes) -> None:
-    """Write a file via a unique temporary name and rename, so a crash never leaves
-    half a file and two writers never share a temporary file."""
+def atomic_write_bytes(path, data: bytes, *, overwrite: bool = True) -> None:
+    """Write a file via a unique temporary name in its folder, fsync and rename.
+
+    A crash or a full disk never leaves half a file (the temporary file is
+    removed), and two writers never share a temporary file. With
+    ``overwrite=False`` an existing ``path`` is never replaced
+    (:class:`FileExistsError`): the file is linked into place, which fails
+    when the name exists.
+    """
     path = Path(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
         os.fchmod(fd, _new_file_mode())
         with os.fdopen(fd, "wb") as f:
             f.write(data)
-        os.replace(tmp, path)
-    except BaseException:
+            f.flush()
+            os.fsync(f.fileno())
+        if overwrite:
+            os.replace(tmp, path)
+        else:
+            os.link(tmp, path)
+            os.unlink(tmp)
+    except BaseException as exc:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
+        if isinstance(exc, OSError) and not isinstance(exc, FileExistsError):
+            # name the target, not the temporary file (a full disk: ENOSPC)
+            raise OSError(exc.errno, exc.strerror or type(exc).__name__, str(path)) from None
         raise
 
 

@@ -1,9 +1,11 @@
-"""Folder locks: one run at a time writes into a result folder.
+"""Folder and file locks: one run at a time writes into a result folder or an output file.
 
 While a run writes into a folder it holds the folder's lock
 (:data:`LOCK_FILE`, JSON: pid, host, start time), taken atomically
 (``O_CREAT | O_EXCL``). A second run is refused with the holder named; a
-lock is re-entrant within its process. Locks are released by
+lock is re-entrant within its process. An output file (``power --csv``,
+``identify --save``, ``record --out``) is locked the same way by a lock file
+beside it (:func:`lock_file`), from the check of its path to the end of the run. Locks are released by
 :func:`unlock_folder` / :func:`release_all`, and at exit.
 
 A lock left by a run that was killed is taken over:
@@ -35,7 +37,7 @@ HEARTBEAT_SECONDS = 30.0
 #: Another host's lock untouched this long (s) is a dead run's.
 STALE_AFTER_SECONDS = 600.0
 
-_HELD: dict[Path, int] = {}  # folder -> nesting depth, in this process
+_HELD: dict[Path, int] = {}  # lock file -> nesting depth, in this process
 _HEARTBEAT: list = []  # the one heartbeat thread of this process, once started
 
 
@@ -49,9 +51,9 @@ def _beat() -> None:
     while True:
         if time.monotonic() - last >= HEARTBEAT_SECONDS:
             last = time.monotonic()
-            for folder in list(_HELD):
+            for lock in list(_HELD):
                 with contextlib.suppress(OSError):  # released meanwhile, or a vanished folder
-                    os.utime(folder / LOCK_FILE)
+                    os.utime(lock)
         time.sleep(min(0.5, HEARTBEAT_SECONDS))
 
 
@@ -97,10 +99,34 @@ def lock_folder(folder) -> None:
     run) is taken over. Released by :func:`unlock_folder` or at exit.
     """
     folder = Path(folder).resolve()
-    if folder in _HELD:
-        _HELD[folder] += 1
+    _acquire(folder / LOCK_FILE, f"folder {str(folder)!r}")
+
+
+def file_lock_path(path) -> Path:
+    """The lock file of the output file ``path``: a hidden file beside it."""
+    path = Path(path).resolve()
+    return path.parent / f".{path.name}{LOCK_FILE}"
+
+
+def lock_file(path, option: str) -> None:
+    """Take the lock of the output file ``path`` (re-entrant), or refuse naming ``option``.
+
+    One run at a time writes a given file: a second run given the same
+    ``--csv``/``--save``/``--out`` while the first computes is refused at
+    once, before it computes anything. Released by :func:`unlock_file` or at exit.
+    """
+    _acquire(file_lock_path(path), f"`{option}` {str(path)!r}")
+
+
+def unlock_file(path) -> None:
+    """Release one hold of the output file ``path``'s lock."""
+    _release(file_lock_path(path))
+
+
+def _acquire(lock: Path, what: str) -> None:
+    if lock in _HELD:
+        _HELD[lock] += 1
         return
-    lock = folder / LOCK_FILE
     for _ in range(3):
         try:
             fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
@@ -112,13 +138,13 @@ def lock_folder(folder) -> None:
             if _is_stale(holder, lock):
                 _break_stale(lock, holder)
                 continue
-            raise FileExistsError(_busy_message(folder, holder)) from None
+            raise FileExistsError(_busy_message(lock, holder, what)) from None
         with os.fdopen(fd, "w") as f:
             f.write(_lock_text())
-        _HELD[folder] = 1
+        _HELD[lock] = 1
         _start_heartbeat()
         return
-    raise FileExistsError(_busy_message(folder, _holder(lock)))
+    raise FileExistsError(_busy_message(lock, _holder(lock), what))
 
 
 def _silent_for(lock: Path) -> float:
@@ -145,8 +171,9 @@ def _break_stale(lock: Path, holder: dict) -> None:
             os.unlink(lock)
 
 
-def _busy_message(folder: Path, holder) -> str:
-    lock = folder / LOCK_FILE
+def _busy_message(lock: Path, holder, what: str | None = None) -> str:
+    if what is None:  # a folder's lock
+        what = f"folder {str(lock.parent)!r}"
     if holder is None:
         who = "an unreadable lock"
     else:
@@ -157,29 +184,43 @@ def _busy_message(folder: Path, holder) -> str:
                 f"silent for {STALE_AFTER_SECONDS:.0f} s"
             )
     return (
-        f"folder {str(folder)!r} is in use by another randvib run ({who}); wait for it to "
+        f"{what} is in use by another randvib run ({who}); wait for it to "
         f"finish, or if no such run exists delete {str(lock)!r}"
     )
 
 
 def unlock_folder(folder) -> None:
     """Release one hold of ``folder``'s lock (the file goes with the last)."""
-    folder = Path(folder).resolve()
-    if folder not in _HELD:
+    _release(Path(folder).resolve() / LOCK_FILE)
+
+
+def _release(lock: Path) -> None:
+    if lock not in _HELD:
         return
-    _HELD[folder] -= 1
-    if _HELD[folder] == 0:
-        del _HELD[folder]
-        lock = folder / LOCK_FILE
+    _HELD[lock] -= 1
+    if _HELD[lock] == 0:
+        del _HELD[lock]
         holder = _holder(lock)
         if holder is not None and holder["pid"] == os.getpid():
             with contextlib.suppress(FileNotFoundError):
                 os.unlink(lock)
 
 
+def release_since(before: set) -> None:
+    """Release every lock taken since ``before`` (a copy of :func:`held`), keeping older ones."""
+    for lock in [lock for lock in _HELD if lock not in before]:
+        _HELD[lock] = 1
+        _release(lock)
+
+
+def held() -> set:
+    """The locks this process holds now (for :func:`release_since`)."""
+    return set(_HELD)
+
+
 @atexit.register
 def release_all() -> None:
-    """Release every folder lock this process holds (end of a run, and at exit)."""
-    for folder in list(_HELD):
-        _HELD[folder] = 1
-        unlock_folder(folder)
+    """Release every folder and file lock this process holds (end of a run, and at exit)."""
+    for lock in list(_HELD):
+        _HELD[lock] = 1
+        _release(lock)

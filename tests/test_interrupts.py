@@ -1,6 +1,7 @@
 """Interrupts that interrupt: Ctrl-C and SIGTERM stop a run, keep what finished, end its workers.
 
-Covers :mod:`randvib._interrupts` as the package uses it: the compiled Monte
+Covers :mod:`randvib._interrupts` as the package uses it, and the entry point
+:mod:`randvib.__main__` (an interrupt while it starts: one line): the compiled Monte
 Carlo loop (:func:`randvib.simulate`), the command line's exit statuses
 (:mod:`randvib.cli`: 130 for Ctrl-C, 143 for SIGTERM, one line), a sweep's
 worker processes (:func:`randvib.montecarlo.sweep.make_executor`: they ignore
@@ -66,12 +67,16 @@ def test_ctrl_c_in_a_study_exits_130_and_releases_its_folder(capsys, tmp_path, m
     def long_study(out_dir, *, quick, seed, workers, scheduler, progress):
         out = _io.prepare_output_dir(out_dir, {"study": "long"})
         _io.write_tracked(out / "first.csv", "finished part\n")
+        # Ctrl-C once the first part is on disk (a fixed time from the start raced with
+        # the folder's set-up on a busy machine), while the long part runs
+        timers.append(_interrupt_after(0.5))
         simulate(BASE, 1.0, t_end=2000.0, dt=1e-4, n_paths=200, progress=False)
 
+    timers = []
     monkeypatch.setattr("randvib.cli.study.load_study", lambda name: long_study)
-    timer = _interrupt_after(1.0)
     code, out, err = run(capsys, "study", "interaction", "--out", tmp_path / "s")
-    timer.cancel()
+    for timer in timers:
+        timer.cancel()
     assert code == 130 and "Traceback" not in err
     assert (tmp_path / "s" / "first.csv").read_text() == "finished part\n"  # kept
     assert not (tmp_path / "s" / _io.LOCK_FILE).exists()
@@ -296,3 +301,54 @@ def test_interrupted_process_pool_sweep_keeps_points_and_ends_workers(tmp_path, 
     for p in points:
         stored = json.loads(p.read_text())
         assert math.isfinite(stored["row"]["power_electrical"])
+
+
+@pytest.mark.parametrize("how, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_interrupt_while_the_command_line_starts_prints_no_traceback(how, code):
+    # The signal lands at several moments of the start (imports, parser, warnings set-up,
+    # the command); every one ends with one line and the signal's status (randvib.__main__).
+    # The delays count from the end of the interpreter's own start (site), which no
+    # program can guard: "ready" is printed once it is over, then `python -m randvib` runs.
+    start = (
+        "import os, runpy, sys; os.write(2, b'ready\\n'); "
+        "sys.argv = ['randvib', 'power', '--preset', 'figure9', '--psd', '1']; "
+        "runpy.run_module('randvib', run_name='__main__', alter_sys=True)"
+    )
+    for delay in (0.05, 0.15, 0.3, 0.5):
+        child = subprocess.Popen(
+            [sys.executable, "-c", start],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            env=_subprocess_env(),
+        )
+        assert child.stderr.readline() == "ready\n"
+        time.sleep(delay)
+        child.send_signal(how)
+        out, err = child.communicate(timeout=60)
+        if child.returncode == 0:
+            continue  # finished before the signal came
+        assert child.returncode == code, (delay, err)
+        assert "Traceback" not in err and len(error_lines(err)) == 1, (delay, err)
+
+
+def test_interrupt_swallowed_by_a_finaliser_still_ends_non_zero(capsys, monkeypatch):
+    # Ctrl-C raised inside a finaliser is "ignored" by Python and the command goes on to
+    # finish: the user asked it to stop, so the status must still say it was stopped.
+    from randvib.cli import power
+
+    class Finalised:
+        def __del__(self):
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.2)  # the handler runs here, inside __del__
+
+    real = power.run
+
+    def run_with_a_finaliser(args):
+        Finalised()  # collected at once: its __del__ swallows the KeyboardInterrupt
+        return real(args)
+
+    monkeypatch.setattr(power, "run", run_with_a_finaliser)  # looked up by register()
+    code, out, err = run(capsys, "power", "--preset", "figure9", "--psd", "1")
+    assert "power_electrical" in out  # the command did finish
+    assert code == 130 and "randvib: interrupted" in err

@@ -95,7 +95,7 @@ def test_another_hosts_live_lock_is_refused_naming_it(tmp_path):
         _io.prepare_output_dir(folder, {"grid": 1})
     assert json.loads(lock.read_text())["host"] == "node-17.cluster"  # untouched
     assert f"silent for {_locks.STALE_AFTER_SECONDS:.0f} s" in _locks._busy_message(
-        folder, json.loads(lock.read_text())
+        folder / _locks.LOCK_FILE, json.loads(lock.read_text())
     )
 
 

@@ -9,6 +9,7 @@ edited since randvib wrote them) as the commands use it
 """
 
 import json
+import shutil
 import threading
 from pathlib import Path
 
@@ -78,12 +79,12 @@ def test_identify_save_failing_after_the_fit_keeps_the_result(
 
     def fit_then_remove_folder(*args, **kwargs):
         result = real(*args, **kwargs)
-        (tmp_path / "out").rmdir()
+        shutil.rmtree(tmp_path / "out")  # with the lock of out/fit.json in it
         return result
 
     monkeypatch.setattr("randvib.cli.identify.identify", fit_then_remove_folder)
     code, out, err = run(capsys, *fit_args(record_csv[0], "--save", "out/fit.json", "--json"))
-    assert code == 0
+    assert code == 1  # not saved where asked
     kept = list(tmp_path.glob("randvib-unsaved-*.json"))
     assert len(kept) == 1 and json.loads(kept[0].read_text())["model"] == "coulomb"
     assert str(kept[0].name) in err
@@ -177,3 +178,143 @@ def test_written_files_follow_the_umask_like_open(tmp_path, monkeypatch, umask):
     assert expected == 0o666 & ~umask
     for path in (tmp_path / "a.png", tmp_path / "b.csv", kept):
         assert stat.S_IMODE(Path(path).stat().st_mode) == expected, path
+
+
+# ------------------------------------------------- one writer per file, full disk
+def _held_by_another_run(target: Path) -> None:
+    """The lock of ``target`` as a live run of this host holds it (our parent process)."""
+    import os
+    import socket
+
+    from randvib import _locks
+
+    _locks.file_lock_path(target).write_text(
+        json.dumps({"pid": os.getppid(), "host": socket.gethostname(), "started": "now"})
+    )
+
+
+@pytest.mark.parametrize(
+    "argv, option",
+    [
+        (["power", "--preset", "figure9", "--psd", "0.1", "--csv", "race.csv"], "--csv"),
+        (["record", "--preset", "figure9", "--rms", "2", "--duration", "2", "--out", "race.csv"],
+         "--out"),
+    ],
+)  # fmt: skip
+def test_second_writer_of_one_output_file_is_refused(capsys, tmp_path, monkeypatch, argv, option):
+    monkeypatch.chdir(tmp_path)
+    _held_by_another_run(tmp_path / "race.csv")
+    one_line_error(capsys, argv, f"`{option}` 'race.csv' is in use by another randvib run")
+    assert not (tmp_path / "race.csv").exists()
+
+
+def test_identify_second_writer_of_save_is_refused(capsys, tmp_path, monkeypatch, record_csv):
+    monkeypatch.chdir(tmp_path)
+    _held_by_another_run(tmp_path / "race.json")
+    fitted = []
+    monkeypatch.setattr("randvib.cli.identify.identify", lambda *a, **k: fitted.append(1))
+    one_line_error(capsys, fit_args(record_csv[0], "--save", "race.json"), "is in use")
+    assert fitted == []  # refused before the fit
+
+
+def test_output_file_lock_released_after_the_run(capsys, tmp_path, monkeypatch):
+    from randvib import _locks
+
+    monkeypatch.chdir(tmp_path)
+    code, _, _ = run(capsys, "power", "--preset", "figure9", "--psd", "0.1", "--csv", "a.csv")
+    assert code == 0 and not _locks.file_lock_path(tmp_path / "a.csv").exists()
+    # a file that appeared meanwhile is not replaced without --force: kept beside instead
+    assert _io.write_or_keep(tmp_path / "a.csv", "other", "--csv") != tmp_path / "a.csv"
+    assert "other" not in (tmp_path / "a.csv").read_text()
+
+
+def _disk_full_in(monkeypatch, folder: Path) -> None:
+    """fsync of any file under ``folder`` fails as on a full disk (ENOSPC)."""
+    import errno
+    import os
+
+    real = os.fsync
+
+    def fsync(fd):
+        if os.readlink(f"/proc/self/fd/{fd}").startswith(str(folder.resolve())):
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real(fd)
+
+    monkeypatch.setattr(os, "fsync", fsync)
+
+
+@pytest.mark.parametrize(
+    "argv, target, option",
+    [
+        (["power", "--preset", "figure9", "--psd", "0.1:1:5", "--csv", "full/p.csv"],
+         "full/p.csv", "--csv"),
+        (["record", "--preset", "figure9", "--rms", "2", "--duration", "2", "--out",
+          "full/r.csv"], "full/r.csv", "--out"),
+    ],
+)  # fmt: skip
+def test_full_disk_leaves_no_partial_file_and_keeps_the_result(
+    capsys, tmp_path, monkeypatch, argv, target, option
+):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "full").mkdir()
+    _disk_full_in(monkeypatch, tmp_path / "full")
+    code, out, err = run(capsys, *argv)
+    assert code == 1 and "wrote" not in out
+    assert (
+        sorted(p.name for p in (tmp_path / "full").iterdir()) == []
+    )  # no target, no temp, no lock
+    assert f"could not write `{option}` {target!r} (No space left on device)" in err
+    kept = list(tmp_path.glob("randvib-unsaved-*.csv"))
+    assert len(kept) == 1 and kept[0].name in err
+    assert kept[0].read_text().count("\n") > 5  # the whole table: header and rows
+
+
+def test_identify_full_disk_leaves_no_empty_save(capsys, tmp_path, monkeypatch, record_csv):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "full").mkdir()
+    _disk_full_in(monkeypatch, tmp_path / "full")
+    code, _, err = run(capsys, *fit_args(record_csv[0], "--save", "full/fit.json"))
+    assert code == 1 and list((tmp_path / "full").iterdir()) == []
+    kept = list(tmp_path.glob("randvib-unsaved-*.json"))
+    assert len(kept) == 1 and json.loads(kept[0].read_text())["model"] == "coulomb"
+
+
+# ------------------------------------------------- a stopped or long power sweep
+@pytest.mark.parametrize("stop, code", [(KeyboardInterrupt, 130), ("sigterm", 143)])
+def test_stopped_power_sweep_keeps_its_finished_points_in_the_csv(
+    capsys, tmp_path, monkeypatch, stop, code
+):
+    from randvib._interrupts import Terminated
+    from randvib.cli import power
+
+    monkeypatch.chdir(tmp_path)
+    real, calls = power._point, []
+
+    def stop_at_the_third(args):
+        calls.append(1)
+        if len(calls) == 3:
+            raise Terminated() if stop == "sigterm" else KeyboardInterrupt()
+        return real(args)
+
+    monkeypatch.setattr(power, "_point", stop_at_the_third)
+    argv = ["power", "--preset", "figure9", "--psd", "0.1:1:5", "--csv", "big.csv"]
+    code_, out, err = run(capsys, *argv)
+    assert code_ == code
+    assert "the 2 finished points of 5 were kept in 'big.csv'" in err
+    rows = (tmp_path / "big.csv").read_text().strip().splitlines()
+    assert len(rows) == 3 and rows[0].startswith("method,psd")  # header and 2 points
+    # without --csv, the line does not claim that anything was kept
+    calls.clear()
+    code_, out, err = run(capsys, *argv[:-2])
+    assert code_ == code and "nothing was saved (no --csv)" in err
+
+
+def test_long_power_sweep_says_how_long_first(capsys, tmp_path, monkeypatch):
+    import itertools
+
+    from randvib import _resources
+
+    ticks = itertools.count(step=100.0)  # every point "takes" 100 s on this clock
+    monkeypatch.setattr(_resources, "clock", lambda: next(ticks))
+    code, out, err = run(capsys, "power", "--preset", "figure9", "--psd", "0.1:1:10")
+    assert code == 0 and "this sweep of 10 points will take about 15 minutes" in err

@@ -185,3 +185,38 @@ def test_bad_records(tmp_path, record, mutate, kwargs, match):
     mutate(record.to_frame()).to_csv(path, index=False)
     with pytest.raises(ValueError, match=match):
         read_record(path, **kwargs)
+
+
+# ------------------------------------------ files that are not CSV text, or too large
+def test_sparse_file_refused_before_parsing_in_one_short_line(tmp_path, capsys):
+    from _cli import one_line_error
+
+    big = tmp_path / "big.csv"
+    with open(big, "wb") as f:
+        f.write(b"time,base_acceleration,relative_displacement\n")
+        f.truncate(2 * 10**9)  # 2 GB, sparse: NUL bytes to the end, no disk used
+    with pytest.raises(ValueError, match="holds NUL bytes") as info:
+        read_record(big)
+    assert len(str(info.value)) < 300  # the file's size named, none of its content
+    code_argv = ["identify", str(big), "--model", "coulomb", "--m", "0.0226"]
+    one_line_error(capsys, code_argv, "is not a CSV text file")
+    one_line_error(capsys, ["power", "--preset", "figure9", "--record", str(big)], "NUL bytes")
+
+
+def test_csv_that_cannot_fit_in_memory_is_refused_before_parsing(tmp_path, monkeypatch):
+    from randvib import _resources
+
+    path = tmp_path / "r.csv"
+    path.write_text("time,base_acceleration,relative_displacement\n" + "0,0,0\n" * 1000)
+    monkeypatch.setattr(_resources, "available_memory", lambda: 1000)
+    with pytest.raises(ValueError, match=r"\(6.04 kB\) needs about 24.2 kB of memory"):
+        read_record(path)
+
+
+def test_message_about_columns_is_bounded(tmp_path):
+    path = tmp_path / "wide.csv"
+    header = ",".join(f"column_with_a_long_name_{i}" * 20 for i in range(500))
+    path.write_text(header + "\n" + ",".join("0" * 500) + "\n")
+    with pytest.raises(ValueError, match="no input column") as info:
+        read_record(path)
+    assert len(str(info.value)) < 600 and "492 more" in str(info.value)

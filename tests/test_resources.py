@@ -2,8 +2,9 @@
 
 Covers :mod:`randvib._resources` (the memory check, the clock and wording of
 the duration announcement) and its users: :mod:`randvib.montecarlo.resources`
-(a simulation's arrays, the speed of a timed probe of the compiled loop) and
-:mod:`randvib.identification.identify` (a population that cannot fit, a long
+(a simulation's arrays, the speed of a timed probe of the compiled loop),
+:mod:`randvib.identification.input_reconstruction` (the input at the sub-steps of
+``record``, ``identify`` and ``validate``) and :mod:`randvib.identification.identify` (a population that cannot fit, a long
 search announced at the speed of its probes of the bounds).
 """
 
@@ -90,3 +91,23 @@ def test_identification_estimate_follows_the_measured_speed(
         # popsize x (maxiter + 1) runs at the speed of len(probes) runs in probe_seconds
         expected = 6 * 2 / (len(probed[0]) / probe_seconds)
         assert f"will take about {duration_text(expected)} (at the speed measured here)" in said[0]
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["record", "--preset", "figure9", "--rms", "2", "--duration", "2", "--substeps", "1e6",
+         "--out", "r.csv"],
+        ["identify", "{rec}", "--model", "coulomb", "--m", "0.0226", "--popsize", "8",
+         "--generations", "2", "--no-progress", "--substeps", "1000000"],
+        ["validate", "{params}", "{rec}", "--substeps", "1000000"],
+    ],
+)  # fmt: skip
+def test_huge_substeps_refused_up_front(capsys, tmp_path, monkeypatch, record_csv, argv):
+    # The fine input is 4e9 values for 2000 samples (2 per sub-step), about 128 GB with
+    # its temporaries: refused with the estimate, not a MemoryError, on a machine of 16 GB.
+    monkeypatch.setattr(_resources, "available_memory", lambda: 16 * 10**9)
+    monkeypatch.chdir(tmp_path)
+    argv = [a.format(rec=record_csv[0], params=record_csv[1]) for a in argv]
+    one_line_error(capsys, argv, "lower `--substeps`")
+    assert not (tmp_path / "r.csv").exists()

@@ -21,7 +21,8 @@ import re
 import sys
 import warnings
 
-from randvib._interrupts import interrupted_exit, sigterm_stops
+from randvib._interrupts import interrupted_exit, interrupts_seen, sigterm_stops
+from randvib._locks import held, release_since
 
 #: Command modules under randvib.cli, in the order shown by --help.
 COMMANDS = ["power", "design", "simulate", "study", "record", "identify", "validate"]
@@ -120,8 +121,19 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv=None) -> int:
     try:
-        code = _main_with_warnings(argv)
+        with sigterm_stops():
+            code = _main_with_warnings(argv)
+            swallowed = interrupts_seen()
+            if swallowed is not None and code < 128:
+                # an interrupt that a finaliser or a callback swallowed: the run went on,
+                # but the user asked it to stop, and the status says it was stopped
+                code, line = interrupted_exit(swallowed)
+                print(line, file=sys.stderr)
         sys.stdout.flush()  # a pipe's buffer is written here, where its closing is handled
+        return code
+    except KeyboardInterrupt as exc:  # while warnings and advice classes were being set up
+        code, line = interrupted_exit(exc)
+        print(line, file=sys.stderr)
         return code
     except BrokenPipeError:
         # The reader (`head`, `less`) has gone: end quietly, as Unix tools do.
@@ -132,6 +144,14 @@ def main(argv=None) -> int:
         except (OSError, ValueError):  # no real file descriptor (captured output)
             pass
         return 141  # 128 + SIGPIPE, what a shell reports for a tool ended by it
+    except Exception:
+        # an interrupt inside an extension module's import surfaces as an ImportError
+        # ("initialization failed"): the interrupt is what happened
+        if interrupts_seen() is None:
+            raise
+        code, line = interrupted_exit(interrupts_seen())
+        print(line, file=sys.stderr)
+        return code
 
 
 def _main_with_warnings(argv) -> int:
@@ -144,12 +164,14 @@ def _main_with_warnings(argv) -> int:
         for advice in _advice_warnings():
             warnings.filterwarnings("default", category=advice)
         warnings.showwarning = _show_warning
+        locks_before = held()
         try:
-            with sigterm_stops():
-                return _main(argv)
+            return _main(argv)
         finally:
             # in-process callers (tests, notebooks) get the API's words back
             _Running.prog, _Running.flags = "randvib", {}
+            # the locks the command took go with it (an in-process caller keeps its own)
+            release_since(locks_before)
 
 
 def _advice_warnings() -> tuple:
@@ -307,6 +329,10 @@ def _main(argv) -> int:
         print(line, file=sys.stderr)
         return code
     except Exception as exc:  # a bug: one line, not a traceback (unless asked for)
+        if interrupts_seen() is not None:  # an interrupt turned into another exception
+            code, line = interrupted_exit(interrupts_seen())
+            print(line, file=sys.stderr)
+            return code
         if os.environ.get("RANDVIB_TRACEBACK"):
             raise
         text = str(exc).strip().splitlines()

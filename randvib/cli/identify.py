@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from randvib._io import check_output_file, dumps, write_or_keep
+from randvib._io import claim_output_file, dumps, write_or_keep
 from randvib._validation import MAX_SEED, integer_option
 from randvib.cli._output import print_table
 from randvib.cli._records import (
@@ -97,7 +97,7 @@ def register(sub) -> None:
 
 def _new_file(path, option, overwrite=False):
     """Checked before the fit, so that a long fit is never thrown away at the end."""
-    return None if path is None else check_output_file(path, option, overwrite=overwrite)
+    return None if path is None else claim_output_file(path, option, overwrite=overwrite)
 
 
 def _save_plot(result, record, plot: Path, title: str, units: dict, json: bool = False) -> None:
@@ -142,8 +142,13 @@ def run(args) -> int:
         progress=not (args.no_progress or args.json),
     )
     out = result.to_dict()
-    if save is not None:
-        write_or_keep(save, dumps(out, indent=2), "--save")
+    # not saved where asked (a full disk): the result is kept elsewhere, and the exit says so
+    status = 0
+    if (
+        save is not None
+        and write_or_keep(save, dumps(out, indent=2), "--save", overwrite=args.force) != save
+    ):
+        status = 1
     if plot is not None:
         _save_plot(
             result,
@@ -155,9 +160,9 @@ def run(args) -> int:
         )
     if args.json:
         print(dumps(out))
-        return 0
+        return status
     print_report(result, record, output_unit(args))
-    return 0
+    return status
 
 
 def _status(name, se, free, at_bound) -> str:

@@ -28,10 +28,12 @@ from __future__ import annotations
 
 import argparse
 import csv
+import io
 import itertools
 import math
 
-from randvib._io import check_output_file, dumps
+from randvib._io import claim_output_file, dumps, write_or_keep
+from randvib._resources import announce_duration, timed
 from randvib.analytic.bridge import optimal_dc_output
 from randvib.analytic.prediction import METHODS, optimal_load_resistance, predict
 from randvib.cli._device import add_device_arguments, harvester_from_args, option_flag
@@ -150,16 +152,17 @@ def _sweep(args) -> tuple[list[str], list[argparse.Namespace]]:
 
 def run(args) -> int:
     csv_file = (
-        None if args.csv is None else check_output_file(args.csv, "--csv", overwrite=args.force)
+        None if args.csv is None else claim_output_file(args.csv, "--csv", overwrite=args.force)
     )
     if args.method is None:  # a bridge's own method, else statistical linearisation
         args.method = "bridge-closure" if args.rectifier is not None else "linearisation"
     swept, points = _sweep(args)
     if wants_event(args):
         return power_event(args, swept, points)
-    results = [_point(point) for point in points]
+    results = _points(points, csv_file, args.force)
+    saved = None
     if csv_file is not None:
-        _write_csv(csv_file, [out for out, _, _ in results])
+        saved = _write_csv(csv_file, [out for out, _, _ in results], args.force)
     if args.json:
         outs = [out for out, _, _ in results]
         print(dumps(outs[0] if len(outs) == 1 and not swept else outs))
@@ -167,9 +170,44 @@ def run(args) -> int:
         _print_sweep(swept, points, results)
     else:
         _print_point(*results[0])
-    if csv_file is not None and not args.json:
+    if saved is not None and saved == csv_file and not args.json:
         print(f"wrote {csv_file} ({len(results)} points)")
-    return 0
+    # not saved where asked (a full disk): the table is kept elsewhere, and the exit says so
+    return 0 if csv_file is None or saved == csv_file else 1
+
+
+def _points(points, csv_file, overwrite: bool) -> list:
+    """Every point, in order; on Ctrl-C or SIGTERM the finished ones go to ``--csv``.
+
+    A sweep whose first point shows it will take long says so first
+    (:func:`randvib._resources.announce_duration`).
+    """
+    results = []
+    try:
+        for i, point in enumerate(points):
+            result, seconds = timed(lambda point=point: _point(point))
+            results.append(result)
+            if i == 0 and len(points) > 1:
+                announce_duration(
+                    f"this sweep of {len(points)} points",
+                    seconds * (len(points) - 1),
+                    basis="at the speed of its first point",
+                )
+    except KeyboardInterrupt as exc:
+        exc.kept = _keep_finished(results, len(points), csv_file, overwrite)
+        raise
+    return results
+
+
+def _keep_finished(results, n_points: int, csv_file, overwrite: bool) -> str:
+    """Write the finished points of a stopped sweep to ``--csv``; what was kept, in words."""
+    if csv_file is None:
+        return f"{len(results)} of {n_points} points were finished; nothing was saved (no --csv)"
+    if not results:
+        return f"no point was finished; {str(csv_file)!r} was not written"
+    saved = _write_csv(csv_file, [out for out, _, _ in results], overwrite)
+    where = "printed above" if saved is None else repr(str(saved))
+    return f"the {len(results)} finished points of {n_points} were kept in {where}"
 
 
 def _point(args) -> tuple[dict, object, object]:
@@ -287,15 +325,20 @@ def _print_sweep(swept: list[str], points, results) -> None:
     print_table(rows, headers)
 
 
-def _write_csv(path, outs: list[dict]) -> None:
-    """Every point's keys (the excitation's as ``excitation.NAME``), one row per point."""
+def _write_csv(path, outs: list[dict], overwrite: bool):
+    """Every point's keys (the excitation's as ``excitation.NAME``), one row per point.
+
+    Written whole or not at all; where it could not be written, the table is
+    kept in an ``randvib-unsaved-*`` file, whose path is returned.
+    """
     rows = []
     for out in outs:
         row = {k: v for k, v in out.items() if k != "excitation"}
         row.update({f"excitation.{k}": v for k, v in out.get("excitation", {}).items()})
         rows.append(row)
     names = list(dict.fromkeys(k for row in rows for k in row))
-    with open(path, "w", newline="") as file:
-        writer = csv.DictWriter(file, fieldnames=names)
-        writer.writeheader()
-        writer.writerows(rows)
+    text = io.StringIO(newline="")
+    writer = csv.DictWriter(text, fieldnames=names)
+    writer.writeheader()
+    writer.writerows(rows)
+    return write_or_keep(path, text.getvalue(), "--csv", overwrite=overwrite)

@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from randvib._io import check_output_file, dumps, write_or_keep
+from randvib._io import claim_output_file, dumps, write_or_keep
 from randvib._resources import check_memory
 from randvib._validation import MAX_SEED, check_int, integer_option
 from randvib.cli._device import add_device_arguments, harvester_from_args
@@ -62,8 +62,8 @@ def run(args) -> int:
     out = Path(args.out)
     if out.exists() and not out.is_dir() and not args.force:
         raise FileExistsError(f"`--out` {str(out)!r} exists; choose a new name or give --force")
-    check_output_file(out, "--out", overwrite=args.force)
-    sidecar = check_output_file(
+    claim_output_file(out, "--out", overwrite=args.force)
+    sidecar = claim_output_file(
         out.with_suffix(".json"), "--out's parameters", overwrite=args.force
     )
     check_int("--seed", args.seed, 0, MAX_SEED)
@@ -91,7 +91,9 @@ def run(args) -> int:
         name=out.stem,
     )
     # Full precision, so that identify reads back exactly the simulated samples.
-    record.to_csv(out, overwrite=args.force, float_format=None)
+    text = record.to_frame().to_csv(index=False, float_format=None)
+    if write_or_keep(out, text, "--out", overwrite=args.force) != out:
+        return 1
     simulated = {
         "record": out.name,
         "device": device.parameters(),

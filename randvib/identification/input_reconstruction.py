@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from randvib._resources import check_memory
 from randvib._validation import check_positive
 from randvib.models.record import INPUT_KINDS
 
@@ -149,6 +150,14 @@ def reconstruct_input(samples, dt, substeps, hold="linear"):
     x = np.asarray(samples, dtype=float)
     n = x.shape[0]
     up = 2 * int(substeps)
+    n_fine = (n - 1) * up + 1
+    # the fine times, the values and the interpolation's temporaries (a spline's or an
+    # FFT's: about four arrays of the fine length), refused before any is allocated
+    check_memory(
+        f"the input at {int(substeps)} sub-steps per sample ({n_fine:.3g} values)",
+        8.0 * 4 * n_fine,
+        "lower `substeps`",
+    )
     fine_t = np.arange((n - 1) * up + 1) / up  # in samples
     if hold == "linear":
         return np.ascontiguousarray(np.interp(fine_t, np.arange(n), x))

@@ -348,12 +348,54 @@ def read_csv(path, what: str = "record file"):
     import pandas as pd
 
     path = existing_file(path, what)
+    _check_text_file(path, what)
     try:
         frame = pd.read_csv(path)
     except (pd.errors.ParserError, pd.errors.EmptyDataError, UnicodeDecodeError) as exc:
         raise ValueError(f"cannot read {str(path)!r} as CSV: {exc}") from None
     frame.columns = [str(c) for c in frame.columns]
     return frame
+
+
+#: Bytes read at each end of a CSV file to tell text from binary before parsing it.
+SNIFF_BYTES = 65536
+#: Memory a parsed CSV needs, in bytes per byte of file (pandas' buffers and columns).
+PARSE_BYTES_PER_BYTE = 4.0
+
+
+def _check_text_file(path: Path, what: str) -> None:
+    """Refuse, before parsing, a file that is binary (or sparse) or too large to parse here.
+
+    The work is bounded by the file's size: its two ends are read (a NUL byte
+    is in no CSV text, and a sparse or binary file has them), and the memory
+    that parsing needs is compared with what is available.
+    """
+    from randvib._resources import check_memory, size_text
+
+    size = path.stat().st_size
+    with open(path, "rb") as f:
+        head = f.read(SNIFF_BYTES)
+        tail = b""
+        if size > 2 * SNIFF_BYTES:
+            f.seek(size - SNIFF_BYTES)
+            tail = f.read(SNIFF_BYTES)
+    if b"\x00" in head or b"\x00" in tail:
+        raise ValueError(
+            f"{what} {str(path)!r} ({size_text(size)}) is not a CSV text file: it holds NUL "
+            "bytes (a binary, sparse or corrupted file)"
+        )
+    check_memory(
+        f"reading {what} {str(path)!r} ({size_text(size)})",
+        PARSE_BYTES_PER_BYTE * size,
+        "cut the file into shorter records",
+    )
+
+
+def _shown(columns, limit: int = 8, width: int = 24) -> str:
+    """Column names for a one-line message: at most ``limit``, each cut to ``width`` chars."""
+    names = [c if len(c) <= width else c[: width - 3] + "..." for c in map(str, columns)]
+    more = f" and {len(names) - limit} more" if len(names) > limit else ""
+    return repr(names[:limit]) + more
 
 
 def read_record(
@@ -410,7 +452,7 @@ def read_record(
     if output_column is not None and output_column not in columns:
         raise ValueError(
             f"{path.name}: output column `{output_column}` not found (relative displacement, m); "
-            f"columns are {columns}; map another name with `output_column`"
+            f"columns are {_shown(columns)}; map another name with `output_column`"
         )
     if rows is not None:
         frame = frame.iloc[slice(*rows)]
@@ -455,13 +497,13 @@ def _input_column(path: Path, columns, input_column, input_kind) -> tuple[str, s
             if input_kind not in columns:
                 raise ValueError(
                     f"{path.name}: no `{input_kind}` column (`input_kind`); columns are "
-                    f"{columns}; name the input column with `input_column`"
+                    f"{_shown(columns)}; name the input column with `input_column`"
                 )
             present = [input_kind]
         if not present:
             raise ValueError(
                 f"{path.name}: no input column; expected one of {', '.join(INPUT_KINDS)} "
-                f"(or name it with `input_column`); columns are {columns}"
+                f"(or name it with `input_column`); columns are {_shown(columns)}"
             )
         if len(present) > 1:
             raise ValueError(
@@ -471,7 +513,7 @@ def _input_column(path: Path, columns, input_column, input_kind) -> tuple[str, s
     if input_column not in columns:
         raise ValueError(
             f"{path.name}: input column {input_column!r} (`input_column`) not found; "
-            f"columns are {columns}"
+            f"columns are {_shown(columns)}"
         )
     if input_kind is None:
         if input_column not in INPUT_KINDS:

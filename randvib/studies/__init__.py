@@ -57,7 +57,7 @@ import inspect
 import sys
 from pathlib import Path
 
-from randvib._interrupts import interrupted_exit, sigterm_stops
+from randvib._interrupts import interrupted_exit, interrupts_seen, sigterm_stops
 from randvib._validation import MAX_SEED, integer_option
 
 #: The package of the study scripts: the top-level ``studies/`` folder, which
@@ -211,6 +211,10 @@ def script_main(run_study, argv=None) -> int:
     try:
         with sigterm_stops():  # SIGTERM stops the study as Ctrl-C does
             print_verdicts(run_with_options(run_study, name, args.out, args))
+            # an interrupt a finaliser swallowed: the study went on, but was asked to stop
+            swallowed = interrupts_seen()
+            if swallowed is not None:
+                raise swallowed
     except KeyboardInterrupt as exc:  # finished points and files are kept
         code, line = interrupted_exit(exc)
         print(line, file=sys.stderr)
