@@ -27,6 +27,7 @@ from randvib.harvester_design.objectives import OBJECTIVES
 from randvib.models.coupling import COUPLINGS
 from randvib.models.friction import FRICTION_MODELS
 from randvib.models.rectifier import BridgeCoil, BridgePiezo
+from randvib.montecarlo.ensembles import GROUP_SEEDS
 from randvib.montecarlo.sweep import SweepSettings
 
 
@@ -87,7 +88,11 @@ def register(sub) -> None:
         help="most Monte Carlo paths per candidate (default 2048)",
     )
     g.add_argument(
-        "--seed", type=integer_option(0, MAX_SEED // 1000), default=0, help="random seed"
+        "--seed",
+        # its Monte Carlo runs as paired-ensemble group 0 on seed GROUP_SEEDS * seed
+        type=integer_option(0, MAX_SEED // GROUP_SEEDS),
+        default=0,
+        help="random seed",
     )
     g.add_argument("--out-dir", help="folder to keep the Monte Carlo cases in and resume from")
     g.add_argument("--scheduler", help="address of a Dask scheduler to run the cases on")
