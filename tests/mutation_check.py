@@ -410,8 +410,8 @@ MUTATIONS: tuple[Mutation, ...] = (
         path="randvib/identification/least_squares.py",
         edits=(
             (
-                "np.linalg.pinv(jacobian_u.T @ jacobian_u) * np.outer(dtheta_du, dtheta_du)",
-                "np.linalg.pinv(jacobian_u.T @ jacobian_u)",
+                "cov = cov_u * np.outer(dtheta_du, dtheta_du)",
+                "cov = cov_u",
             ),
         ),
         tests=("tests/test_measurement_model.py::test_95_percent_intervals_cover_the_truth",),
