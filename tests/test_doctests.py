@@ -32,6 +32,7 @@ MODULES = (
     "randvib.models.event",
     "randvib.models.excitation",
     "randvib.models.harvester",
+    "randvib.models.potential",
     "randvib.models.presets",
     "randvib.models.record",
     "randvib.models.rectifier",

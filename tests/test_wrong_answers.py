@@ -63,7 +63,8 @@ def test_huge_k3_answers_are_refused_by_the_energy_balance(method, k3):
         rv.predict(h, 1.0, method)
 
 
-@pytest.mark.parametrize("method", list(METHODS))
+# the methods of a resistive device (bridge-closure treats only a bridge)
+@pytest.mark.parametrize("method", [m for m in METHODS if not METHODS[m].rectifier])
 @pytest.mark.parametrize("fc", [0.0, 0.0058])
 def test_every_method_meets_the_balance_and_a_broken_answer_is_refused(method, fc):
     """The family's check passes the methods' answers on the paper's device (their

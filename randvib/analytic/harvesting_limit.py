@@ -42,7 +42,7 @@ __all__ = ["gaussian_displacement_budget", "harvesting_limit"]
 
 
 def gaussian_displacement_budget(stroke, exceedance) -> float:
-    """The largest displacement RMS sigma_z with P(|z| > stroke) <= exceedance for Gaussian z.
+    """The largest displacement RMS sigma_z with ``P(|z| > stroke) <= exceedance`` for Gaussian z.
 
     sigma_z = stroke / Phi^-1(1 - exceedance / 2) (docs/conventions.md,
     "Gaussian stroke budget").

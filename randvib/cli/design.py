@@ -36,7 +36,8 @@ def register(sub) -> None:
         "design",
         help="choose device parameters for the most power under a stroke budget",
         description="Search the ranges given for the device that harvests most from the "
-        "excitation with P(|z| > --stroke) <= --exceedance: analytic search, Monte Carlo "
+        "excitation with the fraction of time beyond --stroke at most --exceedance: analytic "
+        "search, Monte Carlo "
         "confirmation with common random numbers, and the limit for a mass of this size.",
     )
     add_device_arguments(p)

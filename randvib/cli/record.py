@@ -110,8 +110,11 @@ def run(args) -> int:
             "offset_input": args.offset_input,
         },
     }
-    where = write_or_keep(sidecar, dumps(simulated, indent=2), "--out's parameters")
+    where = write_or_keep(
+        sidecar, dumps(simulated, indent=2), "--out's parameters", overwrite=args.force
+    )
     print(f"wrote {out} ({record.n} samples at {record.sample_rate:g} Hz, {args.input})")
-    if where is not None:
-        print(f"wrote {where} (the parameters simulated)")
+    if where != sidecar:  # kept beside (write_or_keep said where): not saved as asked
+        return 1
+    print(f"wrote {where} (the parameters simulated)")
     return 0

@@ -80,7 +80,7 @@ def design(
     progress: bool = False,
     min_first_passage: float | None = None,
 ) -> DesignResult:
-    """Choose the varied parameters that maximise the power with P(|z| > stroke) <= exceedance.
+    """Choose the varied parameters that maximise the power with ``P(|z| > stroke) <= exceedance``.
 
     Parameters
     ----------
@@ -371,7 +371,7 @@ class _Confirmed:
         return estimate(samples, self._controls(c))
 
     def first_passage(self, c) -> FirstPassage:
-        """Time to |z| > stroke from each path's (stationary) start, censored at t_end."""
+        """Time to ``|z| > stroke`` from each path's (stationary) start, censored at t_end."""
         result, i = self.where[id(c)]
         return result.simulation(i).stroke_first_passage
 

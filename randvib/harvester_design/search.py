@@ -221,7 +221,7 @@ def analytic_search(
     runners_up: int = 2,
     min_first_passage: float | None = None,
 ):
-    """Maximise the predicted objective over the box with P(|z| > stroke) <= budget.
+    """Maximise the predicted objective over the box with ``P(|z| > stroke) <= budget``.
 
     Parameters
     ----------

@@ -244,6 +244,7 @@ def _record_offsets(harvester, record, measurement, settings) -> MeasurementMode
     (simulation,) = resolve_settings(
         "validate", options, simulation=options.pop("simulation", None)
     )
+    simulation, _ = simulation.for_record(record)  # hold="auto" chosen from this record
     parameters = check_parameters(
         device_parameters(harvester, measurement, "validate"), model_of(harvester.friction_name)
     )
