@@ -24,6 +24,7 @@ recorded histories are requested.
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple, get_type_hints
 
 import numba
@@ -532,10 +533,10 @@ def _bridge_current(v, v_c, rect):
                 break
         i = i_s * np.expm1(y)
         return (i if e > 0.0 else -i), c * y
-    over = abs(e) - v_out - 2.0 * v_d
-    if over <= 0.0:
-        return 0.0, 0.0
-    return (over * inv_r_coil if e > 0.0 else -over * inv_r_coil), 2.0 * v_d
+    # branch-free (the sign of e and conduction are data-dependent, so a branch on them
+    # is mispredicted often); the drop is only ever multiplied by |i|, which is 0 off
+    over = max(abs(e) - v_out - 2.0 * v_d, 0.0)
+    return math.copysign(over * inv_r_coil, e), 2.0 * v_d
 
 
 @numba.njit(cache=True, inline="always")
@@ -546,20 +547,16 @@ def _piezo_clamp(v_p, v_c, rect):
     shared between C_p and the storage capacitor C, which then move together
     (charge conserved: ``C_p (|V_p| - 2 V_d) + C V_C`` before and after).
     """
+    # branch-free min/max (whether the bridge conducts is data-dependent: a branch on it
+    # is mispredicted often); off the clamp, min(|V_p|, limit) = |V_p| and V_C stays
     output, c_p, v_d, v_b, cap = rect[1], rect[3], rect[4], rect[5], rect[6]
     a = abs(v_p)
     if output == 0:
         limit = v_b + 2.0 * v_d
-        if a <= limit:
-            return v_p, v_c, 0.0
-        dq = c_p * (a - limit)
-        return (limit if v_p > 0.0 else -limit), v_c, dq
-    limit = v_c + 2.0 * v_d
-    if a <= limit:
-        return v_p, v_c, 0.0
-    v_c_new = rect[12] * (a - 2.0 * v_d) + rect[13] * v_c  # weights C_p, C over C_p + C
-    clamped = v_c_new + 2.0 * v_d
-    return (clamped if v_p > 0.0 else -clamped), v_c_new, cap * (v_c_new - v_c)
+        return math.copysign(min(a, limit), v_p), v_c, c_p * max(a - limit, 0.0)
+    # the shared level, weights C_p, C over C_p + C; below V_C when the bridge is off
+    v_c_new = max(rect[12] * (a - 2.0 * v_d) + rect[13] * v_c, v_c)
+    return math.copysign(min(a, v_c_new + 2.0 * v_d), v_p), v_c_new, cap * (v_c_new - v_c)
 
 
 @numba.njit(cache=True, inline="always")
