@@ -533,10 +533,10 @@ def _bridge_current(v, v_c, rect):
                 break
         i = i_s * np.expm1(y)
         return (i if e > 0.0 else -i), c * y
-    # branch-free (the sign of e and conduction are data-dependent, so a branch on them
-    # is mispredicted often); the drop is only ever multiplied by |i|, which is 0 off
-    over = max(abs(e) - v_out - 2.0 * v_d, 0.0)
-    return math.copysign(over * inv_r_coil, e), 2.0 * v_d
+    over = abs(e) - v_out - 2.0 * v_d
+    if over <= 0.0:
+        return 0.0, 0.0
+    return (over * inv_r_coil if e > 0.0 else -over * inv_r_coil), 2.0 * v_d
 
 
 @numba.njit(cache=True, inline="always")
