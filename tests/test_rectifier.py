@@ -20,8 +20,9 @@ Covers :mod:`randvib.models.rectifier`, the bridge in the kernel
 (:mod:`randvib.montecarlo.kernel`, :mod:`randvib.montecarlo.kernel_setup`), its
 statistics (:mod:`randvib.montecarlo.results`), its step check
 (:mod:`randvib.montecarlo.bridge_step`), the best output by Monte Carlo
-(:mod:`randvib.montecarlo.bridge_optimum`) and its command-line options
-(:mod:`randvib.cli._device`, ``randvib simulate``).
+(:mod:`randvib.montecarlo.bridge_optimum`, and from ``randvib power
+--optimal-load`` where the closure refuses, :mod:`randvib.cli.power`) and its
+command-line options (:mod:`randvib.cli._device`, ``randvib simulate``).
 """
 
 import dataclasses
@@ -276,6 +277,75 @@ def test_simulated_optimum_agrees_with_the_closure_and_takes_any_bridge():
     assert best.where == "interior" and 0.5 < best.value < 60.0
     with pytest.raises(ValueError, match="`bounds` must be"):
         rv.simulated_dc_optimum(coil, S, (0.05, 0.01))
+
+
+OPTIMUM_KW = dict(n_grid=5, t_end=4.0, n_paths=8)  # small: the CLI's wiring, not the value
+OPTIMUM_ARGS = ("--optimal-load", "--optimal-paths", "8", "--optimal-t-end", "4",
+                "--optimal-grid", "5", "--json")  # fmt: skip
+PIEZO_CAP = ("--coupling", "piezo", "--rectifier", "bridge", "--theta", "1e-3",
+             "--capacitance", "1e-7", "--v-diode", "0.1", "--storage-capacitance", "1e-6",
+             "--r-load", "1e5")  # fmt: skip
+COIL_BATTERY = ("--coupling", "inductive", "--rectifier", "bridge", "--alpha", "0.1992",
+                "--r-coil", "0.48", "--v-diode", "0.01", "--battery", "0.03")  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    "argv, coupling, psd, bounds",
+    [
+        (  # piezo: no analytic method takes it, so the CLI falls back to Monte Carlo
+            (*PIEZO_CAP, "--optimal-bounds", "1e4", "1e7"),
+            rv.BridgePiezo(1e-3, 1e-7, v_diode=0.1, storage_capacitance=1e-6, r_load=1e5),
+            S,
+            (1e4, 1e7),
+        ),
+        (  # coil under band-pass input: the closure takes white noise only
+            (*COIL_BATTERY, "--excitation", "band-pass", "--f0", "8", "--zeta", "0.3",
+             "--optimal-bounds", "0", "0.08"),
+            rv.BridgeCoil(ALPHA, R_COIL, v_diode=0.01, battery=0.03),
+            rv.BandPass(1.0, 8.0, 0.3),
+            (0.0, 0.08),
+        ),
+    ],
+)  # fmt: skip
+def test_cli_power_optimum_falls_back_to_monte_carlo(capsys, argv, coupling, psd, bounds):
+    """Where the closure refuses, ``power --optimal-load`` is simulated_dc_optimum's answer."""
+    code, out, _ = run(capsys, "power", *BRIDGE_ARGS, *argv, *OPTIMUM_ARGS)
+    assert code == 0
+    data = json.loads(out)
+    best = rv.simulated_dc_optimum(device(coupling), psd, bounds, **OPTIMUM_KW)
+    assert data["optimum_method"] == data["method"] == "monte-carlo"
+    assert data[f"{best.parameter}_optimal"] == best.value
+    assert data["power_stored_optimal"] == best.power_stored > 0.0
+    assert data["optimum"] == best.where
+    assert bounds[0] <= best.value <= bounds[1]
+
+
+def test_cli_power_optimum_says_the_closure_found_it(capsys):
+    code, out, _ = run(capsys, "power", *BRIDGE_ARGS, *COIL_BATTERY, "--optimal-load", "--json")
+    assert code == 0
+    data = json.loads(out)
+    assert data["optimum_method"] == data["method"] == "bridge-closure"
+    h = device(rv.BridgeCoil(ALPHA, R_COIL, v_diode=0.01, battery=0.03))
+    assert data["battery_optimal"] == rv.optimal_dc_output(h, S).value
+
+
+@pytest.mark.parametrize(
+    "extra, fragment",
+    [
+        ((*PIEZO_CAP, "--optimal-load"), "give `--optimal-bounds LOW HIGH`"),
+        ((*PIEZO_CAP, "--optimal-load", "--optimal-bounds", "0", "1e6"),
+         "`--optimal-bounds` must be 0 < LOW < HIGH"),
+        ((*COIL_BATTERY, "--optimal-load", "--optimal-bounds", "0.05", "0.01"),
+         "`--optimal-bounds` must be 0 <= LOW < HIGH"),
+        ((*COIL_BATTERY, "--optimal-load", "--optimal-bounds", "-1", "0.01"),
+         "got -1 0.01"),
+        ((*COIL_BATTERY, "--optimal-bounds", "0", "0.1"), "`--optimal-bounds` needs"),
+        ((*COIL_BATTERY, "--optimal-load", "--optimal-bounds", "0", "0.1", "--optimal-grid",
+          "2"), "`--optimal-grid` must be >= 3"),
+    ],
+)  # fmt: skip
+def test_cli_power_optimum_errors_are_one_line(capsys, extra, fragment):
+    one_line_error(capsys, ("power", *BRIDGE_ARGS, *extra), fragment)
 
 
 def test_storage_capacitor_starts_at_its_charge_balance_level():

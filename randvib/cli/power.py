@@ -16,8 +16,14 @@ single-point objects; ``--csv FILE``: all their keys, one row per point).
 ``--optimal-load`` adds the load resistance that maximises the load power
 (:func:`randvib.optimal_load_resistance`) and that power; with a diode
 bridge, the battery voltage or the storage capacitor's load that maximises
-the stored power (:func:`randvib.optimal_dc_output`), that power, and whether
-the optimum is interior or at a bound (``optimum``).
+the stored power, that power, whether the optimum is interior or at a bound
+(``optimum``) and which method found it (``optimum_method``): the bridge
+closure's search (:func:`randvib.optimal_dc_output`) where the closure takes
+the device and input, otherwise -- or when ``--optimal-bounds LOW HIGH`` is
+given -- Monte Carlo over that range (:func:`randvib.simulated_dc_optimum`,
+ensemble set by ``--optimal-paths``, ``--optimal-t-end``, ``--optimal-grid``);
+then the analytic prediction at the given device is left out where no method
+takes it (``method`` is ``"monte-carlo"``).
 
 ``--envelope`` makes the input an event from t = 0 (:mod:`randvib.cli._event`):
 the moments at ``--times`` and the energy to ``--t-end`` by the Lyapunov
@@ -42,6 +48,7 @@ from randvib.cli._excitation import add_excitation_arguments, excitation_from_ar
 from randvib.cli._output import describe_device, describe_excitation, print_table
 from randvib.formatting import cell
 from randvib.models.excitation import Excitation
+from randvib.montecarlo.bridge_optimum import simulated_dc_optimum
 from randvib.quantities import QUANTITIES, unit
 
 
@@ -66,7 +73,35 @@ def register(sub) -> None:
         "--optimal-load",
         action="store_true",
         help="also the load resistance R_L that maximises the load power, and that power "
-        "(needs a coupling: --alpha/--r-load/--r-coil or --coupling; its --r-load is the start)",
+        "(needs a coupling: --alpha/--r-load/--r-coil or --coupling; its --r-load is the start); "
+        "with --rectifier bridge, the battery voltage or storage load maximising the stored power",
+    )
+    p.add_argument(
+        "--optimal-bounds",
+        nargs=2,
+        type=float,
+        metavar=("LOW", "HIGH"),
+        help="with --rectifier bridge --optimal-load: search by Monte Carlo over this range "
+        "(V for --battery, ohm for --r-load); needed where the bridge closure does not take "
+        "the device or input",
+    )
+    p.add_argument(
+        "--optimal-paths",
+        type=int,
+        default=64,
+        help="paths of the Monte Carlo optimum search (default 64)",
+    )
+    p.add_argument(
+        "--optimal-t-end",
+        type=float,
+        default=12.0,
+        help="simulated time of each Monte Carlo optimum point, s, 2 s of it burn-in (default 12)",
+    )
+    p.add_argument(
+        "--optimal-grid",
+        type=int,
+        default=9,
+        help="grid points of the Monte Carlo optimum search, >= 3 (default 9)",
     )
     p.add_argument(
         "--json", action="store_true", help="print one JSON object (a sweep: a list of them)"
@@ -93,7 +128,7 @@ def _method_help() -> str:
 
 
 #: The options that take a single value even in ``power`` (not physical numbers).
-NOT_SWEPT = ("psd_file", "record", "t_end", "sample_rate")
+NOT_SWEPT = ("psd_file", "record", "t_end", "sample_rate", "optimal_bounds", "optimal_t_end")
 
 
 def _allow_sweeps(parser) -> None:
@@ -154,6 +189,9 @@ def run(args) -> int:
     csv_file = (
         None if args.csv is None else claim_output_file(args.csv, "--csv", overwrite=args.force)
     )
+    # a bridge's optimum falls back to Monte Carlo where the closure refuses, unless a
+    # method was asked for by name
+    args.method_defaulted = args.method is None
     if args.method is None:  # a bridge's own method, else statistical linearisation
         args.method = "bridge-closure" if args.rectifier is not None else "linearisation"
     swept, points = _sweep(args)
@@ -215,12 +253,18 @@ def _point(args) -> tuple[dict, object, object]:
     harvester = harvester_from_args(args)
     psd = excitation_from_args(args)
     coloured = isinstance(psd, Excitation)
-    _check_method(args.method, harvester, psd)
     if args.optimal_load and harvester.electrical is None:
         raise ValueError(
             "`--optimal-load` needs a coupling: give `--alpha/--r-load/--r-coil` (resistive) "
             "or `--coupling NAME` with its options, not `--c-e`"
         )
+    if args.optimal_bounds is not None and not (args.optimal_load and harvester.is_rectified):
+        raise ValueError("`--optimal-bounds` needs `--optimal-load` and `--rectifier bridge`")
+    if args.optimal_load and harvester.is_rectified:
+        simulated = _simulated_optimum_point(args, harvester, psd)
+        if simulated is not None:
+            return simulated, harvester, psd
+    _check_method(args.method, harvester, psd)
     result = predict(harvester, psd, method=args.method)
     out = {
         "method": result.method,
@@ -244,6 +288,7 @@ def _point(args) -> tuple[dict, object, object]:
     if args.optimal_load and harvester.is_rectified:
         # the battery voltage or the capacitor's load maximising the stored power
         out.update(optimal_dc_output(harvester, psd).to_dict())
+        out["optimum_method"] = "bridge-closure"
     elif args.optimal_load:
         best = optimal_load_resistance(harvester, psd, method=args.method)
         out["r_load_optimal"], out["power_load_optimal"] = best
@@ -252,6 +297,76 @@ def _point(args) -> tuple[dict, object, object]:
     if coloured:
         out["excitation"] = psd.parameters()
     return out, harvester, psd
+
+
+def _simulated_optimum_point(args, harvester, psd) -> dict | None:
+    """A bridge's optimum by Monte Carlo, or None where the closure's search is used.
+
+    Monte Carlo when ``--optimal-bounds`` is given, or when the method was not
+    named and the bridge closure does not take this device and input (then
+    the analytic prediction at the given device is left out: no method takes
+    it). A closure that refuses only beyond its validity (the search finds no
+    output within it) falls back the same way.
+    """
+    if args.optimal_bounds is None:
+        if not args.method_defaulted:
+            return None
+        if METHODS[args.method].accepts(harvester, psd):
+            try:  # the closure's own range: refused beyond its validity at this level
+                optimal_dc_output(harvester, psd)
+                predict(harvester, psd, method=args.method)
+            except ValueError:
+                pass
+            else:
+                return None
+        refusal = METHODS[args.method].refusal(harvester, psd) or (
+            f"`--method {args.method}` refuses it beyond its validity"
+        )
+        raise ValueError(
+            f"the optimum of this bridge needs Monte Carlo ({refusal.rstrip('.')}): give "
+            f"`--optimal-bounds LOW HIGH` ({_bounds_words(harvester)})"
+        )
+    low, high = args.optimal_bounds
+    battery = harvester.electrical.has_battery
+    if not (math.isfinite(low) and math.isfinite(high) and 0.0 <= low < high) or (
+        not battery and low == 0.0
+    ):
+        raise ValueError(
+            f"`--optimal-bounds` must be {'0 <=' if battery else '0 <'} LOW < HIGH "
+            f"({_bounds_words(harvester)}), finite; got {low:g} {high:g}"
+        )
+    if args.optimal_paths < 2:
+        raise ValueError(f"`--optimal-paths` must be >= 2; got {args.optimal_paths}")
+    if not args.optimal_t_end > 2.0:
+        raise ValueError(
+            f"`--optimal-t-end` must be > 2 s (the 2 s burn-in); got {args.optimal_t_end:g}"
+        )
+    if args.optimal_grid < 3:
+        raise ValueError(f"`--optimal-grid` must be >= 3; got {args.optimal_grid}")
+    best = simulated_dc_optimum(
+        harvester, psd, (low, high), n_grid=args.optimal_grid, t_end=args.optimal_t_end,
+        n_paths=args.optimal_paths,
+    )  # fmt: skip
+    coloured = isinstance(psd, Excitation)
+    out = {
+        "method": "monte-carlo",
+        "psd": getattr(psd, "level", None) if coloured else psd,
+        "friction": harvester.friction_name,
+        "coupling": harvester.coupling_name,
+        **best.to_dict(),
+        "optimum_method": "monte-carlo",
+        "optimal_paths": args.optimal_paths,
+    }
+    if coloured:
+        out["excitation"] = psd.parameters()
+    return out
+
+
+def _bounds_words(harvester) -> str:
+    """What ``--optimal-bounds`` holds for this bridge."""
+    if harvester.electrical.has_battery:
+        return "the battery voltage V_b, V"
+    return "the storage capacitor's load R_L, ohm"
 
 
 def _check_method(name: str, harvester, psd) -> None:

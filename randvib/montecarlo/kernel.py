@@ -24,6 +24,7 @@ recorded histories are requested.
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple, get_type_hints
 
 import numba
@@ -546,20 +547,16 @@ def _piezo_clamp(v_p, v_c, rect):
     shared between C_p and the storage capacitor C, which then move together
     (charge conserved: ``C_p (|V_p| - 2 V_d) + C V_C`` before and after).
     """
+    # branch-free min/max (whether the bridge conducts is data-dependent: a branch on it
+    # is mispredicted often); off the clamp, min(|V_p|, limit) = |V_p| and V_C stays
     output, c_p, v_d, v_b, cap = rect[1], rect[3], rect[4], rect[5], rect[6]
     a = abs(v_p)
     if output == 0:
         limit = v_b + 2.0 * v_d
-        if a <= limit:
-            return v_p, v_c, 0.0
-        dq = c_p * (a - limit)
-        return (limit if v_p > 0.0 else -limit), v_c, dq
-    limit = v_c + 2.0 * v_d
-    if a <= limit:
-        return v_p, v_c, 0.0
-    v_c_new = rect[12] * (a - 2.0 * v_d) + rect[13] * v_c  # weights C_p, C over C_p + C
-    clamped = v_c_new + 2.0 * v_d
-    return (clamped if v_p > 0.0 else -clamped), v_c_new, cap * (v_c_new - v_c)
+        return math.copysign(min(a, limit), v_p), v_c, c_p * max(a - limit, 0.0)
+    # the shared level, weights C_p, C over C_p + C; below V_C when the bridge is off
+    v_c_new = max(rect[12] * (a - 2.0 * v_d) + rect[13] * v_c, v_c)
+    return math.copysign(min(a, v_c_new + 2.0 * v_d), v_p), v_c_new, cap * (v_c_new - v_c)
 
 
 @numba.njit(cache=True, inline="always")
@@ -591,7 +588,7 @@ def rectified_step(
     b1, b2 = weights
     a11, a12, a13, a21, a22, a23, a31, a32, a33 = block[0:9]
     bv1, bv2, bv3, g1, g2, g3, c1, c2, c3, gv = block[9:19]
-    rkind, output, second, v_d, v_b, r_load = rect[0], rect[1], rect[3], rect[4], rect[5], rect[7]
+    rkind, output, second, v_d, v_b = rect[0], rect[1], rect[3], rect[4], rect[5]
     inv_m = drift[0]
     acc1, rate1, force = _acceleration(z, v, theta, drift, kind, p, fn)
     acc1 -= c1 * x1 + c2 * x2 + c3 * x3
@@ -653,7 +650,7 @@ def rectified_step(
         charge = current * dt
         if rkind == 3 and s1n * s1 < 0.0:  # the diodes block the reverse current
             s1n = 0.0
-    stored = v_b * charge if output == 0 else load / r_load * dt
+    stored = v_b * charge if output == 0 else load * rect[17]  # rect[17] = dt / R_L
     # the coil's diodes: their drop times the current at each stage; the piezo's: the charge
     diode = diodes * dt if rkind != 2 else 2.0 * v_d * charge
     return zn, vn, tn, x1n, x2n, x3n, s1n, s2n, force, stored, coil * dt, diode
@@ -690,7 +687,7 @@ def rectified_white_step(z, v, theta, s1, s2, dt, noise, weights, drift, kind, p
     """:func:`rectified_step` without a shaping filter (white or given input): the same
     operations less the filter's exact zeros."""
     b1, b2 = weights
-    rkind, output, second, v_d, v_b, r_load = rect[0], rect[1], rect[3], rect[4], rect[5], rect[7]
+    rkind, output, second, v_d, v_b = rect[0], rect[1], rect[3], rect[4], rect[5]
     inv_m = drift[0]
     acc1, rate1, force = _acceleration(z, v, theta, drift, kind, p, fn)
     f1, ds1, ds2, i1, drop1 = _bridge_rates(v, s1, s2, rect, inv_m)
@@ -733,7 +730,7 @@ def rectified_white_step(z, v, theta, s1, s2, dt, noise, weights, drift, kind, p
         charge = current * dt
         if rkind == 3 and s1n * s1 < 0.0:  # the diodes block the reverse current
             s1n = 0.0
-    stored = v_b * charge if output == 0 else load / r_load * dt
+    stored = v_b * charge if output == 0 else load * rect[17]  # rect[17] = dt / R_L
     # the coil's diodes: their drop times the current at each stage; the piezo's: the charge
     diode = diodes * dt if rkind != 2 else 2.0 * v_d * charge
     return zn, vn, tn, s1n, s2n, force, stored, coil * second * dt, diode
@@ -940,12 +937,12 @@ def run_ensemble(
         rp = rectifier.p
         # (kind, output, gain, R_C or C_p, V_d, V_b, C, R_L) and, to spare divisions
         # per step: 1/R_C, theta/C_p, 1/C, 1/(R_L C), C_p/(C_p + C), C/(C_p + C);
-        # then the Shockley diodes' I_s (0: a constant drop) and 2 n V_T, and 1/L
+        # then the Shockley diodes' I_s (0: a constant drop) and 2 n V_T, 1/L, and dt/R_L
         rect = (
             rectifier.kind, rectifier.output, rp[0], rp[1], rp[2], rp[3], rp[4], rp[5],
             1.0 / rp[1], rp[0] / rp[1], 1.0 / rp[4], 1.0 / (rp[5] * rp[4]),
             rp[1] / (rp[1] + rp[4]), rp[4] / (rp[1] + rp[4]), rp[6], 2.0 * rp[7],
-            1.0 / rp[8] if rp[8] > 0.0 else 0.0,
+            1.0 / rp[8] if rp[8] > 0.0 else 0.0, dt / rp[5] if rp[5] > 0.0 else 0.0,
         )  # fmt: skip
         # energy held by the piezo's and the storage capacitor's voltages: C_p/2, C/2
         # the piezo's C_p V_p^2 / 2, or the coil's L i^2 / 2 (s1 is V_p or i)
