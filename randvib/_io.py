@@ -247,16 +247,7 @@ def write_or_keep(path, text: str | bytes, option: str, *, overwrite: bool = Fal
             fd, spare = tempfile.mkstemp(
                 prefix="randvib-unsaved-", suffix=Path(path).suffix, dir="."
             )
-            try:
-                os.fchmod(fd, _new_file_mode())
-                with os.fdopen(fd, "wb") as f:
-                    f.write(data)
-                    f.flush()
-                    os.fsync(f.fileno())
-            except BaseException:
-                with contextlib.suppress(OSError):
-                    os.unlink(spare)
-                raise
+            _fill_new_file(fd, spare, data)
         except OSError:
             print(f"randvib: could not write `{option}` {str(path)!r} ({reason}); the result:",
                   file=sys.stderr)  # fmt: skip
@@ -279,6 +270,23 @@ def _new_file_mode() -> int:
     return 0o666 & ~mask
 
 
+def _fill_new_file(fd: int, name: str, data: bytes) -> None:
+    """Write ``data`` into the new file ``fd`` (named ``name``) with ``open()``'s mode, fsynced.
+
+    The file is removed if that fails, so no half-written file is left behind.
+    """
+    try:
+        os.fchmod(fd, _new_file_mode())
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(name)
+        raise
+
+
 def atomic_write_bytes(path, data: bytes, *, overwrite: bool = True) -> None:
     """Write a file via a unique temporary name in its folder, fsync and rename.
 
@@ -291,11 +299,7 @@ def atomic_write_bytes(path, data: bytes, *, overwrite: bool = True) -> None:
     path = Path(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
-        os.fchmod(fd, _new_file_mode())
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-            f.flush()
-            os.fsync(f.fileno())
+        _fill_new_file(fd, tmp, data)
         if overwrite:
             os.replace(tmp, path)
         else:
