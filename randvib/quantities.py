@@ -103,8 +103,10 @@ QUANTITIES: dict[str, Quantity] = {
     # A circuit state's unit is its coupling's (current A, voltage V): see unit().
     "circuit_mean_square": Quantity("A^2 or V^2", "mean square of the circuit state", "E[x^2]"),
     "circuit_variance": Quantity("A^2 or V^2", "variance of the circuit state"),
+    # A probability's unit is 1 (SI's unit of a dimensionless ratio), shown so
+    # that a table's unit column does not look like a missing unit.
     "stroke_exceedance": Quantity(
-        "",
+        "1",
         "P(|z| > stroke): stationary probability (Monte Carlo: fraction of time)",
         "P(|z| > stroke)",
     ),
@@ -113,12 +115,12 @@ QUANTITIES: dict[str, Quantity] = {
     "cumulative_energy": Quantity(
         "J", "electrical energy from t = 0: int_0^t E[P_e] dt", "energy to t"
     ),
-    "stroke_reached": Quantity("", "probability that |z| reached the stroke by t", "P(reached)"),
+    "stroke_reached": Quantity("1", "probability that |z| reached the stroke by t", "P(reached)"),
     "stroke_reached_poisson": Quantity(
-        "", "P(reached) by the Poisson crossing approximation", "reached, Poisson*"
+        "1", "P(reached) by the Poisson crossing approximation", "reached, Poisson*"
     ),
     "stroke_reached_vanmarcke": Quantity(
-        "", "P(reached) by Vanmarcke's approximation", "reached, Vanmarcke*"
+        "1", "P(reached) by Vanmarcke's approximation", "reached, Vanmarcke*"
     ),
     "r_load_optimal": Quantity("ohm", "load resistance of the largest load power"),
     "power_load_optimal": Quantity("W", "load power at the optimal load resistance"),
@@ -169,4 +171,5 @@ def report_header(name: str) -> str:
     """A report table's header for quantity ``name``: its symbol and unit, ``S ((m/s²)²/Hz)``."""
     quantity = QUANTITIES[name]
     label = quantity.symbol or name
-    return f"{label} ({unicode_unit(quantity.unit)})" if quantity.unit else label
+    # a probability's symbol P(...) says what it is: no "(1)" after it
+    return f"{label} ({unicode_unit(quantity.unit)})" if quantity.unit not in ("", "1") else label

@@ -230,3 +230,49 @@ def test_identification_result_prints_its_table(record_csv):
     text = str(fit)
     assert text.startswith("Identification") and "IdentificationResult(" not in text
     assert "fc" in text and "N" in text
+
+
+def test_power_optimal_load_of_a_bridge_on_a_record_runs_on_its_windows(capsys, tmp_path):
+    """`power --record R --rectifier bridge --optimal-load --optimal-bounds` searches on the
+    record's own windows (not refused), accepts `--no-progress`, prints no empty psd row,
+    and its optimum's stored power is Monte Carlo's on those windows at that grid point."""
+    import dataclasses
+    import json
+
+    record = rv.synthetic_record(rv.preset("coulomb-td1"), 2.0, duration=12.0,
+                                 sample_rate=1000.0, seed=3)  # fmt: skip
+    path = tmp_path / "rec.csv"
+    record.to_csv(path, float_format=None)
+    argv = ["power", "--preset", "coulomb-td1", "--coupling", "inductive", "--alpha", "1",
+            "--r-coil", "10", "--rectifier", "bridge", "--v-diode", "0.05", "--battery", "1",
+            "--record", path, "--optimal-load", "--optimal-bounds", "0", "0.2",
+            "--optimal-paths", "4", "--optimal-grid", "3", "--no-progress"]  # fmt: skip
+    code, out, err = run_cli(capsys, *argv)
+    assert code == 0, err
+    assert not any(line.split()[:1] == ["psd"] for line in out.splitlines()), out
+    code, out, err = run_cli(capsys, *argv, "--json")
+    assert code == 0, err
+    best = json.loads(out)
+    assert best["optimum_method"] == "monte-carlo" and best["psd"] is None
+    harvester = rv.preset("coulomb-td1")
+    bridge = rv.BridgeCoil(alpha=1.0, r_coil=10.0, v_diode=0.05, battery=0.1)
+
+    at_grid = rv.monte_carlo_on_record(
+        dataclasses.replace(harvester, c_e=0.0, electrical=bridge),
+        rv.Measured(rv.read_record(path)), segments=4, burn_in=2.0, progress=False,
+    )  # fmt: skip
+    # the grid is 0, 0.1, 0.2 V and the best is its middle point (deterministic: the same
+    # windows); the search reports Monte Carlo's power at that point on those windows
+    assert best["optimum"] == "interior"
+    assert best["power_stored_optimal"] == pytest.approx(at_grid.power_stored.mean, rel=1e-12)
+
+
+def test_probabilities_are_shown_with_unit_one():
+    """A stroke exceedance and the events' reached probabilities carry the unit 1, so
+    the CLI's unit column is not blank; report headers do not print "(1)"."""
+    from randvib.quantities import report_header, unit
+
+    for name in ("stroke_exceedance", "stroke_reached", "stroke_reached_poisson",
+                 "stroke_reached_vanmarcke"):  # fmt: skip
+        assert unit(name) == "1"
+        assert not report_header(name).endswith("(1)")

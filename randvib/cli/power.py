@@ -89,7 +89,8 @@ def register(sub) -> None:
         "--optimal-paths",
         type=int,
         default=64,
-        help="paths of the Monte Carlo optimum search (default 64)",
+        help="paths of the Monte Carlo optimum search (default 64; with --record, windows of "
+        "the record)",
     )
     p.add_argument(
         "--optimal-t-end",
@@ -110,6 +111,11 @@ def register(sub) -> None:
         "--csv", metavar="FILE", help="write the sweep's points to a CSV file (a new file)"
     )
     p.add_argument("--force", action="store_true", help="overwrite an existing --csv file")
+    p.add_argument(
+        "--no-progress",
+        action="store_true",
+        help="no progress bar (the Monte Carlo optimum shows one on a terminal)",
+    )
     _allow_sweeps(p)
     p.set_defaults(handler=run)
 
@@ -345,7 +351,7 @@ def _simulated_optimum_point(args, harvester, psd) -> dict | None:
         raise ValueError(f"`--optimal-grid` must be >= 3; got {args.optimal_grid}")
     best = simulated_dc_optimum(
         harvester, psd, (low, high), n_grid=args.optimal_grid, t_end=args.optimal_t_end,
-        n_paths=args.optimal_paths,
+        n_paths=args.optimal_paths, progress=False if args.no_progress or args.json else None,
     )  # fmt: skip
     coloured = isinstance(psd, Excitation)
     out = {
@@ -396,7 +402,9 @@ def _print_point(out: dict, harvester, psd) -> None:
     """One point: the device and excitation used, then quantity / value / unit."""
     print(describe_device(harvester))
     print(describe_excitation(psd))
-    rows = [(k, v, _unit(k, harvester)) for k, v in out.items() if k != "excitation"]
+    # a tabulated or measured spectrum has no level: the excitation line describes it
+    shown = {k: v for k, v in out.items() if k != "excitation" and not (k == "psd" and v is None)}
+    rows = [(k, v, _unit(k, harvester)) for k, v in shown.items()]
     rows += [(k, v, _unit(k, harvester)) for k, v in out.get("excitation", {}).items()]
     print_table(rows, ("quantity", "value", "unit"))
     if harvester.electrical is None and harvester.c_e == 0:

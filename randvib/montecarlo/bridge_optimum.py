@@ -4,7 +4,8 @@
 coil's constant-drop bridge under white noise only. This searches Monte
 Carlo instead, so it takes every bridge (coil, piezo, inductance, Shockley
 diodes), every friction law and every excitation :func:`randvib.simulate`
-takes: the stored power on a grid of the battery voltage (or of the storage
+takes, and a measured record (:class:`randvib.Measured`, simulated on the
+record's own windows by :func:`randvib.monte_carlo_on_record`): the stored power on a grid of the battery voltage (or of the storage
 capacitor's load, on a log grid), every grid point on the same paths (common
 random numbers: the differences between points are estimated with little
 noise), then a parabola through the best point and its neighbours. The answer
@@ -18,8 +19,11 @@ import warnings
 
 import numpy as np
 
+from randvib._progress import progress_bar, progress_wanted
 from randvib.analytic.bridge import DcOptimum
+from randvib.models.excitation import Measured
 from randvib.models.harvester import Harvester
+from randvib.montecarlo.on_record import monte_carlo_on_record
 from randvib.montecarlo.simulation import simulate
 
 
@@ -34,6 +38,7 @@ def simulated_dc_optimum(
     dt: float = 2e-4,
     n_paths: int = 64,
     seed: int = 0,
+    progress: bool | None = None,
 ) -> DcOptimum:
     """The battery voltage (V) or storage load (ohm) maximising Monte Carlo's stored power.
 
@@ -42,14 +47,19 @@ def simulated_dc_optimum(
     harvester : Harvester
         With a bridge (:mod:`randvib.models.rectifier`); its battery's V_b or
         its storage load R_L is what varies.
-    psd : float or Excitation
-        As for :func:`randvib.simulate`.
+    psd : float, Excitation or Measured
+        As for :func:`randvib.simulate`; a :class:`randvib.Measured` record
+        drives every grid point with the same ``n_paths`` windows of the
+        record (:func:`randvib.monte_carlo_on_record`, ``burn_in`` of record
+        time before each; ``t_end``, ``dt`` and ``seed`` do not apply).
     bounds : (float, float)
         The range searched: V_b (V, lower >= 0) or R_L (ohm, lower > 0, a log grid).
     n_grid : int
         Grid points (>= 3), all on the paths of ``seed``.
     t_end, burn_in, dt, n_paths, seed
         As for :func:`randvib.simulate`.
+    progress : bool or None
+        A bar over the grid points; None: on a terminal or in a notebook only.
 
     Returns
     -------
@@ -72,17 +82,31 @@ def simulated_dc_optimum(
         )
     grid = np.geomspace(lo, hi, n_grid) if log else np.linspace(lo, hi, n_grid)
     power = []
-    for value in grid:
-        device = dataclasses.replace(
-            harvester, electrical=dataclasses.replace(bridge, **{parameter: value})
-        )
-        with warnings.catch_warnings():  # one step check is enough: the grid's devices differ
-            warnings.simplefilter("ignore")  # in their output only
-            result = simulate(
-                device, psd, t_end=t_end, burn_in=burn_in, dt=dt, n_paths=n_paths, seed=seed,
-                progress=False,
-            )  # fmt: skip
-        power.append(result.power_stored.mean)
+    bar = None
+    if progress_wanted() if progress is None else progress:
+        bar = progress_bar(n_grid, desc="optimum", unit="point")
+    try:
+        for value in grid:
+            device = dataclasses.replace(
+                harvester, electrical=dataclasses.replace(bridge, **{parameter: value})
+            )
+            with warnings.catch_warnings():  # one step check is enough: the grid's devices
+                warnings.simplefilter("ignore")  # differ in their output only
+                if isinstance(psd, Measured):
+                    result = monte_carlo_on_record(
+                        device, psd, segments=n_paths, burn_in=burn_in, progress=False
+                    )
+                else:
+                    result = simulate(
+                        device, psd, t_end=t_end, burn_in=burn_in, dt=dt, n_paths=n_paths,
+                        seed=seed, progress=False,
+                    )  # fmt: skip
+            power.append(result.power_stored.mean)
+            if bar is not None:
+                bar.update(1)
+    finally:
+        if bar is not None:
+            bar.close()
     power = np.array(power)
     k = int(np.argmax(power))
     if k == 0:
