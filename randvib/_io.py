@@ -99,6 +99,38 @@ def prepare_output_dir(out_dir, identity: dict, extra: dict | None = None) -> Pa
         raise
 
 
+_MISSING = object()
+
+
+def _first_difference(old, new, where: str = "") -> tuple[str, str, str]:
+    """The first place two run identities differ: its path and both values, short.
+
+    A study's identity holds every case (devices, excitations, seeds): the
+    refusal names the one entry that differs (``cases[1].device.inductance``),
+    not the whole lists, so that it stays one readable line.
+    """
+    if isinstance(old, dict) and isinstance(new, dict):
+        for key in sorted(set(old) | set(new), key=str):
+            a, b = old.get(key, _MISSING), new.get(key, _MISSING)
+            if a != b:
+                return _first_difference(a, b, f"{where}.{key}" if where else str(key))
+    if isinstance(old, list) and isinstance(new, list):
+        if len(old) != len(new):
+            return where or "entries", f"{len(old)} entries", f"{len(new)} entries"
+        for i, (a, b) in enumerate(zip(old, new, strict=True)):
+            if a != b:
+                return _first_difference(a, b, f"{where}[{i}]")
+    return where or "identity", _short(old), _short(new)
+
+
+def _short(value, limit: int = 60) -> str:
+    """``repr(value)`` cut to ``limit`` characters; "missing" for an absent entry."""
+    if value is _MISSING:
+        return "missing"
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
 def _foreign_entries(out: Path) -> list:
     return [p for p in out.iterdir() if p.name not in (LOCK_FILE, WRITTEN_FILE)]
 
@@ -109,11 +141,10 @@ def _open_locked(out: Path, identity: dict, extra) -> Path:
     if meta_path.exists() or meta_path.is_symlink():
         old = _read_identity(meta_path)
         if old != identity:
-            keys = sorted(set(old) | set(identity))
-            diff = next(k for k in keys if old.get(k) != identity.get(k))
+            where, there, now = _first_difference(old, identity)
             raise FileExistsError(
                 f"`out` folder {str(out)!r} holds results of a different run "
-                f"({diff}: {old.get(diff)!r} there, {identity.get(diff)!r} now); "
+                f"({where}: {there} there, {now} now); "
                 "choose another folder or delete it yourself"
             )
         return out

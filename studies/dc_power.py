@@ -75,8 +75,8 @@ def sentences(v: dict) -> list[str]:
     return [
         f"The resistive figure overstates the stored power (paired 95 %) in "
         f"{v['n_overstated']} of {v['n_cases']} bridge cases, by up to a factor {factor} "
-        f"where the stored power is resolved; in {v['never_conducts']} cases the bridge "
-        "never conducts.",
+        f"where the stored power is resolved; the bridge never conducts in "
+        f"{v['never_conducts']} of them.",
         f"Best stored / resistive ratio on the grid by level: {best}.",
         f"Best by diode drop: {drops}.",
     ]
@@ -85,14 +85,29 @@ def sentences(v: dict) -> list[str]:
 def figure(stored, out):
     fig, axes = new_figure()
     ax = axes[0, 0]
+    positive = stored.power_stored[stored.power_stored > 0]
+    # a series that stores nothing cannot sit on a log axis: drawn hollow at a floor a
+    # decade below the smallest stored power, and said so in the legend
+    floor = 0.1 * float(positive.min()) if len(positive) else None
+    hollow_drawn = False
     for i, (v_d, sub) in enumerate(stored.groupby("v_diode")):
         best = sub.loc[sub.groupby("psd").power_stored.idxmax()]
-        ax.errorbar(best.psd, best.power_stored, best.power_stored_ci95, marker="o",
-                    color=colour(i), label=f"bridge, V_d = {v_d:g} V, best V_b")  # fmt: skip
+        zero = (best.power_stored <= 0).to_numpy()
+        if not zero.all():
+            ax.errorbar(best.psd[~zero], best.power_stored[~zero], best.power_stored_ci95[~zero],
+                        marker="o", color=colour(i),
+                        label=f"bridge, V$_d$ = {v_d:g} V, best V$_b$")  # fmt: skip
+        if zero.any() and floor is not None:
+            hollow_drawn = True
+            ax.plot(best.psd[zero], [floor] * int(zero.sum()), ls="none", marker="o",
+                    color=colour(i), mfc="white",
+                    label=f"bridge, V$_d$ = {v_d:g} V: stores 0 W (at the floor)")  # fmt: skip
     ref = stored.drop_duplicates("psd")
-    ax.plot(ref.psd, ref.power_resistive, "k--", label="resistive figure (R_L = R_C)")
+    ax.plot(ref.psd, ref.power_resistive, "k--", label="resistive figure (R$_L$ = R$_C$)")
     ax.set(xscale="log", yscale="log", xlabel="S ((m/s$^2$)$^2$/Hz)", ylabel="power (W)")
-    ax.legend()
+    if hollow_drawn:
+        ax.axhline(floor, color="0.6", lw=0.6, ls=":")
+    ax.legend(fontsize=7, title="markers: Monte Carlo with 95 % CI", title_fontsize=7)
     return save_figure(fig, out / "dc_power.png")
 
 

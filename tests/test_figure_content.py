@@ -6,7 +6,8 @@ carries ticks a reader can place -40 % by, a second axis over a logarithmic
 one is logarithmic too, and the limits follow the data rather than a legend.
 
 Covers :mod:`randvib.studies.figures` (power against stroke exceedance, method
-errors against the level) and :mod:`randvib.studies.spectra_figure`.
+errors against the level), :mod:`randvib.studies.spectra_figure` and the
+dc-power study's figure (:mod:`randvib.study_scripts.dc_power`).
 """
 
 import matplotlib
@@ -125,3 +126,25 @@ def test_spectra_limits_follow_the_lines_and_the_excitation_axis_is_logarithmic(
         assert "base excitation (right axis)" in [t.get_text() for t in legend.get_texts()]
     finally:
         plt.close(fig)
+
+
+def test_dc_power_series_that_stores_nothing_is_drawn_hollow_at_a_floor(monkeypatch, tmp_path):
+    """The dc-power figure: a diode drop at which the bridge never conducts (0 W) is drawn
+    as hollow markers at a floor below every stored power, named in the legend, not lost
+    from the log axis; covers the figure of ``randvib.study_scripts.dc_power``."""
+    from randvib.study_scripts import dc_power
+
+    kept = []
+    monkeypatch.setattr(dc_power, "save_figure", lambda fig, path, **_: kept.append(fig))
+    rows = [{"psd": s, "v_diode": v_d, "battery": 0.03, "power_stored": p,
+             "power_stored_ci95": 0.05 * p, "power_resistive": 2e-4 * s}
+            for s in (0.25, 1.0) for v_d, p in ((0.0, 1e-4 * s), (0.3, 0.0))]  # fmt: skip
+    dc_power.figure(pd.DataFrame(rows), tmp_path)
+    (ax,) = kept[0].axes
+    hollow = [line for line in ax.get_lines() if line.get_markerfacecolor() == "white"]
+    assert len(hollow) == 1 and len(hollow[0].get_xdata()) == 2  # both levels of V_d = 0.3 V
+    assert 0 < max(hollow[0].get_ydata()) < 1e-4 * 0.25
+    texts = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert any("0.3 V" in t and "0 W" in t for t in texts)
+    assert not any("0.3 V, best" in t for t in texts)  # no entry for an empty series
+    plt.close("all")

@@ -158,6 +158,22 @@ def test_metadata_that_is_a_list_or_a_folder_is_named(capsys, tmp_path, bad):
         _io.prepare_output_dir(tmp_path, {"grid": 1})
 
 
+def test_different_run_names_the_one_entry_that_differs_not_every_case(tmp_path):
+    """A study's identity lists every case; the refusal to mix runs in one folder names
+    the first entry that differs (its path and both values) and stays short."""
+    cases = [{"seed": i, "device": {"m": 0.0226, "k": 57.4 + i}} for i in range(200)]
+    _io.unlock_folder(_io.prepare_output_dir(tmp_path, {"cases": cases}))
+    changed = [dict(c, device=dict(c["device"])) for c in cases]
+    changed[7]["device"]["inductance"] = 0.0
+    with pytest.raises(FileExistsError) as info:
+        _io.prepare_output_dir(tmp_path, {"cases": changed})
+    message = str(info.value)
+    assert "cases[7].device.inductance: missing there, 0.0 now" in message
+    assert len(message) < 300, message
+    with pytest.raises(FileExistsError, match=r"cases: 200 entries there, 3 entries now"):
+        _io.prepare_output_dir(tmp_path, {"cases": cases[:3]})
+
+
 @pytest.mark.parametrize("umask", [0o022, 0o077, 0o002])
 def test_written_files_follow_the_umask_like_open(tmp_path, monkeypatch, umask):
     """Atomic writes and kept-beside results get the mode ``open()`` would give (0666 less

@@ -119,6 +119,12 @@ def test_verdict_lines_show_sentences_then_numbers(tmp_path):
     lines = verdict_lines(tmp_path)
     assert lines == ["- It holds.", f"  (3 numbers behind them in {tmp_path / 'verdicts.json'})"]
     assert verdict_lines(tmp_path / "missing") == []
+    # with sentences, a long word value behind them is counted, not printed as a sentence
+    where = "upper bound (the closure's validity limit: u0 = 1.25 sigma_v, of the device)"
+    write_verdicts(tmp_path, {"optima": {"S=1": {"where": where}}}, ["It holds."])
+    assert verdict_lines(tmp_path) == [
+        "- It holds.", f"  (1 number behind them in {tmp_path / 'verdicts.json'})"
+    ]  # fmt: skip
     # no sentence stored: the report's verdict paragraphs, else the numbers themselves
     write_verdicts(tmp_path, {"a": {"n": 3}})
     assert verdict_lines(tmp_path) == ["  a.n: 3"]

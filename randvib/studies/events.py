@@ -247,8 +247,11 @@ def energy_and_stroke_figure(results: pd.DataFrame, stroke: float, path: Path) -
         ax.errorbar(sub.level, sub.stroke_reached_mc, yerr=sub.stroke_reached_mc_ci95, fmt="o-",
                     ms=4, capsize=2, color=colour, lw=1, label=f"{name}, Monte Carlo")  # fmt: skip
         if sub.stroke_poisson.notna().any():
-            ax.plot(sub.level, sub.stroke_poisson, "--", color=colour, lw=1, label="Poisson")
-            ax.plot(sub.level, sub.stroke_vanmarcke, ":", color=colour, lw=1, label="Vanmarcke")
+            # both approximations assume the Gaussian response of a linear device
+            ax.plot(sub.level, sub.stroke_poisson, "--", color=colour, lw=1,
+                    label=f"{name}, Poisson (linear device only)")  # fmt: skip
+            ax.plot(sub.level, sub.stroke_vanmarcke, ":", color=colour, lw=1,
+                    label=f"{name}, Vanmarcke (linear device only)")  # fmt: skip
     axes[0, 0].set(xscale="log", yscale="log", xlabel="intensity S ((m/s$^2$)$^2$/Hz)",
                    ylabel="energy per event (mJ)")  # fmt: skip
     axes[0, 1].set(xscale="log", xlabel="intensity S ((m/s$^2$)$^2$/Hz)",

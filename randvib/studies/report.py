@@ -143,8 +143,9 @@ def write_verdicts(out_dir: Path, verdicts: dict, sentences=()) -> Path:
 def verdict_lines(out_dir: Path, max_items: int = 40) -> list[str]:
     """The verdicts of the study in ``out_dir`` as lines for the terminal.
 
-    The sentences: ``verdicts.json``'s ``"verdicts"`` list and any text in it
-    longer than a line's worth, or else the report's ``**Verdict.**`` paragraphs.
+    The sentences: ``verdicts.json``'s ``"verdicts"`` list; without it, any text
+    in the file longer than a line's worth, or else the report's
+    ``**Verdict.**`` paragraphs.
     With sentences, the numbers behind them are only counted (they are in the
     file); without any, every number and word of the file is shown as
     ``key.sub: value`` (lists of records counted, not listed), at most
@@ -157,6 +158,9 @@ def verdict_lines(out_dir: Path, max_items: int = 40) -> list[str]:
         return []
     data = json.loads(path.read_text())
     lines = [f"- {s}" for s in data.pop("verdicts", [])]
+    # a study that stores its sentences says everything in them; a long text among its
+    # numbers is a value (an optimum's "where"), not a sentence to print
+    has_sentences = bool(lines)
     flat = []
 
     def walk(prefix, value):
@@ -165,7 +169,7 @@ def verdict_lines(out_dir: Path, max_items: int = 40) -> list[str]:
                 walk(f"{prefix}.{key}" if prefix else str(key), sub)
         elif isinstance(value, list) and any(isinstance(v, dict | list) for v in value):
             flat.append(f"{prefix}: {len(value)} entries")
-        elif isinstance(value, str) and len(value) > 60:
+        elif isinstance(value, str) and len(value) > 60 and not has_sentences:
             # a verdict sentence stored beside its numbers: shown with the sentences
             lines.append(f"- {prefix}: {value.strip().lstrip(';').strip()}")
         elif isinstance(value, float):
