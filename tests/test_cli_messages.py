@@ -46,6 +46,10 @@ def test_validate_settings_checked_as_identify_does(capsys, tmp_path, record_csv
         (["--bounds", "k=-10:-1"], "`--bounds k` must be > 0"),
         (["--fix", "k=0"], "`--fix k` must be > 0"),
         (["--bounds", "c=0:inf"], "must be finite"),
+        (["--bounds", "c=0:0"], "needs lower < upper; a value known exactly is fixed: `--fix c=0`"),
+        (["--bounds", "k=50:50"], "`--fix k=50`"),
+        (["--fix", "c=0.05", "--fix", "k=57", "--fix", "k3=7e4", "--fix", "fc=0.005",
+          "--fix", "input_offset=0"], "every parameter of model 'coulomb' is fixed"),
     ],
 )
 def test_identify_fixed_values_and_bounds_obey_parameter_rules(capsys, record_csv, extra, fragment):
@@ -119,6 +123,13 @@ def test_record_folder_and_constant_column_named(capsys, tmp_path, record_csv):
         "\n".join([text[0]] + [",".join(line.split(",")[:2] + ["0.001"]) for line in text[1:]])
     )
     one_line_error(capsys, fit_args(const), "constant")
+    # an input channel of zeros drives nothing: named, not scipy's bounds message
+    silent = tmp_path / "silent.csv"
+    silent.write_text(
+        "\n".join([text[0]] + [",".join([line.split(",")[0], "0"] + line.split(",")[2:])
+                               for line in text[1:]])
+    )  # fmt: skip
+    one_line_error(capsys, fit_args(silent), "`base_acceleration` of record 'silent' is constant")
 
 
 def test_record_seed_out_of_range_named(capsys, tmp_path):

@@ -63,6 +63,14 @@ def test_huge_k3_answers_are_refused_by_the_energy_balance(method, k3):
         rv.predict(h, 1.0, method)
 
 
+def test_energy_refusal_on_the_command_line_keeps_the_formula(capsys):
+    """The refusal's formula c_m E[v^2] + P_e is physics: the CLI does not turn its c_m
+    into the option `--c-m` as it does for argument names."""
+    argv = ["power", "--m", "0.0226", "--c-m", "0.05", "--k", "57.4", "--k3", "1e100",
+            "--psd", "1", "--method", "fpk"]  # fmt: skip
+    one_line_error(capsys, argv, "dissipated power c_m E[v^2] + P_e =")
+
+
 # the methods of a resistive device (bridge-closure treats only a bridge)
 @pytest.mark.parametrize("method", [m for m in METHODS if not METHODS[m].rectifier])
 @pytest.mark.parametrize("fc", [0.0, 0.0058])

@@ -246,7 +246,8 @@ class _Running:
 _RENAMED = {"n_paths": "--paths", "scheme": "--method", "maxiter": "--generations"}
 
 _QUOTED_NAME = re.compile(r"`([A-Za-z_][\w ()-]*)`")
-_BARE_NAME = re.compile(r"(?<![\w`./-])([a-z][a-z0-9]*(?:_[a-z0-9]+)+|dt)(?![\w`/(-])")
+# not a coefficient in a formula (``c_m E[v^2]``): that is physics, not an option
+_BARE_NAME = re.compile(r"(?<![\w`./-])([a-z][a-z0-9]*(?:_[a-z0-9]+)+|dt)(?![\w`/(-]| E\[)")
 
 
 def api_flags(parser: argparse.ArgumentParser) -> dict:

@@ -92,6 +92,14 @@ def search_space(record, model, fixed, bounds, skip) -> SearchSpace:
     """Free parameters and their bounds (declared defaults, then the user's)."""
     candidates = MODEL_PARAMETERS[model] + ("m", "k2", "input_offset")
     free = tuple(n for n in candidates if n not in fixed)
+    if not free:
+        raise ValueError(
+            f"every parameter of model {model!r} is fixed "
+            f"({', '.join(n for n in candidates if n not in ('m', 'k2'))}, with m given and "
+            "k2 without --quadratic): nothing is "
+            "left to identify; leave one free (drop its `--fix`), or score fixed values on the "
+            "record with `randvib validate`"
+        )
     needed = max(20, SAMPLES_PER_PARAMETER * (len(free) + 3)) + skip
     if record.n < needed:
         raise ValueError(
@@ -101,6 +109,14 @@ def search_space(record, model, fixed, bounds, skip) -> SearchSpace:
     if np.ptp(record.z[skip:]) == 0:
         raise ValueError(
             f"`{OUTPUT_CHANNEL}` of record {record.name!r} is constant; J (Eq. 11) is undefined"
+        )
+    if np.ptp(record.input) == 0:
+        # nothing drives the device: no parameter is identifiable from its response
+        raise ValueError(
+            f"`{record.input_kind}` of record {record.name!r} is constant "
+            f"({float(record.input[0]):g} throughout): nothing drives the device, so no "
+            "parameter can be identified; give the record's input column "
+            "(`--input-column NAME`)"
         )
     box = default_bounds(record, model, fixed.get("m"))
     box.update(_extra_bounds(record, fixed.get("m")))
@@ -156,6 +172,11 @@ def _user_bounds(model, bounds) -> dict:
         lo, hi = (check_parameter(model, name, x, f"--bounds {name}") for x in pair)
         if lo > hi:
             raise ValueError(f"`--bounds {name}`: lower {lo!r} > upper {hi!r}")
+        if lo == hi:
+            raise ValueError(
+                f"`--bounds {name}={lo:g}:{hi:g}`: a search range needs lower < upper; a value "
+                f"known exactly is fixed: `--fix {name}={lo:g}`"
+            )
         out[name] = (lo, hi)
     return out
 
