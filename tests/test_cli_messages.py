@@ -48,8 +48,21 @@ def test_validate_settings_checked_as_identify_does(capsys, tmp_path, record_csv
         (["--bounds", "c=0:inf"], "must be finite"),
         (["--bounds", "c=0:0"], "needs lower < upper; a value known exactly is fixed: `--fix c=0`"),
         (["--bounds", "k=50:50"], "`--fix k=50`"),
-        (["--fix", "c=0.05", "--fix", "k=57", "--fix", "k3=7e4", "--fix", "fc=0.005",
-          "--fix", "input_offset=0"], "every parameter of model 'coulomb' is fixed"),
+        (
+            [
+                "--fix",
+                "c=0.05",
+                "--fix",
+                "k=57",
+                "--fix",
+                "k3=7e4",
+                "--fix",
+                "fc=0.005",
+                "--fix",
+                "input_offset=0",
+            ],
+            "every parameter of model 'coulomb' is fixed",
+        ),
     ],
 )
 def test_identify_fixed_values_and_bounds_obey_parameter_rules(capsys, record_csv, extra, fragment):
