@@ -39,9 +39,11 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy import optimize, special
 
+from randvib.analytic.linear_response import device_block, output_variances
 from randvib.analytic.linearisation import linear_displacement_variance
-from randvib.analytic.method import AnalyticMethod, Validity
+from randvib.analytic.method import AnalyticMethod, Validity, non_white
 from randvib.analytic.power_prediction import PowerPrediction
+from randvib.models.excitation import as_excitation
 from randvib.models.harvester import Harvester
 from randvib.models.rectifier import BridgeCoil
 
@@ -100,16 +102,67 @@ def _velocity_std(harvester: Harvester, psd: float, v_out: float) -> float:
     return float(np.exp(optimize.brentq(excess, np.log(lo), np.log(hi), xtol=1e-14, rtol=1e-15)))
 
 
-def capacitor_level(harvester: Harvester, psd: float) -> float:
+def _coloured_response(harvester: Harvester, excitation, v_out: float) -> tuple[float, float]:
+    """(sigma_v (m/s), E[z^2] (m^2)) of the statistically linearised device under ``excitation``.
+
+    The bridge's dead-zone force, like the friction, is replaced by its
+    Gaussian equivalent damping ``E[v F_e] / E[v^2] = 2 (alpha^2 / R_C) Q(u0 / s)``
+    and the cubic spring by ``k_eq = k + 3 k3 E[z^2]`` (paper Eq. 19); the
+    variances are the linear device's under the excitation (a Lyapunov
+    equation with the shaping filter of a rational spectrum, the spectral
+    integral otherwise, :func:`~randvib.analytic.linear_response.output_variances`).
+    The two conditions are one fixed point in (log E[v^2], log E[z^2]),
+    solved by Powell's hybrid method from the zero-threshold device (the
+    resistive coil c_e = alpha^2 / R_C, for which it is exact).
+    """
+    coil, law = harvester.electrical, harvester.friction
+    m, c_m, k, k3 = (float(x) for x in (harvester.m, harvester.c_m, harvester.k, harvester.k3))
+    excitation = as_excitation(excitation)
+    used = "lyapunov" if excitation.shaping_filter() else "spectral"
+    g = coil.alpha**2 / coil.r_coil
+    u0 = (v_out + 2.0 * coil.v_diode) / coil.alpha
+
+    def equivalent(x):
+        var_v, var_z = np.exp(x)
+        s = np.sqrt(var_v)
+        friction = 0.0 if law is None else float(law.equivalent_damping_increment(s))
+        return c_m + friction + 2.0 * g * _tail(u0 / s), k + 3.0 * k3 * var_z
+
+    def variances(c_eq, k_eq):
+        out = output_variances(device_block(m, c_eq, k_eq, None), excitation, used)
+        return np.log([out["v"], out["z"]])
+
+    def residual(x):
+        return variances(*equivalent(x)) - x
+
+    start = variances(c_m + g, k)
+    found = optimize.root(residual, start, method="hybr", options={"xtol": 1e-12})
+    if not (found.success and np.all(np.abs(residual(found.x)) < 1e-9)):
+        raise RuntimeError(
+            f"the bridge's statistical linearisation did not converge: {found.message}"
+        )
+    var_v, var_z = np.exp(found.x)
+    return float(np.sqrt(var_v)), float(var_z)
+
+
+def _velocity_spread(harvester: Harvester, psd, v_out: float) -> float:
+    """sigma_v (m/s) of the closure at output voltage ``v_out``: white or coloured input."""
+    if non_white(psd):
+        return _coloured_response(harvester, psd, v_out)[0]
+    return _velocity_std(harvester, float(getattr(psd, "level", psd)), v_out)
+
+
+def capacitor_level(harvester: Harvester, psd) -> float:
     """V_C (V) of the charge balance V_C / R_L = E|i|(V_C) under the closure."""
     coil = harvester.electrical
 
     def balance(v_c):
-        s = _velocity_std(harvester, psd, v_c)
+        s = _velocity_spread(harvester, psd, v_c)
         return bridge_moments(coil, s, v_c)[1] * coil.r_load - v_c
 
     # E|i| R_L - V_C falls from >= 0 at 0 to < 0 where the bridge stops conducting
-    hi = coil.alpha * np.sqrt(psd * harvester.m / max(harvester.c_m, 1e-300))
+    start = _velocity_spread(harvester, psd, 0.0)
+    hi = coil.alpha * start * 4.0
     hi = max(hi, 1e-12)
     while balance(hi) > 0:
         hi *= 2.0
@@ -129,6 +182,7 @@ class BridgeClosure(AnalyticMethod):
         "exceeds 1.25 velocity std"
     )
     rectifier = True
+    coloured = True
     validity = (
         Validity(
             "u0 / sigma_v",
@@ -138,6 +192,10 @@ class BridgeClosure(AnalyticMethod):
             "bridge conducts only in the velocity's tails, which the Gaussian closure misses",
         ),
     )
+
+    def potentials_under(self, harvester, psd) -> tuple[str, ...]:
+        # the coloured fixed point linearises about z = 0 with k_eq > 0: one well only
+        return ("monostable",) if non_white(psd) else self.potentials
 
     def accepts(self, harvester, psd) -> bool:
         return super().accepts(harvester, psd) and self._coil(harvester)
@@ -159,7 +217,8 @@ class BridgeClosure(AnalyticMethod):
 
     def solve(self, harvester: Harvester, psd) -> PowerPrediction:
         coil = harvester.electrical
-        psd = float(psd)
+        coloured = non_white(psd)
+        psd = psd if coloured else float(getattr(psd, "level", psd))
         if np.ndim(harvester.m) or np.ndim(harvester.k):
             raise ValueError(f"{self.called} takes scalar device parameters")
         if not coil.has_battery:
@@ -173,7 +232,11 @@ class BridgeClosure(AnalyticMethod):
                     f"{MIN_CAPACITOR_PERIODS:g} natural periods its ripple is not negligible)",
                 )
         v_out = coil.battery if coil.has_battery else capacitor_level(harvester, psd)
-        s = _velocity_std(harvester, psd, v_out)
+        if coloured:
+            s, zz = _coloured_response(harvester, psd, v_out)
+        else:
+            s = _velocity_std(harvester, psd, v_out)
+            zz = linear_displacement_variance(harvester, s * s)
         ratio = (v_out + 2.0 * coil.v_diode) / coil.alpha / s
         if ratio > MAX_THRESHOLD_RATIO:
             raise self.beyond_validity(
@@ -187,10 +250,10 @@ class BridgeClosure(AnalyticMethod):
         law = harvester.friction
         friction = 0.0 if law is None else float(law.mean_velocity_force(s))
         vv = s * s
-        zz = linear_displacement_variance(harvester, vv)
+        c_eq = harvester.c_m + (friction + electrical) / vv
         return PowerPrediction(
             method=self.name,
-            c_eq=psd * harvester.m / (4.0 * vv),
+            c_eq=float(c_eq),
             velocity_variance=vv,
             displacement_variance=None if harvester.potential.is_free else float(zz),
             mean_abs_velocity=float(np.sqrt(2.0 / np.pi) * s),
