@@ -52,6 +52,11 @@ from randvib.models.rectifier import BridgeCoil
 #: tests/calibration/bridge_closure.py (largest |error| 6.3 %), beyond it off by
 #: up to 33 % (2x near u0 / sigma_v = 3).
 MAX_THRESHOLD_RATIO = 1.25
+#: Largest |relative error| of the stored power against Monte Carlo under the
+#: rational spectra of tests/calibration/bridge_closure.py (``coloured``: band-pass
+#: and Kanai-Tajimi, battery and capacitor, Coulomb friction or none) up to the same
+#: threshold ratio (largest 6.9 %, a capacitor under band-pass input).
+COLOURED_ERROR = 0.07
 #: Smallest R_L C of a storage capacitor, in linear natural periods 2 pi / omega_n,
 #: the closure is offered at (its ripple neglected; the grid's capacitor had 8).
 MIN_CAPACITOR_PERIODS = 8.0
@@ -137,7 +142,8 @@ def _coloured_response(harvester: Harvester, excitation, v_out: float) -> tuple[
 
     start = variances(c_m + g, k)
     found = optimize.root(residual, start, method="hybr", options={"xtol": 1e-12})
-    if not (found.success and np.all(np.abs(residual(found.x)) < 1e-9)):
+    # hybr may stop short of its xtol at a root found to rounding: judge the residual
+    if not np.all(np.abs(residual(found.x)) < 1e-9):
         raise RuntimeError(
             f"the bridge's statistical linearisation did not converge: {found.message}"
         )
@@ -304,21 +310,22 @@ class DcOptimum:
         }
 
 
-def _stored(harvester: Harvester, psd: float) -> tuple[float, float]:
+def _stored(harvester: Harvester, psd) -> tuple[float, float]:
     """(stored power (W), u0 / sigma_v) of the closure, without its validity refusal."""
     coil = harvester.electrical
     v_out = coil.battery if coil.has_battery else capacitor_level(harvester, psd)
-    s = _velocity_std(harvester, psd, v_out)
+    s = _velocity_spread(harvester, psd, v_out)
     _, mean_abs_i, _ = bridge_moments(coil, s, v_out)
     stored = v_out * mean_abs_i if coil.has_battery else v_out**2 / coil.r_load
     return stored, (v_out + 2.0 * coil.v_diode) / coil.alpha / s
 
 
-def optimal_dc_output(harvester: Harvester, psd: float) -> DcOptimum:
+def optimal_dc_output(harvester: Harvester, psd) -> DcOptimum:
     """The battery voltage, or the storage capacitor's load, that maximises the stored power.
 
-    Searched with ``method='bridge-closure'`` (white noise, a coil's bridge,
-    any memoryless friction and confining potential) over the range where
+    Searched with ``method='bridge-closure'`` (a coil's bridge, any memoryless
+    friction; white noise with any confining potential, a non-white excitation
+    with a single well) over the range where
     the closure is offered: V_b from 0 up to the voltage at which the
     threshold reaches 1.25 velocity std; R_L from the 8 natural periods of
     R_L C up to the same threshold limit. A bounded scalar search (Brent);
@@ -334,7 +341,7 @@ def optimal_dc_output(harvester: Harvester, psd: float) -> DcOptimum:
     V_b* = 0.0410 V, 6.5536e-04 W, interior
     """
     BRIDGE_CLOSURE.require(harvester, psd, who="optimal_dc_output")
-    psd = float(psd)
+    psd = psd if non_white(psd) else float(getattr(psd, "level", psd))
     coil = harvester.electrical
     if coil.has_battery:
         parameter, log = "battery", False
