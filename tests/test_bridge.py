@@ -71,6 +71,7 @@ def test_closure_within_its_declared_error_of_monte_carlo(output, fc):
     [
         (rv.BridgeCoil(ALPHA, R_COIL, battery=0.1), 0.25, "velocity std"),
         (rv.BridgeCoil(ALPHA, R_COIL, 0.01, None, 0.01, 2.0), 1.0, "natural periods"),
+        (rv.BridgeCoil(ALPHA, R_COIL, 0.01, None, 2.0, 0.5), 1.0, "below 4 R_C"),
         (rv.BridgePiezo(1e-3, 1e-7, battery=2.0), 1.0, "coil without inductance into a bridge"),
         (rv.BridgeCoil(ALPHA, R_COIL, battery=0.1), rv.BandPass(0.25, 8.0, 0.3), "velocity std"),
     ],
@@ -190,3 +191,19 @@ def test_optimal_battery_voltage_under_band_pass_input():
     for factor in (0.9, 1.1):
         coil = rv.BridgeCoil(ALPHA, R_COIL, v_diode=0.01, battery=factor * best.value)
         assert rv.predict(device(coil), bp, "bridge-closure").power_stored <= best.power_stored
+
+
+@pytest.mark.parametrize("psd", [1.0, rv.BandPass(1.0, 8.0, 0.3)])
+def test_capacitor_closure_is_the_battery_closure_at_its_own_level(psd):
+    """Large C, V_d = 0: the capacitor's level is a fixed point of the battery closure."""
+    from randvib.analytic import bridge
+
+    cap = device(rv.BridgeCoil(ALPHA, R_COIL, storage_capacitance=1.0, r_load=2.0), k3=5e4)
+    v_c = bridge.capacitor_level(cap, psd)
+    battery = device(rv.BridgeCoil(ALPHA, R_COIL, battery=v_c), k3=5e4)
+    p, q = rv.predict(cap, psd, "bridge-closure"), rv.predict(battery, psd, "bridge-closure")
+    assert v_c > 0.0
+    # charge balance V_C / R_L = E|i|: the battery's V_b E|i| is V_C^2 / R_L
+    assert p.power_stored == pytest.approx(q.power_stored, rel=1e-8)
+    assert p.velocity_variance == pytest.approx(q.velocity_variance, rel=1e-8)
+    assert p.power_coil_loss == pytest.approx(q.power_coil_loss, rel=1e-8)
