@@ -19,7 +19,8 @@ in docs/conventions.md ("Rectified circuits").
 
 Coloured grid (``coloured``): the same device and coil with V_d 0.01 V, band-pass
 BandPass(S, 8 Hz, zeta) at (S, zeta) = (1, 0.3), (0.25, 0.3), (1, 0.1) and
-Kanai-Tajimi KanaiTajimi(0.25, 8 Hz, 0.3), no friction or Coulomb Fc = 0.005 N, a
+Kanai-Tajimi KanaiTajimi(0.25, 8 Hz, 0.3) and the paper's flat band
+BandLimited(1, 4 Hz, 20 Hz) (spectral integral, not rational), no friction or Coulomb Fc = 0.005 N, a
 battery V_b in {0.02, 0.05} V or the storage capacitor above; Monte Carlo 128
 paths x 8 s after a burn-in of 4 s, dt 2e-4 s.
 
@@ -50,7 +51,7 @@ ALPHA, R_COIL = 0.1992, 0.48
 
 def main() -> None:
     warnings.simplefilter("ignore")
-    if sys.argv[1:] == ["coloured"]:
+    if sys.argv[1:2] == ["coloured"]:
         coloured()
         return
     if sys.argv[1:] == ["capacitor"]:
@@ -88,9 +89,12 @@ def coloured() -> None:
     rows = []
     spectra = (
         rv.BandPass(1.0, 8.0, 0.3), rv.BandPass(0.25, 8.0, 0.3), rv.BandPass(1.0, 8.0, 0.1),
-        rv.KanaiTajimi(0.25, 8.0, 0.3),
+        rv.KanaiTajimi(0.25, 8.0, 0.3), rv.BandLimited(1.0, 4.0, 20.0),
     )  # fmt: skip
+    only = sys.argv[2:]  # e.g. "BandLimited": that spectrum alone
     for psd in spectra:
+        if only and type(psd).__name__ not in only:
+            continue
         for fc in (0.0, 0.005):
             outputs = [dict(battery=0.02), dict(battery=0.05)]
             outputs.append(dict(storage_capacitance=0.5, r_load=2.0))
