@@ -207,3 +207,21 @@ def test_capacitor_closure_is_the_battery_closure_at_its_own_level(psd):
     assert p.power_stored == pytest.approx(q.power_stored, rel=1e-8)
     assert p.velocity_variance == pytest.approx(q.velocity_variance, rel=1e-8)
     assert p.power_coil_loss == pytest.approx(q.power_coil_loss, rel=1e-8)
+
+
+def test_cli_power_optimal_load_of_a_bridge_under_band_pass_input(capsys):
+    from _cli import run
+
+    code, out, _ = run(
+        capsys, "power", "--m", "0.0226", "--c-m", "0.05", "--k", "57.4", "--psd", "1",
+        "--excitation", "band-pass", "--f0", "8", "--zeta", "0.3",
+        "--coupling", "inductive", "--rectifier", "bridge", "--alpha", "0.1992",
+        "--r-coil", "0.48", "--v-diode", "0.01", "--battery", "0.03", "--optimal-load", "--json",
+    )  # fmt: skip
+    assert code == 0
+    data = json.loads(out)
+    h = device(rv.BridgeCoil(ALPHA, R_COIL, v_diode=0.01, battery=0.03))
+    bp = rv.BandPass(1.0, 8.0, 0.3)
+    assert data["optimum_method"] == data["method"] == "bridge-closure"
+    assert data["battery_optimal"] == rv.optimal_dc_output(h, bp).value
+    assert data["power_stored"] == rv.predict(h, bp, "bridge-closure").power_stored

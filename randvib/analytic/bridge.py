@@ -45,7 +45,8 @@ bridge's power is, and the bridge cuts them. The declared limit is on
   R_L >= 4 R_C; at R_L ~ R_C the mean-level closure underestimates the stored
   power by 10-18.5 % even at 8 periods, and by up to 39 % at 1 period;
 * rational spectra (``coloured``: band-pass at (S, zeta) = (1, 0.3),
-  (0.25, 0.3), (1, 0.1) and Kanai-Tajimi (0.25, 0.3), f0 8 Hz, Coulomb or
+  (0.25, 0.3), (1, 0.1) and Kanai-Tajimi (0.25, 0.3), f0 8 Hz, and the
+  paper's flat band 4-20 Hz (a spectral integral; within 3.5 %), Coulomb or
   none, batteries 20 and 50 mV and a capacitor): within
   :data:`COLOURED_ERROR` (8 %, largest 5.3 %) up to a = 1.25, up to 12.5 %
   to a = 1.54 and 40 % beyond.
@@ -67,7 +68,7 @@ from randvib.analytic.linear_response import device_block, output_variances
 from randvib.analytic.linearisation import linear_displacement_variance
 from randvib.analytic.method import AnalyticMethod, Validity, non_white
 from randvib.analytic.power_prediction import PowerPrediction
-from randvib.models.excitation import as_excitation
+from randvib.models.excitation import Measured, as_excitation
 from randvib.models.harvester import Harvester
 from randvib.models.rectifier import BridgeCoil
 
@@ -242,7 +243,11 @@ class BridgeClosure(AnalyticMethod):
         return ("monostable",) if non_white(psd) else self.potentials
 
     def accepts(self, harvester, psd) -> bool:
-        return super().accepts(harvester, psd) and self._coil(harvester)
+        return (
+            super().accepts(harvester, psd)
+            and self._coil(harvester)
+            and not isinstance(psd, Measured)
+        )
 
     def refusal(self, harvester, psd, who=None):
         reason = super().refusal(harvester, psd, who)
@@ -250,6 +255,12 @@ class BridgeClosure(AnalyticMethod):
             return (
                 f"{who or self.called} treats a coil without inductance into a bridge of "
                 "constant-drop diodes (BridgeCoil without saturation_current) only; "
+                f"use {self._alternatives(harvester, psd)}"
+            )
+        if reason is None and isinstance(psd, Measured):
+            # its error is measured for model spectra only; a record is simulated on its windows
+            return (
+                f"{who or self.called} treats a model spectrum, not a measured record; "
                 f"use {self._alternatives(harvester, psd)}"
             )
         return reason
