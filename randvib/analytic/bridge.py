@@ -41,14 +41,14 @@ bridge's power is, and the bridge cuts them. The declared limit is on
   up to 33 % beyond;
 * white noise, storage capacitor (``capacitor``: S 0.25 and 1, Coulomb or
   none, R_L in {0.5, 2, 8} ohm, R_L C in {1, 2, 4, 8} natural periods): within
-  :data:`CAPACITOR_ERROR` (9.5 %, largest 7.9 %) where R_L C >= 4 periods and
+  ``CAPACITOR_ERROR`` (9.5 %, largest 7.9 %) where R_L C >= 4 periods and
   R_L >= 4 R_C; at R_L ~ R_C the mean-level closure underestimates the stored
   power by 10-18.5 % even at 8 periods, and by up to 39 % at 1 period;
 * rational spectra (``coloured``: band-pass at (S, zeta) = (1, 0.3),
   (0.25, 0.3), (1, 0.1) and Kanai-Tajimi (0.25, 0.3), f0 8 Hz, and the
   paper's flat band 4-20 Hz (a spectral integral; within 3.5 %), Coulomb or
   none, batteries 20 and 50 mV and a capacitor): within
-  :data:`COLOURED_ERROR` (8 %, largest 5.3 %) up to a = 1.25, up to 12.5 %
+  ``COLOURED_ERROR`` (8 %, largest 5.3 %) up to a = 1.25, up to 12.5 %
   to a = 1.54 and 40 % beyond.
 
 The method refuses beyond a = 1.25, for a storage capacitor of R_L C below
@@ -87,7 +87,7 @@ COLOURED_ERROR = 0.08
 #: Smallest R_L C of a storage capacitor, in linear natural periods 2 pi / omega_n,
 #: the closure is offered at (its ripple neglected). Over the capacitor grid of
 #: tests/calibration/bridge_closure.py (``capacitor``) the error falls with R_L C:
-#: at 4 periods and more it is within :data:`CAPACITOR_ERROR` where R_L >= 4 R_C, at
+#: at 4 periods and more it is within ``CAPACITOR_ERROR`` where R_L >= 4 R_C, at
 #: 2 periods up to 13.5 %, at 1 up to 14.7 %.
 MIN_CAPACITOR_PERIODS = 4.0
 #: Smallest storage capacitor's load R_L, in coil resistances R_C, the closure is
