@@ -302,7 +302,7 @@ def test_stored_objective_battery_optimum_is_optimal_dc_output():
     assert result.optimum["battery"] == pytest.approx(exact.value, rel=1e-3)
     assert result.power_predicted == pytest.approx(exact.power_stored, rel=1e-9)
     # a storage capacitor: its load r_load varied (its lower end inside the closure's
-    # R_L C >= 8 natural periods), the same agreement
+    # R_L C >= 4 natural periods and R_L >= 4 R_C), the same agreement
     cap = rv.BridgeCoil(alpha=0.1992, r_coil=0.48, v_diode=0.01, storage_capacitance=1.0,
                         r_load=1.0)  # fmt: skip
     with_cap = rv.Harvester.with_coupling(M, 0.05, 57.4, cap, stroke=0.05)

@@ -298,7 +298,7 @@ COIL_BATTERY = ("--coupling", "inductive", "--rectifier", "bridge", "--alpha", "
             S,
             (1e4, 1e7),
         ),
-        (  # coil under band-pass input: the closure takes white noise only
+        (  # coil under band-pass input with --optimal-bounds: Monte Carlo, as asked
             (*COIL_BATTERY, "--excitation", "band-pass", "--f0", "8", "--zeta", "0.3",
              "--optimal-bounds", "0", "0.08"),
             rv.BridgeCoil(ALPHA, R_COIL, v_diode=0.01, battery=0.03),

@@ -13,8 +13,8 @@ sigma_z <= d / Phi^-1(1 - eps/2), so the optimum found is the exact one
 (to the optimiser's tolerance, 1e-10 relative in the objective).
 
 A coil into a diode bridge (:mod:`randvib.models.rectifier`) is predicted by
-``bridge-closure`` (white noise, within its declared validity; beyond it the
-point is left to Monte Carlo). The closure takes the response as Gaussian, so
+``bridge-closure`` (within its declared validity; beyond it the point is left
+to Monte Carlo). The closure takes the response as Gaussian, so
 its exceedance is that of a Gaussian displacement of the closure's variance,
 P(|z| > d) = erfc(d / (sigma_z sqrt 2)); Monte Carlo confirms it.
 

@@ -1,7 +1,7 @@
 """The bridge's best output by Monte Carlo: ``simulated_dc_optimum``, for any bridge and input.
 
 :func:`randvib.optimal_dc_output` searches the bridge closure, which takes a
-coil's constant-drop bridge under white noise only. This searches Monte
+coil's constant-drop bridge without inductance only, within its validity. This searches Monte
 Carlo instead, so it takes every bridge (coil, piezo, inductance, Shockley
 diodes), every friction law and every excitation :func:`randvib.simulate`
 takes, and a measured record (:class:`randvib.Measured`, simulated on the
