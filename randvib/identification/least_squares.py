@@ -200,6 +200,32 @@ class Uncertainty:
             "bandwidth": int(self.bandwidth),
         }
 
+    @classmethod
+    def from_dict(cls, d: dict, estimate: dict) -> Uncertainty:
+        """The :class:`Uncertainty` that :meth:`to_dict` wrote, with the ``estimate`` values.
+
+        The intervals are recomputed from the estimates, standard errors and
+        degrees of freedom as :func:`uncertainty` computes them (``to_dict``'s
+        may have been cut at a search box by the result that saved them).
+        """
+        from scipy import stats
+
+        names = tuple(d["correlation"]["names"])
+        se = {k: float(d["standard_errors"][k]) for k in names}
+        values = {k: float(estimate[k]) for k in names}
+        t = float(stats.t.ppf(0.975, int(d["dof"])))
+        return cls(
+            names=names,
+            estimate=values,
+            standard_error=se,
+            interval={k: (values[k] - t * se[k], values[k] + t * se[k]) for k in names},
+            correlation=np.array(d["correlation"]["matrix"], dtype=float),
+            noise_std=float(d["noise_std"]),
+            dof=int(d["dof"]),
+            method=d.get("covariance", "white"),
+            bandwidth=int(d.get("bandwidth", 0)),
+        )
+
 
 #: What each covariance estimate means (the report and the JSON say which was used).
 COVARIANCE_METHODS = {
