@@ -54,8 +54,11 @@ def main(n):
             rig = T.shaker_record(seed=seed)
             res = identify(noisy(rig, case, seed), "coulomb", m=T.M, progress=False, seed=seed)
             methods.append(res.uncertainty.method)
+            intervals = res.confidence_intervals
+            if res.at_bound:
+                print(f"  seed {seed}: {res.at_bound} on a search bound (no interval: a miss)")
             for name, value in truth.items():
-                lo, hi = res.confidence_intervals[name]
+                lo, hi = intervals.get(name, (np.nan, np.nan))
                 hits[name] += lo <= value <= hi
         used = {m: methods.count(m) for m in sorted(set(methods))}
         print(f"{case}: {n} seeds, covariance used: {used}")
