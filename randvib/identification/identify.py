@@ -23,6 +23,7 @@ the output offset) and a velocity estimated from the first five samples.
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -235,7 +236,26 @@ def identify(
     )
     if np.isfinite(result.cost):
         result.residuals = result.diagnose(record)
+    _warn_at_bound(result)
     return result
+
+
+def _warn_at_bound(result) -> None:
+    """Warn, naming ``--bounds``, when a free parameter ended on its search box:
+    the cost may fall further beyond it, so the value is not an estimate."""
+    if not result.at_bound:
+        return
+    which = ", ".join(
+        f"{name} = {result.parameters[name]:.4g} {result.unit(name)} on its {side} bound"
+        for name, side in result.at_bound.items()
+    )
+    example = next(iter(result.at_bound))
+    warnings.warn(
+        f"{which}: the optimum may lie beyond the search box, so this is no estimate; "
+        f"widen it (`--bounds {example}=LO:HI`, `bounds=` in Python) and fit again",
+        UserWarning,
+        stacklevel=3,
+    )
 
 
 def _check_population(search: SearchSettings, d: int) -> None:
