@@ -147,6 +147,21 @@ def test_cli_default_identify_of_a_strongly_hardening_record_is_within_5_percent
         assert fit["parameters"][name] == pytest.approx(true, rel=0.05), name
 
 
+def test_input_offset_stays_in_the_box_reported_with_it(rig):
+    """The polish keeps the input offset in its search box (as every searched
+    parameter): with a box given below the true offset 0.3 m/s^2 the value ends
+    on the box's upper edge, labelled there, without an interval, with a warning
+    naming --bounds; the box reported is the one given."""
+    box = (0.0, 0.2)
+    with pytest.warns(UserWarning, match="input_offset = 0.2 m/s.* upper bound.*--bounds"):
+        fit = identify(rig, "coulomb", m=M, progress=False, popsize=8, maxiter=3,
+                       bounds={"input_offset": box})  # fmt: skip
+    assert fit.bounds["input_offset"] == box
+    assert box[0] <= fit.parameters["input_offset"] <= box[1]
+    assert fit.at_bound.get("input_offset") == "upper"
+    assert "input_offset" not in fit.confidence_intervals
+
+
 def test_auto_keeps_linear_for_a_slow_input():
     """The paper's band (4-20 Hz) at 1 kHz: straight lines err by (pi f dt)^2 / 2
     < 2e-3 at the mid-points, below the tolerance: linear, silently."""

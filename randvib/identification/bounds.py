@@ -161,7 +161,7 @@ def _extra_bounds(record, m) -> dict:
 
 
 def _user_bounds(model, bounds) -> dict:
-    allowed = MODEL_PARAMETERS[model] + ("m",)
+    allowed = MODEL_PARAMETERS[model] + ("m", "k2", "input_offset")
     out = {}
     for name, pair in (bounds or {}).items():
         if name not in allowed:

@@ -353,10 +353,10 @@ def _coordinates(cost, space, names):
             is_log = space.log[space.free.index(name)]
             log.append(is_log)
             scale.append(max(abs(lo), abs(hi)) or 1.0)
-            # offsets and k2 are only searched in a box; the polish is free
-            bounded = name not in EXTRA_PARAMETERS
-            lower.append(lo if bounded else -np.inf)
-            upper.append(hi if bounded else np.inf)
+            # the polish keeps the search's box, the input offset's and k2's
+            # included, so that a value is always inside the box reported with it
+            lower.append(lo)
+            upper.append(hi)
         else:
             log.append(False)
             scale.append(scales[name] or 1.0)
