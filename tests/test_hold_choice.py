@@ -148,10 +148,10 @@ def test_cli_default_identify_of_a_strongly_hardening_record_is_within_5_percent
 
 
 def test_input_offset_stays_in_the_box_reported_with_it(rig):
-    """The polish keeps the input offset in its search box (as every searched
-    parameter): with a box given below the true offset 0.3 m/s^2 the value ends
-    on the box's upper edge, labelled there, without an interval, with a warning
-    naming --bounds; the box reported is the one given."""
+    """A box given for the input offset bounds the search and the polish: below
+    the true offset 0.3 m/s^2 the value ends on its upper edge, labelled there,
+    without an interval, with a warning naming --bounds; the box reported is
+    the one given."""
     box = (0.0, 0.2)
     with pytest.warns(UserWarning, match="input_offset = 0.2 m/s.* upper bound.*--bounds"):
         fit = identify(rig, "coulomb", m=M, progress=False, popsize=8, maxiter=3,

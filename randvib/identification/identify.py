@@ -229,7 +229,8 @@ def identify(
     )
     cost.evaluations, cost.seconds = searched.evaluations, searched.seconds
     found = dict(zip(space.free, map(float, res.x), strict=True))
-    refined = _polish(cost, space, found, simulation, search) if search.polish else None
+    given = frozenset(bounds or ())
+    refined = _polish(cost, space, found, simulation, search, given) if search.polish else None
     elapsed = time.perf_counter() - start
     result = _identification_result(
         cost, space, res, refined, elapsed, search, simulation, reported, notes
@@ -303,7 +304,7 @@ class _Polished:
     simulations: int
 
 
-def _polish(cost: CostFunction, space, found: dict, simulation, search) -> _Polished:
+def _polish(cost: CostFunction, space, found: dict, simulation, search, given) -> _Polished:
     """Least squares of the simulation error from the search's best ``found``."""
     from randvib.identification.least_squares import INITIAL_STATE, SimulationError, polish
 
@@ -320,7 +321,7 @@ def _polish(cost: CostFunction, space, found: dict, simulation, search) -> _Poli
     if simulation.initial_state == "estimate":
         names += list(INITIAL_STATE)
         theta0 += [z0, cost.v0]
-    problem = SimulationError(cost, _coordinates(cost, space, names))
+    problem = SimulationError(cost, _coordinates(cost, space, names, given))
     theta, residuals, unc, message = polish(
         problem, np.array(theta0), max_nfev=search.polish_maxfev
     )
@@ -335,8 +336,10 @@ def _polish(cost: CostFunction, space, found: dict, simulation, search) -> _Poli
     )
 
 
-def _coordinates(cost, space, names):
-    """Scales and bounds of the least-squares vector (the search box for model parameters)."""
+def _coordinates(cost, space, names, given=frozenset()):
+    """Scales and bounds of the least-squares vector: the search box for the model's
+    parameters and for the names in ``given`` (bounded by the user); none for the
+    offsets and k2 otherwise."""
     from randvib.identification.least_squares import Coordinates
 
     z_scale = float(np.std(cost.record.z))
@@ -353,10 +356,12 @@ def _coordinates(cost, space, names):
             is_log = space.log[space.free.index(name)]
             log.append(is_log)
             scale.append(max(abs(lo), abs(hi)) or 1.0)
-            # the polish keeps the search's box, the input offset's and k2's
-            # included, so that a value is always inside the box reported with it
-            lower.append(lo)
-            upper.append(hi)
+            # the default boxes of the offsets and k2 only start the search (a
+            # cubic spring about a shifted origin needs an input offset beyond
+            # the input's mean +- half its SD); a box the user gave is kept
+            bounded = name not in EXTRA_PARAMETERS or name in given
+            lower.append(lo if bounded else -np.inf)
+            upper.append(hi if bounded else np.inf)
         else:
             log.append(False)
             scale.append(scales[name] or 1.0)
@@ -421,6 +426,23 @@ def _named_callback(callback, free):
     return named
 
 
+def _outside_search_box(parameters, space) -> tuple:
+    """Notes naming an offset or k2 the unbounded polish moved outside its search box
+    (the ``bounds`` reported for it are the global search's, not the polish's)."""
+    out = []
+    for name in EXTRA_PARAMETERS:
+        if name in space.free and name in parameters:
+            lo, hi = space.box[name]
+            value = parameters[name]
+            if not lo <= value <= hi:
+                out.append(
+                    f"{name} = {value:.6g}: outside its search box [{lo:.6g}, {hi:.6g}], which "
+                    "only starts the search; the least-squares polish leaves it unbounded "
+                    f"(`--bounds {name}=LO:HI` bounds both)"
+                )
+    return tuple(out)
+
+
 def _identification_result(cost, space, res, refined, elapsed, search, simulation, reported, notes):
     if not np.isfinite(res.fun):
         raise ValueError(
@@ -447,6 +469,7 @@ def _identification_result(cost, space, res, refined, elapsed, search, simulatio
         pred = score(checked, cost.model, cost.record, simulation)
         j, start = pred.cost, pred.initial_state
     order = ("m",) + MODEL_PARAMETERS[cost.model] + reported
+    notes = notes + _outside_search_box(parameters, space)
     seconds = cost.seconds
     return IdentificationResult(
         model=cost.model,
