@@ -23,8 +23,11 @@ and the noise variance estimated from the residuals,
 ``s^2 (J^T J)^-1`` (Gauss-Newton / asymptotic least-squares theory: exact to
 first order for white Gaussian output noise, the errors-in-the-output
 setting). Standard errors are its diagonal's roots, 95 % intervals
-``theta +- t_{0.975, N - d} se``. Noise on the input or process noise makes
-the residuals coloured; these intervals then understate the uncertainty.
+``theta +- t_{0.975, N - d} se``. When the residual is not white (Ljung-Box
+at 1 %) the covariance is the sandwich with the residual's fitted
+autoregressive covariance instead (:func:`covariance`), right for coloured
+output noise. Noise on the input makes the model wrong, not only the noise
+coloured: its estimates are biased, and no interval covers a bias.
 """
 
 from __future__ import annotations
