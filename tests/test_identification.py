@@ -408,7 +408,7 @@ def test_cli_identify_json_and_validate(tmp_path, capsys, record):
     params = tmp_path / "p.json"
     argv = [
         "identify", str(data), "--model", "coulomb", "--m", "0.0226", "--seed", "1",
-        "--popsize", "16", "--generations", "15", "--json", "--save", str(params), "--no-polish",
+        "--popsize", "16", "--generations", "30", "--json", "--save", str(params), "--no-polish",
     ]  # fmt: skip
     assert main(argv) == 0
     out = json.loads(capsys.readouterr().out)

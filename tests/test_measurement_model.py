@@ -205,6 +205,12 @@ def test_quadratic_stiffness_is_recovered():
     assert cubic.cost > 3 * floor
     shifted = identify(rec, "coulomb", m=TRUTH["m"], seed=0)
     assert shifted.cost < 1.5 * floor
+    # that offset lies beyond its default search box (the input's mean +- SD / 2),
+    # which only starts the search: the notes say where it ended and which box
+    lo, hi = shifted.bounds["input_offset"]
+    if not lo <= shifted.parameters["input_offset"] <= hi:
+        assert any(n.startswith("input_offset = ") and "outside its search box" in n
+                   for n in shifted.notes)  # fmt: skip
 
 
 # ------------------------------------------------------ input reconstruction

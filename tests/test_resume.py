@@ -99,3 +99,27 @@ def test_unreadable_stored_fit_is_named_and_fitted_again(tmp_path, record_csv):
         fit = identify_cached(path, record, "coulomb", **kwargs)
     again = identify_cached(path, record, "coulomb", **kwargs)  # now loaded, not refitted
     assert again.parameters == fit.parameters and json.loads(path.read_text())["model"] == "coulomb"
+
+
+def test_stored_fit_is_loaded_with_its_uncertainty_and_input_kind(tmp_path, record_csv):
+    """A fit loaded from the campaign's cache keeps what the fit reported: standard
+    errors, the 95 % intervals (recomputed exactly from the saved estimates, standard
+    errors and degrees of freedom), the covariance method, the residual verdict and
+    the input's kind (the unit of input_offset)."""
+    from randvib.models.record import read_record
+    from randvib.studies.campaign import identify_cached, load_fit
+
+    path = tmp_path / "fit.json"
+    record = read_record(record_csv[0])
+    fit = identify_cached(path, record, "coulomb", m=0.0226, popsize=8, maxiter=2)
+    loaded = load_fit(path)
+    assert fit.uncertainty is not None and fit.residuals is not None
+    assert loaded.input_kind == fit.input_kind == "base_acceleration"
+    assert loaded.unit("input_offset") == fit.unit("input_offset")
+    assert loaded.standard_errors == fit.standard_errors
+    assert loaded.confidence_intervals == pytest.approx(fit.confidence_intervals, rel=1e-12)
+    assert loaded.uncertainty.method == fit.uncertainty.method
+    assert loaded.uncertainty.bandwidth == fit.uncertainty.bandwidth
+    np.testing.assert_array_equal(loaded.uncertainty.correlation, fit.uncertainty.correlation)
+    assert loaded.residuals.verdict == fit.residuals.verdict
+    assert loaded.to_dict() == json.loads(path.read_text())

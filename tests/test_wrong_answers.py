@@ -148,6 +148,23 @@ def test_identification_on_a_bound_is_labelled_and_has_no_interval():
     assert out["confidence_intervals_95"] == {"c": [0.04, 0.06]}
 
 
+def test_identification_on_a_bound_warns_naming_bounds():
+    """identify ends by warning when a free parameter stopped on its box, naming
+    the parameter, the side and --bounds; a fit inside its box says nothing."""
+    import warnings
+
+    from randvib.identification.identify import _warn_at_bound
+
+    local = {"c": (0.04, 0.07), "k": (-22.0, 26.0)}
+    on = _fit({"c": 0.05, "k": 2.0}, {"c": (0.01, 0.06), "k": (1.0, 2.0)}, local)
+    with pytest.warns(UserWarning, match=r"k = 2 N/m on its upper bound.*--bounds k=LO:HI"):
+        _warn_at_bound(on)
+    inside = _fit({"c": 0.05, "k": 1.5}, {"c": (0.01, 0.06), "k": (1.0, 2.0)}, local)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        _warn_at_bound(inside)
+
+
 def test_identify_command_labels_a_parameter_on_its_bound(capsys, tmp_path):
     """`--bounds k=100:200` on a record of a k = 57 N/m device: k stops at 100."""
     from _cli import fit_args, run

@@ -207,6 +207,7 @@ def print_report(result, record, output_unit: str = "m") -> None:
     if unc is not None:
         names = list(unc.names)
         band = f", bandwidth {unc.bandwidth} samples" if unc.bandwidth else ""
+        band += f", AR order {unc.ar_order}" if unc.ar_order else ""
         print(f"intervals: {COVARIANCE_METHODS[unc.method]}{band}")
         print(f"correlation matrix (residual noise s = {unc.noise_std:.4g}, {unc.dof} dof):")
         print_table(

@@ -53,7 +53,7 @@ def default_bounds(record: Record, model: str, m: float | None = None) -> dict:
     m       [0.1, 10] x m_ls (free mass only)           log
     c       2 m w x [1e-4, 2] (damping ratio)           log
     k       m w^2 x [0.1, 10]                           log
-    k3      [0, 2 m w^2 / z_max^2]                      linear
+    k3      [0, 10 m w^2 / z_max^2]                     linear
     fc, fs  F x [1e-4, 1]                               log
     beta    [1, 1e10] / v_rms                           log
     sigma0  m w^2 x [1e-3, 10]                          log
@@ -161,7 +161,7 @@ def _extra_bounds(record, m) -> dict:
 
 
 def _user_bounds(model, bounds) -> dict:
-    allowed = MODEL_PARAMETERS[model] + ("m",)
+    allowed = MODEL_PARAMETERS[model] + ("m", "k2", "input_offset")
     out = {}
     for name, pair in (bounds or {}).items():
         if name not in allowed:

@@ -23,6 +23,7 @@ the output offset) and a velocity estimated from the first five samples.
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -228,14 +229,34 @@ def identify(
     )
     cost.evaluations, cost.seconds = searched.evaluations, searched.seconds
     found = dict(zip(space.free, map(float, res.x), strict=True))
-    refined = _polish(cost, space, found, simulation, search) if search.polish else None
+    given = frozenset(bounds or ())
+    refined = _polish(cost, space, found, simulation, search, given) if search.polish else None
     elapsed = time.perf_counter() - start
     result = _identification_result(
         cost, space, res, refined, elapsed, search, simulation, reported, notes
     )
     if np.isfinite(result.cost):
         result.residuals = result.diagnose(record)
+    _warn_at_bound(result)
     return result
+
+
+def _warn_at_bound(result) -> None:
+    """Warn, naming ``--bounds``, when a free parameter ended on its search box:
+    the cost may fall further beyond it, so the value is not an estimate."""
+    if not result.at_bound:
+        return
+    which = ", ".join(
+        f"{name} = {result.parameters[name]:.4g} {result.unit(name)} on its {side} bound"
+        for name, side in result.at_bound.items()
+    )
+    example = next(iter(result.at_bound))
+    warnings.warn(
+        f"{which}: the optimum may lie beyond the search box, so this is no estimate; "
+        f"widen it (`--bounds {example}=LO:HI`, `bounds=` in Python) and fit again",
+        UserWarning,
+        stacklevel=3,
+    )
 
 
 def _check_population(search: SearchSettings, d: int) -> None:
@@ -283,7 +304,7 @@ class _Polished:
     simulations: int
 
 
-def _polish(cost: CostFunction, space, found: dict, simulation, search) -> _Polished:
+def _polish(cost: CostFunction, space, found: dict, simulation, search, given) -> _Polished:
     """Least squares of the simulation error from the search's best ``found``."""
     from randvib.identification.least_squares import INITIAL_STATE, SimulationError, polish
 
@@ -300,7 +321,7 @@ def _polish(cost: CostFunction, space, found: dict, simulation, search) -> _Poli
     if simulation.initial_state == "estimate":
         names += list(INITIAL_STATE)
         theta0 += [z0, cost.v0]
-    problem = SimulationError(cost, _coordinates(cost, space, names))
+    problem = SimulationError(cost, _coordinates(cost, space, names, given))
     theta, residuals, unc, message = polish(
         problem, np.array(theta0), max_nfev=search.polish_maxfev
     )
@@ -315,8 +336,10 @@ def _polish(cost: CostFunction, space, found: dict, simulation, search) -> _Poli
     )
 
 
-def _coordinates(cost, space, names):
-    """Scales and bounds of the least-squares vector (the search box for model parameters)."""
+def _coordinates(cost, space, names, given=frozenset()):
+    """Scales and bounds of the least-squares vector: the search box for the model's
+    parameters and for the names in ``given`` (bounded by the user); none for the
+    offsets and k2 otherwise."""
     from randvib.identification.least_squares import Coordinates
 
     z_scale = float(np.std(cost.record.z))
@@ -333,8 +356,10 @@ def _coordinates(cost, space, names):
             is_log = space.log[space.free.index(name)]
             log.append(is_log)
             scale.append(max(abs(lo), abs(hi)) or 1.0)
-            # offsets and k2 are only searched in a box; the polish is free
-            bounded = name not in EXTRA_PARAMETERS
+            # the default boxes of the offsets and k2 only start the search (a
+            # cubic spring about a shifted origin needs an input offset beyond
+            # the input's mean +- half its SD); a box the user gave is kept
+            bounded = name not in EXTRA_PARAMETERS or name in given
             lower.append(lo if bounded else -np.inf)
             upper.append(hi if bounded else np.inf)
         else:
@@ -401,6 +426,23 @@ def _named_callback(callback, free):
     return named
 
 
+def _outside_search_box(parameters, space) -> tuple:
+    """Notes naming an offset or k2 the unbounded polish moved outside its search box
+    (the ``bounds`` reported for it are the global search's, not the polish's)."""
+    out = []
+    for name in EXTRA_PARAMETERS:
+        if name in space.free and name in parameters:
+            lo, hi = space.box[name]
+            value = parameters[name]
+            if not lo <= value <= hi:
+                out.append(
+                    f"{name} = {value:.6g}: outside its search box [{lo:.6g}, {hi:.6g}], which "
+                    "only starts the search; the least-squares polish leaves it unbounded "
+                    f"(`--bounds {name}=LO:HI` bounds both)"
+                )
+    return tuple(out)
+
+
 def _identification_result(cost, space, res, refined, elapsed, search, simulation, reported, notes):
     if not np.isfinite(res.fun):
         raise ValueError(
@@ -427,6 +469,7 @@ def _identification_result(cost, space, res, refined, elapsed, search, simulatio
         pred = score(checked, cost.model, cost.record, simulation)
         j, start = pred.cost, pred.initial_state
     order = ("m",) + MODEL_PARAMETERS[cost.model] + reported
+    notes = notes + _outside_search_box(parameters, space)
     seconds = cost.seconds
     return IdentificationResult(
         model=cost.model,

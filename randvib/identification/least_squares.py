@@ -23,8 +23,11 @@ and the noise variance estimated from the residuals,
 ``s^2 (J^T J)^-1`` (Gauss-Newton / asymptotic least-squares theory: exact to
 first order for white Gaussian output noise, the errors-in-the-output
 setting). Standard errors are its diagonal's roots, 95 % intervals
-``theta +- t_{0.975, N - d} se``. Noise on the input or process noise makes
-the residuals coloured; these intervals then understate the uncertainty.
+``theta +- t_{0.975, N - d} se``. When the residual is not white (Ljung-Box
+at 1 %) the covariance is the sandwich with the residual's fitted
+autoregressive covariance instead (:func:`covariance`), right for coloured
+output noise. Noise on the input makes the model wrong, not only the noise
+coloured: its estimates are biased, and no interval covers a bias.
 """
 
 from __future__ import annotations
@@ -39,6 +42,14 @@ from randvib.identification.record_integrator import SEARCH_SUBCYCLES, parameter
 INITIAL_STATE = ("z0", "v0")
 #: Relative central-difference step in the optimiser's scaled variables.
 JACOBIAN_STEP = 1e-5
+#: Relative central-difference step of the Jacobian the covariance is computed from.
+#: Larger than the polish's: a response with friction is not smooth in the
+#: parameters at the scale of 1e-5 (stick-slip and switching instants move by
+#: a sub-step), and differences that small made the standard errors of k and k3
+#: vary threefold between noise realisations of one record; at 1e-3 and 1e-2,
+#: the scale of the standard errors themselves, they agree within 10 %
+#: (measured on tests/calibration/hac_coverage.py's records).
+COVARIANCE_STEP = 1e-3
 
 
 @dataclass(frozen=True)
@@ -121,10 +132,10 @@ class SimulationError:
         # a diverged candidate: large finite residuals steer the polish back
         return np.where(np.isfinite(e), e, 1e3 * np.std(self.measured))
 
-    def jacobian_u(self, u) -> np.ndarray:
-        """de/du by central differences, all 2 d simulations in one batch."""
+    def jacobian_u(self, u, step: float = JACOBIAN_STEP) -> np.ndarray:
+        """de/du by central differences of relative ``step``, all 2 d simulations in one batch."""
         d = u.size
-        steps = JACOBIAN_STEP * np.maximum(1.0, np.abs(u))
+        steps = step * np.maximum(1.0, np.abs(u))
         lo, hi = self.coordinates.u_bounds()
         plus = np.minimum(u + steps, np.where(np.isfinite(hi), hi, np.inf))
         minus = np.maximum(u - steps, np.where(np.isfinite(lo), lo, -np.inf))
@@ -165,12 +176,15 @@ class Uncertainty:
     dof : int
         Residual degrees of freedom N - d.
     method : str
-        How the covariance was estimated: ``white`` (``s^2 (J^T J)^-1``, exact
-        to first order for white noise) or ``hac`` (the sandwich
-        ``(J^T J)^-1 S (J^T J)^-1`` with a Newey-West middle S, used when the
-        residual is not white; :func:`covariance`).
+        How the covariance was estimated (:func:`covariance`): ``white``
+        (``s^2 (J^T J)^-1``, exact to first order for white noise), ``ar``
+        (the sandwich with the residual's fitted autoregressive covariance,
+        used when the residual is not white) or ``hac`` (the sandwich with a
+        Newey-West middle, on request).
     bandwidth : int
-        The Newey-West bandwidth L in samples (0 for ``white``).
+        The Newey-West bandwidth L in samples (``hac``; 0 otherwise).
+    ar_order : int
+        The order p of the residual's autoregression (``ar``; 0 otherwise).
     """
 
     names: tuple
@@ -182,6 +196,7 @@ class Uncertainty:
     dof: int
     method: str = "white"
     bandwidth: int = 0
+    ar_order: int = 0
 
     def to_dict(self) -> dict:
         return {
@@ -198,15 +213,81 @@ class Uncertainty:
             "covariance": self.method,
             "covariance_description": COVARIANCE_METHODS[self.method],
             "bandwidth": int(self.bandwidth),
+            "ar_order": int(self.ar_order),
         }
+
+    @classmethod
+    def from_dict(cls, d: dict, estimate: dict) -> Uncertainty:
+        """The :class:`Uncertainty` that :meth:`to_dict` wrote, with the ``estimate`` values.
+
+        The intervals are recomputed from the estimates, standard errors and
+        degrees of freedom as :func:`uncertainty` computes them (``to_dict``'s
+        may have been cut at a search box by the result that saved them).
+        """
+        from scipy import stats
+
+        names = tuple(d["correlation"]["names"])
+        se = {k: float(d["standard_errors"][k]) for k in names}
+        values = {k: float(estimate[k]) for k in names}
+        t = float(stats.t.ppf(0.975, int(d["dof"])))
+        return cls(
+            names=names,
+            estimate=values,
+            standard_error=se,
+            interval={k: (values[k] - t * se[k], values[k] + t * se[k]) for k in names},
+            correlation=np.array(d["correlation"]["matrix"], dtype=float),
+            noise_std=float(d["noise_std"]),
+            dof=int(d["dof"]),
+            method=d.get("covariance", "white"),
+            bandwidth=int(d.get("bandwidth", 0)),
+            ar_order=int(d.get("ar_order", 0)),
+        )
 
 
 #: What each covariance estimate means (the report and the JSON say which was used).
 COVARIANCE_METHODS = {
     "white": "least squares, white residual assumed: s^2 (J^T J)^-1",
-    "hac": "sandwich with a Newey-West (Bartlett kernel) middle, the residual being "
-    "correlated (Ljung-Box rejects whiteness at 1 %); bandwidth by Andrews' AR(1) rule",
+    "ar": "sandwich (J^T J)^-1 J^T Sigma J (J^T J)^-1 with Sigma the covariance of an "
+    "autoregression fitted to the residual (Yule-Walker, order by BIC), the residual being "
+    "correlated (Ljung-Box rejects whiteness at 1 %)",
+    "hac": "sandwich with a Newey-West (Bartlett kernel) middle; bandwidth by Andrews' AR(1) rule",
 }
+#: Largest autoregressive order tried for the residual (``ar``), at most N / 10.
+MAX_AR_ORDER = 40
+
+
+def autoregression(residual, max_order: int = MAX_AR_ORDER) -> tuple[np.ndarray, float]:
+    """AR(p) model of ``residual``: ``e_i = sum_k a_k e_{i-k} + w_i``, w white.
+
+    Yule-Walker estimates (stable by construction) for p = 0..``max_order``
+    (at most N / 10), p chosen by the Bayesian information criterion
+    ``N log(sigma_p^2) + p log N``.
+
+    Returns
+    -------
+    a : ndarray, shape (p,)
+        a_1..a_p.
+    sigma2 : float
+        Variance of the innovation w (units of the residual, squared).
+    """
+    from scipy.linalg import solve_toeplitz
+
+    e = np.asarray(residual, dtype=float) - np.mean(residual)
+    n = e.shape[0]
+    top = int(max(0, min(max_order, n // 10)))
+    acov = np.array([e[k:] @ e[: n - k] / n for k in range(top + 1)])
+    best = (n * np.log(max(acov[0], 1e-300)), np.zeros(0), float(acov[0]))
+    if acov[0] <= 0:
+        return best[1], best[2]
+    for p in range(1, top + 1):
+        a = solve_toeplitz(acov[:p], acov[1 : p + 1])
+        sigma2 = float(acov[0] - a @ acov[1 : p + 1])
+        if sigma2 <= 0:
+            break
+        bic = n * np.log(sigma2) + p * np.log(n)
+        if bic < best[0]:
+            best = (bic, a, sigma2)
+    return best[1], best[2]
 
 
 def newey_west_bandwidth(residual) -> int:
@@ -227,27 +308,42 @@ def newey_west_bandwidth(residual) -> int:
 def covariance(jacobian, residuals, method: str = "auto") -> tuple[np.ndarray, str, int]:
     """Covariance of least-squares estimates (in the Jacobian's coordinates).
 
+    To first order the estimate errs by ``-(J^T J)^-1 J^T e`` (e the output
+    noise), so its covariance is the sandwich ``B J^T Sigma J B``,
+    ``B = (J^T J)^-1``, Sigma the noise's covariance matrix.
+
     Parameters
     ----------
     jacobian : ndarray, shape (N, d)
         d e / d u at the optimum.
     residuals : ndarray, shape (N,)
-    method : {'auto', 'white', 'hac'}
-        ``white``: ``s^2 (J^T J)^-1`` with ``s^2 = |e|^2 / (N - d)``.
-        ``hac``: ``(J^T J)^-1 S (J^T J)^-1`` with
+    method : {'auto', 'white', 'ar', 'hac'}
+        ``white``: ``Sigma = s^2 I``, ``s^2 = |e|^2 / (N - d)``.
+        ``ar``: Sigma of the autoregression fitted to the residual
+        (:func:`autoregression`, ``e = H w``, H the lower-triangular
+        convolution by the AR model's impulse response): ``J^T Sigma J =
+        sigma^2 (H^T J)^T (H^T J)``, H^T J being the columns of J filtered by
+        ``1 / A(q)`` backwards in time. Right to first order when the model
+        is right and the noise is (near) autoregressive; its one estimated
+        noise model makes it far less variable than a kernel estimate when
+        the correlation is long (a lightly damped response sampled fast).
+        ``hac``: ``(J^T J)^-1 S (J^T J)^-1`` with the Newey-West middle
         ``S = sum_{|l| <= L} (1 - |l| / (L + 1)) sum_i g_i g_{i-l}^T``,
         ``g_i = J_i e_i`` (Newey and West 1987), L from
-        :func:`newey_west_bandwidth`; consistent for a correlated residual.
-        ``auto``: ``hac`` when the Ljung-Box test rejects whiteness at 1 %
+        :func:`newey_west_bandwidth`.
+        ``auto``: ``ar`` when the Ljung-Box test rejects whiteness at 1 %
         (:func:`randvib.identification.residuals.ljung_box`), else ``white``.
 
     Returns
     -------
     cov : ndarray, shape (d, d)
     method : str
-        ``white`` or ``hac``.
-    bandwidth : int
+        ``white``, ``ar`` or ``hac``.
+    lag : int
+        The Newey-West bandwidth (``hac``) or the AR order (``ar``); 0 for ``white``.
     """
+    from scipy import signal
+
     from randvib.identification.residuals import LEVEL, ljung_box
 
     j = np.asarray(jacobian, dtype=float)
@@ -255,19 +351,25 @@ def covariance(jacobian, residuals, method: str = "auto") -> tuple[np.ndarray, s
     n, d = j.shape
     bread = np.linalg.pinv(j.T @ j)
     if method == "auto":
-        method = "hac" if ljung_box(e)[1] < LEVEL else "white"
+        method = "ar" if ljung_box(e)[1] < LEVEL else "white"
     if method == "white":
         return float(e @ e) / max(n - d, 1) * bread, "white", 0
+    # small-sample scaling N / (N - d), as s^2 has
+    scaling = n / max(n - d, 1)
+    if method == "ar":
+        a, sigma2 = autoregression(e)
+        filtered = signal.lfilter([1.0], np.r_[1.0, -a], j[::-1], axis=0)[::-1]
+        middle = sigma2 * scaling * (filtered.T @ filtered)
+        return bread @ middle @ bread, "ar", int(a.size)
     if method != "hac":
-        raise ValueError(f"`method` must be one of auto, white, hac; got {method!r}")
+        raise ValueError(f"`method` must be one of auto, white, ar, hac; got {method!r}")
     g = j * e[:, None]
     lag = newey_west_bandwidth(e)
     middle = g.T @ g
     for k in range(1, lag + 1):
         gamma = g[k:].T @ g[:-k]
         middle += (1 - k / (lag + 1)) * (gamma + gamma.T)
-    # small-sample scaling N / (N - d), as s^2 has
-    middle *= n / max(n - d, 1)
+    middle *= scaling
     return bread @ middle @ bread, "hac", lag
 
 
@@ -284,7 +386,7 @@ def uncertainty(problem: SimulationError, u, residuals, jacobian_u) -> Uncertain
     n, d = jacobian_u.shape
     dof = max(n - d, 1)
     s2 = float(residuals @ residuals) / dof
-    cov_u, method, bandwidth = covariance(jacobian_u, residuals)
+    cov_u, method, lag = covariance(jacobian_u, residuals)
     cov = cov_u * np.outer(dtheta_du, dtheta_du)
     se = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -303,7 +405,8 @@ def uncertainty(problem: SimulationError, u, residuals, jacobian_u) -> Uncertain
         noise_std=float(np.sqrt(s2)),
         dof=dof,
         method=method,
-        bandwidth=bandwidth,
+        bandwidth=lag if method == "hac" else 0,
+        ar_order=lag if method == "ar" else 0,
     )
 
 
@@ -326,5 +429,5 @@ def polish(problem: SimulationError, theta0, *, max_nfev=None):
         ftol=1e-12,
         gtol=1e-12,
     )
-    unc = uncertainty(problem, res.x, res.fun, problem.jacobian_u(res.x))
+    unc = uncertainty(problem, res.x, res.fun, problem.jacobian_u(res.x, COVARIANCE_STEP))
     return coords.to_theta(res.x), res.fun, unc, res.message

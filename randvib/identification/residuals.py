@@ -101,6 +101,24 @@ class ResidualDiagnostics:
             "samples": int(self.samples),
         }
 
+    @classmethod
+    def from_dict(cls, d: dict) -> ResidualDiagnostics:
+        """The diagnostics that :meth:`to_dict` wrote."""
+        m = int(d["max_lag"])
+        return cls(
+            lags=np.arange(m + 1),
+            autocorrelation=np.array(d["autocorrelation"], dtype=float),
+            cross_lags=np.arange(-m, m + 1),
+            cross_correlation=np.array(d["cross_correlation"], dtype=float),
+            auto_band=float(d["autocorrelation_band"]),
+            cross_band=float(d["cross_correlation_band"]),
+            ljung_box=float(d["ljung_box"]),
+            ljung_box_p=float(d["ljung_box_p"]),
+            cross_p=float(d["cross_correlation_p"]),
+            verdict=d["verdict"],
+            samples=int(d["samples"]),
+        )
+
 
 def ljung_box(residual, max_lag: int = MAX_LAG) -> tuple[float, float]:
     """Ljung-Box statistic of ``residual`` over lags 1..M and its chi-squared(M) p-value."""

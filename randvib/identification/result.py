@@ -199,6 +199,43 @@ class IdentificationResult:
             ),
         }
 
+    @classmethod
+    def from_dict(cls, d: dict) -> IdentificationResult:
+        """The result that :meth:`to_dict` wrote (a fit saved as JSON), uncertainty included.
+
+        The standard errors, correlations, covariance method and residual
+        diagnostics come back as saved; the intervals are recomputed from
+        them (:meth:`Uncertainty.from_dict
+        <randvib.identification.least_squares.Uncertainty.from_dict>`). The
+        per-generation history is not saved and comes back empty.
+        """
+        from randvib.identification.least_squares import Uncertainty
+
+        initial_state = dict(d.get("initial_state", {}))
+        uncertainty = None
+        if "standard_errors" in d:
+            uncertainty = Uncertainty.from_dict(d, {**initial_state, **d["parameters"]})
+        residuals = d.get("residuals")
+        return cls(
+            model=d["model"],
+            parameters=d["parameters"],
+            free=tuple(d["free"]),
+            cost=d["cost"],
+            bounds={k: tuple(v) for k, v in d["bounds"].items()},
+            nfev=d["simulations"],
+            generations=d["generations"],
+            elapsed=d["elapsed_s"],
+            simulations_per_second=d["simulations_per_second"],
+            message=d["message"],
+            record=d["record"],
+            settings=d["settings"],
+            uncertainty=uncertainty,
+            initial_state=initial_state,
+            notes=tuple(d.get("notes", ())),
+            input_kind=d.get("input_kind", ""),
+            residuals=None if residuals is None else ResidualDiagnostics.from_dict(residuals),
+        )
+
     def to_frame(self):
         """The parameters as a :class:`pandas.DataFrame`, one row per parameter.
 

@@ -123,24 +123,10 @@ def write_records(records: dict, folder: Path) -> None:
 
 
 def load_fit(path: Path) -> IdentificationResult:
-    """An :class:`~randvib.IdentificationResult` saved as its ``to_dict()`` JSON."""
-    d = json.loads(Path(path).read_text())
-    return IdentificationResult(
-        model=d["model"],
-        parameters=d["parameters"],
-        free=tuple(d["free"]),
-        cost=d["cost"],
-        bounds={k: tuple(v) for k, v in d["bounds"].items()},
-        nfev=d["simulations"],
-        generations=d["generations"],
-        elapsed=d["elapsed_s"],
-        simulations_per_second=d["simulations_per_second"],
-        message=d["message"],
-        record=d["record"],
-        settings=d["settings"],
-        initial_state=d.get("initial_state", {}),
-        notes=tuple(d.get("notes", ())),
-    )
+    """An :class:`~randvib.IdentificationResult` saved as its ``to_dict()`` JSON
+    (:meth:`~randvib.IdentificationResult.from_dict`: standard errors, intervals,
+    residual diagnostics and the input's kind included)."""
+    return IdentificationResult.from_dict(json.loads(Path(path).read_text()))
 
 
 def identify_cached(path: Path, record: Record, model: str, **kwargs) -> IdentificationResult:

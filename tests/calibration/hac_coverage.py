@@ -49,16 +49,21 @@ def main(n):
     truth = {**T.TRUTH, **T.OFFSETS}
     for case in CASES:
         hits = {name: 0 for name in truth}
-        methods = []
+        methods, verdicts = [], []
         for seed in range(n):
             rig = T.shaker_record(seed=seed)
             res = identify(noisy(rig, case, seed), "coulomb", m=T.M, progress=False, seed=seed)
             methods.append(res.uncertainty.method)
+            verdicts.append(res.residuals.verdict)
+            intervals = res.confidence_intervals
+            if res.at_bound:
+                print(f"  seed {seed}: {res.at_bound} on a search bound (no interval: a miss)")
             for name, value in truth.items():
-                lo, hi = res.confidence_intervals[name]
+                lo, hi = intervals.get(name, (np.nan, np.nan))
                 hits[name] += lo <= value <= hi
         used = {m: methods.count(m) for m in sorted(set(methods))}
-        print(f"{case}: {n} seeds, covariance used: {used}")
+        said = {v: verdicts.count(v) for v in sorted(set(verdicts))}
+        print(f"{case}: {n} seeds, covariance used: {used}, residual verdicts: {said}")
         for name, k in hits.items():
             ci = stats.binomtest(k, n).proportion_ci(0.95)
             print(f"  {name:>13}: {k}/{n} = {k / n:.2f} [{ci.low:.2f}, {ci.high:.2f}]")
