@@ -34,6 +34,7 @@ from randvib.analytic.linearisation import linear_displacement_variance
 from randvib.analytic.statistical_linearisation import linearise
 from randvib.models.excitation import Excitation, Tabulated, as_excitation
 from randvib.models.harvester import Harvester
+from randvib.models.state_space import StateSpace
 from randvib.montecarlo import integrators
 
 #: Largest stationary-variance bias (relative) of the scheme on the linearised
@@ -64,6 +65,10 @@ def effective_linear_device(harvester: Harvester, psd: float) -> tuple[float, fl
     h = harvester
     if h.friction is not None and not h.friction.has_equivalent_damping:
         h = h.updated(friction=None)
+    if h.potential.is_free and h.has_circuit:
+        # statistical linearisation needs a stationary z; the free mass's
+        # velocity and circuit state are stationary without one
+        return 0.0, _free_mass_velocity(h, as_excitation(psd))[0]
     lin = linearise(h, psd)
     if h.has_circuit:
         return lin.k_eq, lin.c_eq
@@ -288,12 +293,58 @@ def _linearised_under(harvester: Harvester, excitation: Excitation) -> tuple:
     """
     h = harvester
     excitation = coarsened(excitation)
+    if h.potential.is_free:
+        # no stationary z (paths start at z = 0); the velocity's is the free mass's own
+        c_eq, v2 = _free_mass_velocity(h, excitation)
+        return 0.0, c_eq, 0.0, v2
     if h.friction is None or h.friction.has_equivalent_damping:
         res = linearise(h, excitation)
         return res.k_eq, res.c_eq, res.displacement_variance, res.velocity_variance
     block = device_block(float(h.m), float(h.c), float(h.k), h.electrical)
     var = output_variances(block, excitation)
     return float(h.k), float(h.c), var["z"], var["v"]
+
+
+def _free_mass_velocity(harvester: Harvester, excitation: Excitation) -> tuple[float, float]:
+    """(c_eq, E[v^2]) of the free mass (k = k3 = 0) linearised under any excitation.
+
+    Without a spring z feeds back into nothing, so the velocity (and the
+    circuit state) form a stationary linear system on their own: the device
+    block without its z state, with c_eq = c + the friction law's equivalent
+    damping increment at the Gaussian velocity's spread (paper Eq. 19; a
+    friction law with memory, LuGre, is left out: it only adds damping). The
+    fixed point in log E[v^2] is a contraction (E[v^2] grows at most like
+    sqrt(E[v^2]) through the Coulomb increment), so plain iteration converges.
+    """
+    h = harvester
+    friction = h.friction
+    if friction is not None and (not friction.has_equivalent_damping or friction.vanishes):
+        friction = None
+    m, c = float(h.m), float(h.c)
+
+    def velocity_variance(c_eq):
+        full = device_block(m, c_eq, 0.0, h.electrical)
+        keep = list(range(1, full.n_states))  # drop z
+        block = StateSpace(
+            full.a[np.ix_(keep, keep)],
+            full.b[keep],
+            full.c[np.ix_(keep, keep)],
+            full.d[keep],
+            full.outputs[1:],
+        )
+        return output_variances(block, excitation)["v"]
+
+    if friction is None:
+        return c, velocity_variance(c)
+    # start from the friction-free device, or from the friction alone at unit spread
+    c_eq = c if c > 0 else float(friction.equivalent_damping_increment(1.0))
+    for _ in range(200):
+        v2 = velocity_variance(c_eq)
+        updated = c + float(friction.equivalent_damping_increment(np.sqrt(v2)))
+        if abs(updated / c_eq - 1.0) < 1e-12:
+            break
+        c_eq = updated
+    return c_eq, velocity_variance(c_eq)
 
 
 def _scheme_bias(scheme, m, k_eff, c_eff, psd, dt) -> float:
