@@ -35,8 +35,8 @@ from randvib.analytic.exact_solutions import (
 )
 from randvib.analytic.fokker_planck import fast_fpk_moments, fpk_moments, solve_fpk
 from randvib.analytic.linear_response import device_block, output_variances
-from randvib.models.state_space import StateSpace
 from randvib.models.potential import Potential
+from randvib.models.state_space import StateSpace
 from randvib.montecarlo.step_check import largest_step, step_bias
 
 M, C, S = 0.0226, 0.2, 0.5  # kg, Ns/m (c_m = c_e = 0.1), (m/s^2)^2/Hz
