@@ -21,7 +21,7 @@ import time
 exe, top, step, reps = sys.argv[1], float(sys.argv[2]), float(sys.argv[3]), int(sys.argv[4])
 counts = collections.Counter()
 where = collections.defaultdict(list)
-for rep in range(reps):
+for _rep in range(reps):
     off = 0.0
     while off <= top + 1e-9:
         p = subprocess.Popen(
@@ -36,8 +36,8 @@ for rep in range(reps):
         _, err = p.communicate()
         err = err.decode(errors="replace")
         if "Traceback" in err or "Exception ignored" in err:
-            frames = [l for l in err.splitlines() if l.strip().startswith("File ")]
-            ours = any("/randvib/" in l and "__editable__" not in l for l in frames)
+            frames = [line for line in err.splitlines() if line.strip().startswith("File ")]
+            ours = any("/randvib/" in f and "__editable__" not in f for f in frames)
             kind = (
                 "traceback in randvib code"
                 if ours
