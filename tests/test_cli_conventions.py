@@ -395,3 +395,12 @@ def test_degenerate_values_name_the_option_the_user_gave(capsys, tmp_path):
     assert code == 0, err
     for rows in ("10:2", "1000:", "-1:5"):
         one_line_error(capsys, fit_args(out, "--rows", rows), f"`--rows` = {rows} selects none")
+
+
+def test_refused_sweep_point_is_one_line_without_another_points_advice(capsys):
+    """Advice about a finished point is held until the sweep is done, dropped if it is refused."""
+    base = ["power", "--preset", "coulomb-td1", "--c-m", 5e-4, "--c-e", 5e-4, "--psd", 5e-3]
+    # fc = 5.8 mN: friction takes 99.9 % of the dissipation (advice); fc = 5e299 N: refused
+    one_line_error(capsys, [*base, "--fc", "0.0058:1e300:3"], "fc = 5e+299 is beyond the range")
+    code, out, err = run(capsys, *base, "--fc", "0.0058:0.006:2")
+    assert code == 0 and err.count("warning: friction takes") == 1, err
