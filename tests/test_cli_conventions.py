@@ -36,7 +36,7 @@ from randvib.formatting import estimate_parts as format_estimate
 from randvib.formatting import with_standard_error
 from randvib.models.excitation import BandLimited
 from randvib.montecarlo.ensembles import GROUP_SEEDS
-from tests._cli import one_line_error, run
+from tests._cli import fit_args, one_line_error, run
 
 ROOT = Path(__file__).resolve().parents[1]
 FIG9 = rv.preset("figure9")
@@ -382,3 +382,25 @@ def test_identify_table_shows_the_digits_the_standard_error_supports():
     # a noise-free fit: eight significant digits, the tiny error in exponent form
     assert with_standard_error(0.0490000000112, 2.09e-12, None) == ["0.049000000", "2.1e-12", ""]
     assert with_standard_error(0.0226, None, None) == ["0.0226", "", ""]  # a fixed parameter
+
+
+def test_degenerate_values_name_the_option_the_user_gave(capsys, tmp_path):
+    """`record --psd 0` names `--psd` (not the band's `level`); an empty `--rows` range names it."""
+    out = tmp_path / "r.csv"
+    one_line_error(capsys, ["record", "--preset", "coulomb-td1", "--psd", "0", "--out", out],
+                   "`--psd` must be > 0")  # fmt: skip
+    assert not out.exists()
+    code, _, err = run(capsys, "record", "--preset", "coulomb-td1", "--psd", 1, "--duration", 1,
+                       "--out", out)  # fmt: skip
+    assert code == 0, err
+    for rows in ("10:2", "1000:", "-1:5"):
+        one_line_error(capsys, fit_args(out, "--rows", rows), f"`--rows` = {rows} selects none")
+
+
+def test_refused_sweep_point_is_one_line_without_another_points_advice(capsys):
+    """Advice about a finished point is held until the sweep is done, dropped if it is refused."""
+    base = ["power", "--preset", "coulomb-td1", "--c-m", 5e-4, "--c-e", 5e-4, "--psd", 5e-3]
+    # fc = 5.8 mN: friction takes 99.9 % of the dissipation (advice); fc = 5e299 N: refused
+    one_line_error(capsys, [*base, "--fc", "0.0058:1e300:3"], "fc = 5e+299 is beyond the range")
+    code, out, err = run(capsys, *base, "--fc", "0.0058:0.006:2")
+    assert code == 0 and err.count("warning: friction takes") == 1, err

@@ -332,6 +332,33 @@ def test_interrupt_while_the_command_line_starts_prints_no_traceback(how, code):
         assert "Traceback" not in err and len(error_lines(err)) == 1, (delay, err)
 
 
+@pytest.mark.parametrize("how, code", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_interrupt_during_the_entry_points_first_import_prints_one_line(how, code):
+    # The signal is sent from inside the import of randvib._interrupts (a meta-path
+    # hook), the first import of randvib.__main__: the handler must already be in
+    # place, installed by __main__'s first statements through the C module _signal.
+    start = textwrap.dedent(f"""
+        import os, runpy, sys
+        class Kick:
+            def find_spec(self, name, path=None, target=None):
+                if name == "randvib._interrupts":
+                    os.kill(os.getpid(), {int(how)})
+                return None
+        sys.meta_path.insert(0, Kick())
+        sys.argv = ["randvib", "power", "--preset", "figure9", "--psd", "1"]
+        runpy.run_module("randvib", run_name="__main__", alter_sys=True)
+    """)
+    child = subprocess.run(
+        [sys.executable, "-c", start],
+        capture_output=True,
+        text=True,
+        env=_subprocess_env(),
+        timeout=60,
+    )
+    assert child.returncode == code, child.stderr
+    assert "Traceback" not in child.stderr and len(error_lines(child.stderr)) == 1, child.stderr
+
+
 def test_interrupt_swallowed_by_a_finaliser_still_ends_non_zero(capsys, monkeypatch):
     # Ctrl-C raised inside a finaliser is "ignored" by Python and the command goes on to
     # finish: the user asked it to stop, so the status must still say it was stopped.

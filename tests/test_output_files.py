@@ -334,3 +334,32 @@ def test_long_power_sweep_says_how_long_first(capsys, tmp_path, monkeypatch):
     monkeypatch.setattr(_resources, "clock", lambda: next(ticks))
     code, out, err = run(capsys, "power", "--preset", "figure9", "--psd", "0.1:1:10")
     assert code == 0 and "this sweep of 10 points will take about 15 minutes" in err
+
+
+# ------------------------------------------------- exit status 1: computed, not saved where asked
+def _figures_fail(monkeypatch):
+    import errno
+
+    def full_disk(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr("randvib.identification.plots.figure_fit", full_disk)
+
+
+@pytest.mark.parametrize("command", ["identify", "validate"])
+def test_figure_not_written_prints_the_result_and_exits_1(
+    capsys, tmp_path, monkeypatch, record_csv, command
+):
+    """As for --save, --csv and --out: a result computed but not saved where asked exits 1."""
+    rec, params = record_csv
+    _figures_fail(monkeypatch)
+    plot = tmp_path / "fig.png"
+    if command == "identify":
+        argv = fit_args(rec, "--plot", plot)
+    else:
+        argv = ["validate", params, rec, "--plot", plot]
+    code, out, err = run(capsys, *argv)
+    assert code == 1, err
+    assert "J" in out or "cost" in out  # the result is printed
+    assert f"could not write `--plot` {str(plot)!r}" in err and len(err.strip().splitlines()) == 1
+    assert not plot.exists() and "wrote" not in out

@@ -189,6 +189,40 @@ def _advice_warnings() -> tuple:
     )
 
 
+@contextlib.contextmanager
+def advice_when_done():
+    """Hold randvib's advice warnings until the block ends; drop them if it fails.
+
+    For commands that compute several results and print them at the end (a
+    `power` sweep): advice about one point must not precede the refusal of
+    another, which ends the command with one line. Other warnings (a long
+    run's notice) are shown at once; after an interrupt the held advice is
+    shown, as the finished results are kept.
+    """
+    shown = warnings.showwarning
+    advice = _advice_warnings()
+    held = []
+
+    def hold(message, category, *rest, **kwargs):
+        if issubclass(category, advice):
+            held.append((message, category, *rest))
+        else:
+            shown(message, category, *rest, **kwargs)
+
+    warnings.showwarning = hold
+    try:
+        yield
+    except KeyboardInterrupt:
+        warnings.showwarning = shown
+        for item in held:
+            shown(*item)
+        raise
+    finally:
+        warnings.showwarning = shown
+    for item in held:
+        shown(*item)
+
+
 def _show_warning(message, category, filename, lineno, file=None, line=None):
     """A warning as one readable line (no kind, source file or code line)."""
     text = cli_wording(str(message).strip().splitlines()[0] if str(message).strip() else "")

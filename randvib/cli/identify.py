@@ -100,8 +100,11 @@ def _new_file(path, option, overwrite=False):
     return None if path is None else claim_output_file(path, option, overwrite=overwrite)
 
 
-def _save_plot(result, record, plot: Path, title: str, units: dict, json: bool = False) -> None:
-    """The figure; if it cannot be written now, say so and keep going (the result is printed)."""
+def _save_plot(result, record, plot: Path, title: str, units: dict, json: bool = False) -> bool:
+    """The figure; if it cannot be written now, say so and keep going (the result is printed).
+
+    Returns whether the figure was written where asked (the exit status is 1 if not).
+    """
     from randvib.identification.plots import figure_fit
 
     try:
@@ -115,8 +118,9 @@ def _save_plot(result, record, plot: Path, title: str, units: dict, json: bool =
         )
     except OSError as exc:
         print(f"randvib: could not write `--plot` {str(plot)!r} ({exc})", file=sys.stderr)
-        return
+        return False
     print(f"wrote {plot}", file=sys.stderr if json else sys.stdout)
+    return True
 
 
 def run(args) -> int:
@@ -149,15 +153,15 @@ def run(args) -> int:
         and write_or_keep(save, dumps(out, indent=2), "--save", overwrite=args.force) != save
     ):
         status = 1
-    if plot is not None:
-        _save_plot(
-            result,
-            record,
-            plot,
-            f"{args.model} model on {record.name}",
-            plot_units(args),
-            args.json,
-        )
+    if plot is not None and not _save_plot(
+        result,
+        record,
+        plot,
+        f"{args.model} model on {record.name}",
+        plot_units(args),
+        args.json,
+    ):
+        status = 1
     if args.json:
         print(dumps(out))
         return status

@@ -42,6 +42,7 @@ from randvib._io import claim_output_file, dumps, write_or_keep
 from randvib._resources import announce_duration, timed
 from randvib.analytic.bridge import optimal_dc_output
 from randvib.analytic.prediction import METHODS, optimal_load_resistance, predict
+from randvib.cli import advice_when_done
 from randvib.cli._device import add_device_arguments, harvester_from_args, option_flag
 from randvib.cli._event import add_event_arguments, power_event, wants_event
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
@@ -203,7 +204,8 @@ def run(args) -> int:
     swept, points = _sweep(args)
     if wants_event(args):
         return power_event(args, swept, points)
-    results = _points(points, csv_file, args.force)
+    with advice_when_done():  # a refused point leaves one line, not another point's advice
+        results = _points(points, csv_file, args.force)
     saved = None
     if csv_file is not None:
         saved = _write_csv(csv_file, [out for out, _, _ in results], args.force)

@@ -15,7 +15,7 @@ from pathlib import Path
 
 from randvib._io import claim_output_file, dumps, write_or_keep
 from randvib._resources import check_memory
-from randvib._validation import MAX_SEED, check_int, integer_option
+from randvib._validation import MAX_SEED, check_int, check_positive, integer_option
 from randvib.cli._device import add_device_arguments, harvester_from_args
 from randvib.identification.synthetic import PAPER_BAND, SYNTHETIC_INPUTS, synthetic_record
 from randvib.models.excitation import BandLimited
@@ -73,6 +73,8 @@ def run(args) -> int:
     if math.isfinite(samples):
         # the excitation, its spectrum, the response and the CSV text, about 12 floats a sample
         check_memory(f"a record of {samples:.3g} samples", 96.0 * samples, "shorten `--duration`")
+    if args.psd is not None:  # named as the option, not as the band's `level`
+        check_positive("--psd", args.psd, "(m/s^2)^2/Hz")
     excitation = args.rms if args.psd is None else BandLimited(args.psd, args.f_lo, args.f_hi)
     device = harvester_from_args(args)
     record = synthetic_record(

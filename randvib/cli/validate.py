@@ -136,6 +136,7 @@ def run(args) -> int:
     rows = validate(
         harvester, records, measurement=measurement, offsets=args.offsets, simulation=settings
     )
+    status = 0  # 1: the figures could not be written where asked (the table is printed)
     if plot_dir is not None or plot_file is not None:
         from randvib.identification.plots import figure_fit
         from randvib.identification.prediction import predict_record
@@ -148,20 +149,26 @@ def run(args) -> int:
             path = plot_file or plot_dir / f"{i:02d}_{record.name}.png"
             skip = settings.skip
             diagnostics = residual_diagnostics(record.z[skip:] - pred.z[skip:], record.input[skip:])
-            figure_fit(
-                pred,
-                path,
-                title=f"{model} model on {record.name}",
-                validation=True,
-                diagnostics=diagnostics,
-                **plot_units(args),
+            try:
+                figure_fit(
+                    pred,
+                    path,
+                    title=f"{model} model on {record.name}",
+                    validation=True,
+                    diagnostics=diagnostics,
+                    **plot_units(args),
+                )
+            except OSError as exc:  # the table below is the result: print it, exit 1
+                print(f"randvib: could not write `--plot` {str(path)!r} ({exc})", file=sys.stderr)
+                status = 1
+                break
+        if status == 0:
+            print(
+                f"wrote {plot_file}"
+                if plot_file
+                else f"wrote {len(records)} figure(s) into {plot_dir}",
+                file=sys.stderr if args.json else sys.stdout,
             )
-        print(
-            f"wrote {plot_file}"
-            if plot_file
-            else f"wrote {len(records)} figure(s) into {plot_dir}",
-            file=sys.stderr if args.json else sys.stdout,
-        )
     if args.json:
         print(
             dumps(
@@ -182,11 +189,11 @@ def run(args) -> int:
                 }
             )
         )
-        return 0
+        return status
     print(f"model {model}")
     print_table(
         [[r.record, r.samples, r.cost, r.rms_error] for r in rows],
         ["record", "samples", "J", "RMS error"],
     )
     print(f"note: {OFFSETS_NOTE[args.offsets]}")
-    return 0
+    return status

@@ -455,7 +455,14 @@ def read_record(
             f"columns are {_shown(columns)}; map another name with `output_column`"
         )
     if rows is not None:
+        n_rows = len(frame)
         frame = frame.iloc[slice(*rows)]
+        if len(frame) == 0:
+            start, stop = ("" if r is None else r for r in rows)
+            raise ValueError(
+                f"`rows` = {start}:{stop} selects none of the {n_rows} data rows of "
+                f"{path.name}; give START:STOP with 0 <= START < STOP (0-based, STOP excluded)"
+            )
     channels = {input_kind: frame[input_column]}
     if output_column is not None:
         channels[OUTPUT_CHANNEL] = frame[output_column]

@@ -17,14 +17,13 @@ import numpy as np
 from scipy import linalg
 
 from randvib.analytic import exact_solutions as exact
-from randvib.analytic.statistical_linearisation import statistical_linearisation
 from randvib.models.excitation import Excitation
 from randvib.models.friction import kernel_arguments
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import kernel
 from randvib.montecarlo.bridge_step import storage_start
 from randvib.montecarlo.rng import ZIG_FI, ZIG_KI, ZIG_WI
-from randvib.montecarlo.step_check import coarsened
+from randvib.montecarlo.step_check import driven_circuit_variance
 from randvib.montecarlo.validation import Run
 
 
@@ -157,14 +156,11 @@ def _rectifier(run: Run) -> kernel.Rectifier | None:
 def _driven_circuit_variance(harvester: Harvester, excitation: Excitation) -> float:
     """E[x^2] of the circuit state under synthesised or recorded input, for the random start.
 
-    Statistical linearisation under the (coarsened) spectrum; a friction law
-    with memory is left out (it only adds damping, and the burn-in corrects
-    the start).
+    The linear device of the step check under the (coarsened) spectrum
+    (:func:`randvib.montecarlo.step_check.driven_circuit_variance`); the
+    burn-in corrects the start.
     """
-    h = harvester
-    if h.friction is not None and not h.friction.has_equivalent_damping:
-        h = h.updated(friction=None)
-    return float(statistical_linearisation(h, coarsened(excitation)).circuit_variance)
+    return driven_circuit_variance(harvester, excitation)
 
 
 def _start_states(run: Run, linear) -> tuple[kernel.Start, kernel.Companion]:

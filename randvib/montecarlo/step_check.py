@@ -34,6 +34,7 @@ from randvib.analytic.linearisation import linear_displacement_variance
 from randvib.analytic.statistical_linearisation import linearise
 from randvib.models.excitation import Excitation, Tabulated, as_excitation
 from randvib.models.harvester import Harvester
+from randvib.models.state_space import StateSpace
 from randvib.montecarlo import integrators
 
 #: Largest stationary-variance bias (relative) of the scheme on the linearised
@@ -64,6 +65,10 @@ def effective_linear_device(harvester: Harvester, psd: float) -> tuple[float, fl
     h = harvester
     if h.friction is not None and not h.friction.has_equivalent_damping:
         h = h.updated(friction=None)
+    if h.potential.is_free and h.has_circuit:
+        # statistical linearisation needs a stationary z; the free mass's
+        # velocity and circuit state are stationary without one
+        return 0.0, _free_mass_velocity(h, as_excitation(psd))[0]
     lin = linearise(h, psd)
     if h.has_circuit:
         return lin.k_eq, lin.c_eq
@@ -288,12 +293,119 @@ def _linearised_under(harvester: Harvester, excitation: Excitation) -> tuple:
     """
     h = harvester
     excitation = coarsened(excitation)
+    if h.potential.is_free:
+        # no stationary z (paths start at z = 0); the velocity's is the free mass's own
+        c_eq, v2 = _free_mass_velocity(h, excitation)
+        return 0.0, c_eq, 0.0, v2
     if h.friction is None or h.friction.has_equivalent_damping:
-        res = linearise(h, excitation)
+        try:
+            res = linearise(h, excitation)
+        except ValueError:
+            # a double well whose response has no zero-mean Gaussian fixed point
+            # (or several): the simulation needs none, only a step and a start
+            if h.k > 0 or not h.c > 0:
+                raise
+            return _gibbs_linearised_under(h, excitation)
         return res.k_eq, res.c_eq, res.displacement_variance, res.velocity_variance
+    if h.k <= 0 and h.c > 0:  # no stable viscous linear device: the spring's Gibbs stiffness
+        return _gibbs_linearised_under(h, excitation)
     block = device_block(float(h.m), float(h.c), float(h.k), h.electrical)
     var = output_variances(block, excitation)
     return float(h.k), float(h.c), var["z"], var["v"]
+
+
+def driven_circuit_variance(harvester: Harvester, excitation: Excitation) -> float:
+    """E[x^2] of the circuit state under synthesised or recorded input (V^2 or A^2).
+
+    The linear device (k_eff, c_eff) of :func:`_linearised_under` with its
+    circuit, under the coarsened spectrum: statistical linearisation's circuit
+    variance where its fixed point exists, the Gibbs-stiffness device for a
+    double well where it does not, the (v, circuit) block for the free mass.
+    A friction law with memory is left out (it only adds damping). Used for
+    the random start, which the burn-in corrects.
+    """
+    h = harvester
+    if h.friction is not None and not h.friction.has_equivalent_damping:
+        h = h.updated(friction=None)
+    k_eff, c_eff, _, _ = _linearised_under(h, excitation)
+    block = device_block(float(h.m), c_eff, k_eff, h.electrical)
+    if h.potential.is_free:
+        block = _without_z(block)
+    return output_variances(block, coarsened(excitation))[h.electrical.state_name]
+
+
+def _without_z(block: StateSpace) -> StateSpace:
+    """The block without its z state (the first): the free mass's stationary part."""
+    keep = list(range(1, block.n_states))
+    return StateSpace(
+        block.a[np.ix_(keep, keep)],
+        block.b[keep],
+        block.c[np.ix_(keep, keep)],
+        block.d[keep],
+        block.outputs[1:],
+    )
+
+
+def _gibbs_linearised_under(harvester: Harvester, excitation: Excitation) -> tuple:
+    """(k_eff, c_eff, E[z^2], E[v^2]) without statistical linearisation, for a soft spring (k <= 0).
+
+    The stiffness is k + 3 k3 E[z^2] with E[z^2] of the exact friction-free
+    (Gibbs) density at a white level equal to the spectrum's peak height: white
+    noise at that level carries at least the input's power at every frequency,
+    and friction only shrinks the motion, so the stiffness is an upper bound
+    in the mean and the step it admits is conservative. E[z^2] is that Gibbs
+    moment (it sees both wells, so it sizes the start and the histograms);
+    E[v^2] is the linear device's (k_eff, c) under the input; c_eff adds the
+    memoryless friction law's equivalent damping at that spread (Eq. 19).
+    """
+    h = harvester
+    lo, hi = excitation.support
+    grid = np.unique(np.concatenate([excitation.breakpoints(), np.linspace(lo, hi, 4097)]))
+    grid = grid[np.isfinite(grid) & (grid >= lo) & (grid <= hi)]
+    peak = float(np.max(excitation.psd(grid)))
+    m, c, k, k3 = (float(x) for x in (h.m, h.c, h.k, h.k3))
+    z2 = exact.gibbs_displacement_moment(m, c, k, k3, peak)
+    k_eff = k + 3.0 * k3 * z2
+    v2 = output_variances(device_block(m, c, k_eff, h.electrical), excitation)["v"]
+    c_eff = c
+    if h.friction is not None and h.friction.has_equivalent_damping and not h.friction.vanishes:
+        c_eff += float(h.friction.equivalent_damping_increment(np.sqrt(v2)))
+    return k_eff, c_eff, z2, v2
+
+
+def _free_mass_velocity(harvester: Harvester, excitation: Excitation) -> tuple[float, float]:
+    """(c_eq, E[v^2]) of the free mass (k = k3 = 0) linearised under any excitation.
+
+    Without a spring z feeds back into nothing, so the velocity (and the
+    circuit state) form a stationary linear system on their own: the device
+    block without its z state, with c_eq = c + the friction law's equivalent
+    damping increment at the Gaussian velocity's spread (paper Eq. 19; a
+    friction law with memory, LuGre, is left out: it only adds damping). The
+    fixed point in log E[v^2] is a contraction (E[v^2] grows at most like
+    sqrt(E[v^2]) through the Coulomb increment), so plain iteration converges.
+    """
+    h = harvester
+    friction = h.friction
+    if friction is not None and (not friction.has_equivalent_damping or friction.vanishes):
+        friction = None
+    m, c = float(h.m), float(h.c)
+
+    def velocity_variance(c_eq):
+        return output_variances(_without_z(device_block(m, c_eq, 0.0, h.electrical)), excitation)[
+            "v"
+        ]
+
+    if friction is None:
+        return c, velocity_variance(c)
+    # start from the friction-free device, or from the friction alone at unit spread
+    c_eq = c if c > 0 else float(friction.equivalent_damping_increment(1.0))
+    for _ in range(200):
+        v2 = velocity_variance(c_eq)
+        updated = c + float(friction.equivalent_damping_increment(np.sqrt(v2)))
+        if abs(updated / c_eq - 1.0) < 1e-12:
+            break
+        c_eq = updated
+    return c_eq, velocity_variance(c_eq)
 
 
 def _scheme_bias(scheme, m, k_eff, c_eff, psd, dt) -> float:
