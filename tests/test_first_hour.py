@@ -276,3 +276,32 @@ def test_probabilities_are_shown_with_unit_one():
                  "stroke_reached_vanmarcke"):  # fmt: skip
         assert unit(name) == "1"
         assert not report_header(name).endswith("(1)")
+
+
+def test_design_table_gives_every_number_its_unit(capsys):
+    """randvib design's table: the varied parameters in their own units (a coupling's
+    alpha from its class), probabilities and ratios in 1, powers in W; and the Python
+    result's rows (randvib.harvester_design.result) the same."""
+    code, out, err = run_cli(
+        capsys, "design", "--preset", "coulomb-td1", "--psd", "0.5", "--stroke", "0.01",
+        "--alpha", "0.2", "--r-load", "1", "--r-coil", "0.48", "--vary", "k=20:200",
+        "--vary", "alpha=0.05:0.5", "--exceedance", "0.01", "--no-monte-carlo",
+        "--no-progress",
+    )  # fmt: skip
+    assert code == 0, err
+    units = {}
+    for line in out.splitlines():
+        for name in ("optimum k", "optimum alpha", "power_predicted",
+                     "stroke_exceedance_predicted", "input_power", "efficiency"):  # fmt: skip
+            if line.startswith(name + " "):
+                units[name] = line.split()[-1]
+    assert units == {
+        "optimum k": "N/m", "optimum alpha": "Wb/m", "power_predicted": "W",
+        "stroke_exceedance_predicted": "1", "input_power": "W", "efficiency": "1",
+    }  # fmt: skip
+    h = rv.Harvester.from_electrical(
+        m=0.0226, c_m=0.049, k=57.4, alpha=0.2, r_load=1.0, r_coil=0.48, k3=7e4, stroke=0.01
+    )
+    result = rv.design(h, 0.5, {"alpha": (0.05, 0.5)}, exceedance=0.01, monte_carlo=False)
+    rows = {name: u for name, _, u in result._rows()}
+    assert rows["alpha"] == "Wb/m" and rows["power_predicted"] == "W"
