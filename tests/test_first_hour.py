@@ -8,8 +8,9 @@ frames of :mod:`randvib.analytic.power_prediction`, broadcasting in
 bistable devices by their wells (:mod:`randvib.models.potential`,
 :mod:`randvib.models.harvester`), and the CLI's options and refusals
 (:mod:`randvib.cli.power`, :mod:`randvib.cli._device`, :mod:`randvib.cli._excitation`,
-:mod:`randvib.cli._output`, :mod:`randvib.cli.validate`); the printed table of
-:mod:`randvib.identification.result`.
+:mod:`randvib.cli._output`, :mod:`randvib.cli.validate`, :mod:`randvib.cli.design`); the
+printed tables of :mod:`randvib.identification.result` and
+:mod:`randvib.harvester_design.result`, with units from :mod:`randvib.quantities`.
 """
 
 import warnings
@@ -281,7 +282,7 @@ def test_probabilities_are_shown_with_unit_one():
 def test_design_table_gives_every_number_its_unit(capsys):
     """randvib design's table: the varied parameters in their own units (a coupling's
     alpha from its class), probabilities and ratios in 1, powers in W; and the Python
-    result's rows (randvib.harvester_design.result) the same."""
+    result's rows and print() (randvib.harvester_design.result) the same."""
     code, out, err = run_cli(
         capsys, "design", "--preset", "coulomb-td1", "--psd", "0.5", "--stroke", "0.01",
         "--alpha", "0.2", "--r-load", "1", "--r-coil", "0.48", "--vary", "k=20:200",
@@ -305,3 +306,6 @@ def test_design_table_gives_every_number_its_unit(capsys):
     result = rv.design(h, 0.5, {"alpha": (0.05, 0.5)}, exceedance=0.01, monte_carlo=False)
     rows = {name: u for name, _, u in result._rows()}
     assert rows["alpha"] == "Wb/m" and rows["power_predicted"] == "W"
+    assert rows["stroke_exceedance_predicted"] == "1"
+    # print(result) shows the table, as print() of the other results does, not the repr
+    assert str(result).startswith("Design") and "DesignResult(" not in str(result)

@@ -179,6 +179,11 @@ class DesignResult:
         rows.append(
             ("power_predicted", formatting.compact(self.power_predicted), unit("power_predicted"))
         )
+        rows.append((
+            "stroke_exceedance_predicted",
+            formatting.compact(self.exceedance_predicted),
+            unit("stroke_exceedance_predicted"),
+        ))  # fmt: skip
         if self.power_monte_carlo is not None:
             rows.append(
                 ("power_monte_carlo", f"{self.power_monte_carlo}", unit("power_monte_carlo"))
@@ -199,6 +204,10 @@ class DesignResult:
             f"DesignResult({chosen}, power_predicted={formatting.compact(self.power_predicted)}"
             f"{mc})"
         )
+
+    def __str__(self) -> str:
+        """The table of :meth:`_repr_html_` as plain text (``print(result)``)."""
+        return _display.text_table("Design", self._rows())
 
     def _repr_html_(self) -> str:
         return _display.html_table("Design", self._rows())
