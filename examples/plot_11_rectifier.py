@@ -71,7 +71,7 @@ print(f"capacitor + load: stored {1e3 * p_capacitor.mean:.3f} ± {1e3 * p_capaci
 # the capacitor + load and the resistive figure for scale. Even the best
 # battery stores well under what a matched resistor takes: the bridge
 # conducts only on the largest velocity peaks.
-volts = np.linspace(0.002, 0.99 * best.upper, 25)  # best.upper: where the closure stops
+volts = np.linspace(0.002, best.upper, 25)  # best.upper: where the closure stops
 closure = [rv.predict(wired(rv.BridgeCoil(alpha, r_coil, v_diode=v_diode, battery=v)), psd,
                       "bridge-closure").power_stored for v in volts]  # fmt: skip
 checked = (0.01, best.value, 0.05)

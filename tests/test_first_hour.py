@@ -309,3 +309,28 @@ def test_design_table_gives_every_number_its_unit(capsys):
     assert rows["stroke_exceedance_predicted"] == "1"
     # print(result) shows the table, as print() of the other results does, not the repr
     assert str(result).startswith("Design") and "DesignResult(" not in str(result)
+
+
+@pytest.mark.parametrize("output", [{"battery": 0.03}, {"storage_capacitance": 1.0, "r_load": 2.5}])
+def test_dc_optimum_bound_is_offered_and_a_refusal_shows_the_ratio_above_the_limit(output):
+    """optimal_dc_output's upper bound (randvib.analytic.bridge) is a value the closure
+    takes: predict at it answers (brentq's root could land a hair beyond the limit, and
+    an optimum there was refused); just beyond it the refusal prints the ratio with the
+    digits that show it above 1.25, not "1.25 (limit 1.25)"."""
+    import dataclasses
+
+    base = rv.preset("figure9")
+
+    def wired(coil):
+        return rv.Harvester.with_coupling(base.m, base.c_m, base.k, coil, k3=base.k3,
+                                          friction=base.friction)  # fmt: skip
+
+    coil = rv.BridgeCoil(0.1992, 0.48, v_diode=0.01, **output)
+    best = rv.optimal_dc_output(wired(coil), 1.0)
+    at_bound = dataclasses.replace(coil, **{best.parameter: best.upper})
+    assert rv.predict(wired(at_bound), 1.0, "bridge-closure").power_stored > 0
+    beyond = dataclasses.replace(coil, **{best.parameter: best.upper * (1 + 1e-6)})
+    with pytest.raises(ValueError, match="bridge-closure") as info:
+        rv.predict(wired(beyond), 1.0, "bridge-closure")
+    shown = float(str(info.value).split("threshold is ")[1].split()[0])
+    assert shown > 1.25, str(info.value)

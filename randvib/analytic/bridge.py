@@ -176,10 +176,13 @@ class BridgeClosure(AnalyticMethod):
         s = _velocity_std(harvester, psd, v_out)
         ratio = (v_out + 2.0 * coil.v_diode) / coil.alpha / s
         if ratio > MAX_THRESHOLD_RATIO:
+            digits = 3  # enough digits that the ratio shown is above the limit shown
+            while float(f"{ratio:.{digits}g}") <= MAX_THRESHOLD_RATIO and digits < 17:
+                digits += 1
             raise self.beyond_validity(
                 harvester,
                 psd,
-                f"is not offered where the bridge's threshold is {ratio:.3g} velocity std "
+                f"is not offered where the bridge's threshold is {ratio:.{digits}g} velocity std "
                 f"(limit {MAX_THRESHOLD_RATIO:g}: it conducts only in the tails)",
             )
         electrical, mean_abs_i, mean_i2 = bridge_moments(coil, s, v_out)
@@ -304,12 +307,16 @@ def optimal_dc_output(harvester: Harvester, psd: float) -> DcOptimum:
     upper = max(lower, 1e-6) * 2.0
     while ratio_excess(upper) < 0.0:
         upper *= 2.0
+    # brentq's root lies within xtol + rtol |root| of the limit, on either side: the bound
+    # steps back by that much, so that the answer at the bound is itself offered
+    rtol = 4.0 * np.finfo(float).eps
     if log:
-        upper = float(
-            np.exp(optimize.brentq(lambda y: ratio_excess(np.exp(y)), np.log(lower), np.log(upper)))
-        )
+        y = optimize.brentq(lambda y: ratio_excess(np.exp(y)), np.log(lower), np.log(upper))
+        upper = float(np.exp(y - (2e-12 + rtol * abs(y))))
     else:
-        upper = float(optimize.brentq(ratio_excess, lower, upper, xtol=1e-12))
+        x = optimize.brentq(ratio_excess, lower, upper, xtol=1e-12)
+        upper = float(x - (1e-12 + rtol * abs(x)))
+    upper = max(upper, lower)
 
     def loss(y):
         return -_stored(device(np.exp(y) if log else y), psd)[0]
