@@ -316,7 +316,8 @@ def test_dc_optimum_bound_is_offered_and_a_refusal_shows_the_ratio_above_the_lim
     """optimal_dc_output's upper bound (randvib.analytic.bridge) is a value the closure
     takes: predict at it answers (brentq's root could land a hair beyond the limit, and
     an optimum there was refused); just beyond it the refusal prints the ratio with the
-    digits that show it above 1.25, not "1.25 (limit 1.25)"."""
+    digits that show it above 1.25, not "1.25 (limit 1.25)"; print() of the optimum
+    gives its units."""
     import dataclasses
 
     base = rv.preset("figure9")
@@ -327,6 +328,9 @@ def test_dc_optimum_bound_is_offered_and_a_refusal_shows_the_ratio_above_the_lim
 
     coil = rv.BridgeCoil(0.1992, 0.48, v_diode=0.01, **output)
     best = rv.optimal_dc_output(wired(coil), 1.0)
+    # print(best) is one line with units, not the dataclass' repr
+    unit = "V" if best.parameter == "battery" else "ohm"
+    assert str(best).startswith(f"{best.parameter} = ") and f" {unit} (" in str(best)
     at_bound = dataclasses.replace(coil, **{best.parameter: best.upper})
     assert rv.predict(wired(at_bound), 1.0, "bridge-closure").power_stored > 0
     beyond = dataclasses.replace(coil, **{best.parameter: best.upper * (1 + 1e-6)})

@@ -42,8 +42,10 @@ from scipy import optimize, special
 from randvib.analytic.linearisation import linear_displacement_variance
 from randvib.analytic.method import AnalyticMethod, Validity
 from randvib.analytic.power_prediction import PowerPrediction
+from randvib.formatting import compact
 from randvib.models.harvester import Harvester
 from randvib.models.rectifier import BridgeCoil
+from randvib.quantities import unit
 
 #: Largest u0 / sigma_v (threshold over velocity spread) the closure is offered at:
 #: up to it the stored power was within 6.5 % of Monte Carlo over the grid of
@@ -235,6 +237,15 @@ class DcOptimum:
     where: str
     lower: float
     upper: float
+
+    def __str__(self) -> str:
+        """One line with units (``print(optimum)``): the value, its power, where it sits."""
+        u = unit(f"{self.parameter}_optimal")
+        return (
+            f"{self.parameter} = {compact(self.value)} {u} ({self.where}; searched "
+            f"{compact(self.lower)} to {compact(self.upper)} {u}), stored power "
+            f"{compact(self.power_stored)} {unit('power_stored')}"
+        )
 
     def to_dict(self) -> dict:
         return {
