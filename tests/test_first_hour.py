@@ -338,3 +338,12 @@ def test_dc_optimum_bound_is_offered_and_a_refusal_shows_the_ratio_above_the_lim
         rv.predict(wired(beyond), 1.0, "bridge-closure")
     shown = float(str(info.value).split("threshold is ")[1].split()[0])
     assert shown > 1.25, str(info.value)
+
+
+def test_rectifier_without_a_coupling_says_none_given(capsys):
+    """`--rectifier bridge` without --coupling (randvib.cli._device): the refusal says none
+    was given instead of printing Python's None."""
+    one_line_error(capsys, ["power", "--preset", "figure9", "--rectifier", "bridge", "--psd", "1"],
+                   "`--coupling inductive|piezo`; none given")  # fmt: skip
+    _, _, err = run_cli(capsys, "power", "--preset", "figure9", "--rectifier", "bridge")
+    assert "None" not in err
