@@ -49,7 +49,7 @@ print(f"resistive, R_L = R_C: E[P_L] = {1e3 * p_resistive.mean:.3f} "
 # Monte Carlo at that voltage (the four parts add up to m S / 4 under white noise).
 battery = wired(rv.BridgeCoil(alpha, r_coil, v_diode=v_diode, battery=0.03))
 best = rv.optimal_dc_output(battery, psd)
-print(f"optimal battery voltage (bridge closure): {1e3 * best.value:.1f} mV, {best.where}")
+print(best)  # the closure's optimal battery voltage, and whether it is interior
 at_best = wired(rv.BridgeCoil(alpha, r_coil, v_diode=v_diode, battery=best.value))
 run = rv.simulate(at_best, psd, **mc)
 for name in ("power_stored", "power_coil_loss", "power_diode_loss", "power_mechanical"):
