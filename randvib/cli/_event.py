@@ -207,7 +207,10 @@ def start_from_args(args, harvester) -> EventStart:
 def event_settings(event: Enveloped, start: EventStart) -> str:
     """One line: the event and the start, for the tables."""
     numbers = {k: v for k, v in event.envelope.parameters().items() if not isinstance(v, str)}
-    shown = ", ".join(f"{k} {v:.4g}" for k, v in numbers.items())
+    specs = type(event.envelope).parameter_specs()
+    shown = ", ".join(
+        f"{k} {v:.4g} {specs[k].unit if k in specs else ''}".rstrip() for k, v in numbers.items()
+    )
     return (
         f"event: {event.envelope.name} envelope{f' ({shown})' if shown else ''}, "
         f"peak e = {event.envelope.peak:.4g} at t = {event.envelope.peak_time:.4g} s; "
