@@ -347,3 +347,37 @@ def test_rectifier_without_a_coupling_says_none_given(capsys):
                    "`--coupling inductive|piezo`; none given")  # fmt: skip
     _, _, err = run_cli(capsys, "power", "--preset", "figure9", "--rectifier", "bridge")
     assert "None" not in err
+
+
+def test_json_of_power_simulate_and_design_carries_units(capsys):
+    """--json of power, simulate and design (randvib.cli._output.with_units) has a units
+    entry as identify's has: the circuit's mean square in the piezo's V^2, a probability 1."""
+    piezo = ["--preset", "figure9", "--coupling", "piezo", "--theta", "1e-4",
+             "--capacitance", "1e-9", "--r-load", "1e6", "--psd", "0.5", "--stroke", "0.01"]  # fmt: skip
+    import json
+
+    code, out, err = run_cli(capsys, "power", *piezo, "--json")
+    assert code == 0, err
+    units = json.loads(out)["units"]
+    assert units["circuit_mean_square"] == "V^2" and units["stroke_exceedance"] == "1"
+    assert units["power_electrical"] == "W" and "method" not in units
+    code, out, err = run_cli(capsys, "simulate", "--preset", "coulomb-td1", "--psd", "0.5",
+                             "--stroke", "0.01", "--paths", "4", "--t-end", "3", "--json")  # fmt: skip
+    assert code == 0, err
+    units = json.loads(out)["units"]
+    assert units["velocity_variance"] == "(m/s)^2" and units["stroke_exceedance"] == "1"
+    code, out, err = run_cli(capsys, "design", "--preset", "coulomb-td1", "--c-e", "0.05",
+                             "--psd", "0.5", "--stroke", "0.01", "--vary", "k=20:200",
+                             "--no-monte-carlo", "--no-progress", "--json")  # fmt: skip
+    assert code == 0, err
+    units = json.loads(out)["units"]
+    assert units["k"] == "N/m" and units["efficiency"] == "1" and units["input_power"] == "W"
+
+
+def test_design_of_a_device_that_harvests_nothing_is_refused_not_an_internal_error(capsys):
+    """A preset identified without the coil (c_e = 0) whose --vary chooses only k: the
+    search (randvib.harvester_design.search) has nothing to maximise; one line says so
+    instead of an internal ZeroDivisionError."""
+    one_line_error(capsys, ["design", "--preset", "coulomb-td1", "--psd", "0.5", "--stroke",
+                            "0.01", "--vary", "k=20:200", "--no-monte-carlo", "--no-progress"],
+                   "power is 0 at every feasible point")  # fmt: skip

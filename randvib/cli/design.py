@@ -20,7 +20,7 @@ from randvib._io import dumps
 from randvib._validation import MAX_SEED, integer_option
 from randvib.cli._device import add_device_arguments, harvester_from_args
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
-from randvib.cli._output import describe_device, describe_excitation, print_table
+from randvib.cli._output import describe_device, describe_excitation, print_table, with_units
 from randvib.formatting import cell
 from randvib.harvester_design.design import design
 from randvib.harvester_design.objectives import OBJECTIVES
@@ -165,7 +165,8 @@ def run(args) -> int:
         progress=not args.no_progress and not args.json,
     )
     if args.json:
-        print(dumps(result.to_dict()))
+        optimum = {k: u for k in result.optimum if (u := parameter_unit(k, result.device))}
+        print(dumps(with_units(result.to_dict(), extra=optimum)))
         return 0
     print(describe_device(harvester))
     print(describe_excitation(excitation))
