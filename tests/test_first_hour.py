@@ -208,6 +208,7 @@ def test_validate_accepts_no_progress(capsys, record_csv):
     """`randvib validate --no-progress` is accepted as by every other command."""
     code, out, err = run_cli(capsys, "validate", record_csv[1], record_csv[0], "--no-progress")
     assert code == 0, err
+    assert "RMS error (m)" in out  # in the output channel's unit, the relative displacement's
 
 
 def test_measured_record_names_welch_integral_and_record_variance():
