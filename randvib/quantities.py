@@ -112,6 +112,9 @@ QUANTITIES: dict[str, Quantity] = {
     ),
     "stroke_first_passage_time": Quantity("s", "mean first time |z| reaches the stroke"),
     # ------------------------------------------------ events (time-resolved, from t = 0)
+    "times": Quantity("s", "times the time-resolved statistics are given at"),
+    "t_end": Quantity("s", "end of the computed time"),
+    "energy_electrical": Quantity("J", "electrical energy over the whole event: int E[P_e] dt"),
     "cumulative_energy": Quantity(
         "J", "electrical energy from t = 0: int_0^t E[P_e] dt", "energy to t"
     ),
