@@ -31,7 +31,7 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
-__all__ = ["QUANTITIES", "Quantity", "report_header", "unicode_unit", "unit"]
+__all__ = ["QUANTITIES", "Quantity", "parameter_unit", "report_header", "unicode_unit", "unit"]
 
 
 class Quantity(NamedTuple):
@@ -112,6 +112,9 @@ QUANTITIES: dict[str, Quantity] = {
     ),
     "stroke_first_passage_time": Quantity("s", "mean first time |z| reaches the stroke"),
     # ------------------------------------------------ events (time-resolved, from t = 0)
+    "times": Quantity("s", "times the time-resolved statistics are given at"),
+    "t_end": Quantity("s", "end of the computed time"),
+    "energy_electrical": Quantity("J", "electrical energy over the whole event: int E[P_e] dt"),
     "cumulative_energy": Quantity(
         "J", "electrical energy from t = 0: int_0^t E[P_e] dt", "energy to t"
     ),
@@ -126,6 +129,21 @@ QUANTITIES: dict[str, Quantity] = {
     "power_load_optimal": Quantity("W", "load power at the optimal load resistance"),
     "battery_optimal": Quantity("V", "battery voltage of the largest stored power"),
     "power_stored_optimal": Quantity("W", "stored power at the optimal bridge output"),
+    # ------------------------------------------------ a design (randvib.design)
+    "power_predicted": Quantity("W", "the objective's power at the optimum, predicted"),
+    "power_monte_carlo": Quantity("W", "the objective's power at the optimum, Monte Carlo"),
+    "stroke_exceedance_predicted": Quantity("1", "P(|z| > stroke) at the optimum, predicted"),
+    "stroke_exceedance_monte_carlo": Quantity(
+        "1", "P(|z| > stroke) at the optimum, Monte Carlo (fraction of time)"
+    ),
+    "first_passage_predicted": Quantity("s", "mean first time |z| reaches the stroke, predicted"),
+    "first_passage_monte_carlo": Quantity(
+        "s", "mean first time |z| reaches the stroke, Monte Carlo"
+    ),
+    "input_power": Quantity("W", "power the excitation delivers to the device"),
+    "efficiency": Quantity("1", "the objective's power over the input power"),
+    "limit": Quantity("W", "harvesting limit of the mass at the stroke budget"),
+    "fraction_of_limit": Quantity("1", "the optimum's power over the harvesting limit"),
 }
 
 #: Quantities measured in the unit of a coupling's circuit state, squared.
@@ -156,6 +174,28 @@ def unit(name: str, electrical=None) -> str:
     if name in _CIRCUIT_SQUARES and state_unit:
         return f"{state_unit}^2"
     return quantity.unit
+
+
+def parameter_unit(name: str, harvester) -> str:
+    """The SI unit of a device parameter ``name`` of ``harvester`` (``""``: unknown).
+
+    The device's own parameters are :data:`QUANTITIES`; a friction law's or a
+    coupling's (``fc``, ``alpha``, ``r_load``...) are declared by its class.
+
+    Parameters
+    ----------
+    name : str
+        A parameter name, as :func:`randvib.design` varies it.
+    harvester : Harvester
+        The device whose friction law and coupling declare the other names.
+    """
+    if name in QUANTITIES:
+        return QUANTITIES[name].unit
+    for model in (getattr(harvester, "friction", None), getattr(harvester, "electrical", None)):
+        specs = type(model).parameter_specs() if hasattr(model, "parameter_specs") else {}
+        if name in specs:
+            return specs[name].unit
+    return ""
 
 
 def unicode_unit(text: str) -> str:

@@ -63,7 +63,7 @@ def test_power_event_table_and_stroke(capsys):
     assert code == 0, err
     assert "E[z^2] (m^2)" in out and "reached, Poisson*" in out and "approximate" in out
     assert "energy from t = 0 to 2 s" in out and "exact: linear device" in out
-    assert "shinozuka-sato envelope (a 2, b 0.5, c 2)" in out
+    assert "shinozuka-sato envelope (a 2, b 0.5 1/s, c 2 1/s)" in out  # with their units
 
 
 def test_simulate_step_within_intervals_of_the_closed_form(capsys):

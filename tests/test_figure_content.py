@@ -80,6 +80,19 @@ def test_zero_exceedance_is_marked_at_the_edge_not_dropped(drawn, tmp_path):
     assert axes[1].get_title() == "band at $f_n$"
 
 
+def test_hollow_edge_markers_of_two_devices_with_equal_power_do_not_coincide(drawn, tmp_path):
+    """Two devices that never pass the stroke at a level with the same power: their
+    hollow edge markers are staggered, not one drawn over the other."""
+    table = exceedance_table()
+    table.loc[table.g == LEVELS[0], "exceedance_mc"] = 0.0  # both devices, same power_mc
+    figures.power_against_exceedance(table, DEVICES, 0.01, 0.012, tmp_path / "x.png")
+    (fig,) = drawn
+    for ax in [ax for ax in fig.axes if ax.get_xscale() == "log"]:
+        low = [(x, y) for x, y in marker_points(ax) if y == pytest.approx(LEVELS[0])]  # mW
+        assert len(low) == 2 and low[0][0] != pytest.approx(low[1][0], rel=0.2)
+        assert all(ax.get_xlim()[0] < x for x, _ in low)
+
+
 def test_exceedance_legend_names_devices_levels_and_the_hollow_marker(drawn, tmp_path):
     figures.power_against_exceedance(exceedance_table(), DEVICES, 0.01, 0.012, tmp_path / "x.png")
     (fig,) = drawn

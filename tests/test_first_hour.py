@@ -8,8 +8,9 @@ frames of :mod:`randvib.analytic.power_prediction`, broadcasting in
 bistable devices by their wells (:mod:`randvib.models.potential`,
 :mod:`randvib.models.harvester`), and the CLI's options and refusals
 (:mod:`randvib.cli.power`, :mod:`randvib.cli._device`, :mod:`randvib.cli._excitation`,
-:mod:`randvib.cli._output`, :mod:`randvib.cli.validate`); the printed table of
-:mod:`randvib.identification.result`.
+:mod:`randvib.cli._output`, :mod:`randvib.cli.validate`, :mod:`randvib.cli.design`); the
+printed tables of :mod:`randvib.identification.result` and
+:mod:`randvib.harvester_design.result`, with units from :mod:`randvib.quantities`.
 """
 
 import warnings
@@ -207,6 +208,7 @@ def test_validate_accepts_no_progress(capsys, record_csv):
     """`randvib validate --no-progress` is accepted as by every other command."""
     code, out, err = run_cli(capsys, "validate", record_csv[1], record_csv[0], "--no-progress")
     assert code == 0, err
+    assert "RMS error (m)" in out  # in the output channel's unit, the relative displacement's
 
 
 def test_measured_record_names_welch_integral_and_record_variance():
@@ -276,3 +278,107 @@ def test_probabilities_are_shown_with_unit_one():
                  "stroke_reached_vanmarcke"):  # fmt: skip
         assert unit(name) == "1"
         assert not report_header(name).endswith("(1)")
+
+
+def test_design_table_gives_every_number_its_unit(capsys):
+    """randvib design's table: the varied parameters in their own units (a coupling's
+    alpha from its class), probabilities and ratios in 1, powers in W; and the Python
+    result's rows and print() (randvib.harvester_design.result) the same."""
+    code, out, err = run_cli(
+        capsys, "design", "--preset", "coulomb-td1", "--psd", "0.5", "--stroke", "0.01",
+        "--alpha", "0.2", "--r-load", "1", "--r-coil", "0.48", "--vary", "k=20:200",
+        "--vary", "alpha=0.05:0.5", "--exceedance", "0.01", "--no-monte-carlo",
+        "--no-progress",
+    )  # fmt: skip
+    assert code == 0, err
+    units = {}
+    for line in out.splitlines():
+        for name in ("optimum k", "optimum alpha", "power_predicted",
+                     "stroke_exceedance_predicted", "input_power", "efficiency"):  # fmt: skip
+            if line.startswith(name + " "):
+                units[name] = line.split()[-1]
+    assert units == {
+        "optimum k": "N/m", "optimum alpha": "Wb/m", "power_predicted": "W",
+        "stroke_exceedance_predicted": "1", "input_power": "W", "efficiency": "1",
+    }  # fmt: skip
+    h = rv.Harvester.from_electrical(
+        m=0.0226, c_m=0.049, k=57.4, alpha=0.2, r_load=1.0, r_coil=0.48, k3=7e4, stroke=0.01
+    )
+    result = rv.design(h, 0.5, {"alpha": (0.05, 0.5)}, exceedance=0.01, monte_carlo=False)
+    rows = {name: u for name, _, u in result._rows()}
+    assert rows["alpha"] == "Wb/m" and rows["power_predicted"] == "W"
+    assert rows["stroke_exceedance_predicted"] == "1"
+    # print(result) shows the table, as print() of the other results does, not the repr
+    assert str(result).startswith("Design") and "DesignResult(" not in str(result)
+
+
+@pytest.mark.parametrize("output", [{"battery": 0.03}, {"storage_capacitance": 1.0, "r_load": 2.5}])
+def test_dc_optimum_bound_is_offered_and_a_refusal_shows_the_ratio_above_the_limit(output):
+    """optimal_dc_output's upper bound (randvib.analytic.bridge) is a value the closure
+    takes: predict at it answers (brentq's root could land a hair beyond the limit, and
+    an optimum there was refused); just beyond it the refusal prints the ratio with the
+    digits that show it above 1.25, not "1.25 (limit 1.25)"; print() of the optimum
+    gives its units."""
+    import dataclasses
+
+    base = rv.preset("figure9")
+
+    def wired(coil):
+        return rv.Harvester.with_coupling(base.m, base.c_m, base.k, coil, k3=base.k3,
+                                          friction=base.friction)  # fmt: skip
+
+    coil = rv.BridgeCoil(0.1992, 0.48, v_diode=0.01, **output)
+    best = rv.optimal_dc_output(wired(coil), 1.0)
+    # print(best) is one line with units, not the dataclass' repr
+    unit = "V" if best.parameter == "battery" else "ohm"
+    assert str(best).startswith(f"{best.parameter} = ") and f" {unit} (" in str(best)
+    at_bound = dataclasses.replace(coil, **{best.parameter: best.upper})
+    assert rv.predict(wired(at_bound), 1.0, "bridge-closure").power_stored > 0
+    beyond = dataclasses.replace(coil, **{best.parameter: best.upper * (1 + 1e-6)})
+    with pytest.raises(ValueError, match="bridge-closure") as info:
+        rv.predict(wired(beyond), 1.0, "bridge-closure")
+    shown = float(str(info.value).split("threshold is ")[1].split()[0])
+    assert shown > 1.25, str(info.value)
+
+
+def test_rectifier_without_a_coupling_says_none_given(capsys):
+    """`--rectifier bridge` without --coupling (randvib.cli._device): the refusal says none
+    was given instead of printing Python's None."""
+    one_line_error(capsys, ["power", "--preset", "figure9", "--rectifier", "bridge", "--psd", "1"],
+                   "`--coupling inductive|piezo`; none given")  # fmt: skip
+    _, _, err = run_cli(capsys, "power", "--preset", "figure9", "--rectifier", "bridge")
+    assert "None" not in err
+
+
+def test_json_of_power_simulate_and_design_carries_units(capsys):
+    """--json of power, simulate and design (randvib.cli._output.with_units) has a units
+    entry as identify's has: the circuit's mean square in the piezo's V^2, a probability 1."""
+    piezo = ["--preset", "figure9", "--coupling", "piezo", "--theta", "1e-4",
+             "--capacitance", "1e-9", "--r-load", "1e6", "--psd", "0.5", "--stroke", "0.01"]  # fmt: skip
+    import json
+
+    code, out, err = run_cli(capsys, "power", *piezo, "--json")
+    assert code == 0, err
+    units = json.loads(out)["units"]
+    assert units["circuit_mean_square"] == "V^2" and units["stroke_exceedance"] == "1"
+    assert units["power_electrical"] == "W" and "method" not in units
+    code, out, err = run_cli(capsys, "simulate", "--preset", "coulomb-td1", "--psd", "0.5",
+                             "--stroke", "0.01", "--paths", "4", "--t-end", "3", "--json")  # fmt: skip
+    assert code == 0, err
+    units = json.loads(out)["units"]
+    assert units["velocity_variance"] == "(m/s)^2" and units["stroke_exceedance"] == "1"
+    code, out, err = run_cli(capsys, "design", "--preset", "coulomb-td1", "--c-e", "0.05",
+                             "--psd", "0.5", "--stroke", "0.01", "--vary", "k=20:200",
+                             "--no-monte-carlo", "--no-progress", "--json")  # fmt: skip
+    assert code == 0, err
+    units = json.loads(out)["units"]
+    assert units["k"] == "N/m" and units["efficiency"] == "1" and units["input_power"] == "W"
+
+
+def test_design_of_a_device_that_harvests_nothing_is_refused_not_an_internal_error(capsys):
+    """A preset identified without the coil (c_e = 0) whose --vary chooses only k: the
+    search (randvib.harvester_design.search) has nothing to maximise; one line says so
+    instead of an internal ZeroDivisionError."""
+    one_line_error(capsys, ["design", "--preset", "coulomb-td1", "--psd", "0.5", "--stroke",
+                            "0.01", "--vary", "k=20:200", "--no-monte-carlo", "--no-progress"],
+                   "power is 0 at every feasible point")  # fmt: skip

@@ -68,9 +68,11 @@ from randvib.analytic.linear_response import device_block, output_variances
 from randvib.analytic.linearisation import linear_displacement_variance
 from randvib.analytic.method import AnalyticMethod, Validity, non_white
 from randvib.analytic.power_prediction import PowerPrediction
+from randvib.formatting import compact
 from randvib.models.excitation import Measured, as_excitation
 from randvib.models.harvester import Harvester
 from randvib.models.rectifier import BridgeCoil
+from randvib.quantities import unit
 
 #: Largest u0 / sigma_v (threshold over velocity spread) the closure is offered at:
 #: up to it the stored power was within 6.5 % of Monte Carlo over the grid of
@@ -303,10 +305,13 @@ class BridgeClosure(AnalyticMethod):
             zz = linear_displacement_variance(harvester, s * s)
         ratio = (v_out + 2.0 * coil.v_diode) / coil.alpha / s
         if ratio > MAX_THRESHOLD_RATIO:
+            digits = 3  # enough digits that the ratio shown is above the limit shown
+            while float(f"{ratio:.{digits}g}") <= MAX_THRESHOLD_RATIO and digits < 17:
+                digits += 1
             raise self.beyond_validity(
                 harvester,
                 psd,
-                f"is not offered where the bridge's threshold is {ratio:.3g} velocity std "
+                f"is not offered where the bridge's threshold is {ratio:.{digits}g} velocity std "
                 f"(limit {MAX_THRESHOLD_RATIO:g}: it conducts only in the tails)",
             )
         electrical, mean_abs_i, mean_i2 = bridge_moments(coil, s, v_out)
@@ -359,6 +364,15 @@ class DcOptimum:
     where: str
     lower: float
     upper: float
+
+    def __str__(self) -> str:
+        """One line with units (``print(optimum)``): the value, its power, where it sits."""
+        u = unit(f"{self.parameter}_optimal")
+        return (
+            f"{self.parameter} = {compact(self.value)} {u} ({self.where}; searched "
+            f"{compact(self.lower)} to {compact(self.upper)} {u}), stored power "
+            f"{compact(self.power_stored)} {unit('power_stored')}"
+        )
 
     def to_dict(self) -> dict:
         return {
@@ -435,12 +449,16 @@ def optimal_dc_output(harvester: Harvester, psd) -> DcOptimum:
     upper = max(lower, 1e-6) * 2.0
     while ratio_excess(upper) < 0.0:
         upper *= 2.0
+    # brentq's root lies within xtol + rtol |root| of the limit, on either side: the bound
+    # steps back by that much, so that the answer at the bound is itself offered
+    rtol = 4.0 * np.finfo(float).eps
     if log:
-        upper = float(
-            np.exp(optimize.brentq(lambda y: ratio_excess(np.exp(y)), np.log(lower), np.log(upper)))
-        )
+        y = optimize.brentq(lambda y: ratio_excess(np.exp(y)), np.log(lower), np.log(upper))
+        upper = float(np.exp(y - (2e-12 + rtol * abs(y))))
     else:
-        upper = float(optimize.brentq(ratio_excess, lower, upper, xtol=1e-12))
+        x = optimize.brentq(ratio_excess, lower, upper, xtol=1e-12)
+        upper = float(x - (1e-12 + rtol * abs(x)))
+    upper = max(upper, lower)
 
     def loss(y):
         return -_stored(device(np.exp(y) if log else y), psd)[0]

@@ -216,7 +216,8 @@ def _bridge_from_args(args):
         raise ValueError("give either `--c-e` or `--rectifier bridge`, not both")
     if args.coupling not in RECTIFIED:
         raise ValueError(
-            f"`--rectifier bridge` needs `--coupling {'|'.join(RECTIFIED)}`; got {args.coupling!r}"
+            f"`--rectifier bridge` needs `--coupling {'|'.join(RECTIFIED)}`; "
+            + ("none given" if args.coupling is None else f"got {args.coupling!r}")
         )
     cls = RECTIFIED[args.coupling]
     transducer = COUPLINGS[args.coupling]

@@ -16,6 +16,7 @@ import argparse
 from pathlib import Path
 
 from randvib.cli._device import option_flag, options_by_parameter, refuse_foreign_options
+from randvib.cli._output import with_units
 from randvib.models.event import ENVELOPES, STARTS, Enveloped, EventStart, ShinozukaSato
 
 #: The envelope read from ``--envelope-file``.
@@ -207,7 +208,13 @@ def start_from_args(args, harvester) -> EventStart:
 def event_settings(event: Enveloped, start: EventStart) -> str:
     """One line: the event and the start, for the tables."""
     numbers = {k: v for k, v in event.envelope.parameters().items() if not isinstance(v, str)}
-    shown = ", ".join(f"{k} {v:.4g}" for k, v in numbers.items())
+    try:  # a tabulated envelope's fields are a table, not declared parameters
+        specs = type(event.envelope).parameter_specs()
+    except KeyError:
+        specs = {}
+    shown = ", ".join(
+        f"{k} {v:.4g} {specs[k].unit if k in specs else ''}".rstrip() for k, v in numbers.items()
+    )
     return (
         f"event: {event.envelope.name} envelope{f' ({shown})' if shown else ''}, "
         f"peak e = {event.envelope.peak:.4g} at t = {event.envelope.peak_time:.4g} s; "
@@ -276,7 +283,7 @@ def simulate_event(args, harvester, psd) -> int:
     )
     out = {"psd": _level(psd), "friction": harvester.friction_name, **result.to_dict()}
     if args.json:
-        print(dumps(out))
+        print(dumps(with_units(out, harvester.electrical)))
         return 0
     analytic = _analytic_beside(harvester, event, result.times, result.t_end, start)
     _print_simulated(harvester, psd, event, start, result, analytic)
@@ -370,7 +377,7 @@ def power_event(args, swept: list, points: list) -> int:
     )
     out = {"psd": _level(psd), "friction": harvester.friction_name, **result.to_dict()}
     if args.json:
-        print(dumps(out))
+        print(dumps(with_units(out, harvester.electrical)))
         return 0
     _print_predicted(harvester, psd, event, start, result)
     return 0

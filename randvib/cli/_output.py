@@ -45,6 +45,18 @@ def _quantity_units(names) -> dict:
     return {name: unit(name) for name in names if name in QUANTITIES}
 
 
+def with_units(obj: dict, electrical=None, extra: dict | None = None) -> dict:
+    """A JSON object with a ``units`` entry: the unit of each of its quantities.
+
+    Every key of ``obj`` that :mod:`randvib.quantities` declares with a unit
+    (a circuit state's in its coupling's unit) gets one, as identify's
+    ``units`` entry gives its parameters'; ``extra`` adds others (a design's
+    varied parameters). Keys that hold words (method, friction) have none.
+    """
+    units = {k: unit(k, electrical) for k in obj if k in QUANTITIES and unit(k, electrical)}
+    return {**obj, "units": {**units, **(extra or {})}}
+
+
 #: The device's own parameters, shown first.
 DEVICE_PARAMETERS = ("m", "c_m", "c_e", "k", "k3")
 

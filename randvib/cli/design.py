@@ -20,7 +20,7 @@ from randvib._io import dumps
 from randvib._validation import MAX_SEED, integer_option
 from randvib.cli._device import add_device_arguments, harvester_from_args
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
-from randvib.cli._output import describe_device, describe_excitation, print_table
+from randvib.cli._output import describe_device, describe_excitation, print_table, with_units
 from randvib.formatting import cell
 from randvib.harvester_design.design import design
 from randvib.harvester_design.objectives import OBJECTIVES
@@ -29,6 +29,7 @@ from randvib.models.friction import FRICTION_MODELS
 from randvib.models.rectifier import BridgeCoil, BridgePiezo
 from randvib.montecarlo.ensembles import GROUP_SEEDS
 from randvib.montecarlo.sweep import SweepSettings
+from randvib.quantities import parameter_unit, unit
 
 
 def register(sub) -> None:
@@ -164,25 +165,33 @@ def run(args) -> int:
         progress=not args.no_progress and not args.json,
     )
     if args.json:
-        print(dumps(result.to_dict()))
+        optimum = {k: u for k in result.optimum if (u := parameter_unit(k, result.device))}
+        print(dumps(with_units(result.to_dict(), extra=optimum)))
         return 0
     print(describe_device(harvester))
     print(describe_excitation(excitation))
     out = result.to_dict()
-    rows = [(f"optimum {k}", cell(v), "") for k, v in result.optimum.items()]
+    rows = [
+        (f"optimum {k}", cell(v), parameter_unit(k, result.device))
+        for k, v in result.optimum.items()
+    ]
     for key in ("power_predicted", "stroke_exceedance_predicted"):
-        rows.append((key, cell(out[key]), "W" if key.startswith("power") else ""))
+        rows.append((key, cell(out[key]), unit(key)))
     for key in ("power_monte_carlo", "stroke_exceedance_monte_carlo", "input_power"):
         value = out[key]
         if value is None:
             continue
         if isinstance(value, dict):
             value = f"{cell(value['mean'])} ± {cell(value['ci95'])}"
-        rows.append(
-            (key, value if isinstance(value, str) else cell(value), "" if "exceed" in key else "W")
-        )
+        rows.append((key, value if isinstance(value, str) else cell(value), unit(key)))
     if args.min_first_passage is not None:
-        rows.append(("first_passage_predicted", cell(out["first_passage_predicted"]), "s"))
+        rows.append(
+            (
+                "first_passage_predicted",
+                cell(out["first_passage_predicted"]),
+                unit("first_passage_predicted"),
+            )
+        )
         first = result.first_passage_monte_carlo
         if first is not None:
             lower = first.restricted_mean
@@ -190,12 +199,15 @@ def run(args) -> int:
                          f"{cell(first.mean.mean)} ± {cell(first.mean.ci95)}" if first.mean
                          else f">= {cell(lower.mean)} ± {cell(lower.ci95)} (censored)", "s"))  # fmt: skip
             rows.append(("first_passage_confirmed", str(out["first_passage_confirmed"]), ""))
-    rows.append(("efficiency", cell(out["efficiency"]), ""))
-    rows.append(
-        ("limit", "none (white noise)" if out["limit"] is None else cell(out["limit"]), "W")
-    )
+    rows.append(("efficiency", cell(out["efficiency"]), unit("efficiency")))
+    if out["limit"] is None:
+        rows.append(("limit", "none (white noise)", ""))
+    else:
+        rows.append(("limit", cell(out["limit"]), unit("limit")))
     if out["fraction_of_limit"] is not None:
-        rows.append(("fraction_of_limit", cell(out["fraction_of_limit"]), ""))
+        rows.append(
+            ("fraction_of_limit", cell(out["fraction_of_limit"]), unit("fraction_of_limit"))
+        )
     if result.refined:
         cost = result.analytic_cost
         rows.append(("analytic optimum's cost", f"{cell(cost.mean)} ± {cell(cost.ci95)}", "W"))

@@ -46,7 +46,7 @@ from randvib.cli import advice_when_done
 from randvib.cli._device import add_device_arguments, harvester_from_args, option_flag
 from randvib.cli._event import add_event_arguments, power_event, wants_event
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
-from randvib.cli._output import describe_device, describe_excitation, print_table
+from randvib.cli._output import describe_device, describe_excitation, print_table, with_units
 from randvib.formatting import cell
 from randvib.models.excitation import Excitation
 from randvib.montecarlo.bridge_optimum import simulated_dc_optimum
@@ -210,7 +210,7 @@ def run(args) -> int:
     if csv_file is not None:
         saved = _write_csv(csv_file, [out for out, _, _ in results], args.force)
     if args.json:
-        outs = [out for out, _, _ in results]
+        outs = [with_units(out, h.electrical) for out, h, _ in results]
         print(dumps(outs[0] if len(outs) == 1 and not swept else outs))
     elif swept:
         _print_sweep(swept, points, results)

@@ -20,7 +20,7 @@ from randvib.analytic.prediction import METHODS, predict
 from randvib.cli._device import add_device_arguments, harvester_from_args
 from randvib.cli._event import add_event_arguments, simulate_event, wants_event
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
-from randvib.cli._output import describe_device, describe_excitation, print_table
+from randvib.cli._output import describe_device, describe_excitation, print_table, with_units
 from randvib.formatting import cell, estimate_parts
 from randvib.montecarlo.integrators import INTEGRATORS
 from randvib.montecarlo.results import STATISTICS
@@ -136,7 +136,7 @@ def run(args) -> int:
         )
     summary = result.summary()
     if args.json:
-        print(dumps(summary))
+        print(dumps(with_units(summary, harvester.electrical)))
         return 0
     analytic = None
     if METHODS["linearisation"].accepts(harvester, psd):

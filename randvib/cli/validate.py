@@ -11,6 +11,7 @@ from randvib._io import check_output_file, check_output_folder, dumps, existing_
 from randvib.cli._output import print_table
 from randvib.cli._records import (
     add_record_arguments,
+    output_unit,
     parse_assignments,
     plot_units,
     record_from_args,
@@ -193,7 +194,7 @@ def run(args) -> int:
     print(f"model {model}")
     print_table(
         [[r.record, r.samples, r.cost, r.rms_error] for r in rows],
-        ["record", "samples", "J", "RMS error"],
+        ["record", "samples", "J", f"RMS error ({output_unit(args)})"],
     )
     print(f"note: {OFFSETS_NOTE[args.offsets]}")
     return status

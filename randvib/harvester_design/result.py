@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 from randvib import _display, formatting
+from randvib.quantities import parameter_unit, unit
 from randvib.statistics import FirstPassage, Statistic
 
 __all__ = ["DesignResult"]
@@ -171,15 +172,29 @@ class DesignResult:
         return pd.DataFrame(rows)
 
     def _rows(self):
-        rows = [(name, formatting.compact(v), "") for name, v in self.optimum.items()]
-        rows.append(("power_predicted", formatting.compact(self.power_predicted), "W"))
+        rows = [
+            (name, formatting.compact(v), parameter_unit(name, self.device))
+            for name, v in self.optimum.items()
+        ]
+        rows.append(
+            ("power_predicted", formatting.compact(self.power_predicted), unit("power_predicted"))
+        )
+        rows.append((
+            "stroke_exceedance_predicted",
+            formatting.compact(self.exceedance_predicted),
+            unit("stroke_exceedance_predicted"),
+        ))  # fmt: skip
         if self.power_monte_carlo is not None:
-            rows.append(("power_monte_carlo", f"{self.power_monte_carlo}", "W"))
             rows.append(
-                ("stroke_exceedance_monte_carlo", f"{self.stroke_exceedance_monte_carlo}", "")
+                ("power_monte_carlo", f"{self.power_monte_carlo}", unit("power_monte_carlo"))
             )
+            rows.append((
+                "stroke_exceedance_monte_carlo",
+                f"{self.stroke_exceedance_monte_carlo}",
+                unit("stroke_exceedance_monte_carlo"),
+            ))  # fmt: skip
         if self.limit is not None:
-            rows.append(("limit", formatting.compact(self.limit), "W"))
+            rows.append(("limit", formatting.compact(self.limit), unit("limit")))
         return rows
 
     def __repr__(self) -> str:
@@ -189,6 +204,10 @@ class DesignResult:
             f"DesignResult({chosen}, power_predicted={formatting.compact(self.power_predicted)}"
             f"{mc})"
         )
+
+    def __str__(self) -> str:
+        """The table of :meth:`_repr_html_` as plain text (``print(result)``)."""
+        return _display.text_table("Design", self._rows())
 
     def _repr_html_(self) -> str:
         return _display.html_table("Design", self._rows())

@@ -273,6 +273,12 @@ def analytic_search(
         if not feasible:
             feasible = [_longest_first_passage(evaluate, within, budget, min_first_passage, space)]
     scale = feasible[0].power
+    if not scale > 0.0:  # the local search divides by it: nothing to maximise
+        raise ValueError(
+            "the objective's power is 0 at every feasible point of the ranges given (a device "
+            "without electrical damping, c_e = 0, whose `vary` chooses neither c_e nor a "
+            "coupling's parameters harvests nothing): give c_e or a coupling, or vary c_e"
+        )
     optima = []
     for start in feasible[:STARTS]:
         found = _local(evaluate, start, budget, scale, min_first_passage)

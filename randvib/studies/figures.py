@@ -443,7 +443,11 @@ def power_against_exceedance(
         for i, dev in enumerate(devices):
             sub = results[(results.input == name) & (results.device == dev)].sort_values("g")
             zero = (sub.exceedance_mc <= 0).to_numpy()
-            x = np.where(zero, edge, sub.exceedance_mc)
+            # devices staggered about the edge (factors 1.4 apart, within 0.6-1.7 x edge
+            # for three devices): two devices with the same power at the edge would
+            # otherwise draw one hollow marker over the other
+            stagger = 1.4 ** (i - (len(devices) - 1) / 2)
+            x = np.where(zero, edge * stagger, sub.exceedance_mc)
             # the line joins measured exceedances only: a hollow edge point is no value
             ax.plot(x[~zero], 1e3 * sub.power_mc[~zero], "-", color=colour(i), lw=1.2)
             for (_, row), at, hollow in zip(sub.iterrows(), x, zero, strict=True):
@@ -454,7 +458,7 @@ def power_against_exceedance(
         ax.axvline(budget, color="k", ls=":", lw=1)
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_xlim(left=0.6 * edge)
+        ax.set_xlim(left=0.6 * edge / 1.4 ** max(0.0, (len(devices) - 3) / 2))
         for axis in (ax.xaxis, ax.yaxis):
             # minor ticks at 2 and 5 only: on a narrow range all eight minor labels collide
             axis.set_minor_locator(LogLocator(subs=(2.0, 5.0)))

@@ -23,7 +23,7 @@ from randvib.figure_style import PALETTE, new_figure, panel_letters, save_figure
 _PANELS = (
     ("displacement", "$S_z$ (m$^2$/Hz)"),
     ("velocity", "$S_v$ ((m/s)$^2$/Hz)"),
-    ("power", "$c_e S_v$ (W/Hz)"),
+    ("power", r"$c_e\,S_v$ (W/Hz)"),
 )
 
 

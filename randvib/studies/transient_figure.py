@@ -71,11 +71,19 @@ def plot_transient(
         first = next(iter(series.values()))[0]
         t = np.linspace(0.0, t_end, 1000)
         twin = axes[0].twinx()
-        twin.plot(t, first.event.envelope(t) ** 2, ":", color="0.4", lw=1.0, label="$e(t)^2$")
+        twin.plot(
+            t, first.event.envelope(t) ** 2, ":", color="0.4", lw=1.0, label="$e(t)^2$ (right axis)"
+        )
         twin.set_ylabel("$e(t)^2$", color="0.4")
         twin.set_ylim(bottom=0.0)
-        twin.legend(loc="lower right", fontsize=7)
-    axes[0].legend(fontsize=7, loc="upper right")
+    # one legend, on the top-most axis: a second legend at the bottom hid the markers
+    # where the response has decayed to zero
+    handles, labels = axes[0].get_legend_handles_labels()
+    top = axes[0]
+    if envelope:
+        more_handles, more_labels = twin.get_legend_handles_labels()
+        handles, labels, top = handles + more_handles, labels + more_labels, twin
+    top.legend(handles, labels, fontsize=7, loc="upper right")
     axes[-1].set_xlabel("time since the event began (s)")
     axes[-1].set_xlim(0.0, t_end)
     panel_letters(axes)
