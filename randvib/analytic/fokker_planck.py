@@ -893,7 +893,8 @@ class FastFokkerPlanck(AnalyticMethod):
     The power and its k3 dependence to about 0.05 % of :class:`FokkerPlanck`
     in about 3 ms a point: fast enough for sweeps. Any confining potential and
     the free mass; double wells with friction up to a barrier of
-    :data:`FAST_MAX_BARRIER` m E[v^2] (refused beyond).
+    :data:`FAST_MAX_BARRIER` m E[v^2], E[v^2] of equivalent linearisation
+    (:func:`friction_barrier_depth`; refused beyond).
     """
 
     name = "fpk-fast"
@@ -922,7 +923,9 @@ class FokkerPlanck(AnalyticMethod):
 
     The reference the other methods are measured against (converged to about
     1e-5), about 0.5 s a point. Any confining potential and the free mass;
-    double wells up to a barrier of :data:`FPK_MAX_BARRIER` m E[v^2] (refused beyond).
+    double wells up to a barrier of :data:`FPK_MAX_BARRIER` m E[v^2], with
+    friction :data:`FPK_MAX_FRICTION_BARRIER` (the viscous device's E[v^2];
+    refused beyond).
     """
 
     name = "fpk"
