@@ -360,12 +360,13 @@ LINEARISATION_FRICTION_SHARE_LIMIT = 0.85
 #: used without a warning under a non-white excitation or with a circuit state
 #: (there k_eq shapes the response; under white noise with a resistive
 #: coupling it drops out of Eq. 20). From the cross-check campaign
-#: (tests/calibration/crosscheck.py, 260 sampled devices against Monte Carlo):
-#: every monostable device off by more than 10 % + the Monte Carlo interval
-#: there (7 of 24 under coloured input, friction share below 0.85) had a share
-#: of 0.26 or more, every one below 0.2 agreed; a double well (k < 0, share
-#: above 1) was off on 28 of 38 devices (0.26x to 47x), at barriers of 0.1 to
-#: 35 m E[v^2] alike, so it always warns.
+#: (tests/calibration/crosscheck.py, 260 sampled devices against Monte Carlo,
+#: a coil's L/R resolved by the step): of the 32 monostable devices there
+#: whose friction share is below 0.85, the 11 with a share below 0.2 all
+#: agreed, and all 6 off by more than 10 % + the Monte Carlo interval (0.52x to
+#: 1.33x) had a share of 0.26 or more (21 devices); a double well (k < 0,
+#: share above 1) was off on 23 of 36 devices (0.29x to 47x), at barriers of
+#: 0.1 to 35 m E[v^2] alike, so it always warns.
 LINEARISATION_STIFFNESS_SHARE_LIMIT = 0.2
 
 
@@ -395,7 +396,7 @@ class Linearisation(AnalyticMethod):
             "the share of the dissipation taken by friction, 1 - c / c_eq (white noise): "
             "the Gaussian closure underestimates the power increasingly beyond it (by 10 % "
             "near 0.9, 17 % near 1); with a circuit state or coloured input the share is "
-            "E[v F] over all the dissipation, and the error reaches 50 % to 70 %",
+            "E[v F] over all the dissipation, and the power is 0.29x to 1.14x",
         ),
         Validity(
             "stiffness_share",
@@ -403,8 +404,8 @@ class Linearisation(AnalyticMethod):
             "warns",
             "the share of the equivalent stiffness taken by the cubic spring, 1 - k / k_eq, "
             "under a non-white excitation or with a circuit state (where k_eq shapes the "
-            "response): the Gaussian closure misplaces the resonance beyond it (off by 15 % "
-            "to 84 % for a hardening spring, 0.26x to 47x for a double well)",
+            "response): the Gaussian closure misplaces the resonance beyond it (0.52x to "
+            "1.33x for a hardening spring, 0.29x to 47x for a double well)",
         ),
     )
 
