@@ -65,12 +65,17 @@ WARNED = {
         0.376011,
         "double well",
     ),
-    "hardening spring with a coil under Kanai-Tajimi input (0.16x)": (
+    "hardening spring under band-pass input (0.85x)": (
+        resistive(0.0152761, 0.0983967, 24.6428, 35088300.0),
+        rv.BandPass(0.389313, 5.47156, 0.0518544),
+        "cubic spring takes",
+    ),
+    "hardening spring with a piezo element under Kanai-Tajimi input (0.52x)": (
         rv.Harvester.with_coupling(
-            m=M, c_m=0.0668118, k=128.59, k3=79039000.0,
-            coupling=rv.Inductive(0.207191, 4.27174, 0.48, 0.000625334),
+            m=M, c_m=0.127372, k=143.418, k3=323171000000.0, friction=rv.Coulomb(0.000145845),
+            coupling=rv.Piezo(0.000336196, 5e-08, 115230.0),
         ),
-        rv.KanaiTajimi(0.0426662, 16.4542, 0.14812),
+        rv.KanaiTajimi(0.00258484, 6.46389, 0.147082),
         "cubic spring takes",
     ),
     "Coulomb friction with a piezo element under white noise (0.60x)": (

@@ -516,7 +516,7 @@ def _warn_general(harvester: Harvester, lin) -> None:
         where = "a circuit state" if harvester.has_circuit else "a non-white excitation"
         warnings.warn(
             f"{'; '.join(why)}: with {where} statistical linearisation can then be off by "
-            "15 % or more (Monte Carlo campaign); use Monte Carlo (randvib.simulate)",
+            "more than 10 % (Monte Carlo campaign); use Monte Carlo (randvib.simulate)",
             LinearisationValidityWarning,
             stacklevel=4,
         )
