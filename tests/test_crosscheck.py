@@ -36,6 +36,11 @@ REFUSED = {
         0.0072493,
         "fpk-fast",
     ),
+    "fpk-fast, shallow double well with friction taking 93 % of the dissipation (1.19x)": (
+        resistive(0.00706162, 0.000666279, -94.3017, 43247126.4, rv.Tanh(0.00447603, 51.7133)),
+        0.0188833,
+        "fpk-fast",
+    ),
     "fpk, double well 10.6 m E[v^2] deep with Coulomb friction (1.41x)": (
         resistive(0.00197351, 0.00239586, -95.0131, 157038.0, rv.Coulomb(0.00262746)),
         0.0463417,
