@@ -51,7 +51,8 @@ def device(k=K, k3=K3, friction="coulomb", coupling=None):
     return rv.Harvester(m=M, c_m=C / 2, c_e=C / 2, k=k, k3=k3, friction=law[friction])
 
 
-SHALLOW = -np.sqrt(4.0 * K3 * 2.0 * S * M * M / (4.0 * C))  # barrier 2 m E[v^2]: fpk-fast takes it
+# barrier 1 m E[v^2] (viscous E[v^2]; about 1.2 on the friction's scale): fpk-fast takes it
+SHALLOW = -np.sqrt(4.0 * K3 * 1.0 * S * M * M / (4.0 * C))
 CASES = {
     "white": (device(), S),
     "White object": (device(), rv.White(S)),
