@@ -21,7 +21,7 @@ from _cli import one_line_error, run
 import randvib as rv
 from randvib.analytic.averaging import AVERAGING_ZETA_LIMIT, AveragingValidityWarning
 from randvib.analytic.exact_solutions import gibbs_displacement_moment
-from randvib.analytic.fokker_planck import FAST_MAX_BARRIER
+from randvib.analytic.fokker_planck import FAST_MAX_BARRIER, friction_barrier_depth
 from randvib.analytic.linearisation import equivalent_damping, linear_displacement_variance
 from randvib.analytic.statistical_linearisation import linearise
 from randvib.models.friction import FrictionModel, parameter
@@ -51,7 +51,8 @@ def device(k=K, k3=K3, friction="coulomb", coupling=None):
     return rv.Harvester(m=M, c_m=C / 2, c_e=C / 2, k=k, k3=k3, friction=law[friction])
 
 
-SHALLOW = -np.sqrt(4.0 * K3 * 2.0 * S * M * M / (4.0 * C))  # barrier 2 m E[v^2]: fpk-fast takes it
+# barrier 1 m E[v^2] (viscous E[v^2]; about 1.2 on the friction's scale): fpk-fast takes it
+SHALLOW = -np.sqrt(4.0 * K3 * 1.0 * S * M * M / (4.0 * C))
 CASES = {
     "white": (device(), S),
     "White object": (device(), rv.White(S)),
@@ -198,10 +199,13 @@ def test_validity_limits_are_declared_with_the_limits_the_methods_use():
     with pytest.warns(AveragingValidityWarning, match=f"exceeds {AVERAGING_ZETA_LIMIT}"):
         rv.predict(heavy, S, "averaging")
     deep = device(k=-np.sqrt(4.0 * K3 * 20.0 * S * M * M / (4.0 * C)))  # barrier 20 m E[v^2]
+    depth = friction_barrier_depth(deep.m, deep.c, deep.k, deep.k3, deep.friction, S)
+    assert depth > 20.0  # friction lowers E[v^2]: the wells are deeper on its scale
     refusal = (
         f"method='fpk-fast' treats double wells with friction up to a barrier of "
-        f"{FAST_MAX_BARRIER:g} m E[v^2]; this one is 20 m E[v^2] deep (its one-well corrections "
-        "fail there): use method='linearisation' or method='fpk' or Monte Carlo (randvib.simulate)"
+        f"{FAST_MAX_BARRIER:g} m E[v^2] (E[v^2] of equivalent linearisation); this one is "
+        f"{depth:.3g} m E[v^2] deep (its one-well corrections fail there): use "
+        "method='linearisation' or method='fpk' or Monte Carlo (randvib.simulate)"
     )
     with pytest.raises(ValueError) as raised:
         rv.predict(deep, S, "fpk-fast")

@@ -80,6 +80,14 @@ def test_devices_study_end_to_end(tmp_path, monkeypatch, capsys):
     methods = pd.read_csv(out / "methods.csv", **read)
     assert len(results) == 2 * 2 * 3 and len(methods) == 2 * 2 * 3 * 2
     fpk = methods[(methods.method == "fpk-fast") & (methods.input == "white")]
+    # fpk-fast refuses a double well with friction deeper than its measured limit
+    # (fokker_planck.FAST_MAX_BARRIER, the cross-check campaign): a refusal, never a number
+    why = fpk.refused.fillna("")  # an empty cell reads as NaN
+    refused = fpk[why != ""]
+    assert (refused.device == "bistable").all() and refused.power.isna().all()
+    assert refused.refused.str.contains("treats double wells with friction").all()
+    fpk = fpk[why == ""]
+    assert len(fpk) >= 4  # the other devices at both levels
     for r in fpk.itertuples():
         mc = results[(results.input == r.input) & (results.g == r.g) & (results.device == r.device)]
         mc = mc.iloc[0]
