@@ -79,6 +79,11 @@ class DesignResult:
         Monte Carlo's verdict on ``min_first_passage``: True (E[min(tau, t_end)]
         significantly above T), False (E[tau] significantly below T), None
         (undetermined: paths censored at t_end, or no bound).
+    monte_carlo_input : str or None
+        What drove the Monte Carlo: ``"record windows"`` (a measured record
+        itself, its windows the paths, :func:`randvib.monte_carlo_on_record`)
+        or ``"simulated paths"`` (Gaussian paths of the spectrum); None
+        without Monte Carlo.
     """
 
     optimum: dict
@@ -106,6 +111,7 @@ class DesignResult:
     first_passage_predicted: float = float("nan")
     first_passage_monte_carlo: FirstPassage | None = None
     first_passage_confirmed: bool | None = None
+    monte_carlo_input: str | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready: the keys of ``randvib design --json``."""
@@ -142,6 +148,7 @@ class DesignResult:
             if self.first_passage_monte_carlo is None
             else self.first_passage_monte_carlo.to_dict(),
             "first_passage_confirmed": self.first_passage_confirmed,
+            "monte_carlo_input": self.monte_carlo_input,
         }
 
     def to_frame(self):
