@@ -21,8 +21,11 @@ names the parameters to choose with their ranges. The design
    it by Monte Carlo on the confirmed candidates (each path's first time
    beyond the stroke, :class:`randvib.statistics.FirstPassage`);
 5. reports the power the excitation delivers (m S / 4 under white noise),
-   the efficiency, and the fraction of the limit
-   (:func:`randvib.analytic.harvesting_limit.harvesting_limit`).
+   the efficiency, and the fraction of the limit: under a spectrum the
+   stationary bound at the budget's displacement variance
+   (:func:`randvib.analytic.harvesting_limit.harvesting_limit`); on a record
+   the non-causal bound on the record itself with |z| <= stroke
+   (:func:`randvib.analytic.harvesting_limit.record_harvesting_limit`).
 """
 
 from __future__ import annotations
@@ -33,7 +36,11 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from randvib.analytic.harvesting_limit import gaussian_displacement_budget, harvesting_limit
+from randvib.analytic.harvesting_limit import (
+    gaussian_displacement_budget,
+    harvesting_limit,
+    record_harvesting_limit,
+)
 from randvib.harvester_design.objectives import objective_named
 from randvib.harvester_design.result import DesignResult
 from randvib.harvester_design.search import (
@@ -184,7 +191,12 @@ def design(
         raise ValueError(refusal)
     excitation = as_excitation(excitation)
     space = DesignSpace(fixed, vary)
-    limit = harvesting_limit(fixed.m, fixed.c_m, excitation, sigma_budget)
+    if isinstance(excitation, Measured) and fixed.c_m > 0:
+        limit = record_harvesting_limit(fixed.m, fixed.c_m, excitation, stroke)
+        limit_kind = "record: non-causal, |z| <= stroke"
+    else:
+        limit = harvesting_limit(fixed.m, fixed.c_m, excitation, sigma_budget)
+        limit_kind = None if limit is None else "stationary: E[z^2] <= sigma_z^2 of the budget"
     try:
         search = analytic_search(space, excitation, exceedance, goal, runners_up, min_first_passage)
     except NothingPredicted as exc:
@@ -196,7 +208,7 @@ def design(
     confirmed_on = "record windows" if isinstance(excitation, Measured) else "simulated paths"
     common = dict(objective=goal.name, stroke=float(stroke), exceedance_budget=float(exceedance),
                   evaluations=0 if search is None else search.evaluations,
-                  min_first_passage=min_first_passage)  # fmt: skip
+                  min_first_passage=min_first_passage, limit_kind=limit_kind)  # fmt: skip
     if monte_carlo:
         common["monte_carlo_input"] = confirmed_on
     if not monte_carlo:

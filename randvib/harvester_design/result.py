@@ -44,8 +44,14 @@ class DesignResult:
     efficiency : float
         Objective power over input power (mean values).
     limit : float or None
+        The most any transducer on this mass can take (W): under a spectrum
         :func:`randvib.analytic.harvesting_limit.harvesting_limit` at the
-        Gaussian displacement RMS of the budget (W); None where no finite bound exists.
+        Gaussian displacement RMS of the budget; on a measured record
+        :func:`randvib.analytic.harvesting_limit.record_harvesting_limit`,
+        the non-causal bound on the record with |z| <= stroke. None where
+        no finite bound exists.
+    limit_kind : str or None
+        Which bound ``limit`` is: ``"stationary: ..."`` or ``"record: ..."``.
     fraction_of_limit : float or None
         The optimum's power (Monte Carlo mean, else predicted) over ``limit``.
     runners_up : list of dict
@@ -112,6 +118,7 @@ class DesignResult:
     first_passage_monte_carlo: FirstPassage | None = None
     first_passage_confirmed: bool | None = None
     monte_carlo_input: str | None = None
+    limit_kind: str | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready: the keys of ``randvib design --json``."""
@@ -131,6 +138,7 @@ class DesignResult:
             else input_power,
             "efficiency": self.efficiency,
             "limit": self.limit,
+            "limit_kind": self.limit_kind,
             "fraction_of_limit": self.fraction_of_limit,
             "runners_up": [
                 {k: (_stat(v) if isinstance(v, Statistic) else v) for k, v in r.items()}
