@@ -15,7 +15,7 @@ from randvib.analytic.harvesting_limit import record_harvesting_limit
 from randvib.montecarlo.sweep import SweepSettings
 
 M, C_M = 0.0226, 0.049
-FS = 200.0  #: record sample rate (Hz)
+FS = 100.0  #: record sample rate (Hz)
 
 
 @pytest.fixture(scope="module")
