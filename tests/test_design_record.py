@@ -76,7 +76,7 @@ def test_record_limit_without_an_active_stroke_is_m2_a2_over_4cm(short_record):
 
 
 def test_record_limit_decreases_as_the_stroke_shrinks(short_record):
-    strokes = [0.02, 0.008, 0.004, 0.002, 0.001]
+    strokes = [0.008, 0.003, 0.001]
     limits = [record_harvesting_limit(M, C_M, short_record, z) for z in strokes]
     unconstrained = record_harvesting_limit(M, C_M, short_record, 10.0)
     assert limits[0] <= unconstrained
@@ -88,8 +88,7 @@ def test_record_limit_bounds_every_device_on_the_same_record(short_record):
     # devices of the design study's families, each held within |z| <= its max on the record
     devices = [
         rv.Harvester(m=M, c_m=C_M, c_e=c_e, k=k, k3=k3)
-        for k, k3, c_e in [(57.4, 0.0, 0.1), (57.4, 0.0, 0.5), (100.0, 0.0, 1.0),
-                           (57.4, 1e6, 0.3), (-20.0, 1e7, 0.2)]
+        for k, k3, c_e in [(57.4, 0.0, 0.5), (57.4, 1e6, 0.3), (-20.0, 1e7, 0.2)]
     ]  # fmt: skip
     for device in devices:
         run = rv.monte_carlo_on_record(device, short_record, segments=2, burn_in=0.0,
