@@ -138,8 +138,8 @@ def design(
     min_first_passage : float, optional
         T (s), > 0: also require a mean first-passage time to the stroke
         E[tau] >= T, from the ensembles' stationary start. The search uses
-        the prediction where there is one (Gaussian response: Poisson
-        crossings at Rice's rate, conservative for a narrow-band response);
+        the prediction where there is one (Gaussian response: Rice's rate
+        with Vanmarcke's clumping, :func:`~randvib.harvester_design.search.predicted_first_passage`);
         Monte Carlo rejects a candidate whose E[tau] is significantly below
         T (every path reached the stroke and the 95 % interval lies below T)
         and confirms it when E[min(tau, t_end)], a lower bound, is
