@@ -32,13 +32,16 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import optimize, special
+from scipy import optimize, sparse, special
 
 from randvib._validation import check_nonnegative, check_positive
 from randvib.analytic.linear_response import frequency_rule, mechanical_block
-from randvib.models.excitation import Excitation
+from randvib.models.excitation import Excitation, Measured
 
-__all__ = ["gaussian_displacement_budget", "harvesting_limit"]
+__all__ = ["gaussian_displacement_budget", "harvesting_limit", "record_harvesting_limit"]
+
+#: Samples per least-squares problem of :func:`record_harvesting_limit`.
+RECORD_CHUNK = 4096
 
 
 def gaussian_displacement_budget(stroke, exceedance) -> float:
@@ -124,3 +127,78 @@ def harvesting_limit(m, c_m, excitation: Excitation, displacement_rms) -> float 
         hi *= 10.0
     lam = optimize.brentq(lambda x: dual(x)[1], 0.0, hi, xtol=1e-300, rtol=1e-12)
     return dual(lam)[0]
+
+
+def record_harvesting_limit(m, c_m, record: Measured, stroke) -> float:
+    """Upper bound on the mean power any transducer takes on this record with |z(t)| <= stroke (W).
+
+    The non-causal bound of Haji Hosseinloo and Turitsyn, Phys. Rev. Applied
+    4, 064009 (2015), computed on the record (docs/conventions.md, "The
+    limit on a record"): with m z'' + c_m z' + f = -m a, the energy the
+    transducer force f takes is int f z' dt = -m int a z' dt - c_m int z'^2 dt
+    - (the change of kinetic energy). The record a(t) is the line between
+    its samples (as :func:`randvib.monte_carlo_on_record` drives the
+    device), its mean removed. Split z' on each sample interval into its
+    mean v_i = (z_{i+1} - z_i) / dt and the rest: the rest meets only a's
+    departure from its interval mean and takes at most
+    m^2 (a_{i+1} - a_i)^2 / (48 c_m) per unit time; the means v_i, with the
+    stroke imposed at the samples only (a relaxation), take most when
+    ``sum_i (z_{i+1} - z_i - dt b_i)^2``, ``b_i = -m (a_i + a_{i+1}) / (4 c_m)``,
+    is least subject to ``-Z <= z_i <= Z`` (a bounded linear least-squares
+    problem, :func:`scipy.optimize.lsq_linear`). Together
+
+        P_max = m^2 <a^2> / (4 c_m) - c_m <r^2>,
+
+    with <a^2> the mean square of the interpolated record and r the
+    interval velocities' residual: an upper bound on the continuous
+    problem. Without an active stroke constraint r = 0 and the optimum is
+    z' = -m a / (2 c_m). The kinetic energy's change, a boundary term of at
+    most its largest value over the record's length T, is left out. The
+    record is solved in chunks of :data:`RECORD_CHUNK` intervals with the
+    displacement free to jump between chunks, which relaxes the problem
+    further (an upper bound still, slightly looser than the whole-record
+    one). The least-squares solution is iterative: its tolerance (1e-10,
+    relative) bounds how far below the true minimum residual it can stop.
+
+    Parameters
+    ----------
+    m : float
+        Moving mass (kg), > 0.
+    c_m : float
+        Mechanical viscous damping (Ns/m), > 0 (with c_m = 0 the optimum
+        takes unbounded power).
+    record : Measured
+        The base acceleration record (m/s^2).
+    stroke : float
+        Z (m), > 0: the hard bound on |z|.
+
+    Returns
+    -------
+    float
+        P_max (W), the time average over the record.
+    """
+    m = float(check_positive("m", m, "kg"))
+    c_m = float(check_positive("c_m", c_m, "Ns/m"))
+    stroke = float(check_positive("stroke", stroke, "m"))
+    if not isinstance(record, Measured):
+        raise ValueError(f"`record` must be a randvib.Measured record, got {type(record).__name__}")
+    a = np.asarray(record.acceleration, dtype=float)
+    a = a - a.mean()
+    dt = float(record.dt)
+    # mean square of the line between samples, interval by interval
+    square = (a[:-1] ** 2 + a[:-1] * a[1:] + a[1:] ** 2) / 3.0
+    target = -m * (a[:-1] + a[1:]) / (4.0 * c_m)  # the unconstrained optimal mean velocity (m/s)
+    squares = 0.0
+    for start in range(0, target.size, RECORD_CHUNK):
+        b = target[start : start + RECORD_CHUNK] * dt  # displacement steps (m)
+        n = b.size
+        path = np.concatenate([[0.0], np.cumsum(b)])
+        if np.ptp(path) <= 2.0 * stroke:
+            continue  # the unconstrained path fits (centred in the stroke): no residual
+        d = sparse.diags([-np.ones(n), np.ones(n)], [0, 1], shape=(n, n + 1), format="csr")
+        scale = stroke  # solve in units of the stroke: the tolerances are then relative
+        fit = optimize.lsq_linear(d, b / scale, bounds=(-1.0, 1.0), method="trf",
+                                  tol=1e-10, lsmr_tol="auto", max_iter=2000)  # fmt: skip
+        squares += float(np.sum((d @ fit.x - b / scale) ** 2)) * scale**2
+    mean_square_residual = squares / dt**2 / target.size  # <r^2>, (m/s)^2
+    return m**2 * float(np.mean(square)) / (4.0 * c_m) - c_m * mean_square_residual

@@ -8,7 +8,8 @@ Carlo contradicts it, refined) by Monte Carlo with common random numbers
 (:func:`randvib.design`). ``--json`` prints one object with the keys
 ``optimum``, ``power_predicted``, ``power_monte_carlo``,
 ``stroke_exceedance_monte_carlo`` (each ``{"mean", "ci95"}``),
-``input_power``, ``limit``, with ``--min-first-passage`` the first passage
+``input_power``, ``limit`` (``limit_kind`` says which bound: stationary for
+a spectrum, non-causal on the record for ``--record``), with ``--min-first-passage`` the first passage
 predicted and by Monte Carlo, and the rest of :meth:`randvib.DesignResult.to_dict`.
 """
 
@@ -204,6 +205,10 @@ def run(args) -> int:
         rows.append(("limit", "none (white noise)", ""))
     else:
         rows.append(("limit", cell(out["limit"]), unit("limit")))
+    if out["limit_kind"] is not None:
+        rows.append(("limit_kind", out["limit_kind"], ""))
+    if out.get("monte_carlo_input") is not None:
+        rows.append(("monte_carlo_input", out["monte_carlo_input"], ""))
     if out["fraction_of_limit"] is not None:
         rows.append(
             ("fraction_of_limit", cell(out["fraction_of_limit"]), unit("fraction_of_limit"))

@@ -21,18 +21,26 @@ names the parameters to choose with their ranges. The design
    it by Monte Carlo on the confirmed candidates (each path's first time
    beyond the stroke, :class:`randvib.statistics.FirstPassage`);
 5. reports the power the excitation delivers (m S / 4 under white noise),
-   the efficiency, and the fraction of the limit
-   (:func:`randvib.analytic.harvesting_limit.harvesting_limit`).
+   the efficiency, and the fraction of the limit: under a spectrum the
+   stationary bound at the budget's displacement variance
+   (:func:`randvib.analytic.harvesting_limit.harvesting_limit`); on a record
+   the non-causal bound on the record itself with |z| <= stroke
+   (:func:`randvib.analytic.harvesting_limit.record_harvesting_limit`).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from types import SimpleNamespace
 
 import numpy as np
 
-from randvib.analytic.harvesting_limit import gaussian_displacement_budget, harvesting_limit
+from randvib.analytic.harvesting_limit import (
+    gaussian_displacement_budget,
+    harvesting_limit,
+    record_harvesting_limit,
+)
 from randvib.harvester_design.objectives import objective_named
 from randvib.harvester_design.result import DesignResult
 from randvib.harvester_design.search import (
@@ -46,7 +54,8 @@ from randvib.harvester_design.search import (
 from randvib.harvester_design.space import DesignSpace
 from randvib.models.excitation import Measured, as_excitation
 from randvib.models.harvester import Harvester
-from randvib.montecarlo.ensembles import Case, run_ensembles
+from randvib.montecarlo.ensembles import Case, EnsembleResult, run_ensembles
+from randvib.montecarlo.on_record import monte_carlo_on_record
 from randvib.montecarlo.sweep import SweepSettings
 from randvib.statistics import FirstPassage, Statistic, estimate
 
@@ -79,6 +88,7 @@ def design(
     scheduler: str | None = None,
     progress: bool = False,
     min_first_passage: float | None = None,
+    segments: int = 10,
 ) -> DesignResult:
     """Choose the varied parameters that maximise the power with ``P(|z| > stroke) <= exceedance``.
 
@@ -89,9 +99,12 @@ def design(
         coupling; the varied parameters' values in it are ignored.
     excitation : float or Excitation
         White-noise level S ((m/s^2)^2/Hz) or any excitation (a band-pass,
-        Kanai-Tajimi, tabulated or measured spectrum). A measured record's
-        Monte Carlo runs on Gaussian paths synthesised from its Welch PSD
-        (:attr:`randvib.Measured.spectrum`), not on the record itself.
+        Kanai-Tajimi, tabulated or measured spectrum). A measured record
+        is searched with its Welch PSD (:attr:`randvib.Measured.spectrum`)
+        and confirmed (and refined) on the record itself: every candidate is
+        driven by the recorded base acceleration and its ``segments``
+        windows are the paths (:func:`randvib.monte_carlo_on_record`), the
+        same windows for every candidate (common random numbers).
     vary : mapping of str to (low, high)
         The parameters to choose and their ranges (SI): ``k``, ``k3`` (any
         sign; k < 0 < k3 is bistable), ``c_e``, ``c_m``, a friction law's
@@ -118,18 +131,25 @@ def design(
         Refine by Monte Carlo where it disagrees with the analytic ranking.
     out_dir, executor, workers, scheduler, progress : optional
         As for :func:`randvib.run_ensembles` (resumable in ``out_dir``, a
-        Dask cluster at ``scheduler``).
+        Dask cluster at ``scheduler``). A record's runs take ``settings``'
+        ``burn_in`` (record time before each window), ``seed`` and a step
+        of at most ``settings.dt`` (whole substeps of the record's step);
+        they run in this process, without ``out_dir`` or a cluster.
     min_first_passage : float, optional
         T (s), > 0: also require a mean first-passage time to the stroke
         E[tau] >= T, from the ensembles' stationary start. The search uses
-        the prediction where there is one (Gaussian response: Poisson
-        crossings at Rice's rate, conservative for a narrow-band response);
+        the prediction where there is one (Gaussian response: Rice's rate
+        with Vanmarcke's clumping, :func:`~randvib.harvester_design.search.predicted_first_passage`);
         Monte Carlo rejects a candidate whose E[tau] is significantly below
         T (every path reached the stroke and the 95 % interval lies below T)
         and confirms it when E[min(tau, t_end)], a lower bound, is
         significantly above T. Paths censored at the run's end t_end
         (burn-in plus window) leave it undetermined: to confirm T, run
         longer than T (``settings``).
+    segments : int
+        A record's windows (Monte Carlo paths), >= 2; each should be much
+        longer than the device's decay time 2 m / c
+        (:attr:`randvib.RecordSimulation.lag1_correlation` checks it).
 
     Returns
     -------
@@ -171,7 +191,12 @@ def design(
         raise ValueError(refusal)
     excitation = as_excitation(excitation)
     space = DesignSpace(fixed, vary)
-    limit = harvesting_limit(fixed.m, fixed.c_m, excitation, sigma_budget)
+    if isinstance(excitation, Measured) and fixed.c_m > 0:
+        limit = record_harvesting_limit(fixed.m, fixed.c_m, excitation, stroke)
+        limit_kind = "record: non-causal, |z| <= stroke"
+    else:
+        limit = harvesting_limit(fixed.m, fixed.c_m, excitation, sigma_budget)
+        limit_kind = None if limit is None else "stationary: E[z^2] <= sigma_z^2 of the budget"
     try:
         search = analytic_search(space, excitation, exceedance, goal, runners_up, min_first_passage)
     except NothingPredicted as exc:
@@ -180,9 +205,12 @@ def design(
                 f"{exc}: only Monte Carlo can search them (monte_carlo=True)"
             ) from None
         search = None
+    confirmed_on = "record windows" if isinstance(excitation, Measured) else "simulated paths"
     common = dict(objective=goal.name, stroke=float(stroke), exceedance_budget=float(exceedance),
                   evaluations=0 if search is None else search.evaluations,
-                  min_first_passage=min_first_passage)  # fmt: skip
+                  min_first_passage=min_first_passage, limit_kind=limit_kind)  # fmt: skip
+    if monte_carlo:
+        common["monte_carlo_input"] = confirmed_on
     if not monte_carlo:
         best = search.optimum
         return DesignResult(
@@ -207,7 +235,7 @@ def design(
     )
     run = dict(settings=settings, out_dir=out_dir, executor=executor, workers=workers,
                scheduler=scheduler, progress=progress)  # fmt: skip
-    confirmed = _Confirmed(space, excitation, goal, run, min_first_passage)
+    confirmed = _Confirmed(space, excitation, goal, run, min_first_passage, segments)
     if search is None:  # Monte Carlo searches a coarse grid, then refines
         best = None
         candidates = [confirmed.point(u) for u in space.grid(COARSE if space.dimension > 1 else 5)]
@@ -298,15 +326,35 @@ def _neighbours(space: DesignSpace, u, step: float) -> list:
     return [np.clip(u + o, 0.0, 1.0) for o in offsets]
 
 
-class _Confirmed:
-    """Monte Carlo of candidates, every run on group 0 of one seed: path i is common to all."""
+class _OnRecord:
+    """Candidates' runs on a record's windows, read as an :class:`EnsembleResult` is."""
 
-    def __init__(self, space, excitation, goal, run, min_first_passage=None):
+    power_samples = EnsembleResult.power_samples
+
+    def __init__(self, runs):
+        self.runs = runs
+        self.cases = [SimpleNamespace(device=r.harvester) for r in runs]
+        self.settings = SweepSettings(control_variates=False)
+
+    def averages(self, index: int):
+        return self.runs[index].averages
+
+    def simulation(self, index: int):
+        return self.runs[index]
+
+
+class _Confirmed:
+    """Monte Carlo of candidates with common random numbers: path i is common to all.
+
+    Under a spectrum every run is group 0 of one seed; on a record path i is
+    the record's window i for every candidate.
+    """
+
+    def __init__(self, space, excitation, goal, run, min_first_passage=None, segments=10):
         self.space, self.excitation, self.goal, self.run = space, excitation, goal, run
         self.min_first_passage = min_first_passage
-        # A record drives Monte Carlo as Gaussian paths of its Welch spectrum (the same
-        # PSD the analytic search used), so that every candidate sees the same paths.
-        self.simulated = excitation.spectrum if isinstance(excitation, Measured) else excitation
+        self.record = excitation if isinstance(excitation, Measured) else None
+        self.segments = segments
         self.candidates: list = []
         self.where: dict = {}  # candidate id -> (EnsembleResult, index)
 
@@ -327,9 +375,15 @@ class _Confirmed:
         ]
         if not new:
             return
+        if self.record is not None:
+            result = _OnRecord([self._on_record(self.space.device(c.u)) for c in new])
+            for i, c in enumerate(new):
+                self.where[id(c)] = (result, i)
+            self.candidates += new
+            return
         cases = [
             Case(labels={"candidate": len(self.candidates) + i}, device=self.space.device(c.u),
-                 excitation=self.simulated, group=0)
+                 excitation=self.excitation, group=0)
             for i, c in enumerate(new)
         ]  # fmt: skip
         run = self.run
@@ -342,6 +396,15 @@ class _Confirmed:
         for i, c in enumerate(new):
             self.where[id(c)] = (result, i)
         self.candidates += new
+
+    def _on_record(self, device):
+        """The device driven by the record, its windows the paths (the same for every device)."""
+        settings = self.run["settings"]
+        substeps = max(1, math.ceil(self.record.dt / settings.dt - 1e-9))
+        return monte_carlo_on_record(
+            device, self.record, segments=self.segments, burn_in=settings.burn_in,
+            substeps=substeps, scheme=settings.scheme, seed=settings.seed, progress=False,
+        )  # fmt: skip
 
     def _samples(self, c) -> np.ndarray:
         result, i = self.where[id(c)]

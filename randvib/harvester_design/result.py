@@ -45,8 +45,14 @@ class DesignResult:
     efficiency : float
         Objective power over input power (mean values).
     limit : float or None
+        The most any transducer on this mass can take (W): under a spectrum
         :func:`randvib.analytic.harvesting_limit.harvesting_limit` at the
-        Gaussian displacement RMS of the budget (W); None where no finite bound exists.
+        Gaussian displacement RMS of the budget; on a measured record
+        :func:`randvib.analytic.harvesting_limit.record_harvesting_limit`,
+        the non-causal bound on the record with |z| <= stroke. None where
+        no finite bound exists.
+    limit_kind : str or None
+        Which bound ``limit`` is: ``"stationary: ..."`` or ``"record: ..."``.
     fraction_of_limit : float or None
         The optimum's power (Monte Carlo mean, else predicted) over ``limit``.
     runners_up : list of dict
@@ -80,6 +86,11 @@ class DesignResult:
         Monte Carlo's verdict on ``min_first_passage``: True (E[min(tau, t_end)]
         significantly above T), False (E[tau] significantly below T), None
         (undetermined: paths censored at t_end, or no bound).
+    monte_carlo_input : str or None
+        What drove the Monte Carlo: ``"record windows"`` (a measured record
+        itself, its windows the paths, :func:`randvib.monte_carlo_on_record`)
+        or ``"simulated paths"`` (Gaussian paths of the spectrum); None
+        without Monte Carlo.
     """
 
     optimum: dict
@@ -107,6 +118,8 @@ class DesignResult:
     first_passage_predicted: float = float("nan")
     first_passage_monte_carlo: FirstPassage | None = None
     first_passage_confirmed: bool | None = None
+    monte_carlo_input: str | None = None
+    limit_kind: str | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready: the keys of ``randvib design --json``."""
@@ -126,6 +139,7 @@ class DesignResult:
             else input_power,
             "efficiency": self.efficiency,
             "limit": self.limit,
+            "limit_kind": self.limit_kind,
             "fraction_of_limit": self.fraction_of_limit,
             "runners_up": [
                 {k: (_stat(v) if isinstance(v, Statistic) else v) for k, v in r.items()}
@@ -143,6 +157,7 @@ class DesignResult:
             if self.first_passage_monte_carlo is None
             else self.first_passage_monte_carlo.to_dict(),
             "first_passage_confirmed": self.first_passage_confirmed,
+            "monte_carlo_input": self.monte_carlo_input,
         }
 
     def to_frame(self):
