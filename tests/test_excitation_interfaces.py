@@ -123,7 +123,7 @@ def test_white_output_is_unchanged(capsys):
         # (power_mechanical: c_m E[v^2] + friction power)
         assert {key: got[key] for key in before} == before
         assert list(got)[: len(before)] == list(before)
-        assert set(got) - set(before) == {"power_mechanical"}
+        assert set(got) - set(before) == {"power_mechanical", "units"}
 
 
 @pytest.mark.parametrize(("excitation", "argv"), COLOURED, ids=lambda x: getattr(x, "name", ""))
