@@ -146,7 +146,7 @@ def figures(budget: pd.DataFrame, bandwidth: pd.DataFrame, out: Path) -> None:
         colours[family] = drawn[0].get_color()
     limits = budget.dropna(subset=["limit"]).drop_duplicates("stroke").sort_values("stroke")
     ax.plot(1e3 * limits.stroke, 1e3 * limits.limit, "k--", label="limit")
-    ax.set(xlabel="stroke (mm)", ylabel="power (mW)", title="band-pass 8 Hz, zeta 0.3")
+    ax.set(xlabel="stroke (mm)", ylabel="power (mW)", title=r"band-pass 8 Hz, $\zeta$ = 0.3")
     ax.legend()
     # the optimum's stiffness and electrical damping, each on its own labelled axis;
     # the families coincide where k3 -> its lower bound, so their markers differ
@@ -159,13 +159,14 @@ def figures(budget: pd.DataFrame, bandwidth: pd.DataFrame, out: Path) -> None:
     for family in style:
         if family in colours:
             style[family]["color"] = colours[family]
-    for ax, column, label in ((axes[0, 1], "k", "optimum k (N/m)"),
-                              (axes[0, 2], "c_e", "optimum c_e (Ns/m)")):  # fmt: skip
+    for ax, column, symbol, label in ((axes[0, 1], "k", "$k$", "optimum $k$ (N/m)"),
+                                      (axes[0, 2], "c_e", "$c_e$",
+                                       "optimum $c_e$ (Ns/m)")):  # fmt: skip
         for family in ("linear", "hardening"):
             sub = bandwidth[bandwidth.family == family]
             ax.plot(sub.zeta, sub[column], label=family, **style[family])
-        ax.set(xscale="log", xlabel="zeta (bandwidth 2 zeta f0)", ylabel=label,
-               title=f"optimum {column} against bandwidth")  # fmt: skip
+        ax.set(xscale="log", xlabel=r"$\zeta$ (bandwidth 2$\zeta f_0$)", ylabel=label,
+               title=f"optimum {symbol} against bandwidth")  # fmt: skip
         zetas = sorted(bandwidth.zeta.unique())
         ax.set_xticks(zetas, [f"{z:g}" for z in zetas])
         ax.tick_params(which="minor", labelbottom=False)
