@@ -117,7 +117,9 @@ def test_stored_fit_is_loaded_with_its_uncertainty_and_input_kind(tmp_path, reco
     assert loaded.input_kind == fit.input_kind == "base_acceleration"
     assert loaded.unit("input_offset") == fit.unit("input_offset")
     assert loaded.standard_errors == fit.standard_errors
-    assert loaded.confidence_intervals == pytest.approx(fit.confidence_intervals, rel=1e-12)
+    assert loaded.confidence_intervals.keys() == fit.confidence_intervals.keys()
+    for name, interval in fit.confidence_intervals.items():
+        assert loaded.confidence_intervals[name] == pytest.approx(interval, rel=1e-12)
     assert loaded.uncertainty.method == fit.uncertainty.method
     assert loaded.uncertainty.bandwidth == fit.uncertainty.bandwidth
     np.testing.assert_array_equal(loaded.uncertainty.correlation, fit.uncertainty.correlation)
