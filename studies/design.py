@@ -144,10 +144,17 @@ def figures(budget: pd.DataFrame, bandwidth: pd.DataFrame, out: Path) -> None:
         drawn = ax.errorbar(1e3 * sub.stroke, 1e3 * sub.power_mc, 1e3 * sub.power_mc_ci95,
                             marker="o", label=family, capsize=2)  # fmt: skip
         colours[family] = drawn[0].get_color()
+    # a family that cannot meet the budget at a stroke has no power to draw: a cross on
+    # the stroke axis says so instead of a silently missing point
+    for family, sub in budget[~budget.feasible].groupby("family"):
+        ax.plot(1e3 * sub.stroke, [0.0] * len(sub), "x", ms=7, mew=1.5,
+                color=colours.get(family, "0.3"),
+                label=f"{family}: budget cannot be met")  # fmt: skip
     limits = budget.dropna(subset=["limit"]).drop_duplicates("stroke").sort_values("stroke")
     ax.plot(1e3 * limits.stroke, 1e3 * limits.limit, "k--", label="limit")
     ax.set(xlabel="stroke (mm)", ylabel="power (mW)", title=r"band-pass 8 Hz, $\zeta$ = 0.3")
-    ax.legend()
+    # between the limit (above) and the devices' powers (below): the space the data leave
+    ax.legend(loc="lower right", bbox_to_anchor=(1.0, 0.25), fontsize=7)
     # the optimum's stiffness and electrical damping, each on its own labelled axis;
     # the families coincide where k3 -> its lower bound, so their markers differ
     # (filled circles and a solid line: linear; open squares and a dashed line: hardening;
