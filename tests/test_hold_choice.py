@@ -33,6 +33,33 @@ M = 0.0226
 OFFSETS = {"input_offset": 0.3, "output_offset": 5e-4}
 
 
+def rk4_displacement(fine, h, truth, every=1):
+    """Eq. 1 with Coulomb friction (``truth``'s c, k, k3, fc; mass M) by RK4 at step
+    ``h`` on the finely sampled base acceleration ``fine``, from rest; z (m) at every
+    ``every``-th fine sample, the last entry the final state. An independent
+    integrator: none of randvib's simulators."""
+    c, k, k3, fc = (truth[name] for name in ("c", "k", "k3", "fc"))
+
+    def f(z, v, y):
+        return v, -(c * v + k * z + k3 * z**3 + fc * np.sign(v)) / M - y
+
+    z = v = 0.0
+    out = np.empty(len(fine) // every)
+    for i in range(out.size * every - 1):
+        if i % every == 0:
+            out[i // every] = z
+        y0, y1 = fine[i], fine[i + 1]
+        ym = 0.5 * (y0 + y1)
+        d1 = f(z, v, y0)
+        d2 = f(z + h / 2 * d1[0], v + h / 2 * d1[1], ym)
+        d3 = f(z + h / 2 * d2[0], v + h / 2 * d2[1], ym)
+        d4 = f(z + h * d3[0], v + h * d3[1], y1)
+        z += h / 6 * (d1[0] + 2 * d2[0] + 2 * d3[0] + d4[0])
+        v += h / 6 * (d1[1] + 2 * d2[1] + 2 * d3[1] + d4[1])
+    out[-1] = z
+    return out
+
+
 def shaker_record(duration=2.0, fs=1000.0, top=350.0, rms=25.0, up=16, seed=0):
     """Base acceleration (m/s^2) low-passed at ``top`` (8th-order Butterworth,
     forward and backward: an anti-aliased sensor) and the relative displacement
@@ -46,26 +73,7 @@ def shaker_record(duration=2.0, fs=1000.0, top=350.0, rms=25.0, up=16, seed=0):
     a = signal.sosfiltfilt(signal.butter(2, 3.0 / (fs / 2), btype="high", output="sos"), a)
     a *= rms / a.std()
     fine = signal.resample(a, n * up)  # exact at the samples, band-limited between
-    h = 1.0 / (fs * up)
-    c, k, k3, fc = (TRUTH[n] for n in ("c", "k", "k3", "fc"))
-
-    def f(z, v, y):
-        return v, -(c * v + k * z + k3 * z**3 + fc * np.sign(v)) / M - y
-
-    z = v = 0.0
-    out = np.empty(n)
-    for i in range(n * up - 1):
-        if i % up == 0:
-            out[i // up] = z
-        y0, y1 = fine[i], fine[i + 1]
-        ym = 0.5 * (y0 + y1)
-        d1 = f(z, v, y0)
-        d2 = f(z + h / 2 * d1[0], v + h / 2 * d1[1], ym)
-        d3 = f(z + h / 2 * d2[0], v + h / 2 * d2[1], ym)
-        d4 = f(z + h * d3[0], v + h * d3[1], y1)
-        z += h / 6 * (d1[0] + 2 * d2[0] + 2 * d3[0] + d4[0])
-        v += h / 6 * (d1[1] + 2 * d2[1] + 2 * d3[1] + d4[1])
-    out[-1] = z
+    out = rk4_displacement(fine, 1.0 / (fs * up), TRUTH, up)
     return Record(
         1.0 / fs,
         base_acceleration=a + OFFSETS["input_offset"],

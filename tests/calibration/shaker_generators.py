@@ -44,25 +44,7 @@ FS = 1000.0
 
 def rk4(a_fine, h, truth):
     """Eq. 1 with Coulomb friction by RK4 on a finely sampled base acceleration."""
-    c, k, k3, fc = (truth[n] for n in ("c", "k", "k3", "fc"))
-
-    def f(z, v, y):
-        return v, -(c * v + k * z + k3 * z**3 + fc * np.sign(v)) / T.M - y
-
-    z = v = 0.0
-    out = np.empty(a_fine.size)
-    for i in range(a_fine.size - 1):
-        out[i] = z
-        y0, y1 = a_fine[i], a_fine[i + 1]
-        ym = 0.5 * (y0 + y1)
-        d1 = f(z, v, y0)
-        d2 = f(z + h / 2 * d1[0], v + h / 2 * d1[1], ym)
-        d3 = f(z + h / 2 * d2[0], v + h / 2 * d2[1], ym)
-        d4 = f(z + h * d3[0], v + h * d3[1], y1)
-        z += h / 6 * (d1[0] + 2 * d2[0] + 2 * d3[0] + d4[0])
-        v += h / 6 * (d1[1] + 2 * d2[1] + 2 * d3[1] + d4[1])
-    out[-1] = z
-    return out
+    return T.rk4_displacement(a_fine, h, truth)
 
 
 def decimated(kind, seed, duration=2.0, rms=25.0):
