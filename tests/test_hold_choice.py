@@ -112,13 +112,7 @@ def test_linear_hold_on_the_wideband_record_warns_naming_hold(rig):
 
 def test_cli_identify_with_linear_hold_warns_on_stderr(rig, tmp_path, capsys):
     path = tmp_path / "rig.csv"
-    np.savetxt(
-        path,
-        np.c_[rig.time, rig.input, rig.z],
-        delimiter=",",
-        header="time,base_acceleration,relative_displacement",
-        comments="",
-    )
+    rig.to_csv(path, float_format=None)  # every digit: the CLI reads the same record
     code = main(
         ["identify", str(path), "--model", "coulomb", "--m", str(M), "--hold", "linear"]
         + ["--generations", "1", "--popsize", "8", "--no-polish", "--no-progress"]
@@ -130,22 +124,15 @@ def test_cli_identify_with_linear_hold_warns_on_stderr(rig, tmp_path, capsys):
 def test_cli_default_identify_of_a_strongly_hardening_record_is_within_5_percent(tmp_path, capsys):
     """The hardest record of the generator over seeds 0-9: at seed 1 the response
     reaches so far into the cubic range that k3 z_max^2 exceeds twice the linear
-    stiffness, outside the k3 box the defaults once gave (the fit then stopped on
-    its bound at -21 %, with c, Fc and the input offset 24 to 140 % off and no
-    warning). ``randvib identify rig.csv --model coulomb --m 0.0226``, nothing
+    stiffness (a k3 search box of 2 m w^2 / z_max^2 would stop the fit on its bound
+    at -21 %, with c, Fc and the input offset 24 to 140 % off). ``randvib identify rig.csv --model coulomb --m 0.0226``, nothing
     else: every parameter and offset within 5 % (the record is noise-free: only
     the model's discretisation errs), nothing on a bound, no warning."""
     import json
 
     rig = shaker_record(seed=1)
     path = tmp_path / "rig.csv"
-    np.savetxt(
-        path,
-        np.c_[rig.time, rig.input, rig.z],
-        delimiter=",",
-        header="time,base_acceleration,relative_displacement",
-        comments="",
-    )
+    rig.to_csv(path, float_format=None)  # every digit: the CLI reads the same record
     code = main(["identify", str(path), "--model", "coulomb", "--m", str(M), "--json"])
     out = capsys.readouterr()
     assert code == 0 and "--bounds" not in out.err and "--hold" not in out.err
