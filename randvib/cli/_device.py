@@ -236,13 +236,7 @@ def _bridge_from_args(args):
         raise ValueError(
             f"the {cls.name} needs {', '.join(f'`{option_flag(n)}`' for n in missing)}"
         )
-    try:
-        return cls(**given)
-    except ValueError as exc:  # name the flag, not the parameter
-        message = str(exc)
-        for name in own:
-            message = message.replace(f"`{name}`", f"`{option_flag(name)}`")
-        raise ValueError(message) from None
+    return _built(cls, given, own)
 
 
 def _coupling_from_args(args):
@@ -275,11 +269,16 @@ def _coupling_from_args(args):
             f"{flags} must be given together for the {cls.name} coupling "
             f"(missing {', '.join(f'`{option_flag(n)}`' for n in missing)})"
         )
+    return _built(cls, given, given)
+
+
+def _built(cls, given: dict, names):
+    """``cls(**given)``, its refusal naming the flags of ``names``, not the parameters."""
     try:
         return cls(**given)
-    except ValueError as exc:  # name the flag, not the parameter
+    except ValueError as exc:
         message = str(exc)
-        for name in given:
+        for name in names:
             message = message.replace(f"`{name}`", f"`{option_flag(name)}`")
         raise ValueError(message) from None
 
