@@ -52,6 +52,8 @@ _EXPORTS = {
     "randvib.analytic.fokker_planck": ("fast_fpk_statistics", "fpk_statistics", "solve_fpk"),
     "randvib.models.friction": ("Coulomb", "FrictionModel", "LuGre", "Tanh"),
     "randvib.models.harvester": ("Harvester",),
+    "randvib.models.assembly": ("Assembly",),
+    "randvib.models.assembly_parts": ("Element", "ElectricalDamper", "Spring", "Transducer"),
     "randvib.models.coupling": ("Coupling", "COUPLINGS", "Inductive", "Piezo", "Resistive"),
     "randvib.models.rectifier": ("BridgeCoil", "BridgePiezo", "RECTIFIED", "Rectified"),
     "randvib.identification.cost": ("normalised_cost",),
