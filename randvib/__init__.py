@@ -67,6 +67,11 @@ _EXPORTS = {
     "randvib.analytic.linearisation": ("coulomb_equivalent_damping", "equivalent_damping"),
     "randvib.analytic.method": ("AnalyticMethod",),
     "randvib.analytic.power_prediction": ("PowerPrediction",),
+    "randvib.analytic.assembly_prediction": (
+        "AssemblyLoad",
+        "AssemblyPrediction",
+        "optimal_assembly_loads",
+    ),
     "randvib.analytic.bridge": ("DcOptimum", "optimal_dc_output"),
     "randvib.montecarlo.bridge_optimum": ("simulated_dc_optimum",),
     "randvib.analytic.prediction": (
