@@ -99,12 +99,24 @@ def test_power_device_sweep_and_table(capsys):
          "`--method averaging` treats the single-mass harvester; an assembly needs `--method "
          "linearisation`"),
         (["simulate", "--device", "host_with_harvester", "--psd", "0.1"], "is not taken here yet"),
-        (["record", "--device", "host_with_harvester", "--psd", "0.1", "--out", "x.csv"],
-         "is not taken here yet"),
     ],
 )  # fmt: skip
 def test_device_refusals_are_one_line(capsys, argv, fragment):
     one_line_error(capsys, argv, fragment)
+
+
+def test_record_refuses_a_device(capsys, tmp_path):
+    argv = [
+        "record",
+        "--device",
+        "host_with_harvester",
+        "--psd",
+        "0.1",
+        "--out",
+        tmp_path / "r.csv",
+    ]
+    one_line_error(capsys, argv, "is not taken here yet")
+    assert not (tmp_path / "r.csv").exists()
 
 
 def test_bad_device_file_is_one_line(capsys, tmp_path):
