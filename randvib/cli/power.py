@@ -93,7 +93,8 @@ def register(sub) -> None:
         action="store_true",
         help="also the load resistance R_L that maximises the load power, and that power "
         "(needs a coupling: --alpha/--r-load/--r-coil or --coupling; its --r-load is the start); "
-        "with --rectifier bridge, the battery voltage or storage load maximising the stored power",
+        "with --rectifier bridge, the battery voltage or storage load maximising the stored power; "
+        "with --device, each transducer's load (the others as given)",
     )
     p.add_argument(
         "--optimal-bounds",
