@@ -9,6 +9,8 @@ described by its class in :mod:`randvib.models.friction`). It declares
   - one line on its cost and accuracy (the CLI's help);
 * what it accepts: ``coloured`` (a non-white excitation), ``circuit`` (a
   coupling with a circuit state: coil inductance, piezo capacitance),
+  ``assemblies`` (an :class:`~randvib.models.assembly.Assembly` of several
+  DOFs, :mod:`randvib.analytic.assembly_prediction`),
   ``potentials`` (kinds of :mod:`randvib.models.potential`) and
   ``friction_form`` (a key of :data:`FRICTION_FORMS`: any memoryless law, or
   the form Fc tanh(beta v));
@@ -38,6 +40,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from randvib._validation import check_choice
+from randvib.models.assembly import Assembly
 from randvib.models.excitation import Excitation
 from randvib.models.harvester import Harvester
 from randvib.models.potential import CONFINING
@@ -142,6 +145,9 @@ class AnalyticMethod:
     circuit: bool = False
     #: Accepts a coupling through a diode bridge (:mod:`randvib.models.rectifier`).
     rectifier: bool = False
+    #: Accepts an assembly (:class:`~randvib.models.assembly.Assembly`; solved by
+    #: :func:`randvib.analytic.assembly_prediction.predict_assembly`).
+    assemblies: bool = False
     #: Potential kinds it treats (see :data:`randvib.models.potential.KINDS`).
     potentials: tuple[str, ...] = CONFINING + ("free",)
     #: The friction laws it treats: a key of :data:`FRICTION_FORMS`.
@@ -204,6 +210,11 @@ class AnalyticMethod:
 
     def _reason(self, harvester, psd, who, alternatives: bool = False) -> str | None:
         """The first declaration the case fails, in words (with the alternatives), or None."""
+        if isinstance(harvester, Assembly):
+            if self.assemblies:
+                return None
+            others = self._alternatives(harvester, psd) if alternatives else MONTE_CARLO
+            return f"{who} treats the single-mass harvester; an assembly needs {others}"
         potential = harvester.potential
         if getattr(psd, "is_event", False) and not self.transient:
             return (

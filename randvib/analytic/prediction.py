@@ -32,6 +32,7 @@ from randvib._validation import (
     check_scalar,
     check_scalar_device,
 )
+from randvib.analytic.assembly_prediction import predict_assembly
 from randvib.analytic.averaging import AVERAGING
 from randvib.analytic.bridge import BRIDGE_CLOSURE
 from randvib.analytic.fokker_planck import FAST_FOKKER_PLANCK, FOKKER_PLANCK
@@ -44,6 +45,7 @@ from randvib.analytic.method import (
 )
 from randvib.analytic.power_prediction import PowerPrediction
 from randvib.analytic.statistical_linearisation import LINEARISATION, LinearisationDidNotConverge
+from randvib.models.assembly import Assembly
 from randvib.models.excitation import BROADCASTING, Excitation
 from randvib.models.harvester import Harvester
 
@@ -69,9 +71,13 @@ def predict(harvester: Harvester, psd, method="linearisation") -> PowerPredictio
 
     Parameters
     ----------
-    harvester : Harvester
+    harvester : Harvester or Assembly
         Device; parameters may be arrays broadcasting with ``psd`` (scalars
-        under a non-white excitation or with a circuit state).
+        under a non-white excitation or with a circuit state). An
+        :class:`~randvib.models.assembly.Assembly` (several DOFs, elements,
+        transducers; scalars) gives an
+        :class:`~randvib.analytic.assembly_prediction.AssemblyPrediction`:
+        ``method="linearisation"`` only, exact for a linear assembly.
     psd : array_like or Excitation
         One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0 (white noise,
         paper Eq. 17), or an excitation object: ``White(S)`` is the same as
@@ -127,6 +133,8 @@ def predict(harvester: Harvester, psd, method="linearisation") -> PowerPredictio
             "response is randvib.transient_response (or Monte Carlo, randvib.simulate_transient)"
         )
     solver = method_named(method)
+    if isinstance(harvester, Assembly):  # several DOFs: randvib.analytic.assembly_prediction
+        return predict_assembly(harvester, psd, solver)
     solver.require(harvester, psd)
     _refuse_undamped(harvester)
     if not non_white(psd):  # White(S) runs exactly the code of the number S
