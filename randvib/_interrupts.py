@@ -148,10 +148,10 @@ def worker_ignores_ctrl_c() -> None:
 #: The stop flags of the compiled loops running now (:func:`interruptible`): a
 #: Ctrl-C noticed by :func:`ctrl_c_noticed` sets them, so a loop stops even when
 #: the KeyboardInterrupt itself is swallowed on its way to the caller.
-_RUNNING_LOOPS: list = []
+_RUNNING_LOOPS: dict[int, object] = {}
 #: The signals noticed so far by each :func:`ctrl_c_noticed` block now open: a
 #: loop asked to start after one was swallowed does not start.
-_OPEN_WATCHES: list[list[int]] = []
+_OPEN_WATCHES: dict[int, list[int]] = {}
 
 
 def _raise_if_noticed(noticed: list[int]) -> None:
@@ -184,18 +184,18 @@ def ctrl_c_noticed():
 
     def notice(signum, frame):
         noticed.append(signum)
-        for stop in _RUNNING_LOOPS:
+        for stop in list(_RUNNING_LOOPS.values()):
             stop[0] = 1
         previous[signum](signum, frame)
 
     watched = [s for s, handler in previous.items() if callable(handler)]
     for s in watched:
         signal.signal(s, notice)
-    _OPEN_WATCHES.append(noticed)
+    _OPEN_WATCHES[id(noticed)] = noticed  # by identity: two empty lists are equal
     try:
         yield
     finally:
-        _OPEN_WATCHES.remove(noticed)
+        del _OPEN_WATCHES[id(noticed)]
         for s in watched:
             signal.signal(s, previous[s])
     _raise_if_noticed(noticed)  # the block ended normally: its interrupt was swallowed
@@ -230,9 +230,9 @@ def interruptible(compiled, **kwargs):
             outcome["error"] = exc
 
     worker = threading.Thread(target=target, name="randvib-kernel", daemon=True)
-    for noticed in _OPEN_WATCHES:  # an interrupt swallowed before this loop was asked for
+    for noticed in list(_OPEN_WATCHES.values()):  # one swallowed before this loop began
         _raise_if_noticed(noticed)
-    _RUNNING_LOOPS.append(stop)
+    _RUNNING_LOOPS[id(stop)] = stop
     try:
         with ctrl_c_noticed():
             worker.start()
@@ -244,7 +244,7 @@ def interruptible(compiled, **kwargs):
                 worker.join()
                 raise
     finally:
-        _RUNNING_LOOPS.remove(stop)
+        del _RUNNING_LOOPS[id(stop)]
     if "error" in outcome:
         raise outcome["error"]
     return outcome["value"]

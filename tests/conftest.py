@@ -53,6 +53,8 @@ class _ProcessState:
         self.threads = set(threading.enumerate())
         mpl = sys.modules.get("matplotlib")
         self.rc = None if mpl is None else dict(mpl.rcParams)
+        numba = sys.modules.get("numba")
+        self.numba_threads = None if numba is None else numba.get_num_threads()
 
     def changes(self, after: "_ProcessState") -> list[str]:
         """What differs in ``after``, in words (threads are handled apart)."""
@@ -92,6 +94,8 @@ class _ProcessState:
         mpl = sys.modules.get("matplotlib")
         if mpl is not None and self.rc is not None:
             mpl.rcParams.update(self.rc)
+        if self.numba_threads is not None:
+            sys.modules["numba"].set_num_threads(self.numba_threads)
 
 
 @pytest.fixture(autouse=True)
@@ -103,7 +107,7 @@ def _process_state_restored(request):
     it, timers it started are cancelled (a Ctrl-C timer firing in a later test
     stopped the wrong test), threads it started are given a moment to end, and
     signal handlers, mask, environment, working directory, numpy's error state,
-    rcParams and the friction-law registry are put back. A test that changed
+    rcParams, the friction-law registry and numba's thread count are put back. A test that changed
     the signal handlers, the signal mask or the working directory without
     restoring them itself fails here, naming what it left behind: tests must
     restore what they change (monkeypatch, tmp_path), so that none depends on
@@ -180,3 +184,44 @@ if _CPU_LOG:
             log.write(
                 f"{_cpu_seconds() - cpu:.3f}\t{time.perf_counter() - wall:.3f}\t{item.nodeid}\n"
             )
+
+
+# ---------------------------------------------------------------- running in parallel
+# The suite runs on pytest-xdist's workers with --dist loadgroup (pyproject.toml): a
+# test joins its module's group when it uses a module- or class-scoped fixture (a
+# built site, a study's quick run, the mutants), so that the fixture is built on one
+# worker only; other tests are shared out one by one. Groups are handed out in
+# collection order, and the modules that take longest (measured with
+# RANDVIB_TEST_CPU, docs/testing.md) are moved to the front so that neither worker is
+# left with a long module at the end. pytest-randomly shuffles the order first (a
+# new seed every run, printed in the header): an order dependence shows up as a
+# failure that `-p randomly_seed=N` repeats.
+
+#: Test modules moved to the front of the queue, longest first.
+LONG_MODULES = (
+    "test_mutations.py",
+    "test_docs.py",
+)
+
+
+def _shared_scope(item) -> bool:
+    """Whether the test uses a fixture built once per module or class."""
+    info = getattr(item, "_fixtureinfo", None)
+    if info is None:
+        return False
+    for definitions in info.name2fixturedefs.values():
+        if definitions and definitions[-1].scope in ("module", "class", "package"):
+            return True
+    return False
+
+
+def pytest_collection_modifyitems(config, items):
+    for item in items:
+        if _shared_scope(item):
+            item.add_marker(pytest.mark.xdist_group(item.module.__name__))
+
+    def rank(item):
+        name = item.path.name
+        return LONG_MODULES.index(name) if name in LONG_MODULES else len(LONG_MODULES)
+
+    items.sort(key=rank)  # stable: the shuffled order is kept within each rank

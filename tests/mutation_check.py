@@ -745,7 +745,11 @@ def run_prepared(
     if not Path(where).resolve().is_relative_to(root.resolve()):
         raise RuntimeError(f"the mutant copy is not the imported package ({where})")
     targets = ["tests"] if full else list(mutation.tests)
-    cmd = [sys.executable, "-m", "pytest", "-q", "-x", "-p", "no:cacheprovider", *targets]
+    # one process per mutant (the caller runs mutants side by side; --full spreads the
+    # whole suite over the cores), in the named tests' own order
+    workers = ["-n", "auto"] if full else ["-n", "0"]
+    cmd = [sys.executable, "-m", "pytest", "-q", "-x", "-p", "no:cacheprovider", *workers]
+    cmd += ["-p", "no:randomly", *targets]
     cmd += ["--ignore", "tests/test_mutations.py"]  # no mutants of mutants
     start = time.perf_counter()
     proc = subprocess.run(
