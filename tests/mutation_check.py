@@ -17,13 +17,16 @@ the modules the mutation cannot reach (numba keys a cached kernel on its own
 bytecode only, not on the functions it calls from other modules, so every
 module that imports the mutated one, directly or not, is recompiled).
 
-Run by hand::
+Run by hand (not in the default suite: 50+ mutants cost about 8 CPU-minutes)::
 
-    python tests/mutation_check.py            # every mutation, its own tests
+    python tests/mutation_check.py --record   # every mutation, its own tests; keeps
+                                              # the outcomes in tests/mutation_results.txt
     python tests/mutation_check.py --list     # the table of mutations
     python tests/mutation_check.py --only noise-variance --full
 
-and in the test suite by ``tests/test_mutations.py`` (marked ``slow``).
+``tests/test_mutations.py`` checks, in the default suite, that every mutation still
+applies to exactly one place, that the kept results name every mutation as caught by
+one of its own tests, and runs one mutant end to end.
 """
 
 from __future__ import annotations
@@ -36,6 +39,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -930,6 +934,82 @@ def markdown_table(mutations=MUTATIONS) -> str:
     return "\n".join(rows) + "\n"
 
 
+#: The last full run's outcome per mutation (``python tests/mutation_check.py --record``),
+#: read by tests/test_mutations.py: the default suite does not run 50+ mutants (each
+#: a pytest process and often a numba recompile: about 8 CPU-minutes in all).
+RESULTS = ROOT / "tests" / "mutation_results.txt"
+
+
+def _git_state() -> str:
+    """The commit the mutants were made from, ``+dirty`` when the tree had edits."""
+    try:
+        head = subprocess.run(
+            ["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True
+        ).stdout.strip()
+        dirty = subprocess.run(
+            ["git", "status", "--porcelain", "--untracked-files=no"],
+            cwd=ROOT,
+            capture_output=True,
+            text=True,
+        ).stdout.strip()
+    except OSError:
+        return "unknown"
+    return (head or "unknown") + ("+dirty" if dirty else "")
+
+
+def _first_failure(outcome: Outcome) -> str:
+    """The node id of the first failed test in a mutant's run ('-' if none)."""
+    for line in outcome.output.splitlines():
+        if line.startswith("FAILED "):
+            return line.split()[1]
+    return "-"
+
+
+def write_results(outcomes: list, path: Path = RESULTS) -> None:
+    """Keep a run's outcomes: one line per mutation (name, verdict, seconds, first failure)."""
+    lines = [
+        "# python tests/mutation_check.py --record: the curated mutants and what caught them",
+        f"# commit {_git_state()}, {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, "
+        f"python {sys.version.split()[0]}",
+    ]
+    for o in outcomes:
+        verdict = "caught" if o.caught else ("NOT-CAUGHT" if o.returncode == 0 else "ERROR")
+        lines.append(f"{o.mutation.name}\t{verdict}\t{o.seconds:.0f}\t{_first_failure(o)}")
+    path.write_text("\n".join(lines) + "\n")
+
+
+def read_results(path: Path = RESULTS) -> dict[str, tuple[str, str]]:
+    """{mutation name: (verdict, first failed test)} from :data:`RESULTS`."""
+    results = {}
+    for line in path.read_text().splitlines():
+        if line and not line.startswith("#"):
+            name, verdict, _seconds, failed = line.split("\t")
+            results[name] = (verdict, failed)
+    return results
+
+
+def run_all(chosen, full: bool = False, jobs: int = 2) -> list:
+    """Every chosen mutant, ``jobs`` at a time; outcomes in the order of ``chosen``.
+
+    A mutant's run is mostly one pytest process (and numba recompiling what the
+    mutation reaches) on one core, so runs side by side fill the machine.
+    """
+    with tempfile.TemporaryDirectory(prefix="mutants-") as tmp:
+        prepared = []
+        for mutation in chosen:  # serially: ast.parse of CPython 3.11 is not re-entrant
+            work = Path(tmp) / mutation.name
+            work.mkdir()
+            prepared.append((mutation, prepare_mutant(mutation, work)))
+
+        def run(item):
+            outcome = run_prepared(*item, full=full)
+            print(outcome.summary(), flush=True)
+            return outcome
+
+        with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
+            return list(pool.map(run, prepared))
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", nargs="+", metavar="NAME", help="mutations to run")
@@ -938,7 +1018,16 @@ def main(argv=None) -> int:
     parser.add_argument(
         "--markdown", action="store_true", help="print the table for docs/testing.md and exit"
     )
+    parser.add_argument(
+        "--jobs", type=int, default=os.cpu_count() or 1, help="mutants run side by side"
+    )
+    parser.add_argument(
+        "--record", action="store_true", help=f"keep the outcomes in {RESULTS.relative_to(ROOT)}"
+    )
     args = parser.parse_args(argv)
+    unknown = sorted(set(args.only or ()) - {m.name for m in MUTATIONS})
+    if unknown:
+        parser.error(f"--only: no mutation named {', '.join(unknown)} (see --list)")
     chosen = [m for m in MUTATIONS if not args.only or m.name in args.only]
     if args.markdown:
         print(markdown_table(chosen), end="")
@@ -947,13 +1036,13 @@ def main(argv=None) -> int:
         for m in chosen:
             print(f"{m.name:28s} {m.path:32s} {', '.join(m.tests)}\n    {m.why}")
         return 0
-    survivors = 0
-    for mutation in chosen:
-        with tempfile.TemporaryDirectory(prefix=f"mutant-{mutation.name}-") as tmp:
-            outcome = run_mutant(mutation, Path(tmp), full=args.full)
-        print(outcome.summary(), flush=True)
-        survivors += not outcome.caught
+    if args.record and (args.only or args.full):
+        parser.error("--record keeps a run of every mutation on its own tests: drop --only/--full")
+    outcomes = run_all(chosen, full=args.full, jobs=args.jobs)
+    survivors = sum(not o.caught for o in outcomes)
     print(f"{len(chosen) - survivors} of {len(chosen)} mutations caught")
+    if args.record:
+        write_results(outcomes)
     return 1 if survivors else 0
 
 
