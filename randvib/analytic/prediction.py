@@ -34,10 +34,11 @@ from randvib._validation import (
 )
 from randvib.analytic.averaging import AVERAGING
 from randvib.analytic.bridge import BRIDGE_CLOSURE
+from randvib.analytic.fixed_point import LinearisationDidNotConverge
 from randvib.analytic.fokker_planck import FAST_FOKKER_PLANCK, FOKKER_PLANCK
 from randvib.analytic.method import AnalyticMethod, non_white, white_level
 from randvib.analytic.power_prediction import PowerPrediction
-from randvib.analytic.statistical_linearisation import LINEARISATION, LinearisationDidNotConverge
+from randvib.analytic.statistical_linearisation import LINEARISATION
 from randvib.models.excitation import BROADCASTING, Excitation
 from randvib.models.harvester import Harvester
 

@@ -270,7 +270,7 @@ def execute(run: Run, *, control_variates, check_step, threads, batch_paths, pro
         histogram=histogram,
         histories=histories,
         wall_time=wall,
-        excitation=run.excitation,
+        excitation=run.input,
     )
     if check_step:  # the per-run identity: every path sums to m S / 4
         check_bridge_balance(result)
