@@ -51,10 +51,18 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import special
 
+from randvib._validation import check_scalar_device
 from randvib.analytic.fixed_point import TrialUndefined, solve
-from randvib.analytic.linear_response import device_block, output_variances
+from randvib.analytic.linear_response import (
+    ResponseSpectra,
+    device_block,
+    output_variances,
+    response_spectra,
+)
 from randvib.analytic.linearisation import linear_power
+from randvib.analytic.method import is_linear_device
 from randvib.models.combined import parts_of
+from randvib.models.potential import CONFINING
 
 #: Phase points per tone of the equivalents' phase average (trapezoid rule), by number
 #: of tones: a tensor grid of at most 4096 points.
@@ -288,6 +296,50 @@ class CombinedLinearisation:
     tones: tuple
     method: str
 
+    def response_spectra(self, frequency) -> ResponseSpectra:
+        """The random part's PSDs at ``frequency`` (Hz) and the tones' lines (mean squares).
+
+        The continuous spectra are the random parts through the random part's
+        linear device (m, c_r, k_r); each tone is a line of mean square
+        |H|^2 A^2 / 2 on its own linear device (m, c_q, k_q).
+        """
+        h = self.harvester
+        f = np.asarray(frequency, dtype=float)
+        random, _, shocks = parts_of(self.excitation)
+        block = device_block(h.m, self.random_c_eq, self.k_eq, h.electrical)
+        spectra = {name: np.zeros(f.shape) for name in block.outputs}
+        source = np.zeros(f.shape)
+        for part in (random, shocks):
+            if part is not None:
+                source = source + part.psd(f)
+                for name, value in response_spectra(block, part, f).items():
+                    spectra[name] = spectra[name] + value
+        state = h.electrical.state_name if h.has_circuit else None
+        lines = None
+        if self.tones:
+            z2 = np.array([0.5 * t.displacement_amplitude**2 for t in self.tones])
+            v2 = np.array([0.5 * t.velocity_amplitude**2 for t in self.tones])
+            x2 = (
+                None
+                if state is None
+                else np.array([0.5 * t.circuit_amplitude**2 for t in self.tones])
+            )
+            lines = {
+                "frequency": np.array([t.frequency for t in self.tones]),
+                "displacement": z2,
+                "velocity": v2,
+                "power": np.asarray(linear_power(h, v2, x2)[0], dtype=float) * np.ones(z2.size),
+            }
+        return ResponseSpectra(
+            frequency=f,
+            excitation=source,
+            displacement=spectra["z"],
+            velocity=spectra["v"],
+            power=linear_power(h, spectra["v"], None if state is None else spectra[state])[0]
+            * np.ones(f.shape),
+            lines=lines,
+        )
+
     def stroke_exceedance(self, stroke: float | None):
         """P(|z| > stroke) of the sinusoids plus the Gaussian random part; None without a stroke."""
         if stroke is None:
@@ -338,6 +390,7 @@ def combined_linearisation(harvester, excitation) -> CombinedLinearisation:
         near its resonance can have several).
     """
     random, tones, shocks = parts_of(excitation)
+    _check_case(harvester, shocks)
     system = CombinedSystem(harvester, tones, [p for p in (random, shocks) if p is not None])
     start = _Motion(1.0, 1.0, np.ones(len(tones)))  # any motion: a linear device ignores it
     if system.is_linear:
@@ -361,6 +414,25 @@ def combined_linearisation(harvester, excitation) -> CombinedLinearisation:
 
     motion = system.unpack(solve(residual, system.pack(linear.respond(start))))
     return _report(system, excitation, motion, "harmonic")
+
+
+def _check_case(harvester, shocks) -> None:
+    """Scalar parameters, a memoryless law, a confining potential; shocks on a linear device."""
+    check_scalar_device(harvester, "combined_linearisation")
+    law = harvester.friction
+    if law is not None and not law.has_equivalent_damping:
+        raise ValueError(
+            f"combined_linearisation needs a memoryless friction law; {law.name!r} has internal "
+            "state: use Monte Carlo (randvib.simulate)"
+        )
+    harvester.potential.require(
+        "combined_linearisation", CONFINING, "Monte Carlo (randvib.simulate)"
+    )
+    if shocks is not None and not is_linear_device(harvester):
+        raise ValueError(
+            "combined_linearisation treats shocks on a linear device only (Campbell's theorem: "
+            "no friction, no cubic spring): use Monte Carlo (randvib.simulate)"
+        )
 
 
 def _report(system: CombinedSystem, excitation, motion: _Motion, method: str):

@@ -50,7 +50,12 @@ from randvib import _display, formatting
 from randvib._validation import check_scalar_device
 from randvib.analytic.fixed_point import TrialUndefined, solve
 from randvib.analytic.harmonic_linearisation import combined_linearisation
-from randvib.analytic.linear_response import device_block, output_variances, response_spectra
+from randvib.analytic.linear_response import (
+    ResponseSpectra,
+    device_block,
+    output_variances,
+    response_spectra,
+)
 from randvib.analytic.linearisation import (
     LinearisedDevice,
     linear_power,
@@ -70,36 +75,6 @@ from randvib.models.excitation import Excitation, as_excitation
 from randvib.models.harvester import Harvester
 from randvib.models.potential import CONFINING
 from randvib.quantities import unit
-
-
-@dataclass(frozen=True, eq=False)
-class ResponseSpectra:
-    """One-sided PSDs of the linearised response (SI units, f in Hz).
-
-    Attributes
-    ----------
-    frequency : ndarray
-        f (Hz).
-    excitation : ndarray
-        S(f) of the base acceleration ((m/s^2)^2/Hz).
-    displacement, velocity : ndarray
-        PSD of z (m^2/Hz) and of v ((m/s)^2/Hz).
-    power : ndarray
-        Frequency distribution of the electrical power c_e |H_v|^2 S (W/Hz):
-        its integral is E[P_e].
-    """
-
-    frequency: np.ndarray
-    excitation: np.ndarray
-    displacement: np.ndarray
-    velocity: np.ndarray
-    power: np.ndarray
-
-    def to_frame(self):
-        """The spectra as a :class:`pandas.DataFrame`, one row per frequency."""
-        import pandas as pd
-
-        return pd.DataFrame({name: getattr(self, name) for name in self.__dataclass_fields__})
 
 
 @dataclass(frozen=True, eq=False)
@@ -250,6 +225,11 @@ def statistical_linearisation(
     2.4619e-03 W
     """
     excitation = as_excitation(excitation)
+    if has_lines_or_shocks(excitation):
+        raise ValueError(
+            f"statistical_linearisation takes one random input; the {excitation.name} input's "
+            "tones or shocks are linearised with it by randvib.combined_linearisation"
+        )
     friction = _check_harvester(harvester)
     m, c, k, k3 = (float(x) for x in (harvester.m, harvester.c, harvester.k, harvester.k3))
     used = (
