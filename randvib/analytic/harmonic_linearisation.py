@@ -52,7 +52,7 @@ import numpy as np
 from scipy import special
 
 from randvib._validation import check_scalar_device
-from randvib.analytic.fixed_point import TrialUndefined, solve
+from randvib.analytic.fixed_point import LinearisationDidNotConverge, TrialUndefined, solve
 from randvib.analytic.linear_response import (
     ResponseSpectra,
     device_block,
@@ -184,6 +184,7 @@ class CombinedSystem:
         h = harvester
         self.m, self.c, self.k, self.k3 = (float(x) for x in (h.m, h.c, h.k, h.k3))
         self.phases = phase_grid(len(self.tones))
+        self.k_floor = -np.inf
 
     @property
     def has_random(self) -> bool:
@@ -197,6 +198,10 @@ class CombinedSystem:
         z2 = motion.mean_square_z()
         k_r = self.k + 3.0 * self.k3 * z2
         k_q = k_r - 0.75 * self.k3 * motion.amplitudes**2
+        # without a positive k (double well, pure cubic) a trial motion too small would
+        # make the linear devices unstable: the floor keeps the solver's trial steps
+        # defined, and a solution on it is refused (combined_linearisation)
+        k_r, k_q = max(k_r, self.k_floor), np.maximum(k_q, self.k_floor)
         velocity = self.omega * motion.amplitudes
         sigma = float(np.sqrt(motion.var_v)) if self.has_random else 0.0
         mu = np.cos(self.phases) @ velocity if self.tones else np.zeros(1)
@@ -412,7 +417,17 @@ def combined_linearisation(harvester, excitation) -> CombinedLinearisation:
             raise TrialUndefined("no finite response")
         return out
 
+    if system.k <= 0:
+        system.k_floor = 1e-6 * linear.k
     motion = system.unpack(solve(residual, system.pack(linear.respond(start))))
+    _, k_r, _, k_q = system.equivalents(motion)
+    if min(k_r, *k_q) <= system.k_floor:
+        raise LinearisationDidNotConverge(
+            f"the combined linearisation has no solution with positive equivalent stiffness for "
+            f"this {harvester.potential.kind} device under the {excitation.name} input (its "
+            "motion is not a zero-mean Gaussian and sinusoids about the barrier): use Monte "
+            "Carlo (randvib.simulate)"
+        )
     return _report(system, excitation, motion, "harmonic")
 
 

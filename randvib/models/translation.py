@@ -223,6 +223,8 @@ class TranslationFit:
     error : float
         ||S_x - S_T|| / ||S_T|| over the grid.
     iterations : int
+    variance : float
+        The target's power on the grid ((m/s^2)^2): x = sqrt(variance) g(y).
     """
 
     frequency: np.ndarray
@@ -231,6 +233,7 @@ class TranslationFit:
     target: np.ndarray
     error: float
     iterations: int
+    variance: float
 
 
 def _covariance(power: np.ndarray) -> np.ndarray:
@@ -299,7 +302,7 @@ def itam(target, marginal: Marginal, top: float, df: float, iterations=ITAM_ITER
     error, p_gauss, p_x, used = best
     cell = np.full(f.size, df)
     cell[0] = cell[-1] = 0.5 * df
-    return TranslationFit(f, p_gauss / cell, p_x / cell, target_psd, error, used)
+    return TranslationFit(f, p_gauss / cell, p_x / cell, target_psd, error, used, variance)
 
 
 #: The translation's harmonics reach this multiple of the frequency below which 99 %
@@ -398,9 +401,20 @@ class Translated(Excitation, registered=False):
 
     @functools.cached_property
     def fit(self) -> TranslationFit:
-        """ITAM's corrected Gaussian spectrum (:func:`itam`), computed once."""
-        top = _top_frequency(self.spectrum)
-        return itam(self.spectrum, self.marginal, top, _grid_step(self.spectrum, top))
+        """ITAM's corrected Gaussian spectrum (:func:`itam`) on its own grid, computed once."""
+        return self.fit_below(_top_frequency(self.spectrum))
+
+    def fit_below(self, top: float) -> TranslationFit:
+        """ITAM's fit on a grid ending at ``top`` (Hz), computed once per top.
+
+        A simulation whose Nyquist frequency lies below the translation's own
+        top (:attr:`top`) simulates the translation of the spectrum cut there,
+        as it simulates any input only up to its Nyquist frequency.
+        """
+        fits = self.__dict__.setdefault("_fits", {})
+        if top not in fits:
+            fits[top] = itam(self.spectrum, self.marginal, top, _grid_step(self.spectrum, top))
+        return fits[top]
 
     @property
     def translation_error(self) -> float:
@@ -412,13 +426,20 @@ class Translated(Excitation, registered=False):
         """The highest frequency the translation holds (Hz); the simulation must resolve it."""
         return float(self.fit.frequency[-1])
 
-    def gaussian_spectrum(self) -> Tabulated:
-        """The underlying Gaussian's corrected PSD, unit variance (1/Hz)."""
-        return Tabulated(self.fit.frequency, self.fit.gaussian)
+    def gaussian_spectrum(self, top: float | None = None) -> Tabulated:
+        """The underlying Gaussian's corrected PSD, unit variance (1/Hz), up to ``top`` (Hz)."""
+        fit = self.fit if top is None or top >= self.top else self.fit_below(top)
+        return Tabulated(fit.frequency, fit.gaussian)
 
-    def achieved_spectrum(self) -> Tabulated:
-        """The translation's own PSD ((m/s^2)^2/Hz): the process simulated, near the target."""
-        return Tabulated(self.fit.frequency, self.fit.achieved)
+    def achieved_spectrum(self, top: float | None = None) -> Tabulated:
+        """The translation's own PSD ((m/s^2)^2/Hz) up to ``top`` (Hz): the process simulated.
+
+        Near the target (:attr:`translation_error`); ``top`` below the
+        translation's own top gives that of the spectrum cut there, which a
+        simulation of Nyquist frequency ``top`` draws.
+        """
+        fit = self.fit if top is None or top >= self.top else self.fit_below(top)
+        return Tabulated(fit.frequency, fit.achieved)
 
     # the declarations every consumer reads are the target spectrum's
     def psd(self, frequency):
@@ -458,17 +479,14 @@ class Translated(Excitation, registered=False):
         """x at the times j dt + offset of the paths whose Gaussian normals are ``normals``.
 
         The Gaussian y is synthesised with the corrected spectrum
-        (:func:`randvib.models.excitation.synthesised_values`, unit variance
-        below the Nyquist frequency) and translated: x = sigma g(y).
+        (:func:`randvib.models.excitation.synthesised_values`, unit variance)
+        and translated: x = sigma g(y), sigma^2 the target's power on the fit's
+        grid; a Nyquist frequency 1/(2 dt) below the translation's top
+        simulates the translation of the spectrum cut there (:meth:`fit_below`).
         """
-        if self.top > 0.5 / dt * (1 + 1e-12):
-            raise ValueError(
-                f"`dt` = {dt} s resolves frequencies up to {0.5 / dt:.6g} Hz, but the translated "
-                f"{self.spectrum.name} spectrum holds power up to {self.top:.6g} Hz; choose `dt` "
-                f"<= {0.5 / self.top:.3g} s"
-            )
-        y = synthesised_values(self.gaussian_spectrum(), n, dt, normals, offset)
-        return np.sqrt(self.spectrum.variance) * self.marginal.g(y)
+        fit = self.fit if 0.5 / dt >= self.top else self.fit_below(0.5 / dt)
+        y = synthesised_values(Tabulated(fit.frequency, fit.gaussian), n, dt, normals, offset)
+        return np.sqrt(fit.variance) * self.marginal.g(y)
 
     def sample(self, duration: float, dt: float, n_paths: int = 1, seed=None) -> np.ndarray:
         """Paths of the translation process (m/s^2) at the times j dt, shape (n_paths, n)."""
