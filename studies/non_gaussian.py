@@ -130,7 +130,9 @@ def verdicts(results: pd.DataFrame) -> dict:
     out = {"tolerance": TOLERANCE, "tones": {}, "kurtosis": {}}
     for part, rows in (("tones", tones), ("kurtosis", kurt)):
         out[part]["counts"] = {q: verdict_counts(rows, q) for q in ("power", "exceedance")}
-        largest = rows.loc[rows.power_error.abs().idxmax()] if rows.power_error.notna().any() else None
+        largest = (
+            rows.loc[rows.power_error.abs().idxmax()] if rows.power_error.notna().any() else None
+        )
         out[part]["largest_power_error"] = None if largest is None else {
             "error": float(largest.power_error), "ci95": float(largest.power_error_ci95),
             "where": _where(largest)}  # fmt: skip
@@ -141,7 +143,8 @@ def verdicts(results: pd.DataFrame) -> dict:
             for p, sub in rows.groupby("position", sort=False)}  # fmt: skip
     for (name, fc), rows in kurt.groupby(["device", "fc"], sort=False):
         out["kurtosis"][_device_key(name, fc)] = {
-            q: _smallest(rows, f"{q}_verdict", "kurtosis") for q in ("power", "exceedance")}
+            q: _smallest(rows, f"{q}_verdict", "kurtosis") for q in ("power", "exceedance")
+        }
     exact = results[(results.input == "floor")]
     out["floor_power_errors"] = {_device_key(r.device, r.fc): float(r.power_error)
                                  for r in exact.itertuples()}  # fmt: skip
@@ -184,7 +187,9 @@ def _table(rows: pd.DataFrame) -> pd.DataFrame:
     shown["P_Gauss (mW)"] = 1e3 * rows.power_gaussian
     shown["P error (%)"] = _errors(rows.power_error, rows.power_error_ci95)
     shown["P verdict"] = rows.power_verdict
-    shown["beyond stop, MC (%)"] = plus_minus(rows.exceedance_mc, rows.exceedance_mc_ci95, 100.0, ".3g")
+    shown["beyond stop, MC (%)"] = plus_minus(
+        rows.exceedance_mc, rows.exceedance_mc_ci95, 100.0, ".3g"
+    )
     shown["beyond, Gauss (%)"] = 100 * rows.exceedance_gaussian
     shown["stop error (%)"] = _errors(rows.exceedance_error, rows.exceedance_error_ci95)
     shown["stop verdict"] = rows.exceedance_verdict

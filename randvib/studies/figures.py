@@ -551,7 +551,9 @@ def gaussian_errors(table: pd.DataFrame, x: str, xlabel: str, panels: str | None
             ax = axes[row, col]
             ax.axhspan(-100 * tolerance, 100 * tolerance, color="0.9", zorder=0)
             ax.axhline(0.0, color="0.5", lw=0.5, zorder=1)
-            for (dev, fc), s in sub.dropna(subset=[f"{q}_error"]).groupby(["device", "fc"], sort=False):
+            for (dev, fc), s in sub.dropna(subset=[f"{q}_error"]).groupby(
+                ["device", "fc"], sort=False
+            ):
                 s = s.sort_values(x)
                 ax.errorbar(s[x], 100 * s[f"{q}_error"], yerr=100 * s[f"{q}_error_ci95"],
                             color=colour(devices.index(dev)), ls="-" if fc > 0 else "--",

@@ -74,7 +74,9 @@ def error_verdict(error, half, tolerance: float = TOLERANCE) -> np.ndarray:
     """``errs``, ``within``, ``undecided`` or ``no answer`` for each relative error (module doc)."""
     error, half = np.asarray(error, dtype=float), np.asarray(half, dtype=float)
     size = np.abs(error)
-    out = np.where(size - half > tolerance, "errs", np.where(size + half < tolerance, "within", "undecided"))
+    out = np.where(
+        size - half > tolerance, "errs", np.where(size + half < tolerance, "within", "undecided")
+    )
     return np.where(np.isfinite(error) & np.isfinite(half), out, "no answer")
 
 

@@ -127,6 +127,8 @@ def kurtosis_cases() -> list:
 def summarise_tones(table: pd.DataFrame) -> str:
     from randvib.analytic.statistical_linearisation import (
         LINEARISATION_FRICTION_SHARE_LIMIT as F_LIMIT,
+    )
+    from randvib.analytic.statistical_linearisation import (
         LINEARISATION_STIFFNESS_SHARE_LIMIT as K_LIMIT,
     )
 
