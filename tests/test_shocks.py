@@ -39,8 +39,8 @@ def test_pulse_spectrum_is_its_fourier_integral_and_campbell_integrates_to_the_v
     train = rv.ShockTrain(3.0, 10.0, d, shape=shape)
     p = pulse(shape, d)
     for f in (0.0, 20.0, 1.0 / (2 * d), 73.0, 150.0, 410.0):
-        re = integrate.quad(lambda t: p(t) * np.cos(2 * np.pi * f * t), 0, d, limit=200)[0]
-        im = integrate.quad(lambda t: p(t) * np.sin(2 * np.pi * f * t), 0, d, limit=200)[0]
+        re = integrate.quad(lambda t, f=f: p(t) * np.cos(2 * np.pi * f * t), 0, d, limit=200)[0]
+        im = integrate.quad(lambda t, f=f: p(t) * np.sin(2 * np.pi * f * t), 0, d, limit=200)[0]
         assert train.pulse_spectrum(f) == pytest.approx(re**2 + im**2, rel=1e-9, abs=1e-18)
     # lobe by lobe (zeros at k / D) up to F = 400 / D, and the tail beyond by its
     # asymptote: lambda A^2 / (pi^2 F) for the rectangle, O(F^-3) for the half sine
@@ -60,7 +60,11 @@ def test_step_integrals_of_a_pulse_are_exact():
     steps = train.step_integrals(np.array([t0]), np.array([peak]), 40, dt)
     for j in range(40):
         lo, hi = max(j * dt, t0), min((j + 1) * dt, t0 + 0.01)
-        exact = 0.0 if hi <= lo else peak * integrate.quad(lambda t: np.sin(np.pi * (t - t0) / 0.01), lo, hi)[0]
+        exact = (
+            0.0
+            if hi <= lo
+            else peak * integrate.quad(lambda t: np.sin(np.pi * (t - t0) / 0.01), lo, hi)[0]
+        )
         assert steps[j] == pytest.approx(exact, rel=1e-10, abs=1e-16)
     assert steps.sum() == pytest.approx(peak * 2 * 0.01 / np.pi, rel=1e-12)
 
@@ -112,6 +116,7 @@ def test_analytic_methods_take_shocks_on_a_linear_device_only():
 
 def output_variances_v(device, excitation):
     """int |H_v|^2 S df by scipy's quad: an independent route to the spectral integral."""
+
     def integrand(f):
         w = 2 * np.pi * f
         h = -1j * w * device.m / (device.k - device.m * w**2 + 1j * device.c * w)

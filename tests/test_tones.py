@@ -64,7 +64,11 @@ def test_tones_compose_with_every_input_and_say_what_they_are():
         parse_tone("25")
     with pytest.raises(ValueError, match=r"`--tone` '25:x': .*F:A\[:PHASE\]"):
         parse_tone("25:x")
-    assert parse_tone("25:0.5:30").parameters() == {"frequency": 25.0, "amplitude": 0.5, "phase": 30.0}
+    assert parse_tone("25:0.5:30").parameters() == {
+        "frequency": 25.0,
+        "amplitude": 0.5,
+        "phase": 30.0,
+    }
 
 
 def test_methods_declare_tones_and_refuse_them_by_name():
@@ -146,7 +150,9 @@ def test_coulomb_random_damping_under_a_sinusoid_is_the_bessel_closed_form():
     closed = 2 * fc * special.i0e(x) / (sigma * np.sqrt(2 * np.pi))
     assert r.random_c_eq - device.c == pytest.approx(closed, rel=1e-10)
     # and the white-noise random part answers S m / (4 c_r) on its own device
-    assert r.random_velocity_variance == pytest.approx(0.3 * device.m / (4 * r.random_c_eq), rel=1e-12)
+    assert r.random_velocity_variance == pytest.approx(
+        0.3 * device.m / (4 * r.random_c_eq), rel=1e-12
+    )
 
 
 def test_friction_moments_of_a_generic_law_match_coulomb_and_quadrature():
@@ -160,11 +166,12 @@ def test_friction_moments_of_a_generic_law_match_coulomb_and_quadrature():
     law = rv.Tanh(0.01, 50.0)
     mean_force, mean_x_force = gaussian_friction_moments(law, mu, 0.03)
     for i, m in enumerate(mu):
+
         def density(v, m=m):
             return np.exp(-0.5 * ((v - m) / 0.03) ** 2) / (0.03 * np.sqrt(2 * np.pi))
 
         f = integrate.quad(lambda v: law.force(v) * density(v), m - 0.4, m + 0.4, points=[0.0])[0]
-        g = integrate.quad(lambda v: (v - m) / 0.03 * law.force(v) * density(v), m - 0.4, m + 0.4,
+        g = integrate.quad(lambda v, m=m: (v - m) / 0.03 * law.force(v) * density(v), m - 0.4, m + 0.4,
                            points=[0.0])[0]  # fmt: skip
         assert mean_force[i] == pytest.approx(f, rel=1e-9, abs=1e-15)
         assert mean_x_force[i] == pytest.approx(g, rel=1e-9, abs=1e-15)
@@ -225,7 +232,9 @@ def exact_tone_response(device, tone, t):
     lam = np.roots([m, c, k])  # homogeneous part a e^{l1 t} + b e^{l2 t} cancels the start
     zs0, vs0 = (big_z * np.exp(1j * phi)).real, (1j * w * big_z * np.exp(1j * phi)).real
     a, b = np.linalg.solve([[1, 1], lam], [-zs0, -vs0])
-    z = (big_z * np.exp(1j * (w * t + phi))).real + (a * np.exp(lam[0] * t) + b * np.exp(lam[1] * t)).real
+    z = (big_z * np.exp(1j * (w * t + phi))).real + (
+        a * np.exp(lam[0] * t) + b * np.exp(lam[1] * t)
+    ).real
     v = (1j * w * big_z * np.exp(1j * (w * t + phi))).real + (
         a * lam[0] * np.exp(lam[0] * t) + b * lam[1] * np.exp(lam[1] * t)
     ).real
