@@ -44,9 +44,9 @@ _EXPORTS = {
     ),
     "randvib.analytic.statistical_linearisation": (
         "LinearisationResult",
-        "ResponseSpectra",
         "statistical_linearisation",
     ),
+    "randvib.analytic.linear_response": ("ResponseSpectra",),
     "randvib.models.event": (
         "Boxcar",
         "Enveloped",

@@ -5,7 +5,7 @@ speed and its harmonics on a broadband floor. A tone is
 
     a(t) = A cos(2 pi f t + phi)    (m/s^2, f in Hz, phi in radians)
 
-(docs/conventions.md, "Fourth turn: tones"). With its phase drawn uniformly
+(docs/conventions.md, "Tones, shocks and non-Gaussian input"). With its phase drawn uniformly
 on [0, 2 pi) for every realisation (``phase=None``, the default) the tone is a
 stationary process of mean 0 and mean square A^2 / 2, independent of any
 noise it is added to; with a given phase it is the same deterministic signal

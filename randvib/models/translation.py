@@ -195,8 +195,9 @@ class Marginal:
 
     @property
     def skewness(self) -> float:
-        """E[g^3]."""
-        return self.moment(3)
+        """E[g^3] (0 for a symmetric marginal, its rounding noise below 1e-12 cleared)."""
+        value = self.moment(3)
+        return 0.0 if abs(value) < 1e-12 else value
 
     @functools.cached_property
     def correlation_map(self) -> tuple[np.ndarray, np.ndarray]:

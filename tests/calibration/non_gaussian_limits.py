@@ -1,6 +1,9 @@
 """The Gaussian answer's validity under tones and non-Gaussian input, against Monte Carlo (by hand).
 
-python tests/calibration/non_gaussian_limits.py [tones|kurtosis|both] [n_paths] [window_s]
+python tests/calibration/non_gaussian_limits.py [tones|kurtosis|both|summary] [n_paths] [window_s]
+
+(run from tests/calibration/: the per-case tables are written there, and
+``summary`` summarises them again).
 
 Measures the limits that statistical linearisation declares
 (randvib/analytic/statistical_linearisation.py) for inputs beyond
@@ -19,10 +22,10 @@ stationary Gaussian noise:
   limits and beyond each.
 * **kurtosis** - statistical linearisation with the Gaussian input of the
   same spectrum against Monte Carlo on translation processes of kurtosis
-  3.5 to 10 (band-pass and Kanai-Tajimi floors, the same devices, the
-  bistable's where a Gaussian answer exists): for each |kurtosis - 3|, the
-  largest error beyond its interval over the nonlinear devices; the limit
-  is the largest |kurtosis - 3| below which every such error is within 5 %.
+  3 to 10 (band-pass and Kanai-Tajimi floors, the same monostable devices,
+  each with its end stop): for each kurtosis, the largest error of the power
+  and of the stroke exceedance beyond its interval; the limit is the largest
+  |kurtosis - 3| below which every such error is within 5 %.
 
 Results of the last run are in ``non_gaussian_limits.txt`` beside this file.
 """
@@ -53,13 +56,17 @@ def floors() -> dict:
     }
 
 
+#: End stops (m), about 2.5 standard deviations out under the floors (as the study's).
+STROKES = {"paper": 8e-3, "duffing": 6e-3, "bistable": 12e-3}
+
+
 def devices(names) -> dict:
     out = {}
     for name in names:
         k, k3 = SPRINGS[name]
         for fc in (0.0, FC):
             friction = rv.Coulomb(fc) if fc else None
-            out[(name, fc)] = BASE.updated(k=k, k3=k3, friction=friction)
+            out[(name, fc)] = BASE.updated(k=k, k3=k3, friction=friction, stroke=STROKES[name])
     return out
 
 
@@ -74,14 +81,16 @@ def indicators(device, excitation) -> dict:
             else:
                 lin = rv.statistical_linearisation(device, excitation)
                 stiffness = [lin.k_eq]
+        exceedance = rv.predict(device, excitation).stroke_exceedance
     except ValueError:
-        return {"power_gaussian": np.nan, "friction_share": np.nan, "stiffness_share": np.nan}
+        return {"power_gaussian": np.nan, "friction_share": np.nan, "stiffness_share": np.nan,
+                "exceedance_gaussian": np.nan}  # fmt: skip
     vv = lin.velocity_variance
     friction = max(lin.c_eq - device.c, 0.0) * vv
     share_f = friction / (friction + device.c_m * vv + lin.power_electrical)
     share_k = max(1.0 - device.k / k if k > 0 else np.inf for k in stiffness)
     return {"power_gaussian": lin.power_electrical, "friction_share": share_f,
-            "stiffness_share": share_k}  # fmt: skip
+            "stiffness_share": share_k, "exceedance_gaussian": exceedance}  # fmt: skip
 
 
 def run(cases, settings) -> pd.DataFrame:
@@ -89,7 +98,8 @@ def run(cases, settings) -> pd.DataFrame:
     rows = []
     for (case, extra), r in zip(cases, result.table.itertuples(), strict=True):
         row = {**case.labels, **extra, "power_mc": r.power_electrical,
-               "power_mc_ci95": r.power_electrical_ci95}  # fmt: skip
+               "power_mc_ci95": r.power_electrical_ci95, "exceedance_mc": r.stroke_exceedance,
+               "exceedance_mc_ci95": r.stroke_exceedance_ci95}  # fmt: skip
         row.update(indicators(case.device, case.excitation))
         rows.append(row)
     table = pd.DataFrame(rows)
@@ -97,6 +107,12 @@ def run(cases, settings) -> pd.DataFrame:
         table.power_gaussian, table.power_mc, table.power_mc_ci95
     )
     table["beyond"] = (table.error.abs() - table.error_ci95).clip(lower=0.0)
+    table["exceedance_error"], table["exceedance_error_ci95"] = relative_errors(
+        table.exceedance_gaussian, table.exceedance_mc, table.exceedance_mc_ci95
+    )
+    table["exceedance_beyond"] = (table.exceedance_error.abs() - table.exceedance_error_ci95).clip(
+        lower=0.0
+    )
     return table
 
 
@@ -116,8 +132,9 @@ def tone_cases() -> list:
 def kurtosis_cases() -> list:
     out = []
     for floor_name, floor in floors().items():
-        translations = {k: rv.Translated(floor, k) for k in (3.5, 4.0, 5.0, 6.0, 8.0, 10.0)}
-        for (name, fc), device in devices(("paper", "duffing", "bistable")).items():
+        translations = {k: rv.Translated(floor, k) for k in (3.0, 4.0, 6.0, 10.0)}
+        # the monostable devices: a double well's Gaussian closure errs (and warns) at any kurtosis
+        for (name, fc), device in devices(("paper", "duffing")).items():
             for kurtosis, x in translations.items():
                 labels = {"floor": floor_name, "device": name, "fc": fc, "kurtosis": kurtosis}
                 out.append((rv.Case(labels, device, x, group=(floor_name, name, fc)), {}))
@@ -155,19 +172,27 @@ def summarise_kurtosis(table: pd.DataFrame) -> str:
     answered = table.dropna(subset=["error"])
     lines = [f"kurtosis: {len(table)} cases, {len(answered)} with a Gaussian answer"]
     for kurtosis, rows in answered.groupby("kurtosis"):
-        worst = rows.loc[rows.beyond.idxmax()]
-        lines.append(
-            f"  kurtosis {kurtosis:g}: largest |error| {100 * rows.error.abs().max():.1f} %, "
-            f"beyond its interval {100 * worst.beyond:.1f} % ({worst.device}, fc {worst.fc:g}, "
-            f"{worst.floor})"
-        )
-    first_bad = answered[answered.beyond > TOLERANCE].kurtosis.min()
-    lines.append(f"  first kurtosis with an error beyond 5 % + its interval: {first_bad}")
+        for q, column in (("power", "beyond"), ("exceedance", "exceedance_beyond")):
+            error = "error" if q == "power" else "exceedance_error"
+            worst = rows.loc[rows[column].idxmax()]
+            lines.append(
+                f"  kurtosis {kurtosis:g}, {q}: largest |error| {100 * rows[error].abs().max():.1f}"
+                f" %, beyond its interval {100 * worst[column]:.1f} % ({worst.device}, fc "
+                f"{worst.fc:g}, {worst.floor})"
+            )
+    bad = answered[(answered.beyond > TOLERANCE) | (answered.exceedance_beyond > TOLERANCE)]
+    lines.append(
+        f"  first kurtosis with an error beyond 5 % + its interval: {bad['kurtosis'].min()}"
+    )
     return "\n".join(lines)
 
 
 def main(argv) -> None:
     part = argv[1] if len(argv) > 1 else "both"
+    if part == "summary":  # the tables of the last run, summarised again
+        print(summarise_tones(pd.read_csv("non_gaussian_limits_tones.csv")))
+        print(summarise_kurtosis(pd.read_csv("non_gaussian_limits_kurtosis.csv")))
+        return
     n_paths = int(argv[2]) if len(argv) > 2 else 128
     window = float(argv[3]) if len(argv) > 3 else 20.0
     settings = fixed_paths(n_paths, window, dt=2.5e-4, burn_in=2.0, seed=11)
