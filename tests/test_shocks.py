@@ -81,11 +81,12 @@ def case_sampled_step_integrals(seed):
 
     exact = train.rate * train.amplitude**2 * integrate.quad(
         lambda s: (running(s + dt) - running(s)) ** 2, -dt, train.duration, limit=200)[0]  # fmt: skip
-    yield "kick mean square", estimate(np.mean(kicks**2, axis=1)), exact, 0.0, 0.03
+    yield "kick mean square", estimate(np.mean(kicks**2, axis=1)), exact, 0.0, 0.035
 
 
 def test_sampled_train_has_campbell_s_variance():
-    """Calibrated (tests/calibration/non_gaussian_tests.py, results file beside it)."""
+    """Calibrated over 30 seeds (tests/calibration/non_gaussian_tests.txt): z mean +0.17,
+    SD 1.37, max |z| 3.8."""
     for what, stat, ref, bias, detect in case_sampled_step_integrals(4):
         assert_matches(stat, ref, detect=detect, known_bias=bias, what=what)
 
@@ -95,11 +96,12 @@ def case_campbell_linear(seed):
     x = rv.White(0.02) + rv.ShockTrain(20.0, 10.0, 0.01)
     r = rv.simulate(DAMPED, x, t_end=21.0, burn_in=1.0, dt=5e-4, n_paths=64, seed=seed,
                     progress=False)  # fmt: skip
-    yield "E[v^2]", r.velocity_variance, rv.predict(DAMPED, x).velocity_variance, 0.0, 0.06
+    yield "E[v^2]", r.velocity_variance, rv.predict(DAMPED, x).velocity_variance, 0.0, 0.07
 
 
 def test_linear_device_under_shocks_matches_campbell():
-    """Calibrated (tests/calibration/non_gaussian_tests.py, results file beside it)."""
+    """Calibrated over 30 seeds (tests/calibration/non_gaussian_tests.txt): z mean -0.03,
+    SD 1.12, max |z| 2.6."""
     for what, stat, ref, bias, detect in case_campbell_linear(2):
         assert_matches(stat, ref, detect=detect, known_bias=bias, what=what)
 

@@ -272,7 +272,8 @@ def case_linear_noise_and_tone(seed, excitation=None):
     ],
 )
 def test_linear_device_under_noise_and_a_tone_matches_superposition(name, excitation):
-    """Calibrated (40 seeds, tests/calibration/non_gaussian_tests.py): see the results file."""
+    """Calibrated over 30 seeds (tests/calibration/non_gaussian_tests.txt): z mean -0.18 / -0.42,
+    SD 1.06 / 0.99, max |z| 2.2 / 3.5 (white / band-pass floor), power margin >= 7.3 SE."""
     for what, stat, ref, bias, detect in case_linear_noise_and_tone(1, excitation):
         assert_matches(stat, ref, detect=detect, known_bias=bias, what=f"{name}: {what}")
 

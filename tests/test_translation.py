@@ -112,7 +112,8 @@ def case_synthesised_input(seed):
 
 
 def test_synthesised_translation_has_its_variance_kurtosis_and_spectrum():
-    """Calibrated (tests/calibration/non_gaussian_tests.py, results file beside it)."""
+    """Calibrated over 30 seeds (tests/calibration/non_gaussian_tests.txt): z means +0.26,
+    +0.04, +0.53, SDs 0.96, 0.97, 1.01, max |z| 2.5 (variance, kurtosis, band power)."""
     for what, stat, ref, bias, detect in case_synthesised_input(7):
         assert_matches(stat, ref, detect=detect, known_bias=bias, what=what)
 
@@ -124,11 +125,12 @@ def case_translated_linear(seed):
                     progress=False)  # fmt: skip
     block = mechanical_block(DAMPED.m, DAMPED.c, DAMPED.k)
     exact = output_variances(block, x.achieved_spectrum(0.5e3))["v"]
-    yield "E[v^2]", r.velocity_variance, exact, 0.0, 0.05
+    yield "E[v^2]", r.velocity_variance, exact, 0.0, 0.06
 
 
 def test_linear_device_second_moments_are_the_spectrum_s_whatever_the_marginal():
-    """Calibrated (tests/calibration/non_gaussian_tests.py, results file beside it)."""
+    """Calibrated over 30 seeds (tests/calibration/non_gaussian_tests.txt): z mean -0.11,
+    SD 0.98, max |z| 2.4."""
     for what, stat, ref, bias, detect in case_translated_linear(3):
         assert_matches(stat, ref, detect=detect, known_bias=bias, what=what)
 
