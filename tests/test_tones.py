@@ -316,3 +316,24 @@ def test_monte_carlo_lines_are_the_tones_mean_squares():
     assert lines["velocity"][0] == pytest.approx(abs(h) ** 2 / 2, rel=1e-3)
     assert lines["displacement"][0] == pytest.approx(abs(h / tone.omega) ** 2 / 2, rel=1e-3)
     assert lines["power"][0] == pytest.approx(LINEAR.c_e * lines["velocity"][0], rel=1e-12)
+
+
+def test_the_limit_the_optimal_load_and_the_design_take_tones():
+    """A tone is a line in the harvesting limit (unconstrained: m^2 A^2 / (8 c_m) exactly);
+    the optimal load under a tone is a maximum; the design search answers under a tone."""
+    m, c_m, a = 0.0226, 0.05, 0.7
+    limit = rv.harvesting_limit(m, c_m, rv.as_excitation(rv.Tone(9.0, a)), 1.0)
+    assert limit == pytest.approx(m**2 * a**2 / (8 * c_m), rel=1e-12)
+    # a linear device (superposition, no fixed point per point: a second for the searches)
+    wired = rv.Harvester.from_electrical(m=m, c_m=c_m, k=57.4, alpha=0.1992, r_load=2.0,
+                                         r_coil=0.48)  # fmt: skip
+    x = rv.White(0.2) + rv.Tone(8.0, 0.5)
+    best = rv.optimal_load_resistance(wired, x)
+    assert best.location == "interior"
+    for factor in (0.95, 1.05):
+        other = rv.expected_power(wired.updated(r_load=best.r_load * factor), x, into="load")
+        assert other < best.power
+    linear = LINEAR.updated(stroke=0.004)
+    result = rv.design(linear, rv.BandPass(0.3, 8.0, 0.2) + rv.Tone(8.0, 0.5),
+                       {"k": (30.0, 150.0)}, monte_carlo=False)  # fmt: skip
+    assert result.exceedance_predicted <= 0.01 + 1e-9 and np.isnan(result.first_passage_predicted)
