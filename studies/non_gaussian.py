@@ -211,17 +211,27 @@ def part_section(results, v, part: str, figure: Path) -> str:
         f"{q}: errs by more than {100 * TOLERANCE:g} % at {c['errs']} of {sum(c.values())} cases "
         f"({c['within']} within, {c['undecided']} undecided, {c['no answer']} without an answer)"
         for q, c in counts.items())  # fmt: skip
-    onset = "; ".join(f"{key}: {entry}" for key, entry in v[part].items()
+    onset = "; ".join(f"{key}: {_onset_words(entry, part)}" for key, entry in v[part].items()
                       if key not in ("counts", "largest_power_error"))  # fmt: skip
     worst = ("" if largest is None else f" The largest power error is {100 * largest['error']:+.1f} "
              f"± {100 * largest['ci95']:.1f} % ({largest['where']}).")  # fmt: skip
-    along = "amplitude (m/s^2) at which it first errs, by tone position" if part == "tones" else (
+    along = "tone amplitude at which it first errs" if part == "tones" else (
         "kurtosis at which it first errs")  # fmt: skip
     return (
         f"![Gaussian errors]({figure.name})\n\n**Verdict.** The Gaussian answer {sentence}.{worst} "
-        f"Smallest {along} (None: never in the grid): {onset}.\n\n"
+        f"Smallest {along}, by device: {onset}.\n\n"
         + report.markdown_table(_table(rows), floatfmt=".4g")
     )
+
+
+def _onset_words(entry: dict, part: str) -> str:
+    """ "never", or where the verdict first reads "errs": "power from 2 m/s^2 at resonance"."""
+    if part == "kurtosis":
+        words = [f"{q} from kurtosis {k:g}" for q, k in entry.items() if k is not None]
+    else:
+        words = [f"{q} from {a:g} m/s^2 {p} resonance" for p, by in entry.items()
+                 for q, a in by.items() if a is not None]  # fmt: skip
+    return ", ".join(words) or "never"
 
 
 # ----------------------------------------------------------------- the study
