@@ -1,8 +1,8 @@
 """Tones on noise: the model, the exact linear answer, the combined linearisation, Monte Carlo.
 
 * models: :class:`randvib.Tone` and the sum of inputs
-  (:mod:`randvib.models.tone`, :mod:`randvib.models.combined`), their
-  parameters and refusals;
+  (:mod:`randvib.models.tone`, :mod:`randvib.models.combined`, ``+`` reaching
+  the sum through :mod:`randvib.models.composition`), their parameters and refusals;
 * analytic: superposition on a linear device (resistive and with a coil's
   inductance) against transfer functions written out by hand; the combined
   harmonic-and-random linearisation (:mod:`randvib.analytic.harmonic_linearisation`)

@@ -262,7 +262,7 @@ def statistical_linearisation(
         # The solver's trial steps may leave the region where the linearised
         # device is stable and its variances finite (a narrow band near the
         # resonance of a soft or double-well device): that is the solver's
-        # failure to find a fixed point, reported as such by _solve, not a
+        # failure to find a fixed point, reported as such by solve, not a
         # property of the user's device.
         with np.errstate(all="ignore"):
             c_eq, k_eq = equivalent(x)
@@ -386,6 +386,7 @@ class Linearisation(AnalyticMethod):
     tones = True
     non_gaussian = True
     circuit = True
+    assemblies = True
     stroke_exceedance = True
     transient = True
     validity = (
@@ -428,6 +429,25 @@ class Linearisation(AnalyticMethod):
             "within 5 % up to kurtosis 10, the stroke exceedance was 11 to 37 % low at "
             "kurtosis 4 (tests/calibration/non_gaussian_limits.py); a linear device's second "
             "moments are exact for any marginal",
+        ),
+        # assemblies (randvib.analytic.assembly_linearisation): per element, the
+        # single-mass limits, checked against an independent simulator of assemblies
+        Validity(
+            "element_friction_share",
+            LINEARISATION_FRICTION_SHARE_LIMIT,
+            "warns",
+            "an assembly element's friction power over all the power dissipated on its "
+            "coordinate; the single-mass limit, checked on a host with a harvester "
+            "(tests/calibration/assembly_linearisation.py): -5 % at 0.76, -21 % at 0.92",
+        ),
+        Validity(
+            "element_stiffness_share",
+            LINEARISATION_STIFFNESS_SHARE_LIMIT,
+            "warns",
+            "the cubic spring's share 1 - k_dir / k_eq of the stiffness on an assembly "
+            "element's coordinate; the single-mass limit, checked on a host with a harvester "
+            "(tests/calibration/assembly_linearisation.py): within 6 % up to 0.14, -7.5 % to "
+            "-21.5 % from 0.35 to 0.64",
         ),
     )
 

@@ -29,6 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from randvib.models import composition
 from randvib.models.excitation import Excitation, as_excitation
 from randvib.models.shock import ShockTrain
 from randvib.models.tone import Tone
@@ -217,3 +218,6 @@ def parts_of(excitation) -> tuple:
     if isinstance(excitation, ShockTrain):
         return None, (), excitation
     return _parts(excitation)
+
+
+composition.register(combine=combine, as_input=as_input)

@@ -57,6 +57,7 @@ from randvib._validation import (
     check_positive,
     check_scalar,
 )
+from randvib.models import composition
 from randvib.models.record import Record, read_csv, read_record
 from randvib.models.state_space import StateSpace
 from randvib.models.tone import Tone
@@ -230,15 +231,11 @@ class Excitation:
         One random spectrum with any number of tones and at most one shock
         train (:class:`~randvib.models.combined.Combined`).
         """
-        # imported here: the composite module builds on this one (no cycle at import)
-        from randvib.models.combined import combine
-
-        return combine(self, other)
+        # the composite module builds on this one: reached through its registry
+        return composition.combine(self, other)
 
     def __radd__(self, other):
-        from randvib.models.combined import combine
-
-        return combine(other, self)
+        return composition.combine(other, self)
 
     def psd(self, frequency) -> np.ndarray:  # pragma: no cover - abstract
         """One-sided PSD of the base acceleration ((m/s^2)^2/Hz) at ``frequency`` (Hz)."""
@@ -310,10 +307,8 @@ def as_excitation(value) -> Excitation:
     if isinstance(value, Excitation):
         return value
     if isinstance(value, Tone):
-        # the composite module builds on this one: imported where it is needed
-        from randvib.models.combined import as_input
-
-        return as_input(value)
+        # the composite module builds on this one: reached through its registry
+        return composition.as_input(value)
     if getattr(value, "is_event", False):
         raise ValueError(
             f"the {value.name} event is not stationary: its transient response is computed by "

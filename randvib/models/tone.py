@@ -27,6 +27,7 @@ import math
 from dataclasses import dataclass
 
 from randvib._validation import check_finite, check_positive, check_scalar
+from randvib.models import composition
 
 
 @dataclass(frozen=True, eq=False)
@@ -91,14 +92,11 @@ class Tone:
         return (self,)
 
     def __add__(self, other):
-        from randvib.models.combined import combine  # builds on this module
-
-        return combine(self, other)
+        # the composite module builds on this one: reached through its registry
+        return composition.combine(self, other)
 
     def __radd__(self, other):
-        from randvib.models.combined import combine
-
-        return combine(other, self)
+        return composition.combine(other, self)
 
 
 def parse_tone(text: str) -> Tone:
