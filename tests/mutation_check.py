@@ -611,6 +611,21 @@ MUTATIONS: tuple[Mutation, ...] = (
         "beyond 5 %): the verdicts must follow the whole interval.",
     ),
     Mutation(
+        name="assembly-tones-ignored",
+        path="randvib/analytic/method.py",
+        edits=(
+            (
+                '    if tones:\n        listed = ", ".join(f"{tone.frequency:g} Hz" for tone in tones)\n        return (\n            f"{who} does not take',
+                '    if False:\n        listed = ", ".join(f"{tone.frequency:g} Hz" for tone in tones)\n        return (\n            f"{who} does not take',
+            ),
+        ),
+        tests=(
+            "tests/test_translation.py::test_assemblies_take_shocks_and_translations_when_linear_and_refuse_tones",
+        ),
+        why="An assembly answers under tones as if they were absent (the continuous part alone): "
+        "the silent wrong answer the refusal exists to prevent.",
+    ),
+    Mutation(
         name="assembly-dashpot-to-ground",
         path="randvib/models/assembly.py",
         edits=(

@@ -28,6 +28,7 @@ from _stats import assert_matches
 import randvib as rv
 from randvib.analytic.linear_response import mechanical_block, output_variances
 from randvib.analytic.statistical_linearisation import LinearisationValidityWarning
+from randvib.models.assembly import Assembly
 from randvib.models.translation import MAX_TRANSLATION_ERROR, Marginal
 from randvib.statistics import Statistic, estimate
 
@@ -154,3 +155,24 @@ def test_analytic_methods_answer_with_the_spectrum_and_warn_naming_the_kurtosis(
     assert nonlinear.power_electrical == pytest.approx(gaussian.power_electrical, rel=1e-6)
     refusal = rv.METHODS["fpk-fast"].refusal(linear, x)
     assert "assumes Gaussian input; the translated input needs method='linearisation'" in refusal
+
+
+def test_assemblies_take_shocks_and_translations_when_linear_and_refuse_tones():
+    """A linear assembly's second moments are its input's spectrum's (Campbell's for shocks);
+    a one-DOF assembly must equal the single-mass answer. Tones, and non-Gaussian input on
+    nonlinear elements, are refused by name rather than answered as the continuous part."""
+    x = rv.Translated(rv.BandPass(1.0, 8.0, 0.1), 6.0)
+    shocks = rv.White(0.02) + rv.ShockTrain(20.0, 10.0, 0.01)
+    one_dof = Assembly.from_harvester(DAMPED)
+    for excitation in (x, shocks):
+        single = rv.predict(DAMPED, excitation)
+        (transducer,) = rv.predict(one_dof, excitation).transducers
+        assert transducer.power_electrical == pytest.approx(single.power_electrical, rel=1e-6)
+    with pytest.raises(
+        ValueError, match=r"does not take tones on an assembly yet \(the tones 8 Hz"
+    ):
+        rv.predict(one_dof, rv.White(0.02) + rv.Tone(8.0, 1.0))
+    nonlinear = Assembly.from_harvester(rv.preset("figure9"))
+    for excitation in (x, shocks):
+        with pytest.raises(ValueError, match="input on a linear assembly only"):
+            rv.predict(nonlinear, excitation)

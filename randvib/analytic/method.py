@@ -222,7 +222,7 @@ class AnalyticMethod:
         """The first declaration the case fails, in words (with the alternatives), or None."""
         if isinstance(harvester, Assembly):
             if self.assemblies:
-                return None
+                return _assembly_input_reason(harvester, psd, who)
             others = self._alternatives(harvester, psd) if alternatives else MONTE_CARLO
             return f"{who} treats the single-mass harvester; an assembly needs {others}"
         potential = harvester.potential
@@ -397,6 +397,34 @@ def is_linear_device(harvester: Harvester) -> bool:
     law = harvester.friction
     return (
         (law is None or law.vanishes) and np.all(harvester.k3 == 0) and not harvester.is_rectified
+    )
+
+
+def _assembly_input_reason(assembly: Assembly, psd, who: str) -> str | None:
+    """Why tones, shocks or a non-Gaussian input are beyond the assembly solver, or None.
+
+    A linear assembly's second moments are its input's spectrum's, whatever
+    the marginal (a translation process) and for a shock train (Campbell's
+    spectrum, part of :meth:`Excitation.psd`): those are exact. Tones are
+    lines, which the spectral solution of an assembly does not take yet, and a
+    nonlinear element under non-Gaussian input or shocks has no measured
+    limit (Monte Carlo of assemblies has not landed either): both refused.
+    """
+    if not isinstance(psd, Excitation):
+        return None
+    random, tones, shocks = parts_of(psd)
+    if tones:
+        listed = ", ".join(f"{tone.frequency:g} Hz" for tone in tones)
+        return (
+            f"{who} does not take tones on an assembly yet (the tones {listed}); they are "
+            "treated on the single-mass harvester"
+        )
+    gaussian = shocks is None and (random is None or random.is_gaussian)
+    if gaussian or assembly.is_linear:
+        return None
+    return (
+        f"{who} treats the {psd.name} input on a linear assembly only (its spectrum decides "
+        "the second moments); with nonlinear elements it is treated on the single-mass harvester"
     )
 
 
