@@ -33,11 +33,20 @@ _EXPORTS = {
         "Tabulated",
         "White",
     ),
+    "randvib.models.tone": ("Tone",),
+    "randvib.models.shock": ("ShockTrain",),
+    "randvib.models.translation": ("Marginal", "Translated"),
+    "randvib.models.combined": ("Combined",),
+    "randvib.analytic.harmonic_linearisation": (
+        "combined_linearisation",
+        "CombinedLinearisation",
+        "ToneResponse",
+    ),
     "randvib.analytic.statistical_linearisation": (
         "LinearisationResult",
-        "ResponseSpectra",
         "statistical_linearisation",
     ),
+    "randvib.analytic.linear_response": ("ResponseSpectra",),
     "randvib.models.event": (
         "Boxcar",
         "Enveloped",

@@ -35,6 +35,7 @@ from randvib._validation import (
 from randvib.analytic.assembly_prediction import predict_assembly
 from randvib.analytic.averaging import AVERAGING
 from randvib.analytic.bridge import BRIDGE_CLOSURE
+from randvib.analytic.fixed_point import LinearisationDidNotConverge
 from randvib.analytic.fokker_planck import FAST_FOKKER_PLANCK, FOKKER_PLANCK
 from randvib.analytic.method import (
     AnalyticMethod,
@@ -44,7 +45,7 @@ from randvib.analytic.method import (
     white_level,
 )
 from randvib.analytic.power_prediction import PowerPrediction
-from randvib.analytic.statistical_linearisation import LINEARISATION, LinearisationDidNotConverge
+from randvib.analytic.statistical_linearisation import LINEARISATION
 from randvib.models.assembly import Assembly
 from randvib.models.excitation import BROADCASTING, Excitation
 from randvib.models.harvester import Harvester

@@ -244,7 +244,10 @@ def execute(run: Run, *, control_variates, check_step, threads, batch_paths, pro
     setup = KernelSetup.prepare(run, linear)
     if progress is None:
         progress = progress_wanted()
-    if batch_paths is None and run.driver is not None:  # the input's memory stays bounded
+    # the input's memory stays bounded: a synthesised input's samples and a shock
+    # train's step integrals are arrays of (paths in the batch) x (steps)
+    sampled = run.driver is not None or (run.forcing is not None and run.forcing.shocks is not None)
+    if batch_paths is None and sampled:
         batch_paths = driven.batch_paths(run.grid.n_steps)
     batches = batch_bounds(
         run.n_paths, batch_paths, run.grid.n_steps, progress, run.record.record_paths
@@ -268,7 +271,7 @@ def execute(run: Run, *, control_variates, check_step, threads, batch_paths, pro
         histogram=histogram,
         histories=histories,
         wall_time=wall,
-        excitation=run.excitation,
+        excitation=run.input,
     )
     if check_step:  # the per-run identity: every path sums to m S / 4
         check_bridge_balance(result)
