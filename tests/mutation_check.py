@@ -424,8 +424,8 @@ MUTATIONS: tuple[Mutation, ...] = (
         path="randvib/identification/least_squares.py",
         edits=(
             (
-                "return z[:, self.cost.skip :] + matrix[:, -1:]",
-                "return z[:, self.cost.skip :] - matrix[:, -1:]",
+                "return z[:, self.cost.skip :] + matrix[:, OUTPUT_OFFSET_COLUMN, None]",
+                "return z[:, self.cost.skip :] - matrix[:, OUTPUT_OFFSET_COLUMN, None]",
             ),
         ),
         tests=("tests/test_measurement_model.py::test_sensor_offsets_do_not_change_the_estimate",),
