@@ -101,7 +101,7 @@ def output_pairs(args) -> list[tuple[str, str]]:
         unknown = [c for c in columns if c not in OUTPUT_KINDS]
         if unknown:
             raise ValueError(
-                f"`--output-column {unknown[0]}`: say what it holds with `--output-kind "
+                f"`--output-column` {unknown[0]!r}: say what it holds with `--output-kind "
                 f"{'|'.join(OUTPUT_KINDS)}` (a column is fitted only as its declared kind)"
             )
         kinds = list(columns)

@@ -54,6 +54,7 @@ from randvib.identification.identifiability import (
     Configuration,
     IdentifiabilityError,
     _remedies,
+    linear_information,
     local_identifiability,
     structural_identifiability,
 )
@@ -273,7 +274,7 @@ def identify_experiment(
     polished = _polish(cost, space, found, simulation, search, frozenset(bounds or ()))
     result = _result(cost, space, res, polished, time.perf_counter() - start, search,
                      simulation, structure, notes)  # fmt: skip
-    _check_locally(result, configuration(model, coupling, tests, fixed))
+    _check_locally(result, configuration(model, coupling, tests, fixed), cost)
     return result
 
 
@@ -451,11 +452,42 @@ def _result(cost, space, res, polished, elapsed, search, simulation, structure, 
     )  # fmt: skip
 
 
-def _check_locally(result: IdentificationResult, config: Configuration) -> None:
-    """Refuse a split the data do not make (after the fit); warn of one poorly determined value."""
+def _spectra(cost: ExperimentCost, result: IdentificationResult) -> list:
+    """Each record's (frequencies, input weights |A|^2 2/N, channels' noise variances)."""
+    out = []
+    for prep in cost.prepared:
+        a = prep.drive[prep.skip :] - np.mean(prep.drive[prep.skip :])
+        spectrum = np.fft.rfft(a)[1:]
+        omega = 2 * np.pi * np.fft.rfftfreq(a.size, prep.test.record.dt)[1:]
+        noise = {
+            row["output"]: row["rms_error"] ** 2
+            for row in result.channel_costs
+            if row["record"] == prep.test.record.name and row["rms_error"] > 0
+        }
+        out.append((omega, np.abs(spectrum) ** 2 / a.size, noise))
+    return out
+
+
+def _check_locally(result: IdentificationResult, config: Configuration, cost) -> None:
+    """Refuse a split the data do not make (after the fit); warn of one poorly determined value.
+
+    Two opinions: the fit's own covariance (:func:`local_identifiability`) and
+    the linearised device's Fisher information under the records' input
+    spectra and noise (:func:`linear_information`); a split either finds is
+    refused, with each parameter's larger relative standard error.
+    """
     from dataclasses import replace
 
     local = local_identifiability(result.uncertainty, result.parameters)
+    linear = linear_information(config, result.parameters, _spectra(cost, result))
+    if linear:
+        local["linear_response"] = linear
+        local["split"] = local.get("split", []) + [
+            g for g in linear["split"] if g not in local.get("split", [])
+        ]
+        errors = local.setdefault("relative_errors", {})
+        for name, value in linear["relative_errors"].items():
+            errors[name] = max(errors.get(name, 0.0), value)
     result.identifiability = replace(result.identifiability, local=local)
     for group in local.get("split", []):
         errors = local["relative_errors"]

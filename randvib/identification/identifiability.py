@@ -61,6 +61,10 @@ LOADING = 0.3
 RANK_TOLERANCE = 1e-7
 #: Generic frequencies (rad/s) of the nondimensional device, whose resonance is near 1.
 FREQUENCIES = np.array([0.23, 0.41, 0.67, 0.93, 1.18, 1.57, 2.3, 3.9])
+#: The order in which a refusal proposes parameters to fix: what a bench measures
+#: most easily first (the coil's resistance with an ohmmeter, the coupling from a
+#: blocked-magnet test), the mechanics' last.
+FIX_PREFERENCE = ("r_coil", "alpha", "theta", "capacitance", "inductance", "c", "k")
 #: Parameters whose identification the checks are about: the damping split,
 #: the mass and the coupling's.
 SPLIT_PARAMETERS = ("m", "c", "alpha", "r_coil", "inductance", "theta", "capacitance")
@@ -341,8 +345,10 @@ def _remedies(config: Configuration, undetermined) -> tuple:
         )
         if not _blocking(trial):
             out.append("a displacement or velocity channel (`--output-kind relative_velocity`)")
+    order = sorted(undetermined, key=lambda n: FIX_PREFERENCE.index(n) if n in FIX_PREFERENCE
+                   else len(FIX_PREFERENCE))  # fmt: skip
     fixable = [
-        n for n in undetermined if n != "m" and not _blocking(_with(
+        n for n in order if n != "m" and not _blocking(_with(
             config, free=tuple(f for f in config.free if f != n), fixed={**config.fixed, n: 1.0}))
     ]  # fmt: skip
     if fixable:
@@ -449,7 +455,14 @@ def local_identifiability(uncertainty, parameters: dict) -> dict:
     corr = np.asarray(uncertainty.correlation)[np.ix_(index, index)]
     corr = np.where(np.isfinite(corr), corr, 0.0)
     rel = se / scale
-    cov = corr * np.outer(rel, rel)
+    return undetermined_directions(names, corr * np.outer(rel, rel))
+
+
+def undetermined_directions(names, relative_covariance) -> dict:
+    """The eigen-directions of a relative covariance with a standard error above
+    :data:`UNDETERMINED`: ``split`` (moving two or more parameters) and
+    ``poorly_determined`` (one), with each parameter's ``relative_errors``."""
+    cov = np.asarray(relative_covariance, dtype=float)
     eig, vec = np.linalg.eigh(cov)
     split, poor = [], []
     for k in range(len(names)):
@@ -460,8 +473,64 @@ def local_identifiability(uncertainty, parameters: dict) -> dict:
             split.append(moved)
         else:
             poor.extend(moved)
+    rel = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     return {
         "relative_errors": {n: float(r) for n, r in zip(names, rel, strict=True)},
         "split": split,
         "poorly_determined": sorted(set(poor)),
     }
+
+
+def linear_information(config: Configuration, values: dict, spectra) -> dict:
+    """The linearised device's own grip on the damping split, the mass and the coupling.
+
+    A second opinion on :func:`local_identifiability`, free of the fit's own
+    derivatives (which stick-slip and narrow valleys can make too sharp): the
+    Fisher information of the device linearised about z = 0 at the estimate
+    ``values``, each record's measured channels seen through their transfer
+    functions H from the input, under the record's own input spectrum and the
+    channel's residual noise (white, variance s^2):
+
+        F_ij = sum_records sum_channels sum_f 2 Re(dH/du_i conj(dH/du_j)) |A(f)|^2 / (N s^2)
+
+    (u = log of a parameter; positive frequencies of the DFT A of the N-sample
+    input). It sees what the linear response carries: two loads too close, a
+    circuit time constant below what the sample rate resolves. The other
+    parameters (k3, friction) are held at the estimate.
+
+    Parameters
+    ----------
+    config : Configuration
+        The fit's records (their actual loads) and free parameters.
+    values : dict
+        The estimate (SI units).
+    spectra : sequence of (frequencies (rad/s), |A|^2 weights, {kind: noise variance})
+        One per record, in the records' order.
+    """
+    linear = {"m", "c", "k", *COUPLING_PARAMETERS.get(config.coupling, ())}
+    names = [n for n in config.free if n in linear and values.get(n)]
+    if not names:
+        return {}
+    p = {n: float(v) for n, v in values.items() if np.ndim(v) == 0}
+    info = np.zeros((len(names), len(names)))
+    for (r_load, _), (omega, weight, noise) in zip(config.records, spectra, strict=True):
+        s = 1j * omega
+        for kind, variance in noise.items():
+            derivatives = []
+            for name in names:
+                up, down = dict(p), dict(p)
+                up[name] *= np.exp(1e-6)
+                down[name] *= np.exp(-1e-6)
+                derivatives.append(
+                    (
+                        _transfer(config, up, r_load, kind, s)
+                        - _transfer(config, down, r_load, kind, s)
+                    )
+                    / 2e-6
+                )
+            d = np.array(derivatives)
+            info += 2.0 * np.real(d @ (np.conj(d) * weight).T) / variance
+    covariance = np.linalg.pinv(info)
+    split = [n for n in names if n in SPLIT_PARAMETERS]
+    index = [names.index(n) for n in split]
+    return undetermined_directions(split, covariance[np.ix_(index, index)]) if split else {}
