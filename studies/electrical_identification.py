@@ -70,7 +70,7 @@ def settings_for(quick: bool) -> dict:
     """Seeds, record length and rate, the search (and whether it starts near the truth)."""
     if quick:
         return dict(seeds=(0,), duration=0.6, fs=1000.0, popsize=8, generations=2, near=True)
-    return dict(seeds=tuple(range(8)), duration=4.0, fs=1000.0, popsize=30, generations=60,
+    return dict(seeds=tuple(range(4)), duration=4.0, fs=1000.0, popsize=30, generations=60,
                 near=False)  # fmt: skip
 
 

@@ -1,4 +1,9 @@
-"""``randvib identify DATA.csv --model M``: fit a friction model to a record (paper Sec. 3)."""
+"""``randvib identify DATA.csv ... --model M``: fit a friction model (and a circuit) to records.
+
+Paper Sec. 3, and beyond it: several records of one device at their loads,
+any of the displacement, velocity, load voltage and current channels
+(:mod:`randvib.identification.experiment_fit`).
+"""
 
 from __future__ import annotations
 
@@ -34,8 +39,10 @@ def register(sub) -> None:
     p = sub.add_parser(
         "identify",
         help="identify device and friction parameters from a measured record (SaDE, Eq. 11)",
-        description="Fit the device model (Eq. 1) with a friction model to a CSV record by "
-        "minimising J (Eq. 11) with self-adaptive differential evolution.",
+        description="Fit the device model (Eq. 1) with a friction model, and with --coupling "
+        "its circuit, to CSV records of one device (each at its own --r-load) by minimising J "
+        "(Eq. 11, per channel and summed) with self-adaptive differential evolution; what the "
+        "records cannot fix is refused first, naming what to add.",
     )
     p.add_argument(
         "data",

@@ -58,6 +58,7 @@ from randvib.identification.identifiability import (
     local_identifiability,
     structural_identifiability,
 )
+from randvib.identification.input_reconstruction import driving_signal
 from randvib.identification.models import MODEL_PARAMETERS, check_parameter, parameter_specs
 from randvib.identification.record_integrator import EXTRA_PARAMETERS
 from randvib.identification.result import IdentificationResult
@@ -175,7 +176,7 @@ def configuration(model, coupling, tests, fixed) -> Configuration:
     )
 
 
-def search_space(model, coupling, tests, fixed, bounds, quadratic) -> SearchSpace:
+def search_space(model, coupling, tests, fixed, bounds) -> SearchSpace:
     """The free shared parameters and each record's input offset, with their boxes."""
     shared = _names(model, coupling)
     count = len(tests)
@@ -189,16 +190,17 @@ def search_space(model, coupling, tests, fixed, bounds, quadratic) -> SearchSpac
                 f"record {test.record.name!r} has {test.record.n} samples; the {model} model with "
                 f"{len(free)} free parameters needs at least {needed}"
             )
-    m_ref = fixed.get("m") or _mass_reference(first, coupling, bounds)
+    m_ref = fixed.get("m")
+    if m_ref is None and first.record.input_kind != "force":
+        m_ref = _mass_reference(first, coupling, bounds)
+    # a force input without the mass: the displacement's equation-error estimate
     scales = channel_scales(first.record, first.outputs, m_ref)
-    box = default_bounds(first.record, model, None if "m" in free else m_ref, scales=scales)
+    box = default_bounds(first.record, model, None if "m" in free else scales.m, scales=scales)
     if coupling is not None:
         box.update(coupling_bounds(coupling, scales, [t.r_load for t in tests], first.record.dt))
     k2 = 2 * scales.k_ref / scales.z_max
     box["k2"] = (-k2, k2)
     for name, test in zip(offsets, tests, strict=True):
-        from randvib.identification.input_reconstruction import driving_signal
-
         drive, _ = driving_signal(test.record.input, test.record.dt, test.record.input_kind)
         mean, half = float(np.mean(drive)), 0.5 * float(np.std(drive))
         box[name] = (mean - half, mean + half)
@@ -253,7 +255,7 @@ def identify_experiment(
         raise IdentifiabilityError(structure.refusal())
     simulation, why = simulation.for_record(tests[0].record)
     notes += (why,) if why else ()
-    space = search_space(model, coupling, tests, fixed, bounds, quadratic)
+    space = search_space(model, coupling, tests, fixed, bounds)
     cost = ExperimentCost(tests, model, coupling, fixed=fixed, free=space.free,
                           weights=weights, simulation=simulation)  # fmt: skip
     searched = _search_cost(cost, tests, search, simulation, weights)

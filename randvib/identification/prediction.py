@@ -132,7 +132,7 @@ def predict_record(
     harvester : Harvester
         The device (a preset, or :meth:`IdentificationResult.harvester
         <randvib.identification.result.IdentificationResult.harvester>`), with
-        scalar parameters; a coupling with a circuit state is refused.
+        scalar parameters and any coupling but a diode bridge.
     record : Record
         Its input channel drives the device; its relative displacement is
         scored, or the channels ``outputs`` names.
