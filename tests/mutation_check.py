@@ -569,6 +569,22 @@ MUTATIONS: tuple[Mutation, ...] = (
         why="The search's J with the unmeasured start profiled out adds the least-squares "
         "gain instead of taking it off: J at the truth is no longer the noise's.",
     ),
+    Mutation(
+        name="channel-weight-ignored",
+        path="randvib/identification/experiment.py",
+        edits=(
+            (
+                "norm[kind] = 100.0 * weight / ((y.size - skip) * variance)",
+                "norm[kind] = 100.0 / ((y.size - skip) * variance)",
+            ),
+        ),
+        tests=(
+            "tests/test_electrical_identification.py::"
+            "test_weights_multiply_each_channels_own_j_in_the_sum",
+        ),
+        why="`--weight KIND=W` is dropped from the summed J: the weighted cost is compared "
+        "with w times the channel's own J, exactly.",
+    ),
 )
 
 

@@ -313,3 +313,45 @@ def test_the_unmeasured_start_is_profiled_out_of_the_search_cost():
     assert profiled[0] < 1e-9 and abs(cost.start(named, 0)[0][0] + shift[0, 0]) < 1e-6
     guessed = cost.record_cost({**named, "z0": cost.start(named, 0)[0]}, 0)[0]
     assert guessed[0] > 1e3 * profiled[0]
+
+
+def test_weights_multiply_each_channels_own_j_in_the_sum():
+    """The summed cost with ``weights`` is sum_k w_k J_k exactly (the start and the
+    offsets held, so nothing is profiled jointly): on a voltage and velocity record
+    of the piezo, J_voltage weighted 3 and J_velocity 1, at parameters 1 % off (so
+    that neither J is the generator's error alone)."""
+    from randvib.identification.experiment import ExperimentCost, recorded_tests
+    from randvib.identification.settings import SimulationSettings
+
+    kinds = ("relative_velocity", "voltage")
+    rec = E.record("piezo", E.PIEZO, r_load=1e5, duration=0.3, outputs=kinds)
+    tests = recorded_tests(rec, kinds, 1e5, "piezo")
+    fixed = {**E.PIEZO, "k": 1.01 * E.PIEZO["k"], "k2": 0.0, "input_offset": 0.0,
+             "velocity_offset": 0.0, "voltage_offset": 0.0, "z0": 0.0}  # fmt: skip
+    settings = SimulationSettings(hold="linear")
+    costs = {}
+    for weights in (None, {"voltage": 3.0}):
+        cost = ExperimentCost(tests, "viscous", "piezo", fixed=fixed, free=(),
+                              weights=weights, simulation=settings)  # fmt: skip
+        named = cost.parameters(np.zeros((1, 0)))
+        costs[bool(weights)] = float(cost.record_cost(named, 0)[0][0])
+        rows = {row["output"]: row["cost"] for row in cost.channel_costs(named)[0]}
+    assert min(rows.values()) > 1e-3
+    assert costs[False] == pytest.approx(rows["voltage"] + rows["relative_velocity"], rel=1e-9)
+    assert costs[True] == pytest.approx(3 * rows["voltage"] + rows["relative_velocity"], rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    "weights, match",
+    [({"current": 2.0}, "names 'current', which no record fits"),
+     ({"voltage": -1.0}, "voltage=-1.0: a weight must be positive"),
+     ({"voltage": float("nan")}, "a weight must be positive"),
+     ([("voltage", 2.0)], "must be a dict")],
+)  # fmt: skip
+def test_weights_refused_unless_positive_and_on_a_fitted_channel(weights, match):
+    """A weight on a channel no record fits would be ignored, a negative one would
+    reward a misfit: both refused before any simulation."""
+    rec = E.record("coil", E.COIL, r_load=3.0, duration=0.2, outputs=("voltage",))
+    with pytest.raises(ValueError, match=match):
+        rv.identify([rec, rec], "coulomb", m=0.0226, coupling="inductive", r_load=(3.0, 30.0),
+                    outputs=("voltage",), weights=weights, progress=False)  # fmt: skip

@@ -116,6 +116,34 @@ def recorded_tests(records, outputs=None, r_load=None, coupling=None) -> tuple:
     return tuple(RecordedTest(r, kinds, load) for r, load in zip(records, loads, strict=True))
 
 
+def check_weights(weights, tests) -> dict:
+    """``kind -> w`` of the fitted channels: positive and finite, each a kind the records fit.
+
+    A weight for a channel no record fits would be ignored silently, and a
+    negative or zero one would reward a misfit: both are refused.
+    """
+    if weights is None:
+        return {}
+    if not isinstance(weights, dict):
+        raise ValueError(f"`weights` must be a dict of output kind -> weight, got {weights!r}")
+    fitted = tuple(dict.fromkeys(kind for test in tests for kind in test.outputs))
+    out = {}
+    for kind, value in weights.items():
+        if kind not in fitted:
+            raise ValueError(
+                f"`weights` (--weight) names {kind!r}, which no record fits; the fitted "
+                f"channels are {', '.join(fitted)}"
+            )
+        try:
+            w = float(value)
+        except (TypeError, ValueError):
+            w = float("nan")
+        if not (0.0 < w < float("inf")):
+            raise ValueError(f"`weights` (--weight) {kind}={value!r}: a weight must be positive")
+        out[kind] = w
+    return out
+
+
 def _loads(r_load, n: int, coupling) -> list:
     if coupling is None:
         if r_load is not None:
@@ -170,7 +198,7 @@ class ExperimentCost:
         self.coupling = coupling
         self.fixed = dict(fixed)
         self.free = tuple(free)
-        self.weights = dict(weights or {})
+        self.weights = check_weights(weights, self.tests)
         self.substeps = simulation.substeps
         self.hold = simulation.hold
         self.skip = simulation.skip

@@ -48,6 +48,7 @@ from randvib.identification.experiment import (
     ExperimentCost,
     ExperimentError,
     RecordedTest,
+    check_weights,
     own_name,
 )
 from randvib.identification.identifiability import (
@@ -243,6 +244,7 @@ def identify_experiment(
     """Fit ``model`` with ``coupling`` to the records ``tests`` (see :func:`randvib.identify`)."""
     from randvib.identification.identify import _named_callback
 
+    weights = check_weights(weights, tests)
     fixed = resolve_fixed(model, coupling, tests, fixed, m)
     if "m" not in fixed and tests[0].record.input_kind != "force" and coupling is None:
         raise ValueError(
