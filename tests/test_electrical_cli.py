@@ -127,7 +127,8 @@ def test_record_from_a_fit_writes_the_load_voltage(capsys, saved_fit, tmp_path):
 
 def test_a_column_is_fitted_only_as_its_declared_kind(capsys, tmp_path):
     """A voltage column is never fitted as a displacement: a column named otherwise
-    needs its kind, and the kinds pair with the columns in order."""
+    needs its kind, and the kinds pair with the columns in order; a `--weight` names a
+    fitted kind."""
     rec = E.record("coil", E.COIL, r_load=3.0, duration=0.3, outputs=("voltage",))
     path = tmp_path / "rig.csv"
     rec.to_frame().rename(columns={"voltage": "V_load"}).to_csv(path, index=False)
@@ -147,6 +148,11 @@ def test_a_column_is_fitted_only_as_its_declared_kind(capsys, tmp_path):
     one_line_error(
         capsys, base + ["--output-kind", "voltage", "--output-column", "V_load", "--coupling",
                         "resistive", "--r-load", "3"], "cannot determine c, alpha, r_coil",
+    )  # fmt: skip
+    one_line_error(
+        capsys, base + ["--output-kind", "voltage", "--output-column", "V_load", "--coupling",
+                        "resistive", "--r-load", "3", "--weight", "current=2"],
+        "names 'current', which no record fits",
     )  # fmt: skip
 
 

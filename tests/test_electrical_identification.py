@@ -245,6 +245,28 @@ def test_identified_coil_predicts_its_power_at_another_load(coil_fit):
     assert identified == pytest.approx(truth, rel=0.02)
 
 
+def test_coil_at_one_load_recovered_from_its_voltage_with_its_resistance_measured():
+    """The voltage across one load, the mass known: refused as it stands (the four
+    coefficients of V/a cannot give c, k, alpha, R_C and L), identified once R_C is
+    measured (an ohmmeter, ``--fix r_coil=2``): c, k, k3, Fc, alpha and L each within 4
+    standard errors, J at the noise's 100 x 0.01^2 to within 4 of its chi-squared
+    spreads (4.5 % each). Over 30 seeds (tests/calibration/electrical_coverage.txt,
+    ``coil_one_load``) the intervals' coverage is quoted there."""
+    rec = E.record("coil", E.COIL, r_load=3.0, seed=0, noise={"voltage": 0.01}, duration=1.0)
+    options = dict(m=E.COIL["m"], coupling="inductive", r_load=3.0, outputs=("voltage",),
+                   progress=False)  # fmt: skip
+    with pytest.raises(IdentifiabilityError, match="fix one of"):
+        rv.identify(rec, "coulomb", **options)
+    fit = rv.identify(
+        rec, "coulomb", fixed={"r_coil": E.COIL["r_coil"]}, popsize=8, maxiter=3, seed=1,
+        init=near_truth(coil_device, E.COIL, 3.0), **options,
+    )  # fmt: skip
+    names = tuple(n for n in COIL_FREE if n != "r_coil")
+    within(fit, E.COIL, names)
+    assert fit.cost == pytest.approx(100 * 0.01**2, rel=0.18)
+    assert set(fit.identifiability.determined) == set(names) and "r_coil" not in fit.free
+
+
 def test_piezo_duffing_recovered_from_voltage_and_velocity_with_the_mass_free():
     """Voltage and velocity (1 % noise each) fix the mass too: the piezo's voltage
     scales with sqrt(m) under base excitation, so the mass symmetry is broken; the

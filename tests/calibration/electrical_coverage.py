@@ -1,7 +1,7 @@
 """Coverage of identify's 95 % intervals for the whole harvester (run by hand).
 
     NUMBA_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 python tests/calibration/electrical_coverage.py \
-        [n_seeds] [--search]
+        [n_seeds] [--search] [--case coil|coil_one_load|piezo]
 
 Records from the independent generator of tests/_electrical.py (plain RK4 at
 16 kHz of the device with its circuit, on a band-limited 4-20 Hz input at
@@ -10,6 +10,8 @@ and the noise per seed, fitted by ``randvib.identify``:
 
 * ``coil``: Coulomb friction and inductance, the load voltage only, records
   at 3 and 30 ohm (1 s each), the mass given: c, k, k3, Fc, alpha, R_C, L;
+* ``coil_one_load``: the same coil at 3 ohm only (1 s), the mass given and
+  its resistance measured (``--fix r_coil``): c, k, k3, Fc, alpha, L;
 * ``piezo``: Duffing spring, voltage and velocity (1 s), the mass free:
   m, c, k, k3, theta, C_p.
 
@@ -62,11 +64,27 @@ def piezo_fit(seed, search):
                        **options)  # fmt: skip
 
 
-CASES = {"coil": (coil_fit, E.COIL, T.COIL_FREE), "piezo": (piezo_fit, E.PIEZO, T.PIEZO_FREE)}
+def coil_one_load_fit(seed, search):
+    record = E.record("coil", E.COIL, r_load=3.0, seed=3000 + seed, noise={"voltage": 0.01},
+                      duration=1.0)  # fmt: skip
+    options = {} if search else dict(popsize=8, maxiter=3, init=T.near_truth(
+        T.coil_device, E.COIL, 3.0))  # fmt: skip
+    return rv.identify(record, "coulomb", m=E.COIL["m"], coupling="inductive", r_load=3.0,
+                       outputs=("voltage",), fixed={"r_coil": E.COIL["r_coil"]}, seed=seed,
+                       progress=False, **options)  # fmt: skip
 
 
-def main(n, search):
+CASES = {
+    "coil": (coil_fit, E.COIL, T.COIL_FREE),
+    "coil_one_load": (coil_one_load_fit, E.COIL, tuple(n for n in T.COIL_FREE if n != "r_coil")),
+    "piezo": (piezo_fit, E.PIEZO, T.PIEZO_FREE),
+}
+
+
+def main(n, search, only=None):
     for case, (fit, truth, names) in CASES.items():
+        if only is not None and case != only:
+            continue
         hits = {name: 0 for name in names}
         worst = {name: 0.0 for name in names}
         refused, started = 0, time.perf_counter()
@@ -96,5 +114,9 @@ def main(n, search):
 
 
 if __name__ == "__main__":
-    args = [a for a in sys.argv[1:] if not a.startswith("--")]
-    main(int(args[0]) if args else 30, "--search" in sys.argv)
+    argv = sys.argv[1:]
+    only = argv[argv.index("--case") + 1] if "--case" in argv else None
+    if only is not None and only not in CASES:
+        sys.exit(f"--case {only!r}: one of {', '.join(CASES)}")
+    args = [a for a in argv if not a.startswith("--") and a != only]
+    main(int(args[0]) if args else 30, "--search" in argv, only)
