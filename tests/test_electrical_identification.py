@@ -251,7 +251,9 @@ def test_coil_at_one_load_recovered_from_its_voltage_with_its_resistance_measure
     measured (an ohmmeter, ``--fix r_coil=2``): c, k, k3, Fc, alpha and L each within 4
     standard errors, J at the noise's 100 x 0.01^2 to within 4 of its chi-squared
     spreads (4.5 % each). Over 30 seeds (tests/calibration/electrical_coverage.txt,
-    ``coil_one_load``) the intervals' coverage is quoted there."""
+    ``coil_one_load``) the 95 % intervals cover the truth 29 or 30 times of 30 per
+    parameter, the largest error 2.3 standard errors; from scratch (identify's default
+    search, 4 seeds) all cover."""
     rec = E.record("coil", E.COIL, r_load=3.0, seed=0, noise={"voltage": 0.01}, duration=1.0)
     options = dict(m=E.COIL["m"], coupling="inductive", r_load=3.0, outputs=("voltage",),
                    progress=False)  # fmt: skip
