@@ -3,7 +3,10 @@ in its quick form, through ``randvib study`` (:mod:`randvib.cli.study`), and its
 from given tables.
 
 The quick run only exercises the pipeline (one seed, 0.6 s records, a small search
-started next to the truth); what the full run finds is quoted in docs/identification.md.
+started next to the truth). The full run (4 seeds, 4 s records, identify's default
+search from scratch) is run by hand and its results are not yet recorded; the coverage
+of the intervals over seeds is tests/calibration/electrical_coverage.py's (results in
+electrical_coverage.txt beside it).
 """
 
 import json
