@@ -69,9 +69,11 @@ __all__ = ["CHANNELS", "DEVICES", "device", "run_study", "settings_for"]
 def settings_for(quick: bool) -> dict:
     """Seeds, record length and rate, the search (and whether it starts near the truth)."""
     if quick:
-        return dict(seeds=(0,), duration=0.6, fs=1000.0, popsize=8, generations=2, near=True)
+        # the polish from 5 % off: a pipeline check, so a bounded number of steps
+        return dict(seeds=(0,), duration=0.6, fs=1000.0, popsize=8, generations=2, near=True,
+                    polish_maxfev=20)  # fmt: skip
     return dict(seeds=tuple(range(4)), duration=4.0, fs=1000.0, popsize=30, generations=60,
-                near=False)  # fmt: skip
+                near=False, polish_maxfev=None)  # fmt: skip
 
 
 def device(name: str, r_load: float, scale: float = 1.0) -> rv.Harvester:
@@ -108,6 +110,7 @@ def fit(name: str, channels: str, seed: int, settings: dict):
             records(name, seed, settings), model, m=truth["m"], coupling=coupling,
             r_load=loads, outputs=CHANNELS[channels], seed=seed, progress=False,
             popsize=settings["popsize"], maxiter=settings["generations"],
+            polish_maxfev=settings["polish_maxfev"],
             init=device(name, loads[0], 1.05) if settings["near"] else None,
         )  # fmt: skip
     except rv.IdentifiabilityError as refusal:
