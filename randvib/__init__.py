@@ -67,6 +67,7 @@ _EXPORTS = {
     "randvib.models.rectifier": ("BridgeCoil", "BridgePiezo", "RECTIFIED", "Rectified"),
     "randvib.identification.cost": ("normalised_cost",),
     "randvib.identification.models": ("MeasurementModel",),
+    "randvib.identification.identifiability": ("Identifiability", "IdentifiabilityError"),
     "randvib.identification.identify": ("identify",),
     "randvib.identification.prediction": ("predict_record",),
     "randvib.identification.result": ("IdentificationResult",),

@@ -428,8 +428,8 @@ MUTATIONS: tuple[Mutation, ...] = (
         path="randvib/identification/least_squares.py",
         edits=(
             (
-                "return z[:, self.cost.skip :] + matrix[:, -1:]",
-                "return z[:, self.cost.skip :] - matrix[:, -1:]",
+                "return z[:, self.cost.skip :] + matrix[:, OUTPUT_OFFSET_COLUMN, None]",
+                "return z[:, self.cost.skip :] - matrix[:, OUTPUT_OFFSET_COLUMN, None]",
             ),
         ),
         tests=("tests/test_measurement_model.py::test_sensor_offsets_do_not_change_the_estimate",),
@@ -866,6 +866,103 @@ MUTATIONS: tuple[Mutation, ...] = (
         why="Holm's procedure does not stop at its first acceptance: a larger p-value that "
         "meets its own threshold level / (m - i) is rejected after a smaller one was not; "
         "compared with Holm's adjusted p-values.",
+    ),
+    Mutation(
+        name="circuit-force-in-record-kernel",
+        path="randvib/identification/record_integrator.py",
+        edits=(
+            (
+                "return e - dev[1] * v - z * (dev[2] + z * (dev[5] + z * dev[3])) - dev[9] * x",
+                "return e - dev[1] * v - z * (dev[2] + z * (dev[5] + z * dev[3])) - 1.01 * dev[9] * x",
+            ),
+        ),
+        tests=(
+            "tests/test_electrical_identification.py::"
+            "test_piezo_circuit_state_matches_an_independent_rk4_to_fourth_order",
+        ),
+        why="The record simulation's circuit pushes the mass 1 % too hard (theta V or alpha i): "
+        "the piezo's voltage is compared with plain RK4 of the device and its circuit to 5e-8.",
+    ),
+    Mutation(
+        name="coil-load-voltage",
+        path="randvib/identification/circuit.py",
+        edits=(
+            (
+                'scale = r_load if kind == "voltage" else 1.0  # the coil\'s voltage is R_L i',
+                'scale = 1.01 * r_load if kind == "voltage" else 1.0',
+            ),
+        ),
+        tests=(
+            "tests/test_electrical_identification.py::"
+            "test_coil_with_inductance_and_coulomb_friction_matches_the_generator",
+        ),
+        why="A coil's load voltage read 1 % high (R_L i): compared with the independent "
+        "generator's R_L i to 1.5e-4 of its RMS.",
+    ),
+    Mutation(
+        name="nonlinear-forces-not-per-mass",
+        path="randvib/identification/identifiability.py",
+        edits=(
+            (
+                'parts.append(np.atleast_1d(p[name] / p["m"] if force_like else p[name]))',
+                "parts.append(np.atleast_1d(p[name]))",
+            ),
+        ),
+        tests=(
+            "tests/test_electrical_identification.py::"
+            "test_what_records_can_fix_agrees_with_the_symmetries_worked_out_by_hand",
+        ),
+        why="The structural test takes the nonlinear forces (k3, Fc) as seen by themselves "
+        "instead of per unit mass: under base excitation the mass would look fixed by a "
+        "displacement record, against Eq. 1 divided by m.",
+    ),
+    Mutation(
+        name="blocked-covariance-pooled",
+        path="randvib/identification/least_squares.py",
+        edits=(
+            (
+                "middle += float(eb @ eb) / dof * (jb.T @ jb)",
+                "middle += float(e @ e) / max(n - d, 1) * (jb.T @ jb)",
+            ),
+        ),
+        tests=(
+            "tests/test_electrical_identification.py::"
+            "test_blocked_covariance_gives_each_channel_its_own_noise",
+        ),
+        why="The channels' noise pooled into one variance: a quiet channel's parameters "
+        "get the noisy channel's standard errors (a factor of about 25 in variance).",
+    ),
+    Mutation(
+        name="profiled-start-sign",
+        path="randvib/identification/experiment.py",
+        edits=(
+            (
+                'total = total + np.einsum("ij,ij->i", shift, cross)',
+                'total = total - np.einsum("ij,ij->i", shift, cross)',
+            ),
+        ),
+        tests=(
+            "tests/test_electrical_identification.py::"
+            "test_the_unmeasured_start_is_profiled_out_of_the_search_cost",
+        ),
+        why="The search's J with the unmeasured start profiled out adds the least-squares "
+        "gain instead of taking it off: J at the truth is no longer the noise's.",
+    ),
+    Mutation(
+        name="channel-weight-ignored",
+        path="randvib/identification/experiment.py",
+        edits=(
+            (
+                "norm[kind] = 100.0 * weight / ((y.size - skip) * variance)",
+                "norm[kind] = 100.0 / ((y.size - skip) * variance)",
+            ),
+        ),
+        tests=(
+            "tests/test_electrical_identification.py::"
+            "test_weights_multiply_each_channels_own_j_in_the_sum",
+        ),
+        why="`--weight KIND=W` is dropped from the summed J: the weighted cost is compared "
+        "with w times the channel's own J, exactly.",
     ),
 )
 

@@ -81,6 +81,7 @@ STUDIES = (
     "dc-power",
     "design",
     "non-gaussian",
+    "electrical-identification",
 )
 
 
