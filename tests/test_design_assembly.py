@@ -171,7 +171,7 @@ def test_objective_refusals():
     [
         ("element.3.k3", "the assembly has 2 element(s)"),
         ("element.0.beta", "unknown parameter path 'element.0.beta'"),
-        ("transducer.0.c_e", "is derived: the inductive coupling's c_e follows from its circuit"),
+        ("transducer.0.c_e", "is derived: the inductive coupling's electrical damping follows"),
         ("structure.mass.1", "the masses are the device's own"),
         ("structure.influence.0", "influence vector"),
         ("transducer.1.stroke", "a stroke is the budget's"),

@@ -61,10 +61,11 @@ def vary_refusal(assembly: Assembly, path) -> str | None:
     if kind == "transducer" and name == "c_e":
         coupling = assembly.transducers[int(index)].coupling
         if not isinstance(coupling, ElectricalDamper):
-            names = ", ".join(coupling.parameter_names())
+            # dotted paths: the command line would take a bare name for its own flag
+            names = ", ".join(f"{kind}.{index}.{n}" for n in coupling.parameter_names())
             return (
-                f"{path!r} is derived: the {coupling.name} coupling's c_e follows from its "
-                f"circuit; vary {names} instead"
+                f"{path!r} is derived: the {coupling.name} coupling's electrical damping "
+                f"follows from its circuit; vary {names} instead"
             )
     if value is None:
         return f"{path!r} has no value on this assembly"

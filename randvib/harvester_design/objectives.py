@@ -174,9 +174,9 @@ class AssemblyObjective:
             t = assembly.transducers[index]
             if self.name == "load" and not t.has_load:
                 return (
-                    f"objective 'load' counts transducer {index}, a bare electrical damping c_e "
-                    "without a load resistance: give it alpha, r_load, r_coil, or use objective "
-                    "'electrical'"
+                    f"objective 'load' counts transducer {index}, a bare electrical damping "
+                    "without a load resistance: give it a coil (flux gradient, load and coil "
+                    "resistances), or use objective 'electrical'"
                 )
             if self.name == "stored" and not t.is_rectified:
                 return (
