@@ -576,6 +576,55 @@ MUTATIONS: tuple[Mutation, ...] = (
         why="A modal host's influence vector from the transposed mode-shape matrix; r = Phi "
         "gamma is checked with a non-symmetric Phi.",
     ),
+    Mutation(
+        name="assembly-budget-least-coordinate",
+        path="randvib/harvester_design/assembly_budget.py",
+        edits=(("worst = max(worst, float(value))", "worst = min(worst, float(value))"),),
+        tests=(
+            "tests/test_design_assembly.py::test_objective_counts_all_transducers_or_the_one_named",
+            "tests/test_design_assembly.py::"
+            "test_analytic_design_of_a_linear_two_dof_assembly_is_the_exact_optimum",
+        ),
+        why="An assembly's stroke budget read on its least exceeded coordinate instead of its "
+        "worst: the design ignores the budget; the optimum must keep sigma_u within it by a "
+        "hand-built Lyapunov equation, and the reported exceedance be the largest.",
+    ),
+    Mutation(
+        name="assembly-objective-first-transducer",
+        path="randvib/harvester_design/objectives.py",
+        edits=(
+            (
+                "return range(len(assembly.transducers))",
+                "return range(min(1, len(assembly.transducers)))",
+            ),
+        ),
+        tests=(
+            "tests/test_design_assembly.py::test_objective_counts_all_transducers_or_the_one_named",
+        ),
+        why="The objective of all transducers counts only the first: checked against the sum "
+        "of the prediction's per-transducer load powers.",
+    ),
+    Mutation(
+        name="single-mass-answer-damping",
+        path="randvib/studies/assembly_cases.py",
+        edits=(("mechanical_block(m, c_m + c_e, k)", "mechanical_block(m, c_e, k)"),),
+        tests=(
+            "tests/test_study_assemblies.py::"
+            "test_single_mass_answer_under_white_noise_is_the_kanai_tajimi_answer",
+        ),
+        why="The study's single-mass answer loses the harvester's mechanical damping; under "
+        "white base noise it must equal the single-mass harvester's exact power under the "
+        "host's Kanai-Tajimi spectrum.",
+    ),
+    Mutation(
+        name="paired-verdict-ignores-interval",
+        path="randvib/studies/assembly_cases.py",
+        edits=(("    if mean - ci95 > 0:\n", "    if mean > 0:\n"),),
+        tests=("tests/test_study_assemblies.py::test_array_verdicts_from_a_constructed_table",),
+        why="The assemblies study calls an array better when its paired difference is merely "
+        "positive, not significantly so; the constructed table has a positive difference "
+        "inside its interval.",
+    ),
 )
 
 

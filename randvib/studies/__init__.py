@@ -30,6 +30,9 @@ such scripts share lives here:
   bandwidth, power against stroke exceedance, methods' errors against the level;
 - :mod:`~randvib.studies.bridge`: a coil's bridge against its resistive figure (paired
   cases, stored-power tables, the optimum's table, where the resistive figure overstates);
+- :mod:`~randvib.studies.assembly_cases`: harvesters on a host mode and the single-mass
+  answer (exact, in series), arrays and two-mass harvesters, paired Monte Carlo of
+  assemblies, and the assemblies study's verdicts;
 - :mod:`~randvib.studies.report`: CSV, ``verdicts.json``, Markdown tables, ``report.md``.
 
 A script imports only ``randvib`` (its exports), these building blocks and the
@@ -78,6 +81,7 @@ STUDIES = (
     "events",
     "dc-power",
     "design",
+    "assemblies",
 )
 
 
