@@ -257,8 +257,12 @@ def sentences(a: dict, b: dict, c: dict) -> list[str]:
         "(a) Its error passes 5 % at mass ratio "
         + "; ".join(f"{k}: {100 * v:.3g} %" for k, v in crossed.items())
         + (f"; already below 1e-8 for {', '.join(below)}" if below else "")
-        + (". The crossing grows with the host's damping." if a["crossing_grows_with_host_damping"]
-           else ". The crossing does not grow with the host's damping everywhere."),
+        + (". The crossing grows with the host's damping" if a["crossing_grows_with_host_damping"]
+           else ". The crossing does not grow with the host's damping everywhere")
+        + "; in units of zeta_h zeta_a (zeta_a = "
+        + f"{a['harvester_zeta']:g}, the harvester's damping ratio) it is "
+        + "; ".join(f"{k}: {lo:.3g} to {hi:.3g}" for k, (lo, hi) in a["crossing_over_damping"].items())
+        + ".",
         f"(a) Monte Carlo of the assembly agrees with the exact answer (|z| <= 3) at "
         f"{a['monte_carlo_agree']} of {a['monte_carlo_checks']} points.",
         f"(b) An array beats one tuned harvester of the same mass significantly (paired 95 %) in "
@@ -330,7 +334,8 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
     for name, table in (("single_mass.csv", errors), ("crossings.csv", crossings),
                         ("checks.csv", checks), ("arrays.csv", arrays), ("two_mass.csv", pairs)):  # fmt: skip
         report.write_table(out, name, table)
-    v = {"single_mass": single_mass_verdicts(errors, crossings, checks),
+    zeta_a = HARVESTER["mechanical"] + HARVESTER["electrical"]
+    v = {"single_mass": single_mass_verdicts(errors, crossings, checks, zeta_a),
          "arrays": array_verdicts(arrays), "two_mass": two_mass_verdicts(pairs)}  # fmt: skip
     said = sentences(v["single_mass"], v["arrays"], v["two_mass"])
     report.write_verdicts(out, v, said)

@@ -78,7 +78,7 @@ def test_single_mass_verdicts_from_a_constructed_table():
         {"power_assembly": 1.0, "power_mc": 1.0 + 0.5 * 0.01, "power_mc_ci95": t * 0.01, "n_paths": 100},
         {"power_assembly": 1.0, "power_mc": 1.0 + 4.0 * 0.01, "power_mc_ci95": t * 0.01, "n_paths": 100},
     ])  # fmt: skip
-    v = single_mass_verdicts(errors, crossings, checks)
+    v = single_mass_verdicts(errors, crossings, checks, 0.05)
     assert v["overestimates_everywhere"]
     assert v["largest_error"] == 3.0 and v["largest_error_at"]["input"] == "band"
     # within 5 % at the smallest ratio: white at both dampings (0.01, 0.002), band only at
@@ -92,9 +92,14 @@ def test_single_mass_verdicts_from_a_constructed_table():
     assert v["crossings"]["white, zeta_h = 0.05"] == 9e-3
     assert v["crossing_where"]["band, zeta_h = 0.01"] == "below"
     assert v["crossing_grows_with_host_damping"]
+    # crossed ones over zeta_h zeta_a: white 2e-3 / 5e-4 = 4 and 9e-3 / 2.5e-3 = 3.6; band 0.2
+    assert v["crossing_over_damping"]["white"] == pytest.approx([3.6, 4.0])
+    assert v["crossing_over_damping"]["band"] == pytest.approx([0.2, 0.2])
     assert v["monte_carlo_agree"] == 1 and v["monte_carlo_largest_z"] == pytest.approx(4.0)
     crossings.loc[1, "mass_ratio_crossing"] = 1e-3  # white: lighter damping crosses later
-    assert not single_mass_verdicts(errors, crossings, checks)["crossing_grows_with_host_damping"]
+    assert not single_mass_verdicts(errors, crossings, checks, 0.05)[
+        "crossing_grows_with_host_damping"
+    ]
 
 
 def test_array_verdicts_from_a_constructed_table():
@@ -150,7 +155,8 @@ def test_assemblies_quick_run_and_its_verdicts(tmp_path, monkeypatch, capsys):
               for name in ("single_mass", "crossings", "checks", "arrays", "two_mass")}  # fmt: skip
     data = json.loads((out / "verdicts.json").read_text())
     assert data["single_mass"] == json.loads(json.dumps(
-        study.single_mass_verdicts(tables["single_mass"], tables["crossings"], tables["checks"]),
+        study.single_mass_verdicts(tables["single_mass"], tables["crossings"], tables["checks"],
+                                   0.05),
         default=float))  # fmt: skip
     arrays = array_verdicts(tables["arrays"])
     assert data["arrays"]["comparisons"] == arrays["comparisons"] == 1

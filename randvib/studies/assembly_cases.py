@@ -258,13 +258,16 @@ def significance(mean, ci95) -> str:
 
 
 def single_mass_verdicts(errors: pd.DataFrame, crossings: pd.DataFrame,
-                         checks: pd.DataFrame) -> dict:  # fmt: skip
+                         checks: pd.DataFrame, harvester_zeta: float) -> dict:  # fmt: skip
     """The numbers behind question (a)'s sentences.
 
     ``errors``: input, host_zeta, mass_ratio, power_assembly, power_single_mass,
     error. ``crossings``: input, host_zeta, mass_ratio_crossing, where.
     ``checks``: input, host_zeta, mass_ratio, power_assembly (exact), power_mc,
-    power_mc_ci95, n_paths (Monte Carlo of the assembly).
+    power_mc_ci95, n_paths (Monte Carlo of the assembly). ``harvester_zeta``:
+    the harvester's total damping ratio zeta_a; the crossings are also given
+    as multiples of zeta_h zeta_a (``crossing_over_damping``: the smallest and
+    largest per input), the scale on which they collapse.
     """
     smallest = errors[errors.mass_ratio == errors.mass_ratio.min()]
     worst = errors.loc[errors.error.abs().idxmax()]
@@ -275,6 +278,10 @@ def single_mass_verdicts(errors: pd.DataFrame, crossings: pd.DataFrame,
         values = ordered.mass_ratio_crossing.fillna(np.inf).to_numpy()
         monotone.append(bool(np.all(np.diff(values) >= 0)))
     z = [_z(r.power_mc, r.power_mc_ci95, r.power_assembly, r.n_paths) for r in checks.itertuples()]
+    crossed = crossings[crossings["where"] == "crossed"]
+    scaled = crossed.mass_ratio_crossing / (crossed.host_zeta * harvester_zeta)
+    over_damping = {name: [float(sub.min()), float(sub.max())]
+                    for name, sub in scaled.groupby(crossed.input, sort=False)}  # fmt: skip
     return {
         "threshold": ERROR_THRESHOLD,
         "overestimates_everywhere": bool((errors.error > 0).all()),
@@ -299,6 +306,8 @@ def single_mass_verdicts(errors: pd.DataFrame, crossings: pd.DataFrame,
             f"{r.input}, zeta_h = {r.host_zeta:g}": r.where for r in crossings.itertuples()
         },  # fmt: skip
         "crossing_grows_with_host_damping": bool(all(monotone)),
+        "harvester_zeta": float(harvester_zeta),
+        "crossing_over_damping": over_damping,
         "monte_carlo_checks": len(z),
         "monte_carlo_agree": int(sum(abs(v) <= AGREEMENT_Z for v in z)),
         "monte_carlo_largest_z": float(max(map(abs, z))) if z else None,
