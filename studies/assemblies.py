@@ -289,35 +289,48 @@ def figures(errors, arrays, pairs, out: Path) -> Path:
         for i, (host_zeta, sub) in enumerate(errors[errors.input == name].groupby("host_zeta")):
             ax.plot(100 * sub.mass_ratio, 100 * sub.error.abs(), marker="o", ms=3,
                     color=colour(i), label=rf"$\zeta_h$ = {host_zeta:g}")  # fmt: skip
-        ax.axhline(5.0, color="0.4", ls="--", lw=0.8)
+        ax.axhline(5.0, color="0.4", ls="--", lw=0.8, label="5 %")
         ax.set(xscale="log", yscale="log", xlabel="mass ratio (%)",
                ylabel="single-mass error (%)", title=name)  # fmt: skip
-        ax.legend(fontsize=7, title="host damping", title_fontsize=7)
-    ax = axes[0, len(inputs)]
+        ax.legend(fontsize=7, title="host damping (exact)", title_fontsize=7)
+    array_panel(axes[0, len(inputs)], arrays)
+    two_mass_panel(axes[0, len(inputs) + 1], pairs)
+    return save_figure(fig, out / "assemblies.png")
+
+
+def array_panel(ax, arrays) -> None:
+    """The arrays' gain over one harvester: exact (open markers) and paired Monte Carlo."""
+    single = arrays[arrays.n == arrays.n.min()].set_index("bandwidth").power_mc
     for i, (n, sub) in enumerate(arrays[arrays.n > arrays.n.min()].groupby("n")):
-        ax.errorbar(sub.bandwidth, 100 * sub.difference_mc / sub.bandwidth.map(
-            arrays[arrays.n == arrays.n.min()].set_index("bandwidth").power_mc),
-            100 * sub.difference_mc_ci95 / sub.bandwidth.map(
-                arrays[arrays.n == arrays.n.min()].set_index("bandwidth").power_mc),
-            marker="o", capsize=2, color=colour(i), label=f"N = {n}, Monte Carlo")  # fmt: skip
-        ax.plot(sub.bandwidth, 100 * sub.gain, ls="--", color=colour(i), label=f"N = {n}, exact")
+        scale = 100 / sub.bandwidth.map(single)
+        ax.errorbar(sub.bandwidth, scale * sub.difference_mc, scale * sub.difference_mc_ci95,
+                    marker="o", capsize=2, color=colour(i),
+                    label=f"N = {n}, Monte Carlo (paired)")  # fmt: skip
+        ax.plot(sub.bandwidth, 100 * sub.gain, ls="--", marker="s", mfc="none", ms=7,
+                color=colour(i), label=f"N = {n}, exact optimum")  # fmt: skip
     ax.axhline(0.0, color="0.4", lw=0.8)
     ax.set(xscale="log", xlabel=r"input bandwidth $\zeta$", ylabel="gain over one harvester (%)",
            title="array of N against one")  # fmt: skip
     ax.legend(fontsize=7)
-    ax = axes[0, len(inputs) + 1]
+
+
+def two_mass_panel(ax, pairs) -> None:
+    """Both devices' powers per case: Monte Carlo with 95 % intervals, linearisation open."""
     labels = [
         f"{r.input.replace('band-pass ', '')}\nFc {1e3 * r.fc:g} mN" for r in pairs.itertuples()
     ]
     where = np.arange(len(pairs))
-    for shift, column, label in ((-0.15, "single_mc", "single mass"),
-                                 (0.15, "two_mass_mc", "two-mass")):  # fmt: skip
+    for i, (shift, column, predicted, label) in enumerate((
+        (-0.15, "single_mc", "power_single", "single mass"),
+        (0.15, "two_mass_mc", "power_two_mass", "two-mass"),
+    )):  # fmt: skip
         ax.errorbar(where + shift, 1e3 * pairs[column], 1e3 * pairs[f"{column}_ci95"], ls="none",
-                    marker="o", capsize=2, label=f"{label}, Monte Carlo")  # fmt: skip
+                    marker="o", capsize=2, color=colour(i), label=f"{label}, Monte Carlo")  # fmt: skip
+        ax.plot(where + shift, 1e3 * pairs[predicted], ls="none", marker="s", mfc="none", ms=7,
+                color=colour(i), label=f"{label}, linearisation")  # fmt: skip
     ax.set_xticks(where, labels, fontsize=7)
     ax.set(ylabel="power (mW)", title="two-mass against single mass", xlim=(-0.6, len(pairs) - 0.4))
     ax.legend(fontsize=7)
-    return save_figure(fig, out / "assemblies.png")
 
 
 def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, progress=True) -> Path:
