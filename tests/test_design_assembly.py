@@ -19,6 +19,7 @@ import json
 import numpy as np
 import pytest
 from _cli import one_line_error, run
+from _stats import assert_matches
 from scipy import linalg, special
 
 import randvib as rv
@@ -107,20 +108,44 @@ def test_analytic_design_of_a_linear_two_dof_assembly_is_the_exact_optimum():
     assert sigma <= STROKE / special.ndtri(1 - BUDGET / 2) * (1 + 1e-7)
     assert result.stroke == {"transducer.0": STROKE} and result.objective_scope == "all transducers"
     # at least as good as every point of a coarse grid, then of a fine grid around its best
-    coarse = brute_force(K_RANGE, CE_RANGE, 31)
-    step = (np.log(K_RANGE[1] / K_RANGE[0]) / 30, np.log(CE_RANGE[1] / CE_RANGE[0]) / 30)
+    coarse = brute_force(K_RANGE, CE_RANGE, 25)
+    step = (np.log(K_RANGE[1] / K_RANGE[0]) / 24, np.log(CE_RANGE[1] / CE_RANGE[0]) / 24)
     fine = brute_force(
         (coarse[1] * np.exp(-step[0]), coarse[1] * np.exp(step[0])),
         (coarse[2] * np.exp(-step[1]), coarse[2] * np.exp(step[1])),
-        21,
+        17,
     )
     assert fine[0] >= coarse[0]
     assert result.power_predicted >= fine[0] * (1 - 1e-9)
-    # and where the fine grid's best is, to its step (a tenth of a coarse step)
-    assert abs(np.log(k / fine[1])) <= step[0] / 10 * 1.01
-    assert abs(np.log(c_e / fine[2])) <= step[1] / 10 * 1.01
+    # and where the fine grid's best is, to its step (an eighth of a coarse step)
+    assert abs(np.log(k / fine[1])) <= step[0] / 8 * 1.01
+    assert abs(np.log(c_e / fine[2])) <= step[1] / 8 * 1.01
     # the budget binds here: the free optimum would break it
     assert 0.5 * BUDGET < result.exceedance_predicted <= BUDGET * (1 + 1e-6)
+
+
+def test_monte_carlo_confirms_an_assembly_design_on_common_paths():
+    """The optimum's Monte Carlo power against its exact power; the runner-up on the same paths.
+
+    White noise with the energy-balance controls: 64 paths of 3 s, powered
+    for a 5 % bias (seed 0). Needs the assembly kernel
+    (``randvib.montecarlo.assembly_simulation``, branch asmmc): skipped
+    where this build has none.
+    """
+    pytest.importorskip("randvib.montecarlo.assembly_simulation")
+    settings = rv.SweepSettings(dt=5e-4, window=3.0, burn_in=0.5, min_paths=64, max_paths=64,
+                                control_variates=True)  # fmt: skip
+    result = rv.design(host_with_harvester(150.0, 0.7), 0.1, {"transducer.0.c_e": (0.2, 200.0)},
+                       exceedance=BUDGET, settings=settings, runners_up=1)  # fmt: skip
+    exact = rv.predict(result.device, 0.1)
+    assert_matches(result.power_monte_carlo, exact.transducers[0].power_electrical, detect=0.05)
+    # every dissipation together is the injected r^T M r S / 4
+    assert_matches(result.input_power, (HOST_MASS + HARVESTER_MASS) * 0.1 / 4, detect=0.05)
+    assert result.monte_carlo_cases == 2 and not result.refined
+    (runner,) = result.runners_up
+    # common random numbers: the paired difference is far more precise than either power
+    assert runner["difference_to_optimum"].ci95 < 0.5 * runner["power_monte_carlo"].ci95
+    assert result.to_dict()["stroke_exceedance_monte_carlo"]["mean"] >= 0
 
 
 def two_harvesters():
