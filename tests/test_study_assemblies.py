@@ -77,6 +77,7 @@ def test_single_mass_verdicts_from_a_constructed_table():
     checks = pd.DataFrame([
         {"power_assembly": 1.0, "power_mc": 1.0 + 0.5 * 0.01, "power_mc_ci95": t * 0.01, "n_paths": 100},
         {"power_assembly": 1.0, "power_mc": 1.0 + 4.0 * 0.01, "power_mc_ci95": t * 0.01, "n_paths": 100},
+        {"power_assembly": 1.0, "power_mc": math.nan, "power_mc_ci95": math.nan, "n_paths": 0},
     ])  # fmt: skip
     v = single_mass_verdicts(errors, crossings, checks, 0.05)
     assert v["overestimates_everywhere"]
@@ -96,6 +97,7 @@ def test_single_mass_verdicts_from_a_constructed_table():
     assert v["crossing_over_damping"]["white"] == pytest.approx([3.6, 4.0])
     assert v["crossing_over_damping"]["band"] == pytest.approx([0.2, 0.2])
     assert v["monte_carlo_agree"] == 1 and v["monte_carlo_largest_z"] == pytest.approx(4.0)
+    assert v["monte_carlo_checks"] == 2  # the row without a run is not counted
     crossings.loc[1, "mass_ratio_crossing"] = 1e-3  # white: lighter damping crosses later
     assert not single_mass_verdicts(errors, crossings, checks, 0.05)[
         "crossing_grows_with_host_damping"
@@ -114,14 +116,26 @@ def test_array_verdicts_from_a_constructed_table():
                                         "difference_mc_ci95"])  # fmt: skip
     table["power_mc"], table["power_mc_ci95"], table["n_paths"] = table.power, 0.01, 64
     v = array_verdicts(table)
-    assert v["comparisons"] == 3
+    assert v["comparisons"] == v["monte_carlo_comparisons"] == 3 and v["array_better_exact"] == 2
     assert v["array_significantly_better"] == 1 and v["single_significantly_better"] == 1
     assert v["by_bandwidth"]["0.1"] == {"best_n": 2, "best_gain": 0.05, "largest_gain": 0.05,
+                                        "exact": {2: "above", 3: "above"},
                                         "monte_carlo": {2: "above", 3: "neither"}}  # fmt: skip
     assert v["by_bandwidth"]["1"]["best_n"] == 1 and v["by_bandwidth"]["1"]["monte_carlo"] == {
         2: "below"
     }
+    assert v["by_bandwidth"]["1"]["exact"] == {2: "below"}
     assert v["largest_gain"] == 0.05 and v["monte_carlo_agree"] == 5
+    # without Monte Carlo: the exact verdicts stand, nothing is counted as significant
+    table[["difference_mc", "difference_mc_ci95", "power_mc", "power_mc_ci95"]] = math.nan
+    v = array_verdicts(table)
+    assert v["array_better_exact"] == 2 and v["by_bandwidth"]["0.1"]["exact"] == {
+        2: "above",
+        3: "above",
+    }
+    assert v["by_bandwidth"]["0.1"]["monte_carlo"] == {2: None, 3: None}
+    assert v["monte_carlo_comparisons"] == v["monte_carlo_checks"] == 0
+    assert v["array_significantly_better"] == v["single_significantly_better"] == 0
 
 
 def test_two_mass_verdicts_from_a_constructed_table():
@@ -138,15 +152,26 @@ def test_two_mass_verdicts_from_a_constructed_table():
     case = v["cases"]["band-pass zeta 0.3, Fc = 3 mN"]
     assert case["monte_carlo"] == "two-mass"
     assert case["ratio_predicted"] == pytest.approx(1.2) and case["ratio_monte_carlo"] == 1.3 / 1.1
+    assert case["linearisation"] == "two-mass"
+    assert v["cases"]["band-pass zeta 0.05, Fc = 0 mN"]["linearisation"] == "single mass"
+    assert v["two_mass_better_linearisation"] == 1 and v["monte_carlo_cases"] == 2
     # linearisation's largest error: 0.9 / 0.99 - 1 = -9.1 %
     assert v["linearisation_largest_error"] == pytest.approx(abs(0.9 / 0.99 - 1))
+    # without Monte Carlo: linearisation's verdicts only
+    pairs.loc[1, ["single_mc", "two_mass_mc", "difference_mc", "difference_mc_ci95"]] = math.nan
+    v = two_mass_verdicts(pairs)
+    assert v["cases"]["band-pass zeta 0.05, Fc = 0 mN"]["monte_carlo"] is None
+    assert v["cases"]["band-pass zeta 0.05, Fc = 0 mN"]["ratio_monte_carlo"] is None
+    assert v["monte_carlo_cases"] == 1 and v["undecided"] == 0 and v["two_mass_better"] == 1
+    assert v["linearisation_largest_error"] == pytest.approx(abs(1.0 / 1.1 - 1))
 
 
-def test_assemblies_quick_run_and_its_verdicts(tmp_path, monkeypatch, capsys):
+def _quick_run(tmp_path, monkeypatch, capsys, mc):
+    """A tiny run through the command line: (its CSV tables, verdicts.json, output folder)."""
     small = study.grid(True)
+    # (c) without friction here: its exact design takes a second, linearisation's ten
     small.update(ratios=(1e-3, 0.05), host_zetas=(0.05,), inputs={"white": None},
-                 checks=[("white", 0.05, 0.05)], bandwidths=(0.3,),
-                 mc={"n_paths": 16, "window": 1.0, "burn_in": 2.0, "dt": 5e-4})  # fmt: skip
+                 checks=[("white", 0.05, 0.05)], bandwidths=(0.3,), fcs=(0.0,), mc=mc)  # fmt: skip
     monkeypatch.setattr(study, "grid", lambda quick: small)
     out = tmp_path / "assemblies"
     assert main(["study", "assemblies", "--quick", "--out", str(out), "--no-progress"]) == 0
@@ -154,22 +179,42 @@ def test_assemblies_quick_run_and_its_verdicts(tmp_path, monkeypatch, capsys):
     tables = {name: pd.read_csv(out / f"{name}.csv")
               for name in ("single_mass", "crossings", "checks", "arrays", "two_mass")}  # fmt: skip
     data = json.loads((out / "verdicts.json").read_text())
+    # every verdict is recomputed from the tables as written
     assert data["single_mass"] == json.loads(json.dumps(
         study.single_mass_verdicts(tables["single_mass"], tables["crossings"], tables["checks"],
                                    0.05),
         default=float))  # fmt: skip
-    arrays = array_verdicts(tables["arrays"])
-    assert data["arrays"]["comparisons"] == arrays["comparisons"] == 1
-    assert data["arrays"]["array_significantly_better"] == arrays["array_significantly_better"]
-    assert (
-        data["two_mass"]["two_mass_better"]
-        == two_mass_verdicts(tables["two_mass"])["two_mass_better"]
-    )
+    assert data["arrays"] == json.loads(json.dumps(array_verdicts(tables["arrays"])))
+    assert data["two_mass"] == json.loads(json.dumps(two_mass_verdicts(tables["two_mass"])))
     # the exact answers in the tables are those of the building blocks
     row = tables["single_mass"].iloc[-1]
     again = single_mass_error(HostMode(1.0, 10.0, row.host_zeta), row.mass_ratio, rv.White(0.1),
                               **study.HARVESTER)  # fmt: skip
     assert row.power_assembly == pytest.approx(again["power_assembly"], rel=1e-12)
-    assert np.isfinite(tables["arrays"].difference_mc.iloc[-1])
     assert (out / "assemblies.png").stat().st_size > 0
     assert "(c) Two masses" in (out / "report.md").read_text()
+    return tables, data, out
+
+
+def test_assemblies_quick_run_on_exact_and_linearised_answers(tmp_path, monkeypatch, capsys):
+    """Without Monte Carlo (as in a build without the assembly kernel): seconds."""
+    tables, data, out = _quick_run(tmp_path, monkeypatch, capsys, None)
+    assert data["arrays"]["comparisons"] == 1 and data["arrays"]["monte_carlo_comparisons"] == 0
+    gain = tables["arrays"].gain.iloc[-1]
+    assert data["arrays"]["array_better_exact"] == int(gain > 0)
+    assert tables["two_mass"].single_mc.isna().all() and (tables["checks"].n_paths == 0).all()
+    assert data["two_mass"]["monte_carlo_cases"] == 0
+    report = (out / "report.md").read_text()
+    assert study.NO_MONTE_CARLO in report and "No Monte Carlo (no assembly kernel" in report
+
+
+def test_assemblies_quick_run_with_monte_carlo(tmp_path, monkeypatch, capsys):
+    """Paired Monte Carlo of every device: needs the assembly kernel (branch asmmc)."""
+    pytest.importorskip("randvib.montecarlo.assembly_simulation")
+    mc = {"n_paths": 16, "window": 1.0, "burn_in": 2.0, "dt": 5e-4}
+    tables, data, out = _quick_run(tmp_path, monkeypatch, capsys, mc)
+    assert data["arrays"]["monte_carlo_comparisons"] == data["arrays"]["comparisons"] == 1
+    assert np.isfinite(tables["arrays"].difference_mc.iloc[-1])
+    assert data["two_mass"]["monte_carlo_cases"] == len(tables["two_mass"])
+    assert data["single_mass"]["monte_carlo_checks"] == 1
+    assert study.NO_MONTE_CARLO not in (out / "report.md").read_text()

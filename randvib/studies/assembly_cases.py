@@ -25,11 +25,16 @@ Three questions of issue 31 (``randvib study assemblies``, studies/assemblies.py
 
 The verdict functions (:func:`single_mass_verdicts`, :func:`array_verdicts`,
 :func:`two_mass_verdicts`) compute every number of the report's sentences from
-the study's tables.
+the study's tables. Monte Carlo needs the assembly kernel
+(:mod:`randvib.montecarlo.assembly_simulation`; :func:`assembly_monte_carlo`
+says whether this build has it): where a table's Monte Carlo columns are NaN
+(no kernel, or a run not made) the verdicts rest on the exact and linearised
+answers alone, and every Monte Carlo count is over the rows that have one.
 """
 
 from __future__ import annotations
 
+import importlib.util
 import math
 from dataclasses import dataclass
 
@@ -48,6 +53,7 @@ from randvib.statistics import Statistic, estimate
 __all__ = [
     "HostMode",
     "array_verdicts",
+    "assembly_monte_carlo",
     "harvesters_on_host",
     "mass_ratio_at_error",
     "paired_difference",
@@ -242,14 +248,29 @@ def paired_difference(a, b) -> Statistic:
 
 
 # --------------------------------------------------------------------- verdicts
+def assembly_monte_carlo() -> bool:
+    """Whether this build simulates assemblies (:mod:`randvib.montecarlo.assembly_simulation`)."""
+    return importlib.util.find_spec("randvib.montecarlo.assembly_simulation") is not None
+
+
+def _measured(mean, ci95) -> bool:
+    """Whether a Monte Carlo column holds an estimate (NaN: no run)."""
+    return bool(np.isfinite(mean) and np.isfinite(ci95))
+
+
 def _z(mean, ci95, exact, n_paths):
     """z-score of a Monte Carlo mean against an exact value (the t-based 95 % half-width)."""
     se = ci95 / special.stdtrit(int(n_paths) - 1, 0.975)
     return (mean - exact) / se if se > 0 else math.inf
 
 
-def significance(mean, ci95) -> str:
-    """``above``, ``below`` or ``neither``: where a paired difference's 95 % interval lies."""
+def significance(mean, ci95) -> str | None:
+    """``above``, ``below`` or ``neither``: where a paired difference's 95 % interval lies.
+
+    None where there is no estimate (NaN).
+    """
+    if not _measured(mean, ci95):
+        return None
     if mean - ci95 > 0:
         return "above"
     if mean + ci95 < 0:
@@ -277,7 +298,8 @@ def single_mass_verdicts(errors: pd.DataFrame, crossings: pd.DataFrame,
         ordered = sub.sort_values("host_zeta")
         values = ordered.mass_ratio_crossing.fillna(np.inf).to_numpy()
         monotone.append(bool(np.all(np.diff(values) >= 0)))
-    z = [_z(r.power_mc, r.power_mc_ci95, r.power_assembly, r.n_paths) for r in checks.itertuples()]
+    z = [_z(r.power_mc, r.power_mc_ci95, r.power_assembly, r.n_paths)
+         for r in checks.itertuples() if _measured(r.power_mc, r.power_mc_ci95)]  # fmt: skip
     crossed = crossings[crossings["where"] == "crossed"]
     scaled = crossed.mass_ratio_crossing / (crossed.host_zeta * harvester_zeta)
     over_damping = {name: [float(sub.min()), float(sub.max())]
@@ -319,7 +341,10 @@ def array_verdicts(arrays: pd.DataFrame) -> dict:
 
     ``arrays``: bandwidth, n, power (exact optimum), gain (exact, over n = 1),
     difference_mc, difference_mc_ci95 (paired, array - single; NaN for n = 1),
-    power_mc, power_mc_ci95, n_paths.
+    power_mc, power_mc_ci95, n_paths (the Monte Carlo columns NaN where
+    there is no run). ``exact``: an array's sign of gain on the exact optimum
+    (the devices are linear); ``monte_carlo``: its paired interval's verdict,
+    None without a run.
     """
     by_band = {}
     for bandwidth, sub in arrays.groupby("bandwidth", sort=True):
@@ -331,10 +356,13 @@ def array_verdicts(arrays: pd.DataFrame) -> dict:
             "best_n": int(best.n),
             "best_gain": float(best.gain),
             "largest_gain": float(arrays_only.gain.max()) if len(arrays_only) else 0.0,
+            "exact": {int(r.n): "above" if r.gain > 0 else "below" for r in arrays_only.itertuples()},
             "monte_carlo": verdicts,
-        }
-    z = [_z(r.power_mc, r.power_mc_ci95, r.power, r.n_paths) for r in arrays.itertuples()]
+        }  # fmt: skip
+    z = [_z(r.power_mc, r.power_mc_ci95, r.power, r.n_paths)
+         for r in arrays.itertuples() if _measured(r.power_mc, r.power_mc_ci95)]  # fmt: skip
     differences = arrays[arrays.n > 1]
+    measured = [_measured(r.difference_mc, r.difference_mc_ci95) for r in differences.itertuples()]
     return {
         "by_bandwidth": by_band,
         "largest_gain": float(differences.gain.max()) if len(differences) else 0.0,
@@ -345,6 +373,8 @@ def array_verdicts(arrays: pd.DataFrame) -> dict:
             sum(r.difference_mc + r.difference_mc_ci95 < 0 for r in differences.itertuples())
         ),  # fmt: skip
         "comparisons": int(len(differences)),
+        "array_better_exact": int((differences.gain > 0).sum()),
+        "monte_carlo_comparisons": int(sum(measured)),
         "monte_carlo_agree": int(sum(abs(v) <= AGREEMENT_Z for v in z)),
         "monte_carlo_checks": len(z),
     }
@@ -356,22 +386,29 @@ def two_mass_verdicts(pairs: pd.DataFrame) -> dict:
     ``pairs``: input, fc, power_single, power_two_mass (linearisation's, at
     each design's optimum), single_mc, single_mc_ci95, two_mass_mc,
     two_mass_mc_ci95, difference_mc, difference_mc_ci95 (paired, two-mass -
-    single).
+    single; the Monte Carlo columns NaN where there is no run). Per case:
+    ``linearisation``, the better device by the predicted powers;
+    ``monte_carlo``, the paired interval's verdict (None without a run).
     """
+    names = {"above": "two-mass", "below": "single mass", "neither": "neither", None: None}
     rows = {}
     for r in pairs.itertuples():
+        measured = _measured(r.difference_mc, r.difference_mc_ci95)
         rows[f"{r.input}, Fc = {1e3 * r.fc:g} mN"] = {
-            "monte_carlo": {"above": "two-mass", "below": "single mass",
-                            "neither": "neither"}[significance(r.difference_mc,
-                                                               r.difference_mc_ci95)],
+            "linearisation": "two-mass" if r.power_two_mass > r.power_single else "single mass",
+            "monte_carlo": names[significance(r.difference_mc, r.difference_mc_ci95)],
             "ratio_predicted": float(r.power_two_mass / r.power_single),
-            "ratio_monte_carlo": float(r.two_mass_mc / r.single_mc),
+            "ratio_monte_carlo": float(r.two_mass_mc / r.single_mc) if measured else None,
         }  # fmt: skip
     errors = np.concatenate([(pairs.power_single / pairs.single_mc - 1).to_numpy(),
                              (pairs.power_two_mass / pairs.two_mass_mc - 1).to_numpy()])  # fmt: skip
+    errors = errors[np.isfinite(errors)]
     winners = [v["monte_carlo"] for v in rows.values()]
+    predicted = [v["linearisation"] for v in rows.values()]
     return {
         "cases": rows,
+        "two_mass_better_linearisation": predicted.count("two-mass"),
+        "monte_carlo_cases": len(winners) - winners.count(None),
         "two_mass_better": winners.count("two-mass"),
         "single_better": winners.count("single mass"),
         "undecided": winners.count("neither"),
