@@ -625,6 +625,34 @@ MUTATIONS: tuple[Mutation, ...] = (
         "positive, not significantly so; the constructed table has a positive difference "
         "inside its interval.",
     ),
+    Mutation(
+        name="unmeasured-check-counted",
+        path="randvib/studies/assembly_cases.py",
+        edits=(
+            (
+                "for r in checks.itertuples() if _measured(r.power_mc, r.power_mc_ci95)]",
+                "for r in checks.itertuples()]",
+            ),
+        ),
+        tests=(
+            "tests/test_study_assemblies.py::test_single_mass_verdicts_from_a_constructed_table",
+        ),
+        why="The assemblies study counts a check without a Monte Carlo run (NaN, no assembly "
+        "kernel) as a Monte Carlo check; the constructed table has one such row.",
+    ),
+    Mutation(
+        name="two-mass-linearisation-verdict-reversed",
+        path="randvib/studies/assembly_cases.py",
+        edits=(
+            (
+                '"two-mass" if r.power_two_mass > r.power_single',
+                '"two-mass" if r.power_two_mass < r.power_single',
+            ),
+        ),
+        tests=("tests/test_study_assemblies.py::test_two_mass_verdicts_from_a_constructed_table",),
+        why="The assemblies study's verdict without Monte Carlo names the device linearisation "
+        "predicts the lesser power; the constructed table has one case each way.",
+    ),
 )
 
 
