@@ -21,6 +21,7 @@ from randvib.studies import load
 from randvib.studies.assembly_cases import (
     HostMode,
     array_verdicts,
+    assembly_monte_carlo,
     mass_ratio_at_error,
     single_mass_error,
     single_mass_power,
@@ -196,25 +197,27 @@ def _quick_run(tmp_path, monkeypatch, capsys, mc):
     return tables, data, out
 
 
-def test_assemblies_quick_run_on_exact_and_linearised_answers(tmp_path, monkeypatch, capsys):
-    """Without Monte Carlo (as in a build without the assembly kernel): seconds."""
-    tables, data, out = _quick_run(tmp_path, monkeypatch, capsys, None)
-    assert data["arrays"]["comparisons"] == 1 and data["arrays"]["monte_carlo_comparisons"] == 0
-    gain = tables["arrays"].gain.iloc[-1]
-    assert data["arrays"]["array_better_exact"] == int(gain > 0)
-    assert tables["two_mass"].single_mc.isna().all() and (tables["checks"].n_paths == 0).all()
-    assert data["two_mass"]["monte_carlo_cases"] == 0
-    report = (out / "report.md").read_text()
-    assert study.NO_MONTE_CARLO in report and "No Monte Carlo (no assembly kernel" in report
+def test_assemblies_quick_run_and_its_verdicts(tmp_path, monkeypatch, capsys):
+    """With the assembly kernel, paired Monte Carlo of every device; without, none.
 
-
-def test_assemblies_quick_run_with_monte_carlo(tmp_path, monkeypatch, capsys):
-    """Paired Monte Carlo of every device: needs the assembly kernel (branch asmmc)."""
-    pytest.importorskip("randvib.montecarlo.assembly_simulation")
-    mc = {"n_paths": 16, "window": 1.0, "burn_in": 2.0, "dt": 5e-4}
+    The kernel is :mod:`randvib.montecarlo.assembly_simulation` (branch asmmc):
+    with it, 16 paths of 1 s from rest per device; without it the study runs
+    on the exact and linearised answers alone and says so.
+    """
+    simulated = assembly_monte_carlo()
+    mc = {"n_paths": 16, "window": 1.0, "burn_in": 2.0, "dt": 5e-4} if simulated else None
     tables, data, out = _quick_run(tmp_path, monkeypatch, capsys, mc)
-    assert data["arrays"]["monte_carlo_comparisons"] == data["arrays"]["comparisons"] == 1
-    assert np.isfinite(tables["arrays"].difference_mc.iloc[-1])
-    assert data["two_mass"]["monte_carlo_cases"] == len(tables["two_mass"])
-    assert data["single_mass"]["monte_carlo_checks"] == 1
-    assert study.NO_MONTE_CARLO not in (out / "report.md").read_text()
+    assert data["arrays"]["comparisons"] == 1
+    assert data["arrays"]["array_better_exact"] == int(tables["arrays"].gain.iloc[-1] > 0)
+    report = (out / "report.md").read_text()
+    if simulated:
+        assert data["arrays"]["monte_carlo_comparisons"] == 1
+        assert np.isfinite(tables["arrays"].difference_mc.iloc[-1])
+        assert data["two_mass"]["monte_carlo_cases"] == len(tables["two_mass"])
+        assert data["single_mass"]["monte_carlo_checks"] == 1
+        assert study.NO_MONTE_CARLO not in report
+    else:
+        assert data["arrays"]["monte_carlo_comparisons"] == 0
+        assert tables["two_mass"].single_mc.isna().all() and (tables["checks"].n_paths == 0).all()
+        assert data["two_mass"]["monte_carlo_cases"] == 0
+        assert study.NO_MONTE_CARLO in report and "No Monte Carlo (no assembly kernel" in report
