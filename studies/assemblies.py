@@ -296,7 +296,8 @@ def sentences(a: dict, b: dict, c: dict) -> list[str]:
         f"(b) Monte Carlo (paired 95 %): the array significantly better in "
         f"{b['array_significantly_better']} of {b['monte_carlo_comparisons']} comparisons, "
         f"worse in {b['single_significantly_better']}.",
-        f"(c) By linearisation the two-mass harvester harvests more than the single mass in "
+        f"(c) By the analytic answers (exact without friction, else linearisation) the two-mass "
+        f"harvester harvests more than the single mass in "
         f"{c['two_mass_better_linearisation']} of {len(c['cases'])} cases: "
         + "; ".join(f"{k}: ratio {v['ratio_predicted']:.3g}" for k, v in c["cases"].items()) + ".",
         f"(c) Monte Carlo (paired 95 %): the two-mass harvester significantly better in "
