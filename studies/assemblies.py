@@ -54,6 +54,7 @@ from randvib.analytic.statistical_linearisation import LinearisationValidityWarn
 from randvib.figure_style import colour, new_figure, save_figure
 from randvib.studies import report, script_main
 from randvib.studies.assembly_cases import (
+    ANALYTIC_TIE,
     HostMode,
     array_verdicts,
     assembly_monte_carlo,
@@ -289,7 +290,8 @@ def sentences(a: dict, b: dict, c: dict) -> list[str]:
         f"(a) Monte Carlo of the assembly agrees with the exact answer (|z| <= 3) at "
         f"{a['monte_carlo_agree']} of {a['monte_carlo_checks']} points.",
         f"(b) On the exact optima an array beats one tuned harvester of the same mass in "
-        f"{b['array_better_exact']} of {b['comparisons']} comparisons; the largest gain is "
+        f"{b['array_better_exact']} of {b['comparisons']} comparisons (equal, within "
+        f"{ANALYTIC_TIE:g}, in {b['array_equal_exact']}); the largest gain is "
         f"{100 * b['largest_gain']:.3g} %: "
         + "; ".join(f"zeta {bw}: best N = {v['best_n']} (+{100 * v['best_gain']:.3g} %)"
                     for bw, v in b["by_bandwidth"].items()) + ".",

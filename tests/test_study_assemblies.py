@@ -112,21 +112,25 @@ def test_array_verdicts_from_a_constructed_table():
         (0.1, 3, 1.04, 0.04, 0.01, 0.02),
         # bandwidth 1: the single harvester significantly better than N = 2
         (1.0, 1, 2.00, 0.0, math.nan, math.nan), (1.0, 2, 1.90, -0.05, -0.1, 0.02),
+        # and N = 3 the same as one harvester, to the searches' rounding
+        (1.0, 3, 2.0 * (1 - 2e-9), -2e-9, 0.0, 0.02),
     ]  # fmt: skip
     table = pd.DataFrame(rows, columns=["bandwidth", "n", "power", "gain", "difference_mc",
                                         "difference_mc_ci95"])  # fmt: skip
     table["power_mc"], table["power_mc_ci95"], table["n_paths"] = table.power, 0.01, 64
     v = array_verdicts(table)
-    assert v["comparisons"] == v["monte_carlo_comparisons"] == 3 and v["array_better_exact"] == 2
+    assert v["comparisons"] == v["monte_carlo_comparisons"] == 4 and v["array_better_exact"] == 2
+    assert v["array_equal_exact"] == 1
     assert v["array_significantly_better"] == 1 and v["single_significantly_better"] == 1
     assert v["by_bandwidth"]["0.1"] == {"best_n": 2, "best_gain": 0.05, "largest_gain": 0.05,
                                         "exact": {2: "above", 3: "above"},
                                         "monte_carlo": {2: "above", 3: "neither"}}  # fmt: skip
     assert v["by_bandwidth"]["1"]["best_n"] == 1 and v["by_bandwidth"]["1"]["monte_carlo"] == {
-        2: "below"
+        2: "below",
+        3: "neither",
     }
-    assert v["by_bandwidth"]["1"]["exact"] == {2: "below"}
-    assert v["largest_gain"] == 0.05 and v["monte_carlo_agree"] == 5
+    assert v["by_bandwidth"]["1"]["exact"] == {2: "below", 3: "equal"}
+    assert v["largest_gain"] == 0.05 and v["monte_carlo_agree"] == 6
     # without Monte Carlo: the exact verdicts stand, nothing is counted as significant
     table[["difference_mc", "difference_mc_ci95", "power_mc", "power_mc_ci95"]] = math.nan
     v = array_verdicts(table)

@@ -74,6 +74,17 @@ ERROR_THRESHOLD = 0.05
 CROSSING_BOUNDS = (1e-8, 0.2)
 #: A Monte Carlo estimate agrees with an exact value when |z| is at most this.
 AGREEMENT_Z = 3.0
+#: Two analytic optima whose powers differ by less than this (relative) are equal: far
+#: above the rounding of two separate searches (about 1e-9 for (b)'s arrays, whose
+#: optimum is N equal harvesters) and far below any difference worth a device.
+ANALYTIC_TIE = 1e-6
+
+
+def _analytic(gain: float) -> str:
+    """``above``, ``below`` or ``equal``: an analytic gain's sign, ties within ANALYTIC_TIE."""
+    if gain > ANALYTIC_TIE:
+        return "above"
+    return "below" if gain < -ANALYTIC_TIE else "equal"
 
 
 @dataclass(frozen=True)
@@ -343,8 +354,8 @@ def array_verdicts(arrays: pd.DataFrame) -> dict:
     difference_mc, difference_mc_ci95 (paired, array - single; NaN for n = 1),
     power_mc, power_mc_ci95, n_paths (the Monte Carlo columns NaN where
     there is no run). ``exact``: an array's sign of gain on the exact optimum
-    (the devices are linear); ``monte_carlo``: its paired interval's verdict,
-    None without a run.
+    (the devices are linear), ``equal`` within :data:`ANALYTIC_TIE`;
+    ``monte_carlo``: its paired interval's verdict, None without a run.
     """
     by_band = {}
     for bandwidth, sub in arrays.groupby("bandwidth", sort=True):
@@ -356,7 +367,7 @@ def array_verdicts(arrays: pd.DataFrame) -> dict:
             "best_n": int(best.n),
             "best_gain": float(best.gain),
             "largest_gain": float(arrays_only.gain.max()) if len(arrays_only) else 0.0,
-            "exact": {int(r.n): "above" if r.gain > 0 else "below" for r in arrays_only.itertuples()},
+            "exact": {int(r.n): _analytic(r.gain) for r in arrays_only.itertuples()},
             "monte_carlo": verdicts,
         }  # fmt: skip
     z = [_z(r.power_mc, r.power_mc_ci95, r.power, r.n_paths)
@@ -373,7 +384,8 @@ def array_verdicts(arrays: pd.DataFrame) -> dict:
             sum(r.difference_mc + r.difference_mc_ci95 < 0 for r in differences.itertuples())
         ),  # fmt: skip
         "comparisons": int(len(differences)),
-        "array_better_exact": int((differences.gain > 0).sum()),
+        "array_better_exact": int((differences.gain > ANALYTIC_TIE).sum()),
+        "array_equal_exact": int((differences.gain.abs() <= ANALYTIC_TIE).sum()),
         "monte_carlo_comparisons": int(sum(measured)),
         "monte_carlo_agree": int(sum(abs(v) <= AGREEMENT_Z for v in z)),
         "monte_carlo_checks": len(z),
@@ -395,7 +407,9 @@ def two_mass_verdicts(pairs: pd.DataFrame) -> dict:
     for r in pairs.itertuples():
         measured = _measured(r.difference_mc, r.difference_mc_ci95)
         rows[f"{r.input}, Fc = {1e3 * r.fc:g} mN"] = {
-            "linearisation": "two-mass" if r.power_two_mass > r.power_single else "single mass",
+            "linearisation": {"above": "two-mass", "below": "single mass", "equal": "neither"}[
+                _analytic(r.power_two_mass / r.power_single - 1.0)
+            ],
             "monte_carlo": names[significance(r.difference_mc, r.difference_mc_ci95)],
             "ratio_predicted": float(r.power_two_mass / r.power_single),
             "ratio_monte_carlo": float(r.two_mass_mc / r.single_mc) if measured else None,
