@@ -27,8 +27,11 @@ class DesignResult:
         The fixed harvester with the chosen values.
     objective : str
         The maximised power (:data:`randvib.harvester_design.objectives.OBJECTIVES`).
-    stroke, exceedance_budget : float
-        The stroke d (m) and the budget eps on P(|z| > d).
+    stroke : float or dict
+        The stroke d (m); an assembly's: coordinate path -> its stroke (m),
+        each held to the budget.
+    exceedance_budget : float
+        The budget eps on P(|z| > d) (an assembly's: on each coordinate).
     method : str
         The analytic method of the search.
     power_predicted : float
@@ -86,6 +89,9 @@ class DesignResult:
         Monte Carlo's verdict on ``min_first_passage``: True (E[min(tau, t_end)]
         significantly above T), False (E[tau] significantly below T), None
         (undetermined: paths censored at t_end, or no bound).
+    objective_scope : str or None
+        An assembly's: ``"all transducers"`` (their powers summed) or
+        ``"transducer I"``; None for a single mass.
     monte_carlo_input : str or None
         What drove the Monte Carlo: ``"record windows"`` (a measured record
         itself, its windows the paths, :func:`randvib.monte_carlo_on_record`)
@@ -96,7 +102,7 @@ class DesignResult:
     optimum: dict
     device: object = field(repr=False)
     objective: str
-    stroke: float
+    stroke: float | dict
     exceedance_budget: float
     method: str
     power_predicted: float
@@ -120,6 +126,7 @@ class DesignResult:
     first_passage_confirmed: bool | None = None
     monte_carlo_input: str | None = None
     limit_kind: str | None = None
+    objective_scope: str | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready: the keys of ``randvib design --json``."""
@@ -158,6 +165,7 @@ class DesignResult:
             else self.first_passage_monte_carlo.to_dict(),
             "first_passage_confirmed": self.first_passage_confirmed,
             "monte_carlo_input": self.monte_carlo_input,
+            **({} if self.objective_scope is None else {"objective_scope": self.objective_scope}),
         }
 
     def to_frame(self):
