@@ -488,6 +488,94 @@ MUTATIONS: tuple[Mutation, ...] = (
         why="The reference itself: Caughey and Stumpf's E[z^2] with the phase term's sign "
         "flipped; its derivative must be twice the closed-form E[z z'].",
     ),
+    Mutation(
+        name="assembly-dashpot-to-ground",
+        path="randvib/models/assembly.py",
+        edits=(
+            (
+                "c += element.damping * np.outer(d, d)",
+                "c += element.damping * np.diag(np.abs(d))",
+            ),
+        ),
+        tests=(
+            "tests/test_assembly_analytic.py::test_two_dof_chain_against_a_hand_built_lyapunov_equation",
+        ),
+        why="An element's dashpot between two DOFs acts on each DOF's absolute velocity (two "
+        "dashpots to the base) instead of their relative velocity; the two-DOF chain is "
+        "checked against a Lyapunov equation on a state matrix written by hand.",
+    ),
+    Mutation(
+        name="assembly-circuit-drive",
+        path="randvib/models/assembly.py",
+        edits=(("a[slot, n : 2 * n] = b_s * d", "a[slot, n : 2 * n] = 1.01 * b_s * d"),),
+        tests=(
+            "tests/test_assembly_analytic.py::test_host_with_two_harvesters_against_a_frequency_domain_integral",
+        ),
+        why="A transducer's circuit state is driven 1 % too hard by its relative velocity "
+        "(alpha/L or theta/C_p); the three-DOF host is checked against a frequency-domain "
+        "integral with the circuits as frequency-dependent dashpots, to 1e-8.",
+    ),
+    Mutation(
+        name="assembly-white-input-power",
+        path="randvib/analytic/assembly_linear.py",
+        edits=(
+            (
+                "return float(assembly.influence @ mr * excitation.level / 4.0)",
+                "return float(assembly.influence @ mr * excitation.level / 2.0)",
+            ),
+        ),
+        tests=("tests/test_assembly_analytic.py::test_white_noise_energy_balance_is_exact",),
+        why="The injected power r^T M r S / 2 instead of / 4 (S taken as the two-sided "
+        "intensity: E[w w] = (S/2) delta); the balance is written from the masses in the test.",
+    ),
+    Mutation(
+        name="assembly-spectral-conjugate",
+        path="randvib/analytic/assembly_linear.py",
+        edits=(
+            (
+                "covariance = np.real((h * density) @ h.conj().T)",
+                "covariance = np.real((h * density) @ h.T)",
+            ),
+        ),
+        tests=(
+            "tests/test_assembly_analytic.py::test_spectral_route_equals_lyapunov_for_three_dofs",
+        ),
+        why="The spectral covariance int Re(H H^H) S df without the conjugate: the "
+        "cross-covariances (and with them the variances' real parts) are wrong; the two "
+        "routes must agree to 1e-9 as correlations.",
+    ),
+    Mutation(
+        name="assembly-cubic-closure",
+        path="randvib/analytic/assembly_linearisation.py",
+        edits=(
+            (
+                "k += 3.0 * element.spring.k3 * variance * np.outer(d, d)",
+                "k += 3.3 * element.spring.k3 * variance * np.outer(d, d)",
+            ),
+        ),
+        tests=(
+            "tests/test_assembly_analytic.py::test_one_dof_assembly_equals_the_harvester",
+            "tests/test_assembly_analytic.py::test_nonlinear_fixed_point_is_self_consistent",
+        ),
+        why="An element's Gaussian-closure spring 3.3 k3 E[u^2] instead of 3 k3 E[u^2]; the "
+        "one-DOF assembly must equal the single-mass linearisation under coloured input.",
+    ),
+    Mutation(
+        name="assembly-friction-closure",
+        path="randvib/analytic/assembly_linearisation.py",
+        edits=(("sigma = np.sqrt(variance)", "sigma = np.sqrt(1.02 * variance)"),),
+        tests=("tests/test_assembly_analytic.py::test_one_dof_coulomb_under_white_noise_is_eq_30",),
+        why="The friction's equivalent dashpot evaluated at a velocity spread 1 % too large; "
+        "the one-DOF assembly under white noise must give Eq. 30 written out by hand.",
+    ),
+    Mutation(
+        name="modal-participation-transposed",
+        path="randvib/models/structure.py",
+        edits=(("r = phi @ gamma", "r = phi.T @ gamma"),),
+        tests=("tests/test_assembly.py::test_modal_host_keeps_its_modes_and_participation",),
+        why="A modal host's influence vector from the transposed mode-shape matrix; r = Phi "
+        "gamma is checked with a non-symmetric Phi.",
+    ),
 )
 
 

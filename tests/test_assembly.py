@@ -170,7 +170,7 @@ def test_derived_c_e_is_not_set_directly():
 
 def test_strokes_on_elements_and_transducers():
     a = Assembly.from_toml(device_path("two_harvesters_on_host"))
-    assert a.strokes() == [("transducer.0", (1, 0), 0.01), ("transducer.1", (2, 0), 0.01)]
+    assert a.strokes() == [("transducer.0", (1, 0), 0.04), ("transducer.1", (2, 0), 0.04)]
 
 
 def test_every_shipped_device_round_trips_through_toml(tmp_path):

@@ -299,8 +299,17 @@ def _check(result: AssemblyPrediction, solver: AnalyticMethod) -> None:
 
 
 # ------------------------------------------------------------------ optimal loads
+class AssemblyLoadBoundWarning(RuntimeWarning):
+    """A transducer's best load lies on a bound of its search: the power still rises beyond it."""
+
+
 #: Decades searched on each side of a transducer's characteristic loads.
-ASSEMBLY_LOAD_DECADES = 4.0
+ASSEMBLY_LOAD_DECADES = 3.0
+#: Points a decade of the bracketing grid: the load power is smooth and unimodal in
+#: log R_L (a resonance of the circuit is a decade wide at least), and each point of a
+#: nonlinear assembly is a fixed-point solution (about 0.1 s), so the grid is coarse and
+#: the bounded search refines between its neighbours.
+ASSEMBLY_LOAD_GRID = 6
 
 
 @dataclass(frozen=True)
@@ -376,11 +385,11 @@ def optimal_assembly_loads(
     """The load resistance of one transducer, or of each, maximising its own load power.
 
     Each transducer's ``r_load`` (a bare damper's ``c_e``) is searched on a
-    log grid (12 points a decade, :data:`ASSEMBLY_LOAD_DECADES` decades
+    log grid (:data:`ASSEMBLY_LOAD_GRID` points a decade, :data:`ASSEMBLY_LOAD_DECADES` decades
     around its characteristic loads) and refined by a bounded scalar
     search, the other transducers held at their given values. A best value
-    on a bound of the search is reported as such (``location``) with a
-    RuntimeWarning: the power still rises beyond it.
+    on a bound of the search is reported as such (``location``) with an
+    :class:`AssemblyLoadBoundWarning`: the power still rises beyond it.
 
     Parameters
     ----------
@@ -409,7 +418,7 @@ def _optimal_load(assembly, excitation, index, solver) -> AssemblyLoad:
             t = predict_assembly(device, excitation, solver).transducers[index]
         return -(t.power_load if t.power_load is not None else t.power_electrical)
 
-    n = int(min(max(61, np.ceil(12 * np.log10(hi / lo)) + 1), 4001))
+    n = int(min(np.ceil(ASSEMBLY_LOAD_GRID * np.log10(hi / lo)) + 1, 2001))
     grid = np.linspace(np.log(lo), np.log(hi), n)
     values = [negative_power(g) for g in grid]
     i = int(np.argmin(values))
@@ -419,7 +428,7 @@ def _optimal_load(assembly, excitation, index, solver) -> AssemblyLoad:
         warnings.warn(
             f"transducer {index}'s load power rises up to the {location} of the search, "
             f"{name} = {value:g} (bounds {lo:g} .. {hi:g}): the optimum lies beyond it",
-            RuntimeWarning,
+            AssemblyLoadBoundWarning,
             stacklevel=3,
         )
         return AssemblyLoad(index, name, value, -float(values[i]), location, (lo, hi))

@@ -71,6 +71,7 @@ from randvib.models.assembly_parts import (
     check_between_in,
     incidence,
 )
+from randvib.models.device_file import device_text, read_device
 from randvib.models.harvester import Harvester
 from randvib.models.structure import (
     chain_matrices,
@@ -190,14 +191,10 @@ class Assembly:
     @classmethod
     def from_toml(cls, path) -> Assembly:
         """Read a device file (:mod:`randvib.models.device_file`, docs/assemblies.md)."""
-        from randvib.models.device_file import read_device
-
         return cls.from_matrices(**read_device(path))
 
     def to_toml(self) -> str:
         """The device file text of this assembly (matrix form), which :meth:`from_toml` reads back."""
-        from randvib.models.device_file import device_text
-
         return device_text(self)
 
     @classmethod

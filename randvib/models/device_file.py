@@ -45,6 +45,7 @@ the structure has DOFs 0..1 (or "base")``).
 from __future__ import annotations
 
 import tomllib
+from dataclasses import MISSING, fields
 from pathlib import Path
 
 from randvib.models.assembly_parts import (
@@ -276,8 +277,6 @@ def _transducer(table: dict) -> Transducer:
 
 def _required(cls) -> list[str]:
     """A coupling's parameters without a default."""
-    from dataclasses import MISSING, fields
-
     return [f.name for f in fields(cls) if f.default is MISSING and f.default_factory is MISSING]
 
 
