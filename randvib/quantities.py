@@ -78,11 +78,17 @@ QUANTITIES: dict[str, Quantity] = {
     "base_displacement": Quantity("m", "base (shaker) displacement y"),
     "force": Quantity("N", "force u on the mass"),
     "relative_displacement": Quantity("m", "displacement z of the mass relative to the base"),
-    "voltage": Quantity("V", "load voltage"),
+    "relative_velocity": Quantity("m/s", "velocity z' of the mass relative to the base"),
+    "voltage": Quantity("V", "load voltage (R_L i of a coil, V of a piezo element)"),
+    "current": Quantity("A", "load current (i of a coil, V / R_L of a piezo element)"),
     # ------------------------------------------------ identification's measurement model
     "k2": Quantity("N/m^2", "quadratic stiffness (an asymmetric spring)"),
     "input_offset": Quantity("input unit", "offset of the input channel"),
     "output_offset": Quantity("m", "offset of the measured displacement"),
+    "velocity_offset": Quantity("m/s", "offset of the measured relative velocity"),
+    "voltage_offset": Quantity("V", "offset of the measured load voltage"),
+    "current_offset": Quantity("A", "offset of the measured load current"),
+    "r_load": Quantity("ohm", "load resistance R_L"),
     # ------------------------------------------------ statistics, predicted or estimated
     "power_electrical": Quantity(
         "W", "expected electrical power E[P_e] = c_e E[z'^2] (Eq. 32)", "E[P_e]"

@@ -523,6 +523,7 @@ def test_cli_simulate_device_json(capsys, tmp_path):
         ({"initial": ([0.0], [0.0])}, "`initial` must be"),
         ({"dW": np.zeros((2, 3))}, "`dW` must have shape"),
         ({"control_variates": True, "psd": BandLimited(1.0, 4.0, 20.0)}, "`control_variates`"),
+        ({"psd": rv.BandPass(1.0, 8.0, 0.1) + rv.Tone(25.0, 0.5)}, "tones, shocks"),
     ],
 )
 def test_assembly_refusals_name_the_argument(kwargs, fragment):

@@ -59,13 +59,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from randvib.analytic.assembly_linear import AssemblyResponse, UnstableAssembly, linear_response
+from randvib.analytic.fixed_point import LinearisationDidNotConverge, TrialUndefined, solve
 from randvib.analytic.statistical_linearisation import (
     LINEARISATION_FRICTION_SHARE_LIMIT,
     LINEARISATION_STIFFNESS_SHARE_LIMIT,
-    LinearisationDidNotConverge,
     LinearisationValidityWarning,
-    _solve,
-    _TrialUndefined,
 )
 from randvib.models.assembly import Assembly
 from randvib.models.excitation import Excitation
@@ -160,7 +158,7 @@ def linearise_assembly(
     ValueError
         A part the closure does not take (:func:`refusal`), a linearised
         assembly without a stationary response, or no fixed point
-        (:class:`~randvib.analytic.statistical_linearisation.LinearisationDidNotConverge`).
+        (:class:`~randvib.analytic.fixed_point.LinearisationDidNotConverge`).
     """
     why = refusal(assembly)
     if why:
@@ -201,18 +199,16 @@ def linearise_assembly(
         with np.errstate(all="ignore"):
             c, k = equivalent(x)
             if not (np.all(np.isfinite(c)) and np.all(np.isfinite(k))):
-                raise _TrialUndefined("equivalent dashpots or springs not finite")
+                raise TrialUndefined("equivalent dashpots or springs not finite")
             try:
                 out = logs(respond(c, k)) - x
             except (ValueError, np.linalg.LinAlgError):
-                raise _TrialUndefined(
-                    "the linearised assembly has no stationary response"
-                ) from None
+                raise TrialUndefined("the linearised assembly has no stationary response") from None
         if not np.all(np.isfinite(out)):
-            raise _TrialUndefined("variances not finite")
+            raise TrialUndefined("variances not finite")
         return out
 
-    x = _solve(residual, _start(assembly, excitation, closed, slots, respond, logs))
+    x = solve(residual, _start(assembly, excitation, closed, slots, respond, logs))
     c, k = equivalent(x)
     response = respond(c, k)
     closures = _closures(assembly, response)

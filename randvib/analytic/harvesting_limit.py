@@ -21,6 +21,10 @@ the stationary-spectrum counterpart of the non-causal bound of Haji
 Hosseinloo and Turitsyn, Phys. Rev. Applied 4, 064009 (2015). With lambda = 0
 it is the unconstrained bound m^2 E[a^2] / (4 c_m).
 
+A tone, a line of mean square A^2 / 2 at omega, adds the term
+m^2 omega^2 A^2 / (8 (c_m omega^2 + lambda)) to the bracket (the same
+frequency-by-frequency optimum, on a line spectrum).
+
 It is finite when w^2 G_a / (c_m w^2 + lambda) is integrable: for band-pass,
 Kanai-Tajimi, band-limited, tabulated and measured spectra with c_m > 0; for
 white noise it is infinite (an ideal transducer can take unbounded power
@@ -36,6 +40,7 @@ from scipy import optimize, sparse, special
 
 from randvib._validation import check_nonnegative, check_positive
 from randvib.analytic.linear_response import frequency_rule, mechanical_block
+from randvib.models.combined import parts_of
 from randvib.models.excitation import Excitation, Measured
 
 __all__ = ["gaussian_displacement_budget", "harvesting_limit", "record_harvesting_limit"]
@@ -99,16 +104,22 @@ def harvesting_limit(m, c_m, excitation: Excitation, displacement_rms) -> float 
     m = float(check_positive("m", m, "kg"))
     c_m = float(check_nonnegative("c_m", c_m, "Ns/m"))
     sigma2 = float(check_positive("displacement_rms", displacement_rms, "m")) ** 2
-    if excitation.is_white:
+    random = parts_of(excitation)[0]
+    if excitation.is_white or (random is not None and random.is_white):
         return None
+    # a tone is a line of power A^2 / 2 at omega: a term of the sum, not of the integral
+    w_lines = np.array([tone.omega for tone in excitation.lines()])
+    g_lines = m**2 * w_lines**2 * np.array([t.mean_square for t in excitation.lines()]) / 4.0
 
     def dual(lam: float) -> tuple[float, float]:
         """The bound at lambda and its derivative sigma^2 - int s*^2 df."""
         corner = math.sqrt(lam / c_m) / (2 * math.pi) if c_m > 0 and lam > 0 else 1.0
         w, weights, g = _weights(m, c_m, excitation, corner)
         denom = c_m * w**2 + lam
-        bound = float(np.sum(weights * g / denom)) + lam * sigma2
-        return bound, sigma2 - float(np.sum(weights * g / denom**2))
+        line_denom = c_m * w_lines**2 + lam
+        bound = float(np.sum(weights * g / denom) + np.sum(g_lines / line_denom)) + lam * sigma2
+        squares = float(np.sum(weights * g / denom**2) + np.sum(g_lines / line_denom**2))
+        return bound, sigma2 - squares
 
     if c_m == 0:
         # The bracket is int g / lambda + lambda sigma^2, least at
@@ -117,7 +128,7 @@ def harvesting_limit(m, c_m, excitation: Excitation, displacement_rms) -> float 
         if not math.isfinite(excitation.support[1]):
             return None
         w, weights, g = _weights(m, c_m, excitation, 1.0)
-        return 2.0 * math.sqrt(sigma2 * float(np.sum(weights * g)))
+        return 2.0 * math.sqrt(sigma2 * float(np.sum(weights * g) + np.sum(g_lines)))
     value, slope = dual(0.0)
     if slope >= 0:  # the unconstrained optimum already meets the budget
         return value

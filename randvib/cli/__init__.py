@@ -39,6 +39,10 @@ API_NAMES = {
     "--segments": "segments (randvib.monte_carlo_on_record)",
     "--dt (with --record)": "substeps = record step / dt (randvib.monte_carlo_on_record)",
     "--model": "model (randvib.identify)",
+    "--output-kind": "outputs (randvib.identify, randvib.synthetic_record, randvib.predict_record)",
+    "--weight": "weights (randvib.identify)",
+    "--offset (record)": "offsets (randvib.synthetic_record)",
+    "--from-fit": "IdentificationResult.from_dict(...).harvester()",
     "--no-progress": "progress=False",
 }
 

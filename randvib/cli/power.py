@@ -484,11 +484,15 @@ def _print_point(out: dict, harvester, psd) -> None:
         return _print_assembly_point(out, harvester, psd)
     print(describe_device(harvester))
     print(describe_excitation(psd))
-    # a tabulated or measured spectrum has no level: the excitation line describes it
+    # a tabulated or measured spectrum has no level: the excitation line describes it;
+    # tones and shocks are lists and objects: the excitation line, and a table of the tones
     shown = {k: v for k, v in out.items() if k != "excitation" and not (k == "psd" and v is None)}
-    rows = [(k, v, _unit(k, harvester)) for k, v in shown.items()]
-    rows += [(k, v, _unit(k, harvester)) for k, v in out.get("excitation", {}).items()]
+    excitation = out.get("excitation", {})
+    rows = [(k, v, _unit(k, harvester)) for k, v in shown.items() if not _nested(v)]
+    rows += [(k, v, _unit(k, harvester)) for k, v in excitation.items() if not _nested(v)]
     print_table(rows, ("quantity", "value", "unit"))
+    if out.get("tones"):
+        _print_tones(out["tones"])
     if harvester.electrical is None and harvester.c_e == 0:
         print(
             "note: this device has no electrical damping (c_e = 0, as the presets identified "
@@ -496,6 +500,22 @@ def _print_point(out: dict, harvester, psd) -> None:
             f"or --c-e. It dissipates {cell(out['power_mechanical'], 4)} W mechanically "
             "(c_m E[v^2] + friction)."
         )
+
+
+def _nested(value) -> bool:
+    return isinstance(value, list | dict)
+
+
+def _print_tones(tones: list) -> None:
+    """Each tone's response: its frequency and amplitude, the displacement and velocity amplitudes."""
+    print()
+    rows = [
+        (t["frequency"], t["amplitude"], t["displacement_amplitude"], t["velocity_amplitude"],
+         t["c_eq"], t["k_eq"])
+        for t in tones
+    ]  # fmt: skip
+    headers = ("tone (Hz)", "A (m/s^2)", "Z (m)", "V (m/s)", "c_eq (Ns/m)", "k_eq (N/m)")
+    print_table(rows, headers)
 
 
 #: The columns of a sweep's table, after the swept options, where present.

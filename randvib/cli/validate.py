@@ -7,19 +7,37 @@ import dataclasses
 import json
 import sys
 
+import numpy as np
+
 from randvib._io import check_output_file, check_output_folder, dumps, existing_file
+from randvib._validation import check_finite
 from randvib.cli._output import print_table
 from randvib.cli._records import (
+    add_circuit_arguments,
     add_record_arguments,
+    output_kinds,
     output_unit,
     parse_assignments,
-    plot_units,
+    r_loads,
     record_from_args,
     simulation_settings,
 )
-from randvib.identification.models import MODELS, check_parameter, device_from_parameters
+from randvib.identification.circuit import (
+    ALL_COUPLING_PARAMETERS,
+    OFFSET_NAMES,
+    check_coupling_parameter,
+    coupling_from_parameters,
+)
+from randvib.identification.models import (
+    MODELS,
+    MeasurementModel,
+    check_parameter,
+    device_from_parameters,
+)
 from randvib.identification.prediction import validate
 from randvib.identification.settings import SimulationSettings
+from randvib.models.record import OUTPUT_CHANNEL
+from randvib.quantities import unit
 
 SIMULATION_FIELDS = tuple(SimulationSettings().to_dict())
 
@@ -37,7 +55,8 @@ def register(sub) -> None:
         "validate",
         help="J (Eq. 11) of identified parameters on other records",
         description="Simulate each record with parameters saved by `randvib identify --save` "
-        "(or printed by --json) and report J (Eq. 11) and the RMS error per record.",
+        "(or printed by --json) and report J (Eq. 11) and the RMS error per record and "
+        "channel (a voltage's in volts, each record at its own --r-load).",
     )
     p.add_argument(
         "params", metavar="PARAMS.json", help="output of `randvib identify --json/--save`"
@@ -71,6 +90,7 @@ def register(sub) -> None:
         help="overwrite an existing --plot file, or write into a folder that is not empty",
     )
     add_record_arguments(p)
+    add_circuit_arguments(p, identified=False)
     p.set_defaults(handler=run)
 
 
@@ -86,7 +106,9 @@ def _load_parameters(path):
         ) from None
     if not isinstance(model, str) or model not in MODELS:
         raise ValueError(f"{str(path)!r}: model {model!r} is not one of {', '.join(MODELS)}")
-    return model, parameters, data.get("settings", {})
+    if not isinstance(data, dict):
+        raise ValueError(f"{str(path)!r} is not an identification result (a JSON object)")
+    return model, parameters, data
 
 
 def _settings(args, saved: dict, path):
@@ -101,100 +123,193 @@ def _settings(args, saved: dict, path):
 
 
 def _overrides(items, model: str) -> dict:
-    """``--set NAME=VALUE``: a parameter of ``model``, valued as the model allows."""
-    return {
-        name: check_parameter(model, name, value, f"--set {name}")
-        for name, value in parse_assignments(items, "--set").items()
-    }
+    """``--set NAME=VALUE``: a parameter of ``model`` (or its coupling), valued as allowed."""
+    out = {}
+    for name, value in parse_assignments(items, "--set").items():
+        if name in ALL_COUPLING_PARAMETERS:
+            out[name] = check_coupling_parameter(name, value, f"--set {name}")
+        else:
+            out[name] = check_parameter(model, name, value, f"--set {name}")
+    return out
+
+
+def _device(model, parameters, data, path, args):
+    """The saved device and its measurement model (the first record's offsets).
+
+    A fit that identified its coupling is wired to each record's load
+    (``--r-load``, default the fit's first); returns (harvester, measurement,
+    loads or None).
+    """
+    own = {k.partition("[")[0]: v for k, v in parameters.items() if not k.endswith("]")}
+    own.update({k.partition("[")[0]: v for k, v in parameters.items() if k.endswith("[0]")})
+    measurement = MeasurementModel.from_parameters(own)
+    coupling = data.get("coupling") or None
+    if coupling is None:
+        if args.coupling is not None or args.r_load:
+            raise ValueError(
+                f"{str(path)!r} holds no identified coupling: `--coupling`/`--r-load` need a fit "
+                "made with `identify --coupling`"
+            )
+        return device_from_parameters(model, own)[0], measurement, None
+    if args.coupling not in (None, coupling):
+        raise ValueError(f"{str(path)!r} identified the {coupling} coupling, not {args.coupling!r}")
+    loads = data.get("r_loads") or []
+    default = float(loads[0]) if loads else None
+    given = r_loads(args, len(args.data))
+    if given is None and default is None:
+        raise ValueError(f"{str(path)!r} saves no load: give each record's `--r-load`")
+    loads = given if given is not None else default
+    electrical = coupling_from_parameters(coupling, own, np.ravel(loads)[0])
+    return device_from_parameters(model, own, electrical)[0], measurement, loads
+
+
+def _kinds(args, data) -> tuple:
+    """The channels scored: the command line's, else the fit's."""
+    if args.output_kind or args.output_column:
+        return output_kinds(args)
+    saved = tuple(data.get("outputs") or ("relative_displacement",))
+    args.output_kind = list(saved)  # the records are read with these channels
+    return saved
 
 
 def run(args) -> int:
-    model, parameters, saved = _load_parameters(args.params)
+    model, parameters, data = _load_parameters(args.params)
     for name, value in parameters.items():
+        base = name.partition("[")[0]
         try:
-            check_parameter(model, name, value)
+            if base in ALL_COUPLING_PARAMETERS:
+                check_coupling_parameter(base, value)
+            elif base in OFFSET_NAMES.values():
+                check_finite(name, value)
+            else:
+                check_parameter(model, base, value)
         except ValueError as exc:
             raise ValueError(f"{str(args.params)!r}: {exc}") from None
     parameters.update(_overrides(args.set, model))
-    harvester, measurement = device_from_parameters(model, parameters)
-    settings = _settings(args, saved, args.params)
-    plot_dir = plot_file = None
-    if args.plot is not None and str(args.plot).lower().endswith(".png"):
+    harvester, measurement, loads = _device(model, parameters, data, args.params, args)
+    kinds = _kinds(args, data)
+    settings = _settings(args, data.get("settings", {}), args.params)
+    plot_dir, plot_file = _plot_target(args)
+    records = [record_from_args(path, args) for path in args.data]
+    channels = kinds != ("relative_displacement",) or loads is not None
+    rows = validate(
+        harvester, records, measurement=measurement, offsets=args.offsets, simulation=settings,
+        **({"outputs": kinds, "r_load": loads} if channels else {}),
+    )  # fmt: skip
+    status = 0  # 1: the figures could not be written where asked (the table is printed)
+    if plot_dir is not None or plot_file is not None:
+        status = _figures(harvester, records, rows, measurement, settings, kinds, channels,
+                          plot_dir, plot_file, model, args)  # fmt: skip
+    if args.json:
+        print(dumps(_json(model, parameters, rows, kinds, args)))
+        return status
+    _print(model, rows, kinds, args)
+    return status
+
+
+def _plot_target(args):
+    """(folder, file) of ``--plot``, checked before anything is computed."""
+    if args.plot is None:
+        return None, None
+    if str(args.plot).lower().endswith(".png"):
         if len(args.data) != 1:
             raise ValueError(
                 f"`--plot` {args.plot!r} is one file, for one record; got {len(args.data)} "
                 "records: give a folder instead"
             )
-        plot_file = check_output_file(args.plot, "--plot", overwrite=args.force)
-    elif args.plot is not None:
-        plot_dir = check_output_folder(args.plot, "--plot")
-        if plot_dir.exists() and any(plot_dir.iterdir()) and not args.force:
-            raise FileExistsError(
-                f"`--plot` folder {str(plot_dir)!r} is not empty; choose another or give --force"
-            )
-        plot_dir.mkdir(parents=True, exist_ok=True)
-    records = [record_from_args(path, args) for path in args.data]
-    rows = validate(
-        harvester, records, measurement=measurement, offsets=args.offsets, simulation=settings
-    )
-    status = 0  # 1: the figures could not be written where asked (the table is printed)
-    if plot_dir is not None or plot_file is not None:
-        from randvib.identification.plots import figure_fit
-        from randvib.identification.prediction import predict_record
-        from randvib.identification.residuals import residual_diagnostics
-
-        for i, (record, row) in enumerate(zip(records, rows, strict=True)):
-            # the offsets re-estimated on this record, as its J
-            own = dataclasses.replace(measurement, **row.offsets)
-            pred = predict_record(harvester, record, measurement=own, simulation=settings)
-            path = plot_file or plot_dir / f"{i:02d}_{record.name}.png"
-            skip = settings.skip
-            diagnostics = residual_diagnostics(record.z[skip:] - pred.z[skip:], record.input[skip:])
-            try:
-                figure_fit(
-                    pred,
-                    path,
-                    title=f"{model} model on {record.name}",
-                    validation=True,
-                    diagnostics=diagnostics,
-                    **plot_units(args),
-                )
-            except OSError as exc:  # the table below is the result: print it, exit 1
-                print(f"randvib: could not write `--plot` {str(path)!r} ({exc})", file=sys.stderr)
-                status = 1
-                break
-        if status == 0:
-            print(
-                f"wrote {plot_file}"
-                if plot_file
-                else f"wrote {len(records)} figure(s) into {plot_dir}",
-                file=sys.stderr if args.json else sys.stdout,
-            )
-    if args.json:
-        print(
-            dumps(
-                {
-                    "model": model,
-                    "parameters": parameters,
-                    "records": [
-                        {
-                            "record": r.record,
-                            "cost": r.cost,
-                            "rms_error": r.rms_error,
-                            "samples": r.samples,
-                            "offsets": r.offsets,
-                        }
-                        for r in rows
-                    ],
-                    "offsets": OFFSETS_NOTE[args.offsets],
-                }
-            )
+        return None, check_output_file(args.plot, "--plot", overwrite=args.force)
+    plot_dir = check_output_folder(args.plot, "--plot")
+    if plot_dir.exists() and any(plot_dir.iterdir()) and not args.force:
+        raise FileExistsError(
+            f"`--plot` folder {str(plot_dir)!r} is not empty; choose another or give --force"
         )
-        return status
-    print(f"model {model}")
-    print_table(
-        [[r.record, r.samples, r.cost, r.rms_error] for r in rows],
-        ["record", "samples", "J", f"RMS error ({output_unit(args)})"],
+    plot_dir.mkdir(parents=True, exist_ok=True)
+    return plot_dir, None
+
+
+def _figures(harvester, records, rows, measurement, settings, kinds, channels, plot_dir,
+             plot_file, model, args) -> int:  # fmt: skip
+    """One figure per record: time history, residual, densities (the voltage's spike at 0 V)."""
+    from randvib.identification.plots import figure_fit
+    from randvib.identification.prediction import predict_record
+    from randvib.identification.residuals import residual_diagnostics
+
+    for i, (record, row) in enumerate(zip(records, rows, strict=True)):
+        # the offsets re-estimated on this record, as its J
+        device = harvester if row.r_load is None else harvester.updated(r_load=row.r_load)
+        own = _offsets(measurement, row.offsets)
+        pred = predict_record(device, record, measurement=own, simulation=settings,
+                              **({"outputs": kinds} if channels else {}))  # fmt: skip
+        path = plot_file or plot_dir / f"{i:02d}_{record.name}.png"
+        skip = settings.skip
+        first = pred.outputs[0]
+        diagnostics = residual_diagnostics(
+            (record[first] - pred.simulated(first))[skip:], record.input[skip:]
+        )
+        try:
+            figure_fit(pred, path, title=f"{model} model on {record.name}", validation=True,
+                       diagnostics=diagnostics)  # fmt: skip
+        except OSError as exc:  # the table is the result: print it, exit 1
+            print(f"randvib: could not write `--plot` {str(path)!r} ({exc})", file=sys.stderr)
+            return 1
+    print(
+        f"wrote {plot_file}" if plot_file else f"wrote {len(records)} figure(s) into {plot_dir}",
+        file=sys.stderr if args.json else sys.stdout,
     )
+    return 0
+
+
+def _offsets(measurement, used: dict):
+    """``measurement`` with the offsets a validation row used on its record."""
+    channel = {k: used[n] for k, n in OFFSET_NAMES.items() if k != OUTPUT_CHANNEL and n in used}
+    return dataclasses.replace(
+        measurement,
+        input_offset=used.get("input_offset", measurement.input_offset),
+        output_offset=used.get("output_offset", measurement.output_offset),
+        channel_offsets={**measurement.channel_offsets, **channel},
+    )
+
+
+def _json(model, parameters, rows, kinds, args) -> dict:
+    return {
+        "model": model,
+        "parameters": parameters,
+        "outputs": list(kinds),
+        "records": [
+            {
+                "record": r.record,
+                "cost": r.cost,
+                "rms_error": r.rms_error,
+                "samples": r.samples,
+                "offsets": r.offsets,
+                **({"r_load": r.r_load} if r.r_load is not None else {}),
+                **(
+                    {"channels": {k: {**v, "unit": unit(k)} for k, v in r.channels.items()}}
+                    if r.channels
+                    else {}
+                ),
+            }
+            for r in rows
+        ],
+        "offsets": OFFSETS_NOTE[args.offsets],
+    }
+
+
+def _print(model, rows, kinds, args) -> None:
+    print(f"model {model}")
+    if not any(r.channels for r in rows):
+        print_table(
+            [[r.record, r.samples, r.cost, r.rms_error] for r in rows],
+            ["record", "samples", "J", f"RMS error ({output_unit(args)})"],
+        )
+    else:
+        print_table(
+            [
+                [r.record, "" if r.r_load is None else r.r_load, kind, r.samples, v["cost"],
+                 f"{v['rms_error']:.4g} {unit(kind)}"]
+                for r in rows
+                for kind, v in r.channels.items()
+            ],
+            ["record", "R_L (ohm)", "channel", "samples", "J", "RMS error"],
+        )  # fmt: skip
     print(f"note: {OFFSETS_NOTE[args.offsets]}")
-    return status

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from randvib.identification.circuit import OFFSET_NAMES, output_coefficients
 from randvib.identification.cost import CostFunction, normalised_cost
 from randvib.identification.models import (
     MeasurementModel,
@@ -43,11 +44,16 @@ class Prediction:
     rms_error : float
         RMS of z - zhat (units of z).
     voltage : ndarray or None
-        Simulated load voltage (V) when the device has a coil:
-        ``V = alpha z' R_L / (R_L + R_C)``.
+        Simulated load voltage (V) when the device has a coupling (a coil's
+        ``R_L i``, a piezo element's ``V``), without the sensor's offset.
     initial_state : dict
-        ``z0`` (m), ``v0`` (m/s) the simulation started from (estimated by
-        default, see :class:`~randvib.identification.settings.SimulationSettings`).
+        ``z0`` (m), ``v0`` (m/s) (and the circuit's ``x0``) the simulation
+        started from (estimated by default, see
+        :class:`~randvib.identification.settings.SimulationSettings`).
+    channels, costs, rms_errors : dict
+        With ``outputs``: each scored channel as simulated (offset included),
+        its J (Eq. 11, normalised by its own variance) and RMS error (its
+        unit); ``cost`` is then their sum and ``rms_error`` the first's.
     """
 
     record: Record
@@ -57,6 +63,26 @@ class Prediction:
     rms_error: float
     voltage: np.ndarray | None = None
     initial_state: dict = field(default_factory=dict)
+    channels: dict = field(default_factory=dict)
+    costs: dict = field(default_factory=dict)
+    rms_errors: dict = field(default_factory=dict)
+
+    @property
+    def outputs(self) -> tuple:
+        """The channels scored (``relative_displacement`` for a displacement record)."""
+        return tuple(self.channels) or ("relative_displacement",)
+
+    def simulated(self, kind: str) -> np.ndarray:
+        """The simulated channel ``kind`` as its sensor reads it (offset included)."""
+        if kind in self.channels:
+            return self.channels[kind]
+        if kind == "relative_displacement":
+            return self.z
+        if kind == "voltage" and self.voltage is not None:
+            return self.voltage
+        raise ValueError(
+            f"channel {kind!r} was not simulated; simulated: {', '.join(self.outputs)}"
+        )
 
 
 def _start_estimate(cost: CostFunction):
@@ -91,23 +117,29 @@ def predict_record(
     *,
     measurement: MeasurementModel | None = None,
     simulation: SimulationSettings | None = None,
+    outputs=None,
     **options,
 ) -> Prediction:
     """Simulate a record with a device and score it with J (Eq. 11).
 
-    The device is simulated with its total damping c = c_m + c_e (a record
-    cannot separate them); its circuit, if any, gives the load voltage. (The
-    analytic power prediction is :func:`randvib.predict`.)
+    The device is simulated with its coupling: a static one as its damper
+    c_e, a coil with inductance or a piezo element with its circuit state;
+    its circuit, if any, gives the load voltage. (The analytic power
+    prediction is :func:`randvib.predict`.)
 
     Parameters
     ----------
     harvester : Harvester
         The device (a preset, or :meth:`IdentificationResult.harvester
         <randvib.identification.result.IdentificationResult.harvester>`), with
-        scalar parameters; a coupling with a circuit state is refused.
+        scalar parameters and any coupling but a diode bridge.
     record : Record
         Its input channel drives the device; its relative displacement is
-        scored.
+        scored, or the channels ``outputs`` names.
+    outputs : sequence of str, optional
+        The channels scored (:data:`~randvib.identification.circuit.OUTPUT_KINDS`:
+        ``relative_displacement``, ``relative_velocity``, ``voltage``,
+        ``current``), each with its own J; default the displacement.
     measurement : MeasurementModel, optional
         The sensors' offsets and k2 (an identification's ``measurement``);
         default none.
@@ -132,6 +164,8 @@ def predict_record(
     (simulation,) = resolve_settings("predict_record", options, simulation=simulation)
     if isinstance(record, Record):  # else refused by score
         simulation, _ = simulation.for_record(record)
+    if outputs is not None or isinstance(harvester, Harvester) and harvester.has_circuit:
+        return score_channels(harvester, record, measurement, simulation, outputs)
     parameters = device_parameters(harvester, measurement, "predict_record")
     model = model_of(harvester.friction_name)
     return score(
@@ -163,6 +197,83 @@ def score(parameters: dict, model: str, record: Record, simulation, circuit=None
     )
 
 
+def _named_device(harvester: Harvester, measurement) -> tuple[str, str | None, dict, float]:
+    """(model, coupling, named parameters, r_load) of a device for the channel simulation."""
+    if not isinstance(harvester, Harvester):
+        raise ValueError(
+            f"predict_record needs a randvib.Harvester, got {type(harvester).__name__}"
+        )
+    parameters = device_parameters(harvester, measurement, "predict_record")
+    model = model_of(harvester.friction_name)
+    coupling = harvester.electrical
+    if coupling is None:
+        return model, None, parameters, None
+    named = {**parameters, "c": harvester.c_m, **coupling.parameters()}
+    named.pop("r_load")
+    return model, coupling.name, named, coupling.r_load
+
+
+def score_channels(harvester, record, measurement, simulation, outputs=None) -> Prediction:
+    """:func:`predict_record` of the channels ``outputs``, a circuit state simulated.
+
+    The record's initial state (and the circuit's) is estimated by a least-
+    squares fit of the channels' error (``initial_state="estimate"``), or
+    taken from its first samples.
+    """
+    from randvib.identification.experiment import (
+        START,
+        ExperimentCost,
+        ExperimentError,
+        recorded_tests,
+    )
+    from randvib.identification.least_squares import Coordinates, polish
+
+    measurement = measurement or MeasurementModel()
+    model, coupling, named, r_load = _named_device(harvester, measurement)
+    if outputs is None:
+        outputs = ("relative_displacement",) if "relative_displacement" in record else ()
+        outputs += tuple(k for k in ("voltage",) if k in record and coupling)
+    (test,) = recorded_tests(record, outputs, r_load, coupling)
+    fixed = {**named, **{OFFSET_NAMES[k]: measurement.offset(k) for k in test.outputs}}
+    fixed = {k: float(np.ravel(v)[0]) for k, v in fixed.items()}
+    cost = ExperimentCost([test], model, coupling, fixed=fixed, free=(), simulation=simulation)
+    values = {k: np.array([v]) for k, v in fixed.items()}
+    start = dict(zip((*START, "x0"), (float(x[0]) for x in cost.start(values, 0)), strict=True))
+    if simulation.initial_state == "estimate":
+        names = START + (("x0",) if harvester.has_circuit else ())
+        coords = Coordinates(
+            names=names, log=np.zeros(len(names), bool),
+            scale=np.array([max(abs(start[n]), 1e-9) for n in names]),
+            lower=np.full(len(names), -np.inf), upper=np.full(len(names), np.inf),
+        )  # fmt: skip
+        theta, _, _, _ = polish(ExperimentError(cost, coords), np.array([start[n] for n in names]))
+        start.update(zip(names, map(float, theta), strict=True))
+    values.update({k: np.array([v]) for k, v in start.items()})
+    run = cost.run(values, 0, start=tuple(np.array([start[n]]) for n in (*START, "x0")))
+    channels = {
+        kind: y[0] + fixed[OFFSET_NAMES[kind]] for kind, y in cost.outputs(values, 0, run).items()
+    }
+    costs, rms = {}, {}
+    skip = simulation.skip
+    for kind, y in channels.items():
+        measured = record[kind][skip:]
+        finite = np.all(np.isfinite(y))
+        costs[kind] = float(normalised_cost(measured, y[skip:])) if finite else float("inf")
+        rms[kind] = float(np.sqrt(np.mean((measured - y[skip:]) ** 2))) if finite else float("inf")
+    voltage = None
+    if coupling is not None:
+        cz, cv, cx = output_coefficients("voltage", coupling, values, r_load)
+        voltage = (
+            cz * run.z + np.atleast_1d(cv)[:, None] * run.v + np.atleast_1d(cx)[:, None] * run.x
+        )[0]
+    first = test.outputs[0]
+    return Prediction(
+        record=record, z=run.z[0] + fixed.get("output_offset", 0.0), v=run.v[0],
+        cost=float(sum(costs.values())), rms_error=rms[first], voltage=voltage,
+        initial_state=start, channels=channels, costs=costs, rms_errors=rms,
+    )  # fmt: skip
+
+
 @dataclass(frozen=True)
 class ValidationRow:
     """J (Eq. 11), RMS error and length of one record in :func:`validate`."""
@@ -174,6 +285,11 @@ class ValidationRow:
     samples: int
     #: The sensor offsets used on this record (re-estimated on it, or given).
     offsets: dict = field(default_factory=dict)
+    #: With several channels: each one's J and RMS error (kind -> {"cost", "rms_error"});
+    #: ``cost`` is then their sum and ``rms_error`` the first's.
+    channels: dict = field(default_factory=dict)
+    #: The load (ohm) the record was simulated at, with a coupling.
+    r_load: float | None = None
 
 
 #: How :func:`validate` treats the sensors' offsets.
@@ -186,6 +302,8 @@ def validate(
     *,
     measurement: MeasurementModel | None = None,
     offsets: str = "per-record",
+    outputs=None,
+    r_load=None,
     **settings,
 ) -> list[ValidationRow]:
     """J (Eq. 11) and RMS error of a device on each of several records.
@@ -204,11 +322,24 @@ def validate(
         search of J over the record's input mean +- half its standard
         deviation (identify's box). ``"given"``: those of ``measurement`` on
         every record. Each row's ``offsets`` says which were used.
+    outputs : sequence of str, optional
+        The channels scored on each record (``relative_displacement``,
+        ``relative_velocity``, ``voltage``, ``current``), each with its own J
+        and RMS error (``ValidationRow.channels``); then each channel's offset
+        is re-estimated per record (its mean residual) unless ``"given"``.
+    r_load : float or sequence of float, optional
+        Each record's load (ohm) for a device with a coupling (default the
+        device's own).
     """
     if offsets not in OFFSET_POLICIES:
         raise ValueError(f"`offsets` must be one of {', '.join(OFFSET_POLICIES)}; got {offsets!r}")
     model = model_of(harvester.friction_name) if isinstance(harvester, Harvester) else None
     measurement = measurement or MeasurementModel()
+    circuit = isinstance(harvester, Harvester) and harvester.electrical is not None
+    if outputs is not None or r_load is not None or circuit and harvester.has_circuit:
+        return _validate_channels(
+            harvester, records, measurement, offsets, outputs, r_load, settings
+        )
     rows = []
     for record in records:
         used = measurement
@@ -225,6 +356,44 @@ def validate(
                 {"input_offset": used.input_offset, "output_offset": used.output_offset},
             )
         )
+    return rows
+
+
+def _validate_channels(harvester, records, measurement, offsets, outputs, r_load, settings):
+    """:func:`validate` on channels (a circuit simulated), each with its J and RMS error."""
+    from dataclasses import replace
+
+    records = list(records)
+    loads = [r_load] * len(records) if np.ndim(r_load) == 0 else list(r_load)
+    if len(loads) != len(records):
+        raise ValueError(f"`r_load` gives {len(loads)} loads for {len(records)} records")
+    model = model_of(harvester.friction_name)
+    rows = []
+    for record, load in zip(records, loads, strict=True):
+        device = harvester if load is None else harvester.updated(r_load=float(load))
+        pred = predict_record(device, record, measurement=measurement, outputs=outputs, **settings)
+        used = measurement
+        if offsets == "per-record":  # each channel's own offset: its mean residual on this record
+            skip = int(settings.get("skip", 0)) if "simulation" not in settings else 0
+            shift = {
+                k: float(np.mean((record[k] - pred.channels[k])[skip:])) for k in pred.channels
+            }
+            channel = {k: measurement.offset(k) + d for k, d in shift.items()}
+            used = replace(
+                measurement,
+                output_offset=channel.pop("relative_displacement", measurement.output_offset),
+                channel_offsets={**measurement.channel_offsets, **channel},
+            )
+            pred = predict_record(device, record, measurement=used, outputs=outputs, **settings)
+        rows.append(
+            ValidationRow(
+                record.name, model, pred.cost, pred.rms_error, record.n,
+                {"input_offset": float(used.input_offset),
+                 **{OFFSET_NAMES[k]: used.offset(k) for k in pred.channels}},
+                {k: {"cost": pred.costs[k], "rms_error": pred.rms_errors[k]} for k in pred.channels},
+                None if device.electrical is None else float(device.electrical.r_load),
+            )
+        )  # fmt: skip
     return rows
 
 

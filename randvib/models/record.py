@@ -50,7 +50,9 @@ CHANNELS = {
         "base_displacement",
         "force",
         "relative_displacement",
+        "relative_velocity",
         "voltage",
+        "current",
     )
 }
 #: The channels that can drive the device (paper Eq. 1: -m y'' or a force u).
@@ -408,6 +410,7 @@ def read_record(
     sample_rate: float | None = None,
     rows: tuple[int | None, int | None] | None = None,
     name: str | None = None,
+    outputs: dict | None = None,
 ) -> Record:
     """Read a record from CSV (the file is only read, never modified).
 
@@ -438,6 +441,11 @@ def read_record(
         Keep data rows ``start:stop`` (0-based, stop exclusive).
     name : str, optional
         Record label (default: the file name).
+    outputs : dict, optional
+        Output channels by kind: ``{kind: column}`` with kinds among
+        ``relative_displacement``, ``relative_velocity``, ``voltage``,
+        ``current`` (each column read as that channel only); replaces
+        ``output_column``.
 
     Raises
     ------
@@ -449,11 +457,7 @@ def read_record(
     frame = read_csv(path)
     columns = list(frame.columns)
     input_column, input_kind = _input_column(path, columns, input_column, input_kind)
-    if output_column is not None and output_column not in columns:
-        raise ValueError(
-            f"{path.name}: output column `{output_column}` not found (relative displacement, m); "
-            f"columns are {_shown(columns)}; map another name with `output_column`"
-        )
+    wanted = _output_columns(path, columns, output_column, outputs)
     if rows is not None:
         n_rows = len(frame)
         frame = frame.iloc[slice(*rows)]
@@ -464,10 +468,10 @@ def read_record(
                 f"{path.name}; give START:STOP with 0 <= START < STOP (0-based, STOP excluded)"
             )
     channels = {input_kind: frame[input_column]}
-    if output_column is not None:
-        channels[OUTPUT_CHANNEL] = frame[output_column]
-        if "voltage" in columns and output_column != "voltage":
-            channels["voltage"] = frame["voltage"]
+    for kind, column in wanted.items():
+        channels[kind] = frame[column]
+    if wanted and "voltage" in columns and "voltage" not in wanted.values():
+        channels.setdefault("voltage", frame["voltage"])  # the load voltage, for the figures
     _check_length(len(frame), name or path.stem)
     step = (
         None
@@ -485,6 +489,33 @@ def read_record(
     source = None if step is None else f"`sample_rate` = {sample_rate} Hz"
     step = grid_step(time, step, name=time_column, source=source)
     return Record(step, time=time, name=name or path.stem, **channels)
+
+
+#: The response channels a record's CSV may hold (the output kinds of identification).
+OUTPUT_KINDS = ("relative_displacement", "relative_velocity", "voltage", "current")
+
+
+def _output_columns(path: Path, columns, output_column, outputs) -> dict:
+    """``{kind: column}`` of the response channels read (``output_column`` is the displacement's)."""
+    if outputs is None:
+        wanted = {} if output_column is None else {OUTPUT_CHANNEL: output_column}
+    else:
+        if output_column not in (None, OUTPUT_CHANNEL):
+            raise ValueError("give either `output_column` or `outputs` (kind -> column), not both")
+        wanted = dict(outputs)
+    for kind, column in wanted.items():
+        if kind not in OUTPUT_KINDS:
+            raise ValueError(
+                f"`outputs`: {kind!r} is not an output kind; allowed: {', '.join(OUTPUT_KINDS)}"
+            )
+        if column not in columns:
+            what = QUANTITIES[kind]
+            raise ValueError(
+                f"{path.name}: output column `{column}` not found ({what.description}, "
+                f"{what.unit}); columns are {_shown(columns)}; map another name with "
+                + ("`output_column`" if outputs is None else "`--output-column`")
+            )
+    return wanted
 
 
 def _input_column(path: Path, columns, input_column, input_kind) -> tuple[str, str]:

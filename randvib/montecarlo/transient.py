@@ -35,18 +35,18 @@ from __future__ import annotations
 
 import time
 
-import numba
 import numpy as np
 
-from randvib._interrupts import interruptible
+from randvib._interrupts import ctrl_c_noticed, interruptible
 from randvib._progress import progress_bar, progress_wanted
 from randvib._resources import check_memory
-from randvib._validation import check_finite, check_int
+from randvib._validation import check_finite
 from randvib.models.event import Enveloped, EventStart
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import driven, kernel
 from randvib.montecarlo.batches import batch_bounds, raise_if_diverged
 from randvib.montecarlo.kernel_setup import KernelSetup
+from randvib.montecarlo.options import numba_threads
 from randvib.montecarlo.resources import check_resources
 from randvib.montecarlo.step_check import LinearTestSystem
 from randvib.montecarlo.transient_results import TransientResult
@@ -125,6 +125,67 @@ def simulate_transient(
     0.0163 +- 0.0024  exact 0.0158
     0.0293 +- 0.0041  exact 0.0279
     """
+    _check_case(harvester, event)
+    start = EventStart.of(start, harvester)
+    run = validated(
+        harvester,
+        event.excitation,
+        scheme,
+        t_end=t_end,
+        dt=dt,
+        burn_in=0.0,
+        n_paths=n_paths,
+        seed=seed,
+        first_path=first_path,
+        initial=(start.z, start.v),
+        dW=dW,
+        companion=False,
+        record=(0, None, 0, 1),
+    )
+    if run.n_paths < 2:
+        raise ValueError(f"`n_paths` must be >= 2 for the intervals, got {run.n_paths}")
+    snap_steps = snapshot_steps(times, run.grid.dt, run.grid.n_steps)
+    _check_resources(run, snap_steps, batch_paths)
+    # The step check and the scales read the device linearised at the envelope's peak.
+    system = LinearTestSystem.of(run.harvester, event.peak_excitation())
+
+    def linear():
+        return system
+
+    check_scales(run, linear)
+    if check_step:
+        system.check_step(run.scheme.name, run.grid.dt)
+    setup = KernelSetup.prepare(run, linear)
+    if progress is None:
+        progress = progress_wanted()
+    if batch_paths is None and run.driver is not None:  # the input's memory stays bounded
+        batch_paths = driven.batch_paths(run.grid.n_steps)
+    batches = batch_bounds(run.n_paths, batch_paths, run.grid.n_steps, progress, 0)
+    events = EventInput.of(run, event)
+    started = time.perf_counter()
+    with ctrl_c_noticed(), numba_threads(threads):
+        snapshots, integrals, first_hit = _run_batches(
+            run, setup, events, snap_steps, batches, progress
+        )
+    return TransientResult(
+        harvester=run.harvester,
+        event=event,
+        start=start,
+        scheme=run.scheme.name,
+        dt=run.grid.dt,
+        t_end=run.grid.t_end,
+        seed=run.seed,
+        first_path=run.first_path,
+        times=snap_steps * run.grid.dt,
+        snapshots=snapshots,
+        integrals=integrals,
+        first_hit=first_hit,
+        wall_time=time.perf_counter() - started,
+    )
+
+
+def _check_case(harvester, event) -> None:
+    """Refuse, in one line, a case :func:`simulate_transient` does not take."""
     if not isinstance(event, Enveloped):
         raise ValueError(
             "`event` must be a randvib.Enveloped (an excitation times an envelope, e.g. "
@@ -145,69 +206,16 @@ def simulate_transient(
             "a bridge's events are not implemented; simulate its stationary response "
             "with randvib.simulate"
         )
-    start = EventStart.of(start, harvester)
-    run = validated(
-        harvester,
-        event.excitation,
-        scheme,
-        t_end=t_end,
-        dt=dt,
-        burn_in=0.0,
-        n_paths=n_paths,
-        seed=seed,
-        first_path=first_path,
-        initial=(start.z, start.v),
-        dW=dW,
-        companion=False,
-        record=(0, None, 0, 1),
-    )
-    if run.n_paths < 2:
-        raise ValueError(f"`n_paths` must be >= 2 for the intervals, got {run.n_paths}")
-    snap_steps = snapshot_steps(times, run.grid.dt, run.grid.n_steps)
+
+
+def _check_resources(run, snap_steps: np.ndarray, batch_paths) -> None:
+    """The run's options, its memory and time, and the memory of the snapshots it keeps."""
     check_options(run, False)
     check_resources(run, batch_paths)
     check_memory(
         f"keeping {run.n_paths} paths at {snap_steps.size} times",
         8.0 * run.n_paths * (snap_steps.size * kernel.N_SNAP + kernel.N_EVENT + kernel.N_ACC),
         "give fewer `times` or fewer `n_paths`, or run in parts with `first_path`",
-    )
-    # The step check and the scales read the device linearised at the envelope's peak.
-    system = LinearTestSystem.of(run.harvester, event.peak_excitation())
-
-    def linear():
-        return system
-
-    check_scales(run, linear)
-    if check_step:
-        system.check_step(run.scheme.name, run.grid.dt)
-    setup = KernelSetup.prepare(run, linear)
-    if threads is not None:
-        threads = check_int("threads", threads, 1)
-        numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
-    if progress is None:
-        progress = progress_wanted()
-    if batch_paths is None and run.driver is not None:  # the input's memory stays bounded
-        batch_paths = driven.batch_paths(run.grid.n_steps)
-    batches = batch_bounds(run.n_paths, batch_paths, run.grid.n_steps, progress, 0)
-    events = EventInput.of(run, event)
-    started = time.perf_counter()
-    snapshots, integrals, first_hit = _run_batches(
-        run, setup, events, snap_steps, batches, progress
-    )
-    return TransientResult(
-        harvester=run.harvester,
-        event=event,
-        start=start,
-        scheme=run.scheme.name,
-        dt=run.grid.dt,
-        t_end=run.grid.t_end,
-        seed=run.seed,
-        first_path=run.first_path,
-        times=snap_steps * run.grid.dt,
-        snapshots=snapshots,
-        integrals=integrals,
-        first_hit=first_hit,
-        wall_time=time.perf_counter() - started,
     )
 
 
