@@ -710,6 +710,29 @@ MUTATIONS: tuple[Mutation, ...] = (
         "the one-DOF assembly under white noise must give Eq. 30 written out by hand.",
     ),
     Mutation(
+        name="assembly-mc-friction-dissipation",
+        path="randvib/montecarlo/assembly_results.py",
+        edits=(
+            (
+                "total = total + self.per_path[:, self.columns.friction : self.columns.friction + e]",
+                "total = total + 0.0 * self.per_path[:, self.columns.friction : self.columns.friction + e]",
+            ),
+        ),
+        tests=("tests/test_assembly_simulation.py::test_energy_balance_of_the_nonlinear_assembly",),
+        why="The assembly's Monte Carlo dissipation without the elements' friction power; "
+        "the white-noise balance against r^T M r S / 4 must miss it.",
+    ),
+    Mutation(
+        name="assembly-mc-influence-gain",
+        path="randvib/montecarlo/assembly_setup.py",
+        edits=(("gain[ov : ov + n] = assembly.influence", "gain[ov : ov + n] = 1.0"),),
+        tests=(
+            "tests/test_assembly_simulation.py::test_every_state_equals_an_independent_numpy_simulator",
+        ),
+        why="White noise reaching every DOF with unit weight instead of through the influence "
+        "vector r; the numpy simulator's three DOFs have r = (1, 1, 0.8).",
+    ),
+    Mutation(
         name="modal-participation-transposed",
         path="randvib/models/structure.py",
         edits=(("r = phi @ gamma", "r = phi.T @ gamma"),),
