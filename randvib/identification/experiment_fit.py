@@ -63,7 +63,7 @@ from randvib.identification.input_reconstruction import driving_signal
 from randvib.identification.models import MODEL_PARAMETERS, check_parameter, parameter_specs
 from randvib.identification.record_integrator import EXTRA_PARAMETERS
 from randvib.identification.result import IdentificationResult
-from randvib.identification.sade import sade
+from randvib.identification.sade import named_callback, sade
 from randvib.identification.settings import EXPERIMENT_POLISH_MAXFEV
 
 #: Corners of the search box probed before the search (a circuit's stiffest
@@ -242,8 +242,6 @@ def identify_experiment(
     progress, callback,
 ) -> IdentificationResult:  # fmt: skip
     """Fit ``model`` with ``coupling`` to the records ``tests`` (see :func:`randvib.identify`)."""
-    from randvib.identification.identify import _named_callback
-
     weights = check_weights(weights, tests)
     fixed = resolve_fixed(model, coupling, tests, fixed, m)
     if "m" not in fixed and tests[0].record.input_kind != "force" and coupling is None:
@@ -265,7 +263,7 @@ def identify_experiment(
     start = time.perf_counter()
     res = sade(
         searched, [space.box[n] for n in space.free], log=space.log, names=space.free,
-        init=_initial_guess(init, space), callback=_named_callback(callback, space.free),
+        init=_initial_guess(init, space), callback=named_callback(callback, space.free),
         progress=progress, **search.sade_options(),
     )  # fmt: skip
     if not np.isfinite(res.fun):

@@ -48,7 +48,7 @@ from randvib.identification.models import (
 from randvib.identification.prediction import score
 from randvib.identification.record_integrator import EXTRA_PARAMETERS
 from randvib.identification.result import IdentificationResult
-from randvib.identification.sade import sade
+from randvib.identification.sade import named_callback, sade
 from randvib.identification.settings import (
     POLISH_MAXFEV,
     SearchSettings,
@@ -273,7 +273,7 @@ def identify(
         log=space.log,
         names=space.free,
         init=_initial_guess(init, space),
-        callback=_named_callback(callback, space.free),
+        callback=named_callback(callback, space.free),
         progress=progress,
         **search.sade_options(),
     )
@@ -463,17 +463,6 @@ def _initial_guess(init, space: SearchSpace):
     guess = device_parameters(init, None, "identify's `init`")
     guess = {name: value for name, value in guess.items() if name not in EXTRA_PARAMETERS}
     return [[np.clip(guess.get(n, np.mean(space.box[n])), *space.box[n]) for n in space.free]]
-
-
-def _named_callback(callback, free):
-    """SaDE's ``callback(gen, x, f)`` as the user's ``callback(gen, {name: value}, f)``."""
-    if callback is None:
-        return None
-
-    def named(gen, x, f):
-        return callback(gen, dict(zip(free, map(float, x), strict=True)), f)
-
-    return named
 
 
 def _outside_search_box(parameters, space) -> tuple:
