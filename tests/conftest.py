@@ -187,32 +187,23 @@ if _CPU_LOG:
 
 
 # ---------------------------------------------------------------- running in parallel
-# The suite runs on pytest-xdist's workers with --dist loadgroup (pyproject.toml): a
-# test joins its module's group when it uses a module- or class-scoped fixture (a
-# built site, a study's quick run, the mutants), so that the fixture is built on one
-# worker only; other tests are shared out one by one. Groups are handed out in
-# collection order, and the modules that take longest (measured with
-# RANDVIB_TEST_CPU, docs/testing.md) are moved to the front so that neither worker is
-# left with a long module at the end. pytest-randomly shuffles the order first (a
-# new seed every run, printed in the header): an order dependence shows up as a
-# failure that `--randomly-seed=N` repeats (`-p no:randomly` keeps the file order).
+# The suite runs on pytest-xdist's workers with --dist loadfile (pyproject.toml): each
+# test module runs on one worker, so a fixture built once per module (a built site, a
+# study's quick run) is built once. (--dist loadgroup would share modules out finer,
+# but pytest-xdist 3.8 marks its groups on Node._nodeid, which pytest 9 no longer
+# reads: every group was split over the workers and the site was built twice.) Modules
+# are handed out in collection order (--no-loadscope-reorder), and the ones that take
+# longest (measured with RANDVIB_TEST_CPU, docs/testing.md) are moved to the front so
+# that neither worker is left with a long module at the end. pytest-randomly shuffles
+# the order first (a new seed every run, printed in the header): an order dependence
+# shows up as a failure that `--randomly-seed=N` repeats (`-p no:randomly` keeps the
+# file order).
 
 #: Test modules moved to the front of the queue, longest first.
 LONG_MODULES = (
-    "test_mutations.py",
     "test_docs.py",
+    "test_mutations.py",
 )
-
-
-def _shared_scope(item) -> bool:
-    """Whether the test uses a fixture built once per module or class."""
-    info = getattr(item, "_fixtureinfo", None)
-    if info is None:
-        return False
-    for definitions in info.name2fixturedefs.values():
-        if definitions and definitions[-1].scope in ("module", "class", "package"):
-            return True
-    return False
 
 
 def pytest_configure(config):
@@ -224,11 +215,7 @@ def pytest_configure(config):
             os.environ.setdefault(name, "1")
 
 
-@pytest.hookimpl(tryfirst=True)  # before xdist's worker reads the groups from the markers
 def pytest_collection_modifyitems(config, items):
-    for item in items:
-        if _shared_scope(item):
-            item.add_marker(pytest.mark.xdist_group(item.module.__name__))
 
     def rank(item):
         name = item.path.name
