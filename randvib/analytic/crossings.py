@@ -47,7 +47,7 @@ from randvib.analytic.first_passage import outcrossing_rate, spectral_bandwidth,
 from randvib.analytic.gibbs_marginal import GibbsDisplacement
 from randvib.analytic.linear_response import device_block, mechanical_block, output_variances
 from randvib.analytic.method import Validity
-from randvib.models.excitation import Excitation, Measured, as_excitation
+from randvib.models.excitation import Measured, as_excitation
 from randvib.models.harvester import Harvester
 
 __all__ = [
@@ -218,7 +218,9 @@ class RiceLinear(CrossingMethod):
         if not (np.all(h.k3 == 0) and np.all(h.k > 0)):
             return "needs a linear spring (k > 0, k3 = 0): the response is Gaussian only then"
         if not _frictionless(h) or h.is_rectified:
-            return "needs a linear device: friction and diode bridges make the response non-Gaussian"
+            return (
+                "needs a linear device: friction and diode bridges make the response non-Gaussian"
+            )
         return None
 
     def _solve(self, harvester, excitation, stroke, duration):

@@ -61,9 +61,7 @@ def register(sub) -> None:
         help="time step (s) (default: a stationary-variance bias below 1e-4 on the linearised "
         "device and at the stroke's stiffness)",
     )
-    g.add_argument(
-        "--scheme", default="heun", choices=tuple(INTEGRATORS), help="integrator"
-    )
+    g.add_argument("--scheme", default="heun", choices=tuple(INTEGRATORS), help="integrator")
     g.add_argument(
         "--burn-in",
         type=float,

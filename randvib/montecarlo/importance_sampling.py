@@ -37,7 +37,6 @@ they show that a few paths carry it (:data:`MIN_EFFECTIVE_SAMPLES`,
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np

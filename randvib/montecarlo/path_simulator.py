@@ -278,9 +278,7 @@ class HarvesterPaths(PathSimulator):
             device, excitation, scheme, t_end=duration, dt=dt, burn_in=0.0, n_paths=1, seed=0,
             first_path=0, initial="rest", dW=None, companion=False, record=(0, None, 0, 1),
         )  # fmt: skip
-        linear = functools.cache(
-            lambda: LinearTestSystem.of(device.linear_surrogate(), excitation)
-        )
+        linear = functools.cache(lambda: LinearTestSystem.of(device.linear_surrogate(), excitation))
         check_scales(probe, linear)
         linear().check_step(probe.scheme.name, probe.grid.dt)
         if burn_in is None:
