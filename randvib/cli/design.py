@@ -69,6 +69,17 @@ def register(sub) -> None:
         "(predicted where the response is Gaussian, checked by Monte Carlo)",
     )
     g.add_argument(
+        "--max-first-passage",
+        type=float,
+        metavar="P",
+        help="also require P(|z| reaches --stroke within --duration) <= P, from the stationary "
+        "state (predicted where the response is Gaussian, confirmed by the rare-event estimate "
+        "of randvib reliability on the candidates)",
+    )
+    g.add_argument(
+        "--duration", type=float, metavar="SECONDS", help="with --max-first-passage: the window T"
+    )
+    g.add_argument(
         "--objective",
         default="electrical",
         choices=tuple(OBJECTIVES),
@@ -159,6 +170,8 @@ def run(args) -> int:
         exceedance=args.exceedance,
         objective=args.objective,
         min_first_passage=args.min_first_passage,
+        max_first_passage=args.max_first_passage,
+        duration=args.duration,
         monte_carlo=not args.no_monte_carlo,
         settings=settings,
         out_dir=args.out_dir,
@@ -200,6 +213,15 @@ def run(args) -> int:
                          f"{cell(first.mean.mean)} ± {cell(first.mean.ci95)}" if first.mean
                          else f">= {cell(lower.mean)} ± {cell(lower.ci95)} (censored)", "s"))  # fmt: skip
             rows.append(("first_passage_confirmed", str(out["first_passage_confirmed"]), ""))
+    if args.max_first_passage is not None:
+        rows.append(("P(first passage) predicted",
+                     cell(out["first_passage_probability_predicted"]), "1"))  # fmt: skip
+        strikes = out["first_passage_probability"]
+        if strikes is not None:
+            rows.append(("P(first passage), rare-event estimate",
+                         f"{cell(strikes['mean'])} ± {cell(strikes['ci95'])}", "1"))  # fmt: skip
+            rows.append(("first_passage_probability_confirmed",
+                         str(out["first_passage_probability_confirmed"]), ""))  # fmt: skip
     rows.append(("efficiency", cell(out["efficiency"]), unit("efficiency")))
     if out["limit"] is None:
         rows.append(("limit", "none (white noise)", ""))

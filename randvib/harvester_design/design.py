@@ -41,6 +41,7 @@ from randvib.analytic.harvesting_limit import (
     harvesting_limit,
     record_harvesting_limit,
 )
+from randvib.harvester_design.constraints import FirstPassageLimit
 from randvib.harvester_design.objectives import objective_named
 from randvib.harvester_design.result import DesignResult
 from randvib.harvester_design.search import (
@@ -89,6 +90,8 @@ def design(
     progress: bool = False,
     min_first_passage: float | None = None,
     segments: int = 10,
+    max_first_passage: float | None = None,
+    duration: float | None = None,
 ) -> DesignResult:
     """Choose the varied parameters that maximise the power with ``P(|z| > stroke) <= exceedance``.
 
@@ -150,6 +153,13 @@ def design(
         A record's windows (Monte Carlo paths), >= 2; each should be much
         longer than the device's decay time 2 m / c
         (:attr:`randvib.RecordSimulation.lag1_correlation` checks it).
+    max_first_passage, duration : float, optional
+        P in (0, 1) and T (s), given together: also require
+        P(|z| reaches the stroke within T) <= P from the stationary state
+        (:class:`~randvib.harvester_design.constraints.FirstPassageLimit`):
+        predicted from the Gaussian answer in the search, then confirmed by
+        the rare-event estimate (:func:`randvib.first_passage`) on the
+        candidates Monte Carlo confirmed, the best not rejected chosen.
 
     Returns
     -------
@@ -180,6 +190,7 @@ def design(
         raise ValueError(
             f"`min_first_passage` must be a finite time > 0 (s), got {min_first_passage!r}"
         )
+    strikes = FirstPassageLimit.checked(max_first_passage, duration)
     stroke = harvester.stroke if stroke is None else stroke
     if stroke is None:
         raise ValueError("`stroke` is needed: the design's budget is on P(|z| > stroke)")
@@ -198,7 +209,9 @@ def design(
         limit = harvesting_limit(fixed.m, fixed.c_m, excitation, sigma_budget)
         limit_kind = None if limit is None else "stationary: E[z^2] <= sigma_z^2 of the budget"
     try:
-        search = analytic_search(space, excitation, exceedance, goal, runners_up, min_first_passage)
+        search = analytic_search(
+            space, excitation, exceedance, goal, runners_up, min_first_passage, strikes
+        )
     except NothingPredicted as exc:
         if not monte_carlo:
             raise ValueError(
@@ -208,7 +221,8 @@ def design(
     confirmed_on = "record windows" if isinstance(excitation, Measured) else "simulated paths"
     common = dict(objective=goal.name, stroke=float(stroke), exceedance_budget=float(exceedance),
                   evaluations=0 if search is None else search.evaluations,
-                  min_first_passage=min_first_passage, limit_kind=limit_kind)  # fmt: skip
+                  min_first_passage=min_first_passage, limit_kind=limit_kind,
+                  max_first_passage=max_first_passage, duration=duration)  # fmt: skip
     if monte_carlo:
         common["monte_carlo_input"] = confirmed_on
     if not monte_carlo:
@@ -228,6 +242,9 @@ def design(
             fraction_of_limit=None if limit is None else best.power / limit,
             runners_up=[_runner(c) for c in search.runners_up],
             first_passage_predicted=best.first_passage,
+            first_passage_probability_predicted=math.nan
+            if strikes is None
+            else strikes.predicted(best),
             **common,
         )
     settings = settings or SweepSettings(
@@ -260,6 +277,17 @@ def design(
             step /= 3.0
     if best is not None and chosen is not best and not confirmed.better(chosen, best, exceedance):
         chosen = best  # Monte Carlo's maximum is not significantly better: keep the analytic one
+    reliability = verdict = None
+    if strikes is not None:  # the rare-event estimate decides, best Monte Carlo power first
+        others = [c for c in confirmed.candidates
+                  if c is not chosen and confirmed.feasible(c, exceedance)]  # fmt: skip
+        ranked = [chosen, *sorted(others, key=lambda c: -confirmed.power(c).mean)]
+        found, reliability, verdict = strikes.confirm(
+            ranked, lambda c: space.device(c.u), excitation, settings.seed
+        )
+        if found is None:
+            raise InfeasibleBudget(strikes.rejected(len(ranked), reliability, stroke))
+        chosen = found
     x = confirmed.exceedance(chosen)
     if not _within(x, exceedance):
         where = ", ".join(f"{k} = {v:.6g}" for k, v in chosen.values.items())
@@ -308,6 +336,13 @@ def design(
         first_passage_predicted=chosen.first_passage,
         first_passage_monte_carlo=confirmed.first_passage(chosen),
         first_passage_confirmed=confirmed.passage(chosen),
+        first_passage_probability_predicted=math.nan
+        if strikes is None
+        else strikes.predicted(chosen),
+        first_passage_probability=None
+        if reliability is None
+        else reliability.probability_first_passage,
+        first_passage_probability_confirmed=verdict,
         **common,
     )
 

@@ -150,7 +150,9 @@ def next_threshold(y, count: int) -> float:
     return 0.5 * (b_hi + below[0]) if below.size else -math.inf
 
 
-def subset_simulation(simulator, n_per_level: int, rng, *, p0: float = 0.1) -> SubsetRun:
+def subset_simulation(
+    simulator, n_per_level: int, rng, *, p0: float = 0.1, max_levels: int = MAX_LEVELS
+) -> SubsetRun:
     """One subset simulation run of ``simulator`` (a :class:`~randvib.montecarlo.path_simulator.PathSimulator`).
 
     Parameters
@@ -161,6 +163,10 @@ def subset_simulation(simulator, n_per_level: int, rng, *, p0: float = 0.1) -> S
     rng : numpy.random.Generator
     p0 : float
         Conditional probability of each intermediate level, 0 < p0 <= 0.5.
+    max_levels : int
+        Levels after which the run stops short of the stroke (its intermediate
+        levels b_j, P(peak > b_j) ~ p0^j, are then the answer: a pilot's
+        complementary distribution of the peak).
 
     Returns
     -------
@@ -181,7 +187,7 @@ def subset_simulation(simulator, n_per_level: int, rng, *, p0: float = 0.1) -> S
     sigma = INITIAL_SIGMA
     evaluations = n_per_level
     threshold = -math.inf
-    for level in range(MAX_LEVELS - 1):
+    for level in range(max_levels - 1):
         if int(np.sum(records.y > 1.0)) >= n_chains:
             break
         new = next_threshold(records.y, n_chains)

@@ -78,6 +78,7 @@ STUDIES = (
     "events",
     "dc-power",
     "design",
+    "rare-events",
 )
 
 
