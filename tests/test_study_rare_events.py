@@ -20,7 +20,7 @@ from randvib.statistics import Statistic
 from randvib.studies import load
 from randvib.studies.rare_events import unsafe_strokes
 
-study = load("rare_events")
+study = load("rare-events")
 
 
 def test_rare_events_quick_end_to_end(tmp_path, capsys):
