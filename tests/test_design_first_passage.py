@@ -96,7 +96,7 @@ def test_monte_carlo_candidates_are_confirmed_by_the_rare_event_estimate():
 
 def test_cli_design_max_first_passage(capsys):
     base = ["design", "--m", M, "--c-m", C_M, "--excitation", "band-pass", "--psd", 1,
-            "--f0", 8, "--zeta", 0.1, "--stroke", 0.003,
+            "--f0", 8, "--zeta", 0.1, "--stroke", 0.003, "--k", 57.4, "--c-e", 0.1,
             "--vary", "c_e=0.01:1", "--no-monte-carlo"]  # fmt: skip
     code, out, _ = run(capsys, *base, "--max-first-passage", 0.5, "--duration", 10, "--json")
     assert code == 0

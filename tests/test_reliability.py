@@ -192,6 +192,19 @@ CASES = {  # device, excitation, paths, window (s), relative bias to detect
 }  # fmt: skip
 
 
+@pytest.mark.parametrize("name", ["band-pass (exact start)", "coil (exact start)"])
+def test_linear_surrogate_is_the_device_itself_with_a_filter_or_a_circuit(name):
+    """Importance sampling's linear response (the scheme's recursion on the augmented
+    system: filter, device, circuit) is the kernel's path of a linear device, row by row:
+    same start, same sign of the input, to rounding."""
+    h, excitation = CASES[name][:2]
+    sim = HarvesterPaths(h, excitation, stroke=0.01, duration=0.05, dt=5e-4)
+    rows = np.random.default_rng(0).standard_normal((20, sim.dimension))
+    z = sim.linear_surrogate.responses(rows)
+    assert sim.exactly_linear
+    np.testing.assert_allclose(np.abs(z).max(axis=1), sim(rows).peak, rtol=1e-10)
+
+
 def linear_displacement_variance(sim, h, excitation):
     """E[z^2] of the linear device: Lyapunov (filter, coil); for the synthesised input the
     lines of its periodic synthesis, sum_k P_k |H_z(f_k)|^2 (the input the paths get)."""

@@ -462,6 +462,10 @@ class _GaussianStart:
         else:
             f, g, _ = lin.augmented
             n_filter, n_states = lin.n_filter, f.shape[0]
+            if n_filter == 0:
+                # the block's input is the base acceleration (m z'' = ... - m a): the
+                # kernel adds +sqrt(S/2) dW to v, so the rows drive the same path
+                g = -g
         a, b = run.scheme.linear_recursion(f, g, run.grid.dt)
         covariance = linalg.solve_discrete_lyapunov(a, run.grid.dt * (b @ b.T))
         factor = np.linalg.cholesky(0.5 * (covariance + covariance.T))

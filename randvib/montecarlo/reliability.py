@@ -213,7 +213,7 @@ def first_passage(
     >>> r = rv.first_passage(device, 1.0, stroke=0.015, duration=0.5, dt=1e-3,
     ...                      method="importance", target_cov=0.2, progress=False)
     >>> print(f"{r.probability_first_passage.mean:.1e}")
-    3.8e-06
+    3.0e-04
     """
     stroke = harvester.stroke if stroke is None else stroke
     if stroke is None:
