@@ -43,7 +43,8 @@ def test_rare_events_quick_end_to_end(tmp_path, capsys):
                          r.stationary_exceedance_se, 200)  # fmt: skip
         assert_matches(stat, r.exact_exceedance, detect=8.0, what="Gibbs")
     verdicts = json.loads((out / "verdicts.json").read_text())
-    data = verdicts.get("data", verdicts)
+    data = {k: v for k, v in verdicts.items() if k != "verdicts"}
     assert data == json.loads(json.dumps(unsafe_strokes(results)))
+    assert len(verdicts["verdicts"]) == 2 * len(g["devices"])
     assert (out / "probability.png").stat().st_size > 0
     assert (out / "report.md").read_text().count("## ") == 3

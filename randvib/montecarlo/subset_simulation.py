@@ -78,7 +78,7 @@ class SubsetRun:
 
     ``probability`` P(F) and ``cov`` its coefficient of variation; ``means``
     the estimates of E[h] for each h (``beyond``, ``upcrossings``) and
-    ``covs`` theirs; ``evaluations`` the paths simulated.
+    ``covs`` theirs; ``evaluations`` the paths simulated; ``n_per_level`` N.
     """
 
     probability: float
@@ -87,6 +87,7 @@ class SubsetRun:
     covs: dict
     evaluations: int
     levels: list = field(default_factory=list)
+    n_per_level: int = 0
 
 
 def chain_mean_variance(values) -> tuple[float, float, float]:
@@ -223,6 +224,7 @@ def subset_simulation(
         covs=covs,
         evaluations=evaluations,
         levels=levels,
+        n_per_level=n_chains * length,
     )
 
 
