@@ -42,6 +42,7 @@ from randvib.analytic.gibbs_marginal import GibbsDisplacement
 from randvib.montecarlo.integrators import scheme_matrices, scheme_stationary_covariance
 from randvib.montecarlo.path_simulator import HarvesterPaths
 from randvib.montecarlo.reliability import estimate_first_passage
+from randvib.montecarlo.subset_simulation import chain_mean_variance
 from randvib.statistics import Statistic
 
 M, C_M, C_E, K = 0.0226, 0.1, 0.1, 57.4
@@ -299,6 +300,22 @@ def test_importance_sampling_refuses_degenerate_weights():
         with pytest.warns(RuntimeWarning, match="spent its budget"):
             estimate_first_passage(sim, method="importance", target_cov=0.1, seed=0,
                                    max_path_steps=1e6, progress=False)  # fmt: skip
+
+
+def test_chain_variance_counts_the_correlation_along_the_chains():
+    """Au & Beck's variance of a mean over Nc chains of Ns states: chains that never move
+    (each a constant) hold Nc independent values, Var = R(0) / Nc exactly (gamma = Ns - 1);
+    chains of independent states give gamma near 0 (taken as 0 when negative)."""
+    rng = np.random.default_rng(8)
+    constant = np.repeat(rng.standard_normal((50, 1)), 10, axis=1)
+    mean, var, gamma = chain_mean_variance(constant)
+    r0 = np.mean(constant**2) - mean**2
+    assert gamma == pytest.approx(9.0, rel=1e-12)
+    assert var == pytest.approx(r0 / 50, rel=1e-12)
+    independent = rng.standard_normal((50, 10))
+    mean, var, gamma = chain_mean_variance(independent)
+    assert 0.0 <= gamma < 0.5
+    assert var == pytest.approx(independent.var() / 500 * (1 + gamma), rel=1e-12)
 
 
 def test_subset_intervals_cover_the_exact_exceedance():
