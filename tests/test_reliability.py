@@ -322,7 +322,9 @@ def test_subset_intervals_cover_the_exact_exceedance():
     """40 independent single runs (200 samples per level, P(|z| > D) = 1e-3, linear device):
     the 95 % intervals of the exceedance and the crossing rate cover the exact values at
     least as often as Bin(40, 0.95) does with probability 0.999 (>= 33 times). Measured
-    coverage over 400 runs: tests/calibration/rare_event_coverage.py."""
+    over 400 such runs (tests/calibration/rare_event_coverage.py, single-1e-3): 94.2 %
+    (exceedance), 94.8 % (rate), 94.0 % (first passage); Au & Beck's gamma is checked
+    exactly by the test above."""
     d, exceedance, rate = exact_linear(3.29)
     sim = HarvesterPaths(LINEAR, 1.0, stroke=d, duration=0.1, dt=DT)
     hits = np.zeros(2)

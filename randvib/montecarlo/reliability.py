@@ -341,7 +341,14 @@ def _subset(simulator, rng, target, budget, bar, *, samples_per_level, p0):
     pilot = subset_simulation(simulator, n, rng, p0=p0)
     paths = pilot.evaluations
     runs = [pilot]
-    if pilot.cov > target:
+    if not math.isfinite(pilot.cov):  # no failure even at p0^MAX_LEVELS: nothing to plan
+        warnings.warn(
+            f"subset simulation found no path beyond the stroke after {len(pilot.levels)} "
+            f"levels: P(first passage) is below about {p0 ** len(pilot.levels):.0e} here",
+            BudgetWarning,
+            stacklevel=4,
+        )
+    elif pilot.cov > target:
         planned = math.ceil(PLANNING_MARGIN * (pilot.cov / target) ** 2)  # runs of n
         affordable = int((budget / simulator.steps_per_path - paths) // pilot.evaluations)
         if planned > affordable:
