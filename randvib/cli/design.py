@@ -214,14 +214,7 @@ def run(args) -> int:
                          else f">= {cell(lower.mean)} ± {cell(lower.ci95)} (censored)", "s"))  # fmt: skip
             rows.append(("first_passage_confirmed", str(out["first_passage_confirmed"]), ""))
     if args.max_first_passage is not None:
-        rows.append(("P(first passage) predicted",
-                     cell(out["first_passage_probability_predicted"]), "1"))  # fmt: skip
-        strikes = out["first_passage_probability"]
-        if strikes is not None:
-            rows.append(("P(first passage), rare-event estimate",
-                         f"{cell(strikes['mean'])} ± {cell(strikes['ci95'])}", "1"))  # fmt: skip
-            rows.append(("first_passage_probability_confirmed",
-                         str(out["first_passage_probability_confirmed"]), ""))  # fmt: skip
+        rows += _strike_rows(out)
     rows.append(("efficiency", cell(out["efficiency"]), unit("efficiency")))
     if out["limit"] is None:
         rows.append(("limit", "none (white noise)", ""))
@@ -240,3 +233,15 @@ def run(args) -> int:
         rows.append(("analytic optimum's cost", f"{cell(cost.mean)} ± {cell(cost.ci95)}", "W"))
     print_table(rows, ("quantity", "value", "unit"))
     return 0
+
+
+def _strike_rows(out) -> list:
+    """The table's rows of the strike limit (--max-first-passage): predicted, estimated."""
+    rows = [("P(first passage) predicted", cell(out["first_passage_probability_predicted"]), "1")]
+    strikes = out["first_passage_probability"]
+    if strikes is not None:
+        estimate = f"{cell(strikes['mean'])} ± {cell(strikes['ci95'])}"
+        rows.append(("P(first passage), rare-event estimate", estimate, "1"))
+        verdict = str(out["first_passage_probability_confirmed"])
+        rows.append(("first_passage_probability_confirmed", verdict, ""))
+    return rows

@@ -24,6 +24,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from randvib.harvester_design.search import InfeasibleBudget
 from randvib.montecarlo.reliability import ReliabilityResult, first_passage
 
 __all__ = ["FirstPassageLimit"]
@@ -123,6 +124,19 @@ class FirstPassageLimit:
         if p.mean - p.ci95 > self.probability:
             return False
         return None
+
+    def decide(self, confirmed, chosen, budget, space, excitation, seed: int = 0):
+        """The design among Monte Carlo's confirmed candidates: ``chosen`` first, then the
+        others that meet the stroke budget by Monte Carlo power; the first the rare-event
+        estimate does not reject. Returns (candidate, ReliabilityResult, verdict); raises
+        InfeasibleBudget when it rejects them all."""
+        others = [c for c in confirmed.candidates
+                  if c is not chosen and confirmed.feasible(c, budget)]  # fmt: skip
+        ranked = [chosen, *sorted(others, key=lambda c: -confirmed.power(c).mean)]
+        found, result, verdict = self.confirm(ranked, lambda c: space.device(c.u), excitation, seed)
+        if found is None:
+            raise InfeasibleBudget(self.rejected(len(ranked), result, space.harvester.stroke))
+        return found, result, verdict
 
     def confirm(self, ranked, device_of, excitation, seed: int = 0):
         """The first of ``ranked`` candidates the rare-event estimate does not reject.

@@ -279,15 +279,9 @@ def design(
         chosen = best  # Monte Carlo's maximum is not significantly better: keep the analytic one
     reliability = verdict = None
     if strikes is not None:  # the rare-event estimate decides, best Monte Carlo power first
-        others = [c for c in confirmed.candidates
-                  if c is not chosen and confirmed.feasible(c, exceedance)]  # fmt: skip
-        ranked = [chosen, *sorted(others, key=lambda c: -confirmed.power(c).mean)]
-        found, reliability, verdict = strikes.confirm(
-            ranked, lambda c: space.device(c.u), excitation, settings.seed
+        chosen, reliability, verdict = strikes.decide(
+            confirmed, chosen, exceedance, space, excitation, settings.seed
         )
-        if found is None:
-            raise InfeasibleBudget(strikes.rejected(len(ranked), reliability, stroke))
-        chosen = found
     x = confirmed.exceedance(chosen)
     if not _within(x, exceedance):
         where = ", ".join(f"{k} = {v:.6g}" for k, v in chosen.values.items())
