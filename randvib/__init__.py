@@ -52,6 +52,8 @@ _EXPORTS = {
     "randvib.analytic.fokker_planck": ("fast_fpk_statistics", "fpk_statistics", "solve_fpk"),
     "randvib.models.friction": ("Coulomb", "FrictionModel", "LuGre", "Tanh"),
     "randvib.models.harvester": ("Harvester",),
+    "randvib.models.assembly": ("Assembly",),
+    "randvib.models.assembly_parts": ("Element", "ElectricalDamper", "Spring", "Transducer"),
     "randvib.models.coupling": ("Coupling", "COUPLINGS", "Inductive", "Piezo", "Resistive"),
     "randvib.models.rectifier": ("BridgeCoil", "BridgePiezo", "RECTIFIED", "Rectified"),
     "randvib.identification.cost": ("normalised_cost",),
@@ -65,6 +67,11 @@ _EXPORTS = {
     "randvib.analytic.linearisation": ("coulomb_equivalent_damping", "equivalent_damping"),
     "randvib.analytic.method": ("AnalyticMethod",),
     "randvib.analytic.power_prediction": ("PowerPrediction",),
+    "randvib.analytic.assembly_prediction": (
+        "AssemblyLoad",
+        "AssemblyPrediction",
+        "optimal_assembly_loads",
+    ),
     "randvib.analytic.bridge": ("DcOptimum", "optimal_dc_output"),
     "randvib.montecarlo.bridge_optimum": ("simulated_dc_optimum",),
     "randvib.analytic.prediction": (

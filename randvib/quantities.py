@@ -90,6 +90,10 @@ QUANTITIES: dict[str, Quantity] = {
     "power_load": Quantity("W", "expected power into the load E[i^2 R_L]", "E[P_L]"),
     "power_mechanical": Quantity("W", "power dissipated mechanically: c_m E[z'^2] + friction"),
     "friction_power": Quantity("W", "power dissipated by friction E[z' F]"),
+    "power_input": Quantity(
+        "W",
+        "mean power the base acceleration injects (assemblies: r^T M r S / 4 under white noise)",
+    ),
     "power_stored": Quantity(
         "W", "power stored through a bridge: V_b E|i| or E[V_C^2] / R_L", "E[P_stored]"
     ),

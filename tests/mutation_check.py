@@ -595,6 +595,244 @@ MUTATIONS: tuple[Mutation, ...] = (
         why="The design's predicted P(first passage within T) with a hazard 1 % low; it must "
         "equal the crossing anchor's Vanmarcke answer for the chosen device to 1e-6.",
     ),
+    Mutation(
+        name="assembly-dashpot-to-ground",
+        path="randvib/models/assembly.py",
+        edits=(
+            (
+                "c += element.damping * np.outer(d, d)",
+                "c += element.damping * np.diag(np.abs(d))",
+            ),
+        ),
+        tests=(
+            "tests/test_assembly_analytic.py::test_two_dof_chain_against_a_hand_built_lyapunov_equation",
+        ),
+        why="An element's dashpot between two DOFs acts on each DOF's absolute velocity (two "
+        "dashpots to the base) instead of their relative velocity; the two-DOF chain is "
+        "checked against a Lyapunov equation on a state matrix written by hand.",
+    ),
+    Mutation(
+        name="assembly-circuit-drive",
+        path="randvib/models/assembly.py",
+        edits=(("a[slot, n : 2 * n] = b_s * d", "a[slot, n : 2 * n] = 1.01 * b_s * d"),),
+        tests=(
+            "tests/test_assembly_analytic.py::test_host_with_two_harvesters_against_a_frequency_domain_integral",
+        ),
+        why="A transducer's circuit state is driven 1 % too hard by its relative velocity "
+        "(alpha/L or theta/C_p); the three-DOF host is checked against a frequency-domain "
+        "integral with the circuits as frequency-dependent dashpots, to 1e-8.",
+    ),
+    Mutation(
+        name="assembly-white-input-power",
+        path="randvib/analytic/assembly_linear.py",
+        edits=(
+            (
+                "return float(assembly.influence @ mr * excitation.level / 4.0)",
+                "return float(assembly.influence @ mr * excitation.level / 2.0)",
+            ),
+        ),
+        tests=("tests/test_assembly_analytic.py::test_white_noise_energy_balance_is_exact",),
+        why="The injected power r^T M r S / 2 instead of / 4 (S taken as the two-sided "
+        "intensity: E[w w] = (S/2) delta); the balance is written from the masses in the test.",
+    ),
+    Mutation(
+        name="assembly-spectral-conjugate",
+        path="randvib/analytic/assembly_linear.py",
+        edits=(
+            (
+                "covariance = np.real((h * density) @ h.conj().T)",
+                "covariance = np.real((h * density) @ h.T)",
+            ),
+        ),
+        tests=(
+            "tests/test_assembly_analytic.py::test_spectral_route_equals_lyapunov_for_three_dofs",
+        ),
+        why="The spectral covariance int Re(H H^H) S df without the conjugate: the "
+        "cross-covariances (and with them the variances' real parts) are wrong; the two "
+        "routes must agree to 1e-9 as correlations.",
+    ),
+    Mutation(
+        name="assembly-cubic-closure",
+        path="randvib/analytic/assembly_linearisation.py",
+        edits=(
+            (
+                "k += 3.0 * element.spring.k3 * variance * np.outer(d, d)",
+                "k += 3.3 * element.spring.k3 * variance * np.outer(d, d)",
+            ),
+        ),
+        tests=(
+            "tests/test_assembly_analytic.py::test_one_dof_assembly_equals_the_harvester",
+            "tests/test_assembly_analytic.py::test_nonlinear_fixed_point_is_self_consistent",
+        ),
+        why="An element's Gaussian-closure spring 3.3 k3 E[u^2] instead of 3 k3 E[u^2]; the "
+        "one-DOF assembly must equal the single-mass linearisation under coloured input.",
+    ),
+    Mutation(
+        name="assembly-friction-closure",
+        path="randvib/analytic/assembly_linearisation.py",
+        edits=(("sigma = np.sqrt(variance)", "sigma = np.sqrt(1.02 * variance)"),),
+        tests=("tests/test_assembly_analytic.py::test_one_dof_coulomb_under_white_noise_is_eq_30",),
+        why="The friction's equivalent dashpot evaluated at a velocity spread 1 % too large; "
+        "the one-DOF assembly under white noise must give Eq. 30 written out by hand.",
+    ),
+    Mutation(
+        name="modal-participation-transposed",
+        path="randvib/models/structure.py",
+        edits=(("r = phi @ gamma", "r = phi.T @ gamma"),),
+        tests=("tests/test_assembly.py::test_modal_host_keeps_its_modes_and_participation",),
+        why="A modal host's influence vector from the transposed mode-shape matrix; r = Phi "
+        "gamma is checked with a non-symmetric Phi.",
+    ),
+    Mutation(
+        name="ljung-box-dof",
+        path="randvib/identification/residuals.py",
+        edits=(
+            ("return q, float(stats.chi2.sf(q, m))", "return q, float(stats.chi2.sf(q, m - 1))"),
+        ),
+        tests=(
+            "tests/test_residuals.py::test_ljung_box_is_its_definition",
+            "tests/test_residuals.py::test_false_alarm_rates_of_white_residuals_hold_their_levels",
+        ),
+        why="The Ljung-Box p-value from chi-squared with M - 1 degrees of freedom instead of "
+        "M (at M = 25 its false alarms rise from 1 % to 1.4 %): Q and its p-value against "
+        "the definition computed in the test; over 1000 white residuals (M = 10) 60 % of "
+        "p-values fall below 0.5 instead of 50 %.",
+    ),
+    Mutation(
+        name="ljung-box-n-plus-2",
+        path="randvib/identification/residuals.py",
+        edits=(("q = float(n * (n + 2) * np.sum(", "q = float(n * n * np.sum("),),
+        tests=("tests/test_residuals.py::test_ljung_box_is_its_definition",),
+        why="Ljung-Box's N (N + 2) becomes N^2, Q too small by N / (N + 2) (1 % at N = 200): "
+        "against the definition computed in the test.",
+    ),
+    Mutation(
+        name="ljung-box-n-minus-k",
+        path="randvib/identification/residuals.py",
+        edits=(("r**2 / (n - np.arange(1, m + 1))", "r**2 / (n - np.arange(0, m))"),),
+        tests=("tests/test_residuals.py::test_ljung_box_is_its_definition",),
+        why="Lag k of Ljung-Box's sum weighted by 1 / (N - k + 1) instead of 1 / (N - k): "
+        "against the definition computed in the test.",
+    ),
+    Mutation(
+        name="ljung-box-lag-cap",
+        path="randvib/identification/residuals.py",
+        edits=(
+            (
+                "    m = int(min(max_lag, n // 4))\n    if m < 1 or np.std(e) == 0:",
+                "    m = int(min(max_lag, n // 2))\n    if m < 1 or np.std(e) == 0:",
+            ),
+        ),
+        tests=("tests/test_residuals.py::test_ljung_box_is_its_definition",),
+        why="ljung_box caps M at N / 2 instead of the documented N / 4, so a short residual "
+        "is tested over lags its autocorrelation cannot estimate; the 60-sample case of the "
+        "definition test sees M = 25 instead of 15.",
+    ),
+    Mutation(
+        name="cross-band-constant",
+        path="randvib/identification/residuals.py",
+        edits=(("z = stats.norm.ppf(1 - LEVEL / 2)", "z = stats.norm.ppf(1 - LEVEL)"),),
+        tests=("tests/test_residuals.py::test_bands_and_p_values_are_their_definitions",),
+        why="The bands' quantile one-sided (2.33 instead of 2.58): the reported 99 % bands "
+        "of the auto- and cross-correlation are 98 % bands; against the definitions.",
+    ),
+    Mutation(
+        name="bartlett-factor",
+        path="randvib/identification/residuals.py",
+        edits=(
+            (
+                "float(1 + 2 * np.sum(r_ee[1:] * r_uu[1:]))",
+                "float(1 + np.sum(r_ee[1:] * r_uu[1:]))",
+            ),
+        ),
+        tests=(
+            "tests/test_residuals.py::test_bands_and_p_values_are_their_definitions",
+            "tests/test_residuals.py::test_cross_correlation_band_holds_its_level_for_coloured_series",
+        ),
+        why="Bartlett's variance of the cross-correlation counts the lags on one side only "
+        "(1 + sum instead of 1 + 2 sum): the band is too narrow for a coloured residual and "
+        "input, 4.4 % of independent AR(1) pairs outside it at lag 0 instead of 1 %.",
+    ),
+    Mutation(
+        name="cross-p-one-sided",
+        path="randvib/identification/residuals.py",
+        edits=(("p_cross = 2 * stats.norm.sf(", "p_cross = stats.norm.sf("),),
+        tests=("tests/test_residuals.py::test_bands_and_p_values_are_their_definitions",),
+        why="The cross-correlation lags' p-values one-sided, half the two-sided ones: the "
+        "input test rejects twice as often; against Holm's adjusted p-value computed in the "
+        "test.",
+    ),
+    Mutation(
+        name="cross-p-without-holm",
+        path="randvib/identification/residuals.py",
+        edits=(
+            (
+                "cross_p = float(min(1.0, p_cross.size * np.min(p_cross)))",
+                "cross_p = float(min(1.0, np.min(p_cross)))",
+            ),
+        ),
+        tests=(
+            "tests/test_residuals.py::test_bands_and_p_values_are_their_definitions",
+            "tests/test_residuals.py::test_false_alarm_rates_of_white_residuals_hold_their_levels",
+        ),
+        why="The reported cross-correlation p-value is the smallest lag's, not Holm's "
+        "adjusted one over the 2M + 1 lags: 40 % of independent white pairs would read as "
+        "related at 1 % (M = 25; 19 % at the white-residual test's M = 10).",
+    ),
+    Mutation(
+        name="verdict-without-holm",
+        path="randvib/identification/residuals.py",
+        edits=(
+            (
+                "related = bool(np.any(holm_significant(p_cross, LEVEL)))",
+                "related = bool(np.any(p_cross <= LEVEL))",
+            ),
+        ),
+        tests=(
+            "tests/test_residuals.py::test_false_alarm_rates_of_white_residuals_hold_their_levels",
+        ),
+        why="The verdict's input test rejects when any of the 2M + 1 lags does at LEVEL, "
+        "without Holm's correction: about 40 % of white residuals of independent inputs are "
+        "'structured' at M = 25, 20 % at the test's M = 10 (nominal at most 2 %).",
+    ),
+    Mutation(
+        name="verdict-ljung-box-level",
+        path="randvib/identification/residuals.py",
+        edits=(
+            (
+                'verdict = "white" if q_p >= LEVEL and not related',
+                'verdict = "white" if q_p >= LEVEL / 10 and not related',
+            ),
+        ),
+        tests=(
+            "tests/test_residuals.py::test_false_alarm_rates_of_white_residuals_hold_their_levels",
+        ),
+        why="The verdict reads the Ljung-Box p-value at LEVEL / 10: residuals with "
+        "0.001 <= p < 0.01 pass as white; the white-residual test checks the verdict's rule on "
+        "each of its 1000 pairs (about 9 fall there).",
+    ),
+    Mutation(
+        name="holm-bonferroni",
+        path="randvib/statistics.py",
+        edits=(("if p[i] > level / (p.size - rank):", "if p[i] > level / p.size:"),),
+        tests=("tests/test_statistics.py::test_holm_is_the_rule_of_adjusted_p_values",),
+        why="Holm's step-down becomes Bonferroni (level / m at every step, not level / (m - "
+        "i)): fewer rejections after the first; compared with Holm's adjusted p-values.",
+    ),
+    Mutation(
+        name="holm-no-step-down",
+        path="randvib/statistics.py",
+        edits=(
+            (
+                "            break\n        reject[i] = True",
+                "            continue\n        reject[i] = True",
+            ),
+        ),
+        tests=("tests/test_statistics.py::test_holm_is_the_rule_of_adjusted_p_values",),
+        why="Holm's procedure does not stop at its first acceptance: a larger p-value that "
+        "meets its own threshold level / (m - i) is rejected after a smaller one was not; "
+        "compared with Holm's adjusted p-values.",
+    ),
 )
 
 

@@ -32,12 +32,20 @@ from randvib._validation import (
     check_scalar,
     check_scalar_device,
 )
+from randvib.analytic.assembly_prediction import predict_assembly
 from randvib.analytic.averaging import AVERAGING
 from randvib.analytic.bridge import BRIDGE_CLOSURE
 from randvib.analytic.fokker_planck import FAST_FOKKER_PLANCK, FOKKER_PLANCK
-from randvib.analytic.method import AnalyticMethod, non_white, white_level
+from randvib.analytic.method import (
+    AnalyticMethod,
+    method_named,
+    non_white,
+    register_methods,
+    white_level,
+)
 from randvib.analytic.power_prediction import PowerPrediction
 from randvib.analytic.statistical_linearisation import LINEARISATION, LinearisationDidNotConverge
+from randvib.models.assembly import Assembly
 from randvib.models.excitation import BROADCASTING, Excitation
 from randvib.models.harvester import Harvester
 
@@ -51,19 +59,11 @@ from randvib.models.harvester import Harvester
 #: equation on small grids made exact without friction, with kink corrections
 #: and Richardson extrapolation, fast enough for sweeps; ``"fpk"``: the same
 #: equation on fine grids, the slow reference (:mod:`randvib.analytic.fokker_planck`).
-METHODS: dict[str, AnalyticMethod] = {
-    method.name: method
-    for method in (LINEARISATION, AVERAGING, FAST_FOKKER_PLANCK, FOKKER_PLANCK, BRIDGE_CLOSURE)
-}
-
-
-def method_named(method) -> AnalyticMethod:
-    """The method ``method`` names: a key of :data:`METHODS`, or an AnalyticMethod (class or instance)."""
-    if isinstance(method, type) and issubclass(method, AnalyticMethod):
-        return method()
-    if isinstance(method, AnalyticMethod):
-        return method
-    return METHODS[check_choice("method", method, tuple(METHODS))]
+#: The registry is :data:`randvib.analytic.method.METHODS` (this dict), which
+#: the refusals read; :func:`~randvib.analytic.method.method_named` looks a name up.
+METHODS: dict[str, AnalyticMethod] = register_methods(
+    LINEARISATION, AVERAGING, FAST_FOKKER_PLANCK, FOKKER_PLANCK, BRIDGE_CLOSURE
+)
 
 
 def predict(harvester: Harvester, psd, method="linearisation") -> PowerPrediction:
@@ -71,9 +71,13 @@ def predict(harvester: Harvester, psd, method="linearisation") -> PowerPredictio
 
     Parameters
     ----------
-    harvester : Harvester
+    harvester : Harvester or Assembly
         Device; parameters may be arrays broadcasting with ``psd`` (scalars
-        under a non-white excitation or with a circuit state).
+        under a non-white excitation or with a circuit state). An
+        :class:`~randvib.models.assembly.Assembly` (several DOFs, elements,
+        transducers; scalars) gives an
+        :class:`~randvib.analytic.assembly_prediction.AssemblyPrediction`:
+        ``method="linearisation"`` only, exact for a linear assembly.
     psd : array_like or Excitation
         One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0 (white noise,
         paper Eq. 17), or an excitation object: ``White(S)`` is the same as
@@ -129,6 +133,8 @@ def predict(harvester: Harvester, psd, method="linearisation") -> PowerPredictio
             "response is randvib.transient_response (or Monte Carlo, randvib.simulate_transient)"
         )
     solver = method_named(method)
+    if isinstance(harvester, Assembly):  # several DOFs: randvib.analytic.assembly_prediction
+        return predict_assembly(harvester, psd, solver)
     solver.require(harvester, psd)
     _refuse_undamped(harvester)
     if not non_white(psd):  # White(S) runs exactly the code of the number S

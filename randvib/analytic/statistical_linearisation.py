@@ -386,6 +386,7 @@ class Linearisation(AnalyticMethod):
     summary = "Gaussian closure, paper Eq. 32, microseconds, low by up to 9 % at strong friction"
     coloured = True
     circuit = True
+    assemblies = True
     stroke_exceedance = True
     transient = True
     validity = (
@@ -406,6 +407,25 @@ class Linearisation(AnalyticMethod):
             "under a non-white excitation or with a circuit state (where k_eq shapes the "
             "response): the Gaussian closure misplaces the resonance beyond it (0.52x to "
             "1.33x for a hardening spring, 0.29x to 47x for a double well)",
+        ),
+        # assemblies (randvib.analytic.assembly_linearisation): per element, the
+        # single-mass limits, checked against an independent simulator of assemblies
+        Validity(
+            "element_friction_share",
+            LINEARISATION_FRICTION_SHARE_LIMIT,
+            "warns",
+            "an assembly element's friction power over all the power dissipated on its "
+            "coordinate; the single-mass limit, checked on a host with a harvester "
+            "(tests/calibration/assembly_linearisation.py): -5 % at 0.76, -21 % at 0.92",
+        ),
+        Validity(
+            "element_stiffness_share",
+            LINEARISATION_STIFFNESS_SHARE_LIMIT,
+            "warns",
+            "the cubic spring's share 1 - k_dir / k_eq of the stiffness on an assembly "
+            "element's coordinate; the single-mass limit, checked on a host with a harvester "
+            "(tests/calibration/assembly_linearisation.py): within 6 % up to 0.14, -7.5 % to "
+            "-21.5 % from 0.35 to 0.64",
         ),
     )
 

@@ -63,6 +63,7 @@ from randvib.analytic.first_passage import (
     vanmarcke_hazard,
 )
 from randvib.analytic.linear_response import device_block, stationary_covariance
+from randvib.analytic.method import method_named
 from randvib.models.event import Enveloped, EventStart
 from randvib.models.harvester import Harvester
 
@@ -378,8 +379,6 @@ def transient_response(
     >>> print(f"energy from 0 to 5 s: {r.energy_electrical:.4e} J")
     energy from 0 to 5 s: 1.3806e-02 J
     """
-    from randvib.analytic.prediction import method_named  # the driver lists the methods
-
     if not isinstance(harvester, Harvester):
         raise ValueError(f"`harvester` must be a randvib.Harvester, got {type(harvester).__name__}")
     if not isinstance(event, Enveloped):

@@ -176,6 +176,7 @@ def _main_with_warnings(argv) -> int:
 
 def _advice_warnings() -> tuple:
     """randvib's warnings that say something about the user's run (a step size, a validity)."""
+    from randvib.analytic.assembly_prediction import AssemblyLoadBoundWarning
     from randvib.analytic.averaging import AveragingValidityWarning
     from randvib.analytic.prediction import LoadBoundWarning
     from randvib.analytic.statistical_linearisation import LinearisationValidityWarning
@@ -186,6 +187,7 @@ def _advice_warnings() -> tuple:
         AveragingValidityWarning,
         LoadBoundWarning,
         LinearisationValidityWarning,
+        AssemblyLoadBoundWarning,
     )
 
 

@@ -1,9 +1,19 @@
-"""Device options shared by the commands that take a harvester."""
+"""Device options shared by the commands that take a harvester, or an assembly (``--device``).
+
+``--device FILE.toml`` (or the name of a shipped example, ``randvib.datasets.device_names``)
+reads an :class:`~randvib.models.assembly.Assembly` from a device file
+(:mod:`randvib.models.device_file`); it replaces every other device option.
+:func:`assembly_from_args` reads it; :func:`harvester_from_args` refuses it, so a
+command that does not take assemblies yet says so in one line (``power`` takes it).
+"""
 
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
+from randvib.datasets import device_names, device_path
+from randvib.models.assembly import Assembly
 from randvib.models.coupling import COUPLINGS, coupling_class
 from randvib.models.friction import FRICTION_MODELS, RegistryView
 from randvib.models.harvester import ElectricalDampingOverflow, Harvester
@@ -61,8 +71,15 @@ def _coupling_options() -> dict[str, list]:
 
 
 def add_device_arguments(parser: argparse.ArgumentParser) -> None:
-    """Add --preset, the device parameters and --psd to ``parser``."""
+    """Add --device, --preset, the device parameters and --psd to ``parser``."""
     g = parser.add_argument_group("device (SI units; values override --preset)")
+    g.add_argument(
+        "--device",
+        metavar="FILE",
+        help="an assembly from a device file (TOML: structure, elements, transducers; "
+        f"docs/assemblies.md) or a shipped example ({', '.join(device_names())}); instead of "
+        "every other device option",
+    )
     g.add_argument(
         "--preset",
         metavar="NAME",
@@ -147,6 +164,9 @@ def add_device_arguments(parser: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--psd", type=float, default=None, help="one-sided base-acceleration PSD S ((m/s^2)^2/Hz)"
     )
+    # the options --device replaces (not --psd, the excitation's level)
+    own = tuple(a.dest for a in g._group_actions if a.dest not in ("device", "psd"))
+    parser.set_defaults(device_options=own)
 
 
 def _potential_from_wells(args) -> dict:
@@ -167,8 +187,43 @@ def _potential_from_wells(args) -> dict:
     return {"k": potential.k, "k3": potential.k3}
 
 
+def assembly_from_args(args) -> Assembly | None:
+    """The assembly of ``--device`` (a file, or a shipped example's name), or None without it.
+
+    Refuses any other device option beside it, naming the first.
+    """
+    name = getattr(args, "device", None)
+    if name is None:
+        return None
+    given = [d for d in getattr(args, "device_options", ()) if getattr(args, d, None) is not None]
+    if given:
+        raise ValueError(
+            f"`--device` gives the whole device; drop `{option_flag(given[0])}` (change the file, "
+            "or give the single-mass device by its options without --device)"
+        )
+    path = Path(name)
+    if not path.exists() and path.suffix != ".toml":
+        try:
+            path = device_path(name)
+        except ValueError:
+            raise ValueError(
+                f"`--device`: no such file {name} (nor a shipped example: "
+                f"{', '.join(device_names())})"
+            ) from None
+    return Assembly.from_toml(path)
+
+
 def harvester_from_args(args) -> Harvester:
-    """Build the harvester from a preset and/or explicit options."""
+    """Build the harvester from a preset and/or explicit options.
+
+    ``--device`` (an assembly) is refused here: the commands that take it
+    read it with :func:`assembly_from_args` first.
+    """
+    if getattr(args, "device", None) is not None:
+        raise ValueError(
+            "`--device` (an assembly of several masses) is not taken here yet; "
+            "`randvib power --device FILE` predicts its stationary power"
+        )
     if args.preset is not None:
         base = preset(args.preset)
         values = {"m": base.m, "c_m": base.c_m, "c_e": base.c_e, "k": base.k, "k3": base.k3}

@@ -182,14 +182,7 @@ def design(
     >>> print(f"k = {result.optimum['k']:.1f} N/m, c_e = {result.optimum['c_e']:.3f} Ns/m")
     k = 59.1 N/m, c_e = 0.456 Ns/m
     """
-    if min_first_passage is not None and not (
-        isinstance(min_first_passage, (int, float))
-        and math.isfinite(min_first_passage)
-        and min_first_passage > 0
-    ):
-        raise ValueError(
-            f"`min_first_passage` must be a finite time > 0 (s), got {min_first_passage!r}"
-        )
+    _check_min_first_passage(min_first_passage)
     strikes = FirstPassageLimit.checked(max_first_passage, duration)
     stroke = harvester.stroke if stroke is None else stroke
     if stroke is None:
@@ -202,12 +195,7 @@ def design(
         raise ValueError(refusal)
     excitation = as_excitation(excitation)
     space = DesignSpace(fixed, vary)
-    if isinstance(excitation, Measured) and fixed.c_m > 0:
-        limit = record_harvesting_limit(fixed.m, fixed.c_m, excitation, stroke)
-        limit_kind = "record: non-causal, |z| <= stroke"
-    else:
-        limit = harvesting_limit(fixed.m, fixed.c_m, excitation, sigma_budget)
-        limit_kind = None if limit is None else "stationary: E[z^2] <= sigma_z^2 of the budget"
+    limit, limit_kind = _limit(fixed, excitation, stroke, sigma_budget)
     try:
         search = analytic_search(
             space, excitation, exceedance, goal, runners_up, min_first_passage, strikes
@@ -226,33 +214,95 @@ def design(
     if monte_carlo:
         common["monte_carlo_input"] = confirmed_on
     if not monte_carlo:
-        best = search.optimum
-        return DesignResult(
-            optimum=best.values,
-            analytic_optimum=best.values,
-            method=best.method,
-            device=space.device(best.u),
-            power_predicted=best.power,
-            exceedance_predicted=best.exceedance,
-            power_monte_carlo=None,
-            stroke_exceedance_monte_carlo=None,
-            input_power=best.input_power,
-            efficiency=best.power / best.input_power,
-            limit=limit,
-            fraction_of_limit=None if limit is None else best.power / limit,
-            runners_up=[_runner(c) for c in search.runners_up],
-            first_passage_predicted=best.first_passage,
-            first_passage_probability_predicted=math.nan
-            if strikes is None
-            else strikes.predicted(best),
-            **common,
-        )
+        common.update(_strike_fields(strikes, search.optimum))
+        return _analytic_result(space, search, limit, common)
     settings = settings or SweepSettings(
         target_rel_ci=0.01, control_variates=excitation.is_white, max_paths=2048
     )
     run = dict(settings=settings, out_dir=out_dir, executor=executor, workers=workers,
                scheduler=scheduler, progress=progress)  # fmt: skip
     confirmed = _Confirmed(space, excitation, goal, run, min_first_passage, segments)
+    best, candidates, chosen = _confirm(confirmed, space, search, exceedance, refine)
+    reliability = verdict = None
+    if strikes is not None:  # the rare-event estimate decides, best Monte Carlo power first
+        chosen, reliability, verdict = strikes.decide(
+            confirmed, chosen, exceedance, space, excitation, settings.seed
+        )
+    _require_feasible(confirmed, chosen, stroke, exceedance, min_first_passage)
+    common.update(_strike_fields(strikes, chosen, reliability, verdict))
+    return _confirmed_result(confirmed, space, best, chosen, candidates, exceedance, limit, common)
+
+
+def _strike_fields(strikes: FirstPassageLimit | None, chosen, reliability=None, verdict=None):
+    """The result's fields of the strike limit (``max_first_passage``): predicted, estimated."""
+    return dict(
+        first_passage_probability_predicted=math.nan
+        if strikes is None
+        else strikes.predicted(chosen),
+        first_passage_probability=None
+        if reliability is None
+        else reliability.probability_first_passage,
+        first_passage_probability_confirmed=verdict,
+    )
+
+
+def _check_min_first_passage(min_first_passage) -> None:
+    """Refuse a ``min_first_passage`` that is not a finite time > 0 (None: no bound)."""
+    if min_first_passage is not None and not (
+        isinstance(min_first_passage, (int, float))
+        and math.isfinite(min_first_passage)
+        and min_first_passage > 0
+    ):
+        raise ValueError(
+            f"`min_first_passage` must be a finite time > 0 (s), got {min_first_passage!r}"
+        )
+
+
+def _limit(fixed: Harvester, excitation, stroke: float, sigma_budget: float):
+    """The harvesting limit (W) the result compares with, and its kind in words (or None).
+
+    On a record the non-causal bound on the record itself with |z| <= stroke;
+    otherwise the stationary bound at the budget's displacement variance.
+    """
+    if isinstance(excitation, Measured) and fixed.c_m > 0:
+        limit = record_harvesting_limit(fixed.m, fixed.c_m, excitation, stroke)
+        limit_kind = "record: non-causal, |z| <= stroke"
+    else:
+        limit = harvesting_limit(fixed.m, fixed.c_m, excitation, sigma_budget)
+        limit_kind = None if limit is None else "stationary: E[z^2] <= sigma_z^2 of the budget"
+    return limit, limit_kind
+
+
+def _analytic_result(space: DesignSpace, search, limit, common: dict) -> DesignResult:
+    """The analytic answer alone (``monte_carlo=False``): the search's optimum and runners-up."""
+    best = search.optimum
+    return DesignResult(
+        optimum=best.values,
+        analytic_optimum=best.values,
+        method=best.method,
+        device=space.device(best.u),
+        power_predicted=best.power,
+        exceedance_predicted=best.exceedance,
+        power_monte_carlo=None,
+        stroke_exceedance_monte_carlo=None,
+        input_power=best.input_power,
+        efficiency=best.power / best.input_power,
+        limit=limit,
+        fraction_of_limit=None if limit is None else best.power / limit,
+        runners_up=[_runner(c) for c in search.runners_up],
+        first_passage_predicted=best.first_passage,
+        **common,
+    )
+
+
+def _confirm(confirmed: _Confirmed, space: DesignSpace, search, exceedance: float, refine: bool):
+    """Steps 2 and 3 of the design: confirm the candidates by Monte Carlo, refine on disagreement.
+
+    ``search`` None (no method predicts the range): Monte Carlo searches a
+    coarse grid, then refines. Returns ``(best, candidates, chosen)``: the
+    analytic optimum (None without a search), the candidates confirmed beside
+    it, and the chosen one.
+    """
     if search is None:  # Monte Carlo searches a coarse grid, then refines
         best = None
         candidates = [confirmed.point(u) for u in space.grid(COARSE if space.dimension > 1 else 5)]
@@ -277,11 +327,13 @@ def design(
             step /= 3.0
     if best is not None and chosen is not best and not confirmed.better(chosen, best, exceedance):
         chosen = best  # Monte Carlo's maximum is not significantly better: keep the analytic one
-    reliability = verdict = None
-    if strikes is not None:  # the rare-event estimate decides, best Monte Carlo power first
-        chosen, reliability, verdict = strikes.decide(
-            confirmed, chosen, exceedance, space, excitation, settings.seed
-        )
+    return best, candidates, chosen
+
+
+def _require_feasible(
+    confirmed: _Confirmed, chosen, stroke: float, exceedance: float, min_first_passage
+) -> None:
+    """Raise :class:`InfeasibleBudget` when Monte Carlo rejects the chosen device's budget."""
     x = confirmed.exceedance(chosen)
     if not _within(x, exceedance):
         where = ", ".join(f"{k} = {v:.6g}" for k, v in chosen.values.items())
@@ -298,6 +350,20 @@ def design(
             f"|z| > {stroke:g} m) is not met by the best device within the stroke budget: "
             f"Monte Carlo gives {first.mean:.3g} ± {first.ci95:.2g} s (at {where})"
         )
+
+
+def _confirmed_result(
+    confirmed: _Confirmed,
+    space: DesignSpace,
+    best,
+    chosen,
+    candidates,
+    exceedance: float,
+    limit,
+    common: dict,
+) -> DesignResult:
+    """The design confirmed by Monte Carlo: the chosen device, its runners-up, the analytic cost."""
+    x = confirmed.exceedance(chosen)
     power = confirmed.power(chosen)
     input_power = confirmed.input_power(chosen)
     return DesignResult(
@@ -330,13 +396,6 @@ def design(
         first_passage_predicted=chosen.first_passage,
         first_passage_monte_carlo=confirmed.first_passage(chosen),
         first_passage_confirmed=confirmed.passage(chosen),
-        first_passage_probability_predicted=math.nan
-        if strikes is None
-        else strikes.predicted(chosen),
-        first_passage_probability=None
-        if reliability is None
-        else reliability.probability_first_passage,
-        first_passage_probability_confirmed=verdict,
         **common,
     )
 

@@ -34,16 +34,18 @@ class BridgeStepWarning(RuntimeWarning):
     """Halving the time step changes a bridge's stored power noticeably."""
 
 
-def bridge_step_change(harvester, psd, dt: float, scheme: str, t_end: float, seed: int = 0):
+def bridge_step_change(
+    simulate, harvester, psd, dt: float, scheme: str, t_end: float, seed: int = 0
+):
     """Relative change of the stored power, and its 95 % half-width, from dt to dt/2.
 
     A pilot of :data:`PILOT_PATHS` paths over ``min(t_end, PILOT_STEPS dt)``
     from rest, the same Brownian increments at both steps; the change is the
     mean of the paired per-path differences over the dt / 2 mean.
-    Brownian input only: white noise or a shaping filter.
+    Brownian input only: white noise or a shaping filter. ``simulate`` is
+    :func:`randvib.simulate`, handed in by the driver that calls this check
+    (so that this module and the driver need not import each other).
     """
-    from randvib.montecarlo.simulation import simulate
-
     n_coarse = int(min(round(t_end / dt), PILOT_STEPS))
     rng = np.random.default_rng([seed, 2])
     fine = rng.normal(0.0, np.sqrt(dt / 2.0), (PILOT_PATHS, 2 * n_coarse))
@@ -64,13 +66,14 @@ def bridge_step_change(harvester, psd, dt: float, scheme: str, t_end: float, see
     return float(np.mean(diff)), float(1.96 * np.std(diff, ddof=1) / np.sqrt(diff.size))
 
 
-def check_bridge_step(run) -> None:
+def check_bridge_step(run, simulate) -> None:
     """Warn when halving the step changes the bridge's stored power by more than 1 %.
 
     Only a change beyond the pilot's own 95 % interval counts; the warning
     gives the step that would bring it under :data:`BRIDGE_STEP_TOLERANCE`
     at the measured order :data:`BRIDGE_ORDER`. Synthesised or recorded input
-    (no Brownian increments to halve) is not checked.
+    (no Brownian increments to halve) is not checked. ``simulate`` runs the
+    pilot (:func:`bridge_step_change`).
     """
     excitation = run.excitation
     if run.driver is not None or excitation.shaping_filter() is None:
@@ -78,7 +81,7 @@ def check_bridge_step(run) -> None:
     psd = excitation if not excitation.is_white else run.psd
     dt = run.grid.dt
     change, half_width = bridge_step_change(
-        run.harvester, psd, dt, run.scheme.name, run.grid.t_end, run.seed
+        simulate, run.harvester, psd, dt, run.scheme.name, run.grid.t_end, run.seed
     )
     if abs(change) > BRIDGE_STEP_TOLERANCE and abs(change) > half_width:
         quiet = dt * (BRIDGE_STEP_TOLERANCE / abs(change)) ** (1.0 / BRIDGE_ORDER)

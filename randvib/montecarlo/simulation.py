@@ -240,7 +240,7 @@ def execute(run: Run, *, control_variates, check_step, threads, batch_paths, pro
     if check_step:
         linear().check_step(run.scheme.name, run.grid.dt)
         if run.harvester.is_rectified:  # the switching, which the linear check cannot see
-            check_bridge_step(run)
+            check_bridge_step(run, simulate)  # the pilot runs through the driver
     setup = KernelSetup.prepare(run, linear)
     if threads is not None:
         threads = check_int("threads", threads, 1)
