@@ -18,7 +18,10 @@ E[z_n z_(n+1)] = (A P)_zz) at any dt; for the Duffing device the Gibbs density.
 Tolerances are 4 standard errors of the estimates (tests/_stats.py), whose
 z-scores and the intervals' coverage were measured over seeds by
 tests/calibration/rare_event_coverage.py (results in
-rare_event_coverage_results.txt beside it).
+rare_event_coverage_results.txt beside it). Subset simulation on the devices
+without an exact anchor (a diode bridge, the bistable device with Coulomb
+friction, LuGre with a piezo under band-pass input, a recorded input) is
+compared with crude Monte Carlo by tests/calibration/rare_event_devices.py.
 """
 
 import json
