@@ -168,7 +168,7 @@ def first_passage(
     max_path_steps: float = DEFAULT_MAX_PATH_STEPS,
     progress: bool | None = None,
 ) -> ReliabilityResult:
-    """The probability that |z| reaches the stroke within ``duration``, from the stationary state.
+    """The probability that the stroke is reached within ``duration``, from the stationary state.
 
     Parameters
     ----------
