@@ -72,7 +72,7 @@ def register(sub) -> None:
         "--max-first-passage",
         type=float,
         metavar="P",
-        help="also require P(|z| reaches --stroke within --duration) <= P, from the stationary "
+        help="also require P(abs(z) reaches --stroke within --duration) <= P, from the stationary "
         "state (predicted where the response is Gaussian, confirmed by the rare-event estimate "
         "of randvib reliability on the candidates)",
     )

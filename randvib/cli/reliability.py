@@ -31,7 +31,7 @@ def register(sub) -> None:
     p = sub.add_parser(
         "reliability",
         help="rare end-stop strikes: first-passage probability, crossing rate, exceedance",
-        description="Estimate the probability that |z| reaches the stroke within a window "
+        description="Estimate the probability that abs(z) reaches the stroke within a window "
         "from the stationary state, the rate of up-crossings of the stroke and the stationary "
         "exceedance, down to 1e-9, by subset simulation, importance sampling or crude Monte "
         "Carlo; 95 % half-widths.",
