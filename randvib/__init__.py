@@ -113,6 +113,18 @@ _EXPORTS = {
     "randvib.analytic.harvesting_limit": ("gaussian_displacement_budget", "harvesting_limit"),
     "randvib.statistics": ("FirstPassage", "Statistic", "estimate", "TimeStatistics"),
     "randvib.montecarlo.step_check": ("StepSizeWarning",),
+    "randvib.montecarlo.reliability": (
+        "estimate_first_passage",
+        "first_passage",
+        "ReliabilityResult",
+    ),
+    "randvib.montecarlo.path_simulator": ("HarvesterPaths", "PathOutcome", "PathSimulator"),
+    "randvib.analytic.crossings": (
+        "CROSSING_METHODS",
+        "crossing_prediction",
+        "CrossingPrediction",
+    ),
+    "randvib.analytic.gibbs_marginal": ("GibbsDisplacement",),
 }
 _WHERE = {name: module for module, names in _EXPORTS.items() for name in names}
 

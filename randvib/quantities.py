@@ -135,6 +135,22 @@ QUANTITIES: dict[str, Quantity] = {
     "stroke_reached_vanmarcke": Quantity(
         "1", "P(reached) by Vanmarcke's approximation", "reached, Vanmarcke*"
     ),
+    # ------------------------------------------------ rare events (randvib.first_passage)
+    "probability_first_passage": Quantity(
+        "1",
+        "P(|z| reaches the stroke within the window, from the stationary state)",
+        "P(first passage)",
+    ),
+    "upcrossing_rate": Quantity(
+        "1/s",
+        "mean number per second of times |z| rises through the stroke (both ends)",
+        "up-crossings/s",
+    ),
+    "stationary_exceedance": Quantity("1", "P(|z| > stroke) at a fixed time", "P(|z| > D)"),
+    "path_steps": Quantity("1", "integration steps spent: paths x steps per path"),
+    "crude_path_steps": Quantity(
+        "1", "path-steps crude Monte Carlo needs for the same coefficient of variation"
+    ),
     "r_load_optimal": Quantity("ohm", "load resistance of the largest load power"),
     "power_load_optimal": Quantity("W", "load power at the optimal load resistance"),
     "battery_optimal": Quantity("V", "battery voltage of the largest stored power"),

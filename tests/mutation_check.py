@@ -630,6 +630,113 @@ MUTATIONS: tuple[Mutation, ...] = (
         "the silent wrong answer the refusal exists to prevent.",
     ),
     Mutation(
+        name="upcrossings-one-end",
+        path="randvib/montecarlo/kernel.py",
+        edits=(
+            (
+                "if abs(zj) <= stroke and abs(zn) > stroke:",
+                "if abs(zj) <= stroke and zn > stroke:",
+            ),
+        ),
+        tests=(
+            "tests/test_reliability.py::test_paths_equal_a_numpy_heun_loop_from_the_exact_start",
+        ),
+        why="The kernel counts the up-crossings of +D only, not of |z| through D at both ends "
+        "(half the rate); a plain numpy Heun loop on the same rows counts both.",
+    ),
+    Mutation(
+        name="gibbs-start-velocity",
+        path="randvib/montecarlo/path_simulator.py",
+        edits=(
+            (
+                "out[:, 1] = self._gibbs.velocity_std * normals[:, 1]",
+                "out[:, 1] = 1.01 * self._gibbs.velocity_std * normals[:, 1]",
+            ),
+        ),
+        tests=(
+            "tests/test_reliability.py::test_paths_equal_a_numpy_heun_loop_from_the_exact_start",
+        ),
+        why="The exact (Gibbs) start's velocity 1 % too spread, so the stationary start is "
+        "not stationary; the numpy loop starts from the Gibbs law written out independently.",
+    ),
+    Mutation(
+        name="subset-chain-correlation-dropped",
+        path="randvib/montecarlo/subset_simulation.py",
+        edits=(("    gamma = max(gamma, 0.0)\n", "    gamma = 0.0\n"),),
+        tests=(
+            "tests/test_reliability.py::"
+            "test_chain_variance_counts_the_correlation_along_the_chains",
+        ),
+        why="Subset simulation's c.o.v. without Au & Beck's gamma (the chains' correlation): "
+        "chains that never move hold Nc, not N, independent values, and the variance of "
+        "their mean must say so exactly (the intervals' coverage, measured by "
+        "tests/calibration/rare_event_coverage.py, would fall).",
+    ),
+    Mutation(
+        name="importance-mixture-weight",
+        path="randvib/montecarlo/importance_sampling.py",
+        edits=(
+            (
+                "terms = exponent + np.log1p(np.exp(-2.0 * exponent)) - np.log(2.0)",
+                "terms = exponent + np.log1p(np.exp(-2.0 * exponent)) - np.log(2.4)",
+            ),
+        ),
+        tests=(
+            "tests/test_reliability.py::"
+            "test_importance_sampling_matches_the_schemes_exact_exceedance_and_rate",
+        ),
+        why="The mixture's density mis-normalised (each sign weighted 1/2.4): every weight "
+        "20 % too large; compared with the scheme's exact exceedance and crossing rate.",
+    ),
+    Mutation(
+        name="gibbs-crossing-rate",
+        path="randvib/analytic/gibbs_marginal.py",
+        edits=(
+            (
+                "return 2.0 * self.density(d) * self.velocity_std / np.sqrt(2.0 * np.pi)",
+                "return 2.0 * self.density(d) * self.velocity_std / np.sqrt(2.1 * np.pi)",
+            ),
+        ),
+        tests=(
+            "tests/test_reliability.py::"
+            "test_anchors_gibbs_and_rice_agree_on_the_linear_device_and_declare_their_cases",
+        ),
+        why="The exact anchor itself: Rice's rate of the Gibbs density 2.4 % low; the Gaussian "
+        "route (erfc and Rice's closed form) must agree with it on a linear device to 1e-10.",
+    ),
+    Mutation(
+        name="chain-crossing-conditional-mean",
+        path="randvib/analytic/crossings.py",
+        edits=(
+            (
+                "special.ndtr((rho * x - d) / sc)",
+                "special.ndtr((0.99 * rho * x - d) / sc)",
+            ),
+        ),
+        tests=(
+            "tests/test_reliability.py::"
+            "test_discrete_crossing_rate_is_the_bivariate_normal_probability_and_tends_to_rice",
+        ),
+        why="The reference for a scheme's discrete crossings with the one-step correlation 1 % "
+        "low in one tail; checked against scipy's bivariate normal probabilities.",
+    ),
+    Mutation(
+        name="first-passage-limit-hazard",
+        path="randvib/harvester_design/constraints.py",
+        edits=(
+            (
+                "return 1.0 - (1.0 - eps) * math.exp(-hazard * self.duration)",
+                "return 1.0 - (1.0 - eps) * math.exp(-0.99 * hazard * self.duration)",
+            ),
+        ),
+        tests=(
+            "tests/test_design_first_passage.py::"
+            "test_limit_is_met_on_its_boundary_by_the_analytic_search",
+        ),
+        why="The design's predicted P(first passage within T) with a hazard 1 % low; it must "
+        "equal the crossing anchor's Vanmarcke answer for the chosen device to 1e-6.",
+    ),
+    Mutation(
         name="assembly-dashpot-to-ground",
         path="randvib/models/assembly.py",
         edits=(

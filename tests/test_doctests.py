@@ -42,6 +42,7 @@ MODULES = (
     "randvib.quantities",
     "randvib.montecarlo.transient",
     "randvib.harvester_design.design",
+    "randvib.montecarlo.reliability",
 )
 
 FLAGS = doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE

@@ -25,7 +25,7 @@ from randvib._interrupts import interrupted_exit, interrupts_seen, sigterm_stops
 from randvib._locks import held, release_since
 
 #: Command modules under randvib.cli, in the order shown by --help.
-COMMANDS = ["power", "design", "simulate", "study", "record", "identify", "validate"]
+COMMANDS = ["power", "design", "simulate", "reliability", "study", "record", "identify", "validate"]
 
 #: Options whose name differs from the Python API's argument (docs/command_line.md's table).
 API_NAMES = {

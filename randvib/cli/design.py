@@ -93,6 +93,17 @@ def register(sub) -> None:
         "(predicted where the response is Gaussian, checked by Monte Carlo)",
     )
     g.add_argument(
+        "--max-first-passage",
+        type=float,
+        metavar="P",
+        help="also require P(abs(z) reaches --stroke within --duration) <= P, from the stationary "
+        "state (predicted where the response is Gaussian, confirmed by the rare-event estimate "
+        "of randvib reliability on the candidates)",
+    )
+    g.add_argument(
+        "--duration", type=float, metavar="SECONDS", help="with --max-first-passage: the window T"
+    )
+    g.add_argument(
         "--objective",
         default="electrical",
         choices=tuple(OBJECTIVES),
@@ -221,6 +232,8 @@ def run(args) -> int:
         exceedance=args.exceedance,
         objective=args.objective,
         min_first_passage=args.min_first_passage,
+        max_first_passage=args.max_first_passage,
+        duration=args.duration,
         monte_carlo=not args.no_monte_carlo,
         settings=settings,
         out_dir=args.out_dir,
@@ -264,6 +277,8 @@ def run(args) -> int:
                          f"{cell(first.mean.mean)} ± {cell(first.mean.ci95)}" if first.mean
                          else f">= {cell(lower.mean)} ± {cell(lower.ci95)} (censored)", "s"))  # fmt: skip
             rows.append(("first_passage_confirmed", str(out["first_passage_confirmed"]), ""))
+    if args.max_first_passage is not None:
+        rows += _strike_rows(out)
     rows.append(("efficiency", cell(out["efficiency"]), unit("efficiency")))
     if out["limit"] is None:
         why = "white noise" if assembly is None else "not computed for an assembly"
@@ -283,3 +298,15 @@ def run(args) -> int:
         rows.append(("analytic optimum's cost", f"{cell(cost.mean)} ± {cell(cost.ci95)}", "W"))
     print_table(rows, ("quantity", "value", "unit"))
     return 0
+
+
+def _strike_rows(out) -> list:
+    """The table's rows of the strike limit (--max-first-passage): predicted, estimated."""
+    rows = [("P(first passage) predicted", cell(out["first_passage_probability_predicted"]), "1")]
+    strikes = out["first_passage_probability"]
+    if strikes is not None:
+        estimate = f"{cell(strikes['mean'])} ± {cell(strikes['ci95'])}"
+        rows.append(("P(first passage), rare-event estimate", estimate, "1"))
+        verdict = str(out["first_passage_probability_confirmed"])
+        rows.append(("first_passage_probability_confirmed", verdict, ""))
+    return rows

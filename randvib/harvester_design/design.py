@@ -57,6 +57,7 @@ from randvib.harvester_design.confirmation import (
     ConfirmedCandidates,
     within,
 )
+from randvib.harvester_design.constraints import FirstPassageLimit
 from randvib.harvester_design.objectives import AssemblyObjective, objective_named
 from randvib.harvester_design.result import DesignResult
 from randvib.harvester_design.search import (
@@ -103,6 +104,8 @@ def design(
     segments: int = 10,
     stroke_on=None,
     transducer: int | None = None,
+    max_first_passage: float | None = None,
+    duration: float | None = None,
 ) -> DesignResult:
     """Choose the varied parameters that maximise the power with ``P(|z| > stroke) <= exceedance``.
 
@@ -181,6 +184,13 @@ def design(
         An assembly's one transducer whose power the objective counts (the
         others as they are); default the sum over all its transducers
         (:class:`~randvib.harvester_design.objectives.AssemblyObjective`).
+    max_first_passage, duration : float, optional
+        P in (0, 1) and T (s), given together: also require
+        P(|z| reaches the stroke within T) <= P from the stationary state
+        (:class:`~randvib.harvester_design.constraints.FirstPassageLimit`):
+        predicted from the Gaussian answer in the search, then confirmed by
+        the rare-event estimate (:func:`randvib.first_passage`) on the
+        candidates Monte Carlo confirmed, the best not rejected chosen.
 
     Returns
     -------
@@ -204,11 +214,13 @@ def design(
     k = 59.1 N/m, c_e = 0.456 Ns/m
     """
     _check_min_first_passage(min_first_passage)
+    strikes = FirstPassageLimit.checked(max_first_passage, duration)
     excitation = as_excitation(excitation)
     if isinstance(harvester, Assembly):
         space, goal, stroke = _assembly_setup(
             harvester, excitation, vary, stroke, stroke_on, objective, transducer,
-            dict(min_first_passage=min_first_passage, out_dir=out_dir, executor=executor,
+            dict(min_first_passage=min_first_passage, max_first_passage=max_first_passage,
+                 out_dir=out_dir, executor=executor,
                  workers=workers, scheduler=scheduler), monte_carlo,
         )  # fmt: skip
         limit = limit_kind = None  # no harvesting limit of an assembly yet
@@ -222,7 +234,9 @@ def design(
             harvester, excitation, vary, stroke, exceedance, objective
         )
     try:
-        search = analytic_search(space, excitation, exceedance, goal, runners_up, min_first_passage)
+        search = analytic_search(
+            space, excitation, exceedance, goal, runners_up, min_first_passage, strikes
+        )
     except NothingPredicted as exc:
         if not monte_carlo:
             raise ValueError(
@@ -232,12 +246,14 @@ def design(
     confirmed_on = "record windows" if isinstance(excitation, Measured) else "simulated paths"
     common = dict(objective=goal.name, stroke=stroke, exceedance_budget=float(exceedance),
                   evaluations=0 if search is None else search.evaluations,
-                  min_first_passage=min_first_passage, limit_kind=limit_kind)  # fmt: skip
+                  min_first_passage=min_first_passage, limit_kind=limit_kind,
+                  max_first_passage=max_first_passage, duration=duration)  # fmt: skip
     if monte_carlo:
         common["monte_carlo_input"] = confirmed_on
     if space.is_assembly:
         common["objective_scope"] = goal.scope
     if not monte_carlo:
+        common.update(_strike_fields(strikes, search.optimum))
         return _analytic_result(space, search, limit, common)
     settings = settings or SweepSettings(
         target_rel_ci=0.01, control_variates=excitation.is_white, max_paths=2048
@@ -249,7 +265,13 @@ def design(
     else:
         confirmed = _Confirmed(space, excitation, goal, run, min_first_passage, segments)
     best, candidates, chosen = _confirm(confirmed, space, search, exceedance, refine)
+    reliability = verdict = None
+    if strikes is not None:  # the rare-event estimate decides, best Monte Carlo power first
+        chosen, reliability, verdict = strikes.decide(
+            confirmed, chosen, exceedance, space, excitation, settings.seed
+        )
     _require_feasible(confirmed, chosen, space, exceedance, min_first_passage)
+    common.update(_strike_fields(strikes, chosen, reliability, verdict))
     return _confirmed_result(confirmed, space, best, chosen, candidates, exceedance, limit, common)
 
 
@@ -294,6 +316,19 @@ def _assembly_setup(
     if refusal:
         raise ValueError(refusal)
     return DesignSpace(fixed, vary, budget), goal, dict(budget.strokes)
+
+
+def _strike_fields(strikes: FirstPassageLimit | None, chosen, reliability=None, verdict=None):
+    """The result's fields of the strike limit (``max_first_passage``): predicted, estimated."""
+    return dict(
+        first_passage_probability_predicted=math.nan
+        if strikes is None
+        else strikes.predicted(chosen),
+        first_passage_probability=None
+        if reliability is None
+        else reliability.probability_first_passage,
+        first_passage_probability_confirmed=verdict,
+    )
 
 
 def _check_min_first_passage(min_first_passage) -> None:

@@ -92,6 +92,15 @@ class DesignResult:
     objective_scope : str or None
         An assembly's: ``"all transducers"`` (their powers summed) or
         ``"transducer I"``; None for a single mass.
+    max_first_passage, duration : float or None
+        The bound P on P(|z| reaches the stroke within T) and T (s), if any.
+    first_passage_probability_predicted : float
+        That probability by the Gaussian answer (NaN where not predicted).
+    first_passage_probability : Statistic or None
+        That probability by the rare-event estimate (:func:`randvib.first_passage`).
+    first_passage_probability_confirmed : bool or None
+        Its verdict on ``max_first_passage``: True (95 % interval below P),
+        None (undetermined); a rejected candidate is never the design.
     monte_carlo_input : str or None
         What drove the Monte Carlo: ``"record windows"`` (a measured record
         itself, its windows the paths, :func:`randvib.monte_carlo_on_record`)
@@ -127,6 +136,11 @@ class DesignResult:
     monte_carlo_input: str | None = None
     limit_kind: str | None = None
     objective_scope: str | None = None
+    max_first_passage: float | None = None
+    duration: float | None = None
+    first_passage_probability_predicted: float = float("nan")
+    first_passage_probability: Statistic | None = None
+    first_passage_probability_confirmed: bool | None = None
 
     def to_dict(self) -> dict:
         """JSON-ready: the keys of ``randvib design --json``."""
@@ -166,6 +180,11 @@ class DesignResult:
             "first_passage_confirmed": self.first_passage_confirmed,
             "monte_carlo_input": self.monte_carlo_input,
             **({} if self.objective_scope is None else {"objective_scope": self.objective_scope}),
+            "max_first_passage": self.max_first_passage,
+            "duration": self.duration,
+            "first_passage_probability_predicted": self.first_passage_probability_predicted,
+            "first_passage_probability": _stat(self.first_passage_probability),
+            "first_passage_probability_confirmed": self.first_passage_probability_confirmed,
         }
 
     def to_frame(self):

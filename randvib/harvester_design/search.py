@@ -260,9 +260,12 @@ def predicted_first_passage(
     return (1.0 - exceedance) / rate if rate > 0 else math.inf
 
 
-def meets(c: Candidate, budget: float, min_first_passage: float | None) -> bool:
-    """The prediction meets the budget and, where it predicts one, the first-passage bound."""
+def meets(c: Candidate, budget: float, min_first_passage: float | None, limit=None) -> bool:
+    """The prediction meets the budget and, where it predicts them, the first-passage bounds
+    (``limit``: a :class:`~randvib.harvester_design.constraints.FirstPassageLimit`)."""
     if c.exceedance > budget:
+        return False
+    if limit is not None and not limit.admits(c):
         return False
     return min_first_passage is None or not c.first_passage < min_first_passage
 
@@ -274,6 +277,7 @@ def analytic_search(
     objective,
     runners_up: int = 2,
     min_first_passage: float | None = None,
+    limit=None,
 ):
     """Maximise the predicted objective over the box with ``P(|z| > stroke) <= budget``.
 
@@ -290,6 +294,9 @@ def analytic_search(
     min_first_passage : float, optional
         T (s): also require a predicted mean first passage to the stroke of
         at least T where the method predicts one (:func:`predicted_first_passage`).
+    limit : FirstPassageLimit, optional
+        Also require a predicted P(|z| reaches the stroke within T) <= P
+        (:mod:`randvib.harvester_design.constraints`).
 
     Returns
     -------
@@ -309,7 +316,7 @@ def analytic_search(
         raise NothingPredicted(
             "no analytic method predicts any device in the ranges given (every point was refused)"
         )
-    feasible = sorted((c for c in grid if meets(c, budget, min_first_passage)),
+    feasible = sorted((c for c in grid if meets(c, budget, min_first_passage, limit)),
                       key=lambda c: -c.power)  # fmt: skip
     if not feasible:
         within = [c for c in grid if c.exceedance <= budget]
@@ -323,7 +330,9 @@ def analytic_search(
                     f"{best.exceedance:.3g} (at {where})"
                 )
             within = [best]
-        feasible = [c for c in within if meets(c, budget, min_first_passage)]
+        feasible = [c for c in within if meets(c, budget, min_first_passage, limit)]
+        if not feasible and limit is not None and not any(map(limit.admits, within)):
+            raise InfeasibleBudget(limit.refusal(within, space.harvester.stroke))
         if not feasible:
             feasible = [_longest_first_passage(evaluate, within, budget, min_first_passage, space)]
     scale = feasible[0].power
@@ -335,7 +344,7 @@ def analytic_search(
         )
     optima = []
     for start in feasible[:STARTS]:
-        found = _local(evaluate, start, budget, scale, min_first_passage)
+        found = _local(evaluate, start, budget, scale, min_first_passage, limit)
         if all(np.max(np.abs(found.u - o.u)) > SAME_POINT for o in optima):
             optima.append(found)
     optima.sort(key=lambda c: -c.power)
@@ -349,11 +358,13 @@ def analytic_search(
 
 
 def _local(
-    evaluate, start: Candidate, budget: float, scale: float, min_first_passage=None
+    evaluate, start: Candidate, budget: float, scale: float, min_first_passage=None, limit=None
 ) -> Candidate:
     """SLSQP from ``start``; the better of the start and the end (both feasible)."""
     log_budget = math.log(budget)
     constraints = [{"type": "ineq", "fun": lambda u: margin(u)}]
+    if limit is not None:
+        constraints.append({"type": "ineq", "fun": lambda u: limit.margin(evaluate(u))})
     if min_first_passage is not None:
         log_time = math.log(min_first_passage)
 
@@ -384,14 +395,14 @@ def _local(
         options={"ftol": 1e-12, "maxiter": 200, "eps": 1e-7},
     )
     end = evaluate(result.x)
-    if end is None or not meets(end, budget * (1 + 1e-8), _relaxed(min_first_passage)):
+    if end is None or not meets(end, budget * (1 + 1e-8), _relaxed(min_first_passage), limit):
         # SLSQP may stop a hair outside the budget (or on an unpredicted point): the
         # feasible point nearest to it on the segment from the start, by bisection
         lo, hi = 0.0, 1.0
         for _ in range(60):
             mid = 0.5 * (lo + hi)
             c = evaluate(start.u + mid * (result.x - start.u))
-            if c is not None and meets(c, budget, min_first_passage):
+            if c is not None and meets(c, budget, min_first_passage, limit):
                 lo = mid
             else:
                 hi = mid

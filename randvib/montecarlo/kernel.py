@@ -53,7 +53,9 @@ ACC_STORED = 12  # mean power into the bridge's output, battery or storage load 
 ACC_COIL_LOSS = 13  # mean R_C i^2 of a rectified coil (W); 0 without
 ACC_DIODE_LOSS = 14  # mean 2 V_d |i| of a bridge (W); 0 without
 ACC_V_OUT = 15  # mean output voltage of a bridge, V_b or V_C (V); 0 without
-N_ACC = 16
+ACC_PEAK = 16  # largest |z| over the window's states, its end included (m); not an average
+ACC_UPCROSS = 17  # number of the window's steps on which |z| rises through the stroke
+N_ACC = 18
 
 
 class PathAverages:
@@ -142,6 +144,16 @@ class PathAverages:
     def diode_loss(self):
         """Time average of 2 V_d |i| of a bridge per path (W); 0 without one."""
         return self._col(ACC_DIODE_LOSS)
+
+    @property
+    def peak(self):
+        """Largest |z| per path over the window's states, its last included (m)."""
+        return self._col(ACC_PEAK)
+
+    @property
+    def upcrossings(self):
+        """Number of up-crossings of |z| through the stroke per path in the window (both ends)."""
+        return self._col(ACC_UPCROSS)
 
     @property
     def output_voltage(self):
@@ -267,18 +279,29 @@ N_AUX = 3
 N_AUX_COEFFICIENTS = 19
 
 
+#: No given starting states (:attr:`Noise.start`): the :class:`Start` decides.
+NO_START = np.zeros((0, 0))
+#: Columns of :attr:`Noise.start`: z (m), v (m/s) and the auxiliary states x1 .. x3.
+N_START = 2 + 3
+
+
 class Noise(NamedTuple):
-    """Where the Brownian increments come from.
+    """Where the randomness comes from: the Brownian increments and, optionally, the start.
 
     ``dw`` (n_paths, n_steps) given increments (s^0.5), or shape (0, 0) to draw
     them from the paths' streams with the ziggurat tables ``ki, wi, fi``
-    (:mod:`randvib.montecarlo.rng`).
+    (:mod:`randvib.montecarlo.rng`). ``start`` (n_paths, :data:`N_START`)
+    gives each path its own starting state (z, v, x1, x2, x3), in place of
+    :class:`Start`'s (the rare-event estimators express the stationary start
+    through standard normals, :mod:`randvib.montecarlo.path_simulator`), or
+    shape (0, 0) (:data:`NO_START`) for none.
     """
 
     dw: np.ndarray
     ki: np.ndarray
     wi: np.ndarray
     fi: np.ndarray
+    start: np.ndarray = NO_START
 
 
 class Transient(NamedTuple):
@@ -694,7 +717,7 @@ def run_ensemble(
     init_random, init_z, init_v = initial
     with_companion, comp_init_z, comp_init_v = companion
     hist_lo, hist_hi, hist_bins, n_record, record_every, stroke = recording
-    dw, ki, wi, fi = noise
+    dw, ki, wi, fi, given_start = noise
     # `auxiliary is None` is decided when compiling (numba prunes the dead
     # branch for a None argument): white noise with a resistive circuit runs the
     # plain loop, bit for bit and at its own speed; any filter or circuit
@@ -762,6 +785,7 @@ def run_ensemble(
     n_rec_points = n_steps // record_every + 1 if n_record > 0 else 0
     records = np.zeros((n_record, n_rec_points, 3))
     given_noise = dw.shape[0] > 0
+    given_states = given_start.shape[0] > 0
     inv_m = 1.0 / m
     drift = (inv_m, c, k, k3)
     window = (n_steps - n_burn) * dt
@@ -795,7 +819,13 @@ def run_ensemble(
             integrals = np.zeros((LANES, 2))
         for j in range(lanes):
             seed_path_state(seed, first_path + start + j, rng, j)
-            if init_random:
+            if given_states:
+                z[j] = given_start[start + j, 0]
+                v[j] = given_start[start + j, 1]
+                x1[j] = given_start[start + j, 2]
+                x2[j] = given_start[start + j, 3]
+                x3[j] = given_start[start + j, 4]
+            elif init_random:
                 nz = standard_normal(rng, j, ki, wi, fi)
                 nv = standard_normal(rng, j, ki, wi, fi)
                 z[j] = init_z * nz
@@ -919,6 +949,11 @@ def run_ensemble(
                     )
                 if forcing is not None:
                     vn += kick
+                if in_window:  # the path's peak and its up-crossings of the stroke
+                    if abs(zj) > a[j, ACC_PEAK]:
+                        a[j, ACC_PEAK] = abs(zj)
+                    if abs(zj) <= stroke and abs(zn) > stroke:
+                        a[j, ACC_UPCROSS] += 1.0
                 if abs(zj) > stroke:
                     if a[j, ACC_FIRST_HIT] < 0.0:
                         a[j, ACC_FIRST_HIT] = n * dt
@@ -983,12 +1018,15 @@ def run_ensemble(
                 a[j, ACC_H1] += half_cp * s1[j] * s1[j] + half_c * s2[j] * s2[j]
             if abs(zj) > stroke and a[j, ACC_FIRST_HIT] < 0.0:
                 a[j, ACC_FIRST_HIT] = n_steps * dt  # the final state
+            a[j, ACC_PEAK] = max(a[j, ACC_PEAK], abs(zj))
             if transient is not None:
                 event_out[p, EVENT_PEAK] = peak[j]
                 event_out[p, EVENT_V2] = integrals[j, 0]
                 event_out[p, EVENT_X2] = integrals[j, 1]
             for q in range(N_ACC):
                 if q == ACC_H0 or q == ACC_H1 or q == ACC_FIRST_HIT:
+                    acc[p, q] = a[j, q]
+                elif q == ACC_PEAK or q == ACC_UPCROSS:  # a largest value and a count
                     acc[p, q] = a[j, q]
                 elif q == ACC_VDW or q == ACC_STORED or q == ACC_COIL_LOSS or q == ACC_DIODE_LOSS:
                     acc[p, q] = a[j, q] / window

@@ -86,6 +86,7 @@ STUDIES = (
     "non-gaussian",
     "electrical-identification",
     "assemblies",
+    "rare-events",
 )
 
 
