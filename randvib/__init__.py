@@ -72,6 +72,7 @@ _EXPORTS = {
     "randvib.identification.prediction": ("predict_record",),
     "randvib.identification.result": ("IdentificationResult",),
     "randvib.identification.settings": ("SearchSettings", "SimulationSettings"),
+    "randvib.identification.assembly_record": ("AssemblyRecord", "assembly_record"),
     "randvib.identification.synthetic": ("synthetic_record",),
     "randvib.montecarlo.integrators": ("Integrator", "INTEGRATORS"),
     "randvib.analytic.linearisation": ("coulomb_equivalent_damping", "equivalent_damping"),

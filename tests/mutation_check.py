@@ -1180,6 +1180,54 @@ MUTATIONS: tuple[Mutation, ...] = (
         why="`--weight KIND=W` is dropped from the summed J: the weighted cost is compared "
         "with w times the channel's own J, exactly.",
     ),
+    Mutation(
+        name="assembly-record-drive-scale",
+        path="randvib/identification/assembly_record.py",
+        edits=(
+            (
+                "source = RecordedInput(acceleration, substeps,",
+                "source = RecordedInput(1.01 * acceleration, substeps,",
+            ),
+        ),
+        tests=(
+            "tests/test_assembly_record.py::test_one_dof_assembly_matches_the_single_mass_record",
+        ),
+        why="`record --device` drives the assembly with a base acceleration 1 % too large "
+        "(the input column stays right); the one-DOF record is compared path for path with the "
+        "single mass's within the schemes' step error, about 0.1 % of the signal.",
+    ),
+    Mutation(
+        name="assembly-record-circuit-row",
+        path="randvib/identification/assembly_record.py",
+        edits=(
+            (
+                "state[:, oc + order.circuits.index(index)]",
+                "state[:, oc + order.circuits.index(index) - 1]",
+            ),
+        ),
+        tests=(
+            "tests/test_assembly_record.py::test_one_dof_assembly_matches_the_single_mass_record",
+        ),
+        why="A transducer's voltage and current read the kernel row before its circuit "
+        "state (off by one); the one-DOF record's coil voltage and current are compared with "
+        "the single mass's.",
+    ),
+    Mutation(
+        name="assembly-record-velocity-dof",
+        path="randvib/identification/assembly_record.py",
+        edits=(
+            (
+                'true[record_column("relative_velocity", i)] = v[:, i]',
+                'true[record_column("relative_velocity", i)] = v[:, -1 - i]',
+            ),
+        ),
+        tests=(
+            "tests/test_assembly_record.py::"
+            "test_linear_two_dof_mean_squares_match_the_exact_variances",
+        ),
+        why="The velocity columns name the wrong DOFs (reversed); each column's mean square "
+        "is compared with its own DOF's exact variance.",
+    ),
 )
 
 

@@ -4,7 +4,7 @@ The JSON keys the issue fixes (``transducers`` in file order with their
 powers, ``displacement_variance`` and ``velocity_variance`` per DOF) and their
 values, equal to :func:`randvib.predict` on the same file; the optimal loads;
 one-line refusals (a device option beside ``--device``, a bad file, a method
-that does not take assemblies, the commands that do not take ``--device`` yet).
+that does not take assemblies). ``record --device``: tests/test_assembly_record.py.
 """
 
 import json
@@ -104,20 +104,6 @@ def test_power_device_sweep_and_table(capsys):
 )  # fmt: skip
 def test_device_refusals_are_one_line(capsys, argv, fragment):
     one_line_error(capsys, argv, fragment)
-
-
-def test_record_refuses_a_device(capsys, tmp_path):
-    argv = [
-        "record",
-        "--device",
-        "host_with_harvester",
-        "--psd",
-        "0.1",
-        "--out",
-        tmp_path / "r.csv",
-    ]
-    one_line_error(capsys, argv, "is not taken here yet")
-    assert not (tmp_path / "r.csv").exists()
 
 
 def test_bad_device_file_is_one_line(capsys, tmp_path):

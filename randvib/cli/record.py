@@ -6,6 +6,12 @@ exactly) or ``--psd`` (flat level, (m/s^2)^2/Hz) between ``--f-lo`` and
 ``--f-hi``. Sensor noise and offsets make it look like a measurement. The
 parameters simulated (device, excitation, sensors, seed) are written beside
 the record, ``FILE.json`` next to ``FILE.csv``.
+
+``--device FILE.toml`` records an assembly
+(:func:`~randvib.identification.assembly_record.assembly_record`): the input
+and, per DOF, ``dof.I.relative_displacement`` / ``dof.I.relative_velocity``,
+per transducer ``transducer.T.voltage`` / ``transducer.T.current``; every
+option above applies, each noise and offset to every column of its kind.
 """
 
 from __future__ import annotations
@@ -16,8 +22,9 @@ from pathlib import Path
 from randvib._io import claim_output_file, dumps, write_or_keep
 from randvib._resources import check_memory
 from randvib._validation import MAX_SEED, check_int, check_positive, integer_option
-from randvib.cli._device import add_device_arguments, harvester_from_args
+from randvib.cli._device import add_device_arguments, assembly_from_args, harvester_from_args
 from randvib.cli._records import parse_assignments
+from randvib.identification.assembly_record import assembly_record
 from randvib.identification.circuit import OUTPUT_KINDS
 from randvib.identification.synthetic import PAPER_BAND, SYNTHETIC_INPUTS, synthetic_record
 from randvib.models.excitation import BandLimited
@@ -30,7 +37,10 @@ def register(sub) -> None:
         description="Simulate a device under band-limited base excitation and write the "
         "record (time, input, and the response channels: relative_displacement, "
         "relative_velocity, the load voltage or current of its circuit) with optional sensor "
-        "noise and offsets.",
+        "noise and offsets. With --device FILE.toml (an assembly) the response columns are per "
+        "DOF (dof.I.relative_displacement, dof.I.relative_velocity) and per transducer "
+        "(transducer.T.voltage, transducer.T.current), simulated from rest by the assembly's "
+        "Heun kernel.",
     )
     add_device_arguments(p)  # also --psd: the flat level of the band
     g = p.add_argument_group("excitation and record")
@@ -60,9 +70,13 @@ def register(sub) -> None:
         metavar="KIND",
         help=f"a response channel to record, one of {', '.join(OUTPUT_KINDS)} (repeat for "
         "several; default relative_displacement); voltage and current need --coupling: the "
-        "load voltage R_L i of a coil (its current a state with --inductance), V of a piezo",
+        "load voltage R_L i of a coil (its current a state with --inductance), V of a piezo; "
+        "with --device, displacement and velocity give a column per DOF, voltage and current "
+        "one per transducer",
     )
-    s.add_argument("--noise-z", type=float, default=0.0, help="RMS noise on z (m)")
+    s.add_argument(
+        "--noise-z", type=float, default=0.0, help="RMS noise on z (m; every DOF's, --device)"
+    )
     s.add_argument("--noise-input", type=float, default=0.0, help="RMS noise on the input")
     s.add_argument("--offset-z", type=float, default=0.0, help="offset on z (m)")
     s.add_argument("--offset-input", type=float, default=0.0, help="offset on the input")
@@ -101,8 +115,10 @@ def run(args) -> int:
     if args.psd is not None:  # named as the option, not as the band's `level`
         check_positive("--psd", args.psd, "(m/s^2)^2/Hz")
     excitation = args.rms if args.psd is None else BandLimited(args.psd, args.f_lo, args.f_hi)
-    device = harvester_from_args(args)
-    record = synthetic_record(
+    assembly = assembly_from_args(args)
+    device = harvester_from_args(args) if assembly is None else assembly
+    make = synthetic_record if assembly is None else assembly_record
+    record = make(
         device,
         excitation,
         duration=args.duration,
@@ -126,6 +142,7 @@ def run(args) -> int:
         return 1
     simulated = {
         "record": out.name,
+        # an assembly's numbers by their dotted paths (docs/assemblies.md)
         "device": device.parameters(),
         "excitation": {"rms": args.rms, "psd": args.psd, "f_lo": args.f_lo, "f_hi": args.f_hi},
         "duration": args.duration,
@@ -143,6 +160,10 @@ def run(args) -> int:
             "offsets": _channel_values(args.offset, "--offset"),
         },
     }
+    if assembly is not None:
+        simulated["device_file"] = str(args.device)
+        simulated["columns"] = list(record.columns)
+        simulated["scheme"] = "heun"  # the assembly kernel's (the single mass's record: RK4)
     where = write_or_keep(
         sidecar, dumps(simulated, indent=2), "--out's parameters", overwrite=args.force
     )

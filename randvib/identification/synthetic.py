@@ -152,19 +152,21 @@ def synthetic_record(
     excitation_rng, noise_rng = np.random.default_rng(seed).spawn(2)
     with np.errstate(all="ignore"):
         try:
-            true_input = _true_input(excitation, input, duration, sample_rate, band, excitation_rng)
+            true_input = realised_input(
+                excitation, input, duration, sample_rate, band, excitation_rng
+            )
         except BaseMotionOverflow:  # the RMS's velocity or displacement overflows
             true_input = None
     if true_input is None or not np.all(np.isfinite(true_input)):
         raise ValueError(
-            f"`excitation` {_excitation_text(excitation)} overflows float64 in the {input} "
+            f"`excitation` {excitation_text(excitation)} overflows float64 in the {input} "
             "signal; lower it (`--rms` / `--psd`)"
         )
     dt = 1.0 / sample_rate
     sim = record_response(device, Record(dt, **{input: true_input}), substeps=substeps)
     if not (np.all(np.isfinite(sim.z)) and np.all(np.isfinite(sim.x))):
         raise ValueError(
-            f"the simulated response to `excitation` {_excitation_text(excitation)} diverged; "
+            f"the simulated response to `excitation` {excitation_text(excitation)} diverged; "
             "lower the excitation (`--rms` / `--psd`) or raise `substeps`"
         )
     # Independent draws per channel, always drawn so that one channel's noise
@@ -205,7 +207,8 @@ def _sensors(outputs, noise, offsets, sensor, device) -> tuple[tuple, dict, dict
     return outputs, rms, shift
 
 
-def _excitation_text(excitation) -> str:
+def excitation_text(excitation) -> str:
+    """The excitation as an error message names it (an RMS, a spectrum or a given signal)."""
     if isinstance(excitation, Real):
         return f"{excitation!r} m/s^2 RMS"
     return repr(excitation) if not isinstance(excitation, Record) else "(given signal)"
@@ -229,7 +232,7 @@ def _device(device) -> Harvester:
     return device
 
 
-def _true_input(excitation, kind, duration, sample_rate, band, rng) -> np.ndarray:
+def realised_input(excitation, kind, duration, sample_rate, band, rng) -> np.ndarray:
     """The true input channel ``kind`` of one realisation on the record's grid."""
     if isinstance(excitation, Record):
         n = round(duration * sample_rate)
