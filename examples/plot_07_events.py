@@ -13,6 +13,7 @@ exactly for the linear device and by time-dependent statistical
 linearisation for the nonlinear one.
 """
 
+import matplotlib.pyplot as plt
 import numpy as np
 
 import randvib as rv
@@ -48,3 +49,5 @@ mc = rv.simulate_transient(
 )
 print(exact)
 print(f"Monte Carlo P(stroke reached by 6 s): {mc.stroke_reached.mean[-1]:.3f}")
+
+plt.show()  # run as a script: the figures in windows (the gallery draws them itself)

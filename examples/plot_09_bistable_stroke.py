@@ -59,3 +59,5 @@ passage = mc.stroke_first_passage
 print(f"{passage.paths_reached} of {passage.n_paths} paths reached the stroke within "
       f"{passage.horizon:g} s; mean first passage {1e3 * passage.mean.mean:.0f} "
       f"± {1e3 * passage.mean.ci95:.0f} ms")  # fmt: skip
+
+plt.show()  # run as a script: the figures in windows (the gallery draws them itself)

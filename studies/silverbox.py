@@ -25,10 +25,12 @@ fit as JSON (a rerun loads the fits found there:
 :mod:`randvib.studies.benchmark`). The same fit from the command line::
 
     randvib identify SNLS80mV.csv --input-column V1 --input-kind force \\
-        --output-column V2 --sample-rate 610.3515625 --rows 40650:105712 \\
+        --output-column V2 --output-kind relative_displacement \\
+        --sample-rate 610.3515625 --rows 40650:105712 \\
         --model viscous --hold bandlimited --save duffing.json
     randvib validate duffing.json SNLS80mV.csv --input-column V1 --input-kind force \\
-        --output-column V2 --sample-rate 610.3515625 --rows 100:40575 --skip 50 \\
+        --output-column V2 --output-kind relative_displacement \\
+        --sample-rate 610.3515625 --rows 100:40575 --skip 50 \\
         --initial-state record
 """
 

@@ -66,7 +66,7 @@ from scipy import optimize, special
 
 from randvib.analytic.linear_response import device_block, output_variances
 from randvib.analytic.linearisation import linear_displacement_variance
-from randvib.analytic.method import AnalyticMethod, Validity, non_white
+from randvib.analytic.method import MONTE_CARLO, AnalyticMethod, Validity, non_white
 from randvib.analytic.power_prediction import PowerPrediction
 from randvib.formatting import compact
 from randvib.models.excitation import Measured, as_excitation
@@ -412,7 +412,19 @@ def optimal_dc_output(harvester: Harvester, psd) -> DcOptimum:
     >>> print(f"V_b* = {best.value:.4f} V, {best.power_stored:.4e} W, {best.where}")
     V_b* = 0.0410 V, 6.5536e-04 W, interior
     """
-    BRIDGE_CLOSURE.require(harvester, psd, who="optimal_dc_output")
+    try:
+        BRIDGE_CLOSURE.require(harvester, psd, who="optimal_dc_output")
+        return _closure_optimum(harvester, psd)
+    except ValueError as refusal:  # the optimum's own Monte Carlo, not a plain simulation
+        raise ValueError(str(refusal).replace(MONTE_CARLO, MONTE_CARLO_OPTIMUM)) from None
+
+
+#: The alternative that :func:`optimal_dc_output`'s refusals name.
+MONTE_CARLO_OPTIMUM = "Monte Carlo over a range you give (randvib.simulated_dc_optimum)"
+
+
+def _closure_optimum(harvester: Harvester, psd) -> DcOptimum:
+    """:func:`optimal_dc_output` on a case the closure accepts (refused beyond its validity)."""
     psd = psd if non_white(psd) else float(getattr(psd, "level", psd))
     coil = harvester.electrical
     if coil.has_battery:

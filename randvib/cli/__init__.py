@@ -104,7 +104,8 @@ class _Parser(argparse.ArgumentParser):
 def build_parser() -> argparse.ArgumentParser:
     from randvib import __version__
 
-    parser = _Parser(prog="randvib", description=__doc__.splitlines()[0])
+    # the docstring's first line without its reStructuredText markup (``randvib ...``)
+    parser = _Parser(prog="randvib", description=__doc__.splitlines()[0].replace("``", ""))
     parser.add_argument("--version", action="version", version=f"randvib {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True

@@ -7,7 +7,13 @@ import argparse
 from randvib._validation import integer_option
 from randvib.identification.input_reconstruction import AUTO_HOLD, HOLDS
 from randvib.identification.settings import INITIAL_STATES, SimulationSettings
-from randvib.models.record import INPUT_KINDS, OUTPUT_CHANNEL, TIME_COLUMN, read_record
+from randvib.models.record import (
+    INPUT_KINDS,
+    OUTPUT_CHANNEL,
+    OUTPUT_KINDS,
+    TIME_COLUMN,
+    read_record,
+)
 from randvib.quantities import unit
 
 
@@ -22,6 +28,12 @@ def add_record_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="NAME",
         default=OUTPUT_CHANNEL,
         help="relative-displacement column",
+    )
+    g.add_argument(
+        "--output-kind",
+        choices=OUTPUT_KINDS,
+        help="what --output-column holds; needed for a column not named as its kind "
+        "(its values are then used in the column's own units)",
     )
     g.add_argument(
         "--time-column", metavar="NAME", default=TIME_COLUMN, help="time column (s, uniform)"
@@ -81,6 +93,7 @@ def record_from_args(path, args, name=None):
         input_column=args.input_column,
         input_kind=args.input_kind,
         output_column=args.output_column,
+        output_kind=args.output_kind,
         time_column=args.time_column,
         sample_rate=args.sample_rate,
         rows=parse_rows(args.rows),

@@ -58,6 +58,15 @@ class Prediction:
     voltage: np.ndarray | None = None
     initial_state: dict = field(default_factory=dict)
 
+    def __repr__(self) -> str:  # the scores and the start, not the simulated samples
+        start = ", ".join(f"{k} = {float(v):.4g}" for k, v in self.initial_state.items())
+        voltage = ", voltage" if self.voltage is not None else ""
+        return (
+            f"Prediction({self.record.name!r}: {self.z.shape[-1]} samples, J = {self.cost:.4g} "
+            f"(Eq. 11), RMS error {self.rms_error:.4g}{f'; start {start}' if start else ''}; "
+            f"z, v{voltage})"
+        )
+
 
 def _start_estimate(cost: CostFunction):
     """(z0, v0): the initial state that best explains the record, all else given.

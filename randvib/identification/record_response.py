@@ -11,7 +11,7 @@ stopped and gets NaN samples.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -33,12 +33,50 @@ class BatchSimulation:
         Sample times (s).
     z, v : ndarray, shape (n_pop, n)
         Relative displacement (m) and velocity (m/s) at the samples; NaN after
-        a candidate diverged.
+        a candidate diverged. One device is a batch of one: ``z[0]`` is its
+        response, and :meth:`to_record` makes a record of it.
+    record : Record or None
+        The record whose input drove the devices.
     """
 
     time: np.ndarray
     z: np.ndarray
     v: np.ndarray
+    record: Record | None = field(default=None, repr=False)
+
+    @property
+    def n_devices(self) -> int:
+        """How many devices the batch simulated (rows of :attr:`z`)."""
+        return self.z.shape[0]
+
+    def to_record(self, index: int | None = None, name: str | None = None) -> Record:
+        """The driving record with device ``index``'s response as ``relative_displacement``.
+
+        ``index`` may be left out for a batch of one device. The response is
+        the true displacement (no output offset); the driving record's other
+        channels are kept, a measured ``relative_displacement`` replaced.
+        """
+        if index is None:
+            if self.n_devices != 1:
+                raise ValueError(
+                    f"this batch simulated {self.n_devices} devices: give `index` "
+                    f"(0 to {self.n_devices - 1}) for the one to make a record of"
+                )
+            index = 0
+        index = check_int("index", index, minimum=-self.n_devices, maximum=self.n_devices - 1)
+        if self.record is None:
+            raise ValueError("this batch does not hold the record that drove it")
+        channels = {**self.record.channels, "relative_displacement": self.z[index]}
+        label = name or f"{self.record.name} (simulated)"
+        return Record(self.record.dt, time=self.record.time, name=label, **channels)
+
+    def __repr__(self) -> str:  # the sizes, not the samples
+        duration = self.time.size * (self.time[1] - self.time[0]) if self.time.size > 1 else 0.0
+        devices = "1 device" if self.n_devices == 1 else f"{self.n_devices} devices"
+        return (
+            f"BatchSimulation({devices} x {self.time.size} samples, {duration:.6g} s; "
+            f"z, v of shape {self.z.shape})"
+        )
 
 
 def record_response(
@@ -131,7 +169,7 @@ def record_response(
         theta0=theta0,
         response_limit=response_limit,
     )
-    return BatchSimulation(time=record.time, z=z, v=v)
+    return BatchSimulation(time=record.time, z=z, v=v, record=record)
 
 
 def _input_kind(record: Record, input_kind) -> str:

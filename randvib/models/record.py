@@ -57,6 +57,8 @@ CHANNELS = {
 INPUT_KINDS = ("base_displacement", "base_acceleration", "force")
 #: The response channel that identification fits.
 OUTPUT_CHANNEL = "relative_displacement"
+#: What an output column may be declared to hold (``output_kind``, ``--output-kind``).
+OUTPUT_KINDS = (OUTPUT_CHANNEL,)
 #: The CSV column of the sample times (s).
 TIME_COLUMN = "time"
 #: How far (in steps) a sample may lie from the uniform grid; see the module docstring.
@@ -273,6 +275,30 @@ class Record:
         )
 
 
+def _channel_accessor(name: str) -> property:
+    """``record.NAME``: the channel's samples, as ``record[NAME]``; the repr names them so."""
+
+    def get(self) -> np.ndarray:
+        if name not in self._channels:
+            raise AttributeError(
+                f"record {self._name!r} has no {name!r} channel; it has {', '.join(self._channels)}"
+            )
+        return self._channels[name]
+
+    quantity = CHANNELS[name]
+    get.__doc__ = (
+        f"The ``{name}`` channel ({quantity.unit}); AttributeError when the record has none."
+    )
+    return property(get)
+
+
+# every channel by the name the repr and the CSV give it (``voltage`` and ``z`` are above)
+for _name in CHANNELS:
+    if _name != "voltage":
+        setattr(Record, _name, _channel_accessor(_name))
+del _name
+
+
 def _check_length(n: int, name: str) -> None:
     if n < MIN_SAMPLES:
         raise ValueError(f"record {name!r} has {n} samples; at least {MIN_SAMPLES} are needed")
@@ -328,7 +354,12 @@ def _finite_column(name, values):
     except (TypeError, ValueError):
         raise ValueError(f"`{name}` must be numeric") from None
     if arr.ndim != 1:
-        raise ValueError(f"`{name}` must be one-dimensional, got shape {arr.shape}")
+        row = (
+            " (one row of a batch: take it with [0], or BatchSimulation.to_record())"
+            if arr.ndim == 2 and arr.shape[0] == 1
+            else ""
+        )
+        raise ValueError(f"`{name}` must be one-dimensional, got shape {arr.shape}{row}")
     bad = np.flatnonzero(~np.isfinite(arr))
     if bad.size:
         raise ValueError(
@@ -404,6 +435,7 @@ def read_record(
     input_column: str | None = None,
     input_kind: str | None = None,
     output_column: str | None = OUTPUT_CHANNEL,
+    output_kind: str | None = None,
     time_column: str = TIME_COLUMN,
     sample_rate: float | None = None,
     rows: tuple[int | None, int | None] | None = None,
@@ -428,6 +460,11 @@ def read_record(
     output_column : str or None
         Column holding the relative displacement; None for a record of the
         input alone (a measured base acceleration, :meth:`randvib.Measured.from_csv`).
+    output_kind : {'relative_displacement'}, optional
+        What ``output_column`` holds, declared; needed for a column whose name
+        is not a channel name (``V2``, ``laser``: its values are then used in
+        the column's own units). A column named as another kind (``voltage``,
+        ``force``) is refused (:func:`declared_output_kind`).
     time_column : str
         Column of sample times (s); ignored when absent and ``sample_rate``
         is given.
@@ -452,8 +489,11 @@ def read_record(
     if output_column is not None and output_column not in columns:
         raise ValueError(
             f"{path.name}: output column `{output_column}` not found (relative displacement, m); "
-            f"columns are {_shown(columns)}; map another name with `output_column`"
+            f"columns are {_shown(columns)}; map another name with `output_column` and say "
+            "what it holds with `output_kind`"
         )
+    if output_column is not None:
+        declared_output_kind(path.name, output_column, output_kind)
     if rows is not None:
         n_rows = len(frame)
         frame = frame.iloc[slice(*rows)]
@@ -485,6 +525,35 @@ def read_record(
     source = None if step is None else f"`sample_rate` = {sample_rate} Hz"
     step = grid_step(time, step, name=time_column, source=source)
     return Record(step, time=time, name=name or path.stem, **channels)
+
+
+def declared_output_kind(source: str, column: str, kind: str | None) -> str:
+    """What the output ``column`` of ``source`` holds: ``kind`` as declared, else its name.
+
+    The one place that decides whether a column may be fitted as the
+    response: a declared kind must be one of :data:`OUTPUT_KINDS`; an
+    undeclared column must be named as one (``relative_displacement``). A
+    column named as another kind (``voltage``) or by a name that says
+    nothing (``V2``) is refused, in one line that says what to declare.
+    """
+    kinds = ", ".join(OUTPUT_KINDS)
+    if kind is not None:
+        if kind not in OUTPUT_KINDS:
+            raise ValueError(f"`output_kind` must be one of {kinds}; got {kind!r}")
+        return kind
+    if column in OUTPUT_KINDS:
+        return column
+    if column in CHANNELS:
+        held = CHANNELS[column]
+        raise ValueError(
+            f"{source}: output column `{column}` holds the {held.description} ({held.unit}), "
+            f"not a response identification fits (`output_kind`: {kinds}); name the column "
+            "that holds one with `output_column`"
+        )
+    raise ValueError(
+        f"{source}: what output column `{column}` holds is not declared; give `output_kind` "
+        f"({kinds}, in the column's own units) if it is that"
+    )
 
 
 def _input_column(path: Path, columns, input_column, input_kind) -> tuple[str, str]:

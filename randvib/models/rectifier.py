@@ -279,6 +279,15 @@ class BridgeCoil(Rectified):
         """True for Shockley diodes (``saturation_current`` given), False for a constant drop."""
         return self.saturation_current is not None
 
+    def parameters(self) -> dict:
+        """The bridge's parameters; the Shockley law's ``ideality`` and ``thermal_voltage``
+        only for Shockley diodes (a constant drop ``v_diode`` does not use them)."""
+        out = super().parameters()
+        if not self.is_shockley:
+            out.pop("ideality", None)
+            out.pop("thermal_voltage", None)
+        return out
+
     @property
     def _shockley(self) -> tuple[float, float]:
         if not self.is_shockley:
