@@ -394,7 +394,9 @@ def harvester_from_parameters(parameters: dict) -> Harvester:
     law = friction_law(rest.pop("friction", "none"))
     friction = None if law is None else law(**_own(rest, law))
     coupling_name = rest.pop("coupling", "resistive" if "alpha" in rest else None)
-    own = {name: rest.pop(name) for name in ("m", "c_m", "c_e", "k", "k3", "stroke") if name in rest}
+    own = {
+        name: rest.pop(name) for name in ("m", "c_m", "c_e", "k", "k3", "stroke") if name in rest
+    }
     if coupling_name is None:
         _no_leftovers(rest)
         return Harvester(friction=friction, **own)

@@ -53,6 +53,7 @@ from randvib._io import (
     sha256,
     unlock_folder,
 )
+from randvib._processes import WorkerProcessWarning, caller_stacklevel, why_no_processes
 from randvib._progress import progress_bar
 from randvib._validation import MAX_SEED, check_int, check_positive
 from randvib.analytic.prediction import METHODS, predict
@@ -101,7 +102,10 @@ class SweepSettings:
     seed : int
         Common seed of every point (common random numbers).
     control_variates : bool
-        Use the control variates (companion integrated alongside).
+        Use the control variates where they hold: the energy balance's under
+        white noise or a filtered spectrum, and under white noise with a
+        viscous c_e the friction-free companion integrated alongside; plain
+        means under a synthesised or recorded input.
     """
 
     dt: float = 1e-4
@@ -203,6 +207,12 @@ def simulate_to_precision(
     """
     from randvib.montecarlo.simulation import simulate
 
+    # the controls where they hold: the energy balance's under white noise or a shaping
+    # filter (Brownian increments), the companion's exact moments under white noise and
+    # a viscous c_e only (no circuit state, no bridge); elsewhere plain means
+    white = getattr(excitation, "is_white", True)
+    filtered = white or excitation.shaping_filter() is not None
+    controls = settings.control_variates and filtered
     kw = dict(
         t_end=settings.burn_in + settings.window,
         dt=settings.dt,
@@ -210,9 +220,8 @@ def simulate_to_precision(
         scheme=settings.scheme,
         seed=seed,
         initial=initial,
-        # the companion's exact moments need a viscous c_e (no circuit state, no bridge)
-        companion=settings.control_variates and not (device.has_circuit or device.is_rectified),
-        control_variates=settings.control_variates,
+        companion=controls and white and not (device.has_circuit or device.is_rectified),
+        control_variates=controls,
         threads=threads,
         progress=False,
     )
@@ -335,6 +344,14 @@ def make_executor(workers: int | None = None, scheduler: str | None = None, init
         return client.get_executor(pure=False), client.close
     workers = os.cpu_count() or 1 if workers is None else check_int("workers", workers, 1)
     if workers == 1:
+        return None, lambda: None
+    reason = why_no_processes()
+    if reason is not None:  # an unguarded script: its workers would run it again
+        warnings.warn(
+            f"running in this process, not {workers} worker processes: {reason}",
+            WorkerProcessWarning,
+            stacklevel=caller_stacklevel(),
+        )
         return None, lambda: None
     # spawn, not fork: numba's OpenMP threading layer may already be running
     # in this process, and forking it is unsafe (the child aborts)
