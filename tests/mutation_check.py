@@ -488,6 +488,19 @@ MUTATIONS: tuple[Mutation, ...] = (
         why="The reference itself: Caughey and Stumpf's E[z^2] with the phase term's sign "
         "flipped; its derivative must be twice the closed-form E[z z'].",
     ),
+    Mutation(
+        name="wilson-centre",
+        path="randvib/statistics.py",
+        edits=(
+            (
+                "centre = (p + z2n / 2.0) / (1.0 + z2n)",
+                "centre = (p + z2n / 2.0) / (1.0 + 1.1 * z2n)",
+            ),
+        ),
+        tests=("tests/test_statistics.py::test_wilson_interval_is_the_score_test_inverted",),
+        why="A probability's Wilson interval (the stroke reached, the time beyond it) with its "
+        "centre pulled towards zero: the ends are no longer where the score test gives z.",
+    ),
 )
 
 

@@ -22,7 +22,7 @@ from randvib._validation import MAX_SEED, integer_option
 from randvib.cli._device import add_device_arguments, harvester_from_args
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
 from randvib.cli._output import describe_device, describe_excitation, print_table, with_units
-from randvib.formatting import cell
+from randvib.formatting import cell, proportion
 from randvib.harvester_design.design import design
 from randvib.harvester_design.objectives import OBJECTIVES
 from randvib.models.coupling import COUPLINGS
@@ -182,7 +182,9 @@ def run(args) -> int:
         value = out[key]
         if value is None:
             continue
-        if isinstance(value, dict):
+        if isinstance(value, dict) and "ci95_lower" in value:  # a probability's interval
+            value = proportion(value["mean"], value["ci95_lower"], value["ci95_upper"])
+        elif isinstance(value, dict):
             value = f"{cell(value['mean'])} ± {cell(value['ci95'])}"
         rows.append((key, value if isinstance(value, str) else cell(value), unit(key)))
     if args.min_first_passage is not None:

@@ -21,7 +21,7 @@ from randvib.cli._device import add_device_arguments, harvester_from_args
 from randvib.cli._event import add_event_arguments, simulate_event, wants_event
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
 from randvib.cli._output import describe_device, describe_excitation, print_table, with_units
-from randvib.formatting import cell, estimate_parts
+from randvib.formatting import cell, estimate_parts, proportion
 from randvib.montecarlo.integrators import INTEGRATORS
 from randvib.montecarlo.results import STATISTICS
 from randvib.quantities import unit
@@ -150,10 +150,13 @@ def run(args) -> int:
             continue
         s = summary[name]
         lin = getattr(analytic, name, None) if analytic is not None else None
+        shown = _plus_minus(s["mean"], s["ci95"])
+        if "ci95_lower" in s:  # a probability: its Wilson interval, which stays >= 0
+            shown = proportion(s["mean"], s["ci95_lower"], s["ci95_upper"]).split(" ", 1)
         rows.append(
             (
                 name,
-                *estimate_parts(s["mean"], s["ci95"]),
+                *shown,
                 cell(lin),
                 unit(name, harvester.electrical),
             )
@@ -164,14 +167,15 @@ def run(args) -> int:
         rows.append(
             (
                 f"E[min(first passage, {first['horizon']:g} s)]",
-                *estimate_parts(restricted["mean"], restricted["ci95"]),
+                *_plus_minus(restricted["mean"], restricted["ci95"]),
                 f"{first['paths_reached']}/{first['n_paths']} paths reached the stroke",
                 unit("stroke_first_passage_time"),
             )
         )
     print(describe_device(harvester))
     print(describe_excitation(psd) if args.record is None else f"excitation: record {args.record}")
-    print_table(rows, ("statistic", "Monte Carlo", "± 95 %", "linearisation", "unit"))
+    # a half-width (± x), or a probability's interval [lower, upper]
+    print_table(rows, ("statistic", "Monte Carlo", "95 %", "linearisation", "unit"))
     if args.record is not None:
         # one record is one realisation: its windows are batch means, not independent paths
         print(
@@ -185,6 +189,12 @@ def run(args) -> int:
         f"{result.scheme}, seed {result.seed}), {result.wall_time:.2f} s wall"
     )
     return 0
+
+
+def _plus_minus(mean, half_width) -> tuple[str, str]:
+    """A Monte Carlo mean and ``± half-width`` as table cells (the digits the interval allows)."""
+    mean, half = estimate_parts(mean, half_width)
+    return mean, f"± {half}" if half else ""
 
 
 def _on_record(harvester, record, args, burn_in):

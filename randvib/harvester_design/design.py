@@ -57,7 +57,7 @@ from randvib.models.harvester import Harvester
 from randvib.montecarlo.ensembles import Case, EnsembleResult, run_ensembles
 from randvib.montecarlo.on_record import monte_carlo_on_record
 from randvib.montecarlo.sweep import SweepSettings
-from randvib.statistics import FirstPassage, Statistic, estimate
+from randvib.statistics import FirstPassage, Statistic, estimate, proportion
 
 __all__ = ["design"]
 
@@ -420,7 +420,7 @@ class _Confirmed:
 
     def exceedance(self, c) -> Statistic:
         result, i = self.where[id(c)]
-        return estimate(result.averages(i).beyond_stroke)
+        return proportion(result.averages(i).beyond_stroke)  # Wilson: stays in [0, 1]
 
     def input_power(self, c) -> Statistic:
         """c_m E[z'^2] + E[z' F] + electrical power, path by path (every dissipation)."""
@@ -501,4 +501,4 @@ class _Confirmed:
 
 def _within(x: Statistic, budget: float) -> bool:
     """The budget is not significantly exceeded: the 95 % interval reaches down to it."""
-    return x.mean - x.ci95 <= budget
+    return x.interval[0] <= budget

@@ -24,7 +24,7 @@ from randvib.models.excitation import Excitation, as_excitation
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import kernel
 from randvib.quantities import unit
-from randvib.statistics import FirstPassage, Statistic, estimate
+from randvib.statistics import FirstPassage, Statistic, estimate, proportion
 
 #: The statistics of a :class:`SimulationResult` that are shown, in order (their
 #: units: :mod:`randvib.quantities`).
@@ -251,12 +251,16 @@ class SimulationResult:
     def stroke_exceedance(self) -> Statistic | None:
         """Fraction of the window's time with |z| > stroke; None without a stroke.
 
+        Its 95 % interval is the Wilson interval (:func:`randvib.statistics.proportion`).
+
         For the free mass it is the fraction over this window (z is not
         stationary, so it grows with the run), not a stationary probability.
         """
         if self.harvester.stroke is None:
             return None
-        return self.statistic(self.averages.beyond_stroke)
+        # a probability: the Wilson interval stays in [0, 1] where mean +- t SE would not
+        controls = self.controls() if self.control_variates else None
+        return proportion(self.averages.beyond_stroke, controls)
 
     @property
     def stroke_first_passage(self) -> FirstPassage | None:
