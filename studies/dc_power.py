@@ -108,7 +108,8 @@ def figure(stored, out):
     ax.set(xscale="log", yscale="log", xlabel="S ((m/s$^2$)$^2$/Hz)", ylabel="power (W)")
     if hollow_drawn:
         ax.axhline(floor, color="0.6", lw=0.6, ls=":")
-    ax.legend(fontsize=7, title="markers: Monte Carlo with 95 % CI", title_fontsize=7)
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside right upper", fontsize=7,
+               title="markers: Monte Carlo with 95 % CI", title_fontsize=7)  # fmt: skip
     return save_figure(fig, out / "dc_power.png")
 
 

@@ -153,8 +153,8 @@ def figures(budget: pd.DataFrame, bandwidth: pd.DataFrame, out: Path) -> None:
     limits = budget.dropna(subset=["limit"]).drop_duplicates("stroke").sort_values("stroke")
     ax.plot(1e3 * limits.stroke, 1e3 * limits.limit, "k--", label="limit")
     ax.set(xlabel="stroke (mm)", ylabel="power (mW)", title=r"band-pass 8 Hz, $\zeta$ = 0.3")
-    # between the limit (above) and the devices' powers (below): the space the data leave
-    ax.legend(loc="lower right", bbox_to_anchor=(1.0, 0.25), fontsize=7)
+    # below the panel: inside, some stroke's points fell under it
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), fontsize=7, ncols=2)
     # the optimum's stiffness and electrical damping, each on its own labelled axis;
     # the families coincide where k3 -> its lower bound, so their markers differ
     # (filled circles and a solid line: linear; open squares and a dashed line: hardening;
@@ -177,7 +177,8 @@ def figures(budget: pd.DataFrame, bandwidth: pd.DataFrame, out: Path) -> None:
         zetas = sorted(bandwidth.zeta.unique())
         ax.set_xticks(zetas, [f"{z:g}" for z in zetas])
         ax.tick_params(which="minor", labelbottom=False)
-        ax.legend(fontsize="small", title="analytic optimum (family)")
+        ax.legend(fontsize="small", title="analytic optimum (family)", loc="upper center",
+                  bbox_to_anchor=(0.5, -0.2), ncols=2)  # fmt: skip
     save_figure(fig, out / "design.png")
 
 

@@ -25,9 +25,10 @@ SIMULATION_FIELDS = tuple(SimulationSettings().to_dict())
 
 #: What validate does with the fitted record's sensor offsets.
 OFFSETS_NOTE = {
-    "per-record": "the sensor offsets belong to a record, not to the device: they are "
-    "re-estimated on each record (the fitted record's are not reused; `--offsets given` "
-    "reuses them); the other parameters are the file's",
+    "per-record": "the sensor offsets belong to a record, not to the device: on each record "
+    "the file's, the output offset re-estimated and both re-estimated are scored and the "
+    "lowest J kept (column `offsets`; `--offsets given` uses the file's throughout); the "
+    "other parameters are the file's",
     "given": "the file's sensor offsets are used on every record (`--offsets given`)",
 }
 
@@ -139,53 +140,15 @@ def run(args) -> int:
     )
     status = 0  # 1: the figures could not be written where asked (the table is printed)
     if plot_dir is not None or plot_file is not None:
-        from randvib.identification.plots import figure_fit
-        from randvib.identification.prediction import predict_record
-        from randvib.identification.residuals import residual_diagnostics
-
-        for i, (record, row) in enumerate(zip(records, rows, strict=True)):
-            # the offsets re-estimated on this record, as its J
-            own = dataclasses.replace(measurement, **row.offsets)
-            pred = predict_record(harvester, record, measurement=own, simulation=settings)
-            path = plot_file or plot_dir / f"{i:02d}_{record.name}.png"
-            skip = settings.skip
-            diagnostics = residual_diagnostics(record.z[skip:] - pred.z[skip:], record.input[skip:])
-            try:
-                figure_fit(
-                    pred,
-                    path,
-                    title=f"{model} model on {record.name}",
-                    validation=True,
-                    diagnostics=diagnostics,
-                    **plot_units(args),
-                )
-            except OSError as exc:  # the table below is the result: print it, exit 1
-                print(f"randvib: could not write `--plot` {str(path)!r} ({exc})", file=sys.stderr)
-                status = 1
-                break
-        if status == 0:
-            print(
-                f"wrote {plot_file}"
-                if plot_file
-                else f"wrote {len(records)} figure(s) into {plot_dir}",
-                file=sys.stderr if args.json else sys.stdout,
-            )
+        status = _figures(args, model, harvester, measurement, settings, records, rows,
+                          plot_file, plot_dir)  # fmt: skip
     if args.json:
         print(
             dumps(
                 {
                     "model": model,
                     "parameters": parameters,
-                    "records": [
-                        {
-                            "record": r.record,
-                            "cost": r.cost,
-                            "rms_error": r.rms_error,
-                            "samples": r.samples,
-                            "offsets": r.offsets,
-                        }
-                        for r in rows
-                    ],
+                    "records": [r.to_dict() for r in rows],
                     "offsets": OFFSETS_NOTE[args.offsets],
                 }
             )
@@ -193,8 +156,49 @@ def run(args) -> int:
         return status
     print(f"model {model}")
     print_table(
-        [[r.record, r.samples, r.cost, r.rms_error] for r in rows],
-        ["record", "samples", "J", f"RMS error ({output_unit(args)})"],
+        [[r.record, r.samples, r.cost, r.rms_error, r.offsets_source, _verdict(r)] for r in rows],
+        ["record", "samples", "J", f"RMS error ({output_unit(args)})", "offsets", "residual"],
     )
     print(f"note: {OFFSETS_NOTE[args.offsets]}")
+    if any(r.verdict == "structured" for r in rows):
+        print(
+            "note: a structured residual (Ljung-Box p < 0.01, or correlated with the input) "
+            "is what the model misses on that record: its J is not noise alone"
+        )
     return status
+
+
+def _verdict(row) -> str:
+    """The residual's verdict with its Ljung-Box p-value, for the table."""
+    if row.residuals is None:
+        return ""
+    return f"{row.verdict} (p = {row.residuals.ljung_box_p:.2g})"
+
+
+def _figures(args, model, harvester, measurement, settings, records, rows, plot_file, plot_dir):
+    """One figure per record, as validated (its offsets, its residual diagnostics); the exit
+    status: 1 if a figure could not be written (the table is printed anyway)."""
+    from randvib.identification.plots import figure_fit
+    from randvib.identification.prediction import predict_record
+
+    for i, (record, row) in enumerate(zip(records, rows, strict=True)):
+        own = dataclasses.replace(measurement, **row.offsets)  # as its J was scored
+        pred = predict_record(harvester, record, measurement=own, simulation=settings)
+        path = plot_file or plot_dir / f"{i:02d}_{record.name}.png"
+        try:
+            figure_fit(
+                pred,
+                path,
+                title=f"{model} model on {record.name}",
+                validation=True,
+                diagnostics=row.residuals,
+                **plot_units(args),
+            )
+        except OSError as exc:  # the table is the result: print it, exit 1
+            print(f"randvib: could not write `--plot` {str(path)!r} ({exc})", file=sys.stderr)
+            return 1
+    print(
+        f"wrote {plot_file}" if plot_file else f"wrote {len(records)} figure(s) into {plot_dir}",
+        file=sys.stderr if args.json else sys.stdout,
+    )
+    return 0

@@ -37,8 +37,12 @@ def _finish(fig, path):
     return fig
 
 
+#: A legend above its axes, left (the panel's title is on the right): never over the data.
+ABOVE = dict(loc="lower left", bbox_to_anchor=(0.0, 1.0), borderaxespad=0.2, frameon=False)
+
+
 def plot_time_history(
-    prediction, ax=None, *, window=None, scale=MILLI, unit="mm", residual_ax=None
+    prediction, ax=None, *, window=None, scale=MILLI, unit="mm", residual_ax=None, legend=True
 ):
     """Measured (solid black) and simulated (dashed) relative displacement.
 
@@ -57,6 +61,8 @@ def plot_time_history(
     residual_ax : matplotlib Axes, optional
         Where to draw the residual, measured less simulated, over the same
         window (a fit that misses shows there what it misses).
+    legend : bool
+        A legend above the axes (False: the figure has one elsewhere).
     """
     if ax is None:
         _, axes = new_figure(figsize=(7.0, 2.6))
@@ -72,7 +78,8 @@ def plot_time_history(
     # the window shown, stated where the time axis is labelled
     shown = f"time (s); shown: {t[sel][0]:.3g} to {t[sel][-1]:.3g} s of {float(t[-1] - t[0]):.3g} s"
     ax.set_title(f"J = {prediction.cost:.3g} (Eq. 11)", loc="right")
-    ax.legend(loc="upper left", ncols=2, frameon=False)
+    if legend:
+        ax.legend(ncols=2, **ABOVE)
     if residual_ax is None:
         ax.set_xlabel(shown)
         return ax
@@ -140,16 +147,17 @@ def plot_histograms(prediction, axes=None, *, bins=None, scale=MILLI, unit="mm",
         ax.set_xlabel(f"{name} ({unit_text})")
         ax.set_ylabel(f"probability density (1/{unit_text})")
         if legend:
-            ax.legend(loc="upper right", frameon=False)
+            ax.legend(ncols=2, **ABOVE)
     return axes
 
 
-def plot_residual_correlations(diagnostics, axes) -> None:
+def plot_residual_correlations(diagnostics, axes, *, legend=True) -> None:
     """Residual autocorrelation and its cross-correlation with the input, with bands.
 
     ``diagnostics`` is a
     :class:`~randvib.identification.residuals.ResidualDiagnostics`; the dashed
-    lines are its (1 - LEVEL) bands of a white, independent residual.
+    lines are its (1 - LEVEL) bands of a white, independent residual (named
+    in a legend above the first axes unless ``legend`` is False).
     """
     from randvib.identification.residuals import LEVEL
 
@@ -168,7 +176,8 @@ def plot_residual_correlations(diagnostics, axes) -> None:
         ax.set_xlabel("lag (samples)")
         ax.set_ylabel("correlation")
         ax.set_title(name, loc="right", fontsize=8)
-    ax_a.legend(loc="upper right", frameon=False)
+    if legend:
+        ax_a.legend(**ABOVE)
 
 
 @styled
@@ -196,11 +205,16 @@ def figure_fit(
     n_hist = 2 if prediction.voltage is not None else 1
     fig = _fit_layout(n_hist, diagnostics is not None)
     ax_t, ax_r, *rest = fig.axes
-    plot_time_history(prediction, ax_t, window=window, scale=scale, unit=unit, residual_ax=ax_r)
-    # one legend, in (a): in the densities it would cover a tail
+    plot_time_history(prediction, ax_t, window=window, scale=scale, unit=unit, residual_ax=ax_r,
+                      legend=False)  # fmt: skip
     plot_histograms(prediction, rest[:n_hist], scale=scale, unit=unit, legend=False)
+    handles, labels = ax_t.get_legend_handles_labels()
     if diagnostics is not None:
-        plot_residual_correlations(diagnostics, rest[n_hist:])
+        plot_residual_correlations(diagnostics, rest[n_hist:], legend=False)
+        more = rest[n_hist].get_legend_handles_labels()
+        handles, labels = handles + more[0], labels + more[1]
+    # one legend below the panels: inside (a) or (d) it covered the data
+    fig.legend(handles, labels, loc="outside lower center", ncols=len(labels), frameon=False)
     panel_letters(fig.axes)
     what = {None: "", True: "validation: ", False: "fit to the training record: "}[validation]
     fig.suptitle(f"{what}{title if title else prediction.record.name}")

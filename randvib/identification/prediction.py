@@ -174,7 +174,7 @@ def score(parameters: dict, model: str, record: Record, simulation, circuit=None
 
 @dataclass(frozen=True)
 class ValidationRow:
-    """J (Eq. 11), RMS error and length of one record in :func:`validate`."""
+    """J (Eq. 11), RMS error, length and residual verdict of one record in :func:`validate`."""
 
     record: str
     model: str
@@ -183,6 +183,34 @@ class ValidationRow:
     samples: int
     #: The sensor offsets used on this record (re-estimated on it, or given).
     offsets: dict = field(default_factory=dict)
+    #: Where they come from: one of :data:`OFFSET_SOURCES`.
+    offsets_source: str = "given"
+    #: Whiteness of the residual and its independence of the input on this record
+    #: (:func:`~randvib.identification.residuals.residual_diagnostics`).
+    residuals: object = None
+
+    @property
+    def verdict(self) -> str | None:
+        """``white`` or ``structured``: the residual diagnostics' verdict (None if none)."""
+        return None if self.residuals is None else self.residuals.verdict
+
+    def to_dict(self) -> dict:
+        """JSON-ready: the scores, the offsets and their source, the residual diagnostics."""
+        return {
+            "record": self.record,
+            "cost": self.cost,
+            "rms_error": self.rms_error,
+            "samples": self.samples,
+            "offsets": self.offsets,
+            "offsets_source": self.offsets_source,
+            "residuals": None if self.residuals is None else self.residuals.to_dict(),
+        }
+
+
+#: Where a validation row's offsets come from (:func:`validate`, ``offsets="per-record"``):
+#: the given ones, the output offset re-estimated on the record (the input's given),
+#: or both re-estimated; the one of lowest J is kept.
+OFFSET_SOURCES = ("given", "output re-estimated", "both re-estimated")
 
 
 #: How :func:`validate` treats the sensors' offsets.
@@ -209,21 +237,27 @@ def validate(
         ``"per-record"`` (default): the sensor offsets belong to a record, not
         to the device, so they are re-estimated on each record -- the output
         offset in closed form (the mean residual, as identify profiles it),
-        the input offset, where ``measurement`` has one, by a bounded scalar
-        search of J over the record's input mean +- half its standard
-        deviation (identify's box). ``"given"``: those of ``measurement`` on
-        every record. Each row's ``offsets`` says which were used.
+        and the input offset too, where ``measurement`` has one, by a bounded
+        scalar search of J over the record's input mean +- half its standard
+        deviation (identify's box) -- and the given offsets, the output one
+        re-estimated alone and both re-estimated are scored by the J reported
+        (the initial state estimated), the lowest kept: a re-estimate that
+        does not lower J (the pair trading off, nearly unidentifiable apart)
+        never spoils a good model. ``"given"``: those of ``measurement`` on
+        every record. Each row's ``offsets`` and ``offsets_source`` say which
+        were used, its ``residuals`` the residual's verdict on that record.
     """
+    from randvib.identification.residuals import residual_diagnostics
+
     if offsets not in OFFSET_POLICIES:
         raise ValueError(f"`offsets` must be one of {', '.join(OFFSET_POLICIES)}; got {offsets!r}")
     model = model_of(harvester.friction_name) if isinstance(harvester, Harvester) else None
     measurement = measurement or MeasurementModel()
     rows = []
     for record in records:
-        used = measurement
-        if offsets == "per-record":
-            used = _record_offsets(harvester, record, measurement, settings)
-        pred = predict_record(harvester, record, measurement=used, **settings)
+        source, used, pred = _best_offsets(harvester, record, measurement, offsets, settings)
+        skip = _skip(settings)
+        residual = record.z[skip:] - pred.z[skip:]
         rows.append(
             ValidationRow(
                 record.name,
@@ -232,16 +266,50 @@ def validate(
                 pred.rms_error,
                 record.n,
                 {"input_offset": used.input_offset, "output_offset": used.output_offset},
+                source,
+                residual_diagnostics(residual, record.input[skip:]),
             )
         )
     return rows
 
 
-def _record_offsets(harvester, record, measurement, settings) -> MeasurementModel:
+def _skip(settings: dict) -> int:
+    """The samples left out of J at the start, from :func:`validate`'s settings."""
+    options = dict(settings)
+    (simulation,) = resolve_settings(
+        "validate", options, simulation=options.pop("simulation", None)
+    )
+    return int(simulation.skip)
+
+
+def _best_offsets(harvester, record, measurement, policy, settings):
+    """(source, measurement, prediction) of the offsets of lowest J on ``record``."""
+    candidates = {"given": measurement}
+    if policy == "per-record":
+        candidates["output re-estimated"] = _record_offsets(
+            harvester, record, measurement, settings, estimate_input=False
+        )
+        if measurement.input_offset != 0.0:
+            candidates["both re-estimated"] = _record_offsets(
+                harvester, record, measurement, settings, estimate_input=True
+            )
+    scored = {
+        source: (used, predict_record(harvester, record, measurement=used, **settings))
+        for source, used in candidates.items()
+    }
+    # a re-estimate is kept only where it lowers J (ties: the given offsets)
+    source = min(scored, key=lambda s: (scored[s][1].cost, s != "given"))
+    return (source, *scored[source])
+
+
+def _record_offsets(
+    harvester, record, measurement, settings, estimate_input: bool
+) -> MeasurementModel:
     """``measurement`` with the offsets that minimise J on ``record`` (see :func:`validate`).
 
     J is identify's: the output offset profiled in closed form, the start
-    z0 taken from the first sample less the record's mean (:class:`CostFunction`).
+    z0 taken from the first sample less the record's mean (:class:`CostFunction`);
+    the input offset searched too with ``estimate_input``, else kept.
     """
     from dataclasses import replace
 
@@ -258,7 +326,6 @@ def _record_offsets(harvester, record, measurement, settings) -> MeasurementMode
         device_parameters(harvester, measurement, "validate"), model_of(harvester.friction_name)
     )
     model = model_of(harvester.friction_name)
-    estimate_input = measurement.input_offset != 0.0
     fixed = {k: v for k, v in parameters.items() if k != "output_offset"}
     if estimate_input:
         fixed.pop("input_offset", None)
@@ -266,7 +333,7 @@ def _record_offsets(harvester, record, measurement, settings) -> MeasurementMode
     options = simulation.to_dict()
     options.pop("initial_state", None)
     cost = CostFunction(record, model, fixed=fixed, free=free, profile_offset=True, **options)
-    input_offset = 0.0
+    input_offset = measurement.input_offset
     if estimate_input:
         drive, _ = driving_signal(record.input, record.dt, record.input_kind)
         mean, half = float(np.mean(drive)), 0.5 * float(np.std(drive))

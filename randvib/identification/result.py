@@ -21,6 +21,11 @@ from randvib.quantities import unit
 #: the fit and far above float64 rounding).
 BOUND_TOLERANCE = 1e-6
 
+#: |correlation| of two estimates from which they count as not identifiable apart:
+#: the variance of either, the other held, is 1 - r^2 = 0.2 % of its own (a factor
+#: 22 on the standard error): the record determines one combination of the two.
+UNIDENTIFIABLE_CORRELATION = 0.999
+
 
 @dataclass
 class IdentificationResult:
@@ -112,6 +117,21 @@ class IdentificationResult:
         return {n: se[n] for n in self.parameters if n in se}
 
     @property
+    def unidentifiable_pairs(self) -> list[tuple[str, str, float]]:
+        """Pairs of estimates whose |correlation| is at least
+        :data:`UNIDENTIFIABLE_CORRELATION`: ``(name, name, correlation)``; the record
+        determines only a combination of each pair (empty without the polish)."""
+        if self.uncertainty is None:
+            return []
+        names, r = list(self.uncertainty.names), np.asarray(self.uncertainty.correlation)
+        return [
+            (names[i], names[j], float(r[i, j]))
+            for i in range(len(names))
+            for j in range(i + 1, len(names))
+            if abs(r[i, j]) >= UNIDENTIFIABLE_CORRELATION
+        ]
+
+    @property
     def at_bound(self) -> dict:
         """Free parameters the search left on a bound: name -> ``"lower"`` or ``"upper"``.
 
@@ -186,6 +206,8 @@ class IdentificationResult:
             **({} if self.residuals is None else {"residuals": self.residuals.to_dict()}),
             # free parameters left on a search bound: not estimates, no interval
             "at_bound": self.at_bound,
+            # pairs the record cannot tell apart: [name, name, correlation]
+            "unidentifiable_pairs": [list(pair) for pair in self.unidentifiable_pairs],
             **(
                 {}
                 if self.uncertainty is None

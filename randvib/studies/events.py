@@ -262,6 +262,7 @@ def energy_and_stroke_figure(results: pd.DataFrame, stroke: float, path: Path) -
                    ylabel=f"P(|z| reaches {1e3 * stroke:g} mm)", ylim=(-0.02, 1.02))  # fmt: skip
     for ax in axes[0]:
         ax.grid(alpha=0.3, lw=0.5)
-        ax.legend(fontsize=6)
+        # beside the panel, not over its points
+        ax.legend(fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncols=2)
     panel_letters(axes)
     return save_figure(fig, path)
