@@ -19,6 +19,7 @@ import argparse
 
 from randvib._io import dumps
 from randvib._validation import MAX_SEED, integer_option
+from randvib.cli import COMMAND_HELP
 from randvib.cli._device import add_device_arguments, harvester_from_args
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
 from randvib.cli._output import describe_device, describe_excitation, print_table, with_units
@@ -36,7 +37,7 @@ from randvib.quantities import parameter_unit, unit
 def register(sub) -> None:
     p = sub.add_parser(
         "design",
-        help="choose device parameters for the most power under a stroke budget",
+        help=COMMAND_HELP["design"],
         description="Search the ranges given for the device that harvests most from the "
         "excitation with the fraction of time beyond --stroke at most --exceedance: analytic "
         "search, Monte Carlo "
@@ -97,6 +98,13 @@ def register(sub) -> None:
         default=0,
         help="random seed",
     )
+    g.add_argument(
+        "--segments",
+        type=integer_option(2),
+        default=None,
+        help="with --record: windows the record is cut into, the Monte Carlo paths of every "
+        "candidate (default 10)",
+    )
     g.add_argument("--out-dir", help="folder to keep the Monte Carlo cases in and resume from")
     g.add_argument("--scheduler", help="address of a Dask scheduler to run the cases on")
     g.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -146,6 +154,8 @@ def run(args) -> int:
         raise ValueError("`--stroke` is needed: the budget is on P(|z| > stroke)")
     harvester = harvester_from_args(args)
     excitation = excitation_from_args(args)
+    if args.segments is not None and getattr(args, "record", None) is None:
+        raise ValueError("`--segments` cuts a record into paths; it needs `--record`")
     settings = SweepSettings(
         target_rel_ci=args.precision,
         max_paths=args.max_paths,
@@ -161,6 +171,7 @@ def run(args) -> int:
         min_first_passage=args.min_first_passage,
         monte_carlo=not args.no_monte_carlo,
         settings=settings,
+        segments=10 if args.segments is None else args.segments,
         out_dir=args.out_dir,
         scheduler=args.scheduler,
         progress=not args.no_progress and not args.json,

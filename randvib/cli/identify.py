@@ -7,6 +7,7 @@ from pathlib import Path
 
 from randvib._io import claim_output_file, dumps, write_or_keep
 from randvib._validation import MAX_SEED, integer_option
+from randvib.cli import COMMAND_HELP
 from randvib.cli._output import print_table
 from randvib.cli._records import (
     add_record_arguments,
@@ -29,7 +30,7 @@ DEFAULT = SearchSettings()
 def register(sub) -> None:
     p = sub.add_parser(
         "identify",
-        help="identify device and friction parameters from a measured record (SaDE, Eq. 11)",
+        help=COMMAND_HELP["identify"],
         description="Fit the device model (Eq. 1) with a friction model to a CSV record by "
         "minimising J (Eq. 11) with self-adaptive differential evolution.",
     )

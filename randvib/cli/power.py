@@ -42,7 +42,7 @@ from randvib._io import claim_output_file, dumps, write_or_keep
 from randvib._resources import announce_duration, timed
 from randvib.analytic.bridge import optimal_dc_output
 from randvib.analytic.prediction import METHODS, optimal_load_resistance, predict
-from randvib.cli import advice_when_done
+from randvib.cli import COMMAND_HELP, advice_when_done
 from randvib.cli._device import add_device_arguments, harvester_from_args, option_flag
 from randvib.cli._event import add_event_arguments, power_event, wants_event
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
@@ -56,7 +56,7 @@ from randvib.quantities import QUANTITIES, unit
 def register(sub) -> None:
     p = sub.add_parser(
         "power",
-        help="analytic expected power under white noise or a coloured excitation",
+        help=COMMAND_HELP["power"],
         description="Expected power of the harvester under base acceleration (white noise "
         "by default), by an analytic method.",
     )

@@ -16,6 +16,7 @@ from pathlib import Path
 from randvib._io import claim_output_file, dumps, write_or_keep
 from randvib._resources import check_memory
 from randvib._validation import MAX_SEED, check_int, check_positive, integer_option
+from randvib.cli import COMMAND_HELP
 from randvib.cli._device import add_device_arguments, harvester_from_args
 from randvib.identification.synthetic import PAPER_BAND, SYNTHETIC_INPUTS, synthetic_record
 from randvib.models.excitation import BandLimited
@@ -24,7 +25,7 @@ from randvib.models.excitation import BandLimited
 def register(sub) -> None:
     p = sub.add_parser(
         "record",
-        help="write a synthetic shaker record of a device (CSV for identify/validate)",
+        help=COMMAND_HELP["record"],
         description="Simulate a device under band-limited base excitation and write the "
         "record (time, input, relative_displacement) with optional sensor noise and offsets.",
     )

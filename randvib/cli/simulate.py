@@ -17,6 +17,7 @@ from __future__ import annotations
 from randvib._io import dumps
 from randvib._validation import MAX_SEED, integer_option
 from randvib.analytic.prediction import METHODS, predict
+from randvib.cli import COMMAND_HELP
 from randvib.cli._device import add_device_arguments, harvester_from_args
 from randvib.cli._event import add_event_arguments, simulate_event, wants_event
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
@@ -30,7 +31,7 @@ from randvib.quantities import unit
 def register(sub) -> None:
     p = sub.add_parser(
         "simulate",
-        help="Monte Carlo simulation under white, coloured or recorded base acceleration",
+        help=COMMAND_HELP["simulate"],
         description="Simulate an ensemble of the harvester under white-noise, coloured "
         "(filtered or synthesised) or recorded base acceleration; statistics with 95 % "
         "confidence half-widths.",
@@ -92,6 +93,7 @@ def register(sub) -> None:
     )
     g.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--force", action="store_true", help="overwrite an existing --plot file")
     p.set_defaults(handler=run)
 
 

@@ -8,6 +8,7 @@ import json
 import sys
 
 from randvib._io import check_output_file, check_output_folder, dumps, existing_file
+from randvib.cli import COMMAND_HELP
 from randvib.cli._output import print_table
 from randvib.cli._records import (
     add_record_arguments,
@@ -36,7 +37,7 @@ OFFSETS_NOTE = {
 def register(sub) -> None:
     p = sub.add_parser(
         "validate",
-        help="J (Eq. 11) of identified parameters on other records",
+        help=COMMAND_HELP["validate"],
         description="Simulate each record with parameters saved by `randvib identify --save` "
         "(or printed by --json) and report J (Eq. 11) and the RMS error per record.",
     )
