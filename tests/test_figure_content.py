@@ -158,7 +158,9 @@ def test_dc_power_series_that_stores_nothing_is_drawn_hollow_at_a_floor(monkeypa
     hollow = [line for line in ax.get_lines() if line.get_markerfacecolor() == "white"]
     assert len(hollow) == 1 and len(hollow[0].get_xdata()) == 2  # both levels of V_d = 0.3 V
     assert 0 < max(hollow[0].get_ydata()) < 1e-4 * 0.25
-    texts = [t.get_text() for t in ax.get_legend().get_texts()]
+    (legend,) = kept[0].legends  # beside the axes, off the data (issue 35, item 17)
+    assert ax.get_legend() is None
+    texts = [t.get_text() for t in legend.get_texts()]
     assert any("0.3 V" in t and "0 W" in t for t in texts)
     assert not any("0.3 V, best" in t for t in texts)  # no entry for an empty series
     plt.close("all")

@@ -70,7 +70,9 @@ def outcrossing_rate(z2, zv, v2, barrier) -> np.ndarray:
         + mu * special.ndtr(ratio),
         np.maximum(mu, 0.0),
     )
-    density = np.exp(-0.5 * barrier**2 / safe) / (sz * np.sqrt(2 * np.pi))
+    with np.errstate(over="ignore"):  # a barrier beyond float64's square is never crossed
+        exponent = -0.5 * np.square(np.asarray(barrier, dtype=float)) / safe
+    density = np.exp(exponent) / (sz * np.sqrt(2 * np.pi))
     return np.where(spread, 2.0 * density * conditional, 0.0)
 
 

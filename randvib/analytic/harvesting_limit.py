@@ -98,7 +98,9 @@ def harvesting_limit(m, c_m, excitation: Excitation, displacement_rms) -> float 
     """
     m = float(check_positive("m", m, "kg"))
     c_m = float(check_nonnegative("c_m", c_m, "Ns/m"))
-    sigma2 = float(check_positive("displacement_rms", displacement_rms, "m")) ** 2
+    rms = float(check_positive("displacement_rms", displacement_rms, "m"))
+    # a budget whose square is beyond float64 never binds: the largest float keeps lambda = 0
+    sigma2 = min(rms * rms, np.finfo(float).max)
     if excitation.is_white:
         return None
 

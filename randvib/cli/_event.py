@@ -147,7 +147,12 @@ def event_from_args(args, excitation) -> Enveloped:
                 f"`--envelope-file` gives a table envelope; not with `--envelope {name}`"
             )
         envelope = _build(cls, own, given)
-    return Enveloped(excitation, envelope)
+    try:
+        return Enveloped(excitation, envelope)
+    except ValueError as exc:  # the envelope as the user gave it: the file, or its amplitude
+        flag = "--envelope-file" if name == FILE_ENVELOPE else option_flag(_dest("a"))
+        flag = flag if name in (FILE_ENVELOPE, ShinozukaSato.name) else "--envelope"
+        raise ValueError(str(exc).replace("`envelope`", f"`{flag}`")) from None
 
 
 def _build(cls, own, given):
@@ -233,7 +238,7 @@ def event_settings(event: Enveloped, start: EventStart) -> str:
 # ------------------------------------------------------------ the two commands
 def _level(psd):
     """The JSON's ``psd``: the white level, or the excitation's level (None for a table)."""
-    return getattr(psd, "level", psd) if not isinstance(psd, int | float) else psd
+    return psd if isinstance(psd, int | float) else getattr(psd, "level", None)
 
 
 def _refuse_with_event(flags: dict) -> None:

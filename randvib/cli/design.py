@@ -109,7 +109,8 @@ def register(sub) -> None:
     g.add_argument("--scheduler", help="address of a Dask scheduler to run the cases on")
     g.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.set_defaults(handler=run)
+    # SweepSettings' and design's names of the options, as refusals name them
+    p.set_defaults(handler=run, api_flags={"target_rel_ci": "--precision", "stroke": "--stroke"})
 
 
 def vary_option(text: str) -> tuple[str, float, float]:

@@ -40,6 +40,7 @@ import math
 
 from randvib._io import claim_output_file, dumps, write_or_keep
 from randvib._resources import announce_duration, timed
+from randvib._validation import check_positive
 from randvib.analytic.bridge import optimal_dc_output
 from randvib.analytic.prediction import METHODS, optimal_load_resistance, predict
 from randvib.cli import COMMAND_HELP, advice_when_done
@@ -316,6 +317,8 @@ def _simulated_optimum_point(args, harvester, psd) -> dict | None:
     it). A closure that refuses only beyond its validity (the search finds no
     output within it) falls back the same way.
     """
+    if not isinstance(psd, Excitation):  # a bad level is the user's, not the closure's limit
+        check_positive("psd", psd, "(m/s^2)^2/Hz")
     if args.optimal_bounds is None:
         if not args.method_defaulted:
             return None

@@ -415,6 +415,14 @@ class Enveloped:
                 f"`envelope` must be a randvib envelope ({', '.join(ENVELOPES)}), "
                 f"got {self.envelope!r}"
             )
+        peak = float(self.envelope.peak)
+        level = getattr(self.excitation, "level", 1.0)
+        if not (np.isfinite(peak * peak) and np.isfinite(float(level) * peak * peak)):
+            raise ValueError(
+                f"`envelope` peaks at {peak:.3g}: the intensity at its peak, S e^2, is beyond "
+                "float64; scale the envelope (a peak of 1 keeps S the peak's level) or the "
+                "excitation's level down"
+            )
 
     @property
     def name(self) -> str:
@@ -428,7 +436,7 @@ class Enveloped:
 
     def peak_excitation(self) -> Excitation:
         """The stationary excitation at the envelope's peak: the PSD times peak^2."""
-        return self.excitation.scaled(self.envelope.peak**2)
+        return self.excitation.scaled(self.envelope.peak * self.envelope.peak)
 
     def parameters(self) -> dict:
         """The excitation's and the envelope's parameters, ready for JSON."""

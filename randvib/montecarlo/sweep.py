@@ -80,6 +80,11 @@ def cartesian(**axes) -> list[dict]:
     return [dict(zip(names, combo, strict=True)) for combo in itertools.product(*values)]
 
 
+#: Smallest target relative half-width: 1e-6 needs (2 CV / 1e-6)^2 = 4e12 CV^2 paths, far
+#: beyond any max_paths; below it a target is a typing error (1e-300), not a precision.
+MIN_TARGET_REL_CI = 1e-6
+
+
 @dataclass(frozen=True)
 class SweepSettings:
     """How each point is simulated.
@@ -124,7 +129,12 @@ class SweepSettings:
         check_positive("window", self.window, "s")
         if not (np.isfinite(self.burn_in) and self.burn_in >= 0):
             raise ValueError(f"`burn_in` must be >= 0 s, got {self.burn_in!r}")
-        check_positive("target_rel_ci", self.target_rel_ci)
+        if not (np.isfinite(self.target_rel_ci) and self.target_rel_ci >= MIN_TARGET_REL_CI):
+            raise ValueError(
+                f"`target_rel_ci` must be >= {MIN_TARGET_REL_CI:g} (the 95 % half-width over the "
+                f"power; a mean over n paths reaches about 2 CV / sqrt(n)), got "
+                f"{self.target_rel_ci!r}"
+            )
         check_int("min_paths", self.min_paths, 8)
         check_int("batch_paths", self.batch_paths, 1)
         check_int("max_paths", self.max_paths, self.min_paths)
@@ -234,7 +244,9 @@ def simulate_to_precision(
         if not (rel > settings.target_rel_ci) or n >= settings.max_paths:
             return result
         # paths needed if the spread stays the same (CI ~ n^-1/2), plus 10 %
-        wanted = math.ceil(n * (rel / settings.target_rel_ci) ** 2 * 1.1)
+        # (a target far below reach asks for max_paths: the ratio's square would overflow)
+        factor = min(rel / settings.target_rel_ci, math.sqrt(settings.max_paths / n) * 2.0)
+        wanted = math.ceil(n * factor**2 * 1.1)
         extra = max(wanted - n, settings.batch_paths)
         extra = math.ceil(extra / settings.batch_paths) * settings.batch_paths
         extra = min(extra, settings.max_paths - n)

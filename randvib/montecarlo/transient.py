@@ -171,6 +171,11 @@ def simulate_transient(
         8.0 * run.n_paths * (snap_steps.size * kernel.N_SNAP + kernel.N_EVENT + kernel.N_ACC),
         "give fewer `times` or fewer `n_paths`, or run in parts with `first_path`",
     )
+    check_memory(  # the envelope's gain on every step (Gauss-Legendre nodes, a few arrays)
+        f"the envelope's gain on each of the {run.grid.n_steps:.4g} steps of t_end / dt",
+        8.0 * run.grid.n_steps * (4 * ENVELOPE_NODES + 8),
+        "shorten `t_end` (the last of `times`) or lengthen `dt`",
+    )
     # The step check and the scales read the device linearised at the envelope's peak.
     system = LinearTestSystem.of(run.harvester, event.peak_excitation())
 
@@ -209,6 +214,10 @@ def simulate_transient(
         first_hit=first_hit,
         wall_time=time.perf_counter() - started,
     )
+
+
+#: Quadrature nodes per step of the envelope's step integrals (:meth:`Envelope.step_integrals`).
+ENVELOPE_NODES = 6
 
 
 def snapshot_steps(times, dt: float, n_steps: int) -> np.ndarray:
