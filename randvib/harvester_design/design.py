@@ -192,7 +192,7 @@ def design(
     excitation = as_excitation(excitation)
     space = DesignSpace(fixed, vary)
     if isinstance(excitation, Measured) and fixed.c_m > 0:
-        limit = record_harvesting_limit(fixed.m, fixed.c_m, excitation, stroke)
+        limit = record_harvesting_limit(fixed.m, fixed.c_m, excitation, stroke, progress=progress)
         limit_kind = "record: non-causal, |z| <= stroke"
     else:
         limit = harvesting_limit(fixed.m, fixed.c_m, excitation, sigma_budget)
