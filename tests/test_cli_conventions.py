@@ -6,7 +6,9 @@ present with one meaning, choices declared as choices.
 
 Covers :mod:`randvib.cli` (the parser, shared flags, one-line errors, the options named
 differently from the API), the tables and device lines of :mod:`randvib.cli._output` and
-:mod:`randvib.cli._device`, and the digits they print (:mod:`randvib.formatting`).
+:mod:`randvib.cli._device`, and the digits they print (:mod:`randvib.formatting`); help
+without importing the commands and a command's help kept (:mod:`randvib.cli._help`), and
+``randvib compile`` (:mod:`randvib.cli.compile`).
 """
 
 import argparse

@@ -439,6 +439,11 @@ def event_files(tmp_path_factory):
           "--paths", "4"], "--envelope-a"),
         (["simulate", "--preset", "figure9", "--psd", "1", "--envelope", "step", "--times", "1e9",
           "--paths", "4"], "--t-end"),
+        (["simulate", "--preset", "figure9", "--psd", "1", "--envelope", "shinozuka-sato",
+          "--envelope-b", "1e-310", "--envelope-c", "1e-309", "--times", "0.5", "--paths", "4"],
+         "--envelope-b"),
+        (["power", "--preset", "figure9", "--coupling", "inductive", "--rectifier", "bridge",
+          "--alpha", "1e200", "--r-coil", "1e-200", "--battery", "0.02", "--psd", "1"], "--alpha"),
         # ran without end before
         (["design", "--preset", "figure9", "--psd", "1", "--stroke", "0.005", "--vary", "k=40:80",
           "--precision", "1e-300"], "--precision"),
@@ -451,6 +456,15 @@ def test_new_flags_at_extreme_values_are_refused_in_one_line_naming_the_flag(
     code, out, err = _run(capsys, argv)
     _check_contract(code, out, err, False)
     assert code == 2 and f"`{flag}" in err, err
+
+
+def test_a_unit_peak_envelope_with_rates_far_apart_peaks_at_one():
+    """The peak time log(c / b) / (c - b) overflowed for b near float64's smallest (c / b
+    beyond float64) and the amplitude came out 0; as log c - log b it is finite."""
+    envelope = rv.ShinozukaSato.unit_peak(1e-320, 1.0)
+    t_peak = envelope.peak_time
+    assert t_peak == pytest.approx(-np.log(1e-320), rel=1e-12)  # log(c / b) / (c - b), c = 1
+    assert envelope.peak == pytest.approx(1.0, rel=1e-12)
 
 
 def test_valid_extremes_of_the_new_flags_run_and_are_finite(capsys, event_files):

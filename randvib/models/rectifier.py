@@ -257,6 +257,13 @@ class BridgeCoil(Rectified):
 
     def __post_init__(self):
         super().__post_init__()
+        # the conducting bridge's damping alpha^2 / R_C, which every method uses
+        if not np.isfinite(np.float64(self.alpha) * self.alpha / self.r_coil):
+            raise ValueError(
+                f"`alpha` = {self.alpha!r} Wb/m with `r_coil` = {self.r_coil!r} ohm: the "
+                "conducting bridge's damping alpha^2 / R_C is beyond float64; give coupling "
+                "parameters of a physical size"
+            )
         if self.saturation_current is not None:
             if self.v_diode != 0.0:
                 raise ValueError(
