@@ -447,3 +447,16 @@ def test_device_line_names_shockley_parameters_only_for_shockley_diodes(capsys):
     shockley = rv.BridgeCoil(0.1992, 0.48, battery=0.02, saturation_current=1e-9)
     assert {"ideality", "thermal_voltage", "saturation_current"} <= set(shockley.parameters())
     assert "ideality" not in rv.BridgeCoil(0.1992, 0.48, v_diode=0.01, battery=0.02).parameters()
+
+
+def test_every_gallery_script_shows_its_figures_when_run_as_a_script():
+    """Run with `python examples/plot_NN.py`, a gallery script drew figures and ended
+    without showing them (the gallery draws them itself): each ends with plt.show()."""
+    import ast
+    from pathlib import Path
+
+    scripts = sorted((Path(__file__).parents[1] / "examples").glob("plot_*.py"))
+    assert scripts
+    for script in scripts:
+        last = ast.parse(script.read_text()).body[-1]
+        assert ast.unparse(last) == "plt.show()", script.name
