@@ -488,6 +488,46 @@ MUTATIONS: tuple[Mutation, ...] = (
         why="The reference itself: Caughey and Stumpf's E[z^2] with the phase term's sign "
         "flipped; its derivative must be twice the closed-form E[z z'].",
     ),
+    Mutation(
+        name="causal-anticausal-share",
+        path="randvib/analytic/harvesting_limit.py",
+        edits=(("share = m * m / (16.0 * c_m)", "share = m * m / (8.0 * c_m)"),),
+        tests=(
+            "tests/test_harvesting_bounds.py::"
+            "test_causal_limit_is_the_riccati_optimum_as_its_penalty_vanishes",
+        ),
+        why="The causal bound removes twice the anti-causal share m^2 L(p)^2 p / (16 c_m): "
+        "it falls below what the linear-quadratic (Riccati) optimum of device and shaping "
+        "filter, solved independently, actually takes.",
+    ),
+    Mutation(
+        name="record-bound-primal-residual",
+        path="randvib/analytic/harvesting_limit.py",
+        edits=(
+            (
+                "return min(dual, squares) * stroke**2, squares * stroke**2, fit.status > 0",
+                "return squares * stroke**2, squares * stroke**2, fit.status > 0",
+            ),
+        ),
+        tests=(
+            "tests/test_harvesting_bounds.py::"
+            "test_record_limit_is_certified_when_its_solver_stops_short",
+        ),
+        why="The record bound trusts the least-squares solver's point instead of its dual "
+        "certificate: a solver stopped at its iteration limit gives a 'bound' below the "
+        "converged one.",
+    ),
+    Mutation(
+        name="record-bound-at-rest",
+        path="randvib/analytic/harvesting_limit.py",
+        edits=(("/ (4.0 * c_m) + kinetic / duration", "/ (4.0 * c_m) + 0.0 * kinetic / duration"),),
+        tests=(
+            "tests/test_harvesting_bounds.py::"
+            "test_record_limit_counts_the_kinetic_energy_a_device_starts_with",
+        ),
+        why="The record bound forgets the kinetic energy a device starts with: a device "
+        "moving when the record starts (independent DOP853 run) takes more than it.",
+    ),
 )
 
 
