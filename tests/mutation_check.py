@@ -528,6 +528,23 @@ MUTATIONS: tuple[Mutation, ...] = (
         why="The record bound forgets the kinetic energy a device starts with: a device "
         "moving when the record starts (independent DOP853 run) takes more than it.",
     ),
+    Mutation(
+        name="bridge-idle-threshold",
+        path="randvib/models/rectifier.py",
+        edits=(
+            (
+                "threshold = self.threshold(v_out)\n",
+                "threshold = self.threshold(v_out) - self.v_diode\n",
+            ),
+        ),
+        tests=(
+            "tests/test_bridge_idle.py::"
+            "test_advice_names_the_rms_the_threshold_and_what_would_help",
+        ),
+        why="An idle bridge's explanation counts one diode drop instead of two (a half-wave "
+        "rectifier's threshold): the threshold it quotes, V_b + 2 V_d = 4.3 V for the issue's "
+        "device, and its ratio to the EMF's exact RMS are wrong.",
+    ),
 )
 
 
