@@ -123,7 +123,12 @@ QUANTITIES: dict[str, Quantity] = {
         "1", "P(reached) by the Poisson crossing approximation", "reached, Poisson*"
     ),
     "stroke_reached_vanmarcke": Quantity(
-        "1", "P(reached) by Vanmarcke's approximation", "reached, Vanmarcke*"
+        "1",
+        "P(reached) by Vanmarcke's approximation (not conservative early in an event)",
+        "reached, Vanmarcke*",
+    ),
+    "stroke_reached_bound": Quantity(
+        "1", "upper bound on P(reached): the expected out-crossings (Rice)", "reached <= (Rice)"
     ),
     "r_load_optimal": Quantity("ohm", "load resistance of the largest load power"),
     "power_load_optimal": Quantity("W", "load power at the optimal load resistance"),

@@ -545,6 +545,23 @@ MUTATIONS: tuple[Mutation, ...] = (
         "rectifier's threshold): the threshold it quotes, V_b + 2 V_d = 4.3 V for the issue's "
         "device, and its ratio to the EMF's exact RMS are wrong.",
     ),
+    Mutation(
+        name="rice-bound-half",
+        path="randvib/analytic/first_passage.py",
+        edits=(
+            (
+                "np.minimum(1.0, start_beyond + _cumulative(times, rate))",
+                "np.minimum(1.0, start_beyond + 0.5 * _cumulative(times, rate))",
+            ),
+        ),
+        tests=(
+            "tests/test_first_passage_bound.py::"
+            "test_crossing_bound_integrates_a_stationary_rate_exactly",
+        ),
+        why="Rice's bound on P(stroke reached) counts half the expected out-crossings (one "
+        "side of the barrier): no longer an upper bound; checked against the stationary "
+        "rate's exact integral.",
+    ),
 )
 
 
