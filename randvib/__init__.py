@@ -92,7 +92,15 @@ _EXPORTS = {
     "randvib.montecarlo.results": ("SimulationResult",),
     "randvib.harvester_design.design": ("design",),
     "randvib.harvester_design.result": ("DesignResult",),
-    "randvib.analytic.harvesting_limit": ("gaussian_displacement_budget", "harvesting_limit"),
+    "randvib.analytic.harvesting_limit": (
+        "causal_harvesting_limit",
+        "gaussian_displacement_budget",
+        "harvesting_limit",
+        "record_harvesting_limit",
+        "record_limit_certificate",
+        "RecordLimitCertificate",
+        "RecordLimitWarning",
+    ),
     "randvib.statistics": ("FirstPassage", "Statistic", "estimate", "TimeStatistics"),
     "randvib.montecarlo.step_check": ("StepSizeWarning",),
 }

@@ -37,6 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from randvib._validation import check_choice
 from randvib.models.excitation import Excitation
 from randvib.models.harvester import Harvester
 from randvib.models.potential import CONFINING
@@ -239,10 +240,6 @@ class AnalyticMethod:
 
     def _alternatives(self, harvester, psd) -> str:
         """The registered methods that take the case, then Monte Carlo, in words."""
-        # The registry is the driver's; the methods' modules, which the driver
-        # imports, import this module, so it is looked up when a refusal is written.
-        from randvib.analytic.prediction import METHODS
-
         names = [
             name
             for name, method in METHODS.items()
@@ -252,8 +249,6 @@ class AnalyticMethod:
 
     def _transient_alternatives(self) -> str:
         """The registered transient methods, then Monte Carlo of an event, in words."""
-        from randvib.analytic.prediction import METHODS
-
         names = [f"method={name!r}" for name, method in METHODS.items() if method.transient]
         return " or ".join(names + [MONTE_CARLO_EVENT])
 
@@ -324,6 +319,32 @@ class AnalyticMethod:
         the :class:`~randvib.models.event.EventStart`.
         """
         raise NotImplementedError(f"{self.called} is stationary: it has no transient solution")
+
+
+#: The analytic methods by name, in the order the CLI and tables show them: the
+#: registry that :func:`method_named` reads and refusals name alternatives from.
+#: The driver fills it (:data:`randvib.analytic.prediction.METHODS`, the same
+#: dict, through :func:`register_methods`), and the package imports the driver
+#: first (``randvib/analytic/__init__.py``), so it is complete before any method
+#: can be asked. It lives here, below the methods' modules, so that they and the
+#: driver need not import each other.
+METHODS: dict[str, AnalyticMethod] = {}
+
+
+def register_methods(*methods: AnalyticMethod) -> dict[str, AnalyticMethod]:
+    """Add ``methods`` to :data:`METHODS` in the order given, and return it."""
+    for method in methods:
+        METHODS[method.name] = method
+    return METHODS
+
+
+def method_named(method) -> AnalyticMethod:
+    """The method ``method`` names: a key of :data:`METHODS`, or an AnalyticMethod (class or instance)."""
+    if isinstance(method, type) and issubclass(method, AnalyticMethod):
+        return method()
+    if isinstance(method, AnalyticMethod):
+        return method
+    return METHODS[check_choice("method", method, tuple(METHODS))]
 
 
 def _monte_carlo(psd) -> str:

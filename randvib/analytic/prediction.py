@@ -35,7 +35,13 @@ from randvib._validation import (
 from randvib.analytic.averaging import AVERAGING
 from randvib.analytic.bridge import BRIDGE_CLOSURE
 from randvib.analytic.fokker_planck import FAST_FOKKER_PLANCK, FOKKER_PLANCK
-from randvib.analytic.method import AnalyticMethod, non_white, white_level
+from randvib.analytic.method import (
+    AnalyticMethod,
+    method_named,
+    non_white,
+    register_methods,
+    white_level,
+)
 from randvib.analytic.power_prediction import PowerPrediction
 from randvib.analytic.statistical_linearisation import LINEARISATION, LinearisationDidNotConverge
 from randvib.models.excitation import BROADCASTING, Excitation
@@ -51,19 +57,11 @@ from randvib.models.harvester import Harvester
 #: equation on small grids made exact without friction, with kink corrections
 #: and Richardson extrapolation, fast enough for sweeps; ``"fpk"``: the same
 #: equation on fine grids, the slow reference (:mod:`randvib.analytic.fokker_planck`).
-METHODS: dict[str, AnalyticMethod] = {
-    method.name: method
-    for method in (LINEARISATION, AVERAGING, FAST_FOKKER_PLANCK, FOKKER_PLANCK, BRIDGE_CLOSURE)
-}
-
-
-def method_named(method) -> AnalyticMethod:
-    """The method ``method`` names: a key of :data:`METHODS`, or an AnalyticMethod (class or instance)."""
-    if isinstance(method, type) and issubclass(method, AnalyticMethod):
-        return method()
-    if isinstance(method, AnalyticMethod):
-        return method
-    return METHODS[check_choice("method", method, tuple(METHODS))]
+#: The registry is :data:`randvib.analytic.method.METHODS` (this dict), which
+#: the refusals read; :func:`~randvib.analytic.method.method_named` looks a name up.
+METHODS: dict[str, AnalyticMethod] = register_methods(
+    LINEARISATION, AVERAGING, FAST_FOKKER_PLANCK, FOKKER_PLANCK, BRIDGE_CLOSURE
+)
 
 
 def default_method(harvester: Harvester) -> str:

@@ -43,8 +43,9 @@ integrated with them.
 For the linear device with a stroke, the probability of reaching the stroke
 during the event is approximated from the out-crossing rate
 (:mod:`randvib.analytic.first_passage`: Poisson and Vanmarcke), labelled
-approximate; the Gaussian P(|z(t)| > stroke) at each time is exact for the
-linear device.
+approximate (Vanmarcke's is not conservative early in an event), and bounded
+above by the expected number of out-crossings (Rice); the Gaussian
+P(|z(t)| > stroke) at each time is exact for the linear device.
 """
 
 from __future__ import annotations
@@ -57,12 +58,14 @@ from scipy import integrate, linalg, special
 from randvib import _display, formatting
 from randvib._validation import check_finite, check_scalar_device
 from randvib.analytic.first_passage import (
+    crossing_bound,
     outcrossing_rate,
     probability_from_hazard,
     spectral_bandwidth,
     vanmarcke_hazard,
 )
 from randvib.analytic.linear_response import device_block, stationary_covariance
+from randvib.analytic.method import method_named
 from randvib.models.event import Enveloped, EventStart
 from randvib.models.harvester import Harvester
 
@@ -408,8 +411,6 @@ def transient_response(
     >>> print(f"energy from 0 to 5 s: {r.energy_electrical:.4e} J")
     energy from 0 to 5 s: 1.3806e-02 J
     """
-    from randvib.analytic.prediction import method_named  # the driver lists the methods
-
     if not isinstance(harvester, Harvester):
         raise ValueError(f"`harvester` must be a randvib.Harvester, got {type(harvester).__name__}")
     if not isinstance(event, Enveloped):
@@ -489,7 +490,11 @@ class TransientPrediction:
     stroke_reached_poisson, stroke_reached_vanmarcke : ndarray or None
         P(|z| has reached the stroke by t), **approximate** (out-crossing
         rates, :mod:`randvib.analytic.first_passage`); the linear device from
-        a zero-mean start only.
+        a zero-mean start only. Vanmarcke's is not conservative early in an
+        event (below Monte Carlo while the response builds up).
+    stroke_reached_bound : ndarray or None
+        An upper bound on the same probability: the expected number of
+        out-crossings by t (Rice), at most 1.
     bandwidth : float or None
         Vanmarcke's spectral bandwidth q of the stationary displacement.
     """
@@ -517,6 +522,7 @@ class TransientPrediction:
     stroke_reached_poisson: np.ndarray | None = None
     stroke_reached_vanmarcke: np.ndarray | None = None
     bandwidth: float | None = None
+    stroke_reached_bound: np.ndarray | None = None
     covariance: np.ndarray = field(default=None, repr=False)
 
     @classmethod
@@ -537,11 +543,11 @@ class TransientPrediction:
         cumulative, _ = _powers(harvester, int_v2, int_x2 if ix is not None else None)
         pairs = [equivalent(a, b) for a, b in zip(p[:, iz, iz], p[:, iv, iv], strict=True)]
         stroke = harvester.stroke
-        exceedance = reached_poisson = reached_vanmarcke = bandwidth = None
+        exceedance = reached_poisson = reached_vanmarcke = bandwidth = reached_bound = None
         if stroke is not None:
             exceedance = _gaussian_exceedance(stroke, mu[:, iz], p[:, iz, iz])
             if linear and start.is_zero and not harvester.potential.is_free:
-                reached_poisson, reached_vanmarcke, bandwidth = _first_passage(
+                reached_poisson, reached_vanmarcke, reached_bound, bandwidth = _first_passage(
                     system, harvester, event, solution, times, stroke
                 )
         return cls(
@@ -568,6 +574,7 @@ class TransientPrediction:
             stroke_reached_poisson=reached_poisson,
             stroke_reached_vanmarcke=reached_vanmarcke,
             bandwidth=bandwidth,
+            stroke_reached_bound=reached_bound,
             covariance=p,
         )
 
@@ -584,6 +591,7 @@ class TransientPrediction:
             "stroke_exceedance",
             "stroke_reached_poisson",
             "stroke_reached_vanmarcke",
+            "stroke_reached_bound",
         ]
         return _display.time_series(self, names + ([] if self.exact else ["c_eq", "k_eq"]))
 
@@ -611,7 +619,12 @@ class TransientPrediction:
 
     def _note(self) -> str:
         how = "exact (linear device)" if self.exact else "time-dependent closure"
-        approximate = "; * approximate" if self.stroke_reached_poisson is not None else ""
+        approximate = (
+            "; * approximate (Vanmarcke's not conservative early in an event; the bound is "
+            "an upper bound)"
+            if self.stroke_reached_poisson is not None
+            else ""
+        )
         return (
             f"{self.method}, {how}, {self.event.name}, start {self.start.describe()}; energy "
             f"int_0^{self.t_end:g} E[P_e] dt = {formatting.compact(self.energy_electrical)} J"
@@ -658,7 +671,7 @@ def _gaussian_exceedance(stroke, mean, variance):
 
 
 def _first_passage(system, harvester, event, solution, times, stroke):
-    """(Poisson, Vanmarcke) P(stroke reached by t) at ``times``, and the bandwidth q."""
+    """(Poisson, Vanmarcke, Rice's bound) P(stroke reached by t) at ``times``, and q."""
     n, iz, iv = system.n, system.iz, system.iv
     grid = np.union1d(solution.steps(), times)
     p = solution(grid)[:, : n * n].reshape(-1, n, n)
@@ -671,4 +684,4 @@ def _first_passage(system, harvester, event, solution, times, stroke):
     at = np.searchsorted(grid, times)
     poisson = probability_from_hazard(grid, rate)[at]
     vanmarcke = probability_from_hazard(grid, hazard)[at]
-    return poisson, vanmarcke, q
+    return poisson, vanmarcke, crossing_bound(grid, rate)[at], q

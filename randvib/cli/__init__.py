@@ -215,10 +215,12 @@ def _advice_warnings() -> tuple:
     from randvib.analytic.averaging import AveragingValidityWarning
     from randvib.analytic.prediction import LoadBoundWarning
     from randvib.analytic.statistical_linearisation import LinearisationValidityWarning
+    from randvib.montecarlo.bridge_step import BridgeIdleWarning
     from randvib.montecarlo.step_check import StepSizeWarning
 
     return (
         StepSizeWarning,
+        BridgeIdleWarning,
         AveragingValidityWarning,
         LoadBoundWarning,
         LinearisationValidityWarning,

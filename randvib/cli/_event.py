@@ -389,7 +389,9 @@ def _print_simulated(harvester, psd, event, start, result, analytic) -> None:
         if analytic is not None and analytic.stroke_reached_poisson is not None:
             text += (
                 f" (approximate: Poisson {analytic.stroke_reached_poisson[-1]:.4g}, "
-                f"Vanmarcke {analytic.stroke_reached_vanmarcke[-1]:.4g} at t = {result.times[-1]:g} s)"
+                f"Vanmarcke {analytic.stroke_reached_vanmarcke[-1]:.4g}, not conservative early "
+                f"in an event; at most {analytic.stroke_reached_bound[-1]:.4g}, Rice's bound; "
+                f"at t = {result.times[-1]:g} s)"
             )
         print(text)
     print(
@@ -450,6 +452,7 @@ def _print_predicted(harvester, psd, event, start, result) -> None:
         "stroke_exceedance": "P(|z| > stroke)",
         "stroke_reached_poisson": "reached, Poisson*",
         "stroke_reached_vanmarcke": "reached, Vanmarcke*",
+        "stroke_reached_bound": "reached <= (Rice)",
     }
     shown = [(label, getattr(result, name)) for name, label in names.items()]
     shown = [(label, values) for label, values in shown if values is not None]
@@ -466,5 +469,7 @@ def _print_predicted(harvester, psd, event, start, result) -> None:
     if result.stroke_reached_poisson is not None:
         print(
             "* approximate: out-crossing rates (Poisson; Vanmarcke with bandwidth "
-            f"q = {result.bandwidth:.3g}), checked against Monte Carlo (randvib simulate)"
+            f"q = {result.bandwidth:.3g}, not conservative early in an event), checked against "
+            "Monte Carlo (randvib simulate); 'reached <=' is an upper bound, the expected number "
+            "of out-crossings (Rice)"
         )

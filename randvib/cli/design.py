@@ -8,9 +8,12 @@ Carlo contradicts it, refined) by Monte Carlo with common random numbers
 (:func:`randvib.design`). ``--json`` prints one object with the keys
 ``optimum``, ``power_predicted``, ``power_monte_carlo``,
 ``stroke_exceedance_monte_carlo`` (each ``{"mean", "ci95"}``),
-``input_power``, ``limit`` (``limit_kind`` says which bound: stationary for
-a spectrum, non-causal on the record for ``--record``), with ``--min-first-passage`` the first passage
-predicted and by Monte Carlo, and the rest of :meth:`randvib.DesignResult.to_dict`.
+``input_power``, ``limit`` (non-causal; ``limit_kind`` says what it bounds:
+the budget's Gaussian RMS for a spectrum, the record itself for ``--record``),
+``limit_hard_stroke`` (any device within abs(z) <= stroke), ``causal_limit``
+(what a causal device can approach) with ``fraction_of_causal_limit``,
+``notes``, with ``--min-first-passage`` the first passage predicted and by
+Monte Carlo, and the rest of :meth:`randvib.DesignResult.to_dict`.
 """
 
 from __future__ import annotations
@@ -23,7 +26,7 @@ from randvib.cli import COMMAND_HELP
 from randvib.cli._device import add_device_arguments, harvester_from_args
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
 from randvib.cli._output import describe_device, describe_excitation, print_table, with_units
-from randvib.formatting import cell, proportion
+from randvib.formatting import cell, estimate, proportion
 from randvib.harvester_design.design import design
 from randvib.harvester_design.objectives import OBJECTIVES
 from randvib.models.coupling import COUPLINGS
@@ -181,7 +184,22 @@ def run(args) -> int:
         optimum = {k: u for k in result.optimum if (u := parameter_unit(k, result.device))}
         print(dumps(with_units(result.to_dict(), extra=optimum)))
         return 0
-    print(describe_device(harvester))
+    _print_design(args, result, excitation, vary)
+    return 0
+
+
+def _estimate(value: dict) -> str:
+    """A Monte Carlo ``{"mean", "ci95"}`` to the digits its interval supports."""
+    return estimate(value["mean"], value["ci95"])
+
+
+def _print_design(args, result, excitation, vary: dict) -> None:
+    """The device chosen (not the ranges' midpoints), the table, and the notes."""
+    print(describe_device(result.device).replace("device:", "device at the optimum:", 1))
+    print("varied: " + ", ".join(
+        f"{k} {cell(lo)} to {cell(hi)} {parameter_unit(k, result.device)}".rstrip()
+        for k, (lo, hi) in vary.items()
+    ))  # fmt: skip
     print(describe_excitation(excitation))
     out = result.to_dict()
     rows = [
@@ -197,7 +215,7 @@ def run(args) -> int:
         if isinstance(value, dict) and "ci95_lower" in value:  # a probability's interval
             value = proportion(value["mean"], value["ci95_lower"], value["ci95_upper"])
         elif isinstance(value, dict):
-            value = f"{cell(value['mean'])} ± {cell(value['ci95'])}"
+            value = _estimate(value)
         rows.append((key, value if isinstance(value, str) else cell(value), unit(key)))
     if args.min_first_passage is not None:
         rows.append(
@@ -211,24 +229,19 @@ def run(args) -> int:
         if first is not None:
             lower = first.restricted_mean
             rows.append(("first_passage_monte_carlo",
-                         f"{cell(first.mean.mean)} ± {cell(first.mean.ci95)}" if first.mean
-                         else f">= {cell(lower.mean)} ± {cell(lower.ci95)} (censored)", "s"))  # fmt: skip
+                         estimate(first.mean.mean, first.mean.ci95) if first.mean
+                         else f">= {estimate(lower.mean, lower.ci95)} (censored)", "s"))  # fmt: skip
             rows.append(("first_passage_confirmed", str(out["first_passage_confirmed"]), ""))
     rows.append(("efficiency", cell(out["efficiency"]), unit("efficiency")))
-    if out["limit"] is None:
-        rows.append(("limit", "none (white noise)", ""))
-    else:
-        rows.append(("limit", cell(out["limit"]), unit("limit")))
-    if out["limit_kind"] is not None:
-        rows.append(("limit_kind", out["limit_kind"], ""))
+    rows += result.limit_rows(cell)
     if out.get("monte_carlo_input") is not None:
         rows.append(("monte_carlo_input", out["monte_carlo_input"], ""))
-    if out["fraction_of_limit"] is not None:
-        rows.append(
-            ("fraction_of_limit", cell(out["fraction_of_limit"]), unit("fraction_of_limit"))
-        )
     if result.refined:
         cost = result.analytic_cost
-        rows.append(("analytic optimum's cost", f"{cell(cost.mean)} ± {cell(cost.ci95)}", "W"))
+        rows.append(("analytic optimum's cost", estimate(cost.mean, cost.ci95), "W"))
     print_table(rows, ("quantity", "value", "unit"))
-    return 0
+    for key in ("limit_kind", "causal_limit_kind"):  # words: below the table, not in a column
+        if out.get(key) is not None:
+            print(f"{key.replace('_kind', '')}: {out[key]}")
+    for note in result.notes:
+        print(f"note: {note}")

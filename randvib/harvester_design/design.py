@@ -21,24 +21,31 @@ names the parameters to choose with their ranges. The design
    it by Monte Carlo on the confirmed candidates (each path's first time
    beyond the stroke, :class:`randvib.statistics.FirstPassage`);
 5. reports the power the excitation delivers (m S / 4 under white noise),
-   the efficiency, and the fraction of the limit: under a spectrum the
-   stationary bound at the budget's displacement variance
-   (:func:`randvib.analytic.harvesting_limit.harvesting_limit`); on a record
-   the non-causal bound on the record itself with |z| <= stroke
+   the efficiency, and the fractions of the limits: under a spectrum the
+   stationary non-causal bound at the budget's displacement variance
+   (:func:`randvib.analytic.harvesting_limit.harvesting_limit`; a bound for
+   every linear device meeting the budget, not for every device), the same
+   bound with E[z^2] <= d^2 (any device within |z| <= d), and the causal
+   bound a device can approach
+   (:func:`randvib.analytic.harvesting_limit.causal_harvesting_limit`); on
+   a record the non-causal bound on the record itself with |z| <= stroke
    (:func:`randvib.analytic.harvesting_limit.record_harvesting_limit`).
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Mapping
 from types import SimpleNamespace
 
 import numpy as np
 
 from randvib.analytic.harvesting_limit import (
+    causal_harvesting_limit,
     gaussian_displacement_budget,
     harvesting_limit,
+    predictable_spectrum,
     record_harvesting_limit,
 )
 from randvib.harvester_design.objectives import objective_named
@@ -54,6 +61,7 @@ from randvib.harvester_design.search import (
 from randvib.harvester_design.space import DesignSpace
 from randvib.models.excitation import Measured, as_excitation
 from randvib.models.harvester import Harvester
+from randvib.montecarlo.bridge_step import BridgeIdleWarning, bridge_input_rms, never_conducted
 from randvib.montecarlo.ensembles import Case, EnsembleResult, run_ensembles
 from randvib.montecarlo.on_record import monte_carlo_on_record
 from randvib.montecarlo.sweep import SweepSettings
@@ -172,14 +180,7 @@ def design(
     >>> print(f"k = {result.optimum['k']:.1f} N/m, c_e = {result.optimum['c_e']:.3f} Ns/m")
     k = 59.1 N/m, c_e = 0.456 Ns/m
     """
-    if min_first_passage is not None and not (
-        isinstance(min_first_passage, (int, float))
-        and math.isfinite(min_first_passage)
-        and min_first_passage > 0
-    ):
-        raise ValueError(
-            f"`min_first_passage` must be a finite time > 0 (s), got {min_first_passage!r}"
-        )
+    _check_min_first_passage(min_first_passage)
     stroke = harvester.stroke if stroke is None else stroke
     if stroke is None:
         raise ValueError("`stroke` is needed: the design's budget is on P(|z| > stroke)")
@@ -191,12 +192,8 @@ def design(
         raise ValueError(refusal)
     excitation = as_excitation(excitation)
     space = DesignSpace(fixed, vary)
-    if isinstance(excitation, Measured) and fixed.c_m > 0:
-        limit = record_harvesting_limit(fixed.m, fixed.c_m, excitation, stroke, progress=progress)
-        limit_kind = "record: non-causal, |z| <= stroke"
-    else:
-        limit = harvesting_limit(fixed.m, fixed.c_m, excitation, sigma_budget)
-        limit_kind = None if limit is None else "stationary: E[z^2] <= sigma_z^2 of the budget"
+    limits = _limit(fixed, excitation, stroke, sigma_budget, progress)
+    limit = limits.pop("limit")  # the result builders give it beside its fraction
     try:
         search = analytic_search(space, excitation, exceedance, goal, runners_up, min_first_passage)
     except NothingPredicted as exc:
@@ -208,34 +205,117 @@ def design(
     confirmed_on = "record windows" if isinstance(excitation, Measured) else "simulated paths"
     common = dict(objective=goal.name, stroke=float(stroke), exceedance_budget=float(exceedance),
                   evaluations=0 if search is None else search.evaluations,
-                  min_first_passage=min_first_passage, limit_kind=limit_kind)  # fmt: skip
+                  min_first_passage=min_first_passage, **limits)  # fmt: skip
     if monte_carlo:
         common["monte_carlo_input"] = confirmed_on
     if not monte_carlo:
-        best = search.optimum
-        return DesignResult(
-            optimum=best.values,
-            analytic_optimum=best.values,
-            method=best.method,
-            device=space.device(best.u),
-            power_predicted=best.power,
-            exceedance_predicted=best.exceedance,
-            power_monte_carlo=None,
-            stroke_exceedance_monte_carlo=None,
-            input_power=best.input_power,
-            efficiency=best.power / best.input_power,
-            limit=limit,
-            fraction_of_limit=None if limit is None else best.power / limit,
-            runners_up=[_runner(c) for c in search.runners_up],
-            first_passage_predicted=best.first_passage,
-            **common,
-        )
+        return _analytic_result(space, search, limit, common)
     settings = settings or SweepSettings(
         target_rel_ci=0.01, control_variates=excitation.is_white, max_paths=2048
     )
+    common["monte_carlo_precision"] = settings.target_rel_ci
     run = dict(settings=settings, out_dir=out_dir, executor=executor, workers=workers,
                scheduler=scheduler, progress=progress)  # fmt: skip
     confirmed = _Confirmed(space, excitation, goal, run, min_first_passage, segments)
+    best, candidates, chosen = _confirm(confirmed, space, search, exceedance, refine)
+    _require_feasible(confirmed, chosen, stroke, exceedance, min_first_passage)
+    _require_power(confirmed, chosen)
+    return _confirmed_result(confirmed, space, best, chosen, candidates, exceedance, limit, common)
+
+
+def _check_min_first_passage(min_first_passage) -> None:
+    """Refuse a ``min_first_passage`` that is not a finite time > 0 (None: no bound)."""
+    if min_first_passage is not None and not (
+        isinstance(min_first_passage, (int, float))
+        and math.isfinite(min_first_passage)
+        and min_first_passage > 0
+    ):
+        raise ValueError(
+            f"`min_first_passage` must be a finite time > 0 (s), got {min_first_passage!r}"
+        )
+
+
+def _limit(
+    fixed: Harvester, excitation, stroke: float, sigma_budget: float, progress: bool = False
+) -> dict:
+    """The harvesting limits (W) the result compares with, each with what it bounds in words.
+
+    ``limit``: on a record the non-causal bound on the record itself with
+    |z| <= stroke; otherwise the stationary non-causal bound at the budget's
+    Gaussian displacement RMS, which bounds every device with that E[z^2]
+    (every linear device meeting the budget), not every device meeting it.
+    ``limit_hard_stroke``: the bound for any device held within |z| <= stroke
+    (E[z^2] <= d^2). ``causal_limit``: what a causal device can approach at
+    the budget's RMS (:func:`causal_harvesting_limit`; not on a record).
+    ``progress``: a bar over the record bound's chunks (seconds per thousand samples).
+    """
+    m, c_m = fixed.m, fixed.c_m
+    if isinstance(excitation, Measured) and c_m > 0:
+        limit = record_harvesting_limit(m, c_m, excitation, stroke, progress=progress)
+        return dict(
+            limit=limit, limit_hard_stroke=limit, causal_limit=None,
+            limit_kind="record, non-causal (the whole record known): any device within "
+            "|z| <= stroke, from rest",
+            causal_limit_kind="not computed on a record",
+        )  # fmt: skip
+    limit = harvesting_limit(m, c_m, excitation, sigma_budget)
+    causal = causal_harvesting_limit(m, c_m, excitation, sigma_budget)
+    if excitation.is_white:
+        causal_kind = "causal: m S / 4, the power white noise injects (any budget)"
+    elif predictable_spectrum(excitation):
+        lo, hi = excitation.support
+        causal_kind = (
+            f"causal = non-causal: the spectrum vanishes outside {lo:g}-{hi:g} Hz, so its past "
+            "determines its future (Paley-Wiener)"
+        )
+    else:
+        causal_kind = None if causal is None else (
+            "causal (Wiener-Hopf) at the budget's Gaussian RMS: the best linear active "
+            "transducer approaches it"
+        )  # fmt: skip
+    return dict(
+        limit=limit,
+        limit_kind=None if limit is None else (
+            "stationary, non-causal: any device with E[z^2] at most the budget's Gaussian "
+            "RMS squared, so every linear device meeting the budget, not every device "
+            "(limit_hard_stroke: any within |z| <= stroke)"
+        ),
+        limit_hard_stroke=harvesting_limit(m, c_m, excitation, stroke),
+        causal_limit=causal,
+        causal_limit_kind=causal_kind,
+    )  # fmt: skip
+
+
+def _analytic_result(space: DesignSpace, search, limit, common: dict) -> DesignResult:
+    """The analytic answer alone (``monte_carlo=False``): the search's optimum and runners-up."""
+    best = search.optimum
+    return DesignResult(
+        optimum=best.values,
+        analytic_optimum=best.values,
+        method=best.method,
+        device=space.device(best.u),
+        power_predicted=best.power,
+        exceedance_predicted=best.exceedance,
+        power_monte_carlo=None,
+        stroke_exceedance_monte_carlo=None,
+        input_power=best.input_power,
+        efficiency=best.power / best.input_power,
+        limit=limit,
+        fraction_of_limit=None if limit is None else best.power / limit,
+        runners_up=[_runner(c) for c in search.runners_up],
+        first_passage_predicted=best.first_passage,
+        **common,
+    )
+
+
+def _confirm(confirmed: _Confirmed, space: DesignSpace, search, exceedance: float, refine: bool):
+    """Steps 2 and 3 of the design: confirm the candidates by Monte Carlo, refine on disagreement.
+
+    ``search`` None (no method predicts the range): Monte Carlo searches a
+    coarse grid, then refines. Returns ``(best, candidates, chosen)``: the
+    analytic optimum (None without a search), the candidates confirmed beside
+    it, and the chosen one.
+    """
     if search is None:  # Monte Carlo searches a coarse grid, then refines
         best = None
         candidates = [confirmed.point(u) for u in space.grid(COARSE if space.dimension > 1 else 5)]
@@ -260,6 +340,13 @@ def design(
             step /= 3.0
     if best is not None and chosen is not best and not confirmed.better(chosen, best, exceedance):
         chosen = best  # Monte Carlo's maximum is not significantly better: keep the analytic one
+    return best, candidates, chosen
+
+
+def _require_feasible(
+    confirmed: _Confirmed, chosen, stroke: float, exceedance: float, min_first_passage
+) -> None:
+    """Raise :class:`InfeasibleBudget` when Monte Carlo rejects the chosen device's budget."""
     x = confirmed.exceedance(chosen)
     if not _within(x, exceedance):
         where = ", ".join(f"{k} = {v:.6g}" for k, v in chosen.values.items())
@@ -276,6 +363,38 @@ def design(
             f"|z| > {stroke:g} m) is not met by the best device within the stroke budget: "
             f"Monte Carlo gives {first.mean:.3g} ± {first.ci95:.2g} s (at {where})"
         )
+
+
+def _require_power(confirmed: _Confirmed, chosen) -> None:
+    """Refuse an optimum of zero power: no candidate delivered any, so none is best.
+
+    A diode bridge that never conducted says why (its transducer's RMS voltage
+    against the threshold) and what would help.
+    """
+    if confirmed.power(chosen).mean > 0.0:
+        return
+    result, i = confirmed.where[id(chosen)]
+    run = result.simulation(i)
+    why = "no candidate in the ranges delivered any power"
+    if run.harvester.is_rectified and never_conducted(run):
+        where = ", ".join(f"{k} = {v:.6g}" for k, v in chosen.values.items())
+        advice = run.harvester.electrical.idle_advice(bridge_input_rms(run))
+        why += f"; at {where}, {advice}"
+    raise ValueError(f"the design has no optimum: {why}")
+
+
+def _confirmed_result(
+    confirmed: _Confirmed,
+    space: DesignSpace,
+    best,
+    chosen,
+    candidates,
+    exceedance: float,
+    limit,
+    common: dict,
+) -> DesignResult:
+    """The design confirmed by Monte Carlo: the chosen device, its runners-up, the analytic cost."""
+    x = confirmed.exceedance(chosen)
     power = confirmed.power(chosen)
     input_power = confirmed.input_power(chosen)
     return DesignResult(
@@ -392,7 +511,9 @@ class _Confirmed:
             from pathlib import Path
 
             out_dir = Path(out_dir) / f"batch{len(self.candidates)}"
-        result = run_ensembles(cases, **{**run, "out_dir": out_dir}, name="design")
+        with warnings.catch_warnings():  # a candidate whose bridge never conducts is only
+            warnings.simplefilter("ignore", BridgeIdleWarning)  # a poor one; _require_power
+            result = run_ensembles(cases, **{**run, "out_dir": out_dir}, name="design")
         for i, c in enumerate(new):
             self.where[id(c)] = (result, i)
         self.candidates += new

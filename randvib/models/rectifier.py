@@ -186,6 +186,42 @@ class Rectified(Coupling):
         out = self.battery if self.has_battery else v_out
         return out + 2.0 * self.v_diode
 
+    #: The transducer's voltage that must exceed the threshold, in words (for messages).
+    input_words: str = ""
+
+    def idle_advice(self, input_rms: float, v_out: float = 0.0) -> str:
+        """Why a bridge that never conducted stored nothing, and what would help (one sentence).
+
+        Parameters
+        ----------
+        input_rms : float
+            RMS of the transducer's open-circuit voltage (V): the coil's EMF
+            ``alpha z'``, the piezo's ``theta z / C_p``.
+        v_out : float
+            The storage capacitor's voltage (V); a battery's is its own.
+        """
+        threshold = self.threshold(v_out)
+        ratio = threshold / input_rms if input_rms > 0 else np.inf
+        output = "V_b + 2 V_d" if self.has_battery else "V_C + 2 V_d"
+        helps = [
+            f"a {ratio:.2g}-fold larger voltage, from more turns or a stronger coupling "
+            f"({self._coupling_name}), or a step-up transformer or converter of that ratio"
+        ]
+        if 2.0 * self.v_diode >= input_rms:
+            helps.append(
+                f"a lower-drop rectifier (Schottky or active diodes): the drops 2 V_d = "
+                f"{2.0 * self.v_diode:.3g} V alone are {2.0 * self.v_diode / input_rms:.2g} "
+                "times the RMS"
+            )
+        return (
+            f"the bridge never conducted: the {self.input_words} (RMS {input_rms:.3g} V) never "
+            f"reached {output} = {threshold:.3g} V ({ratio:.3g} times its RMS), so nothing "
+            f"was stored; what would help: {'; '.join(helps)}"
+        )
+
+    #: The coupling parameter that scales the transducer's voltage.
+    _coupling_name: str = ""
+
     def linear_surrogate(self) -> Coupling:  # pragma: no cover - abstract
         """A linear coupling with the bridge's largest damping, for the step check and start."""
         raise NotImplementedError
@@ -253,7 +289,9 @@ class BridgeCoil(Rectified):
 
     transducer = "inductive"
     name = "inductive bridge"
+    input_words = "coil's EMF alpha z'"
     _code = COIL
+    _coupling_name = "alpha"
 
     def __post_init__(self):
         super().__post_init__()
@@ -348,7 +386,9 @@ class BridgePiezo(Rectified):
 
     transducer = "piezo"
     name = "piezo bridge"
+    input_words = "piezo's open-circuit voltage theta z / C_p"
     _code = PIEZO
+    _coupling_name = "theta"
 
     def _transducer_parameters(self):
         return self.theta, self.capacitance

@@ -34,16 +34,18 @@ class BridgeStepWarning(RuntimeWarning):
     """Halving the time step changes a bridge's stored power noticeably."""
 
 
-def bridge_step_change(harvester, psd, dt: float, scheme: str, t_end: float, seed: int = 0):
+def bridge_step_change(
+    simulate, harvester, psd, dt: float, scheme: str, t_end: float, seed: int = 0
+):
     """Relative change of the stored power, and its 95 % half-width, from dt to dt/2.
 
     A pilot of :data:`PILOT_PATHS` paths over ``min(t_end, PILOT_STEPS dt)``
     from rest, the same Brownian increments at both steps; the change is the
     mean of the paired per-path differences over the dt / 2 mean.
-    Brownian input only: white noise or a shaping filter.
+    Brownian input only: white noise or a shaping filter. ``simulate`` is
+    :func:`randvib.simulate`, handed in by the driver that calls this check
+    (so that this module and the driver need not import each other).
     """
-    from randvib.montecarlo.simulation import simulate
-
     n_coarse = int(min(round(t_end / dt), PILOT_STEPS))
     rng = np.random.default_rng([seed, 2])
     fine = rng.normal(0.0, np.sqrt(dt / 2.0), (PILOT_PATHS, 2 * n_coarse))
@@ -64,13 +66,14 @@ def bridge_step_change(harvester, psd, dt: float, scheme: str, t_end: float, see
     return float(np.mean(diff)), float(1.96 * np.std(diff, ddof=1) / np.sqrt(diff.size))
 
 
-def check_bridge_step(run) -> None:
+def check_bridge_step(run, simulate) -> None:
     """Warn when halving the step changes the bridge's stored power by more than 1 %.
 
     Only a change beyond the pilot's own 95 % interval counts; the warning
     gives the step that would bring it under :data:`BRIDGE_STEP_TOLERANCE`
     at the measured order :data:`BRIDGE_ORDER`. Synthesised or recorded input
-    (no Brownian increments to halve) is not checked.
+    (no Brownian increments to halve) is not checked. ``simulate`` runs the
+    pilot (:func:`bridge_step_change`).
     """
     excitation = run.excitation
     if run.driver is not None or excitation.shaping_filter() is None:
@@ -78,7 +81,7 @@ def check_bridge_step(run) -> None:
     psd = excitation if not excitation.is_white else run.psd
     dt = run.grid.dt
     change, half_width = bridge_step_change(
-        run.harvester, psd, dt, run.scheme.name, run.grid.t_end, run.seed
+        simulate, run.harvester, psd, dt, run.scheme.name, run.grid.t_end, run.seed
     )
     if abs(change) > BRIDGE_STEP_TOLERANCE and abs(change) > half_width:
         quiet = dt * (BRIDGE_STEP_TOLERANCE / abs(change)) ** (1.0 / BRIDGE_ORDER)
@@ -118,6 +121,56 @@ def check_bridge_balance(result) -> None:
             EnergyBalanceWarning,
             stacklevel=3,
         )
+
+
+class BridgeIdleWarning(RuntimeWarning):
+    """A bridge never conducted: its transducer's voltage never reached the threshold."""
+
+
+def bridge_input_rms(result) -> float:
+    """RMS of the transducer's open-circuit voltage (V) in a run whose bridge never conducted.
+
+    The coil's EMF ``alpha z'`` or the piezo's ``theta z / C_p``, from the
+    run's own E[z'^2] or E[z^2] (the motion of a bridge that never conducts
+    is the open-circuit motion).
+    """
+    bridge = result.harvester.electrical
+    averages = result.averages
+    if bridge.transducer == "piezo":
+        return bridge.theta / bridge.capacitance * float(np.sqrt(np.mean(averages.z2)))
+    return bridge.alpha * float(np.sqrt(np.mean(averages.v2)))
+
+
+def never_conducted(result) -> bool:
+    """No path of a bridge run carried current, though its threshold V_out + 2 V_d is above 0.
+
+    The current shows in the coil's and the diodes' losses and in a battery's
+    stored power (a storage capacitor's is also its discharge); a threshold
+    of 0 (a battery of 0 V or a capacitor with ideal diodes) conducts without
+    storing, which is no idle bridge.
+    """
+    averages = result.averages
+    bridge = result.harvester.electrical
+    carried = averages.coil_loss + averages.diode_loss
+    if bridge.has_battery:
+        carried = carried + averages.stored_power
+        blocked = bridge.threshold() > 0.0
+    else:
+        blocked = bridge.v_diode > 0.0
+    return blocked and bool(np.all(carried == 0.0))
+
+
+def check_bridge_conducted(result) -> None:
+    """Warn (:class:`BridgeIdleWarning`) when a bridge run stored nothing because it never
+    conducted: the transducer's voltage, its RMS and the threshold, and what would help."""
+    if not result.harvester.is_rectified or not never_conducted(result):
+        return
+    advice = result.harvester.electrical.idle_advice(bridge_input_rms(result))
+    warnings.warn(
+        f"{advice} ({result.n_paths} paths x {result.averaging_time:g} s)",
+        BridgeIdleWarning,
+        stacklevel=3,
+    )
 
 
 def storage_start(run) -> float:

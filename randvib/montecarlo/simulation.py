@@ -62,7 +62,11 @@ from randvib.models.excitation import Excitation
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import driven
 from randvib.montecarlo.batches import batch_bounds, run_batches
-from randvib.montecarlo.bridge_step import check_bridge_balance, check_bridge_step
+from randvib.montecarlo.bridge_step import (
+    check_bridge_balance,
+    check_bridge_conducted,
+    check_bridge_step,
+)
 from randvib.montecarlo.kernel_setup import KernelSetup
 from randvib.montecarlo.resources import announce_long_run, check_resources
 from randvib.montecarlo.results import SimulationResult
@@ -240,7 +244,7 @@ def execute(run: Run, *, control_variates, check_step, threads, batch_paths, pro
     if check_step:
         linear().check_step(run.scheme.name, run.grid.dt)
         if run.harvester.is_rectified:  # the switching, which the linear check cannot see
-            check_bridge_step(run)
+            check_bridge_step(run, simulate)  # the pilot runs through the driver
     setup = KernelSetup.prepare(run, linear)
     if threads is not None:
         threads = check_int("threads", threads, 1)
@@ -274,4 +278,5 @@ def execute(run: Run, *, control_variates, check_step, threads, batch_paths, pro
     )
     if check_step:  # the per-run identity: every path sums to m S / 4
         check_bridge_balance(result)
+    check_bridge_conducted(result)  # a bridge that stored nothing says why
     return result

@@ -125,26 +125,7 @@ def simulate_transient(
     0.0163 +- 0.0024  exact 0.0158
     0.0293 +- 0.0041  exact 0.0279
     """
-    if not isinstance(event, Enveloped):
-        raise ValueError(
-            "`event` must be a randvib.Enveloped (an excitation times an envelope, e.g. "
-            f"rv.Enveloped(rv.White(1.0), rv.Step())); got {event!r}; for stationary "
-            "statistics use randvib.simulate"
-        )
-    if event.excitation.name == "measured":
-        raise ValueError(
-            "an event ensemble needs independent paths, and a measured record is one "
-            "realisation: pass its spectrum, rv.Enveloped(record.spectrum, envelope), for "
-            "Gaussian paths with the record's Welch PSD"
-        )
-    if not isinstance(harvester, Harvester):
-        raise ValueError(f"`harvester` must be a randvib.Harvester, got {type(harvester).__name__}")
-    if harvester.is_rectified:
-        raise ValueError(
-            f"simulate_transient does not take the {harvester.electrical.name} coupling: "
-            "a bridge's events are not implemented; simulate its stationary response "
-            "with randvib.simulate"
-        )
+    _check_case(harvester, event)
     start = EventStart.of(start, harvester)
     run = validated(
         harvester,
@@ -164,18 +145,7 @@ def simulate_transient(
     if run.n_paths < 2:
         raise ValueError(f"`n_paths` must be >= 2 for the intervals, got {run.n_paths}")
     snap_steps = snapshot_steps(times, run.grid.dt, run.grid.n_steps)
-    check_options(run, False)
-    check_resources(run, batch_paths)
-    check_memory(
-        f"keeping {run.n_paths} paths at {snap_steps.size} times",
-        8.0 * run.n_paths * (snap_steps.size * kernel.N_SNAP + kernel.N_EVENT + kernel.N_ACC),
-        "give fewer `times` or fewer `n_paths`, or run in parts with `first_path`",
-    )
-    check_memory(  # the envelope's gain on every step (Gauss-Legendre nodes, a few arrays)
-        f"the envelope's gain on each of the {run.grid.n_steps:.4g} steps of t_end / dt",
-        8.0 * run.grid.n_steps * (4 * ENVELOPE_NODES + 8),
-        "shorten `t_end` (the last of `times`) or lengthen `dt`",
-    )
+    _check_resources(run, snap_steps, batch_paths)
     # The step check and the scales read the device linearised at the envelope's peak.
     system = LinearTestSystem.of(run.harvester, event.peak_excitation())
 
@@ -213,6 +183,46 @@ def simulate_transient(
         integrals=integrals,
         first_hit=first_hit,
         wall_time=time.perf_counter() - started,
+    )
+
+
+def _check_case(harvester, event) -> None:
+    """Refuse, in one line, a case :func:`simulate_transient` does not take."""
+    if not isinstance(event, Enveloped):
+        raise ValueError(
+            "`event` must be a randvib.Enveloped (an excitation times an envelope, e.g. "
+            f"rv.Enveloped(rv.White(1.0), rv.Step())); got {event!r}; for stationary "
+            "statistics use randvib.simulate"
+        )
+    if event.excitation.name == "measured":
+        raise ValueError(
+            "an event ensemble needs independent paths, and a measured record is one "
+            "realisation: pass its spectrum, rv.Enveloped(record.spectrum, envelope), for "
+            "Gaussian paths with the record's Welch PSD"
+        )
+    if not isinstance(harvester, Harvester):
+        raise ValueError(f"`harvester` must be a randvib.Harvester, got {type(harvester).__name__}")
+    if harvester.is_rectified:
+        raise ValueError(
+            f"simulate_transient does not take the {harvester.electrical.name} coupling: "
+            "a bridge's events are not implemented; simulate its stationary response "
+            "with randvib.simulate"
+        )
+
+
+def _check_resources(run, snap_steps: np.ndarray, batch_paths) -> None:
+    """The run's options, its memory and time, the snapshots it keeps and the envelope's gains."""
+    check_options(run, False)
+    check_resources(run, batch_paths)
+    check_memory(
+        f"keeping {run.n_paths} paths at {snap_steps.size} times",
+        8.0 * run.n_paths * (snap_steps.size * kernel.N_SNAP + kernel.N_EVENT + kernel.N_ACC),
+        "give fewer `times` or fewer `n_paths`, or run in parts with `first_path`",
+    )
+    check_memory(  # the envelope's gain on every step (Gauss-Legendre nodes, a few arrays)
+        f"the envelope's gain on each of the {run.grid.n_steps:.4g} steps of t_end / dt",
+        8.0 * run.grid.n_steps * (4 * ENVELOPE_NODES + 8),
+        "shorten `t_end` (the last of `times`) or lengthen `dt`",
     )
 
 
