@@ -166,12 +166,17 @@ class DesignResult:
     @property
     def notes(self) -> list[str]:
         """Statements the numbers need: an inactive stroke budget, a missed precision target."""
-        notes, seen = [], []  # the largest exceedance each source allows, and its words
-        if math.isfinite(self.exceedance_predicted):
+        notes, seen = [], []  # the exceedance each source allows, and its words
+        predicted = math.isfinite(self.exceedance_predicted)
+        if predicted:
             seen.append((self.exceedance_predicted, f"{self.exceedance_predicted:.2g} predicted"))
         x = self.stroke_exceedance_monte_carlo
-        if x is not None:  # inactive only if Monte Carlo's interval agrees
-            seen.append((x.mean + x.ci95, f"{formatting.estimate(x.mean, x.ci95)} by Monte Carlo"))
+        if x is not None:
+            # A probability's Wilson interval from n paths that saw nothing still reaches
+            # about 4 / n, far above a budget of 1e-3: beside a prediction Monte Carlo
+            # must not contradict it (its lower end); alone, its upper end must agree.
+            lower, upper = x.interval
+            seen.append((lower if predicted else upper, f"{x} by Monte Carlo"))
         words = ", ".join(w for _, w in seen)
         if seen and max(v for v, _ in seen) < INACTIVE_BUDGET * self.exceedance_budget:
             notes.append(
