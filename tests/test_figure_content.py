@@ -201,6 +201,8 @@ def test_transient_figure_shows_energy_and_the_stroke_and_keeps_its_legend_off_t
     stroke_labels = [line.get_label() for line in stroke_ax.get_lines()]
     assert "linear (Poisson, approximate)" in stroke_labels
     assert "linear (Vanmarcke, approximate)" in stroke_labels
+    (bound,) = [line for line in stroke_ax.get_lines() if "upper bound" in line.get_label()]
+    np.testing.assert_array_equal(bound.get_ydata(), exact.stroke_reached_bound)
     assert all(ax.get_legend() is None for ax in fig.axes) and len(fig.legends) == 1
     twin = next(ax for ax in fig.axes if ax.get_ylabel() == "$e(t)^2$")
     assert twin.get_ylim()[0] == 0.0 == axes[0].get_ylim()[0]

@@ -8,7 +8,8 @@ markers with their 95 % interval and a shaded band; the energy of the whole
 event as one marker at its end; a probability with its Wilson interval) and
 from the Lyapunov equation (:class:`randvib.TransientPrediction`: lines; the
 out-crossing approximations of the stroke, Poisson and Vanmarcke, dashed and
-labelled approximate). A dotted line shows the envelope's intensity e(t)^2 on
+labelled approximate, with Rice's upper bound, the expected number of
+out-crossings). A dotted line shows the envelope's intensity e(t)^2 on
 a second axis whose zero is the first axis' zero. Journal layout: SI units on
 every axis (mm^2, mW and mJ where they read better), one legend below the
 panels (never over the data), constrained layout.
@@ -175,10 +176,14 @@ def _stroke(ax, label, result, colour, monte_carlo) -> None:
         _statistic(ax, np.asarray(result.times), result.stroke_reached, 1.0, colour,
                    f"{label} (Monte Carlo, 95 %)")  # fmt: skip
         return
-    for name, style, words in (("stroke_reached_poisson", "--", "Poisson"),
-                               ("stroke_reached_vanmarcke", "-.", "Vanmarcke")):  # fmt: skip
-        values = getattr(result, name)
+    # Vanmarcke's falls below Monte Carlo early in an event (the envelope's clumping is
+    # the stationary one): Rice's bound, the expected out-crossings, is drawn above them
+    for name, style, words in (("stroke_reached_poisson", "--", "Poisson, approximate"),
+                               ("stroke_reached_vanmarcke", "-.", "Vanmarcke, approximate"),
+                               ("stroke_reached_bound", (0, (5, 1, 1, 1, 1, 1)),
+                                "Rice, an upper bound")):  # fmt: skip
+        values = getattr(result, name, None)
         if values is not None:
-            ax.plot(result.times, values, style, color=colour, lw=1.1,
-                    label=f"{label} ({words}, approximate)")  # fmt: skip
+            ax.plot(result.times, values, linestyle=style, color=colour, lw=1.1,
+                    label=f"{label} ({words})")  # fmt: skip
     ax.set_ylim(top=1.02)
