@@ -444,6 +444,9 @@ def event_files(tmp_path_factory):
          "--envelope-b"),
         (["power", "--preset", "figure9", "--coupling", "inductive", "--rectifier", "bridge",
           "--alpha", "1e200", "--r-coil", "1e-200", "--battery", "0.02", "--psd", "1"], "--alpha"),
+        # refused without naming a flag before (the design's infeasible budget)
+        (["design", "--preset", "figure9", "--psd", "1", "--stroke", "0.005", "--vary", "k=40:80",
+          "--no-monte-carlo", "--no-progress", "--exceedance", "1e-300"], "--exceedance"),
         # ran without end before
         (["design", "--preset", "figure9", "--psd", "1", "--stroke", "0.005", "--vary", "k=40:80",
           "--precision", "1e-300"], "--precision"),
@@ -456,6 +459,8 @@ def test_new_flags_at_extreme_values_are_refused_in_one_line_naming_the_flag(
     code, out, err = _run(capsys, argv)
     _check_contract(code, out, err, False)
     assert code == 2 and f"`{flag}" in err, err
+    if flag == "--exceedance":  # the budget is the stroke's, in the ranges varied
+        assert "`--stroke` = 0.005 m" in err and "(`--vary`)" in err, err
 
 
 def test_a_unit_peak_envelope_with_rates_far_apart_peaks_at_one():

@@ -284,9 +284,9 @@ def analytic_search(
             if best.exceedance > budget:
                 where = ", ".join(f"{k} = {v:.6g}" for k, v in best.values.items())
                 raise InfeasibleBudget(
-                    f"the stroke budget P(|z| > {space.harvester.stroke:g} m) <= {budget:g} "
-                    f"cannot be met in the ranges given: the best reachable exceedance is "
-                    f"{best.exceedance:.3g} (at {where})"
+                    f"the stroke budget P(|z| > `stroke` = {space.harvester.stroke:g} m) <= "
+                    f"`exceedance` = {budget:g} cannot be met in the ranges given (`vary`): the "
+                    f"best reachable exceedance is {best.exceedance:.3g} (at {where})"
                 )
             within = [best]
         feasible = [c for c in within if meets(c, budget, min_first_passage)]
@@ -396,9 +396,10 @@ def _longest_first_passage(evaluate, within, budget, min_first_passage, space) -
         return best  # the grid missed it: the search goes on from there
     where = ", ".join(f"{k} = {v:.6g}" for k, v in best.values.items())
     raise InfeasibleBudget(
-        f"the first-passage constraint E[tau] >= {min_first_passage:g} s (mean time to "
-        f"|z| > {space.harvester.stroke:g} m) cannot be met in the ranges given within the "
-        f"stroke budget: the longest predicted is {best.first_passage:.3g} s (at {where})"
+        f"the first-passage constraint E[tau] >= {min_first_passage:g} s "
+        f"(`min_first_passage`, the mean time to |z| > `stroke` = {space.harvester.stroke:g} m) "
+        "cannot be met in the ranges given (`vary`) within the stroke budget: the longest "
+        f"predicted is {best.first_passage:.3g} s (at {where})"
     )
 
 
