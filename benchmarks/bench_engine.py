@@ -19,6 +19,11 @@ Device: figure9 preset with k3 = 5e5 N/m^3 (Duffing + Coulomb), dt = 1e-4 s,
   whole simulation), and the synthesis alone (``synthesis_over_white``: the
   per-path spectral synthesis of the increments, per path-step, against the
   white-noise kernel).
+* the same engine (Heun) with tones on the white noise, as forcing inside the
+  kernel: one and four tones (``tones_over_white``, per path-step, and
+  ``ns_per_tone``, the added cost of one tone per path-step, whose claim is
+  one cosine), and a shock train (``shocks_over_white``: its step integrals
+  drawn per path, then one more addition per step).
 A module fixture prints ns per path-step and the ratios, and writes
 .benchmarks/engine_ratios.json. Set RANDVIB_BENCH_FULL_MEMORY=1 to also run the
 10^5 paths x 10^6 steps memory case (about 10 minutes on 2 cores).
@@ -59,6 +64,17 @@ COIL = rv.Harvester.with_coupling(
 
 #: The paper's shaker band, synthesised per path.
 BAND_LIMITED = BandLimited(PSD, 4.0, 20.0)
+
+#: Tones and shocks on the white floor, as the kernel's forcing.
+FORCING = {
+    "1-tone": rv.White(PSD) + rv.Tone(8.0, 1.0),
+    "4-tones": rv.White(PSD)
+    + rv.Tone(8.0, 1.0)
+    + rv.Tone(16.0, 0.5)
+    + rv.Tone(24.0, 0.3)
+    + rv.Tone(50.0, 0.2),
+    "shocks": rv.White(PSD) + rv.ShockTrain(2.0, 20.0, 0.01),
+}
 
 
 def _run(method, excitation=PSD, device=DEVICE):
@@ -116,6 +132,28 @@ def test_engine_synthesised_input(benchmark, method):
     _run(method, BAND_LIMITED)  # compile / load cache
     benchmark.pedantic(_run, args=(method, BAND_LIMITED), rounds=5, warmup_rounds=1)
     record(benchmark, f"{method}-band-limited", WORK)
+
+
+@pytest.mark.parametrize("case", list(FORCING))
+def test_engine_forcing(benchmark, case):
+    """Heun on white noise with tones or shocks added as forcing in the kernel."""
+    _run("heun", FORCING[case])  # compile / load cache
+    benchmark.pedantic(_run, args=("heun", FORCING[case]), rounds=5, warmup_rounds=1)
+    record(benchmark, f"heun-{case}", WORK)
+
+
+def _forcing_ratios():
+    """Tones and shocks over the white Heun kernel, and one tone's cost (ns per path-step)."""
+    if "heun" not in TIMINGS:
+        return {}
+    out = {
+        f"{case}_over_white": TIMINGS[f"heun-{case}"] / TIMINGS["heun"]
+        for case in FORCING
+        if f"heun-{case}" in TIMINGS
+    }
+    if "heun-4-tones" in TIMINGS:
+        out["ns_per_tone"] = (TIMINGS["heun-4-tones"] - TIMINGS["heun"]) / 4 * 1e9
+    return out
 
 
 def test_synthesis_alone(benchmark):
@@ -230,6 +268,8 @@ def ratios_and_memory():
         print(f"\ncircuit_over_white: {_over_white('circuit')}")
     if any(_synthesis_ratios().values()):
         print(f"\n{_synthesis_ratios()}")
+    if _forcing_ratios():
+        print(f"\nforcing (heun): {_forcing_ratios()}")
     needed = {"floor", "euler-maruyama", "heun", "sdeint", "numpy"}
     if not needed <= TIMINGS.keys():
         return  # a subset was run: no ratios
@@ -248,6 +288,7 @@ def ratios_and_memory():
         "filter_over_white": _filter_over_white(),
         "circuit_over_white": _over_white("circuit"),
         **_synthesis_ratios(),
+        "forcing_over_white_heun": _forcing_ratios(),
         # (RSS before the run, peak RSS during it) in MB; the difference is
         # what the simulation itself needs
         "rss_mb_baseline_and_peak": memory,

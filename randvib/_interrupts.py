@@ -145,36 +145,106 @@ def worker_ignores_ctrl_c() -> None:
     signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 
+#: The stop flags of the compiled loops running now (:func:`interruptible`): a
+#: Ctrl-C noticed by :func:`ctrl_c_noticed` sets them, so a loop stops even when
+#: the KeyboardInterrupt itself is swallowed on its way to the caller.
+_RUNNING_LOOPS: dict[int, object] = {}
+#: The signals noticed so far by each :func:`ctrl_c_noticed` block now open: a
+#: loop asked to start after one was swallowed does not start.
+_OPEN_WATCHES: dict[int, list[int]] = {}
+
+
+def _raise_if_noticed(noticed: list[int]) -> None:
+    if noticed:
+        raise Terminated() if noticed[-1] == signal.SIGTERM else KeyboardInterrupt()
+
+
+@contextlib.contextmanager
+def ctrl_c_noticed():
+    """Within the block, a Ctrl-C (or a handled SIGTERM) stops the run even if swallowed.
+
+    Python runs a signal handler between any two bytecodes of the main
+    thread, also inside a ``__del__`` method, a weakref or gc callback or a
+    ctypes callback that happens to run then; a KeyboardInterrupt raised
+    there is reported as "Exception ignored" and lost, and a long run went
+    on to its end (tests/test_interrupts.py reproduces it with a gc callback).
+    Within the block the handler also notes the signal and sets the stop
+    flag of every running compiled loop (:func:`interruptible`), then calls
+    the previous handler (Python's default raises KeyboardInterrupt, the
+    command line's :class:`Terminated` for SIGTERM); a block that ends
+    normally after a noted signal raises it. Main thread only; a handler
+    that is not a Python function (SIG_IGN: the user chose to ignore it;
+    SIG_DFL for SIGTERM: the process ends) is left alone.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    noticed = []
+
+    def notice(signum, frame):
+        noticed.append(signum)
+        for stop in list(_RUNNING_LOOPS.values()):
+            stop[0] = 1
+        previous[signum](signum, frame)
+
+    watched = [s for s, handler in previous.items() if callable(handler)]
+    for s in watched:
+        signal.signal(s, notice)
+    _OPEN_WATCHES[id(noticed)] = noticed  # by identity: two empty lists are equal
+    try:
+        yield
+    finally:
+        del _OPEN_WATCHES[id(noticed)]
+        for s in watched:
+            signal.signal(s, previous[s])
+    _raise_if_noticed(noticed)  # the block ended normally: its interrupt was swallowed
+
+
 def interruptible(compiled, **kwargs):
     """Call a compiled (nogil) loop so that Ctrl-C stops it within a fraction of a second.
 
     A compiled loop does not see signals, so it runs in a worker thread while
     this (main) thread waits; on KeyboardInterrupt the shared ``stop`` flag is
     set, the loop ends at its next check, and KeyboardInterrupt is raised
-    (finished batches, points and fits are kept by the callers).
+    (finished batches, points and fits are kept by the callers). The wait is
+    within :func:`ctrl_c_noticed`: a Ctrl-C swallowed by a finaliser still
+    stops the loop and raises here. The worker thread runs the loop on as
+    many numba threads as the calling thread is set to (numba's setting is
+    per thread, and a new thread starts with all of them).
     """
-    import numpy as np  # here: the command line imports this module before it needs numpy
+    import numba  # here: the command line imports this module before it needs numba
+    import numpy as np
 
     stop = np.zeros(1, dtype=np.int64)
     if threading.current_thread() is not threading.main_thread():
         return compiled(stop=stop, **kwargs)  # signals only reach the main thread
     outcome = {}
+    threads = numba.get_num_threads()
 
     def target():
         try:
+            numba.set_num_threads(threads)
             outcome["value"] = compiled(stop=stop, **kwargs)
         except BaseException as exc:  # handed to the caller's thread
             outcome["error"] = exc
 
     worker = threading.Thread(target=target, name="randvib-kernel", daemon=True)
-    worker.start()
+    for noticed in list(_OPEN_WATCHES.values()):  # one swallowed before this loop began
+        _raise_if_noticed(noticed)
+    _RUNNING_LOOPS[id(stop)] = stop
     try:
-        while worker.is_alive():
-            worker.join(0.05)
-    except KeyboardInterrupt:
-        stop[0] = 1
-        worker.join()
-        raise
+        with ctrl_c_noticed():
+            worker.start()
+            try:
+                while worker.is_alive():
+                    worker.join(0.05)
+            except KeyboardInterrupt:
+                stop[0] = 1
+                worker.join()
+                raise
+    finally:
+        del _RUNNING_LOOPS[id(stop)]
     if "error" in outcome:
         raise outcome["error"]
     return outcome["value"]

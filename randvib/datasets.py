@@ -91,3 +91,19 @@ def _read(rows, name):
         rows=rows,
         name=name,
     )
+
+
+def device_names() -> list[str]:
+    """Names of the example device files shipped in ``randvib/data/devices`` (docs/assemblies.md)."""
+    folder = resources.files("randvib").joinpath("data", "devices")
+    return sorted(
+        p.name.removesuffix(".toml") for p in folder.iterdir() if p.name.endswith(".toml")
+    )
+
+
+def device_path(name: str) -> Path:
+    """Path of a shipped example device file, by its name (``host_with_harvester``)."""
+    stem = name.removesuffix(".toml").replace("-", "_")
+    if stem not in device_names():
+        raise ValueError(f"no shipped device file {name!r}; shipped: {', '.join(device_names())}")
+    return Path(str(resources.files("randvib").joinpath("data", "devices", f"{stem}.toml")))

@@ -78,11 +78,17 @@ QUANTITIES: dict[str, Quantity] = {
     "base_displacement": Quantity("m", "base (shaker) displacement y"),
     "force": Quantity("N", "force u on the mass"),
     "relative_displacement": Quantity("m", "displacement z of the mass relative to the base"),
-    "voltage": Quantity("V", "load voltage"),
+    "relative_velocity": Quantity("m/s", "velocity z' of the mass relative to the base"),
+    "voltage": Quantity("V", "load voltage (R_L i of a coil, V of a piezo element)"),
+    "current": Quantity("A", "load current (i of a coil, V / R_L of a piezo element)"),
     # ------------------------------------------------ identification's measurement model
     "k2": Quantity("N/m^2", "quadratic stiffness (an asymmetric spring)"),
     "input_offset": Quantity("input unit", "offset of the input channel"),
     "output_offset": Quantity("m", "offset of the measured displacement"),
+    "velocity_offset": Quantity("m/s", "offset of the measured relative velocity"),
+    "voltage_offset": Quantity("V", "offset of the measured load voltage"),
+    "current_offset": Quantity("A", "offset of the measured load current"),
+    "r_load": Quantity("ohm", "load resistance R_L"),
     # ------------------------------------------------ statistics, predicted or estimated
     "power_electrical": Quantity(
         "W", "expected electrical power E[P_e] = c_e E[z'^2] (Eq. 32)", "E[P_e]"
@@ -90,6 +96,10 @@ QUANTITIES: dict[str, Quantity] = {
     "power_load": Quantity("W", "expected power into the load E[i^2 R_L]", "E[P_L]"),
     "power_mechanical": Quantity("W", "power dissipated mechanically: c_m E[z'^2] + friction"),
     "friction_power": Quantity("W", "power dissipated by friction E[z' F]"),
+    "power_input": Quantity(
+        "W",
+        "mean power the base acceleration injects (assemblies: r^T M r S / 4 under white noise)",
+    ),
     "power_stored": Quantity(
         "W", "power stored through a bridge: V_b E|i| or E[V_C^2] / R_L", "E[P_stored]"
     ),

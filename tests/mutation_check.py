@@ -17,13 +17,16 @@ the modules the mutation cannot reach (numba keys a cached kernel on its own
 bytecode only, not on the functions it calls from other modules, so every
 module that imports the mutated one, directly or not, is recompiled).
 
-Run by hand::
+Run by hand (not in the default suite: 50+ mutants cost about 8 CPU-minutes)::
 
-    python tests/mutation_check.py            # every mutation, its own tests
+    python tests/mutation_check.py --record   # every mutation, its own tests; keeps
+                                              # the outcomes in tests/mutation_results.txt
     python tests/mutation_check.py --list     # the table of mutations
     python tests/mutation_check.py --only noise-variance --full
 
-and in the test suite by ``tests/test_mutations.py`` (marked ``slow``).
+``tests/test_mutations.py`` checks, in the default suite, that every mutation still
+applies to exactly one place, that the kept results name every mutation as caught by
+one of its own tests, and runs one mutant end to end.
 """
 
 from __future__ import annotations
@@ -36,6 +39,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -424,8 +428,8 @@ MUTATIONS: tuple[Mutation, ...] = (
         path="randvib/identification/least_squares.py",
         edits=(
             (
-                "return z[:, self.cost.skip :] + matrix[:, -1:]",
-                "return z[:, self.cost.skip :] - matrix[:, -1:]",
+                "return z[:, self.cost.skip :] + matrix[:, OUTPUT_OFFSET_COLUMN, None]",
+                "return z[:, self.cost.skip :] - matrix[:, OUTPUT_OFFSET_COLUMN, None]",
             ),
         ),
         tests=("tests/test_measurement_model.py::test_sensor_offsets_do_not_change_the_estimate",),
@@ -574,6 +578,478 @@ MUTATIONS: tuple[Mutation, ...] = (
         why="Rice's bound on P(stroke reached) counts half the expected out-crossings (one "
         "side of the barrier): no longer an upper bound; checked against the stationary "
         "rate's exact integral.",
+    ),
+    Mutation(
+        name="tone-step-integral",
+        path="randvib/montecarlo/forcing.py",
+        edits=(
+            (
+                "gain = 2.0 * amplitude * np.sin(0.5 * omega * self.dt) / omega",
+                "gain = 2.02 * amplitude * np.sin(0.5 * omega * self.dt) / omega",
+            ),
+        ),
+        tests=("tests/test_tones.py::test_pathwise_equal_to_a_numpy_heun_on_the_same_input",),
+        why="A tone's step integral 1 % too large in the kernel's forcing; the plain numpy Heun "
+        "writes the integral as (A/w)(sin - sin) and must agree to rounding.",
+    ),
+    Mutation(
+        name="forcing-strang-split",
+        path="randvib/montecarlo/kernel.py",
+        edits=(
+            ("                    vs = vj + kick\n", "                    vs = vj + 2.0 * kick\n"),
+            ("                    vn += kick\n", "                    vn += 0.0 * kick\n"),
+        ),
+        tests=(
+            "tests/test_tones.py::test_tone_forcing_is_second_order_in_dt",
+            "tests/test_tones.py::test_pathwise_equal_to_a_numpy_heun_on_the_same_input",
+        ),
+        why="The forcing given to the velocity all before the step (Lie splitting) instead of "
+        "in two halves around it (Strang): first order in dt, which the convergence test "
+        "against the exact response from rest measures.",
+    ),
+    Mutation(
+        name="campbell-spectrum",
+        path="randvib/models/shock.py",
+        edits=(
+            (
+                "return 2.0 * self.rate * self.amplitude**2 * self.pulse_spectrum(frequency)",
+                "return 2.02 * self.rate * self.amplitude**2 * self.pulse_spectrum(frequency)",
+            ),
+        ),
+        tests=(
+            "tests/test_shocks.py::"
+            "test_pulse_spectrum_is_its_fourier_integral_and_campbell_integrates_to_the_variance",
+        ),
+        why="Campbell's spectrum of a shock train 1 % high (every linear device's analytic power "
+        "under shocks with it); its integral must be lambda E[A^2] int p^2 to 1e-6.",
+    ),
+    Mutation(
+        name="shock-step-integral",
+        path="randvib/models/shock.py",
+        edits=(
+            (
+                "return (d / np.pi) * (1.0 - np.cos(np.pi * s / d))",
+                "return (d / np.pi) * 1.01 * (1.0 - np.cos(np.pi * s / d))",
+            ),
+        ),
+        tests=("tests/test_shocks.py::test_step_integrals_of_a_pulse_are_exact",),
+        why="Monte Carlo's half-sine pulse integrated 1 % too strong over each step; the steps "
+        "are compared with quadrature of the pulse.",
+    ),
+    Mutation(
+        name="harmonic-cubic-first-harmonic",
+        path="randvib/analytic/harmonic_linearisation.py",
+        edits=(
+            (
+                "k_q = k_r - 0.75 * self.k3 * motion.amplitudes**2",
+                "k_q = k_r - 0.7 * self.k3 * motion.amplitudes**2",
+            ),
+        ),
+        tests=("tests/test_tones.py::test_cubic_spring_describing_function_under_a_pure_tone",),
+        why="The cubic spring's describing function under a tone with 3.05/4 instead of 3/4 "
+        "k3 Z^2; the pure tone's k_q is checked against k + 3/4 k3 Z^2 to 1e-12.",
+    ),
+    Mutation(
+        name="harmonic-friction-projection",
+        path="randvib/analytic/harmonic_linearisation.py",
+        edits=(
+            (
+                "np.where(velocity > 0, 2.0 * projections / velocity, 0.0)",
+                "np.where(velocity > 0, 2.02 * projections / velocity, 0.0)",
+            ),
+        ),
+        tests=("tests/test_tones.py::test_coulomb_describing_function_under_a_pure_tone",),
+        why="A tone's friction damping 1 % too strong (its first-harmonic projection); "
+        "Coulomb's describing function 4 Fc / (pi V) is checked to 0.1 %.",
+    ),
+    Mutation(
+        name="translation-scale",
+        path="randvib/models/translation.py",
+        edits=(
+            (
+                "return np.sqrt(fit.variance) * self.marginal.g(y)",
+                "return np.sqrt(1.02 * fit.variance) * self.marginal.g(y)",
+            ),
+        ),
+        tests=(
+            "tests/test_translation.py::"
+            "test_synthesised_translation_has_its_variance_kurtosis_and_spectrum",
+        ),
+        why="The translated input's variance 2 % too large; the synthesised paths' variance is "
+        "compared with the process's, powered for 2 %.",
+    ),
+    Mutation(
+        name="line-projection",
+        path="randvib/montecarlo/spectra.py",
+        edits=(
+            (
+                "amplitude = 2.0 * (x - x.mean(axis=1, keepdims=True)) @ phasors / x.shape[1]",
+                "amplitude = 2.02 * (x - x.mean(axis=1, keepdims=True)) @ phasors / x.shape[1]",
+            ),
+        ),
+        tests=("tests/test_tones.py::test_monte_carlo_lines_are_the_tones_mean_squares",),
+        why="Monte Carlo's lines 2 % high (the projection's amplitude 1 %); a tone alone on a "
+        "linear device must give |H|^2 A^2 / 2 to 0.1 %.",
+    ),
+    Mutation(
+        name="gaussian-verdict-interval",
+        path="randvib/studies/gaussian_error.py",
+        edits=(('size - half > tolerance, "errs"', 'size > tolerance, "errs"'),),
+        tests=(
+            "tests/test_study_non_gaussian.py::test_verdicts_follow_the_interval_and_the_tolerance",
+        ),
+        why="The study's verdict 'errs' without its interval (an error of 6 +- 2 % counted as "
+        "beyond 5 %): the verdicts must follow the whole interval.",
+    ),
+    Mutation(
+        name="assembly-tones-ignored",
+        path="randvib/analytic/method.py",
+        edits=(
+            (
+                '    if tones:\n        listed = ", ".join(f"{tone.frequency:g} Hz" for tone in tones)\n        return (\n            f"{who} does not take',
+                '    if False:\n        listed = ", ".join(f"{tone.frequency:g} Hz" for tone in tones)\n        return (\n            f"{who} does not take',
+            ),
+        ),
+        tests=(
+            "tests/test_translation.py::test_assemblies_take_shocks_and_translations_when_linear_and_refuse_tones",
+        ),
+        why="An assembly answers under tones as if they were absent (the continuous part alone): "
+        "the silent wrong answer the refusal exists to prevent.",
+    ),
+    Mutation(
+        name="assembly-dashpot-to-ground",
+        path="randvib/models/assembly.py",
+        edits=(
+            (
+                "c += element.damping * np.outer(d, d)",
+                "c += element.damping * np.diag(np.abs(d))",
+            ),
+        ),
+        tests=(
+            "tests/test_assembly_analytic.py::test_two_dof_chain_against_a_hand_built_lyapunov_equation",
+        ),
+        why="An element's dashpot between two DOFs acts on each DOF's absolute velocity (two "
+        "dashpots to the base) instead of their relative velocity; the two-DOF chain is "
+        "checked against a Lyapunov equation on a state matrix written by hand.",
+    ),
+    Mutation(
+        name="assembly-circuit-drive",
+        path="randvib/models/assembly.py",
+        edits=(("a[slot, n : 2 * n] = b_s * d", "a[slot, n : 2 * n] = 1.01 * b_s * d"),),
+        tests=(
+            "tests/test_assembly_analytic.py::test_host_with_two_harvesters_against_a_frequency_domain_integral",
+        ),
+        why="A transducer's circuit state is driven 1 % too hard by its relative velocity "
+        "(alpha/L or theta/C_p); the three-DOF host is checked against a frequency-domain "
+        "integral with the circuits as frequency-dependent dashpots, to 1e-8.",
+    ),
+    Mutation(
+        name="assembly-white-input-power",
+        path="randvib/analytic/assembly_linear.py",
+        edits=(
+            (
+                "return float(assembly.influence @ mr * excitation.level / 4.0)",
+                "return float(assembly.influence @ mr * excitation.level / 2.0)",
+            ),
+        ),
+        tests=("tests/test_assembly_analytic.py::test_white_noise_energy_balance_is_exact",),
+        why="The injected power r^T M r S / 2 instead of / 4 (S taken as the two-sided "
+        "intensity: E[w w] = (S/2) delta); the balance is written from the masses in the test.",
+    ),
+    Mutation(
+        name="assembly-spectral-conjugate",
+        path="randvib/analytic/assembly_linear.py",
+        edits=(
+            (
+                "covariance = np.real((h * density) @ h.conj().T)",
+                "covariance = np.real((h * density) @ h.T)",
+            ),
+        ),
+        tests=(
+            "tests/test_assembly_analytic.py::test_spectral_route_equals_lyapunov_for_three_dofs",
+        ),
+        why="The spectral covariance int Re(H H^H) S df without the conjugate: the "
+        "cross-covariances (and with them the variances' real parts) are wrong; the two "
+        "routes must agree to 1e-9 as correlations.",
+    ),
+    Mutation(
+        name="assembly-cubic-closure",
+        path="randvib/analytic/assembly_linearisation.py",
+        edits=(
+            (
+                "k += 3.0 * element.spring.k3 * variance * np.outer(d, d)",
+                "k += 3.3 * element.spring.k3 * variance * np.outer(d, d)",
+            ),
+        ),
+        tests=(
+            "tests/test_assembly_analytic.py::test_one_dof_assembly_equals_the_harvester",
+            "tests/test_assembly_analytic.py::test_nonlinear_fixed_point_is_self_consistent",
+        ),
+        why="An element's Gaussian-closure spring 3.3 k3 E[u^2] instead of 3 k3 E[u^2]; the "
+        "one-DOF assembly must equal the single-mass linearisation under coloured input.",
+    ),
+    Mutation(
+        name="assembly-friction-closure",
+        path="randvib/analytic/assembly_linearisation.py",
+        edits=(("sigma = np.sqrt(variance)", "sigma = np.sqrt(1.02 * variance)"),),
+        tests=("tests/test_assembly_analytic.py::test_one_dof_coulomb_under_white_noise_is_eq_30",),
+        why="The friction's equivalent dashpot evaluated at a velocity spread 1 % too large; "
+        "the one-DOF assembly under white noise must give Eq. 30 written out by hand.",
+    ),
+    Mutation(
+        name="modal-participation-transposed",
+        path="randvib/models/structure.py",
+        edits=(("r = phi @ gamma", "r = phi.T @ gamma"),),
+        tests=("tests/test_assembly.py::test_modal_host_keeps_its_modes_and_participation",),
+        why="A modal host's influence vector from the transposed mode-shape matrix; r = Phi "
+        "gamma is checked with a non-symmetric Phi.",
+    ),
+    Mutation(
+        name="ljung-box-dof",
+        path="randvib/identification/residuals.py",
+        edits=(
+            ("return q, float(stats.chi2.sf(q, m))", "return q, float(stats.chi2.sf(q, m - 1))"),
+        ),
+        tests=(
+            "tests/test_residuals.py::test_ljung_box_is_its_definition",
+            "tests/test_residuals.py::test_false_alarm_rates_of_white_residuals_hold_their_levels",
+        ),
+        why="The Ljung-Box p-value from chi-squared with M - 1 degrees of freedom instead of "
+        "M (at M = 25 its false alarms rise from 1 % to 1.4 %): Q and its p-value against "
+        "the definition computed in the test; over 1000 white residuals (M = 10) 60 % of "
+        "p-values fall below 0.5 instead of 50 %.",
+    ),
+    Mutation(
+        name="ljung-box-n-plus-2",
+        path="randvib/identification/residuals.py",
+        edits=(("q = float(n * (n + 2) * np.sum(", "q = float(n * n * np.sum("),),
+        tests=("tests/test_residuals.py::test_ljung_box_is_its_definition",),
+        why="Ljung-Box's N (N + 2) becomes N^2, Q too small by N / (N + 2) (1 % at N = 200): "
+        "against the definition computed in the test.",
+    ),
+    Mutation(
+        name="ljung-box-n-minus-k",
+        path="randvib/identification/residuals.py",
+        edits=(("r**2 / (n - np.arange(1, m + 1))", "r**2 / (n - np.arange(0, m))"),),
+        tests=("tests/test_residuals.py::test_ljung_box_is_its_definition",),
+        why="Lag k of Ljung-Box's sum weighted by 1 / (N - k + 1) instead of 1 / (N - k): "
+        "against the definition computed in the test.",
+    ),
+    Mutation(
+        name="ljung-box-lag-cap",
+        path="randvib/identification/residuals.py",
+        edits=(
+            (
+                "    m = int(min(max_lag, n // 4))\n    if m < 1 or np.std(e) == 0:",
+                "    m = int(min(max_lag, n // 2))\n    if m < 1 or np.std(e) == 0:",
+            ),
+        ),
+        tests=("tests/test_residuals.py::test_ljung_box_is_its_definition",),
+        why="ljung_box caps M at N / 2 instead of the documented N / 4, so a short residual "
+        "is tested over lags its autocorrelation cannot estimate; the 60-sample case of the "
+        "definition test sees M = 25 instead of 15.",
+    ),
+    Mutation(
+        name="cross-band-constant",
+        path="randvib/identification/residuals.py",
+        edits=(("z = stats.norm.ppf(1 - LEVEL / 2)", "z = stats.norm.ppf(1 - LEVEL)"),),
+        tests=("tests/test_residuals.py::test_bands_and_p_values_are_their_definitions",),
+        why="The bands' quantile one-sided (2.33 instead of 2.58): the reported 99 % bands "
+        "of the auto- and cross-correlation are 98 % bands; against the definitions.",
+    ),
+    Mutation(
+        name="bartlett-factor",
+        path="randvib/identification/residuals.py",
+        edits=(
+            (
+                "float(1 + 2 * np.sum(r_ee[1:] * r_uu[1:]))",
+                "float(1 + np.sum(r_ee[1:] * r_uu[1:]))",
+            ),
+        ),
+        tests=(
+            "tests/test_residuals.py::test_bands_and_p_values_are_their_definitions",
+            "tests/test_residuals.py::test_cross_correlation_band_holds_its_level_for_coloured_series",
+        ),
+        why="Bartlett's variance of the cross-correlation counts the lags on one side only "
+        "(1 + sum instead of 1 + 2 sum): the band is too narrow for a coloured residual and "
+        "input, 4.4 % of independent AR(1) pairs outside it at lag 0 instead of 1 %.",
+    ),
+    Mutation(
+        name="cross-p-one-sided",
+        path="randvib/identification/residuals.py",
+        edits=(("p_cross = 2 * stats.norm.sf(", "p_cross = stats.norm.sf("),),
+        tests=("tests/test_residuals.py::test_bands_and_p_values_are_their_definitions",),
+        why="The cross-correlation lags' p-values one-sided, half the two-sided ones: the "
+        "input test rejects twice as often; against Holm's adjusted p-value computed in the "
+        "test.",
+    ),
+    Mutation(
+        name="cross-p-without-holm",
+        path="randvib/identification/residuals.py",
+        edits=(
+            (
+                "cross_p = float(min(1.0, p_cross.size * np.min(p_cross)))",
+                "cross_p = float(min(1.0, np.min(p_cross)))",
+            ),
+        ),
+        tests=(
+            "tests/test_residuals.py::test_bands_and_p_values_are_their_definitions",
+            "tests/test_residuals.py::test_false_alarm_rates_of_white_residuals_hold_their_levels",
+        ),
+        why="The reported cross-correlation p-value is the smallest lag's, not Holm's "
+        "adjusted one over the 2M + 1 lags: 40 % of independent white pairs would read as "
+        "related at 1 % (M = 25; 19 % at the white-residual test's M = 10).",
+    ),
+    Mutation(
+        name="verdict-without-holm",
+        path="randvib/identification/residuals.py",
+        edits=(
+            (
+                "related = bool(np.any(holm_significant(p_cross, LEVEL)))",
+                "related = bool(np.any(p_cross <= LEVEL))",
+            ),
+        ),
+        tests=(
+            "tests/test_residuals.py::test_false_alarm_rates_of_white_residuals_hold_their_levels",
+        ),
+        why="The verdict's input test rejects when any of the 2M + 1 lags does at LEVEL, "
+        "without Holm's correction: about 40 % of white residuals of independent inputs are "
+        "'structured' at M = 25, 20 % at the test's M = 10 (nominal at most 2 %).",
+    ),
+    Mutation(
+        name="verdict-ljung-box-level",
+        path="randvib/identification/residuals.py",
+        edits=(
+            (
+                'verdict = "white" if q_p >= LEVEL and not related',
+                'verdict = "white" if q_p >= LEVEL / 10 and not related',
+            ),
+        ),
+        tests=(
+            "tests/test_residuals.py::test_false_alarm_rates_of_white_residuals_hold_their_levels",
+        ),
+        why="The verdict reads the Ljung-Box p-value at LEVEL / 10: residuals with "
+        "0.001 <= p < 0.01 pass as white; the white-residual test checks the verdict's rule on "
+        "each of its 1000 pairs (about 9 fall there).",
+    ),
+    Mutation(
+        name="holm-bonferroni",
+        path="randvib/statistics.py",
+        edits=(("if p[i] > level / (p.size - rank):", "if p[i] > level / p.size:"),),
+        tests=("tests/test_statistics.py::test_holm_is_the_rule_of_adjusted_p_values",),
+        why="Holm's step-down becomes Bonferroni (level / m at every step, not level / (m - "
+        "i)): fewer rejections after the first; compared with Holm's adjusted p-values.",
+    ),
+    Mutation(
+        name="holm-no-step-down",
+        path="randvib/statistics.py",
+        edits=(
+            (
+                "            break\n        reject[i] = True",
+                "            continue\n        reject[i] = True",
+            ),
+        ),
+        tests=("tests/test_statistics.py::test_holm_is_the_rule_of_adjusted_p_values",),
+        why="Holm's procedure does not stop at its first acceptance: a larger p-value that "
+        "meets its own threshold level / (m - i) is rejected after a smaller one was not; "
+        "compared with Holm's adjusted p-values.",
+    ),
+    Mutation(
+        name="circuit-force-in-record-kernel",
+        path="randvib/identification/record_integrator.py",
+        edits=(
+            (
+                "return e - dev[1] * v - z * (dev[2] + z * (dev[5] + z * dev[3])) - dev[9] * x",
+                "return e - dev[1] * v - z * (dev[2] + z * (dev[5] + z * dev[3])) - 1.01 * dev[9] * x",
+            ),
+        ),
+        tests=(
+            "tests/test_electrical_identification.py::"
+            "test_piezo_circuit_state_matches_an_independent_rk4_to_fourth_order",
+        ),
+        why="The record simulation's circuit pushes the mass 1 % too hard (theta V or alpha i): "
+        "the piezo's voltage is compared with plain RK4 of the device and its circuit to 5e-8.",
+    ),
+    Mutation(
+        name="coil-load-voltage",
+        path="randvib/identification/circuit.py",
+        edits=(
+            (
+                'scale = r_load if kind == "voltage" else 1.0  # the coil\'s voltage is R_L i',
+                'scale = 1.01 * r_load if kind == "voltage" else 1.0',
+            ),
+        ),
+        tests=(
+            "tests/test_electrical_identification.py::"
+            "test_coil_with_inductance_and_coulomb_friction_matches_the_generator",
+        ),
+        why="A coil's load voltage read 1 % high (R_L i): compared with the independent "
+        "generator's R_L i to 1.5e-4 of its RMS.",
+    ),
+    Mutation(
+        name="nonlinear-forces-not-per-mass",
+        path="randvib/identification/identifiability.py",
+        edits=(
+            (
+                'parts.append(np.atleast_1d(p[name] / p["m"] if force_like else p[name]))',
+                "parts.append(np.atleast_1d(p[name]))",
+            ),
+        ),
+        tests=(
+            "tests/test_electrical_identification.py::"
+            "test_what_records_can_fix_agrees_with_the_symmetries_worked_out_by_hand",
+        ),
+        why="The structural test takes the nonlinear forces (k3, Fc) as seen by themselves "
+        "instead of per unit mass: under base excitation the mass would look fixed by a "
+        "displacement record, against Eq. 1 divided by m.",
+    ),
+    Mutation(
+        name="blocked-covariance-pooled",
+        path="randvib/identification/least_squares.py",
+        edits=(
+            (
+                "middle += float(eb @ eb) / dof * (jb.T @ jb)",
+                "middle += float(e @ e) / max(n - d, 1) * (jb.T @ jb)",
+            ),
+        ),
+        tests=(
+            "tests/test_electrical_identification.py::"
+            "test_blocked_covariance_gives_each_channel_its_own_noise",
+        ),
+        why="The channels' noise pooled into one variance: a quiet channel's parameters "
+        "get the noisy channel's standard errors (a factor of about 25 in variance).",
+    ),
+    Mutation(
+        name="profiled-start-sign",
+        path="randvib/identification/experiment.py",
+        edits=(
+            (
+                'total = total + np.einsum("ij,ij->i", shift, cross)',
+                'total = total - np.einsum("ij,ij->i", shift, cross)',
+            ),
+        ),
+        tests=(
+            "tests/test_electrical_identification.py::"
+            "test_the_unmeasured_start_is_profiled_out_of_the_search_cost",
+        ),
+        why="The search's J with the unmeasured start profiled out adds the least-squares "
+        "gain instead of taking it off: J at the truth is no longer the noise's.",
+    ),
+    Mutation(
+        name="channel-weight-ignored",
+        path="randvib/identification/experiment.py",
+        edits=(
+            (
+                "norm[kind] = 100.0 * weight / ((y.size - skip) * variance)",
+                "norm[kind] = 100.0 / ((y.size - skip) * variance)",
+            ),
+        ),
+        tests=(
+            "tests/test_electrical_identification.py::"
+            "test_weights_multiply_each_channels_own_j_in_the_sum",
+        ),
+        why="`--weight KIND=W` is dropped from the summed J: the weighted cost is compared "
+        "with w times the channel's own J, exactly.",
     ),
 )
 
@@ -744,7 +1220,11 @@ def run_prepared(
     if not Path(where).resolve().is_relative_to(root.resolve()):
         raise RuntimeError(f"the mutant copy is not the imported package ({where})")
     targets = ["tests"] if full else list(mutation.tests)
-    cmd = [sys.executable, "-m", "pytest", "-q", "-x", "-p", "no:cacheprovider", *targets]
+    # one process per mutant (the caller runs mutants side by side; --full spreads the
+    # whole suite over the cores), in the named tests' own order
+    workers = ["-n", "auto"] if full else ["-n", "0"]
+    cmd = [sys.executable, "-m", "pytest", "-q", "-x", "-p", "no:cacheprovider", *workers]
+    cmd += ["-p", "no:randomly", *targets]
     cmd += ["--ignore", "tests/test_mutations.py"]  # no mutants of mutants
     start = time.perf_counter()
     proc = subprocess.run(
@@ -775,6 +1255,82 @@ def markdown_table(mutations=MUTATIONS) -> str:
     return "\n".join(rows) + "\n"
 
 
+#: The last full run's outcome per mutation (``python tests/mutation_check.py --record``),
+#: read by tests/test_mutations.py: the default suite does not run 50+ mutants (each
+#: a pytest process and often a numba recompile: about 8 CPU-minutes in all).
+RESULTS = ROOT / "tests" / "mutation_results.txt"
+
+
+def _git_state() -> str:
+    """The commit the mutants were made from, ``+dirty`` when the tree had edits."""
+    try:
+        head = subprocess.run(
+            ["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True
+        ).stdout.strip()
+        dirty = subprocess.run(
+            ["git", "status", "--porcelain", "--untracked-files=no"],
+            cwd=ROOT,
+            capture_output=True,
+            text=True,
+        ).stdout.strip()
+    except OSError:
+        return "unknown"
+    return (head or "unknown") + ("+dirty" if dirty else "")
+
+
+def _first_failure(outcome: Outcome) -> str:
+    """The node id of the first failed test in a mutant's run ('-' if none)."""
+    for line in outcome.output.splitlines():
+        if line.startswith("FAILED "):
+            return line.split()[1]
+    return "-"
+
+
+def write_results(outcomes: list, path: Path = RESULTS) -> None:
+    """Keep a run's outcomes: one line per mutation (name, verdict, seconds, first failure)."""
+    lines = [
+        "# python tests/mutation_check.py --record: the curated mutants and what caught them",
+        f"# commit {_git_state()}, {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, "
+        f"python {sys.version.split()[0]}",
+    ]
+    for o in outcomes:
+        verdict = "caught" if o.caught else ("NOT-CAUGHT" if o.returncode == 0 else "ERROR")
+        lines.append(f"{o.mutation.name}\t{verdict}\t{o.seconds:.0f}\t{_first_failure(o)}")
+    path.write_text("\n".join(lines) + "\n")
+
+
+def read_results(path: Path = RESULTS) -> dict[str, tuple[str, str]]:
+    """{mutation name: (verdict, first failed test)} from :data:`RESULTS`."""
+    results = {}
+    for line in path.read_text().splitlines():
+        if line and not line.startswith("#"):
+            name, verdict, _seconds, failed = line.split("\t")
+            results[name] = (verdict, failed)
+    return results
+
+
+def run_all(chosen, full: bool = False, jobs: int = 2) -> list:
+    """Every chosen mutant, ``jobs`` at a time; outcomes in the order of ``chosen``.
+
+    A mutant's run is mostly one pytest process (and numba recompiling what the
+    mutation reaches) on one core, so runs side by side fill the machine.
+    """
+    with tempfile.TemporaryDirectory(prefix="mutants-") as tmp:
+        prepared = []
+        for mutation in chosen:  # serially: ast.parse of CPython 3.11 is not re-entrant
+            work = Path(tmp) / mutation.name
+            work.mkdir()
+            prepared.append((mutation, prepare_mutant(mutation, work)))
+
+        def run(item):
+            outcome = run_prepared(*item, full=full)
+            print(outcome.summary(), flush=True)
+            return outcome
+
+        with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
+            return list(pool.map(run, prepared))
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", nargs="+", metavar="NAME", help="mutations to run")
@@ -783,7 +1339,16 @@ def main(argv=None) -> int:
     parser.add_argument(
         "--markdown", action="store_true", help="print the table for docs/testing.md and exit"
     )
+    parser.add_argument(
+        "--jobs", type=int, default=os.cpu_count() or 1, help="mutants run side by side"
+    )
+    parser.add_argument(
+        "--record", action="store_true", help=f"keep the outcomes in {RESULTS.relative_to(ROOT)}"
+    )
     args = parser.parse_args(argv)
+    unknown = sorted(set(args.only or ()) - {m.name for m in MUTATIONS})
+    if unknown:
+        parser.error(f"--only: no mutation named {', '.join(unknown)} (see --list)")
     chosen = [m for m in MUTATIONS if not args.only or m.name in args.only]
     if args.markdown:
         print(markdown_table(chosen), end="")
@@ -792,13 +1357,13 @@ def main(argv=None) -> int:
         for m in chosen:
             print(f"{m.name:28s} {m.path:32s} {', '.join(m.tests)}\n    {m.why}")
         return 0
-    survivors = 0
-    for mutation in chosen:
-        with tempfile.TemporaryDirectory(prefix=f"mutant-{mutation.name}-") as tmp:
-            outcome = run_mutant(mutation, Path(tmp), full=args.full)
-        print(outcome.summary(), flush=True)
-        survivors += not outcome.caught
+    if args.record and (args.only or args.full):
+        parser.error("--record keeps a run of every mutation on its own tests: drop --only/--full")
+    outcomes = run_all(chosen, full=args.full, jobs=args.jobs)
+    survivors = sum(not o.caught for o in outcomes)
     print(f"{len(chosen) - survivors} of {len(chosen)} mutations caught")
+    if args.record:
+        write_results(outcomes)
     return 1 if survivors else 0
 
 

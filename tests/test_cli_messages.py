@@ -274,13 +274,15 @@ def voltage_records(tmp_path_factory, record_csv):
 @pytest.mark.parametrize(
     "file, extra, fragment",
     [
-        # the issue's trip: the refusal's advice followed, a voltage fitted as a displacement
-        ("voltage_only", ["--output-column", "voltage"], "output column `voltage` holds the load voltage (V)"),
-        ("both", ["--output-column", "voltage"], "not a response identification fits (`--output-kind`"),
-        ("both", ["--output-column", "base_acceleration"], "holds the base acceleration"),
-        ("laser", ["--output-column", "laser"], "what output column `laser` holds is not declared; give `--output-kind`"),
-        ("voltage_only", [], "say what it holds with `--output-kind`"),
-        ("voltage_only", ["--output-column", "voltage", "--output-kind", "voltage"], "`--output-kind` must be one of relative_displacement"),
+        # the issue's trip: a voltage declared (or defaulted) as the displacement
+        ("voltage_only", ["--output-column", "voltage", "--output-kind", "relative_displacement"], "it is declared as (`--output-kind` relative_displacement)"),
+        ("both", ["--output-column", "voltage", "--output-kind", "relative_displacement"], "declare it as what it holds (`--output-kind` voltage)"),
+        # a voltage named as such is a voltage (issue 34): without its circuit it is refused
+        ("voltage_only", ["--output-column", "voltage"], "a `voltage` output is the circuit's: name the coupling"),
+        ("both", ["--output-column", "base_acceleration"], "say what it holds with `--output-kind"),
+        ("both", ["--output-column", "base_acceleration", "--output-kind", "relative_displacement"], "holds the base acceleration"),
+        ("laser", ["--output-column", "laser"], "`--output-column` 'laser': say what it holds with `--output-kind"),
+        ("voltage_only", [], "output column `relative_displacement` not found"),
     ],
 )  # fmt: skip
 def test_an_output_column_of_another_or_an_undeclared_kind_is_refused(
@@ -312,6 +314,12 @@ def test_a_declared_output_column_is_fitted_and_the_api_agrees(capsys, voltage_r
     with pytest.raises(ValueError, match="what output column `laser` holds is not declared"):
         read_record(laser, output_column="laser")
     with pytest.raises(ValueError, match="output column `voltage` holds the load voltage"):
-        read_record(voltage_records["both"], output_column="voltage")
+        read_record(voltage_records["both"], output_column="voltage",
+                    output_kind="relative_displacement")  # fmt: skip
+    with pytest.raises(ValueError, match="output column `voltage` holds the load voltage"):
+        read_record(voltage_records["both"], outputs={"relative_displacement": "voltage"})
+    # named as its kind, a voltage column is read as the load voltage, never as z
+    as_named = read_record(voltage_records["both"], output_column="voltage")
+    assert "relative_displacement" not in as_named.channels and "voltage" in as_named.channels
     record = read_record(laser, output_column="laser", output_kind="relative_displacement")
     assert record.z.size == 2000

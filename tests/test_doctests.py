@@ -28,6 +28,7 @@ MODULES = (
     "randvib.identification.prediction",
     "randvib.identification.record_response",
     "randvib.identification.synthetic",
+    "randvib.models.assembly",
     "randvib.models.coupling",
     "randvib.models.event",
     "randvib.models.excitation",

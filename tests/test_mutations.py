@@ -2,14 +2,14 @@
 
 For each curated mutation, a copy of the project is mutated and the tests
 named in its entry must fail. The table of mutations, with what each models
-and which test catches it, is ``python tests/mutation_check.py --list``.
+and which test catches it, is ``python tests/mutation_check.py --list``; the
+whole check is ``python tests/mutation_check.py --record`` (its outcomes kept in
+tests/mutation_results.txt and checked here).
 
 Covers the suite itself: each mutant edits one module of randvib
 (:mod:`randvib.montecarlo.kernel`, :mod:`randvib.statistics`,
 :mod:`randvib.models.friction`, ...; the list is in tests/mutation_check.py).
 """
-
-from concurrent.futures import ThreadPoolExecutor
 
 import mutation_check as mc
 import pytest
@@ -32,32 +32,36 @@ def test_numba_caches_are_dropped_for_every_module_that_imports_the_mutant():
     assert "randvib.montecarlo.rng" not in reached  # the generator does not import friction
 
 
-@pytest.fixture(scope="module")
-def outcomes(tmp_path_factory):
-    """Every mutant's run, two at a time.
+def _caught_by_its_own_test(mutation, failed: str) -> bool:
+    """The first failed test is one the mutation names (a file, a test, or a parametrisation)."""
+    return any(failed == t or failed.startswith((t + "::", t + "[")) for t in mutation.tests)
 
-    A mutant's run is mostly numba compiling the mutated module on one core,
-    so two concurrent runs keep a two-core machine busy and halve the wall time.
+
+def test_the_recorded_run_caught_every_mutation_with_its_own_tests():
+    """tests/mutation_results.txt, kept by ``python tests/mutation_check.py --record``.
+
+    The full run is a command of its own (tests/mutation_check.py's docstring): it is
+    the check of the suite, not of the package, and costs more than the rest of the
+    suite. A mutation added without re-running it, or one that its tests no longer
+    catch, fails here.
     """
-    root = tmp_path_factory.mktemp("mutants")
-    prepared = []
-    for mutation in mc.MUTATIONS:  # serially: copying and parsing is not thread-safe
-        work = root / mutation.name
-        work.mkdir()
-        prepared.append((mutation, mc.prepare_mutant(mutation, work)))
-
-    def run(item):
-        mutation, project = item
-        return mutation.name, mc.run_prepared(mutation, project)
-
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        return dict(pool.map(run, prepared))
+    recorded = mc.read_results()
+    missing = [m.name for m in mc.MUTATIONS if m.name not in recorded]
+    assert not missing, f"not in {mc.RESULTS.name}: {missing}; run mutation_check.py --record"
+    for m in mc.MUTATIONS:
+        verdict, failed = recorded[m.name]
+        assert verdict == "caught", f"{m.name}: {verdict} in the last recorded run"
+        assert _caught_by_its_own_test(m, failed), f"{m.name}: caught by {failed}, not {m.tests}"
 
 
-@pytest.mark.slow
-@pytest.mark.parametrize("mutation", mc.MUTATIONS, ids=lambda m: m.name)
-def test_suite_catches_the_mutation(mutation, outcomes):
-    outcome = outcomes[mutation.name]
+#: a mutation of plain Python (no numba recompile): the machinery's end-to-end check
+CANARY = "ljung-box-n-plus-2"
+
+
+def test_one_mutant_is_caught_end_to_end(tmp_path):
+    """Copy, mutate, run the named tests in the copy: they fail (exit status 1)."""
+    mutation = next(m for m in mc.MUTATIONS if m.name == CANARY)
+    outcome = mc.run_mutant(mutation, tmp_path)
     assert outcome.caught, outcome.summary() + "\n" + outcome.output[-3000:]
 
 

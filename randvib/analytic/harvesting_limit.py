@@ -21,6 +21,10 @@ the stationary-spectrum counterpart of the non-causal bound of Haji
 Hosseinloo and Turitsyn, Phys. Rev. Applied 4, 064009 (2015). With lambda = 0
 it is the unconstrained bound m^2 E[a^2] / (4 c_m).
 
+A tone, a line of mean square A^2 / 2 at omega, adds the term
+m^2 omega^2 A^2 / (8 (c_m omega^2 + lambda)) to the bracket (the same
+frequency-by-frequency optimum, on a line spectrum).
+
 It is finite when w^2 G_a / (c_m w^2 + lambda) is integrable: for band-pass,
 Kanai-Tajimi, band-limited, tabulated and measured spectra with c_m > 0; for
 white noise it is infinite (a transducer that sees the future can take
@@ -75,6 +79,7 @@ from scipy import optimize, sparse, special
 
 from randvib._validation import check_nonnegative, check_positive
 from randvib.analytic.linear_response import frequency_rule, mechanical_block
+from randvib.models.combined import parts_of
 from randvib.models.excitation import Excitation, Measured
 
 __all__ = [
@@ -127,13 +132,24 @@ def _weights(m, c_m, excitation: Excitation, corner: float):
     return w, weights, m**2 * w**2 * excitation.psd(nodes) / 4.0
 
 
+def _lines(m: float, excitation: Excitation) -> tuple[np.ndarray, np.ndarray]:
+    """The tones' omega (rad/s) and m^2 omega^2 (A^2 / 2) / 4: lines of the bracket's sum."""
+    # a tone is a line of power A^2 / 2 at omega: a term of the sum, not of the integral
+    tones = excitation.lines()
+    w_lines = np.array([tone.omega for tone in tones], dtype=float)
+    return w_lines, m**2 * w_lines**2 * np.array([t.mean_square for t in tones], dtype=float) / 4.0
+
+
 def _dual(m: float, c_m: float, excitation: Excitation, sigma2: float, lam: float):
-    """The non-causal bracket at lambda and its derivative sigma^2 - int s*^2 df."""
+    """The non-causal bracket at lambda and its derivative sigma^2 - int s*^2 df (tones included)."""
     corner = math.sqrt(lam / c_m) / (2 * math.pi) if c_m > 0 and lam > 0 else 1.0
     w, weights, g = _weights(m, c_m, excitation, corner)
+    w_lines, g_lines = _lines(m, excitation)
     denom = c_m * w**2 + lam
-    bound = float(np.sum(weights * g / denom)) + lam * sigma2
-    return bound, sigma2 - float(np.sum(weights * g / denom**2))
+    line_denom = c_m * w_lines**2 + lam
+    bound = float(np.sum(weights * g / denom) + np.sum(g_lines / line_denom)) + lam * sigma2
+    squares = float(np.sum(weights * g / denom**2) + np.sum(g_lines / line_denom**2))
+    return bound, sigma2 - squares
 
 
 def _least(dual, lam0: float) -> float:
@@ -187,7 +203,8 @@ def harvesting_limit(m, c_m, excitation: Excitation, displacement_rms) -> float 
     rms = float(check_positive("displacement_rms", displacement_rms, "m"))
     # a budget whose square is beyond float64 never binds: the largest float keeps lambda = 0
     sigma2 = min(rms * rms, np.finfo(float).max)
-    if excitation.is_white:
+    random = parts_of(excitation)[0]
+    if excitation.is_white or (random is not None and random.is_white):
         return None
     if c_m == 0:
         # The bracket is int g / lambda + lambda sigma^2, least at
@@ -196,7 +213,9 @@ def harvesting_limit(m, c_m, excitation: Excitation, displacement_rms) -> float 
         if not math.isfinite(excitation.support[1]):
             return None
         w, weights, g = _weights(m, c_m, excitation, 1.0)
-        return 2.0 * math.sqrt(sigma2 * float(np.sum(weights * g)))
+        return 2.0 * math.sqrt(
+            sigma2 * float(np.sum(weights * g) + np.sum(_lines(m, excitation)[1]))
+        )
     value, slope = _dual(m, c_m, excitation, sigma2, 0.0)
     if slope >= 0:  # the unconstrained optimum already meets the budget
         return value
@@ -284,7 +303,8 @@ def causal_harvesting_limit(m, c_m, excitation: Excitation, displacement_rms) ->
         (:func:`predictable_spectrum`); the Wiener-Hopf bound for a rational
         spectrum with c_m > 0; None where no finite bound exists (c_m = 0
         under a rational coloured spectrum) or none is computed (a
-        non-rational spectrum of unbounded support).
+        non-rational spectrum of unbounded support; a sum with tones or
+        shocks whose spectrum does not vanish on a band).
     """
     m = float(check_positive("m", m, "kg"))
     c_m = float(check_nonnegative("c_m", c_m, "Ns/m"))

@@ -20,6 +20,8 @@ stationary output variances (docs/conventions.md, "Beyond the paper"):
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from scipy import linalg
 
@@ -38,6 +40,43 @@ _PEAK_POWERS = np.arange(-3.0, 40.0)
 _GRID_POINTS = 160
 _TAIL_FACTOR = 20.0  # the tail starts at this multiple of the highest feature
 _TAIL_PANELS = 8
+
+
+@dataclass(frozen=True, eq=False)
+class ResponseSpectra:
+    """One-sided PSDs of the linearised response (SI units, f in Hz).
+
+    Attributes
+    ----------
+    frequency : ndarray
+        f (Hz).
+    excitation : ndarray
+        S(f) of the base acceleration ((m/s^2)^2/Hz).
+    displacement, velocity : ndarray
+        PSD of z (m^2/Hz) and of v ((m/s)^2/Hz).
+    power : ndarray
+        Frequency distribution of the electrical power c_e |H_v|^2 S (W/Hz):
+        its integral is E[P_e].
+    lines : dict or None
+        Under tones, their lines: ``frequency`` (Hz) and the mean squares of
+        each tone's response, ``displacement`` (m^2), ``velocity`` ((m/s)^2)
+        and ``power`` (W), arrays over the tones; the spectra above are then
+        the random part's. None without tones.
+    """
+
+    frequency: np.ndarray
+    excitation: np.ndarray
+    displacement: np.ndarray
+    velocity: np.ndarray
+    power: np.ndarray
+    lines: dict | None = None
+
+    def to_frame(self):
+        """The spectra as a :class:`pandas.DataFrame`, one row per frequency (lines apart)."""
+        import pandas as pd
+
+        names = ("frequency", "excitation", "displacement", "velocity", "power")
+        return pd.DataFrame({name: getattr(self, name) for name in names})
 
 
 def mechanical_block(m, c, k) -> StateSpace:

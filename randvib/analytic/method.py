@@ -7,8 +7,12 @@ described by its class in :mod:`randvib.models.friction`). It declares
 * ``name`` - its key in :data:`randvib.analytic.prediction.METHODS` and the
   CLI's ``--method`` choice; ``title`` - what sentences call it; ``summary``
   - one line on its cost and accuracy (the CLI's help);
-* what it accepts: ``coloured`` (a non-white excitation), ``circuit`` (a
+* what it accepts: ``coloured`` (a non-white excitation), ``tones`` (sinusoids
+  on or without noise), ``non_gaussian`` (a translation process, shocks on a
+  linear device), ``circuit`` (a
   coupling with a circuit state: coil inductance, piezo capacitance),
+  ``assemblies`` (an :class:`~randvib.models.assembly.Assembly` of several
+  DOFs, :mod:`randvib.analytic.assembly_prediction`),
   ``potentials`` (kinds of :mod:`randvib.models.potential`) and
   ``friction_form`` (a key of :data:`FRICTION_FORMS`: any memoryless law, or
   the form Fc tanh(beta v));
@@ -38,6 +42,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from randvib._validation import check_choice
+from randvib.models.assembly import Assembly
+from randvib.models.combined import parts_of
 from randvib.models.excitation import Excitation
 from randvib.models.harvester import Harvester
 from randvib.models.potential import CONFINING
@@ -142,6 +148,9 @@ class AnalyticMethod:
     circuit: bool = False
     #: Accepts a coupling through a diode bridge (:mod:`randvib.models.rectifier`).
     rectifier: bool = False
+    #: Accepts an assembly (:class:`~randvib.models.assembly.Assembly`; solved by
+    #: :func:`randvib.analytic.assembly_prediction.predict_assembly`).
+    assemblies: bool = False
     #: Potential kinds it treats (see :data:`randvib.models.potential.KINDS`).
     potentials: tuple[str, ...] = CONFINING + ("free",)
     #: The friction laws it treats: a key of :data:`FRICTION_FORMS`.
@@ -151,6 +160,13 @@ class AnalyticMethod:
     #: Solves an event's transient moments (randvib.transient_response); the
     #: others are stationary and refuse an event.
     transient: bool = False
+    #: Treats tones (on noise or alone): the combined harmonic-and-random
+    #: linearisation (:mod:`randvib.analytic.harmonic_linearisation`).
+    tones: bool = False
+    #: Answers a non-Gaussian input (a translation process, shocks on a linear
+    #: device) by its spectrum: exact second moments for a linear device, the
+    #: Gaussian closure beyond it, with a warning past its measured kurtosis limit.
+    non_gaussian: bool = False
     #: A slow reference solver (about half a second a point): not for every sweep point.
     reference: bool = False
     #: Its declared validity limits.
@@ -204,6 +220,11 @@ class AnalyticMethod:
 
     def _reason(self, harvester, psd, who, alternatives: bool = False) -> str | None:
         """The first declaration the case fails, in words (with the alternatives), or None."""
+        if isinstance(harvester, Assembly):
+            if self.assemblies:
+                return _assembly_input_reason(harvester, psd, who)
+            others = self._alternatives(harvester, psd) if alternatives else MONTE_CARLO
+            return f"{who} treats the single-mass harvester; an assembly needs {others}"
         potential = harvester.potential
         if getattr(psd, "is_event", False) and not self.transient:
             return (
@@ -226,6 +247,9 @@ class AnalyticMethod:
                 f"{who} assumes a linear coupling; the {harvester.electrical.name}'s "
                 f"switching diodes need {others()}"
             )
+        beyond_noise = self._input_reason(harvester, psd, who, others)
+        if beyond_noise is not None:
+            return beyond_noise
         if non_white(psd) and not self.coloured:
             return f"{who} assumes white noise; the {psd.name} excitation needs {others()}"
         kinds = self.potentials_under(harvester, psd)
@@ -236,6 +260,27 @@ class AnalyticMethod:
             why = "has internal state" if law.has_memory else "is not of that form"
             words = FRICTION_FORMS[self.friction_form].words
             return f"{who} needs {words}; {law.name!r} {why}: use {others()}"
+        return None
+
+    def _input_reason(self, harvester, psd, who, others) -> str | None:
+        """Why tones, shocks or a non-Gaussian input are beyond the method, or None."""
+        if not isinstance(psd, Excitation):
+            return None
+        random, tones, shocks = parts_of(psd)
+        if tones and not self.tones:
+            listed = ", ".join(f"{tone.frequency:g} Hz" for tone in tones)
+            return f"{who} treats random input only; the tones ({listed}) need {others()}"
+        gaussian = shocks is None and (random is None or random.is_gaussian)
+        if not gaussian and not self.non_gaussian:
+            return f"{who} assumes Gaussian input; the {psd.name} input needs {others()}"
+        if shocks is not None and not is_linear_device(harvester):
+            # Campbell's theorem gives a linear device's second moments; nothing else
+            # answers a nonlinear device under a Poisson train of pulses
+            return (
+                f"{who} treats shocks on a linear device only (Campbell's theorem: no friction, "
+                f"no cubic spring); with {_nonlinearity(harvester)} the shock train needs "
+                f"{_monte_carlo(psd)}"
+            )
         return None
 
     def _alternatives(self, harvester, psd) -> str:
@@ -345,6 +390,54 @@ def method_named(method) -> AnalyticMethod:
     if isinstance(method, AnalyticMethod):
         return method
     return METHODS[check_choice("method", method, tuple(METHODS))]
+
+
+def is_linear_device(harvester: Harvester) -> bool:
+    """No friction, no cubic spring, no diode bridge: superposition and Campbell hold."""
+    law = harvester.friction
+    return (
+        (law is None or law.vanishes) and np.all(harvester.k3 == 0) and not harvester.is_rectified
+    )
+
+
+def _assembly_input_reason(assembly: Assembly, psd, who: str) -> str | None:
+    """Why tones, shocks or a non-Gaussian input are beyond the assembly solver, or None.
+
+    A linear assembly's second moments are its input's spectrum's, whatever
+    the marginal (a translation process) and for a shock train (Campbell's
+    spectrum, part of :meth:`Excitation.psd`): those are exact. Tones are
+    lines, which the spectral solution of an assembly does not take yet, and a
+    nonlinear element under non-Gaussian input or shocks has no measured
+    limit (Monte Carlo of assemblies has not landed either): both refused.
+    """
+    if not isinstance(psd, Excitation):
+        return None
+    random, tones, shocks = parts_of(psd)
+    if tones:
+        listed = ", ".join(f"{tone.frequency:g} Hz" for tone in tones)
+        return (
+            f"{who} does not take tones on an assembly yet (the tones {listed}); they are "
+            "treated on the single-mass harvester"
+        )
+    gaussian = shocks is None and (random is None or random.is_gaussian)
+    if gaussian or assembly.is_linear:
+        return None
+    return (
+        f"{who} treats the {psd.name} input on a linear assembly only (its spectrum decides "
+        "the second moments); with nonlinear elements it is treated on the single-mass harvester"
+    )
+
+
+def _nonlinearity(harvester: Harvester) -> str:
+    """The device's nonlinearities in words: "Coulomb friction and a cubic spring"."""
+    words = []
+    if harvester.friction is not None and not harvester.friction.vanishes:
+        words.append(f"{harvester.friction.name} friction")
+    if np.any(harvester.k3 != 0):
+        words.append("a cubic spring")
+    if harvester.is_rectified:
+        words.append(f"the {harvester.electrical.name}'s diodes")
+    return " and ".join(words)
 
 
 def _monte_carlo(psd) -> str:

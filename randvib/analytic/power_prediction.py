@@ -55,6 +55,10 @@ class PowerPrediction:
         harvester's stroke; None without a stroke, for the free mass and for
         methods that do not give it (their ``stroke_exceedance`` declaration
         is False).
+    tones : tuple of ToneResponse or None
+        Under tones, each one's response amplitudes and equivalents
+        (:mod:`randvib.analytic.harmonic_linearisation`); None otherwise
+        (and left out of :meth:`to_dict`).
     power_stored, power_coil_loss, power_diode_loss, power_mechanical : float or None
         With a diode bridge (:mod:`randvib.models.rectifier`): the stored
         power, the coil's and the diodes' losses and c_m E[z'^2] + E[z' F]
@@ -79,6 +83,9 @@ class PowerPrediction:
     power_coil_loss: object = None
     power_diode_loss: object = None
     power_mechanical: object = None
+    #: under tones: each tone's share of the response (a tuple of
+    #: :class:`~randvib.analytic.harmonic_linearisation.ToneResponse`); None otherwise
+    tones: object = None
     #: the device's coupling, for the circuit state's unit (A^2 for a coil, V^2 for a piezo)
     electrical: object = field(default=None, repr=False, compare=False)
     #: the array-valued inputs of a broadcast prediction (name -> values), its sweep's axes
@@ -134,7 +141,9 @@ class PowerPrediction:
         fields = asdict(self)
         del fields["electrical"], fields["inputs"]  # the device's and the sweep's, not results
         out = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in fields.items()}
-        for optional in ("circuit_mean_square", "stroke_exceedance", *BRIDGE_POWERS):
+        if self.tones is not None:
+            out["tones"] = [tone.to_dict() for tone in self.tones]
+        for optional in ("circuit_mean_square", "stroke_exceedance", "tones", *BRIDGE_POWERS):
             if out[optional] is None:
                 del out[optional]
         return out

@@ -32,8 +32,10 @@ from randvib._validation import (
     check_scalar,
     check_scalar_device,
 )
+from randvib.analytic.assembly_prediction import predict_assembly
 from randvib.analytic.averaging import AVERAGING
 from randvib.analytic.bridge import BRIDGE_CLOSURE
+from randvib.analytic.fixed_point import LinearisationDidNotConverge
 from randvib.analytic.fokker_planck import FAST_FOKKER_PLANCK, FOKKER_PLANCK
 from randvib.analytic.method import (
     AnalyticMethod,
@@ -43,7 +45,8 @@ from randvib.analytic.method import (
     white_level,
 )
 from randvib.analytic.power_prediction import PowerPrediction
-from randvib.analytic.statistical_linearisation import LINEARISATION, LinearisationDidNotConverge
+from randvib.analytic.statistical_linearisation import LINEARISATION
+from randvib.models.assembly import Assembly
 from randvib.models.excitation import BROADCASTING, Excitation
 from randvib.models.harvester import Harvester
 
@@ -66,7 +69,10 @@ METHODS: dict[str, AnalyticMethod] = register_methods(
 
 def default_method(harvester: Harvester) -> str:
     """The method used when none is named: the bridge closure for a device with a diode
-    bridge (``randvib power`` chooses the same), statistical linearisation otherwise."""
+    bridge (``randvib power`` chooses the same), statistical linearisation otherwise (and
+    for an assembly, whose only method it is)."""
+    if isinstance(harvester, Assembly):
+        return "linearisation"
     return "bridge-closure" if harvester.is_rectified else "linearisation"
 
 
@@ -75,9 +81,13 @@ def predict(harvester: Harvester, psd, method=None) -> PowerPrediction:
 
     Parameters
     ----------
-    harvester : Harvester
+    harvester : Harvester or Assembly
         Device; parameters may be arrays broadcasting with ``psd`` (scalars
-        under a non-white excitation or with a circuit state).
+        under a non-white excitation or with a circuit state). An
+        :class:`~randvib.models.assembly.Assembly` (several DOFs, elements,
+        transducers; scalars) gives an
+        :class:`~randvib.analytic.assembly_prediction.AssemblyPrediction`:
+        ``method="linearisation"`` only, exact for a linear assembly.
     psd : array_like or Excitation
         One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0 (white noise,
         paper Eq. 17), or an excitation object: ``White(S)`` is the same as
@@ -135,6 +145,8 @@ def predict(harvester: Harvester, psd, method=None) -> PowerPrediction:
             "response is randvib.transient_response (or Monte Carlo, randvib.simulate_transient)"
         )
     solver = method_named(default_method(harvester) if method is None else method)
+    if isinstance(harvester, Assembly):  # several DOFs: randvib.analytic.assembly_prediction
+        return predict_assembly(harvester, psd, solver)
     solver.require(harvester, psd)
     _refuse_undamped(harvester)
     if not non_white(psd):  # White(S) runs exactly the code of the number S

@@ -52,6 +52,10 @@ API_NAMES = {
     "--segments": "segments (randvib.monte_carlo_on_record)",
     "--dt (with --record)": "substeps = record step / dt (randvib.monte_carlo_on_record)",
     "--model": "model (randvib.identify)",
+    "--output-kind": "outputs (randvib.identify, randvib.synthetic_record, randvib.predict_record)",
+    "--weight": "weights (randvib.identify)",
+    "--offset (record)": "offsets (randvib.synthetic_record)",
+    "--from-fit": "IdentificationResult.from_dict(...).harvester()",
     "--no-progress": "progress=False",
 }
 
@@ -212,6 +216,7 @@ def _main_with_warnings(argv) -> int:
 
 def _advice_warnings() -> tuple:
     """randvib's warnings that say something about the user's run (a step size, a validity)."""
+    from randvib.analytic.assembly_prediction import AssemblyLoadBoundWarning
     from randvib.analytic.averaging import AveragingValidityWarning
     from randvib.analytic.prediction import LoadBoundWarning
     from randvib.analytic.statistical_linearisation import LinearisationValidityWarning
@@ -224,6 +229,7 @@ def _advice_warnings() -> tuple:
         AveragingValidityWarning,
         LoadBoundWarning,
         LinearisationValidityWarning,
+        AssemblyLoadBoundWarning,
     )
 
 

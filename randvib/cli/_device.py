@@ -1,9 +1,19 @@
-"""Device options shared by the commands that take a harvester."""
+"""Device options shared by the commands that take a harvester, or an assembly (``--device``).
+
+``--device FILE.toml`` (or the name of a shipped example, ``randvib.datasets.device_names``)
+reads an :class:`~randvib.models.assembly.Assembly` from a device file
+(:mod:`randvib.models.device_file`); it replaces every other device option.
+:func:`assembly_from_args` reads it; :func:`harvester_from_args` refuses it, so a
+command that does not take assemblies yet says so in one line (``power`` takes it).
+"""
 
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
+from randvib.datasets import device_names, device_path
+from randvib.models.assembly import Assembly
 from randvib.models.coupling import COUPLINGS, coupling_class
 from randvib.models.friction import FRICTION_MODELS, RegistryView
 from randvib.models.harvester import ElectricalDampingOverflow, Harvester
@@ -61,13 +71,27 @@ def _coupling_options() -> dict[str, list]:
 
 
 def add_device_arguments(parser: argparse.ArgumentParser) -> None:
-    """Add --preset, the device parameters and --psd to ``parser``."""
-    g = parser.add_argument_group("device (SI units; values override --preset)")
+    """Add --device, --preset, the device parameters and --psd to ``parser``."""
+    g = parser.add_argument_group("device (SI units; values override --preset or --from-fit)")
+    g.add_argument(
+        "--device",
+        metavar="FILE",
+        help="an assembly from a device file (TOML: structure, elements, transducers; "
+        f"docs/assemblies.md) or a shipped example ({', '.join(device_names())}); instead of "
+        "every other device option",
+    )
     g.add_argument(
         "--preset",
         metavar="NAME",
         choices=tuple(PRESETS),
         help=f"start from a paper preset: {', '.join(PRESETS)}",
+    )
+    g.add_argument(
+        "--from-fit",
+        metavar="FILE.json",
+        help="start from an identified device (`randvib identify --save`): its mechanics, "
+        "friction and, when identified, its coupling at the first record's load (--r-load "
+        "and the other options override)",
     )
     g.add_argument("--m", type=float, help="mass (kg)")
     g.add_argument("--c-m", type=float, help="mechanical damping (Ns/m)")
@@ -147,6 +171,9 @@ def add_device_arguments(parser: argparse.ArgumentParser) -> None:
     g.add_argument(
         "--psd", type=float, default=None, help="one-sided base-acceleration PSD S ((m/s^2)^2/Hz)"
     )
+    # the options --device replaces (not --psd, the excitation's level)
+    own = tuple(a.dest for a in g._group_actions if a.dest not in ("device", "psd"))
+    parser.set_defaults(device_options=own)
 
 
 def _potential_from_wells(args) -> dict:
@@ -167,15 +194,87 @@ def _potential_from_wells(args) -> dict:
     return {"k": potential.k, "k3": potential.k3}
 
 
+def assembly_from_args(args) -> Assembly | None:
+    """The assembly of ``--device`` (a file, or a shipped example's name), or None without it.
+
+    Refuses any other device option beside it, naming the first.
+    """
+    name = getattr(args, "device", None)
+    if name is None:
+        return None
+    if getattr(args, "from_fit", None) is not None:
+        raise ValueError("give either `--device` or `--from-fit`, not both")
+    given = [d for d in getattr(args, "device_options", ()) if getattr(args, d, None) is not None]
+    if given:
+        raise ValueError(
+            f"`--device` gives the whole device; drop `{option_flag(given[0])}` (change the file, "
+            "or give the single-mass device by its options without --device)"
+        )
+    path = Path(name)
+    if not path.exists() and path.suffix != ".toml":
+        try:
+            path = device_path(name)
+        except ValueError:
+            raise ValueError(
+                f"`--device`: no such file {name} (nor a shipped example: "
+                f"{', '.join(device_names())})"
+            ) from None
+    return Assembly.from_toml(path)
+
+
+def fitted_device(path) -> Harvester:
+    """The device a saved identification holds (``randvib identify --save`` / ``--json``).
+
+    Its c is the mechanical damping c_m when the fit identified its coupling
+    (wired at the first record's load); otherwise c is the total damping of
+    the record it was fitted to and the device has no coupling.
+    """
+    import json
+
+    from randvib._io import existing_file
+    from randvib.identification.result import IdentificationResult
+
+    path = existing_file(path, "`--from-fit` file", "JSON")
+    try:
+        data = json.loads(path.read_text())
+        result = IdentificationResult.from_dict(data)
+        return result.harvester()
+    except (ValueError, KeyError, TypeError, AttributeError, IndexError) as exc:
+        detail = f": {exc}" if isinstance(exc, ValueError) and str(exc) else ""
+        raise ValueError(
+            f"`--from-fit` {str(path)!r} is not a saved identification (the JSON of `randvib "
+            f"identify --save`){detail}"
+        ) from None
+
+
+def _base_device(args):
+    """(values, friction, coupling) of ``--preset`` or ``--from-fit`` (or none)."""
+    from_fit = getattr(args, "from_fit", None)
+    if args.preset is not None and from_fit is not None:
+        raise ValueError("give either `--preset` or `--from-fit`, not both")
+    base = preset(args.preset) if args.preset is not None else None
+    if from_fit is not None:
+        base = fitted_device(from_fit)
+    if base is None:
+        return {"m": None, "c_m": None, "c_e": None, "k": None, "k3": 0.0}, None, None
+    values = {"m": base.m, "c_m": base.c_m, "c_e": base.c_e, "k": base.k, "k3": base.k3}
+    if base.electrical is not None:
+        values["c_e"] = None  # follows the coupling
+    return values, base.friction, base.electrical
+
+
 def harvester_from_args(args) -> Harvester:
-    """Build the harvester from a preset and/or explicit options."""
-    if args.preset is not None:
-        base = preset(args.preset)
-        values = {"m": base.m, "c_m": base.c_m, "c_e": base.c_e, "k": base.k, "k3": base.k3}
-        friction = base.friction
-    else:
-        values = {"m": None, "c_m": None, "c_e": None, "k": None, "k3": 0.0}
-        friction = None
+    """Build the harvester from a preset, a saved fit and/or explicit options.
+
+    ``--device`` (an assembly) is refused here: the commands that take it
+    read it with :func:`assembly_from_args` first.
+    """
+    if getattr(args, "device", None) is not None:
+        raise ValueError(
+            "`--device` (an assembly of several masses) is not taken here yet; "
+            "`randvib power --device FILE` predicts its stationary power"
+        )
+    values, friction, fitted_coupling = _base_device(args)
     for name in values:
         given = getattr(args, name)
         if given is not None:
@@ -184,7 +283,7 @@ def harvester_from_args(args) -> Harvester:
 
     friction = _friction_from_args(args, friction)
 
-    coupling = _coupling_from_args(args)
+    coupling = _coupling_from_args(args, fitted_coupling)
     if coupling is not None:
         for name in ("m", "c_m", "k"):
             _need(values[name], option_flag(name), "the device")
@@ -239,8 +338,12 @@ def _bridge_from_args(args):
     return _built(cls, given, own)
 
 
-def _coupling_from_args(args):
-    """The coupling from ``--coupling`` and its parameter options, or None (``--c-e``)."""
+def _coupling_from_args(args, fitted=None):
+    """The coupling from ``--coupling`` and its parameter options, or None (``--c-e``).
+
+    ``fitted``: a saved fit's coupling, whose parameters the options override
+    (``--r-load 20`` wires it to another load).
+    """
     if getattr(args, "rectifier", None) is not None:
         return _bridge_from_args(args)
     bridge = [n for n in BRIDGE_OPTIONS if getattr(args, n, None) is not None]
@@ -248,6 +351,14 @@ def _coupling_from_args(args):
         raise ValueError(f"`{option_flag(bridge[0])}` needs `--rectifier bridge`")
     options = _coupling_options()
     given = {n: getattr(args, n) for n in options if getattr(args, n, None) is not None}
+    if fitted is not None and args.coupling in (None, fitted.name):
+        if args.c_e is not None:
+            raise ValueError("`--from-fit` holds the coupling; `--c-e` cannot replace it")
+        owners = {name: [c.name for c in couplings] for name, couplings in options.items()}
+        refuse_foreign_options(
+            given, fitted.parameter_names(), owners, "the {owners} coupling", fitted.name
+        )
+        return _built(type(fitted), {**fitted.parameters(), **given}, given)
     if args.coupling is None and not given:
         return None
     if args.c_e is not None:

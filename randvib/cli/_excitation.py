@@ -1,4 +1,5 @@
-"""Excitation options: ``--excitation`` and its parameters, ``--psd-file``, ``--record``.
+"""Excitation options: ``--excitation`` and its parameters, ``--psd-file``, ``--record``, tones,
+non-Gaussian input and shocks.
 
 The options come from the excitation registry (:data:`randvib.models.excitation.EXCITATIONS`):
 ``--excitation`` offers every registered excitation built from numbers, each
@@ -6,6 +7,14 @@ of its parameters (dataclass fields) other than the level is one option, and
 ``--psd`` is the level of each. The excitations read from a file have an
 option each (:data:`FILE_OPTIONS`). An option that does not apply to the
 chosen excitation is refused, as ``--beta`` is with Coulomb friction.
+
+Beyond stationary Gaussian noise: ``--tone F:A[:PHASE]`` (repeatable),
+``--kurtosis K`` or ``--marginal FILE`` (a translation process of the
+spectrum, :mod:`randvib.models.translation`) and ``--shock-rate``,
+``--shock-amplitude``, ``--shock-duration`` (with ``--shock-shape`` and
+``--shock-distribution``; :mod:`randvib.models.shock`). Tones and shocks are
+added to the spectrum (:class:`randvib.models.combined.Combined`), or stand
+alone with ``--psd 0``.
 """
 
 from __future__ import annotations
@@ -20,7 +29,12 @@ from randvib.cli._device import (
     refuse_foreign_options,
     require_psd,
 )
+from randvib.models.combined import Combined
 from randvib.models.excitation import EXCITATIONS
+from randvib.models.record import read_csv
+from randvib.models.shock import DISTRIBUTIONS, SHAPES, ShockTrain
+from randvib.models.tone import parse_tone
+from randvib.models.translation import Marginal, Translated
 
 #: File option (argparse dest) -> the registered excitation read from it (``from_csv``).
 FILE_OPTIONS = {"psd_file": "tabulated", "record": "measured"}
@@ -92,6 +106,59 @@ def add_excitation_arguments(parser: argparse.ArgumentParser) -> None:
         metavar="HZ",
         help="with --record: sample rate when the file has no time column",
     )
+    _add_beyond_gaussian_arguments(parser)
+
+
+def _add_beyond_gaussian_arguments(parser: argparse.ArgumentParser) -> None:
+    """``--tone``, the translation's ``--kurtosis``/``--marginal`` and the ``--shock-*`` options."""
+    g = parser.add_argument_group(
+        "beyond stationary Gaussian noise (added to the spectrum above, or alone with --psd 0)"
+    )
+    g.add_argument(
+        "--tone",
+        action="append",
+        metavar="F:A[:PHASE]",
+        help="a tone a(t) = A cos(2 pi F t + PHASE): F in Hz, A the base-acceleration amplitude "
+        "in m/s^2, PHASE in degrees (random per path when omitted: stationary); repeatable",
+    )
+    g.add_argument(
+        "--kurtosis",
+        type=float,
+        metavar="K",
+        help="non-Gaussian input: a translation process with the spectrum above and a "
+        "generalised-normal marginal of kurtosis K (> 1.8; 3 is Gaussian, 6 Laplace)",
+    )
+    g.add_argument(
+        "--marginal",
+        metavar="FILE",
+        help="non-Gaussian input: the marginal of the translation process, a CSV with the "
+        "columns value and density, or a record's base_acceleration samples (its histogram)",
+    )
+    g.add_argument(
+        "--shock-rate", type=float, metavar="RATE", help="shocks: Poisson pulses per second (1/s)"
+    )
+    g.add_argument(
+        "--shock-amplitude",
+        type=float,
+        metavar="A",
+        help="shocks: peak base acceleration of each pulse (m/s^2, sign random; the RMS peak "
+        "with --shock-distribution)",
+    )
+    g.add_argument(
+        "--shock-duration", type=float, metavar="S", help="shocks: duration of each pulse (s)"
+    )
+    g.add_argument(
+        "--shock-shape",
+        choices=tuple(SHAPES),
+        default=None,
+        help="shocks: pulse shape (default half-sine)",
+    )
+    g.add_argument(
+        "--shock-distribution",
+        choices=tuple(DISTRIBUTIONS),
+        default=None,
+        help="shocks: distribution of the peaks' sizes, same RMS (default fixed)",
+    )
 
 
 def excitation_from_args(args):
@@ -109,6 +176,19 @@ def excitation_from_args(args):
         One line naming the option: options that do not apply, missing ones,
         bad values, unreadable or invalid files.
     """
+    tones = [parse_tone(text) for text in (getattr(args, "tone", None) or [])]
+    shocks = _shocks(args)
+    alone = bool(tones) or shocks is not None
+    base = _spectrum_from_args(args, alone)
+    base = _translated(args, base)
+    if not alone:
+        return base
+    random = None if isinstance(base, int | float) and base == 0 else base
+    return Combined(random, tuple(tones), shocks)
+
+
+def _spectrum_from_args(args, alone: bool):
+    """The spectrum of ``--excitation``, ``--psd-file`` or ``--record``; 0 for tones or shocks alone."""
     files = {dest: getattr(args, dest) for dest in FILE_OPTIONS if getattr(args, dest) is not None}
     columns = {"input_column": args.input_column, "sample_rate": args.sample_rate}
     if "record" not in files:
@@ -139,6 +219,8 @@ def excitation_from_args(args):
     refuse_foreign_options(given, own, options, "the {owners} excitation", name)
     level = require_psd(args)
     if EXCITATIONS[name].is_white:
+        if alone and level == 0:
+            return 0.0  # the tones or shocks alone (checked downstream: a level is > 0)
         return level
     for parameter in own:
         if parameter not in given:
@@ -166,3 +248,93 @@ def _read(flag: str, name: str, path: str, columns: dict):
         # names inside the file's message are its columns ('psd'), not options
         # (`--psd`): quoted, they are left alone by the CLI's flag wording
         raise ValueError(f"`{flag}` {path}: {first.replace('`', chr(39))}") from None
+
+
+#: The shock train's options (argparse dest) -> the ShockTrain argument each sets.
+SHOCK_OPTIONS = {
+    "shock_rate": "rate",
+    "shock_amplitude": "amplitude",
+    "shock_duration": "duration",
+    "shock_shape": "shape",
+    "shock_distribution": "distribution",
+}
+
+
+def _shocks(args) -> ShockTrain | None:
+    """The shock train of the ``--shock-*`` options; None without them."""
+    given = {dest: getattr(args, dest, None) for dest in SHOCK_OPTIONS}
+    given = {dest: value for dest, value in given.items() if value is not None}
+    if not given:
+        return None
+    needed = ("shock_rate", "shock_amplitude", "shock_duration")
+    missing = [option_flag(dest) for dest in needed if dest not in given]
+    if missing:
+        have = ", ".join(f"`{option_flag(d)}`" for d in given)
+        raise ValueError(
+            f"{have} describe{'s' * (len(given) == 1)} a shock train, which also needs "
+            + " and ".join(f"`{flag}`" for flag in missing)
+        )
+    try:
+        return ShockTrain(**{SHOCK_OPTIONS[dest]: value for dest, value in given.items()})
+    except ValueError as exc:  # name the options, not the class's fields
+        message = str(exc)
+        for dest, field in SHOCK_OPTIONS.items():
+            message = message.replace(f"`{field}`", f"`{option_flag(dest)}`")
+        raise ValueError(message) from None
+
+
+def _translated(args, base):
+    """``base`` as a translation process with ``--kurtosis`` or ``--marginal``; else itself."""
+    kurtosis, marginal_file = getattr(args, "kurtosis", None), getattr(args, "marginal", None)
+    if kurtosis is None and marginal_file is None:
+        return base
+    if kurtosis is not None and marginal_file is not None:
+        raise ValueError("give one of `--kurtosis` and `--marginal`, not both")
+    flag = "--kurtosis" if kurtosis is not None else "--marginal"
+    if getattr(args, "record", None) is not None:
+        raise ValueError(
+            f"`{flag}` makes a translation process of a spectrum; a `--record` already carries "
+            "its own marginal (simulate on it as it is)"
+        )
+    if isinstance(base, int | float):
+        raise ValueError(
+            f"`{flag}` needs a spectrum of finite variance for the translation process "
+            "(`--excitation band-pass|kanai-tajimi|band-limited` or `--psd-file`): white noise "
+            "has none"
+        )
+    try:
+        marginal = (
+            Marginal.from_kurtosis(kurtosis)
+            if kurtosis is not None
+            else _read_marginal(marginal_file)
+        )
+        return Translated(base, marginal)
+    except ValueError as exc:
+        message = str(exc).replace("`kurtosis`", "`--kurtosis`").replace("`dt`", "`--dt`")
+        raise ValueError(message) from None
+
+
+def _read_marginal(path: str) -> Marginal:
+    """``--marginal FILE``: a density table (value, density) or a record's samples."""
+    file = Path(path)
+    if not file.is_file():
+        raise ValueError(f"`--marginal`: no such file {path}")
+    try:
+        frame = read_csv(file, "file")
+    except (ValueError, OSError) as exc:
+        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise ValueError(f"`--marginal` {path}: {first.replace('`', chr(39))}") from None
+    columns = set(frame.columns)
+    try:
+        if {"value", "density"} <= columns:
+            return Marginal.from_table(
+                frame["value"].to_numpy(float), frame["density"].to_numpy(float)
+            )
+        if "base_acceleration" in columns:
+            return Marginal.from_samples(frame["base_acceleration"].to_numpy(float))
+    except ValueError as exc:
+        raise ValueError(f"`--marginal` {path}: {str(exc).replace('`', chr(39))}") from None
+    raise ValueError(
+        f"`--marginal` {path} must have the columns value and density (a table of the "
+        f"density) or base_acceleration (a record's samples); found {', '.join(frame.columns)}"
+    )

@@ -100,8 +100,27 @@ def _bistable(harvester) -> str:
 
 
 def describe_excitation(psd) -> str:
-    """One line: the base excitation used (white level, or the excitation's parameters)."""
+    """One line: the base excitation used (white level, or the excitation's parameters).
+
+    Tones and shocks follow the random part (``none`` without one).
+    """
     if isinstance(psd, int | float):
         return f"excitation: white noise, S = {psd:.6g} {unit('psd')} (one-sided)"
-    numbers = {k: v for k, v in psd.parameters().items() if not isinstance(v, str)}
-    return f"excitation: {psd.name} ({_assignments(numbers, _quantity_units(numbers))})"
+    parameters = psd.parameters()
+    kind = parameters.pop("excitation")
+    tones, shocks = parameters.pop("tones", ()), parameters.pop("shocks", None)
+    numbers = {k: v for k, v in parameters.items() if isinstance(v, int | float) and v is not None}
+    text = f"excitation: {kind}"
+    if numbers:
+        text += f" ({_assignments(numbers, _quantity_units(numbers))})"
+    for tone in tones:
+        phase = "random phase" if tone["phase"] is None else f"phase {cell(tone['phase'], 4)} deg"
+        text += (
+            f" + tone {cell(tone['frequency'], 4)} Hz, {cell(tone['amplitude'], 4)} m/s^2 ({phase})"
+        )
+    if shocks is not None:
+        text += (
+            f" + shocks ({cell(shocks['rate'], 4)} 1/s, {cell(shocks['amplitude'], 4)} m/s^2, "
+            f"{cell(shocks['duration'], 4)} s, {shocks['shape']}, {shocks['distribution']})"
+        )
+    return text

@@ -5,15 +5,10 @@ from __future__ import annotations
 import argparse
 
 from randvib._validation import integer_option
+from randvib.identification.circuit import COUPLING_PARAMETERS, OUTPUT_KINDS
 from randvib.identification.input_reconstruction import AUTO_HOLD, HOLDS
 from randvib.identification.settings import INITIAL_STATES, SimulationSettings
-from randvib.models.record import (
-    INPUT_KINDS,
-    OUTPUT_CHANNEL,
-    OUTPUT_KINDS,
-    TIME_COLUMN,
-    read_record,
-)
+from randvib.models.record import INPUT_KINDS, OUTPUT_CHANNEL, TIME_COLUMN, read_record
 from randvib.quantities import unit
 
 
@@ -24,16 +19,20 @@ def add_record_arguments(parser: argparse.ArgumentParser) -> None:
     )
     g.add_argument("--input-kind", choices=INPUT_KINDS, help="what the input column holds")
     g.add_argument(
-        "--output-column",
-        metavar="NAME",
-        default=OUTPUT_CHANNEL,
-        help="relative-displacement column",
+        "--output-kind",
+        action="append",
+        choices=OUTPUT_KINDS,
+        metavar="KIND",
+        help=f"what an output column holds, one of {', '.join(OUTPUT_KINDS)}; repeat for several "
+        "channels, paired in order with --output-column (default: the column named like its kind, "
+        "relative_displacement)",
     )
     g.add_argument(
-        "--output-kind",
-        choices=OUTPUT_KINDS,
-        help="what --output-column holds; needed for a column not named as its kind "
-        "(its values are then used in the column's own units)",
+        "--output-column",
+        action="append",
+        metavar="NAME",
+        help="an output column, fitted only as its --output-kind (a column named like a kind "
+        "needs none); repeat for several",
     )
     g.add_argument(
         "--time-column", metavar="NAME", default=TIME_COLUMN, help="time column (s, uniform)"
@@ -87,13 +86,48 @@ def parse_rows(text):
         raise ValueError(f"`--rows` must be START:STOP with integers, got {text!r}") from None
 
 
+def output_pairs(args) -> list[tuple[str, str]]:
+    """The (kind, column) pairs of ``--output-kind`` / ``--output-column``, in order.
+
+    A column is fitted only as the kind declared for it: without
+    ``--output-kind`` each column must be named like a kind, and without
+    ``--output-column`` each kind is the column of its name.
+    """
+    kinds = list(getattr(args, "output_kind", None) or [])
+    columns = list(getattr(args, "output_column", None) or [])
+    if not kinds and not columns:
+        return [(OUTPUT_CHANNEL, OUTPUT_CHANNEL)]
+    if not kinds:
+        unknown = [c for c in columns if c not in OUTPUT_KINDS]
+        if unknown:
+            raise ValueError(
+                f"`--output-column` {unknown[0]!r}: say what it holds with `--output-kind "
+                f"{'|'.join(OUTPUT_KINDS)}` (a column is fitted only as its declared kind)"
+            )
+        kinds = list(columns)
+    if not columns:
+        columns = list(kinds)
+    if len(kinds) != len(columns):
+        raise ValueError(
+            f"`--output-kind` and `--output-column` pair in order: got {len(kinds)} kind(s) and "
+            f"{len(columns)} column(s); give one column per kind"
+        )
+    if len(set(kinds)) != len(kinds):
+        raise ValueError(f"`--output-kind` names a kind twice: {', '.join(kinds)}")
+    return list(zip(kinds, columns, strict=True))
+
+
+def output_kinds(args) -> tuple:
+    """The kinds of the output channels (see :func:`output_pairs`)."""
+    return tuple(kind for kind, _ in output_pairs(args))
+
+
 def record_from_args(path, args, name=None):
     return read_record(
         path,
         input_column=args.input_column,
         input_kind=args.input_kind,
-        output_column=args.output_column,
-        output_kind=args.output_kind,
+        outputs=dict(output_pairs(args)),
         time_column=args.time_column,
         sample_rate=args.sample_rate,
         rows=parse_rows(args.rows),
@@ -111,6 +145,62 @@ def simulation_settings(args, defaults=None) -> SimulationSettings:
         if value is not None:
             out[key] = value
     return SimulationSettings(**out)
+
+
+def add_circuit_arguments(parser: argparse.ArgumentParser, *, identified: bool = True) -> None:
+    """``--coupling`` and ``--r-load`` (one per record, or one for all) of a record's circuit."""
+    g = parser.add_argument_group("circuit (the records' coupling and loads)")
+    g.add_argument(
+        "--coupling",
+        choices=tuple(COUPLING_PARAMETERS),
+        help=(
+            "identify the coupling with the mechanics: resistive (alpha, r_coil), inductive "
+            "(alpha, r_coil, inductance) or piezo (theta, capacitance); c is then c_m"
+            if identified
+            else "the coupling of the device (default: the saved fit's)"
+        ),
+    )
+    g.add_argument(
+        "--r-load",
+        type=float,
+        action="append",
+        metavar="OHM",
+        help="each record's known load resistance R_L (ohm), in the records' order; one value "
+        "for all records",
+    )
+    if identified:
+        g.add_argument(
+            "--weight",
+            action="append",
+            metavar="KIND=W",
+            help="weight of an output kind's J in the sum (default 1 each)",
+        )
+
+
+def parse_weights(items) -> dict:
+    """``--weight KIND=W``: positive weights of output kinds."""
+    out = {}
+    for kind, value in parse_assignments(items, "--weight").items():
+        if kind not in OUTPUT_KINDS:
+            raise ValueError(f"`--weight {kind}`: not one of {', '.join(OUTPUT_KINDS)}")
+        if not (value > 0 and value < float("inf")):
+            raise ValueError(f"`--weight {kind}` must be a positive number, got {value!r}")
+        out[kind] = value
+    return out
+
+
+def r_loads(args, count: int):
+    """The records' loads from ``--r-load`` (None when not given)."""
+    loads = getattr(args, "r_load", None)
+    if not loads:
+        return None
+    if len(loads) == 1:
+        return loads[0]
+    if len(loads) != count:
+        raise ValueError(
+            f"`--r-load` gives {len(loads)} loads for {count} records: one for all, or one each"
+        )
+    return loads
 
 
 def parse_assignments(items, option: str) -> dict:
@@ -142,19 +232,23 @@ def parse_bounds(items) -> dict:
 
 
 def output_unit(args) -> str:
-    """The unit of the output column: m for the relative displacement, else the column's own."""
-    if args.output_column == OUTPUT_CHANNEL:
-        return unit(OUTPUT_CHANNEL)
-    return f"{args.output_column} units"
+    """The unit of the first output channel: its kind's (m for the relative displacement),
+    except a displacement column named otherwise (``--output-column laser --output-kind
+    relative_displacement``), which is read in the column's own units (a sensor's volts)."""
+    kind, column = output_pairs(args)[0]
+    if kind == OUTPUT_CHANNEL and column != kind:
+        return f"{column} units"
+    return unit(kind)
 
 
 def plot_units(args) -> dict:
     """``scale`` and ``unit`` of the output in ``--plot`` figures.
 
-    The default output column is the relative displacement in m, which the
-    figures show in mm (their default); a column the user named
-    (``--output-column``) is shown as it is, in the record's own units.
+    A channel in its kind's unit is shown as the figures choose (a
+    displacement in mm); a displacement column in its own units
+    (:func:`output_unit`) is shown as it is.
     """
-    if args.output_column == OUTPUT_CHANNEL:
+    kind, column = output_pairs(args)[0]
+    if kind != OUTPUT_CHANNEL or column == kind:
         return {}
     return dict(scale=1.0, unit=output_unit(args))

@@ -1,4 +1,9 @@
-"""``randvib identify DATA.csv --model M``: fit a friction model to a record (paper Sec. 3)."""
+"""``randvib identify DATA.csv ... --model M``: fit a friction model (and a circuit) to records.
+
+Paper Sec. 3, and beyond it: several records of one device at their loads,
+any of the displacement, velocity, load voltage and current channels
+(:mod:`randvib.identification.experiment_fit`).
+"""
 
 from __future__ import annotations
 
@@ -10,11 +15,15 @@ from randvib._validation import MAX_SEED, integer_option
 from randvib.cli import COMMAND_HELP
 from randvib.cli._output import print_table
 from randvib.cli._records import (
+    add_circuit_arguments,
     add_record_arguments,
+    output_kinds,
     output_unit,
     parse_assignments,
     parse_bounds,
+    parse_weights,
     plot_units,
+    r_loads,
     record_from_args,
     simulation_settings,
 )
@@ -23,6 +32,8 @@ from randvib.identification.identify import identify
 from randvib.identification.least_squares import COVARIANCE_METHODS
 from randvib.identification.models import MODELS
 from randvib.identification.settings import SearchSettings
+from randvib.models.record import OUTPUT_CHANNEL
+from randvib.quantities import unit
 
 DEFAULT = SearchSettings()
 
@@ -31,10 +42,17 @@ def register(sub) -> None:
     p = sub.add_parser(
         "identify",
         help=COMMAND_HELP["identify"],
-        description="Fit the device model (Eq. 1) with a friction model to a CSV record by "
-        "minimising J (Eq. 11) with self-adaptive differential evolution.",
+        description="Fit the device model (Eq. 1) with a friction model, and with --coupling "
+        "its circuit, to CSV records of one device (each at its own --r-load) by minimising J "
+        "(Eq. 11, per channel and summed) with self-adaptive differential evolution; what the "
+        "records cannot fix is refused first, naming what to add.",
     )
-    p.add_argument("data", metavar="DATA.csv", help="record: time, input, relative_displacement")
+    p.add_argument(
+        "data",
+        nargs="+",
+        metavar="DATA.csv",
+        help="record(s) of one device: time, input and output columns (one record per load)",
+    )
     p.add_argument(
         "--model",
         required=True,
@@ -44,7 +62,8 @@ def register(sub) -> None:
     p.add_argument(
         "--m",
         type=float,
-        help="mass (kg); required for base excitation, identified if omitted with a force input",
+        help="mass (kg); required for base excitation unless the records fix it (identify says), "
+        "identified if omitted with a force input",
     )
     p.add_argument("--seed", type=integer_option(0, MAX_SEED), default=0, help="random seed")
     p.add_argument(
@@ -93,6 +112,7 @@ def register(sub) -> None:
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     add_record_arguments(p)
+    add_circuit_arguments(p)
     p.set_defaults(handler=run)
 
 
@@ -102,7 +122,8 @@ def _new_file(path, option, overwrite=False):
 
 
 def _save_plot(result, record, plot: Path, title: str, units: dict, json: bool = False) -> bool:
-    """The figure; if it cannot be written now, say so and keep going (the result is printed).
+    """The figure of the first record; if it cannot be written now, say so and keep going
+    (the result is printed).
 
     Returns whether the figure was written where asked (the exit status is 1 if not).
     """
@@ -127,7 +148,9 @@ def _save_plot(result, record, plot: Path, title: str, units: dict, json: bool =
 def run(args) -> int:
     save = _new_file(args.save, "--save", args.force)
     plot = _new_file(args.plot, "--plot", args.force)
-    record = record_from_args(args.data, args)
+    records = [record_from_args(path, args) for path in args.data]
+    kinds = output_kinds(args)
+    record = records[0]
     search = SearchSettings(
         popsize=args.popsize,
         maxiter=args.generations,
@@ -135,10 +158,15 @@ def run(args) -> int:
         polish=not args.no_polish,
         search_samples=args.search_samples,
     )
+    plain = len(records) == 1 and args.coupling is None and kinds == (OUTPUT_CHANNEL,)
     result = identify(
-        record,
+        record if plain else records,
         args.model,
         m=args.m,
+        coupling=args.coupling,
+        r_load=r_loads(args, len(records)),
+        outputs=None if plain else kinds,
+        weights=parse_weights(args.weight) or None,
         fixed=parse_assignments(args.fix, "--fix"),
         quadratic=args.quadratic,
         bounds=parse_bounds(args.bounds),
@@ -155,18 +183,13 @@ def run(args) -> int:
     ):
         status = 1
     if plot is not None and not _save_plot(
-        result,
-        record,
-        plot,
-        f"{args.model} model on {record.name}",
-        plot_units(args),
-        args.json,
+        result, record, plot, f"{args.model} model on {record.name}", plot_units(args), args.json
     ):
         status = 1
     if args.json:
         print(dumps(out))
         return status
-    print_report(result, record, output_unit(args))
+    print_report(result, records, output_unit(args))
     return status
 
 
@@ -177,35 +200,46 @@ def _status(name, se, free, at_bound) -> str:
     return "identified" if name in se or name in free else "fixed"
 
 
-def print_report(result, record, output_unit: str = "m") -> None:
-    """The parameters with standard errors and 95 % intervals, J, the correlations.
+def print_report(result, records, offset_unit: str | None = None) -> None:
+    """The parameters with standard errors and 95 % intervals, J (per channel), what the
+    records fix and why, the correlations.
 
-    ``output_unit``: the unit of the record's output column (m for the
-    relative displacement; a named ``--output-column`` keeps its own).
+    ``offset_unit``: the unit of the record's displacement column where it is not m (a
+    column declared ``relative_displacement`` under another name is read in its own
+    units), shown for ``output_offset``.
     """
+    records = [records] if not isinstance(records, list | tuple) else records
     se, ci, at_bound = result.standard_errors, result.confidence_intervals, result.at_bound
-    offsets = {"output_offset": output_unit}
     rows = [
         [
             name,
             *with_standard_error(value, se.get(name), ci.get(name)),
-            offsets[name] if name in offsets else result.unit(name),
+            offset_unit if name == "output_offset" and offset_unit else result.unit(name),
             _status(name, se, result.free, at_bound),
         ]
         for name, value in result.parameters.items()
     ]
-    print(f"model {result.model} on {record.name} ({record.n} samples, {record.input_kind} input)")
+    coupling = f" with the {result.coupling} coupling" if result.coupling else ""
+    for record in records:
+        print(
+            f"model {result.model}{coupling} on {record.name} ({record.n} samples, "
+            f"{record.input_kind} input; fitted: {', '.join(result.outputs)})"
+        )
     print_table(rows, ["parameter", "value", "std. error", "95 % interval", "unit", "status"])
     print(
-        f"J = {result.cost:.6g} (Eq. 11); {result.nfev} simulations in {result.elapsed:.1f} s "
+        f"J = {result.cost:.6g} (Eq. 11{', summed over channels' if result.channel_costs else ''}"
+        f"); {result.nfev} simulations in {result.elapsed:.1f} s "
         f"({result.simulations_per_second:.0f} sims/s); {result.message}"
     )
-    start = result.initial_state
-    print(
-        f"initial state z0 = {start['z0']:.6g} {output_unit}, v0 = {start['v0']:.6g} {output_unit}/s"
-    )
+    _print_channels(result)
+    _print_start(result)
     if result.residuals is not None:
         print(result.residuals.summary())
+    if result.identifiability is not None:
+        ident = result.identifiability
+        print(f"the records fix: {', '.join(ident.determined) or 'no free parameter'}")
+        for reason in ident.reasons:
+            print(f"  because {reason}")
     for note in result.notes:
         print(f"note: {note}")
     unc = result.uncertainty
@@ -222,3 +256,31 @@ def print_report(result, record, output_unit: str = "m") -> None:
             ],
             ["", *names],
         )
+
+
+def _print_channels(result) -> None:
+    """J and RMS error of each record's channels (several channels or records)."""
+    if not result.channel_costs:
+        return
+    print_table(
+        [
+            [row["record"], row["output"], "" if row["r_load"] is None else row["r_load"],
+             row["cost"], f"{row['rms_error']:.4g} {unit(row['output'])}"]
+            for row in result.channel_costs
+        ],
+        ["record", "channel", "R_L (ohm)", "J", "RMS error"],
+    )  # fmt: skip
+
+
+def _print_start(result) -> None:
+    """Each record's initial state (z0 m, v0 m/s and the circuit's x0)."""
+    units = {
+        "z0": "m",
+        "v0": "m/s",
+        "x0": {"inductive": "A", "piezo": "V"}.get(result.coupling, ""),
+    }
+    parts = [
+        f"{name} = {value:.6g} {units[name.partition('[')[0]]}".rstrip()
+        for name, value in result.initial_state.items()
+    ]
+    print(f"initial state {', '.join(parts)}")

@@ -25,6 +25,16 @@ ensemble set by ``--optimal-paths``, ``--optimal-t-end``, ``--optimal-grid``);
 then the analytic prediction at the given device is left out where no method
 takes it (``method`` is ``"monte-carlo"``).
 
+``--device FILE.toml`` predicts an assembly (docs/assemblies.md): the JSON
+has ``transducers`` (one entry per transducer in file order, each with
+``power_electrical``, and ``power_load`` where the coupling has a load),
+``displacement_variance`` and ``velocity_variance`` (one entry per DOF),
+``elements`` (each element's closure), ``exact`` (true for a linear
+assembly: the Lyapunov solution), ``power_input`` and ``power_mechanical``;
+``--optimal-load`` adds each transducer's best load (``r_load_optimal``,
+``power_load_optimal``; a bare c_e: ``c_e_optimal``) to its entry, the others
+held as given (:func:`randvib.optimal_assembly_loads`).
+
 ``--envelope`` makes the input an event from t = 0 (:mod:`randvib.cli._event`):
 the moments at ``--times`` and the energy to ``--t-end`` by the Lyapunov
 equation (:func:`randvib.transient_response`), one point at a time.
@@ -41,14 +51,22 @@ import math
 from randvib._io import claim_output_file, dumps, write_or_keep
 from randvib._resources import announce_duration, timed
 from randvib._validation import check_positive
+from randvib.analytic.assembly_prediction import optimal_assembly_loads
 from randvib.analytic.bridge import optimal_dc_output
 from randvib.analytic.prediction import METHODS, optimal_load_resistance, predict
 from randvib.cli import COMMAND_HELP, advice_when_done
-from randvib.cli._device import add_device_arguments, harvester_from_args, option_flag
+from randvib.cli._device import (
+    add_device_arguments,
+    assembly_from_args,
+    harvester_from_args,
+    option_flag,
+)
 from randvib.cli._event import add_event_arguments, power_event, wants_event
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
 from randvib.cli._output import describe_device, describe_excitation, print_table, with_units
 from randvib.formatting import cell
+from randvib.models.assembly import Assembly
+from randvib.models.assembly_parts import between_words
 from randvib.models.excitation import Excitation
 from randvib.montecarlo.bridge_optimum import simulated_dc_optimum
 from randvib.quantities import QUANTITIES, unit
@@ -76,7 +94,8 @@ def register(sub) -> None:
         action="store_true",
         help="also the load resistance R_L that maximises the load power, and that power "
         "(needs a coupling: --alpha/--r-load/--r-coil or --coupling; its --r-load is the start); "
-        "with --rectifier bridge, the battery voltage or storage load maximising the stored power",
+        "with --rectifier bridge, the battery voltage or storage load maximising the stored power; "
+        "with --device, each transducer's load (the others as given)",
     )
     p.add_argument(
         "--optimal-bounds",
@@ -211,7 +230,7 @@ def run(args) -> int:
     if csv_file is not None:
         saved = _write_csv(csv_file, [out for out, _, _ in results], args.force)
     if args.json:
-        outs = [with_units(out, h.electrical) for out, h, _ in results]
+        outs = [with_units(out, getattr(h, "electrical", None)) for out, h, _ in results]
         print(dumps(outs[0] if len(outs) == 1 and not swept else outs))
     elif swept:
         _print_sweep(swept, points, results)
@@ -258,7 +277,10 @@ def _keep_finished(results, n_points: int, csv_file, overwrite: bool) -> str:
 
 
 def _point(args) -> tuple[dict, object, object]:
-    """The JSON object of one point, with its harvester and excitation."""
+    """The JSON object of one point, with its harvester (or assembly) and excitation."""
+    assembly = assembly_from_args(args)
+    if assembly is not None:
+        return _assembly_point(args, assembly)
     harvester = harvester_from_args(args)
     psd = excitation_from_args(args)
     coloured = isinstance(psd, Excitation)
@@ -306,6 +328,30 @@ def _point(args) -> tuple[dict, object, object]:
     if coloured:
         out["excitation"] = psd.parameters()
     return out, harvester, psd
+
+
+def _assembly_point(args, assembly: Assembly) -> tuple[dict, object, object]:
+    """The JSON object of one point of ``--device`` (module docstring), with its assembly."""
+    psd = excitation_from_args(args)
+    coloured = isinstance(psd, Excitation)
+    if args.optimal_bounds is not None:
+        raise ValueError(
+            "`--optimal-bounds` is for a single bridge (`--rectifier bridge`), not `--device`"
+        )
+    result = predict(assembly, psd, method=args.method)
+    out = {
+        "method": result.method,
+        "psd": getattr(psd, "level", None) if coloured else psd,
+        "device": args.device,
+        "n_dof": assembly.n_dof,
+        **result.to_dict(),
+    }
+    if args.optimal_load:
+        for best in optimal_assembly_loads(assembly, psd):
+            out["transducers"][best.transducer].update(best.to_dict())
+    if coloured:
+        out["excitation"] = psd.parameters()
+    return out, assembly, psd
 
 
 def _simulated_optimum_point(args, harvester, psd) -> dict | None:
@@ -400,18 +446,56 @@ def _check_method(name: str, harvester, psd) -> None:
 
 def _unit(key: str, harvester) -> str:
     """The unit of a key of the JSON object (none for words: method, friction...)."""
-    return unit(key, harvester.electrical) if key in QUANTITIES else ""
+    return unit(key, getattr(harvester, "electrical", None)) if key in QUANTITIES else ""
+
+
+def _print_assembly_point(out: dict, assembly: Assembly, psd) -> None:
+    """One point of ``--device``: the assembly, then per transducer and per DOF."""
+    print(f"device: {out['device']}: {assembly.describe()}")
+    print(describe_excitation(psd))
+    what = "exact (Lyapunov)" if out["exact"] else f"{out['method']} ({out['variance_method']})"
+    rows = [("method", what, "")]
+    for index, entry in enumerate(out["transducers"]):
+        where = f"transducer {index} {between_words(assembly.transducers[index].between)}"
+        for key in ("power_electrical", "power_load", "circuit_mean_square", "stroke_exceedance",
+                    "r_load_optimal", "power_load_optimal", "c_e_optimal", "power_electrical_optimal"):  # fmt: skip
+            if entry.get(key) is not None:
+                electrical = assembly.transducers[index].coupling
+                shown = unit(key, electrical) if key in QUANTITIES else _OPTIMAL_UNITS.get(key, "")
+                rows.append((f"{where} {key}", entry[key], shown))
+    for i, (zz, vv) in enumerate(
+        zip(out["displacement_variance"], out["velocity_variance"], strict=True)
+    ):
+        rows += [
+            (f"DOF {i} displacement_variance", zz, "m^2"),
+            (f"DOF {i} velocity_variance", vv, "(m/s)^2"),
+        ]
+    rows += [
+        (k, out[k], "W") for k in ("power_input", "power_mechanical") if out.get(k) is not None
+    ]
+    print_table(rows, ("quantity", "value", "unit"))
+
+
+#: Units of the optimum keys of a transducer entry.
+_OPTIMAL_UNITS = {"r_load_optimal": "ohm", "power_load_optimal": "W", "c_e_optimal": "Ns/m",
+                  "power_electrical_optimal": "W"}  # fmt: skip
 
 
 def _print_point(out: dict, harvester, psd) -> None:
     """One point: the device and excitation used, then quantity / value / unit."""
+    if isinstance(harvester, Assembly):
+        return _print_assembly_point(out, harvester, psd)
     print(describe_device(harvester))
     print(describe_excitation(psd))
-    # a tabulated or measured spectrum has no level: the excitation line describes it
+    # a tabulated or measured spectrum has no level: the excitation line describes it;
+    # tones and shocks are lists and objects: the excitation line, and a table of the tones
     shown = {k: v for k, v in out.items() if k != "excitation" and not (k == "psd" and v is None)}
-    rows = [(k, v, _unit(k, harvester)) for k, v in shown.items()]
-    rows += [(k, v, _unit(k, harvester)) for k, v in out.get("excitation", {}).items()]
+    excitation = out.get("excitation", {})
+    rows = [(k, v, _unit(k, harvester)) for k, v in shown.items() if not _nested(v)]
+    rows += [(k, v, _unit(k, harvester)) for k, v in excitation.items() if not _nested(v)]
     print_table(rows, ("quantity", "value", "unit"))
+    if out.get("tones"):
+        _print_tones(out["tones"])
     if harvester.electrical is None and harvester.c_e == 0:
         print(
             "note: this device has no electrical damping (c_e = 0, as the presets identified "
@@ -419,6 +503,22 @@ def _print_point(out: dict, harvester, psd) -> None:
             f"or --c-e. It dissipates {cell(out['power_mechanical'], 4)} W mechanically "
             "(c_m E[v^2] + friction)."
         )
+
+
+def _nested(value) -> bool:
+    return isinstance(value, list | dict)
+
+
+def _print_tones(tones: list) -> None:
+    """Each tone's response: its frequency and amplitude, the displacement and velocity amplitudes."""
+    print()
+    rows = [
+        (t["frequency"], t["amplitude"], t["displacement_amplitude"], t["velocity_amplitude"],
+         t["c_eq"], t["k_eq"])
+        for t in tones
+    ]  # fmt: skip
+    headers = ("tone (Hz)", "A (m/s^2)", "Z (m)", "V (m/s)", "c_eq (Ns/m)", "k_eq (N/m)")
+    print_table(rows, headers)
 
 
 #: The columns of a sweep's table, after the swept options, where present.
@@ -437,20 +537,54 @@ SWEEP_COLUMNS = (
 )
 
 
+#: The columns of a sweep's table for each transducer of an assembly.
+TRANSDUCER_COLUMNS = ("power_electrical", "power_load", "r_load_optimal", "power_load_optimal")
+
+
 def _print_sweep(swept: list[str], points, results) -> None:
     """One row per point: the swept values, then the powers and main statistics."""
     first = results[0][0]
-    columns = [c for c in SWEEP_COLUMNS if c in first]
+    columns = [c for c in SWEEP_COLUMNS if c in first and not isinstance(first[c], list)]
+    # an assembly's (--device): each transducer's powers and optimum, by its index
+    columns += [
+        key
+        for key in _flat(first.get("transducers", []), "transducers.")
+        if key.rpartition(".")[2] in TRANSDUCER_COLUMNS
+    ]
     print(f"method {first['method']}; swept {', '.join(option_flag(d) for d in swept)}")
     rows = [
-        [getattr(point, dest) for dest in swept] + [out.get(c) for c in columns]
+        [getattr(point, dest) for dest in swept] + [_flat(out).get(c) for c in columns]
         for point, (out, _, _) in zip(points, results, strict=True)
     ]
     harvester = results[0][1]
     headers = [option_flag(d) for d in swept] + [
-        f"{c} ({_unit(c, harvester)})" if _unit(c, harvester) else c for c in columns
+        f"{c} ({_unit(c.rpartition('.')[2], harvester)})"
+        if _unit(c.rpartition(".")[2], harvester)
+        else c
+        for c in columns
     ]
     print_table(rows, headers)
+
+
+def _flat(value, prefix: str = "") -> dict:
+    """A JSON object as one CSV row: nested keys dotted (``excitation.f0``, ``transducers.0.power_load``)."""
+    if isinstance(value, dict):
+        items = value.items()
+    elif (
+        isinstance(value, list)
+        and any(isinstance(x, dict | list) for x in value)
+        or (
+            isinstance(value, list)
+            and prefix.rstrip(".") in ("displacement_variance", "velocity_variance")
+        )
+    ):
+        items = enumerate(value)
+    else:
+        return {prefix.rstrip("."): value}
+    out = {}
+    for key, item in items:
+        out.update(_flat(item, f"{prefix}{key}."))
+    return out
 
 
 def _write_csv(path, outs: list[dict], overwrite: bool):
@@ -459,11 +593,7 @@ def _write_csv(path, outs: list[dict], overwrite: bool):
     Written whole or not at all; where it could not be written, the table is
     kept in an ``randvib-unsaved-*`` file, whose path is returned.
     """
-    rows = []
-    for out in outs:
-        row = {k: v for k, v in out.items() if k != "excitation"}
-        row.update({f"excitation.{k}": v for k, v in out.get("excitation", {}).items()})
-        rows.append(row)
+    rows = [_flat(out) for out in outs]
     names = list(dict.fromkeys(k for row in rows for k in row))
     text = io.StringIO(newline="")
     writer = csv.DictWriter(text, fieldnames=names)

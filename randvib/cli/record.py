@@ -18,6 +18,8 @@ from randvib._resources import check_memory
 from randvib._validation import MAX_SEED, check_int, check_positive, integer_option
 from randvib.cli import COMMAND_HELP
 from randvib.cli._device import add_device_arguments, harvester_from_args
+from randvib.cli._records import parse_assignments
+from randvib.identification.circuit import OUTPUT_KINDS
 from randvib.identification.synthetic import PAPER_BAND, SYNTHETIC_INPUTS, synthetic_record
 from randvib.models.excitation import BandLimited
 
@@ -27,7 +29,9 @@ def register(sub) -> None:
         "record",
         help=COMMAND_HELP["record"],
         description="Simulate a device under band-limited base excitation and write the "
-        "record (time, input, relative_displacement) with optional sensor noise and offsets.",
+        "record (time, input, and the response channels: relative_displacement, "
+        "relative_velocity, the load voltage or current of its circuit) with optional sensor "
+        "noise and offsets.",
     )
     add_device_arguments(p)  # also --psd: the flat level of the band
     g = p.add_argument_group("excitation and record")
@@ -50,10 +54,31 @@ def register(sub) -> None:
         "--seed", type=integer_option(0, MAX_SEED), default=0, help="random seed (default 0)"
     )
     s = p.add_argument_group("sensors (measured = true + offset + noise)")
+    s.add_argument(
+        "--output-kind",
+        action="append",
+        choices=OUTPUT_KINDS,
+        metavar="KIND",
+        help=f"a response channel to record, one of {', '.join(OUTPUT_KINDS)} (repeat for "
+        "several; default relative_displacement); voltage and current need --coupling: the "
+        "load voltage R_L i of a coil (its current a state with --inductance), V of a piezo",
+    )
     s.add_argument("--noise-z", type=float, default=0.0, help="RMS noise on z (m)")
     s.add_argument("--noise-input", type=float, default=0.0, help="RMS noise on the input")
     s.add_argument("--offset-z", type=float, default=0.0, help="offset on z (m)")
     s.add_argument("--offset-input", type=float, default=0.0, help="offset on the input")
+    s.add_argument(
+        "--noise",
+        action="append",
+        metavar="KIND=RMS",
+        help="RMS white noise on an output channel, in its unit (e.g. voltage=1e-3)",
+    )
+    s.add_argument(
+        "--offset",
+        action="append",
+        metavar="KIND=VALUE",
+        help="offset of an output channel, in its unit (e.g. voltage=2e-3)",
+    )
     p.add_argument("--out", required=True, metavar="FILE.csv", help="output file (new)")
     p.add_argument("--force", action="store_true", help="overwrite an existing --out")
     p.set_defaults(handler=run, api_flags={"excitation (RMS base acceleration)": "--rms"})
@@ -92,6 +117,9 @@ def run(args) -> int:
         substeps=args.substeps,
         band=(args.f_lo, args.f_hi),
         name=out.stem,
+        outputs=tuple(args.output_kind or ("relative_displacement",)),
+        noise=_channel_values(args.noise, "--noise"),
+        offsets=_channel_values(args.offset, "--offset"),
     )
     # Full precision, so that identify reads back exactly the simulated samples.
     text = record.to_frame().to_csv(index=False, float_format=None)
@@ -106,11 +134,14 @@ def run(args) -> int:
         "input": args.input,
         "substeps": args.substeps,
         "seed": args.seed,
+        "outputs": list(args.output_kind or ("relative_displacement",)),
         "sensors": {
             "noise_z": args.noise_z,
             "noise_input": args.noise_input,
             "offset_z": args.offset_z,
             "offset_input": args.offset_input,
+            "noise": _channel_values(args.noise, "--noise"),
+            "offsets": _channel_values(args.offset, "--offset"),
         },
     }
     where = write_or_keep(
@@ -121,3 +152,12 @@ def run(args) -> int:
         return 1
     print(f"wrote {where} (the parameters simulated)")
     return 0
+
+
+def _channel_values(items, option: str) -> dict:
+    """``KIND=VALUE`` of an output channel (``--noise``, ``--offset``)."""
+    out = parse_assignments(items, option)
+    for kind in out:
+        if kind not in OUTPUT_KINDS:
+            raise ValueError(f"`{option} {kind}`: not one of {', '.join(OUTPUT_KINDS)}")
+    return out

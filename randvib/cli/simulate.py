@@ -106,12 +106,7 @@ def run(args) -> int:
         return simulate_event(args, harvester, psd)
     burn_in = 2.0 if args.burn_in is None else args.burn_in
     white = isinstance(psd, float | int)
-    if args.control_variates and not white and psd.shaping_filter() is None:
-        raise ValueError(
-            "`--control-variates` needs white noise or a filtered spectrum (band-pass, "
-            f"kanai-tajimi): under the synthesised or recorded {psd.name} input no control "
-            "has a known mean"
-        )
+    _refuse_what_the_input_cannot_take(args, psd, white)
     if args.record is not None:
         result = _on_record(harvester, psd, args, burn_in)
     else:
@@ -197,6 +192,29 @@ def _plus_minus(mean, half_width) -> tuple[str, str]:
     """A Monte Carlo mean and ``± half-width`` as table cells (the digits the interval allows)."""
     mean, half = estimate_parts(mean, half_width)
     return mean, f"± {half}" if half else ""
+
+
+def _refuse_what_the_input_cannot_take(args, psd, white: bool) -> None:
+    """The control variates without Gaussian noise alone, tones or shocks on a record: one line."""
+    beyond = not white and (bool(psd.lines()) or not psd.is_gaussian)
+    if args.control_variates and beyond:
+        raise ValueError(
+            f"`--control-variates` needs Gaussian noise alone: under the {psd.name} input no "
+            "control has a known mean"
+        )
+    if args.control_variates and not white and psd.shaping_filter() is None:
+        raise ValueError(
+            "`--control-variates` needs white noise or a filtered spectrum (band-pass, "
+            f"kanai-tajimi): under the synthesised or recorded {psd.name} input no control "
+            "has a known mean"
+        )
+    if args.record is not None and beyond:
+        extra = "`--tone`" if psd.lines() else "`--shock-rate`"
+        raise ValueError(
+            f"{extra} adds to a spectrum the device is simulated under; `--record` drives it "
+            "with the record itself: simulate on the record alone, or give its spectrum "
+            "(`--psd-file`)"
+        )
 
 
 def _on_record(harvester, record, args, burn_in):

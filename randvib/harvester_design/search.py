@@ -217,6 +217,8 @@ def predicted_first_passage(
     """
     if method.name not in GAUSSIAN_RESPONSE or prediction.displacement_variance is None:
         return math.nan
+    if prediction.tones is not None or not getattr(excitation, "is_gaussian", True):
+        return math.nan  # a sinusoid's or a non-Gaussian input's crossings are not Rice's
     z2, v2 = float(prediction.displacement_variance), float(prediction.velocity_variance)
     rate = float(outcrossing_rate(z2, 0.0, v2, stroke))
     k_eq = None if device is None else device.k + 3.0 * device.k3 * z2

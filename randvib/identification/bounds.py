@@ -41,7 +41,78 @@ def record_scales(record: Record, m: float | None):
     return omega, float(np.max(np.abs(z))), float(np.sqrt(np.mean(v**2))), force, m_ref
 
 
-def default_bounds(record: Record, model: str, m: float | None = None) -> dict:
+def velocity_gain(drive, output, dt) -> float:
+    """|output / z'| near resonance, from the input's and the output's spectra.
+
+    For a channel proportional to the (unmeasured) velocity (a load voltage
+    or current) driven by a base acceleration: the transfer function
+    ``H = S_ay / S_aa`` (Welch) peaks at the resonance w0, where the
+    velocity's own is ``1 / (2 zeta w0)`` with zeta from the peak's
+    half-power width; the gain is ``|H(w0)| 2 zeta w0``. Scales only (a
+    friction or hardening device is not linear): the search boxes are
+    decades wide.
+    """
+    from scipy import signal
+
+    n = drive.size
+    nperseg = int(min(n, max(256, n // 8)))
+    f, p_ay = signal.csd(drive, output, fs=1.0 / dt, nperseg=nperseg)
+    _, p_aa = signal.welch(drive, fs=1.0 / dt, nperseg=nperseg)
+    excited = p_aa > 1e-2 * np.max(p_aa)
+    gain = np.where(excited, np.abs(p_ay) / np.where(excited, p_aa, 1.0), 0.0)
+    peak = int(np.argmax(gain))
+    half = gain >= gain[peak] / np.sqrt(2.0)
+    lo = hi = peak
+    while lo > 0 and half[lo - 1]:
+        lo -= 1
+    while hi < gain.size - 1 and half[hi + 1]:
+        hi += 1
+    width = max(f[hi] - f[lo], f[1] - f[0])
+    zeta = float(np.clip(width / (2.0 * max(f[peak], f[1])), 0.005, 1.0))
+    return float(gain[peak] * 2.0 * zeta * 2.0 * np.pi * max(f[peak], f[1]))
+
+
+def channel_scales(record: Record, outputs, m: float | None) -> RecordScales:
+    """The :class:`RecordScales` of a record from whichever channels it has.
+
+    A displacement channel gives them as :func:`record_scales` does; a
+    velocity channel through its running integral (detrended); a voltage or
+    current alone through :func:`velocity_gain`, the velocity's scale being
+    fixed by the input (Eq. 1: z'' + ... = -y''), which makes the
+    displacement's an estimate: the cubic stiffness's box is widened for it.
+    """
+    from scipy import signal
+
+    if "relative_displacement" in outputs:
+        omega, z_max, v_rms, force, m_ref = record_scales(record, m)
+        return RecordScales(m=m_ref, omega=omega, z_max=z_max, v_rms=v_rms, force=force)
+    drive, base = driving_signal(record.input, record.dt, record.input_kind)
+    if "relative_velocity" in outputs:
+        v = record["relative_velocity"] - np.mean(record["relative_velocity"])
+        widen = 1.0
+    else:
+        kind = next(k for k in outputs if k in ("voltage", "current"))
+        y = record[kind] - np.mean(record[kind])
+        gain = velocity_gain(drive, y, record.dt) * (1.0 if base else 1.0 / (m or 1.0))
+        v = y / gain
+        widen = 2.0  # an estimated displacement: half of it in the cubic box
+    z = signal.detrend(np.cumsum(v) * record.dt)
+    if m is None:
+        raise ValueError(
+            f"record {record.name!r} measures no displacement: give the mass (`--m`) or its "
+            "search range (`--bounds m=LO:HI`)"
+        )
+    omega = float(np.sqrt(np.mean(v**2) / np.mean(z**2)))
+    force = float(np.sqrt(np.mean(drive**2))) * (float(m) if base else 1.0)
+    return RecordScales(
+        m=float(m), omega=omega, z_max=float(np.max(np.abs(z))) / widen,
+        v_rms=float(np.sqrt(np.mean(v**2))), force=force,
+    )  # fmt: skip
+
+
+def default_bounds(
+    record: Record, model: str, m: float | None = None, scales: RecordScales | None = None
+) -> dict:
     """Search bounds derived from the record's own scales, as each parameter declares.
 
     With the characteristic angular frequency ``w = rms(z')/rms(z)``, the
@@ -69,8 +140,9 @@ def default_bounds(record: Record, model: str, m: float | None = None) -> dict:
     default bounds must be fixed or bounded there.
     """
     specs = parameter_specs(model)
-    omega, z_max, v_rms, force, m_ref = record_scales(record, m)
-    scales = RecordScales(m=m_ref, omega=omega, z_max=z_max, v_rms=v_rms, force=force)
+    if scales is None:
+        omega, z_max, v_rms, force, m_ref = record_scales(record, m)
+        scales = RecordScales(m=m_ref, omega=omega, z_max=z_max, v_rms=v_rms, force=force)
     names = MODEL_PARAMETERS[model] + (("m",) if m is None else ())
     return {
         name: tuple(float(x) for x in specs[name].search(scales))
@@ -185,16 +257,64 @@ def _user_bounds(model, bounds) -> dict:
 PROBE_CORNERS = 64
 
 
-def probe_points(space: SearchSpace) -> np.ndarray:
-    """The box's corners (a seeded sample of 64 of them in more than 6 dimensions)
+def probe_points(space: SearchSpace, corners: int = PROBE_CORNERS) -> np.ndarray:
+    """The box's corners (a seeded sample of ``corners`` of them when there are more)
     and its centre (arithmetic, and geometric on log-scaled axes), one per row."""
     lo = np.array([space.box[n][0] for n in space.free], dtype=float)
     hi = np.array([space.box[n][1] for n in space.free], dtype=float)
     d = lo.size
-    if 2**d <= PROBE_CORNERS:
+    if 2**d <= corners:
         bits = (np.arange(2**d)[:, None] >> np.arange(d)) & 1
     else:
-        bits = np.random.default_rng(0).integers(0, 2, size=(PROBE_CORNERS, d))
+        bits = np.random.default_rng(0).integers(0, 2, size=(corners, d))
     centre = lo / 2 + hi / 2  # (lo + hi) / 2 overflows at 1e308
     geometric = np.where(space.log, np.sqrt(np.abs(lo)) * np.sqrt(np.abs(hi)), centre)
     return np.vstack([np.where(bits == 1, hi, lo), centre, geometric])
+
+
+def equation_error_mass(record: Record, outputs, coupling: str | None, r_load) -> float | None:
+    """A rough mass (kg) from a base-excited record with a motion and a circuit channel.
+
+    Equation error, as the force-input scale does: the circuit's own equation
+    (a coil's ``R_L i = alpha z' - L i' - R_C i``, a piezo's ``V / R_L =
+    theta z' - C_p V'``) regressed on the measured channels gives the
+    coupling's gain g (alpha or theta, force ``g x``); then Eq. 1 divided by
+    m, ``-(y'' + z'') = (c/m) z' + (k/m) z + (k3/m) z^3 + (g/m) x + const``,
+    regressed gives g/m and so m. The circuit's force is small beside the
+    inertia and nearly collinear with z' and z in a narrow band, so this is
+    a scale (within a factor of a few), which only centres the mass's search
+    box; None when the channels do not allow it.
+    """
+    from scipy import signal
+
+    if coupling is None or record.input_kind == "force":
+        return None
+    dt = record.dt
+    if "relative_velocity" in outputs:
+        v = record["relative_velocity"] - np.mean(record["relative_velocity"])
+        z = signal.detrend(np.cumsum(v) * dt)
+    elif "relative_displacement" in outputs:
+        z = record.z - np.mean(record.z)
+        v = np.gradient(z, dt)
+    else:
+        return None
+    if "voltage" in outputs:
+        y = record["voltage"] - np.mean(record["voltage"])
+        state = y if coupling == "piezo" else y / r_load
+    elif "current" in outputs:
+        y = record["current"] - np.mean(record["current"])
+        state = y * r_load if coupling == "piezo" else y
+    else:
+        return None
+    if coupling == "piezo":  # V / R_L = theta z' - C_p V'
+        columns = [v, -np.gradient(state, dt)]
+        target = state / r_load
+    else:  # R_L i = alpha z' - L i' - R_C i (no L column for a resistive coil)
+        columns = [v, -state] + ([-np.gradient(state, dt)] if coupling == "inductive" else [])
+        target = r_load * state
+    gain = np.linalg.lstsq(np.column_stack(columns), target, rcond=None)[0][0]
+    drive, _ = driving_signal(record.input, dt, record.input_kind)
+    a = np.column_stack([v, z, z**3, state, np.ones_like(v)])
+    per_mass = np.linalg.lstsq(a, -drive - np.gradient(v, dt), rcond=None)[0][3]
+    m = float(gain / per_mass) if per_mass != 0 else float("nan")
+    return m if np.isfinite(m) and m > 0 else None

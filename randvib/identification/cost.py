@@ -131,14 +131,14 @@ class CostFunction:
         params = self.parameters(X)
         matrix = parameter_matrix(params, self.friction)
         start = time.perf_counter()
-        sse, _, _ = self.run(
+        sse = self.run(
             matrix,
             reference=self.record.z,
             skip=self.skip,
             store=False,
             max_subcycles=SEARCH_SUBCYCLES,
             profile_offset=self.profile_offset,
-        )
+        ).sse
         self.seconds += time.perf_counter() - start
         self.evaluations += matrix.shape[0]
         return 100.0 * sse / (self.n_scored * self.variance)
@@ -150,5 +150,5 @@ class CostFunction:
             params["c"] = params["c"] + electrical.electrical_damping
         matrix = parameter_matrix(params, self.friction)
         start = {k: v for k, v in (("z0", z0), ("v0", v0)) if v is not None}
-        _, z, v = self.run(matrix, **start)
-        return z[0], v[0]
+        run = self.run(matrix, **start)
+        return run.z[0], run.v[0]

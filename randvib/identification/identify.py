@@ -36,6 +36,7 @@ from randvib.identification.bounds import (
     probe_points,
     search_space,
 )
+from randvib.identification.circuit import OUTPUT_KINDS, check_coupling_kind
 from randvib.identification.cost import CostFunction
 from randvib.identification.models import (
     MODEL_PARAMETERS,
@@ -47,13 +48,14 @@ from randvib.identification.models import (
 from randvib.identification.prediction import score
 from randvib.identification.record_integrator import EXTRA_PARAMETERS
 from randvib.identification.result import IdentificationResult
-from randvib.identification.sade import sade
+from randvib.identification.sade import named_callback, sade
 from randvib.identification.settings import (
+    POLISH_MAXFEV,
     SearchSettings,
     SimulationSettings,
     resolve_settings,
 )
-from randvib.models.record import Record
+from randvib.models.record import OUTPUT_CHANNEL, Record
 
 
 def _resolve_fixed(model, fixed, m, record):
@@ -120,10 +122,14 @@ def _measurement_model(record, fixed, quadratic) -> tuple[dict, tuple, tuple]:
 
 
 def identify(
-    record: Record,
+    record,
     model: str,
     *,
     m: float | None = None,
+    coupling: str | None = None,
+    r_load=None,
+    outputs=None,
+    weights: dict | None = None,
     fixed: dict | None = None,
     bounds: dict | None = None,
     init=None,
@@ -149,16 +155,42 @@ def identify(
     restoring force makes it identifiable (k3 free or nonzero and k2 not
     free; see ``notes`` of the result otherwise).
 
+    With ``coupling`` (and each record's load ``r_load``) the circuit is
+    identified with the mechanics: alpha, the coil's resistance and
+    inductance, or theta and C_p, c being then the mechanical damping c_m;
+    ``outputs`` fits the load voltage, the current or the velocity instead
+    of (or beside) the displacement, each channel's J normalised by its own
+    variance and summed (``weights``); several records of one device (each
+    at its own load) are fitted at once. What the records can fix is checked
+    first (:mod:`randvib.identification.identifiability`): a parameter no
+    record of this kind can fix is refused with one line naming what to add,
+    and after the fit a split of the damping, the mass or the coupling that
+    the data do not make is refused too (:class:`IdentifiabilityError
+    <randvib.identification.identifiability.IdentifiabilityError>`); the
+    result's ``identifiability`` says what was fixed and why
+    (docs/identification.md).
+
     Parameters
     ----------
-    record : Record
-        Training record.
+    record : Record or sequence of Record
+        Training record(s) of one device.
     model : {'viscous', 'coulomb', 'tanh', 'lugre'}
         Friction model (``viscous`` is the paper's no-friction model), or
         any other registered law.
     m : float, optional
-        Mass (kg); required with base excitation, identified when omitted
-        with a force input.
+        Mass (kg); required with base excitation unless the records fix it
+        (a circuit channel at two loads, a piezo's voltage and velocity),
+        identified when omitted with a force input.
+    coupling : {'resistive', 'inductive', 'piezo'}, optional
+        Identify the coupling too (:mod:`randvib.identification.circuit`).
+    r_load : float or sequence of float, optional
+        Each record's known load resistance R_L (ohm), with ``coupling``.
+    outputs : sequence of str, optional
+        The channels fitted, by kind: ``relative_displacement`` (default),
+        ``relative_velocity``, ``voltage`` (the load voltage), ``current``;
+        each is the record's channel of that name, fitted only as that kind.
+    weights : dict, optional
+        ``kind -> w`` multiplying each channel's J (default 1).
     fixed : dict, optional
         Parameters held at given values, e.g. ``{"k3": 0.0}`` for a linear
         spring, ``{"input_offset": 0.0, "output_offset": 0.0}`` for sensors
@@ -198,9 +230,27 @@ def identify(
     IdentificationResult
     """
     check_model(model)
+    search, simulation = resolve_settings("identify", options, search=search, simulation=simulation)
+    single = isinstance(record, Record)
+    if outputs is None and single and OUTPUT_CHANNEL not in record:
+        others = [k for k in OUTPUT_KINDS if k in record]
+        raise ValueError(
+            f"record {record.name!r} has no {OUTPUT_CHANNEL} channel"
+            + (f"; fit its {', '.join(others)} with `outputs=` (`--output-kind`)" if others else "")
+        )
+    plain = outputs is None or tuple(np.atleast_1d(outputs)) == (OUTPUT_CHANNEL,)
+    if not (single and plain and coupling is None and r_load is None and not weights):
+        from randvib.identification.experiment import recorded_tests
+        from randvib.identification.experiment_fit import identify_experiment
+
+        coupling = check_coupling_kind(coupling)
+        return identify_experiment(
+            recorded_tests(record, outputs, r_load, coupling), model, coupling, m=m,
+            fixed=fixed, bounds=bounds, init=init, quadratic=quadratic, weights=weights,
+            search=search, simulation=simulation, progress=progress, callback=callback,
+        )  # fmt: skip
     if not isinstance(record, Record):
         raise ValueError(f"`record` must be a randvib Record, got {type(record).__name__}")
-    search, simulation = resolve_settings("identify", options, search=search, simulation=simulation)
     fixed = _resolve_fixed(model, fixed, m, record)
     fixed, reported, notes = _measurement_model(record, fixed, bool(quadratic))
     simulation, why = simulation.for_record(record)
@@ -223,7 +273,7 @@ def identify(
         log=space.log,
         names=space.free,
         init=_initial_guess(init, space),
-        callback=_named_callback(callback, space.free),
+        callback=named_callback(callback, space.free),
         progress=progress,
         **search.sade_options(),
     )
@@ -367,7 +417,7 @@ def _polish(cost: CostFunction, space, found: dict, simulation, search, given) -
         theta0 += [z0, cost.v0]
     problem = SimulationError(cost, _coordinates(cost, space, names, given))
     theta, residuals, unc, message = polish(
-        problem, np.array(theta0), max_nfev=search.polish_maxfev
+        problem, np.array(theta0), max_nfev=search.polish_maxfev or POLISH_MAXFEV
     )
     values = dict(zip(names, map(float, theta), strict=True))
     return _Polished(
@@ -457,17 +507,6 @@ def _initial_guess(init, space: SearchSpace):
     guess = device_parameters(init, None, "identify's `init`")
     guess = {name: value for name, value in guess.items() if name not in EXTRA_PARAMETERS}
     return [[np.clip(guess.get(n, np.mean(space.box[n])), *space.box[n]) for n in space.free]]
-
-
-def _named_callback(callback, free):
-    """SaDE's ``callback(gen, x, f)`` as the user's ``callback(gen, {name: value}, f)``."""
-    if callback is None:
-        return None
-
-    def named(gen, x, f):
-        return callback(gen, dict(zip(free, map(float, x), strict=True)), f)
-
-    return named
 
 
 def _outside_search_box(parameters, space) -> tuple:

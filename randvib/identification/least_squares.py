@@ -36,7 +36,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from randvib.identification.record_integrator import SEARCH_SUBCYCLES, parameter_matrix
+from randvib.identification.record_integrator import (
+    OUTPUT_OFFSET_COLUMN,
+    SEARCH_SUBCYCLES,
+    parameter_matrix,
+)
 
 #: Names of the initial-state coordinates in the least-squares vector.
 INITIAL_STATE = ("z0", "v0")
@@ -123,9 +127,9 @@ class SimulationError:
         matrix = parameter_matrix(named, self.cost.friction)
         # bristles stiffer than the search allows are rejected here too (NaN):
         # otherwise one trial step can cost thousands of sub-cycles per step
-        _, z, _ = self.cost.run(matrix, z0=z0, v0=v0, max_subcycles=SEARCH_SUBCYCLES)
+        z = self.cost.run(matrix, z0=z0, v0=v0, max_subcycles=SEARCH_SUBCYCLES).z
         self.simulations += matrix.shape[0]
-        return z[:, self.cost.skip :] + matrix[:, -1:]
+        return z[:, self.cost.skip :] + matrix[:, OUTPUT_OFFSET_COLUMN, None]
 
     def residuals_u(self, u) -> np.ndarray:
         e = self.responses(self.coordinates.to_theta(u))[0] - self.measured
@@ -135,7 +139,7 @@ class SimulationError:
     def jacobian_u(self, u, step: float = JACOBIAN_STEP) -> np.ndarray:
         """de/du by central differences of relative ``step``, all 2 d simulations in one batch."""
         d = u.size
-        steps = step * np.maximum(1.0, np.abs(u))
+        steps = self.difference_steps(u, step)
         lo, hi = self.coordinates.u_bounds()
         plus = np.minimum(u + steps, np.where(np.isfinite(hi), hi, np.inf))
         minus = np.maximum(u - steps, np.where(np.isfinite(lo), lo, -np.inf))
@@ -155,6 +159,14 @@ class SimulationError:
         width = np.where(plus > minus, plus - minus, 1.0)
         z = np.where(np.isfinite(z), z, 0.0)
         return ((z[:d] - z[d:]) / width[:, None]).T
+
+    def difference_steps(self, u, step: float) -> np.ndarray:
+        """The central differences' steps in u: ``step`` relative to max(1, |u|)."""
+        return step * np.maximum(1.0, np.abs(u))
+
+    def covariance_jacobian(self, u) -> np.ndarray:
+        """de/du for the covariance: central differences of :data:`COVARIANCE_STEP`."""
+        return self.jacobian_u(u, COVARIANCE_STEP)
 
 
 @dataclass(frozen=True)
@@ -305,7 +317,9 @@ def newey_west_bandwidth(residual) -> int:
     return int(min(np.ceil(1.1447 * (alpha * n) ** (1 / 3)), n // 4))
 
 
-def covariance(jacobian, residuals, method: str = "auto") -> tuple[np.ndarray, str, int]:
+def covariance(
+    jacobian, residuals, method: str = "auto", blocks=None
+) -> tuple[np.ndarray, str, int]:
     """Covariance of least-squares estimates (in the Jacobian's coordinates).
 
     To first order the estimate errs by ``-(J^T J)^-1 J^T e`` (e the output
@@ -333,6 +347,12 @@ def covariance(jacobian, residuals, method: str = "auto") -> tuple[np.ndarray, s
         :func:`newey_west_bandwidth`.
         ``auto``: ``ar`` when the Ljung-Box test rejects whiteness at 1 %
         (:func:`randvib.identification.residuals.ljung_box`), else ``white``.
+    blocks : sequence of slice, optional
+        Rows whose noise is its own (one record's channel each, when several
+        channels or records are fitted together): the middle is the sum of
+        the blocks' own (white: ``s_b^2 J_b^T J_b``; ``ar``: each block's own
+        autoregression), the noise independent between blocks. ``auto``
+        chooses ``ar`` when any block's residual is not white.
 
     Returns
     -------
@@ -350,6 +370,8 @@ def covariance(jacobian, residuals, method: str = "auto") -> tuple[np.ndarray, s
     e = np.asarray(residuals, dtype=float)
     n, d = j.shape
     bread = np.linalg.pinv(j.T @ j)
+    if blocks is not None and len(blocks) > 1:
+        return _blocked_covariance(j, e, bread, method, blocks)
     if method == "auto":
         method = "ar" if ljung_box(e)[1] < LEVEL else "white"
     if method == "white":
@@ -373,6 +395,34 @@ def covariance(jacobian, residuals, method: str = "auto") -> tuple[np.ndarray, s
     return bread @ middle @ bread, "hac", lag
 
 
+def _blocked_covariance(j, e, bread, method, blocks):
+    """:func:`covariance` with each block's noise its own (white or autoregressive)."""
+    from scipy import signal
+
+    from randvib.identification.residuals import LEVEL, ljung_box
+
+    if method not in ("auto", "white", "ar"):
+        raise ValueError(f"`method` with blocks must be one of auto, white, ar; got {method!r}")
+    n, d = j.shape
+    if method == "auto":
+        coloured = any(ljung_box(e[b])[1] < LEVEL for b in blocks)
+        method = "ar" if coloured else "white"
+    middle = np.zeros((d, d))
+    order = 0
+    for b in blocks:
+        jb, eb = j[b], e[b]
+        nb = eb.size
+        dof = max(nb - d * nb / n, 1.0)  # the parameters' degrees of freedom shared pro rata
+        if method == "white":
+            middle += float(eb @ eb) / dof * (jb.T @ jb)
+            continue
+        a, sigma2 = autoregression(eb)
+        order = max(order, int(a.size))
+        filtered = signal.lfilter([1.0], np.r_[1.0, -a], jb[::-1], axis=0)[::-1]
+        middle += sigma2 * (nb / dof) * (filtered.T @ filtered)
+    return bread @ middle @ bread, method, order
+
+
 def uncertainty(problem: SimulationError, u, residuals, jacobian_u) -> Uncertainty:
     """:class:`Uncertainty` at the optimum ``u`` from the residuals and de/du there."""
     from scipy import stats
@@ -386,7 +436,7 @@ def uncertainty(problem: SimulationError, u, residuals, jacobian_u) -> Uncertain
     n, d = jacobian_u.shape
     dof = max(n - d, 1)
     s2 = float(residuals @ residuals) / dof
-    cov_u, method, lag = covariance(jacobian_u, residuals)
+    cov_u, method, lag = covariance(jacobian_u, residuals, blocks=getattr(problem, "blocks", None))
     cov = cov_u * np.outer(dtheta_du, dtheta_du)
     se = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -429,5 +479,5 @@ def polish(problem: SimulationError, theta0, *, max_nfev=None):
         ftol=1e-12,
         gtol=1e-12,
     )
-    unc = uncertainty(problem, res.x, res.fun, problem.jacobian_u(res.x, COVARIANCE_STEP))
+    unc = uncertainty(problem, res.x, res.fun, problem.covariance_jacobian(res.x))
     return coords.to_theta(res.x), res.fun, unc, res.message

@@ -25,7 +25,9 @@ pair into the named parameters the compiled simulation takes,
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+
+import numpy as np
 
 from randvib._validation import (
     check_finite,
@@ -33,6 +35,12 @@ from randvib._validation import (
     check_positive,
     check_scalar_device,
     scalar_or_array,
+)
+from randvib.identification.circuit import (
+    ALL_COUPLING_PARAMETERS,
+    OFFSET_NAMES,
+    circuit_terms,
+    coupling_unit,
 )
 from randvib.identification.record_integrator import EXTRA_PARAMETERS
 from randvib.models.friction import FRICTION_MODELS, RegistryView
@@ -72,10 +80,16 @@ def parameter_specs(model) -> dict[str, Parameter]:
 
 
 def unit_of(model, name):
-    """The unit of parameter ``name`` of ``model``: a law's own declaration, else
-    :func:`randvib.quantities.unit` (``m``, ``c``, ``k``, ``k3``, ``k2``, the offsets)."""
+    """The unit of parameter ``name`` of ``model``: a law's or a coupling's own
+    declaration, else :func:`randvib.quantities.unit` (``m``, ``c``, ``k``,
+    ``k3``, ``k2``, the offsets); a record's own ``name[i]`` as ``name``'s."""
+    base = name.split("[")[0]
     specs = parameter_specs(model)
-    return specs[name].unit if name in specs else unit(name)
+    if base in specs:
+        return specs[base].unit
+    if base in ALL_COUPLING_PARAMETERS:
+        return coupling_unit(base)
+    return unit(base)
 
 
 def check_model(model):
@@ -152,24 +166,50 @@ class MeasurementModel:
         Offset of the relative-displacement sensor (m).
     k2 : float
         Quadratic stiffness (N/m^2).
+    channel_offsets : dict
+        The other output channels' offsets by kind (``relative_velocity``
+        m/s, ``voltage`` V, ``current`` A); absent ones are 0.
     """
 
     input_offset: float = 0.0
     output_offset: float = 0.0
     k2: float = 0.0
+    channel_offsets: dict = field(default_factory=dict)
 
     def __post_init__(self):
         for name in EXTRA_PARAMETERS:
             object.__setattr__(self, name, scalar_or_array(check_finite(name, getattr(self, name))))
+        offsets = {}
+        for kind, value in dict(self.channel_offsets).items():
+            if kind not in OFFSET_NAMES or kind == "relative_displacement":
+                raise ValueError(
+                    f"`channel_offsets`: {kind!r} is not an output channel other than the "
+                    f"displacement (whose offset is `output_offset`); allowed: "
+                    f"{', '.join(k for k in OFFSET_NAMES if k != 'relative_displacement')}"
+                )
+            offsets[kind] = float(check_finite(f"channel_offsets[{kind!r}]", value))
+        object.__setattr__(self, "channel_offsets", offsets)
 
     def parameters(self) -> dict:
         """``k2``, ``input_offset`` and ``output_offset`` by name."""
         return {name: getattr(self, name) for name in EXTRA_PARAMETERS}
 
+    def offset(self, kind: str) -> float:
+        """The sensor offset of output channel ``kind`` (its unit; 0 when not given)."""
+        if kind == "relative_displacement":
+            return float(np.ravel(self.output_offset)[0])
+        return self.channel_offsets.get(kind, 0.0)
+
     @classmethod
     def from_parameters(cls, parameters: dict) -> MeasurementModel:
         """The measurement model among identified ``parameters`` (absent ones: 0)."""
-        return cls(**{name: parameters[name] for name in EXTRA_PARAMETERS if name in parameters})
+        channel = {
+            kind: parameters[name]
+            for kind, name in OFFSET_NAMES.items()
+            if kind != "relative_displacement" and name in parameters
+        }
+        given = {name: parameters[name] for name in EXTRA_PARAMETERS if name in parameters}
+        return cls(**given, channel_offsets=channel)
 
 
 def device_parameters(
@@ -177,9 +217,10 @@ def device_parameters(
 ) -> dict:
     """The record simulation's named parameters of a device and its measurement model.
 
-    ``m``, ``c`` (= c_m + c_e), ``k``, ``k3``, the friction law's
-    parameters, ``k2`` and the offsets. ``function`` is named in refusals:
-    anything but a Harvester, a coupling with a circuit state (the record
+    ``m``, ``c`` (= c_m + c_e, the static coupling's damping included),
+    ``k``, ``k3``, the friction law's parameters, ``k2`` and the offsets; a
+    coupling with a circuit state is :func:`device_circuit`'s. ``function``
+    is named in refusals: anything but a Harvester, a diode bridge (the record
     simulation has none) and, with ``scalar``, array parameters.
     """
     if not isinstance(harvester, Harvester):
@@ -195,12 +236,28 @@ def device_parameters(
         )
     if scalar:
         check_scalar_device(harvester, function)
-    harvester.require_resistive(function, "randvib.simulate")
+    if harvester.is_rectified:
+        raise ValueError(
+            f"{function} integrates a coil or a piezo element on its load, not the "
+            f"{harvester.electrical.name}'s switching; the bridge is simulated by randvib.simulate"
+        )
     out = {"m": harvester.m, "c": harvester.c, "k": harvester.k, "k3": harvester.k3}
     if harvester.friction is not None:
         out.update(harvester.friction.parameters())
     out.update(measurement.parameters())
     return out
+
+
+def device_circuit(harvester: Harvester):
+    """``(a, b, f)`` of the device's circuit state (``x' = a x + b z'``, force ``f x``), or None.
+
+    None for a device without a coupling or with a static one (whose c_e
+    is in :attr:`Harvester.c <randvib.models.harvester.Harvester.c>`).
+    """
+    if not harvester.has_circuit:
+        return None
+    coupling = harvester.electrical
+    return circuit_terms(coupling.name, coupling.parameters(), coupling.r_load)[1]
 
 
 def device_from_parameters(

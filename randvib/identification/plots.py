@@ -26,6 +26,28 @@ MODEL_STYLE = {
 #: The figures show displacements (m) in mm and voltages (V) in mV, as the paper does.
 MILLI = 1e3
 
+#: How each output channel is shown: its name on an axis and its SI unit.
+CHANNEL_DISPLAY = {
+    "relative_displacement": ("relative displacement z", "m"),
+    "relative_velocity": ("relative velocity z'", "m/s"),
+    "voltage": ("load voltage V", "V"),
+    "current": ("load current i", "A"),
+}
+
+
+def display_scale(kind: str, values) -> tuple[float, str]:
+    """(factor, unit) showing channel ``kind``: displacements in mm (the paper's), the
+    others with the prefix (none, m, µ) that puts the largest value between 1 and 1000."""
+    base = CHANNEL_DISPLAY[kind][1]
+    if kind == "relative_displacement":
+        return MILLI, "mm"
+    largest = float(np.nanmax(np.abs(values))) if np.size(values) else 1.0
+    for factor, prefix in ((1.0, ""), (1e3, "m"), (1e6, "µ")):
+        if largest * factor >= 1.0:
+            return factor, prefix + base
+    return 1e6, "µ" + base
+
+
 #: Measured data in black, the model's simulation dashed in vermilion.
 MEASURED = dict(color="black", lw=1.0, label="measured")
 SIMULATED = dict(color=PALETTE[1], lw=1.0, ls="--", label="simulated")
@@ -42,9 +64,17 @@ ABOVE = dict(loc="lower left", bbox_to_anchor=(0.0, 1.0), borderaxespad=0.2, fra
 
 
 def plot_time_history(
-    prediction, ax=None, *, window=None, scale=MILLI, unit="mm", residual_ax=None, legend=True
+    prediction,
+    ax=None,
+    *,
+    window=None,
+    scale=None,
+    unit=None,
+    residual_ax=None,
+    kind=None,
+    legend=True,
 ):
-    """Measured (solid black) and simulated (dashed) relative displacement.
+    """Measured (solid black) and simulated (dashed) output channel.
 
     The shown window is stated with the time axis (``t0 to t1 s of T s``).
 
@@ -56,11 +86,13 @@ def plot_time_history(
     window : (t0, t1), optional
         Time window (s) to show; default :func:`default_window`.
     scale, unit : float, str
-        Display scaling of the record's output, by default from m to mm; a
-        record whose output is not a displacement in m gives its own.
+        Display scaling of the output, by default :func:`display_scale`
+        (a displacement in mm).
     residual_ax : matplotlib Axes, optional
         Where to draw the residual, measured less simulated, over the same
         window (a fit that misses shows there what it misses).
+    kind : str, optional
+        The channel shown (default the prediction's first scored one).
     legend : bool
         A legend above the axes (False: the figure has one elsewhere).
     """
@@ -68,22 +100,28 @@ def plot_time_history(
         _, axes = new_figure(figsize=(7.0, 2.6))
         ax = axes[0, 0]
     rec = prediction.record
+    kind = kind or prediction.outputs[0]
+    measured, simulated = rec[kind], prediction.simulated(kind)
+    label = CHANNEL_DISPLAY[kind][0]
+    if scale is None or unit is None:
+        scale, unit = display_scale(kind, measured)
     t = rec.time
-    t0, t1 = window if window is not None else (0.0, default_window(rec))
+    t0, t1 = window if window is not None else (0.0, default_window(rec, kind))
     sel = (t >= t0) & (t <= t1)
-    ax.plot(t[sel], rec.z[sel] * scale, **MEASURED)
-    ax.plot(t[sel], prediction.z[sel] * scale, **SIMULATED)
-    ax.set_ylabel(f"relative displacement z ({unit})")
+    ax.plot(t[sel], measured[sel] * scale, **MEASURED)
+    ax.plot(t[sel], simulated[sel] * scale, **SIMULATED)
+    ax.set_ylabel(f"{label} ({unit})")
     ax.set_xlim(t[sel][0], t[sel][-1])
     # the window shown, stated where the time axis is labelled
     shown = f"time (s); shown: {t[sel][0]:.3g} to {t[sel][-1]:.3g} s of {float(t[-1] - t[0]):.3g} s"
-    ax.set_title(f"J = {prediction.cost:.3g} (Eq. 11)", loc="right")
+    cost = prediction.costs.get(kind, prediction.cost)
+    ax.set_title(f"J = {cost:.3g} (Eq. 11)", loc="right")
     if legend:
         ax.legend(ncols=2, **ABOVE)
     if residual_ax is None:
         ax.set_xlabel(shown)
         return ax
-    residual = (rec.z - prediction.z) * scale
+    residual = (measured - simulated) * scale
     residual_ax.plot(t[sel], residual[sel], color=PALETTE[2], lw=0.8)
     residual_ax.axhline(0.0, color="black", lw=0.5)
     residual_ax.set_xlim(t[sel][0], t[sel][-1])
@@ -94,14 +132,15 @@ def plot_time_history(
     return ax
 
 
-def default_window(record, cycles: float = 30.0, longest: float = 2.0) -> float:
+def default_window(record, kind="relative_displacement", cycles=30.0, longest=2.0) -> float:
     """End (s) of the shown window: about ``cycles`` oscillations of the measured output.
 
     At most ``longest`` s, so that both curves stay readable whether the
     device rings at 5 Hz (2 s shown) or at 60 Hz (the Silverbox: 0.5 s); the
     oscillation rate is counted from the output's mean crossings.
     """
-    z = record.z - np.mean(record.z)
+    values = record.z if kind == "relative_displacement" else record[kind]
+    z = values - np.mean(values)
     crossings = np.count_nonzero(np.signbit(z[1:]) != np.signbit(z[:-1]))
     duration = float(record.time[-1] - record.time[0])
     if crossings < 2:
@@ -118,8 +157,28 @@ def histogram_bins(n: int) -> int:
     return int(np.clip(np.ceil(2.0 * n ** (1.0 / 3.0)), 10, 81))
 
 
-def plot_histograms(prediction, axes=None, *, bins=None, scale=MILLI, unit="mm", legend=True):
-    """Densities of the measured and simulated displacement and, with a coil, load voltage.
+def histogram_panels(prediction, scale=None, unit=None) -> list:
+    """(measured or None, simulated, name, unit) of each density panel: every scored
+    channel, and the simulated load voltage of a device with a circuit.
+
+    ``scale`` and ``unit`` apply to the first channel (default :func:`display_scale`)."""
+    rec = prediction.record
+    panels = []
+    for kind in prediction.outputs:
+        factor, shown = display_scale(kind, rec[kind])
+        if kind == prediction.outputs[0] and scale is not None and unit is not None:
+            factor, shown = scale, unit
+        name = "z" if kind == "relative_displacement" else CHANNEL_DISPLAY[kind][0]
+        panels.append((rec[kind] * factor, prediction.simulated(kind) * factor, name, shown))
+    if prediction.voltage is not None and "voltage" not in prediction.outputs:
+        factor, shown = display_scale("voltage", prediction.voltage)
+        measured = None if rec.voltage is None else rec.voltage * factor
+        panels.append((measured, prediction.voltage * factor, "load voltage V", shown))
+    return panels
+
+
+def plot_histograms(prediction, axes=None, *, bins=None, scale=None, unit=None, legend=True):
+    """Densities of each measured and simulated channel and, with a coil, the load voltage.
 
     ``bins`` defaults to :func:`histogram_bins` of the record's length.
 
@@ -127,11 +186,7 @@ def plot_histograms(prediction, axes=None, *, bins=None, scale=MILLI, unit="mm",
     by sticking (paper Figure 8b): while the magnet sticks, z' = 0 and so V = 0.
     ``legend=False`` leaves the legends out (a figure that has one elsewhere).
     """
-    rec = prediction.record
-    panels = [(rec.z * scale, prediction.z * scale, "z", unit)]
-    if prediction.voltage is not None:
-        measured = None if rec.voltage is None else rec.voltage * MILLI
-        panels.append((measured, prediction.voltage * MILLI, "load voltage V", "mV"))
+    panels = histogram_panels(prediction, scale, unit)
     if axes is None:
         _, grid = new_figure(1, len(panels), figsize=(3.5 * len(panels), 2.6))
         axes = grid[0]
@@ -145,7 +200,8 @@ def plot_histograms(prediction, axes=None, *, bins=None, scale=MILLI, unit="mm",
             ax.hist(meas, edges, density=True, histtype="step", **MEASURED)
         ax.hist(sim, edges, density=True, histtype="step", **SIMULATED)
         ax.set_xlabel(f"{name} ({unit_text})")
-        ax.set_ylabel(f"probability density (1/{unit_text})")
+        per = unit_text if "/" not in unit_text else f"({unit_text})"
+        ax.set_ylabel(f"density (1/{per})")
         if legend:
             ax.legend(ncols=2, **ABOVE)
     return axes
@@ -186,13 +242,18 @@ def figure_fit(
     path=None,
     *,
     window=None,
-    scale=MILLI,
-    unit="mm",
+    scale=None,
+    unit=None,
     title=None,
     validation=None,
     diagnostics=None,
 ):
     """Paper Figure 8 analogue: (a) time history, (b) residual, then densities.
+
+    The time history is of the first scored channel (the displacement, or
+    the load voltage of a voltage fit); a density panel is drawn for each
+    scored channel and for the simulated load voltage of a device with a
+    circuit: a voltage's density shows the spike at 0 V of sticking.
 
     ``title`` defaults to the record's name; ``validation=True`` marks the
     figure as a validation (a record the model was not fitted to) in its
@@ -202,7 +263,7 @@ def figure_fit(
     with the residual's autocorrelation and its cross-correlation with the
     input (:func:`plot_residual_correlations`).
     """
-    n_hist = 2 if prediction.voltage is not None else 1
+    n_hist = len(histogram_panels(prediction))
     fig = _fit_layout(n_hist, diagnostics is not None)
     ax_t, ax_r, *rest = fig.axes
     plot_time_history(prediction, ax_t, window=window, scale=scale, unit=unit, residual_ax=ax_r,
@@ -234,8 +295,9 @@ def _fit_layout(n_hist: int, correlations: bool = False):
     if n_hist == 1:
         fig.add_subplot(grid[2, :])
     else:
+        row = grid[2, :].subgridspec(1, n_hist)
         for j in range(n_hist):
-            fig.add_subplot(grid[2, j])
+            fig.add_subplot(row[0, j])
     if correlations:
         fig.add_subplot(grid[3, 0])
         fig.add_subplot(grid[3, 1])

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from randvib.identification.circuit import OFFSET_NAMES, output_coefficients
 from randvib.identification.cost import CostFunction, normalised_cost
 from randvib.identification.models import (
     MeasurementModel,
@@ -43,11 +44,16 @@ class Prediction:
     rms_error : float
         RMS of z - zhat (units of z).
     voltage : ndarray or None
-        Simulated load voltage (V) when the device has a coil:
-        ``V = alpha z' R_L / (R_L + R_C)``.
+        Simulated load voltage (V) when the device has a coupling (a coil's
+        ``R_L i``, a piezo element's ``V``), without the sensor's offset.
     initial_state : dict
-        ``z0`` (m), ``v0`` (m/s) the simulation started from (estimated by
-        default, see :class:`~randvib.identification.settings.SimulationSettings`).
+        ``z0`` (m), ``v0`` (m/s) (and the circuit's ``x0``) the simulation
+        started from (estimated by default, see
+        :class:`~randvib.identification.settings.SimulationSettings`).
+    channels, costs, rms_errors : dict
+        With ``outputs``: each scored channel as simulated (offset included),
+        its J (Eq. 11, normalised by its own variance) and RMS error (its
+        unit); ``cost`` is then their sum and ``rms_error`` the first's.
     """
 
     record: Record
@@ -57,14 +63,35 @@ class Prediction:
     rms_error: float
     voltage: np.ndarray | None = None
     initial_state: dict = field(default_factory=dict)
+    channels: dict = field(default_factory=dict)
+    costs: dict = field(default_factory=dict)
+    rms_errors: dict = field(default_factory=dict)
+
+    @property
+    def outputs(self) -> tuple:
+        """The channels scored (``relative_displacement`` for a displacement record)."""
+        return tuple(self.channels) or ("relative_displacement",)
+
+    def simulated(self, kind: str) -> np.ndarray:
+        """The simulated channel ``kind`` as its sensor reads it (offset included)."""
+        if kind in self.channels:
+            return self.channels[kind]
+        if kind == "relative_displacement":
+            return self.z
+        if kind == "voltage" and self.voltage is not None:
+            return self.voltage
+        raise ValueError(
+            f"channel {kind!r} was not simulated; simulated: {', '.join(self.outputs)}"
+        )
 
     def __repr__(self) -> str:  # the scores and the start, not the simulated samples
         start = ", ".join(f"{k} = {float(v):.4g}" for k, v in self.initial_state.items())
         voltage = ", voltage" if self.voltage is not None else ""
+        scored = f" of {', '.join(self.outputs)}" if self.channels else ""
         return (
             f"Prediction({self.record.name!r}: {self.z.shape[-1]} samples, J = {self.cost:.4g} "
-            f"(Eq. 11), RMS error {self.rms_error:.4g}{f'; start {start}' if start else ''}; "
-            f"z, v{voltage})"
+            f"(Eq. 11{scored}), RMS error {self.rms_error:.4g}"
+            f"{f'; start {start}' if start else ''}; z, v{voltage})"
         )
 
 
@@ -100,23 +127,29 @@ def predict_record(
     *,
     measurement: MeasurementModel | None = None,
     simulation: SimulationSettings | None = None,
+    outputs=None,
     **options,
 ) -> Prediction:
     """Simulate a record with a device and score it with J (Eq. 11).
 
-    The device is simulated with its total damping c = c_m + c_e (a record
-    cannot separate them); its circuit, if any, gives the load voltage. (The
-    analytic power prediction is :func:`randvib.predict`.)
+    The device is simulated with its coupling: a static one as its damper
+    c_e, a coil with inductance or a piezo element with its circuit state;
+    its circuit, if any, gives the load voltage. (The analytic power
+    prediction is :func:`randvib.predict`.)
 
     Parameters
     ----------
     harvester : Harvester
         The device (a preset, or :meth:`IdentificationResult.harvester
         <randvib.identification.result.IdentificationResult.harvester>`), with
-        scalar parameters; a coupling with a circuit state is refused.
+        scalar parameters and any coupling but a diode bridge.
     record : Record
         Its input channel drives the device; its relative displacement is
-        scored.
+        scored, or the channels ``outputs`` names.
+    outputs : sequence of str, optional
+        The channels scored (:data:`~randvib.identification.circuit.OUTPUT_KINDS`:
+        ``relative_displacement``, ``relative_velocity``, ``voltage``,
+        ``current``), each with its own J; default the displacement.
     measurement : MeasurementModel, optional
         The sensors' offsets and k2 (an identification's ``measurement``);
         default none.
@@ -141,6 +174,8 @@ def predict_record(
     (simulation,) = resolve_settings("predict_record", options, simulation=simulation)
     if isinstance(record, Record):  # else refused by score
         simulation, _ = simulation.for_record(record)
+    if outputs is not None or isinstance(harvester, Harvester) and harvester.has_circuit:
+        return score_channels(harvester, record, measurement, simulation, outputs)
     parameters = device_parameters(harvester, measurement, "predict_record")
     model = model_of(harvester.friction_name)
     return score(
@@ -172,6 +207,83 @@ def score(parameters: dict, model: str, record: Record, simulation, circuit=None
     )
 
 
+def _named_device(harvester: Harvester, measurement) -> tuple[str, str | None, dict, float]:
+    """(model, coupling, named parameters, r_load) of a device for the channel simulation."""
+    if not isinstance(harvester, Harvester):
+        raise ValueError(
+            f"predict_record needs a randvib.Harvester, got {type(harvester).__name__}"
+        )
+    parameters = device_parameters(harvester, measurement, "predict_record")
+    model = model_of(harvester.friction_name)
+    coupling = harvester.electrical
+    if coupling is None:
+        return model, None, parameters, None
+    named = {**parameters, "c": harvester.c_m, **coupling.parameters()}
+    named.pop("r_load")
+    return model, coupling.name, named, coupling.r_load
+
+
+def score_channels(harvester, record, measurement, simulation, outputs=None) -> Prediction:
+    """:func:`predict_record` of the channels ``outputs``, a circuit state simulated.
+
+    The record's initial state (and the circuit's) is estimated by a least-
+    squares fit of the channels' error (``initial_state="estimate"``), or
+    taken from its first samples.
+    """
+    from randvib.identification.experiment import (
+        START,
+        ExperimentCost,
+        ExperimentError,
+        recorded_tests,
+    )
+    from randvib.identification.least_squares import Coordinates, polish
+
+    measurement = measurement or MeasurementModel()
+    model, coupling, named, r_load = _named_device(harvester, measurement)
+    if outputs is None:
+        outputs = ("relative_displacement",) if "relative_displacement" in record else ()
+        outputs += tuple(k for k in ("voltage",) if k in record and coupling)
+    (test,) = recorded_tests(record, outputs, r_load, coupling)
+    fixed = {**named, **{OFFSET_NAMES[k]: measurement.offset(k) for k in test.outputs}}
+    fixed = {k: float(np.ravel(v)[0]) for k, v in fixed.items()}
+    cost = ExperimentCost([test], model, coupling, fixed=fixed, free=(), simulation=simulation)
+    values = {k: np.array([v]) for k, v in fixed.items()}
+    start = dict(zip((*START, "x0"), (float(x[0]) for x in cost.start(values, 0)), strict=True))
+    if simulation.initial_state == "estimate":
+        names = START + (("x0",) if harvester.has_circuit else ())
+        coords = Coordinates(
+            names=names, log=np.zeros(len(names), bool),
+            scale=np.array([max(abs(start[n]), 1e-9) for n in names]),
+            lower=np.full(len(names), -np.inf), upper=np.full(len(names), np.inf),
+        )  # fmt: skip
+        theta, _, _, _ = polish(ExperimentError(cost, coords), np.array([start[n] for n in names]))
+        start.update(zip(names, map(float, theta), strict=True))
+    values.update({k: np.array([v]) for k, v in start.items()})
+    run = cost.run(values, 0, start=tuple(np.array([start[n]]) for n in (*START, "x0")))
+    channels = {
+        kind: y[0] + fixed[OFFSET_NAMES[kind]] for kind, y in cost.outputs(values, 0, run).items()
+    }
+    costs, rms = {}, {}
+    skip = simulation.skip
+    for kind, y in channels.items():
+        measured = record[kind][skip:]
+        finite = np.all(np.isfinite(y))
+        costs[kind] = float(normalised_cost(measured, y[skip:])) if finite else float("inf")
+        rms[kind] = float(np.sqrt(np.mean((measured - y[skip:]) ** 2))) if finite else float("inf")
+    voltage = None
+    if coupling is not None:
+        cz, cv, cx = output_coefficients("voltage", coupling, values, r_load)
+        voltage = (
+            cz * run.z + np.atleast_1d(cv)[:, None] * run.v + np.atleast_1d(cx)[:, None] * run.x
+        )[0]
+    first = test.outputs[0]
+    return Prediction(
+        record=record, z=run.z[0] + fixed.get("output_offset", 0.0), v=run.v[0],
+        cost=float(sum(costs.values())), rms_error=rms[first], voltage=voltage,
+        initial_state=start, channels=channels, costs=costs, rms_errors=rms,
+    )  # fmt: skip
+
+
 @dataclass(frozen=True)
 class ValidationRow:
     """J (Eq. 11), RMS error, length and residual verdict of one record in :func:`validate`."""
@@ -188,6 +300,11 @@ class ValidationRow:
     #: Whiteness of the residual and its independence of the input on this record
     #: (:func:`~randvib.identification.residuals.residual_diagnostics`).
     residuals: object = None
+    #: With several channels: each one's J and RMS error (kind -> {"cost", "rms_error"});
+    #: ``cost`` is then their sum and ``rms_error`` the first's.
+    channels: dict = field(default_factory=dict)
+    #: The load (ohm) the record was simulated at, with a coupling.
+    r_load: float | None = None
 
     @property
     def verdict(self) -> str | None:
@@ -204,6 +321,8 @@ class ValidationRow:
             "offsets": self.offsets,
             "offsets_source": self.offsets_source,
             "residuals": None if self.residuals is None else self.residuals.to_dict(),
+            **({"channels": self.channels} if self.channels else {}),
+            **({"r_load": self.r_load} if self.r_load is not None else {}),
         }
 
 
@@ -223,6 +342,8 @@ def validate(
     *,
     measurement: MeasurementModel | None = None,
     offsets: str = "per-record",
+    outputs=None,
+    r_load=None,
     **settings,
 ) -> list[ValidationRow]:
     """J (Eq. 11) and RMS error of a device on each of several records.
@@ -246,6 +367,16 @@ def validate(
         never spoils a good model. ``"given"``: those of ``measurement`` on
         every record. Each row's ``offsets`` and ``offsets_source`` say which
         were used, its ``residuals`` the residual's verdict on that record.
+    outputs : sequence of str, optional
+        The channels scored on each record (``relative_displacement``,
+        ``relative_velocity``, ``voltage``, ``current``), each with its own J
+        and RMS error (``ValidationRow.channels``); then, with ``"per-record"``,
+        each channel's offset is re-estimated on the record (its mean
+        residual) and kept where it lowers J, the input offset given; the
+        residual verdict is the first channel's.
+    r_load : float or sequence of float, optional
+        Each record's load (ohm) for a device with a coupling (default the
+        device's own).
     """
     from randvib.identification.residuals import residual_diagnostics
 
@@ -253,6 +384,11 @@ def validate(
         raise ValueError(f"`offsets` must be one of {', '.join(OFFSET_POLICIES)}; got {offsets!r}")
     model = model_of(harvester.friction_name) if isinstance(harvester, Harvester) else None
     measurement = measurement or MeasurementModel()
+    circuit = isinstance(harvester, Harvester) and harvester.electrical is not None
+    if outputs is not None or r_load is not None or circuit and harvester.has_circuit:
+        return _validate_channels(
+            harvester, records, measurement, offsets, outputs, r_load, settings
+        )
     rows = []
     for record in records:
         source, used, pred = _best_offsets(harvester, record, measurement, offsets, settings)
@@ -300,6 +436,61 @@ def _best_offsets(harvester, record, measurement, policy, settings):
     # a re-estimate is kept only where it lowers J (ties: the given offsets)
     source = min(scored, key=lambda s: (scored[s][1].cost, s != "given"))
     return (source, *scored[source])
+
+
+def _validate_channels(harvester, records, measurement, offsets, outputs, r_load, settings):
+    """:func:`validate` on channels (a circuit simulated), each with its J and RMS error."""
+    from randvib.identification.residuals import residual_diagnostics
+
+    records = list(records)
+    loads = [r_load] * len(records) if np.ndim(r_load) == 0 else list(r_load)
+    if len(loads) != len(records):
+        raise ValueError(f"`r_load` gives {len(loads)} loads for {len(records)} records")
+    model = model_of(harvester.friction_name)
+    skip = _skip(settings)
+    rows = []
+    for record, load in zip(records, loads, strict=True):
+        device = harvester if load is None else harvester.updated(r_load=float(load))
+        source, used, pred = _best_channel_offsets(
+            device, record, measurement, offsets, outputs, settings, skip
+        )
+        first = pred.outputs[0]
+        residual = (record[first] - pred.simulated(first))[skip:]
+        rows.append(
+            ValidationRow(
+                record.name, model, pred.cost, pred.rms_error, record.n,
+                offsets={"input_offset": float(used.input_offset),
+                         **{OFFSET_NAMES[k]: used.offset(k) for k in pred.channels}},
+                offsets_source=source,
+                residuals=residual_diagnostics(residual, record.input[skip:]),
+                channels={k: {"cost": pred.costs[k], "rms_error": pred.rms_errors[k]}
+                          for k in pred.channels},
+                r_load=None if device.electrical is None else float(device.electrical.r_load),
+            )
+        )  # fmt: skip
+    return rows
+
+
+def _best_channel_offsets(device, record, measurement, policy, outputs, settings, skip):
+    """(source, measurement, prediction) on channels: the given offsets, or with
+    ``"per-record"`` each channel's re-estimated (its mean residual) where that lowers J."""
+    from dataclasses import replace
+
+    given = predict_record(device, record, measurement=measurement, outputs=outputs, **settings)
+    if policy != "per-record":
+        return "given", measurement, given
+    shift = {k: float(np.mean((record[k] - given.channels[k])[skip:])) for k in given.channels}
+    channel = {k: measurement.offset(k) + d for k, d in shift.items()}
+    used = replace(
+        measurement,
+        output_offset=channel.pop("relative_displacement", measurement.output_offset),
+        channel_offsets={**measurement.channel_offsets, **channel},
+    )
+    pred = predict_record(device, record, measurement=used, outputs=outputs, **settings)
+    # a re-estimate is kept only where it lowers J (ties: the given offsets)
+    if pred.cost < given.cost:
+        return "output re-estimated", used, pred
+    return "given", measurement, given
 
 
 def _record_offsets(

@@ -58,6 +58,7 @@ becomes non-finite is stopped and gets an infinite cost / NaN samples.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numba
 import numpy as np
@@ -97,8 +98,9 @@ EXTRA_PARAMETERS = ("k2", "input_offset", "output_offset")
 
 
 #: Columns of a kernel parameter row: m, c, k, k3, the friction law's
-#: parameters (padded to N_KERNEL_PARAMETERS), then EXTRA_PARAMETERS.
-MATRIX_COLUMNS = 4 + N_KERNEL_PARAMETERS + len(EXTRA_PARAMETERS)
+#: parameters (padded to N_KERNEL_PARAMETERS), then EXTRA_PARAMETERS, then the
+#: circuit's (a, b, f) (:data:`CIRCUIT_COLUMNS`).
+MATRIX_COLUMNS = 4 + N_KERNEL_PARAMETERS + len(EXTRA_PARAMETERS) + 3
 
 
 _K2 = 4 + N_KERNEL_PARAMETERS
@@ -108,6 +110,14 @@ _INPUT_OFFSET = _K2 + 1
 
 
 _OUTPUT_OFFSET = _K2 + 2
+
+#: The column of a kernel parameter row holding the output sensor's offset.
+OUTPUT_OFFSET_COLUMN = _OUTPUT_OFFSET
+
+
+#: The circuit state's equation ``x' = a x + b z'`` and force ``f x`` on the mass
+#: (:meth:`randvib.models.coupling.Coupling.circuit_equation`); all 0 without one.
+CIRCUIT_COLUMNS = (_K2 + 3, _K2 + 4, _K2 + 5)
 
 
 _SLIP = 0
@@ -122,16 +132,18 @@ _MAX_EVENTS = 24  # events handled inside one sub-step before the step is forced
 #: LuGre sub-cycles per sub-step allowed while searching: stiffer candidates
 #: (bristle relaxation much faster than the record's dynamics) are rejected as
 #: diverged instead of costing thousands of steps each. Single simulations
-#: (prediction, validation) allow 4096.
+#: (prediction, validation) allow 4096. A circuit state relaxing at |a| counts
+#: the same way (|a| h sub-cycles per sub-step h).
 SEARCH_SUBCYCLES = 32
 
 
 # --------------------------------------------------------------------- kernel
 # The compiled pieces hand each other small tuples instead of long argument
 # lists (numba passes them by value, so they cost nothing):
-#   dev   = (m, c, k, k3, gain, k2, u_off)  one candidate's device; the input
-#           drives it with e(t) = gain * (input(t) - u_off), gain = -m for a
-#           base input, else 1
+#   dev   = (m, c, k, k3, gain, k2, u_off, ca, cb, cf)  one candidate's device;
+#           the input drives it with e(t) = gain * (input(t) - u_off), gain = -m
+#           for a base input, else 1; the circuit state x obeys
+#           x' = ca x + cb z' and pushes the mass back with cf x (all 0: none)
 #   law   = (kind, fn, p)        the friction law's kernel code, compiled
 #           callback and parameters, for :func:`evaluate_friction`
 #   layer = (tanh_mode, fc, beta, vb, fstick)  the friction as the stick-slip
@@ -141,7 +153,7 @@ SEARCH_SUBCYCLES = 32
 #   slipping = (layer, sgn)      the friction while slipping in direction sgn = +-1
 #   seg   = (a, u0, c1, c2)      input over one sub-step [a, b] of the sample
 #           interval, u0 + c1 (s - a) + c2 (s - a)^2 (c2 = 0: linear)
-#   st    = (z, v, mode, sgn)    the stick-slip integrator's state
+#   st    = (z, v, mode, sgn, x) the stick-slip integrator's state
 @numba.njit(cache=True, inline="always")
 def _input(dev, seg, s):
     # e at time s into the sample interval: the sub-step's quadratic through
@@ -152,14 +164,14 @@ def _input(dev, seg, s):
 
 
 @numba.njit(cache=True, inline="always")
-def _free_force(dev, e, z, v):
-    # g = e - c z' - k z - k2 z^2 - k3 z^3: everything but friction (N)
-    return e - dev[1] * v - z * (dev[2] + z * (dev[5] + z * dev[3]))
+def _free_force(dev, e, z, v, x):
+    # g = e - c z' - k z - k2 z^2 - k3 z^3 - f x: everything but friction (N)
+    return e - dev[1] * v - z * (dev[2] + z * (dev[5] + z * dev[3])) - dev[9] * x
 
 
 @numba.njit(cache=True, inline="always")
-def _acceleration(dev, e, z, v, f):
-    return (_free_force(dev, e, z, v) - f) / dev[0]
+def _acceleration(dev, e, z, v, x, f):
+    return (_free_force(dev, e, z, v, x) - f) / dev[0]
 
 
 @numba.njit(cache=True, inline="always")
@@ -188,41 +200,51 @@ def _slip_friction(slipping, v, th):
 
 
 @numba.njit(cache=True, inline="always")
-def _rk4(friction, fr, dev, seg, s, hh, z, v, th):
-    """Classical RK4 step of length hh from s on (z, z', theta).
+def _rk4(friction, fr, dev, seg, s, hh, z, v, th, x):
+    """Classical RK4 step of length hh from s on (z, z', theta, x).
 
     ``friction(fr, v, theta) -> (F, theta')`` is :func:`_law_friction` (``fr`` =
     ``law``) or :func:`_slip_friction` (``fr`` = ``slipping``), a compiled
     function named where the step is used: inlined there, each use compiles
     without the other's code (a run-time choice in every stage cost 12 % of
     the Coulomb search, and a function passed at run time defeats caching).
+    The circuit state x (``x' = ca x + cb z'``) is a fourth RK4 variable.
     Returns the state after the step and the acceleration at its start (the
     slope that the event interpolant needs).
     """
+    ca, cb = dev[7], dev[8]
     e0 = _input(dev, seg, s)
     e1 = _input(dev, seg, s + 0.5 * hh)
     e2 = _input(dev, seg, s + hh)
     f1, r1 = friction(fr, v, th)
-    a1 = _acceleration(dev, e0, z, v, f1)
+    a1 = _acceleration(dev, e0, z, v, x, f1)
+    q1 = ca * x + cb * v
     z2 = z + 0.5 * hh * v
     v2 = v + 0.5 * hh * a1
     t2 = th + 0.5 * hh * r1
+    x2 = x + 0.5 * hh * q1
     f2, r2 = friction(fr, v2, t2)
-    a2 = _acceleration(dev, e1, z2, v2, f2)
+    a2 = _acceleration(dev, e1, z2, v2, x2, f2)
+    q2 = ca * x2 + cb * v2
     z3 = z + 0.5 * hh * v2
     v3 = v + 0.5 * hh * a2
     t3 = th + 0.5 * hh * r2
+    x3 = x + 0.5 * hh * q2
     f3, r3 = friction(fr, v3, t3)
-    a3 = _acceleration(dev, e1, z3, v3, f3)
+    a3 = _acceleration(dev, e1, z3, v3, x3, f3)
+    q3 = ca * x3 + cb * v3
     z4 = z + hh * v3
     v4 = v + hh * a3
     t4 = th + hh * r3
+    x4 = x + hh * q3
     f4, r4 = friction(fr, v4, t4)
-    a4 = _acceleration(dev, e2, z4, v4, f4)
+    a4 = _acceleration(dev, e2, z4, v4, x4, f4)
+    q4 = ca * x4 + cb * v4
     zn = z + hh / 6.0 * (v + 2.0 * v2 + 2.0 * v3 + v4)
     vn = v + hh / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
     tn = th + hh / 6.0 * (r1 + 2.0 * r2 + 2.0 * r3 + r4)
-    return zn, vn, tn, a1
+    xn = x + hh / 6.0 * (q1 + 2.0 * q2 + 2.0 * q3 + q4)
+    return zn, vn, tn, xn, a1
 
 
 @numba.njit(cache=True, inline="always")
@@ -232,6 +254,18 @@ def _creep_velocity(layer, g):
     if not tanh_mode:
         return 0.0
     return math.atanh(g / fc) / beta
+
+
+@numba.njit(cache=True, inline="always")
+def _circuit_at(dev, x, w, tau):
+    # The circuit state tau after a moment where it was x, the mass moving at
+    # the constant (creep or zero) velocity w meanwhile: exact solution of
+    # x' = ca x + cb w
+    ca, cb = dev[7], dev[8]
+    if ca == 0.0:
+        return x + cb * w * tau
+    forced = -cb * w / ca
+    return forced + (x - forced) * math.exp(ca * tau)
 
 
 @numba.njit(cache=True)
@@ -276,30 +310,34 @@ def _stick_slip_layer(slip, p, m, h):
 
 
 @numba.njit(cache=True, inline="always")
-def _starting_state(dev, layer, e, z, v):
-    """(z, v, mode, sgn) at t = 0: stuck when at rest (or inside the layer) and
+def _starting_state(dev, layer, e, z, v, x):
+    """(z, v, mode, sgn, x) at t = 0: stuck when at rest (or inside the layer) and
     the non-friction force is held, else slipping in its direction."""
     vb = layer[3]
     if abs(v) <= vb or v == 0.0:
-        g = _free_force(dev, e, z, v)
+        g = _free_force(dev, e, z, v, x)
         if abs(g) <= layer[4]:
-            return z, _creep_velocity(layer, g), _STICK, 1.0
+            return z, _creep_velocity(layer, g), _STICK, 1.0, x
         sgn = 1.0 if g > 0 else -1.0
-        return z, sgn * vb, _SLIP, sgn
-    return z, v, _SLIP, 1.0 if v > 0 else -1.0
+        return z, sgn * vb, _SLIP, sgn, x
+    return z, v, _SLIP, 1.0 if v > 0 else -1.0, x
 
 
 @numba.njit(cache=True, inline="always")
-def _breakaway_newton(dev, seg, z, target, s, b, guess):
-    # With a curved (quadratic) input sub-step g is quadratic in time: refine
-    # the chord's breakaway time by Newton steps on g(t) = target, kept in [s, b].
+def _breakaway_newton(dev, seg, z, stuck, target, s, b, guess):
+    # With a curved (quadratic) input sub-step, or a circuit state decaying
+    # meanwhile, g is not linear in time: refine the chord's breakaway time by
+    # Newton steps on g(t) = target, kept in [s, b]. ``stuck`` = (x_s, w):
+    # the circuit state at s and the (creep) velocity while stuck.
+    x_s, w = stuck
     t = guess
     for _ in range(4):
         r = t - seg[0]
-        slope = dev[4] * (seg[2] + 2.0 * r * seg[3])
+        x = _circuit_at(dev, x_s, w, t - s)
+        slope = dev[4] * (seg[2] + 2.0 * r * seg[3]) - dev[9] * (dev[7] * x + dev[8] * w)
         if slope == 0.0:
             break
-        t -= (_free_force(dev, _input(dev, seg, t), z, 0.0) - target) / slope
+        t -= (_free_force(dev, _input(dev, seg, t), z, 0.0, x) - target) / slope
         t = min(max(t, s), b)
     return t
 
@@ -308,20 +346,23 @@ def _breakaway_newton(dev, seg, z, target, s, b, guess):
 def _stick(dev, layer, seg, s, b, st):
     """Advance a stick from s: to b, or to breakaway. Returns (s, st).
 
-    With ``z`` frozen, g is linear in time (linear hold), so breakaway
-    ``|g| = fstick`` is found exactly (a curved sub-step refines the chord's
-    time by Newton steps). In tanh mode the mass creeps at the
-    quasi-static velocity instead of standing still.
+    With ``z`` frozen and no circuit, g is linear in time (linear hold), so
+    breakaway ``|g| = fstick`` is found exactly (a curved sub-step, or a
+    circuit state decaying meanwhile, refines the chord's time by Newton
+    steps). In tanh mode the mass creeps at the quasi-static velocity
+    instead of standing still.
     """
-    z, v, mode, sgn = st
+    z, v, mode, sgn, x = st
     tanh_mode, _, _, vb, fstick = layer
-    ga = _free_force(dev, _input(dev, seg, s), z, 0.0)
-    gb = _free_force(dev, _input(dev, seg, b), z, 0.0)
+    ga = _free_force(dev, _input(dev, seg, s), z, 0.0, x)
+    w = _creep_velocity(layer, ga) if tanh_mode else 0.0
+    xb = _circuit_at(dev, x, w, b - s)
+    gb = _free_force(dev, _input(dev, seg, b), z, 0.0, xb)
     if abs(ga) <= fstick and abs(gb) <= fstick:
         if tanh_mode:
             z += (b - s) * _creep_velocity(layer, 0.5 * (ga + gb))
             v = _creep_velocity(layer, gb)
-        return b, (z, v, mode, sgn)
+        return b, (z, v, mode, sgn, xb)
     if abs(ga) > fstick:
         s_new = s
         sgn = 1.0 if ga > 0 else -1.0
@@ -330,13 +371,14 @@ def _stick(dev, layer, seg, s, b, st):
         frac = (target - ga) / (gb - ga)
         frac = min(max(frac, 0.0), 1.0)
         s_new = s + frac * (b - s)
-        if seg[3] != 0.0:
-            s_new = _breakaway_newton(dev, seg, z, target, s, b, s_new)
+        if seg[3] != 0.0 or dev[9] * x != 0.0:
+            s_new = _breakaway_newton(dev, seg, z, (x, w), target, s, b, s_new)
         sgn = 1.0 if gb > 0 else -1.0
+    x_new = _circuit_at(dev, x, w, s_new - s)
     if tanh_mode:
         # creep up to breakaway at the mean quasi-static velocity
         z += (s_new - s) * _creep_velocity(layer, 0.5 * (ga + sgn * fstick))
-    return s_new, (z, sgn * vb, _SLIP, sgn)
+    return s_new, (z, sgn * vb, _SLIP, sgn, x_new)
 
 
 @numba.njit(cache=True, inline="always")
@@ -346,35 +388,40 @@ def _slip(dev, layer, seg, s, b, st, accept):
     non-friction force decides between stick and slip. ``accept`` takes the
     step to b whatever happens in it (the event budget is spent). Returns (s, st).
     """
-    z, v, mode, sgn = st
+    z, v, mode, sgn, x = st
     vb = layer[3]
     fr = (layer, sgn)
     hh = b - s
-    z1, v1, _, a0 = _rk4(_slip_friction, fr, dev, seg, s, hh, z, v, 0.0)
+    z1, v1, _, x1, a0 = _rk4(_slip_friction, fr, dev, seg, s, hh, z, v, 0.0, x)
     if sgn * v1 > vb or accept:
-        return b, (z1, v1, mode, sgn)
+        return b, (z1, v1, mode, sgn, x1)
     # velocity reaches the boundary inside the step: locate, redo
-    a1 = _acceleration(dev, _input(dev, seg, b), z1, v1, _slip_force(layer, sgn, v1))
+    a1 = _acceleration(dev, _input(dev, seg, b), z1, v1, x1, _slip_force(layer, sgn, v1))
     frac = _hermite_root(hh, sgn * v - vb, sgn * a0, sgn * v1 - vb, sgn * a1)
     hs = frac * hh
-    z, v, _, a0 = _rk4(_slip_friction, fr, dev, seg, s, hs, z, v, 0.0)
+    z, v, _, x, a0 = _rk4(_slip_friction, fr, dev, seg, s, hs, z, v, 0.0, x)
     s = min(s + hs, b)
     v = sgn * vb
-    g = _free_force(dev, _input(dev, seg, s), z, v)
+    g = _free_force(dev, _input(dev, seg, s), z, v, x)
     if abs(g) <= layer[4]:
-        return s, (z, _creep_velocity(layer, g), _STICK, sgn)
+        return s, (z, _creep_velocity(layer, g), _STICK, sgn, x)
     new = 1.0 if g > 0 else -1.0
     if new != sgn:
         sgn = new
         v = sgn * vb  # cross the (zero-width or 1/beta) layer
-    return s, (z, v, _SLIP, sgn)
+    return s, (z, v, _SLIP, sgn, x)
 
 
 @numba.njit(cache=True, inline="always")
-def _stick_slip_substep(dev, layer, seg, a, b, tiny, st):
-    """The event-located stick-slip integrator over one sub-step [a, b]."""
+def _stick_slip_substep(dev, layer, seg, a, b, tiny, st, hmax):
+    """The event-located stick-slip integrator over one sub-step [a, b].
+
+    A slip advances at most ``hmax`` at a time (1 / |ca|: a circuit state
+    relaxing faster than the sub-step is resolved, as RK4's stability needs).
+    """
     s = a
-    for it in range(_MAX_EVENTS):
+    budget = _MAX_EVENTS + int((b - a) / hmax)
+    for it in range(budget):
         if s >= b:
             break
         if st[2] == _STICK:
@@ -382,34 +429,36 @@ def _stick_slip_substep(dev, layer, seg, a, b, tiny, st):
         elif b - s <= tiny:
             break
         else:
-            s, st = _slip(dev, layer, seg, s, b, st, it == _MAX_EVENTS - 1)
+            end = b if b - s <= hmax else s + hmax
+            s, st = _slip(dev, layer, seg, s, end, st, it == budget - 1)
     return st
 
 
 @numba.njit(cache=True, inline="always")
-def _smooth_substep(dev, fr, seg, a, b, subcycling, z, v, th):
-    """RK4 over the sub-step [a, b], sub-cycled so that a law with memory
-    relaxes by less than one e-fold per step. Returns (ok, z, v, th); ok is
-    False when that needs more than the allowed sub-cycles."""
+def _smooth_substep(dev, fr, seg, a, b, subcycling, z, v, th, x):
+    """RK4 over the sub-step [a, b], sub-cycled so that a law with memory and a
+    circuit state relax by less than one e-fold per step. Returns (ok, z, v,
+    th, x); ok is False when that needs more than the allowed sub-cycles."""
     relax_rate, max_sub = subcycling
+    rate = abs(v) * relax_rate + abs(dev[7])
     nc = 1
-    if relax_rate > 0.0:
-        nc = int(abs(v) * relax_rate * (b - a)) + 1
+    if rate > 0.0:
+        nc = int(rate * (b - a)) + 1
         if nc > max_sub:
-            return False, z, v, th
+            return False, z, v, th, x
     hh = (b - a) / nc
     for q in range(nc):
-        z, v, th, _ = _rk4(_law_friction, fr, dev, seg, a + q * hh, hh, z, v, th)
-    return True, z, v, th
+        z, v, th, x, _ = _rk4(_law_friction, fr, dev, seg, a + q * hh, hh, z, v, th, x)
+    return True, z, v, th, x
 
 
 @numba.njit(cache=True, inline="always")
-def _diverged(out_z, out_v, store, first):
+def _diverged(outputs, store, first):
     # A rejected candidate: NaN samples from ``first`` on, infinite cost.
     if store:
-        for r in range(first, out_z.shape[0]):
-            out_z[r] = math.nan
-            out_v[r] = math.nan
+        for out in outputs:
+            for r in range(first, out.shape[0]):
+                out[r] = math.nan
     return math.inf, 0.0
 
 
@@ -433,38 +482,52 @@ def _segment(u, i, j, nsub, curved, a, b):
     return (a, ua, (4.0 * um - 3.0 * ua - ub) / (2.0 * hm), (ua - 2.0 * um + ub) / (2.0 * hm * hm))
 
 
+@numba.njit(cache=True, inline="always")
+def _store(outputs, store, i, z, v, x):
+    if store:
+        outputs[0][i] = z
+        outputs[1][i] = v
+        outputs[2][i] = x
+
+
 @numba.njit(cache=True)
-def _run_one(par, relax_rate, state0, friction, drive, scoring, out_z, out_v, store):
+def _run_one(par, relax_rate, state0, friction, drive, scoring, outputs, store):
     """Simulate one parameter set; return the sum of squared errors against zref
     over the samples from index ``skip`` on.
 
-    ``par`` is ``[m, c, k, k3, p..., k2, input offset, output offset]``
-    (:data:`MATRIX_COLUMNS`), ``state0`` ``[z0, v0, theta0]``; the error is
+    ``par`` is ``[m, c, k, k3, p..., k2, input offset, output offset, a, b, f]``
+    (:data:`MATRIX_COLUMNS`), ``state0`` ``[z0, v0, theta0, x0]``; the error is
     that of ``z + output offset``; ``friction = (kind, fn, stick_slip)``,
-    ``drive = (u, dt, nsub, curved, base_input)``, ``scoring = (zref, skip, zlim, max_subcycles)`` as built by
-    :func:`run_kernel`.
+    ``drive = (u, dt, nsub, curved, base_input)``, ``scoring = (zref, skip,
+    zlim, max_subcycles)`` as built by :func:`run_kernel`; ``outputs`` =
+    (z, v, x) rows written when ``store``.
     """
     kind, fn, slip = friction
     u, dt, nsub, curved, base_input = drive
     zref, skip, zlim, max_sub = scoring
     m = par[0]
     p = par[4 : 4 + N_KERNEL_PARAMETERS]
-    dev = (m, par[1], par[2], par[3], -m if base_input else 1.0, par[_K2], par[_INPUT_OFFSET])
+    ca, cb, cf = par[_OUTPUT_OFFSET + 1], par[_OUTPUT_OFFSET + 2], par[_OUTPUT_OFFSET + 3]
+    dev = (m, par[1], par[2], par[3], -m if base_input else 1.0, par[_K2], par[_INPUT_OFFSET],
+           ca, cb, cf)  # fmt: skip
     z_off = par[_OUTPUT_OFFSET]
     h = dt / nsub
+    hmax = 1.0 / abs(ca) if ca != 0.0 else math.inf
     n = (u.shape[0] - 1) // (2 * nsub) + 1 if curved else u.shape[0]
     have_ref = zref.shape[0] == n
 
     sticky, layer = _stick_slip_layer(slip, p, m, h)
+    if sticky and abs(ca) * h > max_sub:
+        # a circuit far faster than the step: as many slip chunks per sub-step
+        # as a law's sub-cycles, rejected alike
+        return _diverged(outputs, store, 0)
     if slip == STICK_SLIP_SIGN and not sticky or slip == STICK_SLIP_TANH and p[0] == 0.0:
         kind = KERNEL_NONE  # Fc = 0: viscous only
     law = (kind, fn, p)
-    z = state0[0]
-    v = state0[1]
-    th = state0[2]
-    st = (z, v, _SLIP, 1.0)
+    z, v, th, x = state0[0], state0[1], state0[2], state0[3]
+    st = (z, v, _SLIP, 1.0, x)
     if sticky:
-        st = _starting_state(dev, layer, dev[4] * (u[0] - dev[6]), z, v)
+        st = _starting_state(dev, layer, dev[4] * (u[0] - dev[6]), z, v, x)
         v = st[1]
 
     sse = 0.0
@@ -472,45 +535,44 @@ def _run_one(par, relax_rate, state0, friction, drive, scoring, out_z, out_v, st
     if have_ref and skip == 0:
         sse = (z + z_off - zref[0]) ** 2
         sres = z + z_off - zref[0]
-    if store:
-        out_z[0] = z
-        out_v[0] = v
+    _store(outputs, store, 0, z, v, x)
     for i in range(n - 1):
         for j in range(nsub):
             a = j * h
             b = dt if j == nsub - 1 else a + h
             seg = _segment(u, i, j, nsub, curved, a, b)
             if sticky:
-                st = _stick_slip_substep(dev, layer, seg, a, b, 1e-14 * dt, st)
-                z = st[0]
-                v = st[1]
+                st = _stick_slip_substep(dev, layer, seg, a, b, 1e-14 * dt, st, hmax)
+                z, v, x = st[0], st[1], st[4]
             else:
-                ok, z, v, th = _smooth_substep(dev, law, seg, a, b, (relax_rate, max_sub), z, v, th)
+                ok, z, v, th, x = _smooth_substep(
+                    dev, law, seg, a, b, (relax_rate, max_sub), z, v, th, x
+                )
                 if not ok:
-                    # bristles stiffer than the step resolves: rejected as diverged
-                    return _diverged(out_z, out_v, store, i + 1)
-        if not (abs(z) < zlim) or not (abs(v) < math.inf):
-            return _diverged(out_z, out_v, store, i + 1)
+                    # bristles or a circuit stiffer than the step resolves: rejected as diverged
+                    return _diverged(outputs, store, i + 1)
+        if not (abs(z) < zlim) or not (abs(v) < math.inf) or not (abs(x) < math.inf):
+            return _diverged(outputs, store, i + 1)
         if have_ref and i + 1 >= skip:
             err = z + z_off - zref[i + 1]
             sse += err * err
             sres += err
-        if store:
-            out_z[i + 1] = z
-            out_v[i + 1] = v
+        _store(outputs, store, i + 1, z, v, x)
     return sse, sres
 
 
 @numba.njit(cache=True, parallel=True)
-def _run_batch(params, relax, state0, friction, drive, scoring, out_z, out_v, store):
-    # Without stored responses (store False) out_z, out_v are (1, 1), never written.
+def _run_batch(params, relax, state0, friction, drive, scoring, out_z, out_v, out_x, store):
+    # Without stored responses (store False) the outputs are (1, 1), never written.
     n_pop = params.shape[0]
     sums = np.empty((n_pop, 2))
     for i in numba.prange(n_pop):
-        row = out_z[i] if store else out_z[0]
-        row_v = out_v[i] if store else out_v[0]
+        if store:
+            outputs = (out_z[i], out_v[i], out_x[i])
+        else:
+            outputs = (out_z[0], out_v[0], out_x[0])
         sse, sres = _run_one(
-            params[i], relax[i], state0[i], friction, drive, scoring, row, row_v, store
+            params[i], relax[i], state0[i], friction, drive, scoring, outputs, store
         )
         sums[i, 0] = sse
         sums[i, 1] = sres
@@ -526,8 +588,8 @@ def _law(friction):
     return None if friction == "none" else FRICTION_MODELS[friction]
 
 
-def parameter_matrix(parameters: dict, friction) -> np.ndarray:
-    """Kernel parameter rows ``[m, c, k, k3, friction..., k2, offsets]`` from named arrays.
+def parameter_matrix(parameters: dict, friction, circuit=None) -> np.ndarray:
+    """Kernel parameter rows ``[m, c, k, k3, friction..., k2, offsets, a, b, f]``.
 
     Parameters
     ----------
@@ -537,6 +599,10 @@ def parameter_matrix(parameters: dict, friction) -> np.ndarray:
         (default 0); scalars or 1-D arrays of one length.
     friction : str or FrictionModel subclass
         One of :data:`FRICTION_KINDS`, or a law class.
+    circuit : (a, b, f), optional
+        A circuit state ``x' = a x + b z'`` with the force ``f x`` on the mass
+        (:meth:`~randvib.models.coupling.Coupling.circuit_equation`), scalars
+        or 1-D arrays; default none.
     """
     law = _law(friction)
     friction = "none" if law is None else law.name
@@ -553,15 +619,19 @@ def parameter_matrix(parameters: dict, friction) -> np.ndarray:
             f"{', '.join(names + EXTRA_PARAMETERS)}"
         )
     extras = [name for name in EXTRA_PARAMETERS if name in parameters]
-    columns = [
-        np.atleast_1d(check_finite(name, parameters[name])) for name in names + tuple(extras)
-    ]
+    labels = names + tuple(extras)
+    columns = [np.atleast_1d(check_finite(name, parameters[name])) for name in labels]
     where = list(range(len(names))) + [_K2 + EXTRA_PARAMETERS.index(name) for name in extras]
+    if circuit is not None:
+        labels += ("circuit a", "circuit b", "circuit f")
+        pairs = zip(labels[-3:], circuit, strict=True)
+        columns += [np.atleast_1d(check_finite(name, x)) for name, x in pairs]
+        where += list(CIRCUIT_COLUMNS)
     n_pop = max(col.shape[0] for col in columns)
     out = np.zeros((n_pop, MATRIX_COLUMNS))
     for j, col in zip(where, columns, strict=True):
         if col.ndim != 1 or col.shape[0] not in (1, n_pop):
-            name = (names + tuple(extras))[where.index(j)]
+            name = labels[where.index(j)]
             raise ValueError(f"parameter `{name}` must be a scalar or a 1-D array of {n_pop}")
         out[:, j] = col
     if np.any(out[:, 0] <= 0):
@@ -581,6 +651,7 @@ def run_kernel(
     z0=0.0,
     v0=0.0,
     theta0=0.0,
+    x0=0.0,
     reference=None,
     skip=0,
     response_limit=np.inf,
@@ -593,13 +664,16 @@ def run_kernel(
 
     Parameters
     ----------
-    matrix : ndarray, shape (n_pop, 4 + N_KERNEL_PARAMETERS)
+    matrix : ndarray, shape (n_pop, MATRIX_COLUMNS)
         Parameter rows from :func:`parameter_matrix`.
     friction : str or FrictionModel subclass or None
     drive, base_input
         From :func:`~randvib.identification.input_reconstruction.driving_signal`.
     dt : float
         Sample interval (s).
+    z0, v0, theta0, x0 : float or ndarray
+        Initial displacement (m), velocity (m/s), bristle state (m) and
+        circuit state (its unit), one per row or shared.
     reference : ndarray, optional
         Measured z (m) to score the sum of squared errors against, from
         sample ``skip`` on.
@@ -617,20 +691,22 @@ def run_kernel(
 
     Returns
     -------
-    sse : ndarray, shape (n_pop,)
-        Sums of squared errors (0 without a reference; inf when diverged).
-    z, v : ndarray, shape (n_pop, n), or None when not stored
+    KernelRun
+        ``sse`` (n_pop,): sums of squared errors (0 without a reference; inf
+        when diverged); ``z``, ``v``, ``x`` (n_pop, n): displacement,
+        velocity and circuit state at the samples, or None when not stored.
     """
     law = _law(friction)
     n_pop = matrix.shape[0]
     n = drive.shape[0]
-    state0 = np.empty((n_pop, 3))
-    for j, value in enumerate((z0, v0, theta0)):
+    state0 = np.empty((n_pop, 4))
+    for j, value in enumerate((z0, v0, theta0, x0)):
         state0[:, j] = np.broadcast_to(np.asarray(value, dtype=float), (n_pop,))
     zref = np.empty(0) if reference is None else np.ascontiguousarray(reference, dtype=float)
     shape = (n_pop, n) if store else (1, 1)
     out_z = np.empty(shape)
     out_v = np.empty(shape)
+    out_x = np.empty(shape)
     kernel_friction = (
         KERNEL_NONE if law is None else law.kernel_code,
         kernel_callback(law),
@@ -654,10 +730,22 @@ def run_kernel(
         scoring,
         out_z,
         out_v,
+        out_x,
         bool(store),
     )
     sse = sums[:, 0]
     if profile_offset and zref.size:
         # the best constant added to z: J's minimum over the output offset
         sse = sse - sums[:, 1] ** 2 / (zref.size - int(skip))
-    return sse, (out_z if store else None), (out_v if store else None)
+    if not store:
+        return KernelRun(sse, None, None, None)
+    return KernelRun(sse, out_z, out_v, out_x)
+
+
+class KernelRun(NamedTuple):
+    """What :func:`run_kernel` returns: error sums and the stored responses."""
+
+    sse: np.ndarray
+    z: np.ndarray | None
+    v: np.ndarray | None
+    x: np.ndarray | None

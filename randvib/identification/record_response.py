@@ -16,8 +16,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from randvib._validation import check_int
+from randvib.identification.circuit import (
+    ELECTRICAL_OUTPUTS,
+    OUTPUT_KINDS,
+    check_output_kind,
+    output_coefficients,
+)
 from randvib.identification.input_reconstruction import HOLDS, driving_signal
-from randvib.identification.models import MeasurementModel, device_parameters
+from randvib.identification.models import MeasurementModel, device_circuit, device_parameters
 from randvib.identification.record_integrator import parameter_matrix, run_kernel
 from randvib.models.harvester import Harvester
 from randvib.models.record import INPUT_KINDS, Record
@@ -35,6 +41,11 @@ class BatchSimulation:
         Relative displacement (m) and velocity (m/s) at the samples; NaN after
         a candidate diverged. One device is a batch of one: ``z[0]`` is its
         response, and :meth:`to_record` makes a record of it.
+    x : ndarray, shape (n_pop, n)
+        The circuit state (a coil's current, A; a piezo element's voltage,
+        V); zeros without one.
+    harvester : Harvester or None
+        The simulated device, whose coupling says what :meth:`output` reads.
     record : Record or None
         The record whose input drove the devices.
     """
@@ -42,7 +53,31 @@ class BatchSimulation:
     time: np.ndarray
     z: np.ndarray
     v: np.ndarray
+    x: np.ndarray | None = None
+    harvester: Harvester | None = None
     record: Record | None = field(default=None, repr=False)
+
+    def output(self, kind: str) -> np.ndarray:
+        """The channel ``kind`` of :data:`~randvib.identification.circuit.OUTPUT_KINDS`.
+
+        ``relative_displacement`` z (m), ``relative_velocity`` z' (m/s),
+        ``voltage`` the load voltage (V: R_L i of a coil, V of a piezo
+        element) and ``current`` the load current (A), as the sensors would
+        read them without offset or noise; shape (n_pop, n).
+        """
+        check_output_kind(kind, "kind")
+        coupling = None if self.harvester is None else self.harvester.electrical
+        if kind in ELECTRICAL_OUTPUTS and coupling is None:
+            raise ValueError(
+                f"a `{kind}` output needs the device's circuit: build it with a coupling "
+                "(Harvester.with_coupling or Harvester.from_electrical)"
+            )
+        name = None if coupling is None else coupling.name
+        r_load = None if coupling is None else coupling.r_load
+        params = {} if coupling is None else coupling.parameters()
+        cz, cv, cx = output_coefficients(kind, name, params, r_load)
+        x = self.x if self.x is not None else 0.0
+        return cz * self.z + np.atleast_1d(cv)[:, None] * self.v + np.atleast_1d(cx)[:, None] * x
 
     @property
     def n_devices(self) -> int:
@@ -53,8 +88,10 @@ class BatchSimulation:
         """The driving record with device ``index``'s response as ``relative_displacement``.
 
         ``index`` may be left out for a batch of one device. The response is
-        the true displacement (no output offset); the driving record's other
-        channels are kept, a measured ``relative_displacement`` replaced.
+        the true one (no sensor offset): the displacement, and each output
+        channel the driving record holds (:meth:`output`) replaced by its
+        simulated value (a circuit channel dropped where the device has no
+        circuit); the record's other channels are kept.
         """
         if index is None:
             if self.n_devices != 1:
@@ -66,7 +103,15 @@ class BatchSimulation:
         index = check_int("index", index, minimum=-self.n_devices, maximum=self.n_devices - 1)
         if self.record is None:
             raise ValueError("this batch does not hold the record that drove it")
-        channels = {**self.record.channels, "relative_displacement": self.z[index]}
+        channels = dict(self.record.channels)
+        coupled = self.harvester is not None and self.harvester.electrical is not None
+        for kind in OUTPUT_KINDS:
+            if kind != "relative_displacement" and kind not in channels:
+                continue
+            if kind in ELECTRICAL_OUTPUTS and not coupled:
+                channels.pop(kind)  # measured, and not simulated: not this device's
+            else:
+                channels[kind] = self.output(kind)[index]
         label = name or f"{self.record.name} (simulated)"
         return Record(self.record.dt, time=self.record.time, name=label, **channels)
 
@@ -91,6 +136,7 @@ def record_response(
     z0=0.0,
     v0=0.0,
     theta0=0.0,
+    x0=0.0,
     response_limit: float = np.inf,
 ) -> BatchSimulation:
     """The response of Eq. 1 to a record's input, for one device or a batch at once.
@@ -103,11 +149,12 @@ def record_response(
     Parameters
     ----------
     harvester : Harvester
-        The device, simulated with its total damping c = c_m + c_e (a record
-        cannot separate them) and any friction law; a coupling with a circuit
-        state is refused. Its parameters may be 1-D arrays of one length:
-        a batch of devices, one response each, simulated in one parallel
-        compiled call.
+        The device with any friction law: a static coupling as its damper
+        c_e (in c = c_m + c_e), a coil with inductance or a piezo element
+        with its circuit state (the current i, A, or the voltage V, V),
+        integrated with the motion; a diode bridge is refused. Its parameters
+        may be 1-D arrays of one length: a batch of devices, one response
+        each, simulated in one parallel compiled call.
     record : Record
         Its input channel drives the device: base displacement (m,
         differentiated twice), base acceleration (m/s^2) or force on the
@@ -126,15 +173,17 @@ def record_response(
         (:func:`~randvib.identification.input_reconstruction.reconstruct_input`).
     lowpass : float, optional
         Zero-phase low-pass cut-off (Hz) for the driving signal.
-    z0, v0, theta0 : float or array_like
-        Initial displacement (m), velocity (m/s), LuGre bristle state (m).
+    z0, v0, theta0, x0 : float or array_like
+        Initial displacement (m), velocity (m/s), LuGre bristle state (m),
+        circuit state (A or V).
     response_limit : float, optional
         |z| above which a candidate counts as diverged (m).
 
     Returns
     -------
     BatchSimulation
-        One row of z and v per device of the batch.
+        One row of z, v and the circuit state per device of the batch; its
+        :meth:`~BatchSimulation.output` gives a channel (the load voltage...).
 
     Examples
     --------
@@ -147,6 +196,7 @@ def record_response(
     (2, 1000)
     """
     parameters = device_parameters(harvester, measurement, "record_response", scalar=False)
+    circuit = device_circuit(harvester)
     if not isinstance(record, Record):
         raise ValueError(f"`record` must be a randvib.Record, got {type(record).__name__}")
     kind = _input_kind(record, input_kind)
@@ -154,9 +204,9 @@ def record_response(
     if hold not in HOLDS:
         raise ValueError(f"`hold` must be one of {', '.join(HOLDS)}; got {hold!r}")
     friction = None if harvester.friction is None else type(harvester.friction)
-    matrix = parameter_matrix(parameters, friction)
+    matrix = parameter_matrix(parameters, friction, circuit)
     drive, base_input = driving_signal(record[kind], record.dt, kind, lowpass)
-    _, z, v = run_kernel(
+    _, z, v, x = run_kernel(
         matrix,
         friction,
         drive,
@@ -167,9 +217,10 @@ def record_response(
         z0=z0,
         v0=v0,
         theta0=theta0,
+        x0=x0,
         response_limit=response_limit,
     )
-    return BatchSimulation(time=record.time, z=z, v=v, record=record)
+    return BatchSimulation(time=record.time, z=z, v=v, x=x, harvester=harvester, record=record)
 
 
 def _input_kind(record: Record, input_kind) -> str:

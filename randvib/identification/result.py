@@ -7,6 +7,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from randvib import _display, formatting
+from randvib.identification.circuit import coupling_from_parameters
+from randvib.identification.identifiability import Identifiability
 from randvib.identification.models import MeasurementModel, device_from_parameters, unit_of
 from randvib.identification.prediction import Prediction, predict_record
 from randvib.identification.residuals import MAX_LAG, ResidualDiagnostics, residual_diagnostics
@@ -80,7 +82,29 @@ class IdentificationResult:
     residuals : ResidualDiagnostics or None
         Whiteness of the training residual and its independence of the input
         (:func:`~randvib.identification.residuals.residual_diagnostics`), with
-        the verdict ``white`` or ``structured``; None when not computed.
+        the verdict ``white`` or ``structured``; None when not computed (of
+        the first record's first channel when there are several).
+    coupling : str
+        The coupling identified with the mechanics (``resistive``,
+        ``inductive``, ``piezo``); empty when c is the total damping.
+    outputs : tuple of str
+        The channels fitted (``relative_displacement`` unless told).
+    r_loads : tuple of float
+        Each record's known load R_L (ohm), with a coupling.
+    records : tuple of str
+        The records' names, in the order of their ``[i]`` parameters.
+    weights : dict
+        The channels' weights in J (absent: 1).
+    channel_costs : list of dict
+        J (Eq. 11, each channel normalised by its own variance) and the RMS
+        error of each record's channels: ``record``, ``output``, ``r_load``,
+        ``cost``, ``rms_error``, ``samples``.
+    channel_residuals : list of dict
+        Each record's channels' residual verdicts (``record``, ``output``,
+        ``verdict``, ``ljung_box_p``).
+    identifiability : Identifiability or None
+        What the records fix and why, and the check at the estimate
+        (:mod:`randvib.identification.identifiability`).
     """
 
     model: str
@@ -101,10 +125,18 @@ class IdentificationResult:
     notes: tuple = ()
     input_kind: str = ""
     residuals: ResidualDiagnostics | None = None
+    coupling: str = ""
+    outputs: tuple = ("relative_displacement",)
+    r_loads: tuple = ()
+    records: tuple = ()
+    weights: dict = field(default_factory=dict)
+    channel_costs: list = field(default_factory=list)
+    channel_residuals: list = field(default_factory=list)
+    identifiability: Identifiability | None = None
 
     def unit(self, name: str) -> str:
         """The SI unit of parameter ``name``; ``input_offset`` is in the input channel's unit."""
-        if name == "input_offset" and self.input_kind:
+        if name.partition("[")[0] == "input_offset" and self.input_kind:
             return unit(self.input_kind)
         return unit_of(self.model, name)
 
@@ -191,6 +223,7 @@ class IdentificationResult:
             "parameters": {k: float(v) for k, v in self.parameters.items()},
             "units": {k: self.unit(k) for k in self.parameters},
             "input_kind": self.input_kind,
+            **self._electrical_dict(),
             "cost": float(self.cost),
             "free": list(self.free),
             "bounds": {k: [float(a), float(b)] for k, (a, b) in self.bounds.items()},
@@ -220,6 +253,22 @@ class IdentificationResult:
                 }
             ),
         }
+
+    def _electrical_dict(self) -> dict:
+        """The coupling, channels, loads and identifiability (only what a fit has)."""
+        out = {}
+        if self.coupling:
+            out["coupling"] = self.coupling
+            out["r_loads"] = [float(r) for r in self.r_loads]
+        if tuple(self.outputs) != ("relative_displacement",) or self.channel_costs:
+            out["outputs"] = list(self.outputs)
+            out["records"] = list(self.records)
+            out["weights"] = dict(self.weights)
+            out["channel_costs"] = list(self.channel_costs)
+            out["channel_residuals"] = list(self.channel_residuals)
+        if self.identifiability is not None:
+            out["identifiability"] = self.identifiability.to_dict()
+        return out
 
     @classmethod
     def from_dict(cls, d: dict) -> IdentificationResult:
@@ -256,6 +305,16 @@ class IdentificationResult:
             notes=tuple(d.get("notes", ())),
             input_kind=d.get("input_kind", ""),
             residuals=None if residuals is None else ResidualDiagnostics.from_dict(residuals),
+            coupling=d.get("coupling", ""),
+            outputs=tuple(d.get("outputs", ("relative_displacement",))),
+            r_loads=tuple(float(r) for r in d.get("r_loads", ())),
+            records=tuple(d.get("records", ())),
+            weights=dict(d.get("weights", {})),
+            channel_costs=list(d.get("channel_costs", [])),
+            channel_residuals=list(d.get("channel_residuals", [])),
+            identifiability=None
+            if "identifiability" not in d
+            else Identifiability.from_dict(d["identifiability"]),
         )
 
     def to_frame(self):
@@ -348,22 +407,46 @@ class IdentificationResult:
     def _repr_html_(self) -> str:
         return _display.html_table(self._title(), self._rows(), self._search_line())
 
-    def harvester(self, electrical=None) -> Harvester:
-        """The identified device, its damping c as c_m (c_e = 0).
+    def harvester(self, electrical=None, *, r_load: float | None = None) -> Harvester:
+        """The identified device, its damping c as c_m.
 
         Parameters
         ----------
         electrical : Coupling, optional
             A coupling to wire the device with (its c_e is added to the
             identified c, which a record taken in open circuit does not hold),
-            e.g. ``randvib.Resistive(alpha, r_load, r_coil)``.
+            e.g. ``randvib.Resistive(alpha, r_load, r_coil)``. A fit that
+            identified its coupling has it already (c is then c_m).
+        r_load : float, optional
+            With an identified coupling: the load (ohm) to wire it to;
+            default the first record's.
         """
+        if self.coupling:
+            if electrical is not None:
+                raise ValueError(
+                    f"this fit identified its {self.coupling} coupling: give `r_load` to wire it "
+                    "to another load, not another coupling"
+                )
+            load = self.r_loads[0] if r_load is None else r_load
+            electrical = coupling_from_parameters(self.coupling, self.parameters, load)
+        elif r_load is not None:
+            raise ValueError("`r_load` needs a fit that identified its coupling (`coupling=`)")
         return device_from_parameters(self.model, self.parameters, electrical)[0]
 
     @property
     def measurement(self) -> MeasurementModel:
-        """The identified (or fixed) offsets and k2; those not estimated are 0."""
-        return MeasurementModel.from_parameters(self.parameters)
+        """The identified (or fixed) offsets and k2 (the first record's); absent ones are 0."""
+        return self.measurement_of(0)
+
+    def measurement_of(self, index: int) -> MeasurementModel:
+        """The offsets of record ``index`` (its ``[index]`` parameters) and k2."""
+        count = max(len(self.records), 1)
+        own = {}
+        for name, value in self.parameters.items():
+            base, _, which = name.partition("[")
+            if not which and count == 1 or which and int(which.rstrip("]")) == index:
+                own[base] = value
+        return MeasurementModel.from_parameters(own)
 
     @property
     def simulation(self) -> SimulationSettings:
@@ -379,21 +462,31 @@ class IdentificationResult:
         """
         pred = self.predict(record)
         skip = int(self.settings.get("skip", 0))
-        return residual_diagnostics(record.z[skip:] - pred.z[skip:], record.input[skip:], max_lag)
+        kind = pred.outputs[0]
+        residual = record[kind][skip:] - pred.simulated(kind)[skip:]
+        return residual_diagnostics(residual, record.input[skip:], max_lag)
 
-    def predict(self, record: Record, electrical=None) -> Prediction:
+    def predict(
+        self, record: Record, electrical=None, *, r_load: float | None = None, index: int = 0
+    ) -> Prediction:
         """``record`` simulated with the identified device and measurement model.
 
         :func:`~randvib.identification.prediction.predict_record` with
-        :meth:`harvester` (wired with ``electrical``, if given),
-        :attr:`measurement` and the fit's :attr:`simulation` settings; the
-        initial state is obtained for ``record`` as the fit obtained it.
+        :meth:`harvester` (wired with ``electrical``, or with the identified
+        coupling at ``r_load``, default the ``index``-th record's load),
+        the ``index``-th record's offsets (:meth:`measurement_of`), the fit's
+        channels and its :attr:`simulation` settings; the initial state is
+        obtained for ``record`` as the fit obtained it.
         """
+        channels = bool(self.coupling) or tuple(self.outputs) != ("relative_displacement",)
+        if self.coupling and r_load is None:
+            r_load = self.r_loads[index]
         return predict_record(
-            self.harvester(electrical),
+            self.harvester(electrical, r_load=r_load),
             record,
-            measurement=self.measurement,
+            measurement=self.measurement_of(index),
             simulation=self.simulation,
+            **({"outputs": tuple(self.outputs)} if channels else {}),
         )
 
 

@@ -21,6 +21,9 @@ from randvib.identification.input_reconstruction import (
     driving_signal,
 )
 
+#: The polish's evaluations for one displacement record, and for any other fit.
+POLISH_MAXFEV = 40
+EXPERIMENT_POLISH_MAXFEV = 200
 #: How the simulation's initial state is obtained (SimulationSettings.initial_state).
 INITIAL_STATES = ("estimate", "record")
 
@@ -110,9 +113,12 @@ class SearchSettings:
         Finish with the least-squares polish of the simulation error
         (:mod:`randvib.identification.least_squares`), which also estimates
         the initial state and gives the parameters' uncertainty.
-    polish_maxfev : int
+    polish_maxfev : int or None
         Most residual evaluations of the polish (each Jacobian costs 2 d
-        more simulations, run in one batch).
+        more simulations, run in one batch); None: 40 for one displacement
+        record, :data:`EXPERIMENT_POLISH_MAXFEV` for several records or
+        channels (more offsets and initial states to estimate, and the
+        coupling's parameters in narrower valleys).
     search_samples : int or None
         Search on the record's first ``search_samples`` samples only (None:
         all); the polish always fits the whole record. The search only has
@@ -126,7 +132,7 @@ class SearchSettings:
     tol: float = 1e-6
     patience: int | None = 15
     polish: bool = True
-    polish_maxfev: int = 40
+    polish_maxfev: int | None = None
     search_samples: int | None = None
 
     def __post_init__(self):

@@ -28,12 +28,14 @@ from randvib._validation import (
     check_positive,
     check_scalar_device,
 )
+from randvib.identification.circuit import ELECTRICAL_OUTPUTS, OUTPUT_KINDS, check_output_kind
 from randvib.identification.record_response import record_response
 from randvib.models.excitation import BaseMotionOverflow, Excitation, band_limited_excitation
 from randvib.models.harvester import Harvester
 from randvib.models.potential import CONFINING
 from randvib.models.presets import PRESETS, preset
 from randvib.models.record import Record
+from randvib.quantities import unit
 
 #: The input channels a synthetic record can carry (the shaker's sensors).
 SYNTHETIC_INPUTS = ("base_acceleration", "base_displacement")
@@ -56,6 +58,9 @@ def synthetic_record(
     substeps: int = 8,
     band: tuple[float, float] = PAPER_BAND,
     name: str = "synthetic",
+    outputs=("relative_displacement",),
+    noise: dict | None = None,
+    offsets: dict | None = None,
 ) -> Record:
     """Simulate a device under a band-limited base excitation and record it as sensors would.
 
@@ -98,6 +103,16 @@ def synthetic_record(
         Band (Hz) of an excitation given as an RMS; default the paper's.
     name : str
         Record label.
+    outputs : sequence of str
+        The response channels recorded
+        (:data:`~randvib.identification.circuit.OUTPUT_KINDS`): the
+        relative displacement (default), velocity, and with a coupling the
+        load voltage (a coil's ``R_L i``, its inductance's current a state;
+        a piezo element's ``V``) and current, simulated as measured.
+    noise, offsets : dict, optional
+        ``kind -> RMS`` of each output channel's white sensor noise and
+        ``kind -> offset`` (its unit); ``noise_z`` and ``offset_z`` are the
+        displacement's.
 
     Returns
     -------
@@ -133,6 +148,7 @@ def synthetic_record(
         "offset_input": float(check_finite("offset_input", offset_input)),
     }
     substeps = check_int("substeps", substeps, minimum=1)
+    outputs, noise, offsets = _sensors(outputs, noise, offsets, sensor, device)
     excitation_rng, noise_rng = np.random.default_rng(seed).spawn(2)
     with np.errstate(all="ignore"):
         try:
@@ -145,20 +161,48 @@ def synthetic_record(
             "signal; lower it (`--rms` / `--psd`)"
         )
     dt = 1.0 / sample_rate
-    z = record_response(device, Record(dt, **{input: true_input}), substeps=substeps).z[0]
-    if not np.all(np.isfinite(z)):
+    sim = record_response(device, Record(dt, **{input: true_input}), substeps=substeps)
+    if not (np.all(np.isfinite(sim.z)) and np.all(np.isfinite(sim.x))):
         raise ValueError(
             f"the simulated response to `excitation` {_excitation_text(excitation)} diverged; "
             "lower the excitation (`--rms` / `--psd`) or raise `substeps`"
         )
     # Independent draws per channel, always drawn so that one channel's noise
-    # does not depend on whether the other has any.
-    eps_input, eps_z = noise_rng.standard_normal((2, z.size))
-    measured = {
-        input: true_input + sensor["offset_input"] + sensor["noise_input"] * eps_input,
-        "relative_displacement": z + sensor["offset_z"] + sensor["noise_z"] * eps_z,
-    }
+    # does not depend on whether another has any (the input's and the
+    # displacement's first, as before the other channels existed).
+    eps = noise_rng.standard_normal((2 + len(OUTPUT_KINDS), sim.z.shape[1]))
+    measured = {input: true_input + sensor["offset_input"] + sensor["noise_input"] * eps[0]}
+    for kind in outputs:
+        row = 1 if kind == "relative_displacement" else 2 + OUTPUT_KINDS.index(kind)
+        measured[kind] = sim.output(kind)[0] + offsets[kind] + noise[kind] * eps[row]
     return Record(dt, name=name, **measured)
+
+
+def _sensors(outputs, noise, offsets, sensor, device) -> tuple[tuple, dict, dict]:
+    """The output channels and each one's noise RMS and offset, checked."""
+    outputs = (outputs,) if isinstance(outputs, str) else tuple(outputs)
+    if not outputs or len(set(outputs)) != len(outputs):
+        raise ValueError(f"`outputs` must name distinct output kinds, got {outputs!r}")
+    for kind in outputs:
+        check_output_kind(kind)
+        if kind in ELECTRICAL_OUTPUTS and device.electrical is None:
+            raise ValueError(
+                f"a `{kind}` output needs the device's circuit: give it a coupling "
+                "(`--coupling` with its options, Harvester.with_coupling)"
+            )
+    rms = {kind: 0.0 for kind in OUTPUT_KINDS}
+    shift = dict(rms)
+    rms["relative_displacement"], shift["relative_displacement"] = (
+        sensor["noise_z"],
+        sensor["offset_z"],
+    )
+    for kind, value in (noise or {}).items():
+        check_output_kind(kind, "noise")
+        rms[kind] = float(check_nonnegative(f"noise of {kind}", value, unit(kind)))
+    for kind, value in (offsets or {}).items():
+        check_output_kind(kind, "offsets")
+        shift[kind] = float(check_finite(f"offset of {kind}", value))
+    return outputs, rms, shift
 
 
 def _excitation_text(excitation) -> str:

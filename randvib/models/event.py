@@ -418,6 +418,14 @@ class Enveloped:
         if isinstance(self.excitation, Enveloped):
             raise ValueError("`excitation` must be a stationary excitation, not another event")
         object.__setattr__(self, "excitation", as_excitation(self.excitation))
+        if self.excitation.lines() or not self.excitation.is_gaussian:
+            # the envelope modulates a Gaussian process (Priestley); tones, shocks and
+            # translation processes are stationary inputs of randvib.simulate
+            raise ValueError(
+                f"an Enveloped event's excitation must be a Gaussian spectrum; the "
+                f"{self.excitation.name} input (tones, shocks or a non-Gaussian marginal) is "
+                "simulated stationary by randvib.simulate"
+            )
         if not isinstance(self.envelope, Envelope):
             raise ValueError(
                 f"`envelope` must be a randvib envelope ({', '.join(ENVELOPES)}), "

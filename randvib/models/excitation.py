@@ -57,8 +57,10 @@ from randvib._validation import (
     check_positive,
     check_scalar,
 )
+from randvib.models import composition
 from randvib.models.record import Record, read_csv, read_record
 from randvib.models.state_space import StateSpace
+from randvib.models.tone import Tone
 from randvib.quantities import unit
 
 
@@ -202,11 +204,38 @@ class Excitation:
     #: True for ideal white noise (the paper's model, which every analytic method
     #: accepts; each declares whether it accepts another, ``AnalyticMethod.coloured``).
     is_white: bool = False
+    #: True for a stationary Gaussian process: its spectrum says everything about it.
+    #: Translation processes, measured records, shock trains and tones are not
+    #: (:mod:`randvib.models.translation`, :mod:`randvib.models.shock`, :mod:`randvib.models.combined`).
+    is_gaussian: bool = True
 
-    def __init_subclass__(cls, **kwargs):
+    def __init_subclass__(cls, registered: bool = True, **kwargs):
+        # ``registered=False``: a composite or a non-Gaussian process, built from
+        # other objects rather than from numbers, is not an ``--excitation`` spectrum
         super().__init_subclass__(**kwargs)
-        if "name" in cls.__dict__:
+        if registered and "name" in cls.__dict__:
             EXCITATIONS[cls.name] = cls
+
+    @property
+    def kurtosis(self) -> float:
+        """E[a^4] / E[a^2]^2 of the base acceleration a: 3 for a Gaussian process."""
+        return 3.0
+
+    def lines(self) -> tuple:
+        """The deterministic tones (:class:`~randvib.models.tone.Tone`) in the input; none here."""
+        return ()
+
+    def __add__(self, other):
+        """The sum of independent inputs: ``BandPass(...) + Tone(25, 1) + ShockTrain(...)``.
+
+        One random spectrum with any number of tones and at most one shock
+        train (:class:`~randvib.models.combined.Combined`).
+        """
+        # the composite module builds on this one: reached through its registry
+        return composition.combine(self, other)
+
+    def __radd__(self, other):
+        return composition.combine(other, self)
 
     def psd(self, frequency) -> np.ndarray:  # pragma: no cover - abstract
         """One-sided PSD of the base acceleration ((m/s^2)^2/Hz) at ``frequency`` (Hz)."""
@@ -270,9 +299,16 @@ def _one(name: str, value):
 
 
 def as_excitation(value) -> Excitation:
-    """An :class:`Excitation` as is; a number S as white noise ``White(S)``."""
+    """An :class:`Excitation` as is; a number S as white noise ``White(S)``; a tone as an input.
+
+    A :class:`~randvib.models.tone.Tone` alone becomes the
+    :class:`~randvib.models.combined.Combined` input of that tone.
+    """
     if isinstance(value, Excitation):
         return value
+    if isinstance(value, Tone):
+        # the composite module builds on this one: reached through its registry
+        return composition.as_input(value)
     if getattr(value, "is_event", False):
         raise ValueError(
             f"the {value.name} event is not stationary: its transient response is computed by "
@@ -752,6 +788,18 @@ class Measured(Excitation):
         }
 
     @property
+    def kurtosis(self) -> float:
+        """The recorded acceleration's sample kurtosis E[(a - mean)^4] / var^2 (3: Gaussian).
+
+        A record carries its own marginal: Monte Carlo on it
+        (:func:`randvib.monte_carlo_on_record`) drives the device with it as
+        it is; the Gaussian analytic methods name this number where it is
+        beyond their measured limit (:mod:`randvib.analytic.method`).
+        """
+        a = self.acceleration - np.mean(self.acceleration)
+        return float(np.mean(a**4) / np.mean(a**2) ** 2)
+
+    @property
     def record_variance(self) -> float:
         """Variance of the recorded acceleration about its mean ((m/s^2)^2)."""
         return float(np.var(self.acceleration))
@@ -895,3 +943,31 @@ def synthesised_increments(excitation: Excitation, n: int, dt: float, normals) -
     g = np.asarray(normals, dtype=float).reshape(-1, 2, f.size)
     sine = np.where(scale == n, 0.0, g[:, 1])  # no sine at f = 0 and at the Nyquist bin
     return fft.irfft(factor * (g[:, 0] - 1j * sine), n, axis=-1, workers=-1)
+
+
+def synthesised_values(excitation: Excitation, n: int, dt: float, normals, offset: float = 0.0):
+    """Synthesised paths sampled at the times ``j dt + offset``, from each path's own normals.
+
+    The process of :func:`synthesised_increments` (same bins, same normals,
+    so the same path) evaluated at ``j dt + offset`` instead of integrated
+    over the steps: each bin's coefficient turned by e^{i w_k offset}.
+    ``offset = dt / 2`` gives the steps' midpoints, where a pointwise
+    function of the path (a translation, :mod:`randvib.models.translation`)
+    is integrated over each step by the midpoint rule.
+
+    Returns
+    -------
+    ndarray, shape (n_paths, n)
+        The process's values (its unit).
+    """
+    from scipy import fft
+
+    f, power = synthesis_power(excitation, n, dt)
+    scale = _irfft_scale(n, f.size)
+    turn = np.exp(1j * 2.0 * np.pi * f * offset)
+    if n % 2 == 0:
+        turn[-1] = np.cos(2.0 * np.pi * f[-1] * offset)  # the Nyquist bin stays real
+    g = np.asarray(normals, dtype=float).reshape(-1, 2, f.size)
+    sine = np.where(scale == n, 0.0, g[:, 1])
+    coefficients = scale * np.sqrt(power) * turn * (g[:, 0] - 1j * sine)
+    return fft.irfft(coefficients, n, axis=-1, workers=-1)

@@ -50,15 +50,19 @@ CHANNELS = {
         "base_displacement",
         "force",
         "relative_displacement",
+        "relative_velocity",
         "voltage",
+        "current",
     )
 }
 #: The channels that can drive the device (paper Eq. 1: -m y'' or a force u).
 INPUT_KINDS = ("base_displacement", "base_acceleration", "force")
 #: The response channel that identification fits.
 OUTPUT_CHANNEL = "relative_displacement"
-#: What an output column may be declared to hold (``output_kind``, ``--output-kind``).
-OUTPUT_KINDS = (OUTPUT_CHANNEL,)
+#: The response channels a record's CSV may hold: what an output column may be
+#: declared to hold (``output_kind``, ``outputs``, ``--output-kind``); the output
+#: kinds of identification.
+OUTPUT_KINDS = ("relative_displacement", "relative_velocity", "voltage", "current")
 #: The CSV column of the sample times (s).
 TIME_COLUMN = "time"
 #: How far (in steps) a sample may lie from the uniform grid; see the module docstring.
@@ -440,6 +444,7 @@ def read_record(
     sample_rate: float | None = None,
     rows: tuple[int | None, int | None] | None = None,
     name: str | None = None,
+    outputs: dict | None = None,
 ) -> Record:
     """Read a record from CSV (the file is only read, never modified).
 
@@ -458,13 +463,17 @@ def read_record(
         is given.
     input_kind : {'base_displacement', 'base_acceleration', 'force'}, optional
     output_column : str or None
-        Column holding the relative displacement; None for a record of the
+        Column holding the response (the relative displacement unless
+        ``output_kind`` or its name says otherwise); None for a record of the
         input alone (a measured base acceleration, :meth:`randvib.Measured.from_csv`).
-    output_kind : {'relative_displacement'}, optional
+    output_kind : {'relative_displacement', 'relative_velocity', 'voltage', 'current'}, optional
         What ``output_column`` holds, declared; needed for a column whose name
-        is not a channel name (``V2``, ``laser``: its values are then used in
-        the column's own units). A column named as another kind (``voltage``,
-        ``force``) is refused (:func:`declared_output_kind`).
+        is not an output kind (``V2``, ``laser``: its values are then used in
+        the column's own units). Undeclared, a column named as an output kind
+        is read as that kind (``voltage``: the load voltage, not a
+        displacement); a column named as another channel than its declared
+        kind, or as no response (``force``), is refused
+        (:func:`declared_output_kind`).
     time_column : str
         Column of sample times (s); ignored when absent and ``sample_rate``
         is given.
@@ -475,6 +484,11 @@ def read_record(
         Keep data rows ``start:stop`` (0-based, stop exclusive).
     name : str, optional
         Record label (default: the file name).
+    outputs : dict, optional
+        Output channels by kind: ``{kind: column}`` with kinds among
+        ``relative_displacement``, ``relative_velocity``, ``voltage``,
+        ``current`` (each column read as that channel only); replaces
+        ``output_column``.
 
     Raises
     ------
@@ -486,14 +500,7 @@ def read_record(
     frame = read_csv(path)
     columns = list(frame.columns)
     input_column, input_kind = _input_column(path, columns, input_column, input_kind)
-    if output_column is not None and output_column not in columns:
-        raise ValueError(
-            f"{path.name}: output column `{output_column}` not found (relative displacement, m); "
-            f"columns are {_shown(columns)}; map another name with `output_column` and say "
-            "what it holds with `output_kind`"
-        )
-    if output_column is not None:
-        declared_output_kind(path.name, output_column, output_kind)
+    wanted = _output_columns(path, columns, output_column, output_kind, outputs)
     if rows is not None:
         n_rows = len(frame)
         frame = frame.iloc[slice(*rows)]
@@ -504,10 +511,10 @@ def read_record(
                 f"{path.name}; give START:STOP with 0 <= START < STOP (0-based, STOP excluded)"
             )
     channels = {input_kind: frame[input_column]}
-    if output_column is not None:
-        channels[OUTPUT_CHANNEL] = frame[output_column]
-        if "voltage" in columns and output_column != "voltage":
-            channels["voltage"] = frame["voltage"]
+    for kind, column in wanted.items():
+        channels[kind] = frame[column]
+    if wanted and "voltage" in columns and "voltage" not in wanted.values():
+        channels.setdefault("voltage", frame["voltage"])  # the load voltage, for the figures
     _check_length(len(frame), name or path.stem)
     step = (
         None
@@ -530,16 +537,29 @@ def read_record(
 def declared_output_kind(source: str, column: str, kind: str | None) -> str:
     """What the output ``column`` of ``source`` holds: ``kind`` as declared, else its name.
 
-    The one place that decides whether a column may be fitted as the
-    response: a declared kind must be one of :data:`OUTPUT_KINDS`; an
-    undeclared column must be named as one (``relative_displacement``). A
-    column named as another kind (``voltage``) or by a name that says
-    nothing (``V2``) is refused, in one line that says what to declare.
+    The one place that decides what a column may be fitted as: a declared
+    kind must be one of :data:`OUTPUT_KINDS`, and a column named as another
+    channel (``voltage`` declared ``relative_displacement``) is refused; an
+    undeclared column must be named as an output kind (``voltage`` is then
+    read as the load voltage). A column named as a channel that is no
+    response (``force``) or by a name that says nothing (``V2``) is refused,
+    in one line that says what to declare.
     """
     kinds = ", ".join(OUTPUT_KINDS)
     if kind is not None:
         if kind not in OUTPUT_KINDS:
             raise ValueError(f"`output_kind` must be one of {kinds}; got {kind!r}")
+        if column in CHANNELS and column != kind:
+            held = CHANNELS[column]
+            raise ValueError(
+                f"{source}: output column `{column}` holds the {held.description} ({held.unit}), "
+                f"not the {CHANNELS[kind].description} it is declared as (`output_kind` {kind}); "
+                + (
+                    f"declare it as what it holds (`output_kind` {column})"
+                    if column in OUTPUT_KINDS
+                    else "name the column that holds one with `output_column`"
+                )
+            )
         return kind
     if column in OUTPUT_KINDS:
         return column
@@ -554,6 +574,41 @@ def declared_output_kind(source: str, column: str, kind: str | None) -> str:
         f"{source}: what output column `{column}` holds is not declared; give `output_kind` "
         f"({kinds}, in the column's own units) if it is that"
     )
+
+
+def _output_columns(path: Path, columns, output_column, output_kind, outputs) -> dict:
+    """``{kind: column}`` of the response channels read, each column's kind checked
+    (:func:`declared_output_kind`); ``output_column`` is one channel, ``outputs`` several."""
+    if outputs is None:
+        if output_column is None:
+            return {}
+        wanted = {declared_output_kind(path.name, output_column, output_kind): output_column}
+    else:
+        if output_column not in (None, OUTPUT_CHANNEL) or output_kind is not None:
+            raise ValueError(
+                "give either `output_column` (with `output_kind`) or `outputs` (kind -> column), "
+                "not both"
+            )
+        wanted = dict(outputs)
+        for kind, column in wanted.items():
+            if kind not in OUTPUT_KINDS:
+                raise ValueError(
+                    f"`outputs`: {kind!r} is not an output kind; allowed: {', '.join(OUTPUT_KINDS)}"
+                )
+            declared_output_kind(path.name, column, kind)
+    for kind, column in wanted.items():
+        if column not in columns:
+            what = QUANTITIES[kind]
+            raise ValueError(
+                f"{path.name}: output column `{column}` not found ({what.description}, "
+                f"{what.unit}); columns are {_shown(columns)}; map another name with "
+                + (
+                    "`output_column` and say what it holds with `output_kind`"
+                    if outputs is None
+                    else "`--output-column`"
+                )
+            )
+    return wanted
 
 
 def _input_column(path: Path, columns, input_column, input_kind) -> tuple[str, str]:

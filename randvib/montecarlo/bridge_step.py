@@ -71,13 +71,13 @@ def check_bridge_step(run, simulate) -> None:
 
     Only a change beyond the pilot's own 95 % interval counts; the warning
     gives the step that would bring it under :data:`BRIDGE_STEP_TOLERANCE`
-    at the measured order :data:`BRIDGE_ORDER`. Synthesised or recorded input
-    (no Brownian increments to halve) is not checked. ``simulate`` runs the
-    pilot (:func:`bridge_step_change`).
+    at the measured order :data:`BRIDGE_ORDER`. Synthesised or recorded input,
+    and tones or shocks (no Brownian increments alone to halve) are not checked.
+    ``simulate`` runs the pilot (:func:`bridge_step_change`).
     """
     excitation = run.excitation
-    if run.driver is not None or excitation.shaping_filter() is None:
-        return
+    if run.driver is not None or run.forcing is not None or excitation.shaping_filter() is None:
+        return  # no Brownian increments alone to halve
     psd = excitation if not excitation.is_white else run.psd
     dt = run.grid.dt
     change, half_width = bridge_step_change(
@@ -186,6 +186,8 @@ def storage_start(run) -> float:
     h = run.harvester
     bridge = h.electrical
     if bridge.has_battery or run.initial.kind != "stationary" or run.driver is not None:
+        return 0.0
+    if run.forcing is not None:  # tones or shocks: the closure's level is white noise's
         return 0.0
     if not (run.excitation.is_white and BRIDGE_CLOSURE._coil(h)):
         return 0.0

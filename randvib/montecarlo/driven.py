@@ -5,7 +5,7 @@ with an additive velocity increment per step. Under white noise that
 increment is sqrt(S/2) dW; when the base acceleration y(t) is a known signal
 it is exactly ``-int_{t_n}^{t_n + dt} y(t) dt`` (paper Eq. 1, m z'' = ... -
 m y''), which the kernel takes through its given-increments path with unit
-amplitude. Two sources provide those increments, path by path:
+amplitude. Three sources provide those increments, path by path:
 
 * :class:`SynthesisedInput` - a stationary Gaussian process with a
   non-rational spectrum (band-limited, tabulated), synthesised in the
@@ -15,6 +15,10 @@ amplitude. Two sources provide those increments, path by path:
   path), the synthesis seed derived from ``seed`` so that these streams are
   not the kernel's): results do not depend on batching or threads, and
   batches bound the memory;
+* :class:`TranslatedInput` - a non-Gaussian translation process
+  (:class:`randvib.models.translation.Translated`): its Gaussian
+  synthesised from the same streams, translated, integrated by the
+  midpoint rule;
 * :class:`RecordedInput` - a measured record, linearly interpolated between
   its samples, cut into segments that become the paths of
   :func:`randvib.montecarlo.on_record.monte_carlo_on_record`.
@@ -82,6 +86,40 @@ class SynthesisedInput:
         """Increments of paths ``first`` to ``first + count - 1``, shape (count, n_steps)."""
         normals = path_amplitudes(self.seed, first, count, self.n_steps)
         return -synthesised_increments(self.excitation, self.n_steps, self.dt, normals)
+
+
+@dataclass(frozen=True)
+class TranslatedInput:
+    """Velocity increments (m/s) of a non-Gaussian translation process, path by path.
+
+    The Gaussian y with ITAM's corrected spectrum is synthesised per path from
+    the same streams as :class:`SynthesisedInput` (:func:`path_amplitudes`),
+    at the steps' midpoints, translated, x = sigma g(y)
+    (:class:`randvib.models.translation.Translated`), and integrated over each
+    step by the midpoint rule: -dt x((j + 1/2) dt) (second order in dt, the
+    scheme's order; x is a pointwise function of y, whose exact step
+    integral has no closed form).
+
+    Attributes
+    ----------
+    excitation : Translated
+    n_steps : int
+        Steps per path; the synthesis period is n_steps dt.
+    dt : float
+        Step (s); 1/(2 dt) must reach the translation's top frequency.
+    seed : int
+    """
+
+    excitation: Excitation
+    n_steps: int
+    dt: float
+    seed: int
+
+    def __call__(self, first: int, count: int) -> np.ndarray:
+        """Increments of paths ``first`` to ``first + count - 1``, shape (count, n_steps)."""
+        normals = path_amplitudes(self.seed, first, count, self.n_steps)
+        x = self.excitation.values(self.n_steps, self.dt, normals, offset=0.5 * self.dt)
+        return -self.dt * x
 
 
 @dataclass(frozen=True)

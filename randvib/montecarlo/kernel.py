@@ -327,6 +327,26 @@ class Rectifier(NamedTuple):
     v_c0: float
 
 
+class Forcing(NamedTuple):
+    """Deterministic and sampled base acceleration added to any input: tones and shocks.
+
+    Step n's velocity increment gets ``u_n = kicks[i, n] - sum_q gain_q cos(omega_q
+    (n + 1/2) dt + phase[i, q])`` for path i of the batch: the exact integral of
+    -a(t) over the step for the tones a = A_q cos(omega_q t + phase), with
+    ``gain_q = 2 A_q sin(omega_q dt / 2) / omega_q`` (one cosine per tone per
+    step), and for a shock train its exact step integrals ``kicks``
+    (:mod:`randvib.montecarlo.forcing`). The kernel gives it to the velocity in two
+    halves, before and after the scheme's step (Strang splitting: second order
+    in dt, like the scheme), whatever the step (white noise, filter, circuit,
+    bridge). Build it with :func:`randvib.montecarlo.forcing.ForcingInput.group`.
+    """
+
+    omega: np.ndarray  #: float64[n_tones] (rad/s)
+    gain: np.ndarray  #: float64[n_tones] (m/s)
+    phase: np.ndarray  #: float64[count, n_tones] (rad)
+    kicks: np.ndarray  #: float64[count, n_steps] (m/s), or shape (0, 0) without shocks
+
+
 SNAP_Z, SNAP_V, SNAP_X, SNAP_PEAK = 0, 1, 2, 3
 N_SNAP = 4
 #: Columns of :attr:`Transient.event`: peak |z| over the run (m), int v^2 dt
@@ -583,6 +603,16 @@ def _snapshots(snapshots, snap, k, state, start, lanes, z, v, square, peak):
     return k
 
 
+@numba.njit(cache=True, inline="always")
+def _forced_increment(n, dt, row, omega, gain, phase, kicks):
+    """u_n of :class:`Forcing` for the batch's path ``row`` at step ``n`` (m/s)."""
+    u = kicks[row, n] if kicks.shape[0] > 0 else 0.0
+    t = (n + 0.5) * dt
+    for q in range(omega.shape[0]):
+        u -= gain[q] * np.cos(omega[q] * t + phase[row, q])
+    return u
+
+
 @numba.njit(cache=True, parallel=True, nogil=True)
 def run_ensemble(
     scheme,
@@ -598,6 +628,7 @@ def run_ensemble(
     stop,
     transient=None,
     rectifier=None,
+    forcing=None,
 ):
     """Integrate ``paths.count`` paths and return per-path time averages.
 
@@ -642,6 +673,10 @@ def run_ensemble(
         (None: white or given input); its stored power and losses go to
         ``ACC_STORED``, ``ACC_COIL_LOSS``, ``ACC_DIODE_LOSS``, its capacitors'
         energy into ``ACC_H0``/``ACC_H1``. None compiles the loop without it.
+    forcing : Forcing or None
+        Tones and shocks added to the input (:class:`Forcing`), given to the
+        velocity in two half kicks around every step. None compiles the loop
+        without them.
 
     Returns
     -------
@@ -718,6 +753,8 @@ def run_ensemble(
                 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
                 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0,
             )  # fmt: skip
+    if forcing is not None:
+        f_omega, f_gain, f_phase, f_kicks = forcing
     n_chunks = (n_paths + LANES - 1) // LANES
     acc = np.zeros((n_paths, N_ACC))
     failed = np.full(n_paths, -1, dtype=np.int64)
@@ -809,6 +846,12 @@ def run_ensemble(
                 zj = z[j]
                 vj = v[j]
                 tj = th[j]
+                vs = vj  # the velocity the step starts from: with forcing, after its half kick
+                if forcing is not None:
+                    kick = 0.5 * _forced_increment(
+                        n, dt, start + j, f_omega, f_gain, f_phase, f_kicks
+                    )
+                    vs = vj + kick
                 if rectifier is not None:
                     if in_window and n == n_burn:
                         a[j, ACC_H0] = half_cp * s1[j] * s1[j] + half_c * s2[j] * s2[j]
@@ -816,13 +859,13 @@ def run_ensemble(
                     if auxiliary is not None:
                         zn, vn, tn, x1[j], x2[j], x3[j], s1[j], s2[j], f1, e_s, e_c, e_d = (
                             rectified_step(
-                                zj, vj, tj, x1[j], x2[j], x3[j], s1[j], s2[j], dt, noise,
+                                zj, vs, tj, x1[j], x2[j], x3[j], s1[j], s2[j], dt, noise,
                                 scheme, drift, fr_kind, fr_p, fr_fn, rblock, rect,
                             )
                         )  # fmt: skip
                     else:
                         zn, vn, tn, s1[j], s2[j], f1, e_s, e_c, e_d = rectified_white_step(
-                            zj, vj, tj, s1[j], s2[j], dt, noise, scheme, drift, fr_kind,
+                            zj, vs, tj, s1[j], s2[j], dt, noise, scheme, drift, fr_kind,
                             fr_p, fr_fn, rect,
                         )  # fmt: skip
                     if in_window:
@@ -834,7 +877,7 @@ def run_ensemble(
                 elif auxiliary is not None and filter_only:
                     zn, vn, tn, x1[j], x2[j], f1 = filter_step(
                         zj,
-                        vj,
+                        vs,
                         tj,
                         x1[j],
                         x2[j],
@@ -856,7 +899,7 @@ def run_ensemble(
                         a[j, ACC_CIRCUIT2] += sq * sq
                     zn, vn, tn, x1[j], x2[j], x3[j], f1 = auxiliary_step(
                         zj,
-                        vj,
+                        vs,
                         tj,
                         x1j,
                         x2j,
@@ -872,8 +915,10 @@ def run_ensemble(
                     )
                 else:
                     zn, vn, tn, f1 = scheme_step(
-                        zj, vj, tj, dt, noise, scheme, drift, fr_kind, fr_p, fr_fn
+                        zj, vs, tj, dt, noise, scheme, drift, fr_kind, fr_p, fr_fn
                     )
+                if forcing is not None:
+                    vn += kick
                 if abs(zj) > stroke:
                     if a[j, ACC_FIRST_HIT] < 0.0:
                         a[j, ACC_FIRST_HIT] = n * dt

@@ -22,6 +22,7 @@ from randvib.models.friction import kernel_arguments
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import kernel
 from randvib.montecarlo.bridge_step import storage_start
+from randvib.montecarlo.forcing import forcing_spread
 from randvib.montecarlo.rng import ZIG_FI, ZIG_KI, ZIG_WI
 from randvib.montecarlo.step_check import driven_circuit_variance
 from randvib.montecarlo.validation import Run
@@ -86,6 +87,9 @@ class KernelSetup:
             noise=kernel.Noise(dw, ZIG_KI, ZIG_WI, ZIG_FI),
             auxiliary=self.auxiliary,
             rectifier=self.rectifier,
+            forcing=None
+            if run.forcing is None
+            else run.forcing.group(run.first_path + lo, hi - lo),
         )
 
 
@@ -168,6 +172,10 @@ def _start_states(run: Run, linear) -> tuple[kernel.Start, kernel.Companion]:
     h, psd = run.harvester, run.psd
     random = run.initial.kind == "stationary"
     z, v = linear().spread if random else (run.initial.z, run.initial.v)
+    if random and run.forcing is not None:
+        # the tones' and shocks' own spread on the linearised device (the random part's
+        # only where there is one: tones alone see a nominal level, kept out of the start)
+        z, v = forcing_spread(run, linear(), (z, v) if psd else (0.0, 0.0))
     # The friction-free companion starts from its own stationary spread (exact
     # Gaussian velocity, Gibbs displacement variance), so its known moments
     # hold from t = 0 and its control mean is right without a long burn-in.

@@ -118,7 +118,7 @@ def monte_carlo_on_record(
         companion=False,
         record=(0, None, record_paths, record_every),
     )
-    run = dataclasses.replace(run, excitation=record, psd=None, driver=source)
+    run = dataclasses.replace(run, excitation=record, input=record, psd=None, driver=source)
     result = execute(
         run,
         control_variates=False,

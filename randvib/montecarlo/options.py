@@ -9,11 +9,35 @@ and recorded paths).
 
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from randvib._validation import check_choice, check_int, check_positive
+
+
+@contextlib.contextmanager
+def numba_threads(threads):
+    """Within the block, compiled loops run on ``threads`` numba threads (None: as set).
+
+    numba's thread count is a setting of the calling thread that outlives the
+    call; a run's ``threads`` option applies to that run alone, so the
+    caller's setting is put back after it (a ``threads=1`` run once left
+    every later run in the session on one thread).
+    """
+    if threads is None:
+        yield
+        return
+    threads = check_int("threads", threads, 1)
+    previous = numba.get_num_threads()
+    numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+    try:
+        yield
+    finally:
+        numba.set_num_threads(previous)
+
 
 #: Most steps per path (int64 step counters, with room to spare).
 MAX_STEPS = 2**62

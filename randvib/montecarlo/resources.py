@@ -9,8 +9,8 @@ of the compiled loop timed on this machine (the shared wording and clock:
 from __future__ import annotations
 
 import numba
-import numpy as np
 
+from randvib._interrupts import interruptible
 from randvib._resources import LONG_RUN_SECONDS, announce_duration, check_memory, timed
 from randvib.montecarlo import kernel
 from randvib.montecarlo.kernel_setup import KernelSetup
@@ -60,7 +60,10 @@ def _measured_speed(run: Run, setup: KernelSetup, threads: int) -> float:
         arguments = setup.arguments(run, 0, n_paths)
         arguments["timing"] = timing
         arguments["recording"] = arguments["recording"]._replace(n_record=0)
-        kernel.run_ensemble(stop=np.zeros(1, dtype=np.int64), **arguments)
+        # in a worker thread, as every run of the loop: a Ctrl-C whose handler ran
+        # in the main thread while it was inside the compiled probe came out of
+        # numba's runtime as a SystemError, or not at all (tests/test_interrupts.py)
+        interruptible(kernel.run_ensemble, **arguments)
 
     probe(1, 2)  # compiles (or loads) the loop: not part of the speed
     _, elapsed = timed(lambda: probe(paths, steps))

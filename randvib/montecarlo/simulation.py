@@ -54,10 +54,8 @@ from __future__ import annotations
 import functools
 import time
 
-import numba
-
+from randvib._interrupts import ctrl_c_noticed
 from randvib._progress import progress_wanted
-from randvib._validation import check_int
 from randvib.models.excitation import Excitation
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import driven
@@ -68,6 +66,7 @@ from randvib.montecarlo.bridge_step import (
     check_bridge_step,
 )
 from randvib.montecarlo.kernel_setup import KernelSetup
+from randvib.montecarlo.options import numba_threads
 from randvib.montecarlo.resources import announce_long_run, check_resources
 from randvib.montecarlo.results import SimulationResult
 from randvib.montecarlo.step_check import LinearTestSystem
@@ -198,29 +197,30 @@ def simulate(
     >>> print(f"{power.mean:.3e} +- {power.ci95:.1e} W")
     2.426e-03 +- 2.5e-04 W
     """
-    run = validated(
-        harvester,
-        psd,
-        scheme,
-        t_end=t_end,
-        dt=dt,
-        burn_in=burn_in,
-        n_paths=n_paths,
-        seed=seed,
-        first_path=first_path,
-        initial=initial,
-        dW=dW,
-        companion=companion,
-        record=(histogram_bins, histogram_range, record_paths, record_every),
-    )
-    return execute(
-        run,
-        control_variates=control_variates,
-        check_step=check_step,
-        threads=threads,
-        batch_paths=batch_paths,
-        progress=progress,
-    )
+    with ctrl_c_noticed():  # a Ctrl-C swallowed by a finaliser still stops the run
+        run = validated(
+            harvester,
+            psd,
+            scheme,
+            t_end=t_end,
+            dt=dt,
+            burn_in=burn_in,
+            n_paths=n_paths,
+            seed=seed,
+            first_path=first_path,
+            initial=initial,
+            dW=dW,
+            companion=companion,
+            record=(histogram_bins, histogram_range, record_paths, record_every),
+        )
+        return execute(
+            run,
+            control_variates=control_variates,
+            check_step=check_step,
+            threads=threads,
+            batch_paths=batch_paths,
+            progress=progress,
+        )
 
 
 def execute(run: Run, *, control_variates, check_step, threads, batch_paths, progress):
@@ -246,20 +246,21 @@ def execute(run: Run, *, control_variates, check_step, threads, batch_paths, pro
         if run.harvester.is_rectified:  # the switching, which the linear check cannot see
             check_bridge_step(run, simulate)  # the pilot runs through the driver
     setup = KernelSetup.prepare(run, linear)
-    if threads is not None:
-        threads = check_int("threads", threads, 1)
-        numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
-    announce_long_run(run, setup)
     if progress is None:
         progress = progress_wanted()
-    if batch_paths is None and run.driver is not None:  # the input's memory stays bounded
+    # the input's memory stays bounded: a synthesised input's samples and a shock
+    # train's step integrals are arrays of (paths in the batch) x (steps)
+    sampled = run.driver is not None or (run.forcing is not None and run.forcing.shocks is not None)
+    if batch_paths is None and sampled:
         batch_paths = driven.batch_paths(run.grid.n_steps)
     batches = batch_bounds(
         run.n_paths, batch_paths, run.grid.n_steps, progress, run.record.record_paths
     )
-    started = time.perf_counter()
-    per_path, histogram, histories = run_batches(run, setup, batches, progress)
-    wall = time.perf_counter() - started
+    with numba_threads(threads):
+        announce_long_run(run, setup)
+        started = time.perf_counter()
+        per_path, histogram, histories = run_batches(run, setup, batches, progress)
+        wall = time.perf_counter() - started
     result = SimulationResult(
         harvester=run.harvester,
         psd=run.psd,
@@ -274,7 +275,7 @@ def execute(run: Run, *, control_variates, check_step, threads, batch_paths, pro
         histogram=histogram,
         histories=histories,
         wall_time=wall,
-        excitation=run.excitation,
+        excitation=run.input,
     )
     if check_step:  # the per-run identity: every path sums to m S / 4
         check_bridge_balance(result)

@@ -5,7 +5,10 @@ Where does the power come from, and how does the spring detune the device?
 electrical power's frequency distribution c_e S_v(f) (W/Hz, its integral is
 E[P_e], paper Eq. 31) from the paths a simulation recorded
 (``simulate(..., record_paths=N)``), to set beside the linearisation's
-(:meth:`randvib.LinearisationResult.response_spectra`).
+(:meth:`randvib.LinearisationResult.response_spectra`). Under tones each
+tone's line is measured by projection on it (:func:`line_mean_squares`):
+its mean square, beside the combined linearisation's
+(:meth:`randvib.CombinedLinearisation.response_spectra`).
 
 Each recorded path's averaging window (after the burn-in) gives one Welch
 estimate (Hann window, 50 % overlap, no detrending: the response has zero
@@ -46,6 +49,11 @@ class SampledSpectra:
         Recorded paths behind the estimate.
     segment_duration : float
         Welch segment length (s); the resolution is about twice its inverse.
+    lines : dict or None
+        Under tones, each tone's line: ``frequency`` (Hz) and the mean squares
+        of the response at it, ``displacement`` (m^2), ``velocity``
+        ((m/s)^2), ``power`` (c_e times the velocity's, W), with ``*_ci95``
+        half-widths over paths (:func:`line_mean_squares`). None without tones.
     """
 
     frequency: np.ndarray
@@ -57,6 +65,7 @@ class SampledSpectra:
     power_ci95: np.ndarray
     n_paths: int
     segment_duration: float
+    lines: dict | None = None
 
     def __repr__(self) -> str:  # the grid and the evidence, not the arrays
         peak = float(self.frequency[int(np.argmax(self.power))]) if self.power.size else np.nan
@@ -124,6 +133,16 @@ def response_spectra(result, segment_duration: float | None = None) -> SampledSp
     _, pv = signal.welch(v, detrend=False, **welch)
     c_e = float(result.harvester.c_e)
     (sz, hz), (sv, hv) = mean_and_half_width(pz), mean_and_half_width(pv)
+    tones = result.excitation.lines() if result.excitation is not None else ()
+    lines = None
+    if tones:
+        frequencies = np.array([tone.frequency for tone in tones])
+        lines = {"frequency": frequencies}
+        for name, x in (("displacement", z), ("velocity", v)):
+            lines[name], lines[f"{name}_ci95"] = mean_and_half_width(
+                line_mean_squares(x, step, frequencies)
+            )
+        lines["power"], lines["power_ci95"] = c_e * lines["velocity"], c_e * lines["velocity_ci95"]
     return SampledSpectra(
         frequency=f,
         displacement=sz,
@@ -134,4 +153,31 @@ def response_spectra(result, segment_duration: float | None = None) -> SampledSp
         power_ci95=c_e * hv,
         n_paths=z.shape[0],
         segment_duration=length * step,
+        lines=lines,
     )
+
+
+def line_mean_squares(x, step: float, frequencies) -> np.ndarray:
+    """Each path's mean square at each frequency: |(2/T) sum x e^{-i w t} dt|^2 / 2.
+
+    The amplitude of the sinusoid at f in a record of length T by projection
+    (a lock-in estimate, at f itself rather than on a Welch bin), halved: the
+    line's mean square. The random part adds about 2 S(f) / T, its power in
+    the projection's bandwidth 1/T, which a long window makes small.
+
+    Parameters
+    ----------
+    x : ndarray, shape (n_paths, n)
+        Samples every ``step`` seconds.
+    frequencies : array_like
+        Line frequencies (Hz).
+
+    Returns
+    -------
+    ndarray, shape (n_paths, n_lines)
+    """
+    x = np.asarray(x, dtype=float)
+    t = np.arange(x.shape[1]) * step
+    phasors = np.exp(-2j * np.pi * np.outer(t, np.asarray(frequencies, dtype=float)))
+    amplitude = 2.0 * (x - x.mean(axis=1, keepdims=True)) @ phasors / x.shape[1]
+    return 0.5 * np.abs(amplitude) ** 2

@@ -35,18 +35,18 @@ from __future__ import annotations
 
 import time
 
-import numba
 import numpy as np
 
-from randvib._interrupts import interruptible
+from randvib._interrupts import ctrl_c_noticed, interruptible
 from randvib._progress import progress_bar, progress_wanted
 from randvib._resources import check_memory
-from randvib._validation import check_finite, check_int
+from randvib._validation import check_finite
 from randvib.models.event import Enveloped, EventStart
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import driven, kernel
 from randvib.montecarlo.batches import batch_bounds, raise_if_diverged
 from randvib.montecarlo.kernel_setup import KernelSetup
+from randvib.montecarlo.options import numba_threads
 from randvib.montecarlo.resources import check_resources
 from randvib.montecarlo.step_check import LinearTestSystem
 from randvib.montecarlo.transient_results import TransientResult
@@ -156,9 +156,6 @@ def simulate_transient(
     if check_step:
         system.check_step(run.scheme.name, run.grid.dt)
     setup = KernelSetup.prepare(run, linear)
-    if threads is not None:
-        threads = check_int("threads", threads, 1)
-        numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
     if progress is None:
         progress = progress_wanted()
     if batch_paths is None and run.driver is not None:  # the input's memory stays bounded
@@ -166,9 +163,10 @@ def simulate_transient(
     batches = batch_bounds(run.n_paths, batch_paths, run.grid.n_steps, progress, 0)
     events = EventInput.of(run, event)
     started = time.perf_counter()
-    snapshots, integrals, first_hit = _run_batches(
-        run, setup, events, snap_steps, batches, progress
-    )
+    with ctrl_c_noticed(), numba_threads(threads):
+        snapshots, integrals, first_hit = _run_batches(
+            run, setup, events, snap_steps, batches, progress
+        )
     return TransientResult(
         harvester=run.harvester,
         event=event,

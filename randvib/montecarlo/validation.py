@@ -17,11 +17,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from randvib._validation import MAX_SEED, check_int, check_scalar_device
-from randvib.models.excitation import Excitation, as_excitation
+from randvib.models.combined import as_input, parts_of
+from randvib.models.excitation import Excitation, White, as_excitation
 from randvib.models.harvester import Harvester
 from randvib.models.potential import CONFINING
+from randvib.models.translation import Translated
 from randvib.montecarlo import driven
 from randvib.montecarlo.bridge_step import storage_start
+from randvib.montecarlo.forcing import ForcingInput, nyquist_refusal
 from randvib.montecarlo.integrators import Integrator, integrator
 from randvib.montecarlo.options import InitialState, RecordOptions, TimeGrid
 
@@ -48,6 +51,13 @@ class Run:
     #: Velocity increments of a given base acceleration, ``driver(first, count)``
     #: -> (count, n_steps) (m/s): synthesised or recorded input (:mod:`randvib.montecarlo.driven`).
     driver: object = None
+    #: Tones and shocks added to the input (:class:`~randvib.montecarlo.forcing.ForcingInput`), or None.
+    forcing: object = None
+    #: The whole input as given (the random part, tones and shocks); ``excitation``
+    #: is its random part, or, with none (tones or shocks alone), the white
+    #: noise of a nominal level that the linear checks and the start see while
+    #: the kernel's noise is switched off (``psd`` 0).
+    input: Excitation | None = None
 
 
 def validated(
@@ -83,23 +93,26 @@ def validated(
             "E[z^2] (Gibbs) does not exist for the free mass (k = k3 = 0)"
         )
     scheme = integrator(scheme)
-    excitation = _simulated_excitation(psd)
+    whole = as_input(psd)
+    random, tones, shocks = parts_of(whole)
+    excitation = _simulated_excitation(random if random is not None else _nominal_white(whole))
     grid = TimeGrid.from_times(t_end, dt, burn_in)
     n_paths = check_int("n_paths", n_paths, 1)
     seed = check_int("seed", seed, 0, MAX_SEED)
-    driver = None
-    if excitation.shaping_filter() is None:  # synthesised input: the kernel takes its increments
-        if dW is not None:
-            raise ValueError(
-                f"`dW` drives white noise or a shaping filter; the {excitation.name} input is "
-                "synthesised from the seed (leave dW=None)"
-            )
-        driver = driven.SynthesisedInput(excitation, grid.n_steps, grid.dt, seed)
+    driver = _driver(excitation, grid, seed, dW)
+    forcing = None
+    if tones or shocks is not None:
+        refusal = nyquist_refusal(tones, grid.dt)
+        if refusal:
+            raise ValueError(refusal)
+        forcing = ForcingInput(tones, shocks, grid.n_steps, grid.dt, seed)
     return Run(
         harvester=harvester,
-        psd=getattr(excitation, "level", None),
+        psd=0.0 if random is None else getattr(excitation, "level", None),
         excitation=excitation,
         driver=driver,
+        forcing=forcing,
+        input=whole,
         scheme=scheme,
         grid=grid,
         n_paths=n_paths,
@@ -110,6 +123,35 @@ def validated(
         dW=_checked_increments(dW, n_paths, grid.n_steps),
         companion=bool(companion),
     )
+
+
+def _driver(excitation: Excitation, grid: TimeGrid, seed: int, dW):
+    """The given increments of a synthesised or translated input, or None (noise, filter)."""
+    if excitation.shaping_filter() is not None and excitation.is_gaussian:
+        return None
+    if dW is not None:
+        raise ValueError(
+            f"`dW` drives white noise or a shaping filter; the {excitation.name} input is "
+            "synthesised from the seed (leave dW=None)"
+        )
+    if isinstance(excitation, Translated):
+        return driven.TranslatedInput(excitation, grid.n_steps, grid.dt, seed)
+    return driven.SynthesisedInput(excitation, grid.n_steps, grid.dt, seed)
+
+
+def _nominal_white(whole: Excitation) -> Excitation:
+    """White noise of a nominal level for an input of tones or shocks alone.
+
+    The kernel's noise is off (``psd`` 0); the step check, the random start
+    and the histogram ranges see the device linearised under this level:
+    the input's mean square spread over its highest frequency (a tone's, or
+    a pulse's 1/D), so that the start has about the right energy.
+    """
+    tops = [tone.frequency for tone in whole.lines()]
+    shocks = parts_of(whole)[2]
+    if shocks is not None:
+        tops.append(1.0 / shocks.duration)
+    return White(whole.variance / max(tops))
 
 
 def _simulated_excitation(psd) -> Excitation:
@@ -124,6 +166,8 @@ def _simulated_excitation(psd) -> Excitation:
     if not isinstance(psd, Excitation):
         return as_excitation(psd)  # one positive number (an array refused by name)
     if psd.is_white:
+        return psd
+    if isinstance(psd, Translated):
         return psd
     if psd.name == "measured":
         raise ValueError(
@@ -156,10 +200,27 @@ def _checked_increments(dW, n_paths, n_steps):
 
 def check_options(run: Run, control_variates: bool) -> None:
     """Refuse the options that this run's input or circuit cannot honour, saying why."""
+    if run.forcing is not None or not run.excitation.is_gaussian:
+        _check_forced_options(run, control_variates)
     _check_coloured_options(run.excitation, run.companion, control_variates)
     _check_circuit_options(run.harvester, run.companion)
     if run.harvester.is_rectified:
         _check_bridge(run)
+
+
+def _check_forced_options(run: Run, control_variates: bool):
+    """Refuse the companion and the controls under tones, shocks or a non-Gaussian input.
+
+    The friction-free companion's exact moments are white noise's; the
+    energy-balance controls need the stationary Brownian input alone (a
+    tone's energy change over a window has no zero mean at a fixed phase).
+    """
+    option = "companion" if run.companion else "control_variates" if control_variates else None
+    if option is not None:
+        raise ValueError(
+            f"`{option}` needs Gaussian noise alone; under the {run.input.name} input no "
+            f"control has a known mean: use {option}=False"
+        )
 
 
 def _check_coloured_options(excitation: Excitation, companion: bool, control_variates: bool):

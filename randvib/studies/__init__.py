@@ -30,6 +30,8 @@ such scripts share lives here:
   bandwidth, power against stroke exceedance, methods' errors against the level;
 - :mod:`~randvib.studies.bridge`: a coil's bridge against its resistive figure (paired
   cases, stored-power tables, the optimum's table, where the resistive figure overstates);
+- :mod:`~randvib.studies.gaussian_error`: the Gaussian answer against Monte Carlo under
+  tones or non-Gaussian input, relative errors with intervals and a 5 % verdict;
 - :mod:`~randvib.studies.report`: CSV, ``verdicts.json``, Markdown tables, ``report.md``.
 
 A script imports only ``randvib`` (its exports), these building blocks and the
@@ -78,6 +80,8 @@ STUDIES = (
     "events",
     "dc-power",
     "design",
+    "non-gaussian",
+    "electrical-identification",
 )
 
 

@@ -1,5 +1,6 @@
 """Figures the studies share: power and contrasts against the Coulomb level or the bandwidth,
-power against stroke exceedance, the methods' errors against the input level.
+power against stroke exceedance, the methods' errors against the input level, the Gaussian
+answer's errors under tones and non-Gaussian input.
 
 Each function draws from a study's table, saves one PNG at ``path``
 (:func:`randvib.figure_style.save_figure`) and returns the path; nothing
@@ -537,5 +538,51 @@ def method_errors_against_level(methods: pd.DataFrame, devices, path: Path) -> P
                 labels.append(label)
     fig.legend([handles[k] for k in labels], labels, loc="outside lower center", ncol=4,
                title="colour: method; marker: device; bars: 95 % CI")  # fmt: skip
+    panel_letters(axes)
+    return save_figure(fig, path)
+
+
+@styled
+def gaussian_errors(table: pd.DataFrame, x: str, xlabel: str, panels: str | None, path: Path,
+                    tolerance: float = 0.05) -> Path:  # fmt: skip
+    """The Gaussian answer's relative error against Monte Carlo, power (top) and exceedance (bottom).
+
+    ``table`` has ``device``, ``fc``, ``x`` and, for each quantity,
+    ``{power,exceedance}_error`` and ``_error_ci95``
+    (:func:`randvib.studies.gaussian_error.with_errors`); one column of
+    panels per value of ``panels`` (None: one), a colour per device, solid
+    with friction and dashed without, 95 % bars; the band of +-``tolerance``
+    shaded. The error axis is symmetric-log beyond +-10 %.
+    """
+    groups = [(None, table)] if panels is None else list(table.groupby(panels, sort=False))
+    fig, axes = new_figure(2, len(groups), figsize=(3.4 * len(groups) + 1.5, 6.0), sharex=True)
+    devices = list(dict.fromkeys(table.device))
+    for col, (key, sub) in enumerate(groups):
+        for row, q in enumerate(("power", "exceedance")):
+            ax = axes[row, col]
+            ax.axhspan(-100 * tolerance, 100 * tolerance, color="0.9", zorder=0)
+            ax.axhline(0.0, color="0.5", lw=0.5, zorder=1)
+            for (dev, fc), s in sub.dropna(subset=[f"{q}_error"]).groupby(
+                ["device", "fc"], sort=False
+            ):
+                s = s.sort_values(x)
+                ax.errorbar(s[x], 100 * s[f"{q}_error"], yerr=100 * s[f"{q}_error_ci95"],
+                            color=colour(devices.index(dev)), ls="-" if fc > 0 else "--",
+                            marker="o" if fc > 0 else "s", ms=3, capsize=1.5, lw=1,
+                            label=f"{dev}, {'Fc = ' + f'{1e3 * fc:g} mN' if fc > 0 else 'no friction'}")  # fmt: skip
+            if (sub[f"{q}_error"].abs() > 0.1).any():
+                ax.set_yscale("symlog", linthresh=10)
+            ax.set_ylabel(f"Gaussian {q} error (%)" if col == 0 else "")
+            if row == 0 and key is not None:
+                ax.set_title(f"{panels} {key}", loc="right", fontsize=8)
+        axes[1, col].set_xlabel(xlabel)
+    handles, labels = {}, []
+    for ax in axes.ravel():
+        for h, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            if label not in handles:
+                handles[label] = h
+                labels.append(label)
+    fig.legend([handles[k] for k in labels], labels, loc="outside lower center", ncol=3,
+               title=f"bars: 95 % CI of Monte Carlo; grey: +-{100 * tolerance:g} %")  # fmt: skip
     panel_letters(axes)
     return save_figure(fig, path)

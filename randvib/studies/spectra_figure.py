@@ -7,7 +7,7 @@ statistical linearisation (:class:`randvib.ResponseSpectra`) and/or Monte
 Carlo (:class:`randvib.SampledSpectra`, with its 95 % band), several
 labelled series at once (e.g. the device with and without its Duffing
 spring). Journal layout: SI units on every axis, a legend, constrained
-layout, logarithmic PSD axes. :func:`spectra_against_linearisation`
+layout, logarithmic PSD axes; tones as lines (stems). :func:`spectra_against_linearisation`
 simulates the series it draws: Monte Carlo and statistical linearisation
 for each of several devices under one input.
 """
@@ -27,6 +27,39 @@ _PANELS = (
 )
 
 
+def _line_bandwidth(series: dict) -> float:
+    """The Hann window's noise bandwidth 1.5 / segment (Hz) of the first Monte Carlo series.
+
+    A tone's line, of mean square P, reads as a Welch peak of height about
+    P / B; drawn at that height the lines of both routes meet the sampled
+    peaks. 1.5 / (4 s) without a Monte Carlo series.
+    """
+    for spectra in series.values():
+        if hasattr(spectra, "segment_duration"):
+            return 1.5 / float(spectra.segment_duration)
+    return 1.5 / 4.0
+
+
+def _draw_lines(axes, spectra, colour, sampled: bool, bandwidth: float, drawn) -> None:
+    """A series' tones as stems at mean square / ``bandwidth`` in each panel (with 95 % bars)."""
+    lines = getattr(spectra, "lines", None)
+    if not lines:
+        return
+    f = np.asarray(lines["frequency"])
+    for k, (ax, (name, _)) in enumerate(zip(axes, _PANELS, strict=True)):
+        height = np.asarray(lines[name]) / bandwidth
+        keep = height > 0
+        marker = "o" if sampled else "D"
+        ax.vlines(f[keep], 0.02 * height[keep], height[keep], color=colour, lw=0.8, alpha=0.7)
+        ax.plot(
+            f[keep], height[keep], marker, color=colour, ms=4, mfc="none" if not sampled else colour
+        )
+        if sampled:
+            half = np.asarray(lines[f"{name}_ci95"])[keep] / bandwidth
+            ax.errorbar(f[keep], height[keep], yerr=half, fmt="none", color=colour, lw=0.8)
+        drawn[k].append((f[keep], height[keep]))
+
+
 @styled
 def plot_response_spectra(
     series: dict, *, excitation=None, f_max: float | None = None, path: str | Path | None = None
@@ -38,7 +71,11 @@ def plot_response_spectra(
     series : dict
         Label -> spectra: a :class:`randvib.ResponseSpectra` (drawn as a
         dashed line, "linearisation") or a :class:`randvib.SampledSpectra`
-        (solid line with its shaded 95 % band, "Monte Carlo").
+        (solid line with its shaded 95 % band, "Monte Carlo"). Under tones
+        each series' lines are stems at their mean square divided by the
+        Welch noise bandwidth 1.5 / segment (the height of their Welch peak;
+        :func:`_line_bandwidth`), open diamonds from linearisation, dots with
+        95 % bars from Monte Carlo.
     excitation : Excitation, optional
         Its PSD is drawn on a second axis of the power panel ((m/s^2)^2/Hz).
     f_max : float, optional
@@ -60,6 +97,7 @@ def plot_response_spectra(
     colours = PALETTE
     top, peak = 0.0, None
     drawn = [[] for _ in _PANELS]  # (frequency, values) per panel, for the axis limits
+    bandwidth = _line_bandwidth(series)
     for i, (label, spectra) in enumerate(series.items()):
         colour = colours[i % len(colours)]
         sampled = hasattr(spectra, "velocity_ci95")
@@ -67,6 +105,9 @@ def plot_response_spectra(
         top = max(top, float(f.max()))
         if peak is None:
             peak = float(f[np.argmax(np.asarray(spectra.power))])
+            if getattr(spectra, "lines", None):  # room for the highest tone
+                peak = max(peak, float(np.max(spectra.lines["frequency"])) / 2.0)
+        _draw_lines(axes, spectra, colour, sampled, bandwidth, drawn)
         for ax, (name, ylabel) in zip(axes, _PANELS, strict=True):
             values = np.asarray(getattr(spectra, name))
             keep = values > 0  # log axes
@@ -123,7 +164,9 @@ def spectra_against_linearisation(
     Welch spectra (segments of at most 4 s, half the window) are drawn
     beside statistical linearisation's on the same frequencies.
     """
+    from randvib.analytic.harmonic_linearisation import combined_linearisation
     from randvib.analytic.statistical_linearisation import statistical_linearisation
+    from randvib.models.combined import as_input
     from randvib.montecarlo.simulation import simulate
 
     series = {}
@@ -134,7 +177,10 @@ def spectra_against_linearisation(
                      progress=False)  # fmt: skip
         mc = r.response_spectra(segment_duration=min(4.0, settings.window / 2))
         series[f"{label}, Monte Carlo"] = mc
-        series[f"{label}, linearisation"] = statistical_linearisation(
-            device, excitation
-        ).response_spectra(mc.frequency)
+        linearise = (
+            combined_linearisation if as_input(excitation).lines() else statistical_linearisation
+        )
+        series[f"{label}, linearisation"] = linearise(device, excitation).response_spectra(
+            mc.frequency
+        )
     return plot_response_spectra(series, excitation=excitation, path=path)
