@@ -107,6 +107,7 @@ _EXPORTS = {
     "randvib.montecarlo.transient_results": ("TransientResult",),
     "randvib.montecarlo.batches": ("SimulationDivergedError",),
     "randvib.montecarlo.results": ("SimulationResult",),
+    "randvib.montecarlo.assembly_results": ("AssemblySimulationResult",),
     "randvib.harvester_design.design": ("design",),
     "randvib.harvester_design.result": ("DesignResult",),
     "randvib.analytic.harvesting_limit": (

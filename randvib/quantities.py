@@ -208,9 +208,15 @@ def parameter_unit(name: str, harvester) -> str:
     ----------
     name : str
         A parameter name, as :func:`randvib.design` varies it.
-    harvester : Harvester
-        The device whose friction law and coupling declare the other names.
+    harvester : Harvester or Assembly
+        The device whose friction law and coupling declare the other names
+        (an assembly names its parameters by dotted path).
     """
+    if hasattr(harvester, "parameter_unit"):  # an Assembly: dotted paths
+        try:
+            return harvester.parameter_unit(name)
+        except ValueError:
+            return ""
     if name in QUANTITIES:
         return QUANTITIES[name].unit
     for model in (getattr(harvester, "friction", None), getattr(harvester, "electrical", None)):

@@ -224,6 +224,7 @@ def pytest_configure(config):
             os.environ.setdefault(name, "1")
 
 
+@pytest.hookimpl(tryfirst=True)  # before xdist's worker reads the groups from the markers
 def pytest_collection_modifyitems(config, items):
     for item in items:
         if _shared_scope(item):

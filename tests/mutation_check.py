@@ -797,12 +797,121 @@ MUTATIONS: tuple[Mutation, ...] = (
         "the one-DOF assembly under white noise must give Eq. 30 written out by hand.",
     ),
     Mutation(
+        name="assembly-mc-friction-dissipation",
+        path="randvib/montecarlo/assembly_results.py",
+        edits=(
+            (
+                "total = total + self.per_path[:, self.columns.friction : self.columns.friction + e]",
+                "total = total + 0.0 * self.per_path[:, self.columns.friction : self.columns.friction + e]",
+            ),
+        ),
+        tests=("tests/test_assembly_simulation.py::test_energy_balance_of_the_nonlinear_assembly",),
+        why="The assembly's Monte Carlo dissipation without the elements' friction power; "
+        "the white-noise balance against r^T M r S / 4 must miss it.",
+    ),
+    Mutation(
+        name="assembly-mc-influence-gain",
+        path="randvib/montecarlo/assembly_setup.py",
+        edits=(("gain[ov : ov + n] = assembly.influence", "gain[ov : ov + n] = 1.0"),),
+        tests=(
+            "tests/test_assembly_simulation.py::test_every_state_equals_an_independent_numpy_simulator",
+        ),
+        why="White noise reaching every DOF with unit weight instead of through the influence "
+        "vector r; the numpy simulator's three DOFs have r = (1, 1, 0.8).",
+    ),
+    Mutation(
         name="modal-participation-transposed",
         path="randvib/models/structure.py",
         edits=(("r = phi @ gamma", "r = phi.T @ gamma"),),
         tests=("tests/test_assembly.py::test_modal_host_keeps_its_modes_and_participation",),
         why="A modal host's influence vector from the transposed mode-shape matrix; r = Phi "
         "gamma is checked with a non-symmetric Phi.",
+    ),
+    Mutation(
+        name="assembly-budget-least-coordinate",
+        path="randvib/harvester_design/assembly_budget.py",
+        edits=(("worst = max(worst, float(value))", "worst = min(worst, float(value))"),),
+        tests=(
+            "tests/test_design_assembly.py::test_objective_counts_all_transducers_or_the_one_named",
+            "tests/test_design_assembly.py::"
+            "test_analytic_design_of_a_linear_two_dof_assembly_is_the_exact_optimum",
+        ),
+        why="An assembly's stroke budget read on its least exceeded coordinate instead of its "
+        "worst: the design ignores the budget; the optimum must keep sigma_u within it by a "
+        "hand-built Lyapunov equation, and the reported exceedance be the largest.",
+    ),
+    Mutation(
+        name="assembly-objective-first-transducer",
+        path="randvib/harvester_design/objectives.py",
+        edits=(
+            (
+                "return range(len(assembly.transducers))",
+                "return range(min(1, len(assembly.transducers)))",
+            ),
+        ),
+        tests=(
+            "tests/test_design_assembly.py::test_objective_counts_all_transducers_or_the_one_named",
+        ),
+        why="The objective of all transducers counts only the first: checked against the sum "
+        "of the prediction's per-transducer load powers.",
+    ),
+    Mutation(
+        name="single-mass-answer-damping",
+        path="randvib/studies/assembly_cases.py",
+        edits=(("mechanical_block(m, c_m + c_e, k)", "mechanical_block(m, c_e, k)"),),
+        tests=(
+            "tests/test_study_assemblies.py::"
+            "test_single_mass_answer_under_white_noise_is_the_kanai_tajimi_answer",
+        ),
+        why="The study's single-mass answer loses the harvester's mechanical damping; under "
+        "white base noise it must equal the single-mass harvester's exact power under the "
+        "host's Kanai-Tajimi spectrum.",
+    ),
+    Mutation(
+        name="paired-verdict-ignores-interval",
+        path="randvib/studies/assembly_cases.py",
+        edits=(("    if mean - ci95 > 0:\n", "    if mean > 0:\n"),),
+        tests=("tests/test_study_assemblies.py::test_array_verdicts_from_a_constructed_table",),
+        why="The assemblies study calls an array better when its paired difference is merely "
+        "positive, not significantly so; the constructed table has a positive difference "
+        "inside its interval.",
+    ),
+    Mutation(
+        name="unmeasured-check-counted",
+        path="randvib/studies/assembly_cases.py",
+        edits=(
+            (
+                "for r in checks.itertuples() if _measured(r.power_mc, r.power_mc_ci95)]",
+                "for r in checks.itertuples()]",
+            ),
+        ),
+        tests=(
+            "tests/test_study_assemblies.py::test_single_mass_verdicts_from_a_constructed_table",
+        ),
+        why="The assemblies study counts a check without a Monte Carlo run (NaN, no assembly "
+        "kernel) as a Monte Carlo check; the constructed table has one such row.",
+    ),
+    Mutation(
+        name="two-mass-linearisation-verdict-reversed",
+        path="randvib/studies/assembly_cases.py",
+        edits=(
+            (
+                '{"above": "two-mass", "below": "single mass", "equal": "neither"}',
+                '{"above": "single mass", "below": "two-mass", "equal": "neither"}',
+            ),
+        ),
+        tests=("tests/test_study_assemblies.py::test_two_mass_verdicts_from_a_constructed_table",),
+        why="The assemblies study's verdict without Monte Carlo names the device linearisation "
+        "predicts the lesser power; the constructed table has one case each way.",
+    ),
+    Mutation(
+        name="analytic-tie-ignored",
+        path="randvib/studies/assembly_cases.py",
+        edits=(('return "below" if gain < -ANALYTIC_TIE else "equal"', 'return "below"'),),
+        tests=("tests/test_study_assemblies.py::test_array_verdicts_from_a_constructed_table",),
+        why="The assemblies study calls an array worse than one harvester when their exact "
+        "optima differ only by the searches' rounding (2e-9 in the constructed table; (b)'s "
+        "arrays converge to N equal harvesters).",
     ),
     Mutation(
         name="ljung-box-dof",

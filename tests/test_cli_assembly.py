@@ -98,7 +98,8 @@ def test_power_device_sweep_and_table(capsys):
         (["power", "--device", "host_with_harvester", "--psd", "0.1", "--method", "averaging"],
          "`--method averaging` treats the single-mass harvester; an assembly needs `--method "
          "linearisation`"),
-        (["simulate", "--device", "host_with_harvester", "--psd", "0.1"], "is not taken here yet"),
+        (["simulate", "--device", "host_with_harvester", "--psd", "0.1", "--envelope", "boxcar"],
+         "not implemented for `--device` assemblies"),
     ],
 )  # fmt: skip
 def test_device_refusals_are_one_line(capsys, argv, fragment):

@@ -8,7 +8,9 @@ sphinx-gallery's own parser, the blocks executed in one namespace in order, and 
 value of each block's last expression shown the way the gallery would show it. The
 examples then spread over the test workers and share their compiled kernels.
 
-Covers the scripts in examples/ (the gallery of the documentation site).
+Covers the scripts in examples/ (the gallery of the documentation site), which reach the
+package through its exports: :mod:`randvib.analytic.prediction`,
+:mod:`randvib.montecarlo.simulation`, :mod:`randvib.identification.identify` and others.
 """
 
 import json

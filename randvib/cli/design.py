@@ -14,6 +14,13 @@ the budget's Gaussian RMS for a spectrum, the record itself for ``--record``),
 (what a causal device can approach) with ``fraction_of_causal_limit``,
 ``notes``, with ``--min-first-passage`` the first passage predicted and by
 Monte Carlo, and the rest of :meth:`randvib.DesignResult.to_dict`.
+
+``--device FILE`` designs an assembly (docs/assemblies.md): ``--vary`` names a
+parameter of the file by its dotted path (``transducer.0.r_load``,
+``element.1.k3``), the budget holds on each coordinate with a stroke in the
+file (or those ``--stroke-on`` names), and the objective is the sum over
+the transducers (or ``--transducer N``'s alone); ``stroke`` in the JSON is
+then {coordinate: stroke} and ``objective_scope`` says whose power counts.
 """
 
 from __future__ import annotations
@@ -23,10 +30,11 @@ import argparse
 from randvib._io import dumps
 from randvib._validation import MAX_SEED, integer_option
 from randvib.cli import COMMAND_HELP
-from randvib.cli._device import add_device_arguments, harvester_from_args
+from randvib.cli._device import add_device_arguments, assembly_from_args, harvester_from_args
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
 from randvib.cli._output import describe_device, describe_excitation, print_table, with_units
 from randvib.formatting import cell, estimate, proportion
+from randvib.harvester_design.assembly_budget import vary_refusal
 from randvib.harvester_design.design import design
 from randvib.harvester_design.objectives import OBJECTIVES
 from randvib.models.coupling import COUPLINGS
@@ -57,7 +65,23 @@ def register(sub) -> None:
         required=True,
         help="a parameter to choose and its range (SI; repeatable): k, k3 (negative k "
         "with k3 > 0 is bistable), c_e, c_m, a friction or coupling parameter (alpha, "
-        "r_load, theta, ...) or of a --rectifier bridge (battery, v_diode, ...)",
+        "r_load, theta, ...) or of a --rectifier bridge (battery, v_diode, ...); with "
+        "--device a dotted path of the file (transducer.0.r_load, element.1.k3, "
+        "structure.stiffness.0.0)",
+    )
+    g.add_argument(
+        "--stroke-on",
+        action="append",
+        metavar="PART",
+        help="with --device: the coordinate the stroke budget holds on, element.N or "
+        "transducer.N (repeatable; default every part with a stroke in the file)",
+    )
+    g.add_argument(
+        "--transducer",
+        type=integer_option(0),
+        metavar="N",
+        help="with --device: maximise transducer N's power alone (default: the sum over "
+        "the transducers)",
     )
     g.add_argument(
         "--exceedance",
@@ -128,17 +152,13 @@ def vary_option(text: str) -> tuple[str, float, float]:
     raise argparse.ArgumentTypeError(f"{text!r} is not NAME=LOW:HIGH (for example k=20:120)")
 
 
-def _known_names() -> tuple[str, ...]:
-    """Every parameter some device can vary: the device's, every friction law's, coupling's
-    and bridge's (``battery``, ``r_load``, ``v_diode``, ...)."""
-    names = ["c_m", "c_e", "k", "k3"]
-    for family in (FRICTION_MODELS, COUPLINGS, {"coil": BridgeCoil, "piezo": BridgePiezo}):
-        for member in family.values():
-            names += list(member.parameter_names())
-    return tuple(dict.fromkeys(names))
-
-
-def run(args) -> int:
+def _single_mass_vary(args) -> dict:
+    """``--vary`` of a single mass: names checked, the device given a value for each."""
+    for flag, value in (("--stroke-on", args.stroke_on), ("--transducer", args.transducer)):
+        if value is not None:
+            raise ValueError(
+                f"`{flag}` names a part of an assembly: give the device with --device FILE"
+            )
     vary = {}
     known = _known_names()
     for name, low, high in args.vary:
@@ -156,7 +176,49 @@ def run(args) -> int:
             setattr(args, name, 0.5 * (low + high))
     if args.stroke is None:
         raise ValueError("`--stroke` is needed: the budget is on P(|z| > stroke)")
-    harvester = harvester_from_args(args)
+    return vary
+
+
+def _assembly_vary(args, assembly) -> dict:
+    """``--vary`` of ``--device``: dotted paths checked against the file, in one line each."""
+    for flag, dest in (("--out-dir", "out_dir"), ("--scheduler", "scheduler"),
+                       ("--min-first-passage", "min_first_passage")):  # fmt: skip
+        if getattr(args, dest, None) is not None:
+            raise ValueError(
+                f"`{flag}` is not taken with --device: an assembly's candidates run in this "
+                "process, without a resume folder, a cluster or a first-passage bound"
+            )
+    vary = {}
+    for name, low, high in args.vary:
+        if name in vary:
+            raise ValueError(f"`--vary {name}` is given twice")
+        why = vary_refusal(assembly, name)
+        if why is not None:
+            raise ValueError(f"`--vary {name}={low:g}:{high:g}`: {why}")
+        if not low < high:
+            raise ValueError(f"`--vary {name}={low:g}:{high:g}` is an empty range: need LOW < HIGH")
+        vary[name] = (low, high)
+    return vary
+
+
+def _known_names() -> tuple[str, ...]:
+    """Every parameter some device can vary: the device's, every friction law's, coupling's
+    and bridge's (``battery``, ``r_load``, ``v_diode``, ...)."""
+    names = ["c_m", "c_e", "k", "k3"]
+    for family in (FRICTION_MODELS, COUPLINGS, {"coil": BridgeCoil, "piezo": BridgePiezo}):
+        for member in family.values():
+            names += list(member.parameter_names())
+    return tuple(dict.fromkeys(names))
+
+
+def run(args) -> int:
+    assembly = assembly_from_args(args)
+    if assembly is None:
+        vary = _single_mass_vary(args)
+        device = harvester_from_args(args)
+    else:
+        vary = _assembly_vary(args, assembly)
+        device = assembly
     excitation = excitation_from_args(args)
     if args.segments is not None and getattr(args, "record", None) is None:
         raise ValueError("`--segments` cuts a record into paths; it needs `--record`")
@@ -167,7 +229,7 @@ def run(args) -> int:
         control_variates=not hasattr(excitation, "is_white") or excitation.is_white,
     )
     result = design(
-        harvester,
+        device,
         excitation,
         vary,
         exceedance=args.exceedance,
@@ -179,12 +241,14 @@ def run(args) -> int:
         out_dir=args.out_dir,
         scheduler=args.scheduler,
         progress=not args.no_progress and not args.json,
+        stroke_on=args.stroke_on,
+        transducer=args.transducer,
     )
     if args.json:
         optimum = {k: u for k in result.optimum if (u := parameter_unit(k, result.device))}
         print(dumps(with_units(result.to_dict(), extra=optimum)))
         return 0
-    _print_design(args, result, excitation, vary)
+    _print_design(args, result, excitation, vary, assembly is not None)
     return 0
 
 
@@ -193,9 +257,12 @@ def _estimate(value: dict) -> str:
     return estimate(value["mean"], value["ci95"])
 
 
-def _print_design(args, result, excitation, vary: dict) -> None:
+def _print_design(args, result, excitation, vary: dict, is_assembly: bool) -> None:
     """The device chosen (not the ranges' midpoints), the table, and the notes."""
-    print(describe_device(result.device).replace("device:", "device at the optimum:", 1))
+    if is_assembly:
+        print(f"device at the optimum: {result.device.describe()}")
+    else:
+        print(describe_device(result.device).replace("device:", "device at the optimum:", 1))
     print("varied: " + ", ".join(
         f"{k} {cell(lo)} to {cell(hi)} {parameter_unit(k, result.device)}".rstrip()
         for k, (lo, hi) in vary.items()

@@ -10,6 +10,15 @@ integrates the shaping filter with the device, ``band-limited`` and
 FILE`` simulates the device on the record itself
 (:func:`randvib.monte_carlo_on_record`), ``--segments`` windows giving the
 interval.
+
+``--device FILE.toml`` simulates an assembly (docs/assemblies.md;
+:func:`randvib.simulate` with an :class:`~randvib.models.assembly.Assembly`):
+``--json`` gives ``transducers`` (a list in file order, each with
+``power_electrical`` and, where they apply, ``power_load``, ``power_stored``,
+``power_coil_loss``, ``power_diode_loss``, ``circuit_mean_square``, the
+coordinate's variances, as {mean, ci95}), ``displacement_variance`` and
+``velocity_variance`` (lists per DOF, {mean, ci95}), ``elements``,
+``power_dissipated`` and, under white noise, ``power_input`` (r^T M r S / 4).
 """
 
 from __future__ import annotations
@@ -18,7 +27,7 @@ from randvib._io import dumps
 from randvib._validation import MAX_SEED, integer_option
 from randvib.analytic.prediction import METHODS, predict
 from randvib.cli import COMMAND_HELP
-from randvib.cli._device import add_device_arguments, harvester_from_args
+from randvib.cli._device import add_device_arguments, assembly_from_args, harvester_from_args
 from randvib.cli._event import add_event_arguments, simulate_event, wants_event
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
 from randvib.cli._output import describe_device, describe_excitation, print_table, with_units
@@ -100,6 +109,9 @@ def register(sub) -> None:
 def run(args) -> int:
     from randvib.montecarlo.simulation import simulate
 
+    assembly = assembly_from_args(args)
+    if assembly is not None:
+        return _run_assembly(args, assembly)
     harvester = harvester_from_args(args)
     psd = excitation_from_args(args)
     if wants_event(args):
@@ -254,3 +266,39 @@ def _on_record(harvester, record, args, burn_in):
     except ValueError as exc:  # name the options, not the function's arguments
         message = str(exc).replace("`segments`", "`--segments`").replace("`burn_in`", "`--burn-in`")
         raise ValueError(message) from None
+
+
+def _run_assembly(args, assembly) -> int:
+    """``--device``: Monte Carlo of the assembly; JSON per transducer and per DOF, or a table."""
+    from randvib.montecarlo.simulation import simulate
+
+    if wants_event(args):
+        raise ValueError("`--envelope` (an event) is not implemented for `--device` assemblies")
+    psd = excitation_from_args(args)
+    burn_in = 2.0 if args.burn_in is None else args.burn_in
+    if args.record is not None:
+        result = _on_record(assembly, psd, args, burn_in)
+    else:
+        if args.segments is not None:
+            raise ValueError("`--segments` cuts a record into paths; it needs `--record`")
+        result = simulate(
+            assembly,
+            psd,
+            t_end=20.0 if args.t_end is None else args.t_end,
+            dt=1e-4 if args.dt is None else args.dt,
+            n_paths=1000 if args.paths is None else args.paths,
+            burn_in=burn_in,
+            scheme=args.method,
+            seed=args.seed,
+            threads=args.threads,
+            progress=False if args.no_progress or args.json else None,
+            control_variates=args.control_variates,
+        )
+    summary = {"device": args.device, "n_dof": assembly.n_dof, **result.summary()}
+    if args.json:
+        print(dumps(summary))
+        return 0
+    print(f"device: {args.device}: {assembly.describe()}")
+    print(describe_excitation(psd) if args.record is None else f"excitation: record {args.record}")
+    print(str(result))
+    return 0

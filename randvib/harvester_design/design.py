@@ -12,7 +12,8 @@ names the parameters to choose with their ranges. The design
    resume as for every sweep);
 3. where Monte Carlo disagrees with the analytic answer (a runner-up
    significantly better, paired; the optimum significantly beyond the budget;
-   or its prediction off by more than :data:`PREDICTION_TOLERANCE`), refines
+   or its prediction off by more than
+   :data:`~randvib.harvester_design.confirmation.PREDICTION_TOLERANCE`), refines
    by Monte Carlo on shrinking local grids around the best confirmed
    feasible candidate, and reports what the analytic answer would have cost;
 4. with a bound on the mean first-passage time to the stroke
@@ -30,6 +31,15 @@ names the parameters to choose with their ranges. The design
    (:func:`randvib.analytic.harvesting_limit.causal_harvesting_limit`); on
    a record the non-causal bound on the record itself with |z| <= stroke
    (:func:`randvib.analytic.harvesting_limit.record_harvesting_limit`).
+
+An :class:`~randvib.models.assembly.Assembly` goes through the same steps
+with its own parts: dotted-path parameters and a stroke budget on its
+coordinates (:mod:`randvib.harvester_design.assembly_budget`), the objective
+summed over its transducers or one transducer's
+(:class:`~randvib.harvester_design.objectives.AssemblyObjective`), the
+search by ``linearisation`` and the confirmation by its own Monte Carlo
+(:mod:`randvib.harvester_design.assembly_confirmation`); no harvesting limit
+or first passage yet.
 """
 
 from __future__ import annotations
@@ -48,17 +58,23 @@ from randvib.analytic.harvesting_limit import (
     predictable_spectrum,
     record_harvesting_limit,
 )
-from randvib.harvester_design.objectives import objective_named
+from randvib.harvester_design.assembly_budget import stroke_budget
+from randvib.harvester_design.assembly_confirmation import AssemblyConfirmed
+from randvib.harvester_design.confirmation import (
+    ConfirmedCandidates,
+    within,
+)
+from randvib.harvester_design.objectives import AssemblyObjective, objective_named
 from randvib.harvester_design.result import DesignResult
 from randvib.harvester_design.search import (
     COARSE,
     Candidate,
-    Evaluator,
     InfeasibleBudget,
     NothingPredicted,
     analytic_search,
 )
 from randvib.harvester_design.space import DesignSpace
+from randvib.models.assembly import Assembly
 from randvib.models.excitation import Measured, as_excitation
 from randvib.models.harvester import Harvester
 from randvib.montecarlo.bridge_step import BridgeIdleWarning, bridge_input_rms, never_conducted
@@ -72,14 +88,10 @@ __all__ = ["design"]
 #: Monte Carlo refinement: rounds, and the half-width of the first local grid (unit box).
 REFINE_ROUNDS = 2
 REFINE_STEP = 0.15
-#: A prediction further than this fraction (beyond the 95 % interval) from Monte Carlo
-#: is off, and Monte Carlo refines: linearisation's error under white noise is within
-#: a few per cent (README), so a larger gap means the analytic ranking is not reliable.
-PREDICTION_TOLERANCE = 0.02
 
 
 def design(
-    harvester: Harvester,
+    harvester: Harvester | Assembly,
     excitation,
     vary: Mapping,
     *,
@@ -97,14 +109,20 @@ def design(
     progress: bool = False,
     min_first_passage: float | None = None,
     segments: int = 10,
+    stroke_on=None,
+    transducer: int | None = None,
 ) -> DesignResult:
     """Choose the varied parameters that maximise the power with ``P(|z| > stroke) <= exceedance``.
 
     Parameters
     ----------
-    harvester : Harvester
+    harvester : Harvester or Assembly
         What is fixed: mass (kg), mechanical damping (Ns/m), friction,
-        coupling; the varied parameters' values in it are ignored.
+        coupling; the varied parameters' values in it are ignored. An
+        :class:`~randvib.models.assembly.Assembly` (a harvester on a host, a
+        two-mass harvester, an array; docs/assemblies.md) is searched with
+        ``linearisation`` (exact for a linear assembly) and confirmed by its
+        own Monte Carlo (:mod:`randvib.harvester_design.assembly_confirmation`).
     excitation : float or Excitation
         White-noise level S ((m/s^2)^2/Hz) or any excitation (a band-pass,
         Kanai-Tajimi, tabulated or measured spectrum). A measured record
@@ -117,9 +135,14 @@ def design(
         The parameters to choose and their ranges (SI): ``k``, ``k3`` (any
         sign; k < 0 < k3 is bistable), ``c_e``, ``c_m``, a friction law's
         or the coupling's parameters (``alpha``, ``r_load``, ``theta``, ...;
-        a bridge's ``battery`` V_b (V) or storage load ``r_load``).
+        a bridge's ``battery`` V_b (V) or storage load ``r_load``). An
+        assembly's by dotted path: ``transducer.0.r_load``, ``element.1.k3``,
+        ``structure.stiffness.0.0`` (:meth:`~randvib.models.assembly.Assembly.updated`);
+        refused: an unknown path, a mass, the influence, a stroke, a derived
+        c_e (:func:`~randvib.harvester_design.assembly_budget.vary_refusal`).
     stroke : float, optional
-        Stroke d (m), > 0; default the harvester's.
+        Stroke d (m), > 0; default the harvester's (an assembly's: set on
+        each ``stroke_on`` coordinate; default the strokes it carries).
     exceedance : float
         The budget eps: the stationary fraction of time with |z| > d, in (0, 1).
     objective : str or Objective
@@ -158,6 +181,14 @@ def design(
         A record's windows (Monte Carlo paths), >= 2; each should be much
         longer than the device's decay time 2 m / c
         (:attr:`randvib.RecordSimulation.lag1_correlation` checks it).
+    stroke_on : str or list of str, optional
+        An assembly's coordinates the budget holds on, ``element.N`` or
+        ``transducer.N``; default every part with a stroke, each of which
+        must then meet it (:class:`~randvib.harvester_design.assembly_budget.StrokeBudget`).
+    transducer : int, optional
+        An assembly's one transducer whose power the objective counts (the
+        others as they are); default the sum over all its transducers
+        (:class:`~randvib.harvester_design.objectives.AssemblyObjective`).
 
     Returns
     -------
@@ -181,19 +212,25 @@ def design(
     k = 59.1 N/m, c_e = 0.456 Ns/m
     """
     _check_min_first_passage(min_first_passage)
-    stroke = harvester.stroke if stroke is None else stroke
-    if stroke is None:
-        raise ValueError("`stroke` is needed: the design's budget is on P(|z| > stroke)")
-    sigma_budget = gaussian_displacement_budget(stroke, exceedance)
-    fixed = harvester.updated(stroke=stroke)
-    goal = objective_named(objective)
-    refusal = goal.requires(fixed)
-    if refusal:
-        raise ValueError(refusal)
     excitation = as_excitation(excitation)
-    space = DesignSpace(fixed, vary)
-    limits = _limit(fixed, excitation, stroke, sigma_budget, progress)
-    limit = limits.pop("limit")  # the result builders give it beside its fraction
+    if isinstance(harvester, Assembly):
+        space, goal, stroke = _assembly_setup(
+            harvester, excitation, vary, stroke, stroke_on, objective, transducer,
+            dict(min_first_passage=min_first_passage, out_dir=out_dir, executor=executor,
+                 workers=workers, scheduler=scheduler), monte_carlo,
+        )  # fmt: skip
+        limits = dict(limit_kind=None)  # no harvesting limit of an assembly yet
+        limit = None
+    else:
+        if stroke_on is not None or transducer is not None:
+            raise ValueError(
+                "`stroke_on` and `transducer` name the parts of an assembly; a single-mass "
+                "harvester has one stroke, on z, and one transducer"
+            )
+        space, goal, stroke, limits = _single_mass_setup(
+            harvester, excitation, vary, stroke, exceedance, objective, progress
+        )
+        limit = limits.pop("limit")  # the result builders give it beside its fraction
     try:
         search = analytic_search(space, excitation, exceedance, goal, runners_up, min_first_passage)
     except NothingPredicted as exc:
@@ -203,11 +240,13 @@ def design(
             ) from None
         search = None
     confirmed_on = "record windows" if isinstance(excitation, Measured) else "simulated paths"
-    common = dict(objective=goal.name, stroke=float(stroke), exceedance_budget=float(exceedance),
+    common = dict(objective=goal.name, stroke=stroke, exceedance_budget=float(exceedance),
                   evaluations=0 if search is None else search.evaluations,
                   min_first_passage=min_first_passage, **limits)  # fmt: skip
     if monte_carlo:
         common["monte_carlo_input"] = confirmed_on
+    if space.is_assembly:
+        common["objective_scope"] = goal.scope
     if not monte_carlo:
         return _analytic_result(space, search, limit, common)
     settings = settings or SweepSettings(
@@ -216,11 +255,57 @@ def design(
     common["monte_carlo_precision"] = settings.target_rel_ci
     run = dict(settings=settings, out_dir=out_dir, executor=executor, workers=workers,
                scheduler=scheduler, progress=progress)  # fmt: skip
-    confirmed = _Confirmed(space, excitation, goal, run, min_first_passage, segments)
+    if space.is_assembly:
+        confirmed = AssemblyConfirmed(space, excitation, goal, settings, progress)
+    else:
+        confirmed = _Confirmed(space, excitation, goal, run, min_first_passage, segments)
     best, candidates, chosen = _confirm(confirmed, space, search, exceedance, refine)
-    _require_feasible(confirmed, chosen, stroke, exceedance, min_first_passage)
+    _require_feasible(confirmed, chosen, space, exceedance, min_first_passage)
     _require_power(confirmed, chosen)
     return _confirmed_result(confirmed, space, best, chosen, candidates, exceedance, limit, common)
+
+
+def _single_mass_setup(harvester, excitation, vary, stroke, exceedance, objective, progress):
+    """A single mass's design space, objective, stroke and limits (:func:`_limit`)."""
+    stroke = harvester.stroke if stroke is None else stroke
+    if stroke is None:
+        raise ValueError("`stroke` is needed: the design's budget is on P(|z| > stroke)")
+    sigma_budget = gaussian_displacement_budget(stroke, exceedance)
+    fixed = harvester.updated(stroke=stroke)
+    goal = objective_named(objective)
+    refusal = goal.requires(fixed)
+    if refusal:
+        raise ValueError(refusal)
+    limits = _limit(fixed, excitation, stroke, sigma_budget, progress)
+    return DesignSpace(fixed, vary), goal, float(stroke), limits
+
+
+def _assembly_setup(
+    assembly, excitation, vary, stroke, stroke_on, objective, transducer, options, monte_carlo
+):
+    """An assembly's design space (with its stroke budget), objective and strokes.
+
+    Refuses in one line what a design does not do for assemblies yet: a
+    first-passage bound, a resumable folder or a cluster (the candidates run
+    in this process, on numba threads), Monte Carlo on a measured record.
+    """
+    for name, value in options.items():
+        if value is not None:
+            raise ValueError(
+                f"`{name}` is not taken with an assembly: its candidates run in this process "
+                "(numba threads), without a first-passage bound, resume folder or cluster"
+            )
+    if monte_carlo and isinstance(excitation, Measured):
+        raise ValueError(
+            "an assembly's design is confirmed on simulated paths: give the record's spectrum "
+            "(Measured.spectrum) or monte_carlo=False"
+        )
+    fixed, budget = stroke_budget(assembly, stroke, stroke_on)
+    goal = AssemblyObjective(objective_named(objective), transducer)
+    refusal = goal.requires(fixed)
+    if refusal:
+        raise ValueError(refusal)
+    return DesignSpace(fixed, vary, budget), goal, dict(budget.strokes)
 
 
 def _check_min_first_passage(min_first_passage) -> None:
@@ -344,14 +429,14 @@ def _confirm(confirmed: _Confirmed, space: DesignSpace, search, exceedance: floa
 
 
 def _require_feasible(
-    confirmed: _Confirmed, chosen, stroke: float, exceedance: float, min_first_passage
+    confirmed: _Confirmed, chosen, space: DesignSpace, exceedance: float, min_first_passage
 ) -> None:
     """Raise :class:`InfeasibleBudget` when Monte Carlo rejects the chosen device's budget."""
     x = confirmed.exceedance(chosen)
-    if not _within(x, exceedance):
+    if not within(x, exceedance):
         where = ", ".join(f"{k} = {v:.6g}" for k, v in chosen.values.items())
         raise InfeasibleBudget(
-            f"the stroke budget P(|z| > {stroke:g} m) <= {exceedance:g} cannot be met in the "
+            f"the stroke budget {space.budget_words()} <= {exceedance:g} cannot be met in the "
             f"ranges given: the best reachable exceedance (Monte Carlo) is {x.mean:.3g} "
             f"± {x.ci95:.2g} (at {where})"
         )
@@ -360,22 +445,25 @@ def _require_feasible(
         where = ", ".join(f"{k} = {v:.6g}" for k, v in chosen.values.items())
         raise InfeasibleBudget(
             f"the first-passage constraint E[tau] >= {min_first_passage:g} s (mean time to "
-            f"|z| > {stroke:g} m) is not met by the best device within the stroke budget: "
+            f"|z| > {space.harvester.stroke:g} m) is not met by the best device within the stroke budget: "
             f"Monte Carlo gives {first.mean:.3g} ± {first.ci95:.2g} s (at {where})"
         )
 
 
-def _require_power(confirmed: _Confirmed, chosen) -> None:
+def _require_power(confirmed: ConfirmedCandidates, chosen) -> None:
     """Refuse an optimum of zero power: no candidate delivered any, so none is best.
 
     A diode bridge that never conducted says why (its transducer's RMS voltage
-    against the threshold) and what would help.
+    against the threshold) and what would help (a single mass's runs).
     """
     if confirmed.power(chosen).mean > 0.0:
         return
-    result, i = confirmed.where[id(chosen)]
-    run = result.simulation(i)
     why = "no candidate in the ranges delivered any power"
+    located = getattr(confirmed, "where", {}).get(id(chosen))
+    if located is None:  # an assembly's runs: no bridge diagnosis yet
+        raise ValueError(f"the design has no optimum: {why}")
+    result, i = located
+    run = result.simulation(i)
     if run.harvester.is_rectified and never_conducted(run):
         where = ", ".join(f"{k} = {v:.6g}" for k, v in chosen.values.items())
         advice = run.harvester.electrical.idle_advice(bridge_input_rms(run))
@@ -462,36 +550,21 @@ class _OnRecord:
         return self.runs[index]
 
 
-class _Confirmed:
-    """Monte Carlo of candidates with common random numbers: path i is common to all.
+class _Confirmed(ConfirmedCandidates):
+    """The single mass's candidates by Monte Carlo with common random numbers.
 
     Under a spectrum every run is group 0 of one seed; on a record path i is
     the record's window i for every candidate.
     """
 
     def __init__(self, space, excitation, goal, run, min_first_passage=None, segments=10):
-        self.space, self.excitation, self.goal, self.run = space, excitation, goal, run
-        self.min_first_passage = min_first_passage
+        super().__init__(space, excitation, goal, min_first_passage)
+        self.run = run
         self.record = excitation if isinstance(excitation, Measured) else None
         self.segments = segments
-        self.candidates: list = []
-        self.where: dict = {}  # candidate id -> (EnsembleResult, index)
-
-    def point(self, u) -> Candidate | None:
-        """A candidate at ``u``: predicted where a method takes it, else unpredicted (nan)."""
-        known = Evaluator(self.space, self.excitation, self.goal)(u)
-        if known is not None:
-            return known
-        try:
-            self.space.device(u)
-        except ValueError:
-            return None
-        return Candidate(u, self.space.values(u), math.nan, math.nan, "none", math.nan)
 
     def add(self, candidates) -> None:
-        new = [
-            c for c in candidates if all(np.max(np.abs(c.u - o.u)) > 1e-9 for o in self.candidates)
-        ]
+        new = self.new(candidates)
         if not new:
             return
         if self.record is not None:
@@ -536,9 +609,6 @@ class _Confirmed:
         result, i = self.where[id(c)]
         return result.simulation(i).controls() if result.settings.control_variates else None
 
-    def power(self, c) -> Statistic:
-        return estimate(self._samples(c), self._controls(c))
-
     def exceedance(self, c) -> Statistic:
         result, i = self.where[id(c)]
         return proportion(result.averages(i).beyond_stroke)  # Wilson: stays in [0, 1]
@@ -572,54 +642,3 @@ class _Confirmed:
         if first.mean is not None and first.mean.mean + first.mean.ci95 < self.min_first_passage:
             return False
         return None
-
-    def feasible(self, c, budget: float) -> bool:
-        """Monte Carlo rejects neither the stroke budget nor the first-passage bound."""
-        return _within(self.exceedance(c), budget) and self.passage(c) is not False
-
-    def difference(self, a, b) -> Statistic:
-        """Power of ``a`` minus that of ``b`` on their common paths (paired, W)."""
-        x, y = self._samples(a), self._samples(b)
-        n = min(len(x), len(y))
-        controls = None
-        if self._controls(a) is not None:
-            controls = np.hstack([self._controls(a)[:n], self._controls(b)[:n]])
-        return estimate(x[:n] - y[:n], controls)
-
-    def best(self, budget: float, among) -> Candidate:
-        """The highest Monte Carlo power among those the budget does not reject.
-
-        A candidate is rejected when its Monte Carlo exceedance is significantly
-        above the budget (the 95 % interval lies above it): an optimum on the
-        budget's boundary has an estimate on either side of it by chance. If
-        every candidate is rejected, the one with the least exceedance.
-        """
-        feasible = [c for c in among if self.feasible(c, budget)]
-        if not feasible:
-            return min(among, key=lambda c: self.exceedance(c).mean)
-        return max(feasible, key=lambda c: self.power(c).mean)
-
-    def disagrees(self, best, candidates, budget: float) -> bool:
-        """Monte Carlo contradicts the analytic choice: the optimum is significantly beyond
-        the budget, its prediction lies outside its Monte Carlo interval by more than
-        :data:`PREDICTION_TOLERANCE`, or another candidate is significantly better (paired
-        95 % interval above 0)."""
-        if not self.feasible(best, budget):
-            return True
-        power = self.power(best)
-        if abs(power.mean - best.power) > power.ci95 + PREDICTION_TOLERANCE * best.power:
-            return True  # the predictor is off here: its ranking is not to be trusted
-        return any(self.better(c, best, budget) for c in candidates if c is not best)
-
-    def better(self, a, b, budget: float) -> bool:
-        """``a`` meets the budget and harvests significantly more than ``b`` on the common
-        paths (paired 95 % interval above 0, and above rounding: 1e-9 of the power)."""
-        if not self.feasible(a, budget):
-            return False
-        d = self.difference(a, b)
-        return d.mean - d.ci95 > 1e-9 * abs(self.power(b).mean)
-
-
-def _within(x: Statistic, budget: float) -> bool:
-    """The budget is not significantly exceeded: the 95 % interval reaches down to it."""
-    return x.interval[0] <= budget

@@ -7,6 +7,12 @@ path by path, from a Monte Carlo ensemble
 search and its confirmation maximise the same thing. :data:`OBJECTIVES`
 lists them by name: the electrical power, the load's share of it, and the
 power stored through a diode bridge (:mod:`randvib.models.rectifier`).
+
+For an :class:`~randvib.models.assembly.Assembly` the same objectives are
+read per transducer (:class:`AssemblyObjective`): by default the sum over
+all its transducers (the device's whole harvest, what an array or a
+two-mass harvester is built for), or one transducer's alone
+(``transducer=i``: one harvester of an array, the others as they are).
 """
 
 from __future__ import annotations
@@ -16,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["OBJECTIVES", "Objective", "objective_named"]
+__all__ = ["OBJECTIVES", "AssemblyObjective", "Objective", "objective_named"]
 
 
 @dataclass(frozen=True)
@@ -37,6 +43,9 @@ class Objective:
     requires : callable
         ``requires(harvester) -> str | None``: why the objective does not
         apply to the harvester, or None.
+    transducer_power : str
+        Its name on an assembly's transducer: ``power_electrical``,
+        ``power_load`` or ``power_stored`` (:class:`AssemblyObjective`).
     """
 
     name: str
@@ -44,6 +53,7 @@ class Objective:
     analytic: Callable
     monte_carlo: Callable
     requires: Callable
+    transducer_power: str = "power_electrical"
 
 
 def _load_refusal(harvester) -> str | None:
@@ -92,6 +102,7 @@ OBJECTIVES: dict[str, Objective] = {
             lambda prediction, harvester: float(prediction.power_load),
             _load_fraction_samples,
             _load_refusal,
+            "power_load",
         ),
         Objective(
             "stored",
@@ -99,6 +110,7 @@ OBJECTIVES: dict[str, Objective] = {
             lambda prediction, harvester: float(prediction.power_stored),
             lambda ensembles, index: ensembles.averages(index).stored_power,
             _stored_refusal,
+            "power_stored",
         ),
     )
 }
@@ -113,3 +125,79 @@ def objective_named(objective) -> Objective:
             f"`objective` must be one of {', '.join(map(repr, OBJECTIVES))}, got {objective!r}"
         )
     return OBJECTIVES[objective]
+
+
+@dataclass(frozen=True)
+class AssemblyObjective:
+    """An objective read from an assembly's transducers: their sum, or one transducer's.
+
+    Attributes
+    ----------
+    objective : Objective
+        What is read on each transducer (its :attr:`Objective.transducer_power`).
+    transducer : int or None
+        The one transducer whose power is maximised (the others as they are);
+        None for the sum over every transducer.
+    """
+
+    objective: Objective
+    transducer: int | None = None
+
+    @property
+    def name(self) -> str:
+        return self.objective.name
+
+    @property
+    def scope(self) -> str:
+        """``all transducers`` or ``transducer I``: whose power is maximised."""
+        return "all transducers" if self.transducer is None else f"transducer {self.transducer}"
+
+    def counted(self, assembly) -> range | list:
+        """The indices of the transducers whose power counts."""
+        if self.transducer is None:
+            return range(len(assembly.transducers))
+        return [self.transducer]
+
+    def requires(self, assembly) -> str | None:
+        """Why the objective does not apply to the assembly (one line), or None."""
+        n = len(assembly.transducers)
+        if n == 0:
+            return "the assembly has no transducer: there is no power to maximise"
+        if self.transducer is not None and not (
+            isinstance(self.transducer, int) and 0 <= self.transducer < n
+        ):
+            return (
+                f"`transducer` = {self.transducer!r}: the assembly has {n} transducer(s), "
+                f"indices 0..{n - 1}"
+            )
+        for index in self.counted(assembly):
+            t = assembly.transducers[index]
+            if self.name == "load" and not t.has_load:
+                return (
+                    f"objective 'load' counts transducer {index}, a bare electrical damping "
+                    "without a load resistance: give it a coil (flux gradient, load and coil "
+                    "resistances), or use objective 'electrical'"
+                )
+            if self.name == "stored" and not t.is_rectified:
+                return (
+                    f"objective 'stored' counts transducer {index}, which has no diode bridge: "
+                    "give it rectifier = \"bridge\", or use objective 'load' or 'electrical'"
+                )
+        return None
+
+    def analytic(self, prediction, assembly) -> float:
+        """The predicted power (W) from an :class:`~randvib.analytic.assembly_prediction.AssemblyPrediction`."""
+        field = self.objective.transducer_power
+        values = [getattr(prediction.transducers[i], field, None) for i in self.counted(assembly)]
+        if any(v is None for v in values):
+            return float("nan")
+        return float(sum(values))
+
+    def monte_carlo(self, result) -> np.ndarray:
+        """Each path's power (W) from an assembly's Monte Carlo result.
+
+        ``result.transducer_power(i)`` gives per path (electrical, load); a
+        bridge's load is its stored power.
+        """
+        which = 0 if self.objective.transducer_power == "power_electrical" else 1
+        return sum(result.transducer_power(i)[which] for i in self.counted(result.assembly))

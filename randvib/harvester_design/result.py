@@ -31,8 +31,11 @@ class DesignResult:
         The fixed harvester with the chosen values.
     objective : str
         The maximised power (:data:`randvib.harvester_design.objectives.OBJECTIVES`).
-    stroke, exceedance_budget : float
-        The stroke d (m) and the budget eps on P(|z| > d).
+    stroke : float or dict
+        The stroke d (m); an assembly's: coordinate path -> its stroke (m),
+        each held to the budget.
+    exceedance_budget : float
+        The budget eps on P(|z| > d) (an assembly's: on each coordinate).
     method : str
         The analytic method of the search.
     power_predicted : float
@@ -112,6 +115,9 @@ class DesignResult:
         Monte Carlo's verdict on ``min_first_passage``: True (E[min(tau, t_end)]
         significantly above T), False (E[tau] significantly below T), None
         (undetermined: paths censored at t_end, or no bound).
+    objective_scope : str or None
+        An assembly's: ``"all transducers"`` (their powers summed) or
+        ``"transducer I"``; None for a single mass.
     monte_carlo_input : str or None
         What drove the Monte Carlo: ``"record windows"`` (a measured record
         itself, its windows the paths, :func:`randvib.monte_carlo_on_record`)
@@ -122,7 +128,7 @@ class DesignResult:
     optimum: dict
     device: object = field(repr=False)
     objective: str
-    stroke: float
+    stroke: float | dict
     exceedance_budget: float
     method: str
     power_predicted: float
@@ -150,6 +156,7 @@ class DesignResult:
     causal_limit: float | None = None
     causal_limit_kind: str | None = None
     monte_carlo_precision: float | None = None
+    objective_scope: str | None = None
 
     @property
     def power(self) -> float:
@@ -180,7 +187,7 @@ class DesignResult:
         words = ", ".join(w for _, w in seen)
         if seen and max(v for v, _ in seen) < INACTIVE_BUDGET * self.exceedance_budget:
             notes.append(
-                f"the stroke budget is inactive: P(|z| > {self.stroke:g} m) at the optimum is "
+                f"the stroke budget is inactive: {self._budget_event()} at the optimum is "
                 f"{words}, against {self.exceedance_budget:g} allowed; the ranges or the "
                 "device limit the power, not the stroke"
             )
@@ -194,6 +201,12 @@ class DesignResult:
                     "(max_paths, --max-paths) or a looser target"
                 )
         return notes
+
+    def _budget_event(self) -> str:
+        """``P(|z| > d m)``, or an assembly's strokes by coordinate."""
+        if isinstance(self.stroke, dict):
+            return "P(" + " or ".join(f"|{k}| > {v:g} m" for k, v in self.stroke.items()) + ")"
+        return f"P(|z| > {self.stroke:g} m)"
 
     def to_dict(self) -> dict:
         """JSON-ready: the keys of ``randvib design --json``."""
@@ -238,6 +251,7 @@ class DesignResult:
             else self.first_passage_monte_carlo.to_dict(),
             "first_passage_confirmed": self.first_passage_confirmed,
             "monte_carlo_input": self.monte_carlo_input,
+            **({} if self.objective_scope is None else {"objective_scope": self.objective_scope}),
         }
 
     def to_frame(self):
@@ -305,6 +319,8 @@ class DesignResult:
             value = getattr(self, key)
             if value is not None:
                 rows.append((label, number(value), unit(key)))
+            elif key == "limit" and self.objective_scope is not None:  # an assembly's design
+                rows.append((label, "none (not computed for an assembly)", ""))
             elif key == "limit" and self.causal_limit is not None:
                 rows.append((label, "none (unbounded for white noise)", ""))
         for key, label in (

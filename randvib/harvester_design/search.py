@@ -35,6 +35,14 @@ Poisson is 5-9x too short (tests/test_design.py), so Monte Carlo's check of
 the bound on the confirmed candidates is what decides. Elsewhere (``fpk-fast``'s
 non-Gaussian density) no first passage is predicted and only Monte Carlo
 checks the constraint.
+
+An :class:`~randvib.models.assembly.Assembly` is predicted by the method that
+takes assemblies (``linearisation``: the exact Lyapunov solution of a linear
+assembly, each nonlinear element's Gaussian closure otherwise); its
+exceedance is the worst of the budget's coordinates
+(:class:`~randvib.harvester_design.assembly_budget.StrokeBudget`), its input
+power the dissipated power of the linear(ised) assembly, and no first
+passage is predicted.
 """
 
 from __future__ import annotations
@@ -51,6 +59,7 @@ from randvib.analytic.linear_response import mechanical_block
 from randvib.analytic.power_prediction import gaussian_exceedance
 from randvib.analytic.prediction import METHODS, predict
 from randvib.harvester_design.space import DesignSpace
+from randvib.models.assembly import Assembly
 
 __all__ = ["Candidate", "SearchOutcome", "analytic_search", "predictor_for"]
 
@@ -145,7 +154,11 @@ def predictor_for(harvester, excitation):
 
     A linear device without friction is linearisation's: exact there (Lyapunov).
     A device behind a diode bridge is :data:`RECTIFIED`'s where it accepts it.
+    An assembly is the method's that takes assemblies.
     """
+    if isinstance(harvester, Assembly):
+        methods = (m for m in METHODS.values() if m.assemblies and m.accepts(harvester, excitation))
+        return next(methods, None)
     if harvester.is_rectified:
         method = METHODS[RECTIFIED]
         return method if method.accepts(harvester, excitation) else None
@@ -185,6 +198,8 @@ class Evaluator:
                 prediction = predict(device, self.excitation, method=method)
             except (ValueError, ArithmeticError):
                 return None  # refused beyond its validity, or no Gaussian solution
+        if isinstance(device, Assembly):
+            return self._assembly_candidate(u, device, method, prediction, bool(caught))
         power = self.objective.analytic(prediction, device)
         exceedance = prediction.stroke_exceedance
         if exceedance is None and method.name in GAUSSIAN_DISPLACEMENT:
@@ -202,6 +217,23 @@ class Evaluator:
             first_passage=predicted_first_passage(
                 prediction, method, device.stroke, exceedance, device, self.excitation
             ),
+        )
+
+    def _assembly_candidate(self, u, device, method, prediction, warned) -> Candidate | None:
+        """An assembly's candidate: the objective over its transducers, the budget's worst
+        coordinate, the dissipated power as the input (they balance); no first passage."""
+        power = self.objective.analytic(prediction, device)
+        exceedance = self.space.budget.predicted(prediction)
+        if not (math.isfinite(power) and math.isfinite(exceedance)):
+            return None
+        return Candidate(
+            u=u,
+            values=self.space.values(u),
+            power=power,
+            exceedance=exceedance,
+            method=method.name,
+            input_power=float(prediction.power_dissipated),
+            warned=warned,
         )
 
 
@@ -286,9 +318,9 @@ def analytic_search(
             if best.exceedance > budget:
                 where = ", ".join(f"{k} = {v:.6g}" for k, v in best.values.items())
                 raise InfeasibleBudget(
-                    f"the stroke budget P(|z| > `stroke` = {space.harvester.stroke:g} m) <= "
-                    f"`exceedance` = {budget:g} cannot be met in the ranges given (`vary`): the "
-                    f"best reachable exceedance is {best.exceedance:.3g} (at {where})"
+                    f"the stroke budget {_budget_event(space)} <= `exceedance` = {budget:g} "
+                    f"cannot be met in the ranges given (`vary`): the best reachable exceedance "
+                    f"is {best.exceedance:.3g} (at {where})"
                 )
             within = [best]
         feasible = [c for c in within if meets(c, budget, min_first_passage)]
@@ -417,3 +449,11 @@ def _least_exceedance(evaluate, start: Candidate, space: DesignSpace) -> Candida
     )
     end = evaluate(result.x)
     return end if end is not None and end.exceedance < start.exceedance else start
+
+
+def _budget_event(space) -> str:
+    """The budget's event, naming the argument that sets the stroke (``stroke``) for a single
+    mass; an assembly's strokes are its coordinates' (:meth:`DesignSpace.budget_words`)."""
+    if space.is_assembly:
+        return space.budget_words()
+    return f"P(|z| > `stroke` = {space.harvester.stroke:g} m)"

@@ -7,6 +7,13 @@ resistance act multiplicatively), linearly otherwise (a range through zero,
 such as k from negative to positive for bistable devices). The search works
 in the box; the devices are the fixed harvester with the chosen values
 (:meth:`randvib.Harvester.updated`).
+
+An :class:`~randvib.models.assembly.Assembly` is varied by dotted paths
+(``transducer.0.r_load``, ``element.1.k3``, ``structure.stiffness.0.0``;
+:meth:`Assembly.get`, :meth:`Assembly.updated`), refused where
+:func:`randvib.harvester_design.assembly_budget.vary_refusal` says why (an
+unknown path, a mass, a stroke, a derived c_e); its stroke budget is a
+:class:`~randvib.harvester_design.assembly_budget.StrokeBudget`.
 """
 
 from __future__ import annotations
@@ -17,6 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from randvib.harvester_design.assembly_budget import StrokeBudget, vary_refusal
+from randvib.models.assembly import Assembly
 from randvib.models.harvester import Harvester
 
 __all__ = ["DesignSpace", "Range", "designable_parameters"]
@@ -69,15 +78,18 @@ class DesignSpace:
 
     Parameters
     ----------
-    harvester : Harvester
+    harvester : Harvester or Assembly
         Everything that is fixed (mass, mechanical damping, friction, the
         coupling's fixed values); the varied parameters' own values in it
         are ignored. A coupling's parameter (``alpha``, ``r_load``, ...)
         needs the harvester built with that coupling; without one,
         ``alpha``/``r_load``/``r_coil`` are refused with the reason.
     vary : mapping of str to (low, high)
-        Parameter name -> range, in SI units (:mod:`randvib.quantities`),
-        low < high, both finite.
+        Parameter name (an assembly's: dotted path) -> range, in SI units
+        (:mod:`randvib.quantities`), low < high, both finite.
+    budget : StrokeBudget, optional
+        An assembly's stroke budget (its coordinates); the single mass's is
+        its own stroke.
 
     Raises
     ------
@@ -86,26 +98,22 @@ class DesignSpace:
         or non-finite range, or a range the harvester cannot take.
     """
 
-    def __init__(self, harvester: Harvester, vary: Mapping):
-        if not isinstance(harvester, Harvester):
-            raise ValueError(f"`harvester` must be a randvib Harvester, got {harvester!r}")
+    def __init__(self, harvester, vary: Mapping, budget: StrokeBudget | None = None):
+        if not isinstance(harvester, Harvester | Assembly):
+            raise ValueError(
+                f"`harvester` must be a randvib Harvester or Assembly, got {harvester!r}"
+            )
         if not isinstance(vary, Mapping) or not vary:
+            example = "'k': (20.0, 120.0)"
+            if isinstance(harvester, Assembly):
+                example = "'transducer.0.c_e': (0.01, 1.0)"
             raise ValueError(
                 "`vary` must name at least one parameter with its range, e.g. "
-                f"{{'k': (20.0, 120.0)}}; got {vary!r}"
+                f"{{{example}}}; got {vary!r}"
             )
-        allowed = designable_parameters(harvester)
         ranges = []
         for name, bounds in vary.items():
-            if name in FIXED:
-                raise ValueError(
-                    f"`vary` cannot choose {name!r}: the design keeps the mass, the stroke and "
-                    f"the damping split fixed; allowed: {', '.join(allowed)}"
-                )
-            if name not in allowed:
-                raise ValueError(
-                    f"`vary` names unknown parameter {name!r}; allowed: {', '.join(allowed)}"
-                )
+            _check_name(harvester, name)
             try:
                 low, high = (float(x) for x in bounds)
             except (TypeError, ValueError):
@@ -120,6 +128,7 @@ class DesignSpace:
             ranges.append(Range(name, low, high, low > 0 and high / low >= LOG_RATIO))
         self.harvester = harvester
         self.ranges = tuple(ranges)
+        self.budget = budget
         for u in (0.0, 1.0):  # both corners must make devices (a bad coupling is named here)
             self.device(np.full(self.dimension, u))
 
@@ -139,8 +148,20 @@ class DesignSpace:
         """The box point of parameter ``values``."""
         return np.array([r.coordinate(values[r.name]) for r in self.ranges])
 
-    def device(self, u) -> Harvester:
-        """The harvester at the box point ``u``."""
+    @property
+    def is_assembly(self) -> bool:
+        return isinstance(self.harvester, Assembly)
+
+    def budget_words(self) -> str:
+        """The stroke budget's event in words: ``P(|z| > 0.003 m)``, or an assembly's."""
+        if self.budget is not None:
+            return self.budget.words()
+        return f"P(|z| > {self.harvester.stroke:g} m)"
+
+    def device(self, u):
+        """The harvester (or assembly) at the box point ``u``."""
+        if self.is_assembly:
+            return self.harvester.updated(self.values(u))
         return self.harvester.updated(**self.values(u))
 
     def builds(self, u) -> bool:
@@ -155,3 +176,20 @@ class DesignSpace:
         """Every point of a regular grid of the box, shape (per_dimension^d, d)."""
         axes = [np.linspace(0.0, 1.0, per_dimension)] * self.dimension
         return np.stack([a.ravel() for a in np.meshgrid(*axes, indexing="ij")], axis=-1)
+
+
+def _check_name(harvester, name) -> None:
+    """Refuse a parameter the design cannot vary on ``harvester``, in one line naming it."""
+    if isinstance(harvester, Assembly):
+        why = vary_refusal(harvester, name)
+        if why is not None:
+            raise ValueError(f"`vary`: {why}")
+        return
+    allowed = designable_parameters(harvester)
+    if name in FIXED:
+        raise ValueError(
+            f"`vary` cannot choose {name!r}: the design keeps the mass, the stroke and "
+            f"the damping split fixed; allowed: {', '.join(allowed)}"
+        )
+    if name not in allowed:
+        raise ValueError(f"`vary` names unknown parameter {name!r}; allowed: {', '.join(allowed)}")

@@ -448,3 +448,14 @@ def _small_simplex(center, pop, costs):
         step = scale[i] if center[i] + scale[i] <= 1.0 else -scale[i]
         simplex[i + 1, i] += step
     return np.clip(simplex, 0.0, 1.0)
+
+
+def named_callback(callback, free):
+    """SaDE's ``callback(gen, x, f)`` as the user's ``callback(gen, {name: value}, f)``."""
+    if callback is None:
+        return None
+
+    def named(gen, x, f):
+        return callback(gen, dict(zip(free, map(float, x), strict=True)), f)
+
+    return named

@@ -83,6 +83,10 @@ __all__ = ["Assembly"]
 
 #: The structure's matrices by the name a dotted path uses.
 MATRICES = ("mass", "stiffness", "damping")
+#: The units of the structure's entries, by the name a dotted path uses.
+STRUCTURE_UNITS = {"mass": "kg", "stiffness": "N/m", "damping": "Ns/m", "influence": ""}
+#: The units of an element's own numbers and of any part's stroke.
+PART_UNITS = {"k": "N/m", "k2": "N/m^2", "k3": "N/m^3", "damping": "Ns/m", "stroke": "m"}
 
 
 @dataclass(frozen=True, eq=False)
@@ -411,6 +415,21 @@ class Assembly:
         if name not in values:
             raise ValueError(_unknown_path(path, kind, index, part))
         return values[name]
+
+    def parameter_unit(self, path: str) -> str:
+        """The SI unit of the number at a dotted path (``""`` for the influence or unknown)."""
+        kind, index, name = _split(path, self)
+        if kind == "structure":
+            return STRUCTURE_UNITS[index]
+        part = _part(self, kind, index, path)
+        if name in PART_UNITS:
+            return PART_UNITS[name]
+        models = (part.friction,) if kind == "element" else (part.coupling,)
+        for model in models:
+            specs = type(model).parameter_specs() if model is not None else {}
+            if name in specs:
+                return specs[name].unit
+        return ""
 
     def updated(self, changes: dict) -> Assembly:
         """A copy with the numbers at the given dotted paths changed (validated again).

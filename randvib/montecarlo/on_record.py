@@ -37,16 +37,19 @@ import dataclasses
 import numpy as np
 
 from randvib._validation import check_int, check_positive
+from randvib.models.assembly import Assembly
 from randvib.models.excitation import Measured
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import driven
+from randvib.montecarlo.assembly_results import AssemblySimulationResult
+from randvib.montecarlo.assembly_simulation import execute_assembly, validated_assembly
 from randvib.montecarlo.results import SimulationResult
 from randvib.montecarlo.simulation import execute
 from randvib.montecarlo.validation import validated
 
 
 def monte_carlo_on_record(
-    harvester: Harvester,
+    harvester: Harvester | Assembly,
     record: Measured,
     *,
     segments: int = 10,
@@ -65,8 +68,12 @@ def monte_carlo_on_record(
 
     Parameters
     ----------
-    harvester : Harvester
-        Device with scalar parameters; any friction law.
+    harvester : Harvester or Assembly
+        Device with scalar parameters; any friction law. An
+        :class:`~randvib.models.assembly.Assembly` takes the record as its
+        base acceleration (through its influence vector) and returns an
+        :class:`~randvib.montecarlo.assembly_results.AssemblySimulationResult`
+        with the same paths (one per window).
     record : Measured
         The measured base acceleration (``rv.Measured(record)`` of a
         :class:`randvib.Record`, or ``rv.Measured.from_csv(path)``). Its mean
@@ -103,6 +110,12 @@ def monte_carlo_on_record(
         raise ValueError(f"`burn_in` must be a finite number of seconds >= 0, got {burn_in!r}")
     source = driven.RecordedInput.cut(record, segments, burn_in, substeps)
     dt = check_positive("dt", source.dt, "s")
+    if isinstance(harvester, Assembly):
+        return _assembly_on_record(
+            harvester, record, source, segments, scheme=scheme, seed=seed, initial=initial,
+            keep=(record_paths, record_every), threads=threads, progress=progress,
+            check_step=check_step,
+        )  # fmt: skip
     run = validated(
         harvester,
         record.spectrum,  # validated as a spectrum; the record replaces it below
@@ -142,3 +155,24 @@ class RecordSimulation(SimulationResult):
         if v2.size < 3 or np.std(v2) == 0:
             return float("nan")
         return float(np.corrcoef(v2[:-1], v2[1:])[0, 1])
+
+
+def _assembly_on_record(
+    assembly, record, source, segments, *, scheme, seed, initial, keep, threads, progress,
+    check_step,
+) -> AssemblySimulationResult:  # fmt: skip
+    """:func:`monte_carlo_on_record` of an assembly: the same windows, the assembly's kernel.
+
+    ``keep`` is (record_paths, record_every).
+    """
+    dt = source.dt
+    run = validated_assembly(
+        assembly, record.spectrum, scheme, t_end=source.n_steps * dt, dt=dt,
+        burn_in=source.n_burn * source.substeps * dt, n_paths=segments, seed=seed, first_path=0,
+        initial=initial, dW=None, record=keep,
+    )  # fmt: skip
+    run = dataclasses.replace(run, excitation=record, psd=None, driver=source)
+    return execute_assembly(
+        run, control_variates=False, check_step=check_step, threads=threads, batch_paths=None,
+        progress=progress,
+    )  # fmt: skip

@@ -56,9 +56,11 @@ import time
 
 from randvib._interrupts import ctrl_c_noticed
 from randvib._progress import progress_wanted
+from randvib.models.assembly import Assembly
 from randvib.models.excitation import Excitation
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import driven
+from randvib.montecarlo.assembly_simulation import simulate_assembly
 from randvib.montecarlo.batches import batch_bounds, run_batches
 from randvib.montecarlo.bridge_step import (
     check_bridge_balance,
@@ -77,7 +79,7 @@ __all__ = ["simulate"]
 
 
 def simulate(
-    harvester: Harvester,
+    harvester: Harvester | Assembly,
     psd: float | Excitation,
     *,
     t_end: float,
@@ -104,8 +106,14 @@ def simulate(
 
     Parameters
     ----------
-    harvester : Harvester
-        Device with scalar parameters; any friction model; any coupling
+    harvester : Harvester or Assembly
+        An :class:`~randvib.models.assembly.Assembly` (several DOFs, elements
+        and transducers on relative coordinates) is simulated by its own
+        kernel with the same options
+        (:func:`~randvib.montecarlo.assembly_simulation.simulate_assembly`)
+        and returns an
+        :class:`~randvib.montecarlo.assembly_results.AssemblySimulationResult`.
+        A Harvester: device with scalar parameters; any friction model; any coupling
         (:mod:`randvib.models.coupling`): a coil's current or a piezo's
         voltage is integrated as an auxiliary state with the device, under
         white or rational input, and its mean square is averaged per path
@@ -182,6 +190,8 @@ def simulate(
     Returns
     -------
     SimulationResult
+        Or an :class:`~randvib.montecarlo.assembly_results.AssemblySimulationResult`
+        for an Assembly.
 
     Examples
     --------
@@ -198,6 +208,15 @@ def simulate(
     2.426e-03 +- 2.5e-04 W
     """
     with ctrl_c_noticed():  # a Ctrl-C swallowed by a finaliser still stops the run
+        if isinstance(harvester, Assembly):
+            return simulate_assembly(
+                harvester, psd, t_end=t_end, dt=dt, n_paths=n_paths, burn_in=burn_in, scheme=scheme,
+                seed=seed, dW=dW, initial=initial, first_path=first_path, companion=companion,
+                control_variates=control_variates, histogram_bins=histogram_bins,
+                histogram_range=histogram_range, record_paths=record_paths,
+                record_every=record_every, threads=threads, batch_paths=batch_paths,
+                progress=progress, check_step=check_step,
+            )  # fmt: skip
         run = validated(
             harvester,
             psd,

@@ -32,6 +32,9 @@ such scripts share lives here:
   cases, stored-power tables, the optimum's table, where the resistive figure overstates);
 - :mod:`~randvib.studies.gaussian_error`: the Gaussian answer against Monte Carlo under
   tones or non-Gaussian input, relative errors with intervals and a 5 % verdict;
+- :mod:`~randvib.studies.assembly_cases`: harvesters on a host mode and the single-mass
+  answer (exact, in series), arrays and two-mass harvesters, paired Monte Carlo of
+  assemblies, and the assemblies study's verdicts;
 - :mod:`~randvib.studies.report`: CSV, ``verdicts.json``, Markdown tables, ``report.md``.
 
 A script imports only ``randvib`` (its exports), these building blocks and the
@@ -82,6 +85,7 @@ STUDIES = (
     "design",
     "non-gaussian",
     "electrical-identification",
+    "assemblies",
 )
 
 
