@@ -59,3 +59,5 @@ for name, method in rv.METHODS.items():
     print(f"{name:14} white: {method.accepts(device, 1.0)}, band-pass: "
           f"{method.accepts(device, band)}  ({method.summary})")  # fmt: skip
 print(rv.METHODS["fpk-fast"].refusal(device, band))
+
+plt.show()  # run as a script: the figures in windows (the gallery draws them itself)

@@ -73,3 +73,5 @@ ax.errorbar(
 ax.set_xticks([0, 1, 2], ["Monte Carlo", "Eq. 32", "FPK (fast)"])
 ax.set_ylabel("expected electrical power (mW)")
 ax.legend()
+
+plt.show()  # run as a script: the figures in windows (the gallery draws them itself)

@@ -47,3 +47,5 @@ ax.errorbar(
 ax.set_xlabel("Coulomb friction $F_c$ (mN)")
 ax.set_ylabel("expected electrical power (mW)")
 ax.legend()
+
+plt.show()  # run as a script: the figures in windows (the gallery draws them itself)

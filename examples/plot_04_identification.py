@@ -45,3 +45,5 @@ ax.set_xlabel("time (s)")
 ax.set_ylabel("relative displacement $z$ (mm)")
 ax.set_xlim(0, 1)
 ax.legend()
+
+plt.show()  # run as a script: the figures in windows (the gallery draws them itself)

@@ -77,3 +77,5 @@ ax.set_xticks([0.03, 0.05, 0.1, 0.2, 0.5], ["0.03", "0.05", "0.1", "0.2", "0.5"]
 ax.set_xlabel(r"band-pass damping ratio $\zeta$ (bandwidth $\approx 2 \zeta f_0$)")
 ax.set_ylabel("expected electrical power (mW)")
 ax.legend()
+
+plt.show()  # run as a script: the figures in windows (the gallery draws them itself)

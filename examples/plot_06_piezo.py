@@ -34,3 +34,5 @@ ax.axvline(r_opt, ls=":", color="k", label="optimum")
 ax.set_xlabel("load resistance $R_L$ ($\\Omega$)")
 ax.set_ylabel("power into the load ($\\mu$W)")
 ax.legend()
+
+plt.show()  # run as a script: the figures in windows (the gallery draws them itself)

@@ -52,3 +52,5 @@ power = simulated.power_electrical
 print(f"linearisation on the Welch PSD: {1e3 * predicted:.4f} mW")
 print(f"Monte Carlo on the record:      {1e3 * power.mean:.4f} +- {1e3 * power.ci95:.4f} mW (95 %)")
 print(f"lag-1 correlation of the windows' means: {simulated.lag1_correlation:.2f}")
+
+plt.show()  # run as a script: the figures in windows (the gallery draws them itself)

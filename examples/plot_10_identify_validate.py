@@ -50,3 +50,5 @@ ax.set_xlabel("RMS base acceleration (m/s$^2$)")
 ax.set_ylabel("normalised cost J (Eq. 11)")
 ax.set_ylim(bottom=0)
 ax.set_title("fitted on test B (1.07 m/s$^2$)")
+
+plt.show()  # run as a script: the figures in windows (the gallery draws them itself)

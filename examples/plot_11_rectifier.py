@@ -92,3 +92,5 @@ ax.set_ylabel("power (mW)")
 ax.set_ylim(bottom=0.0)
 ax.set_title(f"bridge with $V_d$ = {1e3 * v_diode:g} mV, S = {psd:g} (m/s²)²/Hz")
 _ = ax.legend(fontsize=8, loc="center right")
+
+plt.show()  # run as a script: the figures in windows (the gallery draws them itself)

@@ -74,3 +74,5 @@ bottom.xaxis.set_minor_formatter(NullFormatter())
 bottom.set_ylim(bottom=1e-4)
 _ = top.legend(fontsize=8)
 _ = bottom.legend(fontsize=8)
+
+plt.show()  # run as a script: the figures in windows (the gallery draws them itself)

@@ -8,7 +8,7 @@ throughout; S is the one-sided PSD of the base acceleration in (m/s^2)^2/Hz.
 # Public names load on first use (PEP 562): ``import randvib`` stays light, and
 # a script that only simulates never pays for the identification, FPK or
 # plotting stacks (time and memory; see benchmarks/bench_engine.py).
-import importlib
+import importlib as _importlib
 
 __version__ = "0.1.0"
 
@@ -111,7 +111,15 @@ _EXPORTS = {
     "randvib.montecarlo.assembly_results": ("AssemblySimulationResult",),
     "randvib.harvester_design.design": ("design",),
     "randvib.harvester_design.result": ("DesignResult",),
-    "randvib.analytic.harvesting_limit": ("gaussian_displacement_budget", "harvesting_limit"),
+    "randvib.analytic.harvesting_limit": (
+        "causal_harvesting_limit",
+        "gaussian_displacement_budget",
+        "harvesting_limit",
+        "record_harvesting_limit",
+        "record_limit_certificate",
+        "RecordLimitCertificate",
+        "RecordLimitWarning",
+    ),
     "randvib.statistics": ("FirstPassage", "Statistic", "estimate", "TimeStatistics"),
     "randvib.montecarlo.step_check": ("StepSizeWarning",),
     "randvib.montecarlo.reliability": (
@@ -136,7 +144,7 @@ def __getattr__(name):
     module = _WHERE.get(name)
     if module is None:
         raise AttributeError(f"module 'randvib' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
+    value = getattr(_importlib.import_module(module), name)
     globals()[name] = value  # later lookups skip this function
     return value
 

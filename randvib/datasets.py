@@ -86,6 +86,7 @@ def _read(rows, name):
         input_column="V1",
         input_kind="force",
         output_column="V2",
+        output_kind="relative_displacement",  # the circuit's response, Eq. 1's z, in volts
         sample_rate=SILVERBOX_SAMPLE_RATE,
         rows=rows,
         name=name,

@@ -6,7 +6,8 @@ with it; it imports nothing of randvib's layers, so every layer may use it.
 (font sizes a journal accepts at column width, a colour-blind-safe cycle);
 :func:`panel_letters` labels the panels (a), (b), (c)...;
 :func:`text_overlaps` lists the pairs of texts (titles, axis labels, tick
-labels, legends) that overlap once drawn, which :func:`save_figure` turns
+labels, legends) that overlap once drawn, and :func:`legends_over_data` the
+legends drawn over data points or lines, which :func:`save_figure` turns
 into a :class:`FigureLayoutWarning` (an error in the tests) before it saves.
 """
 
@@ -189,8 +190,120 @@ def _describe(artist) -> str:
     return artist.get_text() if hasattr(artist, "get_text") else type(artist).__name__
 
 
+def legends_over_data(fig) -> list[str]:
+    """The legends of ``fig`` that cover data, as 'legend X over Y' descriptions.
+
+    Data are the lines, markers, error bars and scatter points drawn in data
+    coordinates of any axes (a twin's too), where they are inside their axes;
+    reference lines in axes coordinates (``axhline``), shaded bands and texts
+    are not counted. A line counts where a segment crosses the legend's
+    frame, a marker where its centre lies inside it (less a pixel).
+    """
+    from matplotlib.collections import LineCollection, PathCollection
+    from matplotlib.transforms import Bbox
+
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    legends = list(fig.legends) + [ax.get_legend() for ax in fig.axes if ax.get_legend()]
+    found = []
+    for legend in legends:
+        if not legend.get_visible():
+            continue
+        frame = legend.get_window_extent(renderer).padded(-1.0)
+        for ax in fig.axes:
+            region = Bbox.intersection(frame, ax.bbox) if ax.get_visible() else None
+            if region is None or region.width <= 0 or region.height <= 0:
+                continue
+            for artist in (*ax.lines, *ax.collections):
+                if not artist.get_visible() or not _in_data_coordinates(artist, ax):
+                    continue
+                if isinstance(artist, PathCollection):
+                    hit = _points_inside(
+                        artist.get_offset_transform(), artist.get_offsets(), region
+                    )
+                elif isinstance(artist, LineCollection):
+                    hit = any(_crosses(artist.get_transform(), path.vertices, region)
+                              for path in artist.get_paths())  # fmt: skip
+                elif hasattr(artist, "get_xydata"):
+                    hit = _line_over(artist, region)
+                else:
+                    continue
+                if hit:
+                    covered = _artist_name(artist, ax)
+                    found.append(f"legend {_legend_name(legend)!r} over {covered!r}")
+                    break
+    return found
+
+
+def _in_data_coordinates(artist, ax) -> bool:
+    """Drawn in ``ax``'s data coordinates (not an axes-fraction reference line)."""
+    transform = artist.get_transform()
+    return transform.contains_branch(ax.transData) or (
+        hasattr(artist, "get_offset_transform")
+        and artist.get_offset_transform().contains_branch(ax.transData)
+    )
+
+
+def _line_over(line, region) -> bool:
+    """A Line2D's segments cross ``region``, or one of its markers lies inside it."""
+    xy = line.get_xydata()
+    if len(xy) == 0:
+        return False
+    drawn = line.get_linestyle() not in ("None", "none", "", " ")
+    if drawn and len(xy) > 1 and _crosses(line.get_transform(), xy, region):
+        return True
+    return line.get_marker() not in ("None", "none", "", " ", None) and _points_inside(
+        line.get_transform(), xy, region
+    )
+
+
+def _points_inside(transform, xy, region) -> bool:
+    import numpy as np
+
+    points = transform.transform(np.asarray(xy, dtype=float))
+    points = points[np.all(np.isfinite(points), axis=1)]
+    inside = (
+        (points[:, 0] >= region.x0)
+        & (points[:, 0] <= region.x1)
+        & (points[:, 1] >= region.y0)
+        & (points[:, 1] <= region.y1)
+    )
+    return bool(np.any(inside))
+
+
+def _crosses(transform, xy, region) -> bool:
+    """Whether the polyline ``xy`` (in ``transform``'s coordinates) enters ``region``."""
+    import numpy as np
+    from matplotlib.path import Path as MplPath
+
+    points = transform.transform(np.asarray(xy, dtype=float))
+    keep = np.all(np.isfinite(points), axis=1)
+    if keep.sum() < 2:
+        return _points_inside(transform, np.asarray(xy)[keep], region) if keep.any() else False
+    return bool(MplPath(points[keep]).intersects_bbox(region, filled=False)) or _points_inside(
+        transform, np.asarray(xy, dtype=float)[keep], region
+    )
+
+
+def _legend_name(legend) -> str:
+    """A legend by its title, else its entries."""
+    title = legend.get_title().get_text()
+    texts = ", ".join(t.get_text() for t in legend.get_texts())
+    return title or texts or "legend"
+
+
+def _artist_name(artist, ax) -> str:
+    """An artist by its label, or by its container's (an error bar's line and bars)."""
+    for container in ax.containers:
+        if artist in container.get_children() and not container.get_label().startswith("_"):
+            return container.get_label()
+    label = artist.get_label()
+    return label if label and not label.startswith("_") else type(artist).__name__
+
+
 def check_layout(fig, name: str) -> None:
-    """Warn (:class:`FigureLayoutWarning`) if ``fig`` lacks constrained layout or texts overlap."""
+    """Warn (:class:`FigureLayoutWarning`) if ``fig`` lacks constrained layout, texts overlap
+    or a legend covers data (:func:`legends_over_data`)."""
     from matplotlib.layout_engine import ConstrainedLayoutEngine
 
     if not isinstance(fig.get_layout_engine(), ConstrainedLayoutEngine):
@@ -199,6 +312,13 @@ def check_layout(fig, name: str) -> None:
     if overlaps:
         warnings.warn(
             f"figure {name}: overlapping texts: " + "; ".join(overlaps),
+            FigureLayoutWarning,
+            stacklevel=3,
+        )
+    covered = legends_over_data(fig)
+    if covered:
+        warnings.warn(
+            f"figure {name}: legend over data: " + "; ".join(covered),
             FigureLayoutWarning,
             stacklevel=3,
         )

@@ -14,7 +14,8 @@ notebook tables, the command line's tables, the studies' reports):
   half-width, a fitted value and its standard error) to the decimal of the
   interval's second significant digit, so that no digit is shown that the
   data do not support (:func:`estimate_parts`, :func:`estimate`,
-  :func:`with_standard_error`).
+  :func:`with_standard_error`); a probability with its interval's ends
+  (:func:`proportion`), which a mean +- half-width would take below 0.
 - **A column of a report table** with a fixed format, so that the column
   lines up (:func:`plus_minus`, :func:`formatted`, :func:`percent`).
 - **An object holding arrays** by their shape and range (:func:`compact`).
@@ -38,6 +39,7 @@ __all__ = [
     "formatted",
     "percent",
     "plus_minus",
+    "proportion",
     "significant",
     "unsigned_zeros",
     "with_standard_error",
@@ -176,6 +178,24 @@ def _fixed(value: float, decimals: int, plain: bool) -> str:
         return f"{rounded:.0f}"
     digits = max(1, math.floor(math.log10(abs(rounded))) + decimals + 1) if rounded else 1
     return f"{rounded:.{digits - 1}e}"
+
+
+def proportion(mean, lower, upper) -> str:
+    """A probability with its (asymmetric) 95 % interval: ``0.0010 [0.00018, 0.0057]``.
+
+    The three numbers to the decimal of the second significant digit of the
+    interval's longer side, as :func:`estimate_parts` writes an estimate.
+
+    Examples
+    --------
+    >>> proportion(0.001, 0.000177, 0.00566)
+    '0.0010 [0.0002, 0.0057]'
+    """
+    half = max(mean - lower, upper - mean) if _finite(lower) and _finite(upper) else 0.0
+    if not half > 0:
+        return f"{significant(mean, 6)} [{significant(lower, 2)}, {significant(upper, 2)}]"
+    shown = [estimate_parts(x, half)[0] for x in (mean, lower, upper)]
+    return f"{shown[0]} [{shown[1]}, {shown[2]}]"
 
 
 def with_standard_error(value, se, interval=None) -> list[str]:

@@ -133,7 +133,12 @@ QUANTITIES: dict[str, Quantity] = {
         "1", "P(reached) by the Poisson crossing approximation", "reached, Poisson*"
     ),
     "stroke_reached_vanmarcke": Quantity(
-        "1", "P(reached) by Vanmarcke's approximation", "reached, Vanmarcke*"
+        "1",
+        "P(reached) by Vanmarcke's approximation (not conservative early in an event)",
+        "reached, Vanmarcke*",
+    ),
+    "stroke_reached_bound": Quantity(
+        "1", "upper bound on P(reached): the expected out-crossings (Rice)", "reached <= (Rice)"
     ),
     # ------------------------------------------------ rare events (randvib.first_passage)
     "probability_first_passage": Quantity(
@@ -168,8 +173,15 @@ QUANTITIES: dict[str, Quantity] = {
     ),
     "input_power": Quantity("W", "power the excitation delivers to the device"),
     "efficiency": Quantity("1", "the objective's power over the input power"),
-    "limit": Quantity("W", "harvesting limit of the mass at the stroke budget"),
-    "fraction_of_limit": Quantity("1", "the optimum's power over the harvesting limit"),
+    "limit": Quantity(
+        "W", "non-causal harvesting limit of the mass with E[z^2] at the budget's Gaussian RMS"
+    ),
+    "limit_hard_stroke": Quantity(
+        "W", "non-causal harvesting limit of the mass held within |z| <= stroke"
+    ),
+    "causal_limit": Quantity("W", "harvesting limit of a causal device at the budget's RMS"),
+    "fraction_of_limit": Quantity("1", "the optimum's power over the non-causal limit"),
+    "fraction_of_causal_limit": Quantity("1", "the optimum's power over the causal limit"),
 }
 
 #: Quantities measured in the unit of a coupling's circuit state, squared.

@@ -15,7 +15,10 @@ the sweeps, the response spectra and every study:
   mean and Holm's step-down correction for a family of them;
 - :class:`FirstPassage` and :func:`median_first_passage`: first-passage times
   censored at the end of the run;
-- :class:`TimeStatistics`: one estimate per time of a transient ensemble.
+- :class:`TimeStatistics`: one estimate per time of a transient ensemble;
+- :func:`proportion` and :func:`wilson_interval`: a probability over paths
+  with the Wilson score interval, which stays in [0, 1] (a mean +- t SE of a
+  rare event goes below zero: ``0.0010 +- 0.0020``).
 """
 
 from __future__ import annotations
@@ -54,6 +57,18 @@ class Statistic:
     ci95: float
     std_error: float
     n_paths: int
+    #: The 95 % interval's ends when it is not mean +- ci95 (a probability's
+    #: Wilson interval, :func:`proportion`); None otherwise. ``ci95`` is then
+    #: the longer side, so that mean +- ci95 still covers the interval.
+    lower: float | None = None
+    upper: float | None = None
+
+    @property
+    def interval(self) -> tuple[float, float]:
+        """The 95 % confidence interval (lower, upper)."""
+        if self.lower is not None:
+            return self.lower, self.upper
+        return self.mean - self.ci95, self.mean + self.ci95
 
     @property
     def relative_ci95(self) -> float:
@@ -61,11 +76,20 @@ class Statistic:
         return self.ci95 / abs(self.mean) if self.mean != 0 else float("nan")
 
     def to_dict(self) -> dict:
-        return {"mean": self.mean, "ci95": self.ci95}
+        """``mean`` and ``ci95``; for a probability also ``ci95_lower`` and ``ci95_upper``."""
+        out = {"mean": self.mean, "ci95": self.ci95}
+        if self.lower is not None:
+            out.update(ci95_lower=self.lower, ci95_upper=self.upper)
+        return out
 
     def __format__(self, spec):
-        """``mean ± ci95``; without a spec the mean is rounded to its interval
-        (:func:`randvib.formatting.estimate`), with one (``f"{stat:.3e}"``) both use it."""
+        """``mean ± ci95`` (a probability: ``mean [lower, upper]``); without a spec the
+        mean is rounded to its interval (:mod:`randvib.formatting`), with one
+        (``f"{stat:.3e}"``) every number uses it."""
+        if self.lower is not None:
+            if not spec:
+                return formatting.proportion(self.mean, self.lower, self.upper)
+            return f"{self.mean:{spec}} [{self.lower:{spec}}, {self.upper:{spec}}]"
         if not spec:
             return formatting.estimate(self.mean, self.ci95)
         return f"{self.mean:{spec}} ± {self.ci95:{spec}}"
@@ -82,11 +106,19 @@ class Statistic:
     # correlation (paired_ratio) and are refused, as is a number divided by one.
     def _scaled(self, factor: float) -> Statistic:
         factor = float(factor)
+        ends = {}
+        if self.lower is not None:
+            low, high = sorted((self.lower * factor, self.upper * factor))
+            ends = {"lower": low, "upper": high}
         return Statistic(self.mean * factor, self.ci95 * abs(factor),
-                         self.std_error * abs(factor), self.n_paths)  # fmt: skip
+                         self.std_error * abs(factor), self.n_paths, **ends)  # fmt: skip
 
     def _shifted(self, offset: float) -> Statistic:
-        return Statistic(self.mean + float(offset), self.ci95, self.std_error, self.n_paths)
+        offset = float(offset)
+        ends = {}
+        if self.lower is not None:
+            ends = {"lower": self.lower + offset, "upper": self.upper + offset}
+        return Statistic(self.mean + offset, self.ci95, self.std_error, self.n_paths, **ends)
 
     def __mul__(self, other):
         return self._scaled(other) if _is_scalar(other) else NotImplemented
@@ -169,6 +201,68 @@ def estimate(samples, controls=None, folds: int = 4) -> Statistic:
     )
 
 
+#: The normal quantile of a two-sided 95 % interval.
+Z95 = float(special.ndtri(0.975))
+
+
+def wilson_interval(p, n, z: float = Z95):
+    """The Wilson score interval of a proportion ``p`` observed over ``n`` trials.
+
+    ``(p + z^2/(2n) +- z sqrt(p (1 - p)/n + z^2/(4 n^2))) / (1 + z^2/n)``
+    (Wilson 1927; Agresti and Coull 1998, Brown, Cai and DasGupta 2001): it
+    stays inside [0, 1] and keeps close to its nominal coverage for rare
+    events, where the Wald interval p +- z sqrt(p (1 - p)/n) has none (it is
+    [0, 0] when no path reached the level). Arrays broadcast.
+
+    Returns
+    -------
+    (lower, upper)
+    """
+    p, n = np.asarray(p, dtype=float), np.asarray(n, dtype=float)
+    z2n = z * z / n
+    centre = (p + z2n / 2.0) / (1.0 + z2n)
+    half = z * np.sqrt(p * (1.0 - p) / n + z2n / (4.0 * n)) / (1.0 + z2n)
+    # at p = 0 (1) the lower (upper) end is 0 (1) exactly, not a rounding of it
+    lower = np.where(p <= 0.0, 0.0, np.clip(centre - half, 0.0, 1.0))
+    upper = np.where(p >= 1.0, 1.0, np.clip(centre + half, 0.0, 1.0))
+    return lower, upper
+
+
+def effective_trials(p, std_error, n_paths):
+    """The number of independent trials behind a probability ``p`` estimated over paths.
+
+    For 0/1 outcomes it is the number of paths. A path's fraction of time
+    beyond a level (in [0, 1], mean p) varies less than one outcome,
+    Var <= p (1 - p), so the estimate's variance p (1 - p) / n_eff defines
+    ``n_eff = p (1 - p) / SE^2 >= n_paths`` (the design-effect adjustment of
+    Korn and Graubard 1998 for correlated samples; a controlled estimate's
+    smaller SE counts as more trials); n_paths where the paths do not vary.
+    Arrays broadcast.
+    """
+    p = np.clip(np.asarray(p, dtype=float), 0.0, 1.0)
+    variance = np.asarray(std_error, dtype=float) ** 2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(variance > 0, p * (1.0 - p) / variance, n_paths)
+    return np.maximum(ratio, n_paths)
+
+
+def proportion(per_path, controls=None) -> Statistic:
+    """A probability over independent paths: the mean with the Wilson 95 % interval.
+
+    ``per_path`` holds one outcome per path: 0 or 1 (did the path reach the
+    stroke), or a fraction of the path's time (beyond the stroke), whose
+    interval counts :func:`effective_trials`. ``controls`` as for
+    :func:`estimate` (the controlled mean, clipped to [0, 1]). ``ci95`` is the
+    interval's longer side, ``std_error`` the estimate's.
+    """
+    plain = estimate(per_path, controls)
+    p = min(max(plain.mean, 0.0), 1.0)
+    trials = effective_trials(p, plain.std_error, plain.n_paths)
+    lower, upper = (float(x) for x in wilson_interval(p, trials))
+    half = max(p - lower, upper - p)
+    return Statistic(p, half, plain.std_error, plain.n_paths, lower=lower, upper=upper)
+
+
 @dataclass(frozen=True)
 class FirstPassage:
     """Time for |z| to first exceed the stroke, from each path's start state.
@@ -248,6 +342,9 @@ class TimeStatistics:
     ci95: np.ndarray
     std_error: np.ndarray
     n_paths: int
+    #: A probability's Wilson interval at each time (:meth:`proportions`); else None.
+    lower: np.ndarray | None = None
+    upper: np.ndarray | None = None
 
     @classmethod
     def from_paths(cls, per_path) -> TimeStatistics:
@@ -259,17 +356,37 @@ class TimeStatistics:
         mean, half = mean_and_half_width(per_path)
         return cls(mean, half, per_path.std(axis=0, ddof=1) / np.sqrt(n), n)
 
+    @classmethod
+    def proportions(cls, per_path) -> TimeStatistics:
+        """Probabilities at each time from outcomes (n_paths, n_times) in [0, 1]: the
+        Wilson interval of :func:`proportion` at each time (``ci95`` its longer side)."""
+        plain = cls.from_paths(per_path)
+        trials = effective_trials(plain.mean, plain.std_error, plain.n_paths)
+        lower, upper = wilson_interval(plain.mean, trials)
+        half = np.maximum(plain.mean - lower, upper - plain.mean)
+        return cls(plain.mean, half, plain.std_error, plain.n_paths, lower, upper)
+
     def __len__(self) -> int:
         return self.mean.size
 
     def __getitem__(self, i) -> Statistic:
+        ends = {}
+        if self.lower is not None:
+            ends = {"lower": float(self.lower[i]), "upper": float(self.upper[i])}
         return Statistic(
-            float(self.mean[i]), float(self.ci95[i]), float(self.std_error[i]), self.n_paths
-        )
+            float(self.mean[i]), float(self.ci95[i]), float(self.std_error[i]), self.n_paths,
+            **ends,
+        )  # fmt: skip
 
     def to_list(self) -> list:
         """[[mean, 95 % half-width], ...] over the times, ready for JSON."""
         return [[float(m), float(h)] for m, h in zip(self.mean, self.ci95, strict=True)]
+
+    def intervals(self) -> list:
+        """[[lower, upper], ...]: the 95 % interval at each time (JSON-ready)."""
+        if self.lower is not None:
+            return [[float(a), float(b)] for a, b in zip(self.lower, self.upper, strict=True)]
+        return [[float(m - h), float(m + h)] for m, h in zip(self.mean, self.ci95, strict=True)]
 
 
 def mean_and_half_width(per_path: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

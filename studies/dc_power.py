@@ -93,9 +93,9 @@ def figure(stored, out):
     for i, (v_d, sub) in enumerate(stored.groupby("v_diode")):
         best = sub.loc[sub.groupby("psd").power_stored.idxmax()]
         zero = (best.power_stored <= 0).to_numpy()
-        if not zero.all():
+        if not zero.all():  # markers only: each level's best V_b differs, nothing between
             ax.errorbar(best.psd[~zero], best.power_stored[~zero], best.power_stored_ci95[~zero],
-                        marker="o", color=colour(i),
+                        marker="o", ls="none", color=colour(i),
                         label=f"bridge, V$_d$ = {v_d:g} V, best V$_b$")  # fmt: skip
         if zero.any() and floor is not None:
             hollow_drawn = True
@@ -103,11 +103,13 @@ def figure(stored, out):
                     color=colour(i), mfc="white",
                     label=f"bridge, V$_d$ = {v_d:g} V: stores 0 W (at the floor)")  # fmt: skip
     ref = stored.drop_duplicates("psd")
-    ax.plot(ref.psd, ref.power_resistive, "k--", label="resistive figure (R$_L$ = R$_C$)")
+    # Monte Carlo at each level too: markers, not a line through levels never simulated
+    ax.plot(ref.psd, ref.power_resistive, "kx", label="resistive figure (R$_L$ = R$_C$)")
     ax.set(xscale="log", yscale="log", xlabel="S ((m/s$^2$)$^2$/Hz)", ylabel="power (W)")
     if hollow_drawn:
         ax.axhline(floor, color="0.6", lw=0.6, ls=":")
-    ax.legend(fontsize=7, title="markers: Monte Carlo with 95 % CI", title_fontsize=7)
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside right upper", fontsize=7,
+               title="markers: Monte Carlo with 95 % CI", title_fontsize=7)  # fmt: skip
     return save_figure(fig, out / "dc_power.png")
 
 

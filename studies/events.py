@@ -215,10 +215,13 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
             ("Energy per event and the stroke", results_section(results, lines, figure)),
             (
                 "Through the event",
-                f"![transient](transient.png)\n\nMean-square displacement, velocity and "
-                f"electrical power against time at S = {level:g}: Monte Carlo (95 % band) "
-                "beside time-dependent statistical linearisation (the paper's device) and the "
-                "exact Lyapunov solution (the linear device); dotted, the envelope's intensity.",
+                f"![transient](transient.png)\n\nMean-square displacement, electrical power, "
+                f"the energy harvested since the event began and P(stroke reached) against "
+                f"time at S = {level:g}: Monte Carlo (95 % band; the whole event's energy as "
+                "one marker at its end; probabilities with Wilson intervals) beside "
+                "time-dependent statistical linearisation (the paper's device) and the exact "
+                "Lyapunov solution with the Poisson and Vanmarcke approximations (the linear "
+                "device); dotted, the envelope's intensity.",
             ),
         ],
     )

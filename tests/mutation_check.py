@@ -493,6 +493,93 @@ MUTATIONS: tuple[Mutation, ...] = (
         "flipped; its derivative must be twice the closed-form E[z z'].",
     ),
     Mutation(
+        name="wilson-centre",
+        path="randvib/statistics.py",
+        edits=(
+            (
+                "centre = (p + z2n / 2.0) / (1.0 + z2n)",
+                "centre = (p + z2n / 2.0) / (1.0 + 1.1 * z2n)",
+            ),
+        ),
+        tests=("tests/test_statistics.py::test_wilson_interval_is_the_score_test_inverted",),
+        why="A probability's Wilson interval (the stroke reached, the time beyond it) with its "
+        "centre pulled towards zero: the ends are no longer where the score test gives z.",
+    ),
+    Mutation(
+        name="causal-anticausal-share",
+        path="randvib/analytic/harvesting_limit.py",
+        edits=(("share = m * m / (16.0 * c_m)", "share = m * m / (8.0 * c_m)"),),
+        tests=(
+            "tests/test_harvesting_bounds.py::"
+            "test_causal_limit_is_the_riccati_optimum_as_its_penalty_vanishes",
+        ),
+        why="The causal bound removes twice the anti-causal share m^2 L(p)^2 p / (16 c_m): "
+        "it falls below what the linear-quadratic (Riccati) optimum of device and shaping "
+        "filter, solved independently, actually takes.",
+    ),
+    Mutation(
+        name="record-bound-primal-residual",
+        path="randvib/analytic/harvesting_limit.py",
+        edits=(
+            (
+                "return min(dual, squares) * stroke**2, squares * stroke**2, fit.status > 0",
+                "return squares * stroke**2, squares * stroke**2, fit.status > 0",
+            ),
+        ),
+        tests=(
+            "tests/test_harvesting_bounds.py::"
+            "test_record_limit_is_certified_when_its_solver_stops_short",
+        ),
+        why="The record bound trusts the least-squares solver's point instead of its dual "
+        "certificate: a solver stopped at its iteration limit gives a 'bound' below the "
+        "converged one.",
+    ),
+    Mutation(
+        name="record-bound-at-rest",
+        path="randvib/analytic/harvesting_limit.py",
+        edits=(("/ (4.0 * c_m) + kinetic / duration", "/ (4.0 * c_m) + 0.0 * kinetic / duration"),),
+        tests=(
+            "tests/test_harvesting_bounds.py::"
+            "test_record_limit_counts_the_kinetic_energy_a_device_starts_with",
+        ),
+        why="The record bound forgets the kinetic energy a device starts with: a device "
+        "moving when the record starts (independent DOP853 run) takes more than it.",
+    ),
+    Mutation(
+        name="bridge-idle-threshold",
+        path="randvib/models/rectifier.py",
+        edits=(
+            (
+                "threshold = self.threshold(v_out)\n",
+                "threshold = self.threshold(v_out) - self.v_diode\n",
+            ),
+        ),
+        tests=(
+            "tests/test_bridge_idle.py::"
+            "test_advice_names_the_rms_the_threshold_and_what_would_help",
+        ),
+        why="An idle bridge's explanation counts one diode drop instead of two (a half-wave "
+        "rectifier's threshold): the threshold it quotes, V_b + 2 V_d = 4.3 V for the issue's "
+        "device, and its ratio to the EMF's exact RMS are wrong.",
+    ),
+    Mutation(
+        name="rice-bound-half",
+        path="randvib/analytic/first_passage.py",
+        edits=(
+            (
+                "np.minimum(1.0, start_beyond + _cumulative(times, rate))",
+                "np.minimum(1.0, start_beyond + 0.5 * _cumulative(times, rate))",
+            ),
+        ),
+        tests=(
+            "tests/test_first_passage_bound.py::"
+            "test_crossing_bound_integrates_a_stationary_rate_exactly",
+        ),
+        why="Rice's bound on P(stroke reached) counts half the expected out-crossings (one "
+        "side of the barrier): no longer an upper bound; checked against the stationary "
+        "rate's exact integral.",
+    ),
+    Mutation(
         name="tone-step-integral",
         path="randvib/montecarlo/forcing.py",
         edits=(

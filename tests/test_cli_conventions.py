@@ -6,7 +6,9 @@ present with one meaning, choices declared as choices.
 
 Covers :mod:`randvib.cli` (the parser, shared flags, one-line errors, the options named
 differently from the API), the tables and device lines of :mod:`randvib.cli._output` and
-:mod:`randvib.cli._device`, and the digits they print (:mod:`randvib.formatting`).
+:mod:`randvib.cli._device`, and the digits they print (:mod:`randvib.formatting`); help
+without importing the commands and a command's help kept (:mod:`randvib.cli._help`), and
+``randvib compile`` (:mod:`randvib.cli.compile`).
 """
 
 import argparse
@@ -404,3 +406,93 @@ def test_refused_sweep_point_is_one_line_without_another_points_advice(capsys):
     one_line_error(capsys, [*base, "--fc", "0.0058:1e300:3"], "fc = 5e+299 is beyond the range")
     code, out, err = run(capsys, *base, "--fc", "0.0058:0.006:2")
     assert code == 0 and err.count("warning: friction takes") == 1, err
+
+
+# ----------------------------------------------------- help and compiling (issue 35, 12 and 15)
+def test_help_lists_the_commands_without_importing_them():
+    """`randvib --help` imported the whole package (4.7-6 s): it now imports no command,
+    hence neither numba, scipy nor pandas; the list names every command with its line."""
+    probe = (
+        "import sys\nfrom randvib.cli import main\n"
+        "try:\n    main(['--help'])\nexcept SystemExit:\n    pass\n"
+        "print(sorted(m for m in ('numba', 'scipy', 'pandas', 'matplotlib') if m in sys.modules))"
+    )
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                          timeout=60, check=False, cwd=ROOT)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    out = done.stdout.splitlines()
+    assert out[-1] == "[]", done.stdout
+    from randvib.cli import COMMAND_HELP
+
+    text = "\n".join(out)
+    for name in COMMAND_HELP:
+        assert name in text
+    # the one-line help of each command's own parser is the list's
+    for name, parser in subcommands().items():
+        choice = next(a for a in build_parser()._actions if a.dest == "command")
+        helps = {c.dest: c.help for c in choice._choices_actions}
+        assert helps[name] == COMMAND_HELP[name], name
+        assert parser.prog == f"randvib {name}"
+
+
+def test_a_commands_help_is_kept_and_printed_without_building_the_parser(capsys, monkeypatch):
+    """`randvib COMMAND --help` is built once, kept beside the package's bytecode (keyed by
+    the sources and the terminal's width), then printed without importing the command."""
+    import randvib.cli as cli
+    from randvib.cli import _help
+
+    monkeypatch.setattr(_help.shutil, "get_terminal_size", lambda: os.terminal_size((97, 40)))
+    _help._path("record").unlink(missing_ok=True)
+    with pytest.raises(SystemExit):
+        cli.main(["record", "--help"])
+    built = capsys.readouterr().out
+    assert built.startswith("usage: randvib record") and _help.kept_help("record") == built
+
+    def no_parser(*args, **kwargs):
+        raise AssertionError("the parser was built")
+
+    monkeypatch.setattr(cli, "build_parser", no_parser)
+    assert cli.main(["record", "--help"]) == 0
+    assert capsys.readouterr().out == built
+    monkeypatch.setattr(_help.shutil, "get_terminal_size", lambda: os.terminal_size((61, 40)))
+    assert _help.kept_help("record") is None  # another width: built again
+    _help._path("record").unlink(missing_ok=True)
+
+
+def test_compile_says_what_it_compiled_and_what_it_loaded(capsys, monkeypatch):
+    """`randvib compile` runs each group of kernels once and says, per group, whether it was
+    compiled or loaded from the cache, and how long the whole took."""
+    from randvib.cli import compile as compile_command
+
+    steps = [("a new kernel", lambda: numba.njit(lambda x: x * 3)(1)), ("nothing", lambda: None)]
+    monkeypatch.setattr(compile_command, "warm_up_steps", lambda: steps)
+    code, out, err = run(capsys, "compile")
+    assert code == 0 and COMPILING not in err, err
+    lines = out.splitlines()
+    assert lines[0] == "compiling randvib's numerical kernels (2 groups; once per install)"
+    assert lines[1].startswith("  [1/2] a new kernel: 1 compiled, ")
+    assert lines[2].startswith("  [2/2] nothing: loaded from the cache, ")
+    assert lines[3].startswith("done in ") and "1 function(s) compiled" in lines[3]
+
+
+def test_design_takes_segments_for_a_record_only(capsys, monkeypatch, tmp_path):
+    """`--segments` (the windows of a record, the Monte Carlo paths) was missing from
+    `design`: passed to rv.design with --record, refused without one."""
+    one_line_error(capsys, ["design", "--preset", "figure9", "--psd", "1", "--stroke", "0.005",
+                            "--vary", "k=40:80", "--segments", "4"],
+                   "`--segments` cuts a record into paths; it needs `--record`")  # fmt: skip
+    import randvib.cli.design as design_command
+
+    seen = {}
+
+    def fake_design(*args, **kwargs):
+        seen.update(kwargs)
+        raise ValueError("stop here")
+
+    monkeypatch.setattr(design_command, "design", fake_design)
+    t = np.arange(2000) * 1e-3
+    path = tmp_path / "record.csv"
+    rv.Record(time=t, base_acceleration=np.sin(2 * np.pi * 8 * t)).to_csv(path)
+    code, out, err = run(capsys, "design", "--preset", "figure9", "--record", path,
+                         "--stroke", "0.005", "--vary", "k=40:80", "--segments", "4")  # fmt: skip
+    assert code == 2 and "stop here" in err and seen["segments"] == 4

@@ -139,3 +139,29 @@ def test_envelope_file_errors(capsys, tmp_path):
                             "--times", 1], "strictly increasing")  # fmt: skip
     one_line_error(capsys, ["power", *DEVICE, "--envelope", "table", "--envelope-file",
                             tmp_path / "missing.csv", "--times", 1], "no such file")  # fmt: skip
+
+
+def test_events_plot_from_both_commands_and_probabilities_as_intervals(capsys, tmp_path):
+    """`--plot` draws an event's figure (issue 35, item 10) from `power` (analytic) and
+    `simulate` (Monte Carlo beside it), refused without `--envelope` and over an existing
+    file; P(stroke reached) is printed with its Wilson interval, never mean +- half."""
+    figure = tmp_path / "event.png"
+    code, out, err = run(capsys, "power", *DEVICE, *SS, "--t-end", 1, "--stroke", 0.004,
+                         "--plot", figure)  # fmt: skip
+    assert code == 0, err
+    assert f"wrote {figure}" in out and figure.stat().st_size > 10_000
+    one_line_error(capsys, ["power", *DEVICE, *SS, "--t-end", 1, "--plot", figure],
+                   "exists")  # fmt: skip
+    one_line_error(capsys, ["simulate", *DEVICE, "--plot", tmp_path / "x.png"],
+                   "`--plot` describes an event: it needs `--envelope`")  # fmt: skip
+    simulated = tmp_path / "simulated.png"
+    code, out, err = run(capsys, "simulate", *DEVICE, *SS, "--times", "0.5,1", "--paths", 32,
+                         "--dt", 5e-4, "--stroke", 0.004, "--plot", simulated, "--json")  # fmt: skip
+    assert code == 0, err
+    data = json.loads(out)
+    assert simulated.stat().st_size > 10_000 and f"wrote {simulated}" in err
+    for (mean, _), (lower, upper) in zip(data["stroke_reached"], data["stroke_reached_interval"],
+                                         strict=True):  # fmt: skip
+        assert 0.0 <= lower <= mean <= upper <= 1.0
+    lower, upper = data["stroke_reached_event_interval"]
+    assert 0.0 <= lower <= data["stroke_reached_event"][0] <= upper <= 1.0

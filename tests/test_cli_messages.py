@@ -249,3 +249,77 @@ def test_messages_name_the_flag_the_user_typed(capsys, record_csv, tmp_path, mon
             # the few refusals that explain the device (not confining) name its parameters
             assert "not confining" in err, (flag, err)
     assert checked >= 3
+
+
+@pytest.fixture(scope="module")
+def voltage_records(tmp_path_factory, record_csv):
+    """The record with a load voltage beside the displacement, with the voltage only,
+    and with the displacement under a name that says nothing (``laser``)."""
+    import pandas as pd
+
+    folder = tmp_path_factory.mktemp("voltage")
+    frame = pd.read_csv(record_csv[0])
+    frame["voltage"] = 0.2 * frame["relative_displacement"].diff().fillna(0.0) * 1000.0
+    files = {
+        "both": frame,
+        "voltage_only": frame.drop(columns="relative_displacement"),
+        "laser": frame.drop(columns="voltage").rename(columns={"relative_displacement": "laser"}),
+    }
+    for name, table in files.items():
+        table.to_csv(folder / f"{name}.csv", index=False)
+    return {name: folder / f"{name}.csv" for name in files}
+
+
+@pytest.mark.parametrize("command", ["identify", "validate"])
+@pytest.mark.parametrize(
+    "file, extra, fragment",
+    [
+        # the issue's trip: a voltage declared (or defaulted) as the displacement
+        ("voltage_only", ["--output-column", "voltage", "--output-kind", "relative_displacement"], "it is declared as (`--output-kind` relative_displacement)"),
+        ("both", ["--output-column", "voltage", "--output-kind", "relative_displacement"], "declare it as what it holds (`--output-kind` voltage)"),
+        # a voltage named as such is a voltage (issue 34): without its circuit it is refused
+        ("voltage_only", ["--output-column", "voltage"], "a `voltage` output is the circuit's: name the coupling"),
+        ("both", ["--output-column", "base_acceleration"], "say what it holds with `--output-kind"),
+        ("both", ["--output-column", "base_acceleration", "--output-kind", "relative_displacement"], "holds the base acceleration"),
+        ("laser", ["--output-column", "laser"], "`--output-column` 'laser': say what it holds with `--output-kind"),
+        ("voltage_only", [], "output column `relative_displacement` not found"),
+    ],
+)  # fmt: skip
+def test_an_output_column_of_another_or_an_undeclared_kind_is_refused(
+    capsys, voltage_records, record_csv, command, file, extra, fragment
+):
+    """identify and validate refuse, in one line naming the flag, to fit a column that is
+    not declared as the relative displacement (issue 35, item 5); before, `--output-column
+    voltage` ran a fit with exit 0 (J = 79.6, k 50 +- 510 in "voltage units")."""
+    path = voltage_records[file]
+    argv = (
+        fit_args(path, *extra)
+        if command == "identify"
+        else ["validate", record_csv[1], path, *extra]
+    )
+    one_line_error(capsys, argv, fragment)
+
+
+def test_a_declared_output_column_is_fitted_and_the_api_agrees(capsys, voltage_records):
+    """Declared (`--output-kind relative_displacement`), a column of any name is fitted,
+    in its own units; the Python reader refuses and accepts exactly what the command does."""
+    from randvib.models.record import read_record
+
+    laser = voltage_records["laser"]
+    code, out, err = run(
+        capsys, *fit_args(laser, "--output-column", "laser", "--output-kind", "relative_displacement")
+    )  # fmt: skip
+    assert code == 0, err
+    assert "laser units" in out
+    with pytest.raises(ValueError, match="what output column `laser` holds is not declared"):
+        read_record(laser, output_column="laser")
+    with pytest.raises(ValueError, match="output column `voltage` holds the load voltage"):
+        read_record(voltage_records["both"], output_column="voltage",
+                    output_kind="relative_displacement")  # fmt: skip
+    with pytest.raises(ValueError, match="output column `voltage` holds the load voltage"):
+        read_record(voltage_records["both"], outputs={"relative_displacement": "voltage"})
+    # named as its kind, a voltage column is read as the load voltage, never as z
+    as_named = read_record(voltage_records["both"], output_column="voltage")
+    assert "relative_displacement" not in as_named.channels and "voltage" in as_named.channels
+    record = read_record(laser, output_column="laser", output_kind="relative_displacement")
+    assert record.z.size == 2000

@@ -7,6 +7,8 @@ types (:mod:`randvib.montecarlo.results`, :mod:`randvib.analytic.power_predictio
 and their units (:mod:`randvib.quantities`).
 """
 
+import re
+
 import numpy as np
 import pytest
 
@@ -101,9 +103,108 @@ def test_identification_repr_leaves_the_history_out():
     assert len(text) < 200 and "0.0079" in text and "fc=0.0058" in text
     frame = result.to_frame()
     assert frame.loc["k", "value"] == 57.4 and frame.loc["k", "unit"] == "N/m"
-    assert not frame.loc["m", "free"] and np.isnan(frame.loc["m", "lower"])
-    assert frame.loc["fc", "upper"] == 0.02
-    assert "(fixed)" in result._repr_html_()
+    assert not frame.loc["m", "free"] and np.isnan(frame.loc["m", "search_lower"])
+    assert frame.loc["fc", "search_upper"] == 0.02  # the search box, named as such
+    assert "lower" not in frame.columns and "upper" not in frame.columns
+    assert np.isnan(frame.loc["k", "std_error"])  # no polish: no standard error, no interval
+    assert "(fixed)" in result._repr_html_() and "polish was skipped" in str(result)
+
+
+def _fitted(**changes):
+    """A saved fit with standard errors and residual diagnostics (as identify writes them)."""
+    names = ["c", "k", "k3", "fc"]
+    saved = {
+        "model": "coulomb",
+        "parameters": {"m": 0.0226, "c": 0.049, "k": 57.4, "k3": 7.07e4, "fc": 0.0058},
+        "free": names,
+        "cost": 0.0079,
+        "bounds": {"c": [1e-4, 1.0], "k": [5.0, 500.0], "k3": [0.0, 1e7], "fc": [0.0, 0.02]},
+        "record": "test",
+        "simulations": 2000,
+        "generations": 50,
+        "elapsed_s": 3.0,
+        "simulations_per_second": 700.0,
+        "message": "converged",
+        "settings": {},
+        "standard_errors": {"c": 0.002, "k": 0.3, "k3": 900.0, "fc": 0.0004},
+        "correlation": {"names": names, "matrix": np.eye(4).tolist()},
+        "noise_std": 1e-6,
+        "dof": 996,
+        "residuals": {
+            "verdict": "structured",
+            "level": 0.01,
+            "ljung_box": 80.0,
+            "ljung_box_p": 1e-7,
+            "cross_correlation_p": 0.5,
+            "autocorrelation_band": 0.08,
+            "cross_correlation_band": 0.08,
+            "autocorrelation": [1.0, 0.3, 0.1],
+            "cross_correlation": [0.0, 0.01, 0.0, 0.02, 0.0],
+            "max_lag": 2,
+            "samples": 1000,
+        },  # fmt: skip
+    }
+    saved.update(changes)
+    return IdentificationResult.from_dict(saved)
+
+
+def test_identification_frame_and_print_show_the_standard_errors_and_the_verdict():
+    """A notebook user reads intervals in to_frame() and print(): the 95 % interval is
+    value +- t(0.975, dof) SE, the search box is named search_lower/search_upper, and the
+    residual verdict is in the table, the repr and the frame's source dict."""
+    from scipy import stats
+
+    result = _fitted()
+    frame = result.to_frame()
+    t = stats.t.ppf(0.975, 996)
+    assert frame.loc["k", "std_error"] == 0.3
+    assert frame.loc["k", "ci95_lower"] == pytest.approx(57.4 - t * 0.3, rel=1e-12)
+    assert frame.loc["k", "ci95_upper"] == pytest.approx(57.4 + t * 0.3, rel=1e-12)
+    assert (frame.loc["k", "search_lower"], frame.loc["k", "search_upper"]) == (5.0, 500.0)
+    assert frame.loc["k", "status"] == "identified" and frame.loc["m", "status"] == "fixed"
+    assert np.isnan(frame.loc["m", "std_error"]) and np.isnan(frame.loc["m", "ci95_lower"])
+    text = str(result)
+    assert "57.40 ± 0.30 [56.81, 57.99]" in text, text
+    assert re.search(r"\n  residual\s+structured\n", text), text
+    assert "k=57.40 ± 0.30" in repr(result) and "residual structured" in repr(result)
+    # a parameter the search left on its bound: no interval, its status says so
+    on_bound = _fitted(parameters={"m": 0.0226, "c": 0.049, "k": 57.4, "k3": 0.0, "fc": 0.0058})
+    row = on_bound.to_frame().loc["k3"]
+    assert row["status"] == "at lower bound" and np.isnan(row["ci95_lower"])
+    assert "k3 (at lower bound)" in str(on_bound)
+
+
+def test_record_and_prediction_reprs_name_what_they_hold():
+    """Record's repr names its channels, and each is an attribute by that name; a
+    prediction, a batch response and residual diagnostics print their sizes and scores,
+    not arrays; a batch of one device makes a Record."""
+    record = rv.synthetic_record(
+        rv.preset("coulomb-td1"), 2.0, duration=0.1, sample_rate=1000.0, seed=2
+    )
+    assert "relative_displacement" in repr(record)
+    assert record.relative_displacement is record.z
+    assert record.base_acceleration is record.input
+    with pytest.raises(AttributeError, match="no 'force' channel; it has base_acceleration"):
+        _ = record.force
+    assert not hasattr(record, "base_velocity")
+    device = rv.preset("coulomb-td1")
+    batch = rv.record_response(device, record)
+    assert batch.z.shape == (1, 100) and "array" not in repr(batch) and "1 device" in repr(batch)
+    rebuilt = batch.to_record()
+    np.testing.assert_array_equal(rebuilt.z, batch.z[0])
+    np.testing.assert_array_equal(rebuilt.base_acceleration, record.base_acceleration)
+    with pytest.raises(ValueError, match=r"one row of a batch"):
+        rv.Record(record.dt, relative_displacement=batch.z, base_acceleration=record.input)
+    two = rv.record_response(device.updated(fc=np.array([0.0, 0.0058])), record)
+    with pytest.raises(ValueError, match="2 devices: give `index`"):
+        two.to_record()
+    np.testing.assert_array_equal(two.to_record(1).z, two.z[1])
+    prediction = rv.predict_record(device, record)
+    text = repr(prediction)
+    assert "array" not in text and "J = " in text and "'synthetic'" in text and "\n" not in text
+    diagnostics = _fitted().residuals
+    assert repr(diagnostics).startswith("ResidualDiagnostics(residual structured")
+    assert "array" not in repr(diagnostics)
 
 
 def test_results_under_a_table_or_a_record_show_themselves():
@@ -172,3 +273,30 @@ def test_units_come_from_one_vocabulary():
     assert all(u == unit(name) for name, _, u in prediction._quantities())
     with pytest.raises(KeyError, match="not a reported quantity"):
         unit("power")
+
+
+def test_simulation_result_round_trips_through_json(simulation):
+    """SimulationResult had no from_dict (reload only by pickle): to_dict(per_path=True)
+    and from_dict give back every statistic exactly, through JSON text, the device (with
+    its friction and stroke) and a named excitation rebuilt; a summary alone, or a table
+    excitation without the table, is refused with what to do."""
+    import json
+
+    from randvib._io import dumps
+
+    back = rv.SimulationResult.from_dict(json.loads(dumps(simulation.to_dict(per_path=True))))
+    assert back.summary() == simulation.summary()
+    assert back.harvester.parameters() == simulation.harvester.parameters()
+    banded = rv.simulate(rv.preset("figure9").updated(stroke=0.002), rv.BandPass(1.0, 8.0, 0.2),
+                         t_end=0.3, burn_in=0.1, dt=5e-4, n_paths=4, seed=1, progress=False)  # fmt: skip
+    again = rv.SimulationResult.from_dict(json.loads(dumps(banded.to_dict(per_path=True))))
+    assert again.summary() == banded.summary() and again.excitation.f0 == 8.0
+    with pytest.raises(ValueError, match=r"to_dict\(per_path=True\)"):
+        rv.SimulationResult.from_dict(simulation.to_dict())
+    table = rv.Tabulated(np.array([1.0, 5.0, 20.0, 30.0]), np.array([0.0, 1.0, 1.0, 0.0]))
+    tabled = rv.simulate(rv.preset("figure9"), table, t_end=0.3, burn_in=0.1, dt=1e-3,
+                         n_paths=4, progress=False)  # fmt: skip
+    saved = json.loads(dumps(tabled.to_dict(per_path=True)))
+    with pytest.raises(ValueError, match="pass it as `excitation`"):
+        rv.SimulationResult.from_dict(saved)
+    assert rv.SimulationResult.from_dict(saved, excitation=table).summary() == tabled.summary()

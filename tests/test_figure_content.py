@@ -6,8 +6,9 @@ carries ticks a reader can place -40 % by, a second axis over a logarithmic
 one is logarithmic too, and the limits follow the data rather than a legend.
 
 Covers :mod:`randvib.studies.figures` (power against stroke exceedance, method
-errors against the level), :mod:`randvib.studies.spectra_figure` and the
-dc-power study's figure (:mod:`randvib.study_scripts.dc_power`).
+errors against the level), :mod:`randvib.studies.spectra_figure`, the events'
+figure (:mod:`randvib.studies.transient_figure`) and the dc-power study's figure
+(:mod:`randvib.study_scripts.dc_power`).
 """
 
 import matplotlib
@@ -157,7 +158,52 @@ def test_dc_power_series_that_stores_nothing_is_drawn_hollow_at_a_floor(monkeypa
     hollow = [line for line in ax.get_lines() if line.get_markerfacecolor() == "white"]
     assert len(hollow) == 1 and len(hollow[0].get_xdata()) == 2  # both levels of V_d = 0.3 V
     assert 0 < max(hollow[0].get_ydata()) < 1e-4 * 0.25
-    texts = [t.get_text() for t in ax.get_legend().get_texts()]
+    (legend,) = kept[0].legends  # beside the axes, off the data (issue 35, item 17)
+    assert ax.get_legend() is None
+    texts = [t.get_text() for t in legend.get_texts()]
     assert any("0.3 V" in t and "0 W" in t for t in texts)
     assert not any("0.3 V, best" in t for t in texts)  # no entry for an empty series
     plt.close("all")
+
+
+@pytest.fixture(scope="module")
+def event_results():
+    """A linear device with a stroke through a short event: Monte Carlo and the exact curves."""
+    device = rv.preset("figure9").updated(fc=0.0, k3=0.0, stroke=0.003)
+    event = rv.Enveloped(rv.BandPass(2.0, 8.0, 0.2), rv.ShinozukaSato.unit_peak(0.5, 2.0))
+    times = np.linspace(0.0, 2.0, 11)
+    simulated = rv.simulate_transient(device, event, t_end=2.0, dt=5e-4, n_paths=40,
+                                      times=times, seed=3, progress=False)  # fmt: skip
+    exact = rv.transient_response(device, event, np.linspace(0.0, 2.0, 201))
+    return simulated, exact
+
+
+def test_transient_figure_shows_energy_and_the_stroke_and_keeps_its_legend_off_the_data(
+    event_results,
+):
+    """Panels b and c were one curve scaled by c_e (issue 35, item 10): the figure now shows
+    the energy harvested since t = 0 (Monte Carlo's whole event at its end) and P(stroke
+    reached) with its Wilson interval beside the labelled approximations; one legend below
+    the panels; the envelope's axis starts at the data axis' zero."""
+    simulated, exact = event_results
+    fig = rv.plot_transient({"linear": (simulated, exact)})
+    axes = [ax for ax in fig.axes if ax.get_ylabel() != "$e(t)^2$"]
+    labels = [ax.get_ylabel() for ax in axes]
+    assert labels == ["E[$z^2$] (mm$^2$)", "E[$P_e$] (mW)", "energy since t = 0 (mJ)",
+                      "P(|z| reached the stroke)"]  # fmt: skip
+    energy_ax, stroke_ax = axes[2], axes[3]
+    curve = next(line for line in energy_ax.get_lines() if len(line.get_xdata()) > 100)
+    assert curve.get_ydata()[-1] == pytest.approx(1e3 * exact.energy_electrical, rel=1e-9)
+    marker = next(line for line in energy_ax.get_lines() if list(line.get_xdata()) == [2.0])
+    assert marker.get_ydata()[0] == pytest.approx(1e3 * simulated.energy_electrical.mean)
+    reached = simulated.stroke_reached
+    assert np.all(reached.lower >= 0.0) and np.all(reached.upper <= 1.0)
+    stroke_labels = [line.get_label() for line in stroke_ax.get_lines()]
+    assert "linear (Poisson, approximate)" in stroke_labels
+    assert "linear (Vanmarcke, approximate)" in stroke_labels
+    (bound,) = [line for line in stroke_ax.get_lines() if "upper bound" in line.get_label()]
+    np.testing.assert_array_equal(bound.get_ydata(), exact.stroke_reached_bound)
+    assert all(ax.get_legend() is None for ax in fig.axes) and len(fig.legends) == 1
+    twin = next(ax for ax in fig.axes if ax.get_ylabel() == "$e(t)^2$")
+    assert twin.get_ylim()[0] == 0.0 == axes[0].get_ylim()[0]
+    plt.close(fig)

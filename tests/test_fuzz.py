@@ -411,3 +411,96 @@ def test_monte_carlo_on_record_refuses_or_is_finite(short_record, p, scale, segm
     if result is not None:
         for name in ("power_electrical", "velocity_variance", "displacement_variance"):
             assert math.isfinite(getattr(result, name).mean), (name, result)
+
+
+# --------------------------------------------------- issue 35, item 18: the new flags' crashes
+BRIDGE_ARGS = ["--preset", "figure9", "--coupling", "inductive", "--rectifier", "bridge",
+               "--alpha", "0.1992", "--r-coil", "0.48", "--battery", "0.02"]  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def event_files(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("events")
+    (folder / "huge.csv").write_text("time,envelope\n0,0\n0.5,1e300\n1,0\n")
+    (folder / "psd.csv").write_text("frequency,psd\n1,1\n10,1\n20,1\n")
+    return folder
+
+
+@pytest.mark.parametrize(
+    "argv, flag",
+    [
+        # internal errors before (OverflowError, ZeroDivisionError, MemoryError)
+        (["power", *BRIDGE_ARGS, "--psd", "1", "--v-diode", "1e300", "--optimal-load"], "--optimal-bounds"),
+        (["power", *BRIDGE_ARGS, "--psd", "0", "--v-diode", "1e300", "--optimal-load"], "--psd"),
+        (["simulate", "--preset", "figure9", "--psd", "1", "--envelope", "table", "--envelope-file",
+          "{huge}", "--times", "0.5", "--paths", "4"], "--envelope-file"),
+        (["simulate", "--preset", "figure9", "--psd", "1", "--envelope", "shinozuka-sato",
+          "--envelope-a", "1e300", "--envelope-b", "1", "--envelope-c", "2", "--times", "0.5",
+          "--paths", "4"], "--envelope-a"),
+        (["simulate", "--preset", "figure9", "--psd", "1", "--envelope", "step", "--times", "1e9",
+          "--paths", "4"], "--t-end"),
+        (["simulate", "--preset", "figure9", "--psd", "1", "--envelope", "shinozuka-sato",
+          "--envelope-b", "1e-310", "--envelope-c", "1e-309", "--times", "0.5", "--paths", "4"],
+         "--envelope-b"),
+        (["power", "--preset", "figure9", "--coupling", "inductive", "--rectifier", "bridge",
+          "--alpha", "1e200", "--r-coil", "1e-200", "--battery", "0.02", "--psd", "1"], "--alpha"),
+        # refused without naming a flag before (the design's infeasible budget)
+        (["design", "--preset", "figure9", "--psd", "1", "--stroke", "0.005", "--vary", "k=40:80",
+          "--no-monte-carlo", "--no-progress", "--exceedance", "1e-300"], "--exceedance"),
+        # ran without end before
+        (["design", "--preset", "figure9", "--psd", "1", "--stroke", "0.005", "--vary", "k=40:80",
+          "--precision", "1e-300"], "--precision"),
+    ],
+)  # fmt: skip
+def test_new_flags_at_extreme_values_are_refused_in_one_line_naming_the_flag(
+    capsys, event_files, argv, flag
+):
+    argv = [a.format(huge=event_files / "huge.csv") for a in argv]
+    code, out, err = _run(capsys, argv)
+    _check_contract(code, out, err, False)
+    assert code == 2 and f"`{flag}" in err, err
+    if flag == "--exceedance":  # the budget is the stroke's, in the ranges varied
+        assert "`--stroke` = 0.005 m" in err and "(`--vary`)" in err, err
+
+
+def test_a_unit_peak_envelope_with_rates_far_apart_peaks_at_one():
+    """The peak time log(c / b) / (c - b) overflowed for b near float64's smallest (c / b
+    beyond float64) and the amplitude came out 0; as log c - log b it is finite."""
+    envelope = rv.ShinozukaSato.unit_peak(1e-320, 1.0)
+    t_peak = envelope.peak_time
+    assert t_peak == pytest.approx(-np.log(1e-320), rel=1e-12)  # log(c / b) / (c - b), c = 1
+    assert envelope.peak == pytest.approx(1.0, rel=1e-12)
+
+
+def test_valid_extremes_of_the_new_flags_run_and_are_finite(capsys, event_files):
+    """A tabulated spectrum through an event printed JSON that could not be written
+    (Tabulated is not JSON); a stroke of 1e300 m overflowed the design's limit and first
+    passage: both are valid requests with finite answers."""
+    argv = ["simulate", "--preset", "figure9", "--psd-file", event_files / "psd.csv",
+            "--envelope", "step", "--times", "0.05", "--paths", "4", "--dt", "1e-3", "--json"]  # fmt: skip
+    code, out, err = _run(capsys, argv)
+    _check_contract(code, out, err, True)
+    assert code == 0 and json.loads(out)["psd"] is None  # a table has no single level
+    argv = ["design", "--preset", "figure9", "--psd", "1", "--excitation", "band-pass",
+            "--f0", "8", "--zeta", "0.2", "--stroke", "1e300", "--vary", "k=40:80",
+            "--no-monte-carlo", "--json"]  # fmt: skip
+    code, out, err = _run(capsys, argv)
+    _check_contract(code, out, err, True)
+    data = json.loads(out)
+    assert code == 0 and data["stroke_exceedance_predicted"] == 0.0 and data["limit"] > 0
+
+
+def test_a_closure_too_stiff_to_finish_is_stopped_and_refused(capsys, monkeypatch):
+    """`power --psd 1e-300 --envelope shinozuka-sato` ran without end (the friction's
+    equivalent damping against a vanishing input: a stiffness the solver crawls through).
+    The moment equations are stopped after a bounded number of evaluations (here lowered,
+    so that the test is quick) and refused naming Monte Carlo."""
+    from randvib.analytic import transient
+
+    monkeypatch.setattr(transient, "MAX_EVALUATIONS", 3000)
+    monkeypatch.setattr(transient, "MAX_EVALUATIONS_PER_SECOND", 500)
+    argv = ["power", "--preset", "figure9", "--psd", "1e-300", "--envelope", "shinozuka-sato",
+            "--envelope-b", "0.5", "--envelope-c", "2", "--t-end", "6"]  # fmt: skip
+    code, out, err = _run(capsys, argv)
+    _check_contract(code, out, err, False)
+    assert code == 2 and "stopped at t = " in err and "randvib simulate --envelope" in err

@@ -131,7 +131,11 @@ def test_read_record_round_trip_and_mapping(tmp_path, record):
         tmp_path / "m.csv", record, base_acceleration="acc", relative_displacement="laser"
     )
     frame = read_record(
-        mapped, input_column="acc", input_kind="base_acceleration", output_column="laser"
+        mapped,
+        input_column="acc",
+        input_kind="base_acceleration",
+        output_column="laser",
+        output_kind="relative_displacement",
     )
     np.testing.assert_allclose(frame.input, record.input)
     no_time = tmp_path / "nt.csv"

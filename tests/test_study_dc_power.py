@@ -37,3 +37,25 @@ def test_dc_power_quick_run_and_its_verdicts(tmp_path, capsys):
     assert set(optimum.optimum.str.split(" ").str[0]) <= {"interior", "upper", "lower", "refused"}
     assert (out / "report.md").read_text().count("## ") == 3
     assert (out / "dc_power.png").stat().st_size > 0
+
+
+def test_dc_power_figure_draws_monte_carlo_levels_as_points_not_lines(tmp_path, monkeypatch):
+    """On log axes a line through two Monte Carlo levels (each at its own best battery)
+    drew a trend nothing computed (issue 35): every series is markers only."""
+    from randvib.study_scripts import dc_power
+
+    drawn = {}
+    monkeypatch.setattr(dc_power, "save_figure", lambda fig, path: drawn.setdefault("fig", fig))
+    rows = [
+        {"psd": s, "v_diode": d, "battery": b, "power_stored": p, "power_stored_ci95": 0.1 * p,
+         "power_resistive": 2e-3 * s}
+        for s in (0.25, 1.0) for d in (0.0, 0.02) for b, p in ((0.01, 1e-4 * s), (0.03, 3e-4 * s))
+    ]  # fmt: skip
+    dc_power.figure(pd.DataFrame(rows), tmp_path)
+    lines = [
+        line for ax in drawn["fig"].axes for line in ax.get_lines() if len(line.get_xdata()) > 1
+    ]
+    assert lines, "nothing drawn"
+    assert all(line.get_linestyle() == "None" for line in lines), [
+        (line.get_label(), line.get_linestyle()) for line in lines
+    ]

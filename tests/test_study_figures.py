@@ -57,6 +57,37 @@ def test_overlapping_texts_are_found():
     assert text_overlaps(fig)
 
 
+def test_a_legend_over_data_is_found_and_one_beside_them_is_not(tmp_path):
+    """The check that keeps legends off the data (issue 35, item 17): a legend on a line,
+    on markers or on error bars is named with what it covers; a legend below the panels,
+    or over a reference line in axes coordinates only, is not."""
+    from randvib.figure_style import legends_over_data
+
+    x = np.linspace(0.0, 1.0, 50)
+    fig, axes = new_figure(1, 1, figsize=(4, 3))
+    ax = axes[0, 0]
+    ax.plot(x, 1.0 - x, label="falling line")  # through the upper left corner
+    ax.legend(loc="upper left")
+    assert legends_over_data(fig) == ["legend 'falling line' over 'falling line'"]
+    with pytest.warns(FigureLayoutWarning, match="legend over data"):
+        save_figure(fig, tmp_path / "covered.png")
+    fig, axes = new_figure(1, 1, figsize=(4, 3))
+    ax = axes[0, 0]
+    ax.errorbar([0.9], [0.9], yerr=[0.05], fmt="o", label="Monte Carlo")
+    ax.plot(x, x**4, label="curve")
+    ax.set(xlim=(0, 1), ylim=(0, 1))
+    ax.axhline(0.95, color="k")  # a reference line in axes coordinates: not data
+    ax.legend(loc="upper right")
+    assert legends_over_data(fig) == ["legend 'curve, Monte Carlo' over 'Monte Carlo'"]
+    ax.get_legend().remove()
+    ax.legend(loc="upper left")  # over the axhline only
+    assert legends_over_data(fig) == []
+    ax.get_legend().remove()
+    fig.legend(*ax.get_legend_handles_labels(), loc="outside lower center")
+    assert legends_over_data(fig) == []
+    assert save_figure(fig, tmp_path / "clean.png").stat().st_size > 0
+
+
 def test_save_figure_refuses_layout_without_constrained_engine(tmp_path):
     import matplotlib.pyplot as plt
 

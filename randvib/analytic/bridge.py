@@ -64,9 +64,10 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy import optimize, special
 
+from randvib._validation import check_positive
 from randvib.analytic.linear_response import device_block, output_variances
 from randvib.analytic.linearisation import linear_displacement_variance
-from randvib.analytic.method import AnalyticMethod, Validity, non_white
+from randvib.analytic.method import MONTE_CARLO, AnalyticMethod, Validity, non_white
 from randvib.analytic.power_prediction import PowerPrediction
 from randvib.formatting import compact
 from randvib.models.excitation import Measured, as_excitation
@@ -103,6 +104,12 @@ MIN_LOAD_OVER_COIL = 4.0
 CAPACITOR_ERROR = 0.095
 
 
+#: Threshold in velocity standard deviations beyond which the bridge's Gaussian moments
+#: are 0 in float64 (Q(38) = 2.9e-316, below the smallest normal number): computing
+#: them would overflow (u0^2 of a 1e300 V drop) for nothing.
+NEVER_CONDUCTS = 38.0
+
+
 def _tail(a):
     """Q(a) = P(N(0,1) > a)."""
     return 0.5 * special.erfc(a / np.sqrt(2.0))
@@ -119,6 +126,8 @@ def bridge_moments(coil: BridgeCoil, sigma_v: float, v_out: float):
     if sigma_v <= 0.0:
         return 0.0, 0.0, 0.0
     a = u0 / sigma_v
+    if a > NEVER_CONDUCTS:  # Q(a) < 1e-315: every moment is 0 to float64 precision
+        return 0.0, 0.0, 0.0
     q, p = _tail(a), _pdf(a)
     power = 2.0 * coil.alpha * g * sigma_v**2 * q
     mean_abs_i = 2.0 * g * (sigma_v * p - u0 * q)
@@ -412,7 +421,21 @@ def optimal_dc_output(harvester: Harvester, psd) -> DcOptimum:
     >>> print(f"V_b* = {best.value:.4f} V, {best.power_stored:.4e} W, {best.where}")
     V_b* = 0.0410 V, 6.5536e-04 W, interior
     """
-    BRIDGE_CLOSURE.require(harvester, psd, who="optimal_dc_output")
+    if not non_white(psd):  # checked as randvib.predict checks it
+        check_positive("psd", float(getattr(psd, "level", psd)), "(m/s^2)^2/Hz")
+    try:
+        BRIDGE_CLOSURE.require(harvester, psd, who="optimal_dc_output")
+        return _closure_optimum(harvester, psd)
+    except ValueError as refusal:  # the optimum's own Monte Carlo, not a plain simulation
+        raise ValueError(str(refusal).replace(MONTE_CARLO, MONTE_CARLO_OPTIMUM)) from None
+
+
+#: The alternative that :func:`optimal_dc_output`'s refusals name.
+MONTE_CARLO_OPTIMUM = "Monte Carlo over a range you give (randvib.simulated_dc_optimum)"
+
+
+def _closure_optimum(harvester: Harvester, psd) -> DcOptimum:
+    """:func:`optimal_dc_output` on a case the closure accepts (refused beyond its validity)."""
     psd = psd if non_white(psd) else float(getattr(psd, "level", psd))
     coil = harvester.electrical
     if coil.has_battery:

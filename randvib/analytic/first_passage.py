@@ -70,7 +70,9 @@ def outcrossing_rate(z2, zv, v2, barrier) -> np.ndarray:
         + mu * special.ndtr(ratio),
         np.maximum(mu, 0.0),
     )
-    density = np.exp(-0.5 * barrier**2 / safe) / (sz * np.sqrt(2 * np.pi))
+    with np.errstate(over="ignore"):  # a barrier beyond float64's square is never crossed
+        exponent = -0.5 * np.square(np.asarray(barrier, dtype=float)) / safe
+    density = np.exp(exponent) / (sz * np.sqrt(2 * np.pi))
     return np.where(spread, 2.0 * density * conditional, 0.0)
 
 
@@ -87,12 +89,27 @@ def vanmarcke_hazard(rate, z2, barrier, bandwidth) -> np.ndarray:
     return np.where(spread, np.asarray(rate, dtype=float) * clumping, 0.0)
 
 
+def _cumulative(times, rate) -> np.ndarray:
+    """int_0^t rate dt at ``times`` (from t = 0), trapezoid rule."""
+    times = np.asarray(times, dtype=float)
+    rate = np.asarray(rate, dtype=float)
+    return np.concatenate([[0.0], np.cumsum(0.5 * np.diff(times) * (rate[1:] + rate[:-1]))])
+
+
 def probability_from_hazard(times, hazard) -> np.ndarray:
     """P(reached by t) = 1 - exp(-int_0^t h), trapezoid rule on ``times`` (from t = 0)."""
-    times = np.asarray(times, dtype=float)
-    hazard = np.asarray(hazard, dtype=float)
-    integral = np.concatenate([[0.0], np.cumsum(0.5 * np.diff(times) * (hazard[1:] + hazard[:-1]))])
-    return -np.expm1(-integral)
+    return -np.expm1(-_cumulative(times, hazard))
+
+
+def crossing_bound(times, rate, start_beyond: float = 0.0) -> np.ndarray:
+    """Rice's upper bound on P(reached by t): ``start_beyond + int_0^t rate dt``, at most 1.
+
+    The probability of at least one out-crossing is at most their expected
+    number (Markov's inequality), whatever their clumping; ``start_beyond``
+    is P(|z(0)| > b) (0 from rest). ``rate`` is :func:`outcrossing_rate` on
+    ``times`` (from t = 0), integrated by the trapezoid rule.
+    """
+    return np.minimum(1.0, start_beyond + _cumulative(times, rate))
 
 
 def spectral_bandwidth(block: StateSpace, excitation: Excitation, output: str = "z") -> float:

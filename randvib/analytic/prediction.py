@@ -67,7 +67,16 @@ METHODS: dict[str, AnalyticMethod] = register_methods(
 )
 
 
-def predict(harvester: Harvester, psd, method="linearisation") -> PowerPrediction:
+def default_method(harvester: Harvester) -> str:
+    """The method used when none is named: the bridge closure for a device with a diode
+    bridge (``randvib power`` chooses the same), statistical linearisation otherwise (and
+    for an assembly, whose only method it is)."""
+    if isinstance(harvester, Assembly):
+        return "linearisation"
+    return "bridge-closure" if harvester.is_rectified else "linearisation"
+
+
+def predict(harvester: Harvester, psd, method=None) -> PowerPrediction:
     """Predict the stationary response and power under white noise or another excitation.
 
     Parameters
@@ -83,8 +92,10 @@ def predict(harvester: Harvester, psd, method="linearisation") -> PowerPredictio
         One-sided base-acceleration PSD S ((m/s^2)^2/Hz), > 0 (white noise,
         paper Eq. 17), or an excitation object: ``White(S)`` is the same as
         S; a non-white one needs a method that declares ``coloured``.
-    method : str or AnalyticMethod
-        A key of :data:`METHODS` (or a method object): ``"linearisation"``
+    method : str or AnalyticMethod, optional
+        A key of :data:`METHODS` (or a method object). Default
+        (:func:`default_method`): ``"bridge-closure"`` for a device with a
+        diode bridge, else ``"linearisation"``
         (paper Eq. 19-32), ``"averaging"`` (stochastic averaging, beyond
         Gaussian closure), ``"fpk-fast"`` (small corrected FPK grids; the
         power and its k3 dependence to about 0.05 %, about 3 ms per point) or
@@ -133,7 +144,7 @@ def predict(harvester: Harvester, psd, method="linearisation") -> PowerPredictio
             f"randvib.predict gives stationary statistics; the {psd.name} event's transient "
             "response is randvib.transient_response (or Monte Carlo, randvib.simulate_transient)"
         )
-    solver = method_named(method)
+    solver = method_named(default_method(harvester) if method is None else method)
     if isinstance(harvester, Assembly):  # several DOFs: randvib.analytic.assembly_prediction
         return predict_assembly(harvester, psd, solver)
     solver.require(harvester, psd)
@@ -257,7 +268,7 @@ def _out_of_range(method, harvester, psd, what, overflow: bool = True) -> str:
 
 
 def expected_power(
-    harvester: Harvester, psd, method: str = "linearisation", *, into: str = "electrical"
+    harvester: Harvester, psd, method: str | None = None, *, into: str = "electrical"
 ):
     """Expected power (W) delivered by the harvester under white noise or an excitation.
 
@@ -290,8 +301,8 @@ def expected_power(
     return result.power_electrical
 
 
-def velocity_variance(harvester: Harvester, psd, method: str = "linearisation"):
-    """E[z'^2] ((m/s)^2) (paper Eq. 20 for linearisation)."""
+def velocity_variance(harvester: Harvester, psd, method: str | None = None):
+    """E[z'^2] ((m/s)^2) (paper Eq. 20 for linearisation; ``method`` as :func:`predict`'s)."""
     return predict(harvester, psd, method).velocity_variance
 
 

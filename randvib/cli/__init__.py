@@ -1,4 +1,4 @@
-"""Command line: ``randvib <command> ...``.
+"""Command line: ``randvib <command> [options]``.
 
 Each command lives in its own module exposing ``register(subparsers)`` which
 adds its parser and sets ``handler``; :data:`COMMANDS` lists the modules.
@@ -25,7 +25,24 @@ from randvib._interrupts import interrupted_exit, interrupts_seen, sigterm_stops
 from randvib._locks import held, release_since
 
 #: Command modules under randvib.cli, in the order shown by --help.
-COMMANDS = ["power", "design", "simulate", "reliability", "study", "record", "identify", "validate"]
+COMMANDS = [
+    "power", "design", "simulate", "reliability", "study", "record", "identify", "validate",
+    "compile",
+]  # fmt: skip
+
+#: Each command's line in ``randvib --help`` (its module's parser uses the same), here so
+#: that the list of commands is printed without importing them (numba, scipy, pandas).
+COMMAND_HELP = {
+    "power": "analytic expected power under white noise or a coloured excitation",
+    "design": "choose device parameters for the most power under a stroke budget",
+    "simulate": "Monte Carlo simulation under white, coloured or recorded base acceleration",
+    "reliability": "rare end-stop strikes: first-passage probability, crossing rate, exceedance",
+    "study": "run a study script (figures, CSV, Markdown report)",
+    "record": "write a synthetic shaker record of a device (CSV for identify/validate)",
+    "identify": "identify device and friction parameters from a measured record (SaDE, Eq. 11)",
+    "validate": "J (Eq. 11) of identified parameters on other records",
+    "compile": "compile every numerical kernel now (once per install), so no command waits",
+}
 
 #: Options whose name differs from the Python API's argument (docs/command_line.md's table).
 API_NAMES = {
@@ -104,15 +121,38 @@ class _Parser(argparse.ArgumentParser):
     def error(self, message):  # one line, no usage dump, exit 2
         raise UserError(f"{self.prog}: error: {one_line_choice_error(message)}")
 
+    def print_help(self, file=None):
+        """Print the help; a command's is kept for the next time (:mod:`randvib.cli._help`)."""
+        text = self.format_help()
+        command = self.prog.removeprefix("randvib ")
+        if command in COMMANDS and file in (None, sys.stdout):
+            from randvib.cli._help import keep_help
 
-def build_parser() -> argparse.ArgumentParser:
+            keep_help(command, text)
+        self._print_message(text, sys.stdout if file is None else file)
+
+
+def build_parser(argv=None) -> argparse.ArgumentParser:
+    """The ``randvib`` parser; with ``argv``, only the commands it names are built in full.
+
+    Every command module imports the numerical stack (numba, scipy, pandas:
+    seconds); to parse ``argv`` only its own command's module is needed, and
+    ``randvib --help`` needs none (the others are listed by
+    :data:`COMMAND_HELP`). Without ``argv`` every command is built (the
+    reference docs, the tests of every option).
+    """
     from randvib import __version__
 
-    parser = _Parser(prog="randvib", description=__doc__.splitlines()[0])
+    # the docstring's first line without its reStructuredText markup (``randvib ...``)
+    parser = _Parser(prog="randvib", description=__doc__.splitlines()[0].replace("``", ""))
     parser.add_argument("--version", action="version", version=f"randvib {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     sub.required = True
+    wanted = set(COMMANDS) if argv is None else {a for a in argv if a in COMMANDS}
     for name in COMMANDS:
+        if name not in wanted:  # listed by its name and help line only
+            sub.add_parser(name, help=COMMAND_HELP[name], add_help=False)
+            continue
         try:
             module = importlib.import_module(f"randvib.cli.{name}")
         except ModuleNotFoundError as exc:
@@ -164,9 +204,9 @@ def _main_with_warnings(argv) -> int:
         # checked for finiteness instead, and refused with a message naming it
         warnings.filterwarnings("ignore", category=RuntimeWarning, module=r"(numpy|scipy|randvib)")
         warnings.filterwarnings("ignore", message=r"Matrix is exactly singular")
-        # ... but randvib's own advice, also RuntimeWarnings, is for the user
-        for advice in _advice_warnings():
-            warnings.filterwarnings("default", category=advice)
+        # randvib's own advice, also RuntimeWarnings, is for the user: shown, by filters
+        # set once the command is parsed (their classes import the numerical stack, which
+        # `--help` does not need)
         warnings.showwarning = _show_warning
         locks_before = held()
         try:
@@ -184,10 +224,12 @@ def _advice_warnings() -> tuple:
     from randvib.analytic.averaging import AveragingValidityWarning
     from randvib.analytic.prediction import LoadBoundWarning
     from randvib.analytic.statistical_linearisation import LinearisationValidityWarning
+    from randvib.montecarlo.bridge_step import BridgeIdleWarning
     from randvib.montecarlo.step_check import StepSizeWarning
 
     return (
         StepSizeWarning,
+        BridgeIdleWarning,
         AveragingValidityWarning,
         LoadBoundWarning,
         LinearisationValidityWarning,
@@ -307,7 +349,10 @@ def api_flags(parser: argparse.ArgumentParser) -> dict:
 
 
 #: What the compile notice says, once per run, on stderr.
-COMPILING = "randvib: compiling the numerical kernels (once; later runs load them from the cache)"
+COMPILING = (
+    "randvib: compiling the numerical kernels this command needs (each once per install; "
+    "`randvib compile` compiles them all now)"
+)
 
 
 @contextlib.contextmanager
@@ -345,7 +390,17 @@ def _command_parser(parser, command: str) -> argparse.ArgumentParser:
 
 def _main(argv) -> int:
     try:
-        parser = build_parser()
+        argv = sys.argv[1:] if argv is None else [str(a) for a in argv]
+        # only the command named is built: the first word that is one (no option's value is)
+        named = next((a for a in argv if a in COMMANDS), None)
+        if named is not None and {"-h", "--help"} & set(argv[argv.index(named) :]):
+            from randvib.cli._help import kept_help
+
+            text = kept_help(named)  # printed before by this package: no parser to build
+            if text is not None:
+                sys.stdout.write(text)
+                return 0
+        parser = build_parser([] if named is None else [named])
         args, unknown = parser.parse_known_args(argv)
         # "randvib COMMAND" from here on, as argparse names it ("randvib" until then)
         prog = _Running.prog = f"randvib {args.command}"
@@ -354,6 +409,10 @@ def _main(argv) -> int:
             raise UserError(
                 f"{prog}: error: unrecognized arguments: {' '.join(unknown)} (see `{prog} --help`)"
             )
+        for advice in _advice_warnings():
+            warnings.filterwarnings("default", category=advice)
+        if args.command == "compile":  # it says what it compiles itself
+            return int(args.handler(args) or 0)
         with compile_notice():
             return int(args.handler(args) or 0)
     except BrokenPipeError:

@@ -15,6 +15,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+import numpy as np
+
 from randvib.cli._device import option_flag, options_by_parameter, refuse_foreign_options
 from randvib.cli._output import with_units
 from randvib.models.event import ENVELOPES, STARTS, Enveloped, EventStart, ShinozukaSato
@@ -80,6 +82,12 @@ def add_event_arguments(parser: argparse.ArgumentParser, *, t_end: bool = False)
         help="rest (z = 0, v = 0) or unexcited (at rest at the bottom of the potential: "
         "a bistable device in its well at z = +sqrt(-k/k3))",
     )
+    g.add_argument(
+        "--plot",
+        metavar="FILE.png",
+        help="with --envelope: the event's figure (mean squares, power, energy since t = 0, "
+        "P(stroke reached)); a new file",
+    )
     if t_end:
         g.add_argument(
             "--t-end",
@@ -93,7 +101,7 @@ def add_event_arguments(parser: argparse.ArgumentParser, *, t_end: bool = False)
 #: The event options other than ``--envelope`` (argparse dests) and their defaults.
 def _event_dests() -> dict:
     dests = {_dest(name): None for name in _envelope_options()}
-    dests.update(envelope_file=None, times=None, start="rest")
+    dests.update(envelope_file=None, times=None, start="rest", plot=None)
     return dests
 
 
@@ -139,7 +147,12 @@ def event_from_args(args, excitation) -> Enveloped:
                 f"`--envelope-file` gives a table envelope; not with `--envelope {name}`"
             )
         envelope = _build(cls, own, given)
-    return Enveloped(excitation, envelope)
+    try:
+        return Enveloped(excitation, envelope)
+    except ValueError as exc:  # the envelope as the user gave it: the file, or its amplitude
+        flag = "--envelope-file" if name == FILE_ENVELOPE else option_flag(_dest("a"))
+        flag = flag if name in (FILE_ENVELOPE, ShinozukaSato.name) else "--envelope"
+        raise ValueError(str(exc).replace("`envelope`", f"`{flag}`")) from None
 
 
 def _build(cls, own, given):
@@ -225,7 +238,7 @@ def event_settings(event: Enveloped, start: EventStart) -> str:
 # ------------------------------------------------------------ the two commands
 def _level(psd):
     """The JSON's ``psd``: the white level, or the excitation's level (None for a table)."""
-    return getattr(psd, "level", psd) if not isinstance(psd, int | float) else psd
+    return psd if isinstance(psd, int | float) else getattr(psd, "level", None)
 
 
 def _refuse_with_event(flags: dict) -> None:
@@ -265,6 +278,7 @@ def simulate_event(args, harvester, psd) -> int:
     )
     event = event_from_args(args, psd)
     start = start_from_args(args, harvester)
+    plot = _claimed_plot(args)
     # without either, simulate's own default window (20 s)
     t_end = 20.0 if args.t_end is None and args.times is None else args.t_end
     times, t_end = parse_times(args.times, t_end)
@@ -282,11 +296,41 @@ def simulate_event(args, harvester, psd) -> int:
         progress=False if args.no_progress or args.json else None,
     )
     out = {"psd": _level(psd), "friction": harvester.friction_name, **result.to_dict()}
+    analytic = _analytic_beside(harvester, event, result.times, result.t_end, start)
     if args.json:
         print(dumps(with_units(out, harvester.electrical)))
+    else:
+        _print_simulated(harvester, psd, event, start, result, analytic)
+    if plot is not None and analytic is not None:  # the curves on a fine grid
+        fine = np.linspace(0.0, result.t_end, 401)
+        analytic = _analytic_beside(harvester, event, fine, result.t_end, start)
+    return _draw_event(plot, result, analytic, args.json)
+
+
+def _claimed_plot(args):
+    """``--plot``'s file, checked before the run (a new file unless ``--force``)."""
+    from randvib._io import claim_output_file
+
+    if args.plot is None:
+        return None
+    return claim_output_file(args.plot, "--plot", overwrite=getattr(args, "force", False))
+
+
+def _draw_event(plot, simulated, analytic, json_out: bool) -> int:
+    """The event's figure at ``plot`` (:func:`randvib.plot_transient`); 1 if it cannot be written."""
+    import sys
+
+    from randvib.studies.transient_figure import plot_transient
+
+    if plot is None:
         return 0
-    analytic = _analytic_beside(harvester, event, result.times, result.t_end, start)
-    _print_simulated(harvester, psd, event, start, result, analytic)
+    group = tuple(r for r in (simulated, analytic) if r is not None)
+    try:
+        plot_transient({"device": group}, path=plot)
+    except OSError as exc:
+        print(f"randvib: could not write `--plot` {str(plot)!r} ({exc})", file=sys.stderr)
+        return 1
+    print(f"wrote {plot}", file=sys.stderr if json_out else sys.stdout)
     return 0
 
 
@@ -316,9 +360,8 @@ def _print_simulated(harvester, psd, event, start, result, analytic) -> None:
     headers += ["E[P_e] (W)", "± 95 %"]
     columns = [result.displacement_variance, result.velocity_variance, result.power_electrical]
     reached = result.stroke_reached
-    if reached is not None:
-        headers += ["P(stroke reached)", "± 95 %"]
-        columns.append(reached)
+    if reached is not None:  # a probability: its Wilson interval, never below 0
+        headers += ["P(stroke reached)", "95 % interval"]
     if analytic is not None:
         headers.append("E[P_e] analytic (W)")
     rows = []
@@ -326,6 +369,9 @@ def _print_simulated(harvester, psd, event, start, result, analytic) -> None:
         row = [cell(float(t))]
         for stat in columns:
             row += list(estimate_parts(float(stat.mean[i]), float(stat.ci95[i])))
+        if reached is not None:
+            mean, interval = format(reached[i], "").split(" ", 1)
+            row += [mean, interval]
         if analytic is not None:
             row.append(cell(float(analytic.power_electrical[i])))
         rows.append(row)
@@ -339,11 +385,13 @@ def _print_simulated(harvester, psd, event, start, result, analytic) -> None:
     print(f"peak |z| over the event: {quantiles}")
     if reached is not None:
         p = result.peak_exceedance(harvester.stroke)
-        text = f"P(peak |z| > stroke {harvester.stroke:g} m): {' ± '.join(estimate_parts(p.mean, p.ci95))}"
+        text = f"P(peak |z| > stroke {harvester.stroke:g} m): {p} (95 % interval)"
         if analytic is not None and analytic.stroke_reached_poisson is not None:
             text += (
                 f" (approximate: Poisson {analytic.stroke_reached_poisson[-1]:.4g}, "
-                f"Vanmarcke {analytic.stroke_reached_vanmarcke[-1]:.4g} at t = {result.times[-1]:g} s)"
+                f"Vanmarcke {analytic.stroke_reached_vanmarcke[-1]:.4g}, not conservative early "
+                f"in an event; at most {analytic.stroke_reached_bound[-1]:.4g}, Rice's bound; "
+                f"at t = {result.times[-1]:g} s)"
             )
         print(text)
     print(
@@ -371,6 +419,7 @@ def power_event(args, swept: list, points: list) -> int:
     psd = excitation_from_args(point)
     event = event_from_args(point, psd)
     start = start_from_args(point, harvester)
+    plot = _claimed_plot(args)
     times, t_end = parse_times(point.times, point.t_end)
     result = transient_response(
         harvester, event, times, t_end=t_end, start=start, method=point.method
@@ -378,9 +427,13 @@ def power_event(args, swept: list, points: list) -> int:
     out = {"psd": _level(psd), "friction": harvester.friction_name, **result.to_dict()}
     if args.json:
         print(dumps(with_units(out, harvester.electrical)))
-        return 0
-    _print_predicted(harvester, psd, event, start, result)
-    return 0
+    else:
+        _print_predicted(harvester, psd, event, start, result)
+    if plot is not None:  # the curves on a fine grid, not only at the report times
+        fine = np.linspace(0.0, t_end, 401)
+        result = transient_response(harvester, event, fine, t_end=t_end, start=start,
+                                    method=point.method)  # fmt: skip
+    return _draw_event(plot, None, result, args.json)
 
 
 def _print_predicted(harvester, psd, event, start, result) -> None:
@@ -399,6 +452,7 @@ def _print_predicted(harvester, psd, event, start, result) -> None:
         "stroke_exceedance": "P(|z| > stroke)",
         "stroke_reached_poisson": "reached, Poisson*",
         "stroke_reached_vanmarcke": "reached, Vanmarcke*",
+        "stroke_reached_bound": "reached <= (Rice)",
     }
     shown = [(label, getattr(result, name)) for name, label in names.items()]
     shown = [(label, values) for label, values in shown if values is not None]
@@ -415,5 +469,7 @@ def _print_predicted(harvester, psd, event, start, result) -> None:
     if result.stroke_reached_poisson is not None:
         print(
             "* approximate: out-crossing rates (Poisson; Vanmarcke with bandwidth "
-            f"q = {result.bandwidth:.3g}), checked against Monte Carlo (randvib simulate)"
+            f"q = {result.bandwidth:.3g}, not conservative early in an event), checked against "
+            "Monte Carlo (randvib simulate); 'reached <=' is an upper bound, the expected number "
+            "of out-crossings (Rice)"
         )

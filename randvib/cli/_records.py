@@ -232,5 +232,23 @@ def parse_bounds(items) -> dict:
 
 
 def output_unit(args) -> str:
-    """The unit of the first output channel, its kind's (m for the relative displacement)."""
-    return unit(output_kinds(args)[0])
+    """The unit of the first output channel: its kind's (m for the relative displacement),
+    except a displacement column named otherwise (``--output-column laser --output-kind
+    relative_displacement``), which is read in the column's own units (a sensor's volts)."""
+    kind, column = output_pairs(args)[0]
+    if kind == OUTPUT_CHANNEL and column != kind:
+        return f"{column} units"
+    return unit(kind)
+
+
+def plot_units(args) -> dict:
+    """``scale`` and ``unit`` of the output in ``--plot`` figures.
+
+    A channel in its kind's unit is shown as the figures choose (a
+    displacement in mm); a displacement column in its own units
+    (:func:`output_unit`) is shown as it is.
+    """
+    kind, column = output_pairs(args)[0]
+    if kind != OUTPUT_CHANNEL or column == kind:
+        return {}
+    return dict(scale=1.0, unit=output_unit(args))

@@ -8,9 +8,12 @@ Carlo contradicts it, refined) by Monte Carlo with common random numbers
 (:func:`randvib.design`). ``--json`` prints one object with the keys
 ``optimum``, ``power_predicted``, ``power_monte_carlo``,
 ``stroke_exceedance_monte_carlo`` (each ``{"mean", "ci95"}``),
-``input_power``, ``limit`` (``limit_kind`` says which bound: stationary for
-a spectrum, non-causal on the record for ``--record``), with ``--min-first-passage`` the first passage
-predicted and by Monte Carlo, and the rest of :meth:`randvib.DesignResult.to_dict`.
+``input_power``, ``limit`` (non-causal; ``limit_kind`` says what it bounds:
+the budget's Gaussian RMS for a spectrum, the record itself for ``--record``),
+``limit_hard_stroke`` (any device within abs(z) <= stroke), ``causal_limit``
+(what a causal device can approach) with ``fraction_of_causal_limit``,
+``notes``, with ``--min-first-passage`` the first passage predicted and by
+Monte Carlo, and the rest of :meth:`randvib.DesignResult.to_dict`.
 
 ``--device FILE`` designs an assembly (docs/assemblies.md): ``--vary`` names a
 parameter of the file by its dotted path (``transducer.0.r_load``,
@@ -26,10 +29,11 @@ import argparse
 
 from randvib._io import dumps
 from randvib._validation import MAX_SEED, integer_option
+from randvib.cli import COMMAND_HELP
 from randvib.cli._device import add_device_arguments, assembly_from_args, harvester_from_args
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
 from randvib.cli._output import describe_device, describe_excitation, print_table, with_units
-from randvib.formatting import cell
+from randvib.formatting import cell, estimate, proportion
 from randvib.harvester_design.assembly_budget import vary_refusal
 from randvib.harvester_design.design import design
 from randvib.harvester_design.objectives import OBJECTIVES
@@ -44,7 +48,7 @@ from randvib.quantities import parameter_unit, unit
 def register(sub) -> None:
     p = sub.add_parser(
         "design",
-        help="choose device parameters for the most power under a stroke budget",
+        help=COMMAND_HELP["design"],
         description="Search the ranges given for the device that harvests most from the "
         "excitation with the fraction of time beyond --stroke at most --exceedance: analytic "
         "search, Monte Carlo "
@@ -132,11 +136,19 @@ def register(sub) -> None:
         default=0,
         help="random seed",
     )
+    g.add_argument(
+        "--segments",
+        type=integer_option(2),
+        default=None,
+        help="with --record: windows the record is cut into, the Monte Carlo paths of every "
+        "candidate (default 10)",
+    )
     g.add_argument("--out-dir", help="folder to keep the Monte Carlo cases in and resume from")
     g.add_argument("--scheduler", help="address of a Dask scheduler to run the cases on")
     g.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.set_defaults(handler=run)
+    # SweepSettings' and design's names of the options, as refusals name them
+    p.set_defaults(handler=run, api_flags={"target_rel_ci": "--precision", "stroke": "--stroke"})
 
 
 def vary_option(text: str) -> tuple[str, float, float]:
@@ -219,6 +231,8 @@ def run(args) -> int:
         vary = _assembly_vary(args, assembly)
         device = assembly
     excitation = excitation_from_args(args)
+    if args.segments is not None and getattr(args, "record", None) is None:
+        raise ValueError("`--segments` cuts a record into paths; it needs `--record`")
     settings = SweepSettings(
         target_rel_ci=args.precision,
         max_paths=args.max_paths,
@@ -236,6 +250,7 @@ def run(args) -> int:
         duration=args.duration,
         monte_carlo=not args.no_monte_carlo,
         settings=settings,
+        segments=10 if args.segments is None else args.segments,
         out_dir=args.out_dir,
         scheduler=args.scheduler,
         progress=not args.no_progress and not args.json,
@@ -246,7 +261,25 @@ def run(args) -> int:
         optimum = {k: u for k in result.optimum if (u := parameter_unit(k, result.device))}
         print(dumps(with_units(result.to_dict(), extra=optimum)))
         return 0
-    print(describe_device(device) if assembly is None else f"device: {assembly.describe()}")
+    _print_design(args, result, excitation, vary, assembly is not None)
+    return 0
+
+
+def _estimate(value: dict) -> str:
+    """A Monte Carlo ``{"mean", "ci95"}`` to the digits its interval supports."""
+    return estimate(value["mean"], value["ci95"])
+
+
+def _print_design(args, result, excitation, vary: dict, is_assembly: bool) -> None:
+    """The device chosen (not the ranges' midpoints), the table, and the notes."""
+    if is_assembly:
+        print(f"device at the optimum: {result.device.describe()}")
+    else:
+        print(describe_device(result.device).replace("device:", "device at the optimum:", 1))
+    print("varied: " + ", ".join(
+        f"{k} {cell(lo)} to {cell(hi)} {parameter_unit(k, result.device)}".rstrip()
+        for k, (lo, hi) in vary.items()
+    ))  # fmt: skip
     print(describe_excitation(excitation))
     out = result.to_dict()
     rows = [
@@ -259,8 +292,10 @@ def run(args) -> int:
         value = out[key]
         if value is None:
             continue
-        if isinstance(value, dict):
-            value = f"{cell(value['mean'])} ± {cell(value['ci95'])}"
+        if isinstance(value, dict) and "ci95_lower" in value:  # a probability's interval
+            value = proportion(value["mean"], value["ci95_lower"], value["ci95_upper"])
+        elif isinstance(value, dict):
+            value = _estimate(value)
         rows.append((key, value if isinstance(value, str) else cell(value), unit(key)))
     if args.min_first_passage is not None:
         rows.append(
@@ -274,29 +309,24 @@ def run(args) -> int:
         if first is not None:
             lower = first.restricted_mean
             rows.append(("first_passage_monte_carlo",
-                         f"{cell(first.mean.mean)} ± {cell(first.mean.ci95)}" if first.mean
-                         else f">= {cell(lower.mean)} ± {cell(lower.ci95)} (censored)", "s"))  # fmt: skip
+                         estimate(first.mean.mean, first.mean.ci95) if first.mean
+                         else f">= {estimate(lower.mean, lower.ci95)} (censored)", "s"))  # fmt: skip
             rows.append(("first_passage_confirmed", str(out["first_passage_confirmed"]), ""))
     if args.max_first_passage is not None:
         rows += _strike_rows(out)
     rows.append(("efficiency", cell(out["efficiency"]), unit("efficiency")))
-    if out["limit"] is None:
-        why = "white noise" if assembly is None else "not computed for an assembly"
-        rows.append(("limit", f"none ({why})", ""))
-    else:
-        rows.append(("limit", cell(out["limit"]), unit("limit")))
-    if out["limit_kind"] is not None:
-        rows.append(("limit_kind", out["limit_kind"], ""))
+    rows += result.limit_rows(cell)
     if out.get("monte_carlo_input") is not None:
         rows.append(("monte_carlo_input", out["monte_carlo_input"], ""))
-    if out["fraction_of_limit"] is not None:
-        rows.append(
-            ("fraction_of_limit", cell(out["fraction_of_limit"]), unit("fraction_of_limit"))
-        )
     if result.refined:
         cost = result.analytic_cost
-        rows.append(("analytic optimum's cost", f"{cell(cost.mean)} ± {cell(cost.ci95)}", "W"))
+        rows.append(("analytic optimum's cost", estimate(cost.mean, cost.ci95), "W"))
     print_table(rows, ("quantity", "value", "unit"))
+    for key in ("limit_kind", "causal_limit_kind"):  # words: below the table, not in a column
+        if out.get(key) is not None:
+            print(f"{key.replace('_kind', '')}: {out[key]}")
+    for note in result.notes:
+        print(f"note: {note}")
     return 0
 
 
@@ -305,8 +335,13 @@ def _strike_rows(out) -> list:
     rows = [("P(first passage) predicted", cell(out["first_passage_probability_predicted"]), "1")]
     strikes = out["first_passage_probability"]
     if strikes is not None:
-        estimate = f"{cell(strikes['mean'])} ± {cell(strikes['ci95'])}"
-        rows.append(("P(first passage), rare-event estimate", estimate, "1"))
+        rows.append(
+            (
+                "P(first passage), rare-event estimate",
+                estimate(strikes["mean"], strikes["ci95"]),
+                "1",
+            )
+        )
         verdict = str(out["first_passage_probability_confirmed"])
         rows.append(("first_passage_probability_confirmed", verdict, ""))
     return rows

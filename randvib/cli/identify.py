@@ -12,14 +12,17 @@ from pathlib import Path
 
 from randvib._io import claim_output_file, dumps, write_or_keep
 from randvib._validation import MAX_SEED, integer_option
+from randvib.cli import COMMAND_HELP
 from randvib.cli._output import print_table
 from randvib.cli._records import (
     add_circuit_arguments,
     add_record_arguments,
     output_kinds,
+    output_unit,
     parse_assignments,
     parse_bounds,
     parse_weights,
+    plot_units,
     r_loads,
     record_from_args,
     simulation_settings,
@@ -38,7 +41,7 @@ DEFAULT = SearchSettings()
 def register(sub) -> None:
     p = sub.add_parser(
         "identify",
-        help="identify device and friction parameters from a measured record (SaDE, Eq. 11)",
+        help=COMMAND_HELP["identify"],
         description="Fit the device model (Eq. 1) with a friction model, and with --coupling "
         "its circuit, to CSV records of one device (each at its own --r-load) by minimising J "
         "(Eq. 11, per channel and summed) with self-adaptive differential evolution; what the "
@@ -118,7 +121,7 @@ def _new_file(path, option, overwrite=False):
     return None if path is None else claim_output_file(path, option, overwrite=overwrite)
 
 
-def _save_plot(result, record, plot: Path, title: str, json: bool = False) -> bool:
+def _save_plot(result, record, plot: Path, title: str, units: dict, json: bool = False) -> bool:
     """The figure of the first record; if it cannot be written now, say so and keep going
     (the result is printed).
 
@@ -133,6 +136,7 @@ def _save_plot(result, record, plot: Path, title: str, json: bool = False) -> bo
             title=title,
             validation=False,
             diagnostics=result.residuals,
+            **units,
         )
     except OSError as exc:
         print(f"randvib: could not write `--plot` {str(plot)!r} ({exc})", file=sys.stderr)
@@ -179,13 +183,13 @@ def run(args) -> int:
     ):
         status = 1
     if plot is not None and not _save_plot(
-        result, record, plot, f"{args.model} model on {record.name}", args.json
+        result, record, plot, f"{args.model} model on {record.name}", plot_units(args), args.json
     ):
         status = 1
     if args.json:
         print(dumps(out))
         return status
-    print_report(result, records)
+    print_report(result, records, output_unit(args))
     return status
 
 
@@ -196,16 +200,21 @@ def _status(name, se, free, at_bound) -> str:
     return "identified" if name in se or name in free else "fixed"
 
 
-def print_report(result, records) -> None:
+def print_report(result, records, offset_unit: str | None = None) -> None:
     """The parameters with standard errors and 95 % intervals, J (per channel), what the
-    records fix and why, the correlations."""
+    records fix and why, the correlations.
+
+    ``offset_unit``: the unit of the record's displacement column where it is not m (a
+    column declared ``relative_displacement`` under another name is read in its own
+    units), shown for ``output_offset``.
+    """
     records = [records] if not isinstance(records, list | tuple) else records
     se, ci, at_bound = result.standard_errors, result.confidence_intervals, result.at_bound
     rows = [
         [
             name,
             *with_standard_error(value, se.get(name), ci.get(name)),
-            result.unit(name),
+            offset_unit if name == "output_offset" and offset_unit else result.unit(name),
             _status(name, se, result.free, at_bound),
         ]
         for name, value in result.parameters.items()

@@ -50,10 +50,11 @@ import math
 
 from randvib._io import claim_output_file, dumps, write_or_keep
 from randvib._resources import announce_duration, timed
+from randvib._validation import check_positive
 from randvib.analytic.assembly_prediction import optimal_assembly_loads
 from randvib.analytic.bridge import optimal_dc_output
 from randvib.analytic.prediction import METHODS, optimal_load_resistance, predict
-from randvib.cli import advice_when_done
+from randvib.cli import COMMAND_HELP, advice_when_done
 from randvib.cli._device import (
     add_device_arguments,
     assembly_from_args,
@@ -74,7 +75,7 @@ from randvib.quantities import QUANTITIES, unit
 def register(sub) -> None:
     p = sub.add_parser(
         "power",
-        help="analytic expected power under white noise or a coloured excitation",
+        help=COMMAND_HELP["power"],
         description="Expected power of the harvester under base acceleration (white noise "
         "by default), by an analytic method.",
     )
@@ -362,6 +363,8 @@ def _simulated_optimum_point(args, harvester, psd) -> dict | None:
     it). A closure that refuses only beyond its validity (the search finds no
     output within it) falls back the same way.
     """
+    if not isinstance(psd, Excitation):  # a bad level is the user's, not the closure's limit
+        check_positive("psd", psd, "(m/s^2)^2/Hz")
     if args.optimal_bounds is None:
         if not args.method_defaulted:
             return None

@@ -22,6 +22,7 @@ from pathlib import Path
 from randvib._io import claim_output_file, dumps, write_or_keep
 from randvib._resources import check_memory
 from randvib._validation import MAX_SEED, check_int, check_positive, integer_option
+from randvib.cli import COMMAND_HELP
 from randvib.cli._device import add_device_arguments, assembly_from_args, harvester_from_args
 from randvib.cli._records import parse_assignments
 from randvib.identification.assembly_record import assembly_record
@@ -33,7 +34,7 @@ from randvib.models.excitation import BandLimited
 def register(sub) -> None:
     p = sub.add_parser(
         "record",
-        help="write a synthetic shaker record of a device (CSV for identify/validate)",
+        help=COMMAND_HELP["record"],
         description="Simulate a device under band-limited base excitation and write the "
         "record (time, input, and the response channels: relative_displacement, "
         "relative_velocity, the load voltage or current of its circuit) with optional sensor "

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from randvib._io import dumps
 from randvib._validation import MAX_SEED, integer_option
+from randvib.cli import COMMAND_HELP
 from randvib.cli._device import add_device_arguments, harvester_from_args
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
 from randvib.cli._output import describe_device, describe_excitation, print_table, with_units
@@ -30,7 +31,7 @@ ROWS = ("probability_first_passage", "upcrossing_rate", "stationary_exceedance")
 def register(sub) -> None:
     p = sub.add_parser(
         "reliability",
-        help="rare end-stop strikes: first-passage probability, crossing rate, exceedance",
+        help=COMMAND_HELP["reliability"],
         description="Estimate the probability that abs(z) reaches the stroke within a window "
         "from the stationary state, the rate of up-crossings of the stroke and the stationary "
         "exceedance, down to 1e-9, by subset simulation, importance sampling or crude Monte "

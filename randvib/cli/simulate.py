@@ -26,11 +26,12 @@ from __future__ import annotations
 from randvib._io import dumps
 from randvib._validation import MAX_SEED, integer_option
 from randvib.analytic.prediction import METHODS, predict
+from randvib.cli import COMMAND_HELP
 from randvib.cli._device import add_device_arguments, assembly_from_args, harvester_from_args
 from randvib.cli._event import add_event_arguments, simulate_event, wants_event
 from randvib.cli._excitation import add_excitation_arguments, excitation_from_args
 from randvib.cli._output import describe_device, describe_excitation, print_table, with_units
-from randvib.formatting import cell, estimate_parts
+from randvib.formatting import cell, estimate_parts, proportion
 from randvib.montecarlo.integrators import INTEGRATORS
 from randvib.montecarlo.results import STATISTICS
 from randvib.quantities import unit
@@ -39,7 +40,7 @@ from randvib.quantities import unit
 def register(sub) -> None:
     p = sub.add_parser(
         "simulate",
-        help="Monte Carlo simulation under white, coloured or recorded base acceleration",
+        help=COMMAND_HELP["simulate"],
         description="Simulate an ensemble of the harvester under white-noise, coloured "
         "(filtered or synthesised) or recorded base acceleration; statistics with 95 % "
         "confidence half-widths.",
@@ -101,6 +102,7 @@ def register(sub) -> None:
     )
     g.add_argument("--no-progress", action="store_true", help="no progress bar")
     p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--force", action="store_true", help="overwrite an existing --plot file")
     p.set_defaults(handler=run)
 
 
@@ -157,10 +159,13 @@ def run(args) -> int:
             continue
         s = summary[name]
         lin = getattr(analytic, name, None) if analytic is not None else None
+        shown = _plus_minus(s["mean"], s["ci95"])
+        if "ci95_lower" in s:  # a probability: its Wilson interval, which stays >= 0
+            shown = proportion(s["mean"], s["ci95_lower"], s["ci95_upper"]).split(" ", 1)
         rows.append(
             (
                 name,
-                *estimate_parts(s["mean"], s["ci95"]),
+                *shown,
                 cell(lin),
                 unit(name, harvester.electrical),
             )
@@ -171,14 +176,15 @@ def run(args) -> int:
         rows.append(
             (
                 f"E[min(first passage, {first['horizon']:g} s)]",
-                *estimate_parts(restricted["mean"], restricted["ci95"]),
+                *_plus_minus(restricted["mean"], restricted["ci95"]),
                 f"{first['paths_reached']}/{first['n_paths']} paths reached the stroke",
                 unit("stroke_first_passage_time"),
             )
         )
     print(describe_device(harvester))
     print(describe_excitation(psd) if args.record is None else f"excitation: record {args.record}")
-    print_table(rows, ("statistic", "Monte Carlo", "± 95 %", "linearisation", "unit"))
+    # a half-width (± x), or a probability's interval [lower, upper]
+    print_table(rows, ("statistic", "Monte Carlo", "95 %", "linearisation", "unit"))
     if args.record is not None:
         # one record is one realisation: its windows are batch means, not independent paths
         print(
@@ -192,6 +198,12 @@ def run(args) -> int:
         f"{result.scheme}, seed {result.seed}), {result.wall_time:.2f} s wall"
     )
     return 0
+
+
+def _plus_minus(mean, half_width) -> tuple[str, str]:
+    """A Monte Carlo mean and ``± half-width`` as table cells (the digits the interval allows)."""
+    mean, half = estimate_parts(mean, half_width)
+    return mean, f"± {half}" if half else ""
 
 
 def _refuse_what_the_input_cannot_take(args, psd, white: bool) -> None:

@@ -12,6 +12,7 @@ identification study).
 
 from __future__ import annotations
 
+from randvib.cli import COMMAND_HELP
 from randvib.studies import STUDIES, add_run_options, load, run_with_options
 
 
@@ -23,7 +24,7 @@ def load_study(name: str):
 def register(sub) -> None:
     p = sub.add_parser(
         "study",
-        help="run a study script (figures, CSV, Markdown report)",
+        help=COMMAND_HELP["study"],
         description="Run one of the study scripts (the studies/ folder, installed with the "
         "package as randvib.study_scripts); "
         "writes PNG figures, CSV tables and a Markdown report into --out.",

@@ -11,6 +11,7 @@ import numpy as np
 
 from randvib._io import check_output_file, check_output_folder, dumps, existing_file
 from randvib._validation import check_finite
+from randvib.cli import COMMAND_HELP
 from randvib.cli._output import print_table
 from randvib.cli._records import (
     add_circuit_arguments,
@@ -18,6 +19,7 @@ from randvib.cli._records import (
     output_kinds,
     output_unit,
     parse_assignments,
+    plot_units,
     r_loads,
     record_from_args,
     simulation_settings,
@@ -43,9 +45,10 @@ SIMULATION_FIELDS = tuple(SimulationSettings().to_dict())
 
 #: What validate does with the fitted record's sensor offsets.
 OFFSETS_NOTE = {
-    "per-record": "the sensor offsets belong to a record, not to the device: they are "
-    "re-estimated on each record (the fitted record's are not reused; `--offsets given` "
-    "reuses them); the other parameters are the file's",
+    "per-record": "the sensor offsets belong to a record, not to the device: on each record "
+    "the file's, the output offsets re-estimated and (with an input offset) both re-estimated "
+    "are scored and the lowest J kept (column `offsets`; `--offsets given` uses the file's "
+    "throughout); the other parameters are the file's",
     "given": "the file's sensor offsets are used on every record (`--offsets given`)",
 }
 
@@ -53,7 +56,7 @@ OFFSETS_NOTE = {
 def register(sub) -> None:
     p = sub.add_parser(
         "validate",
-        help="J (Eq. 11) of identified parameters on other records",
+        help=COMMAND_HELP["validate"],
         description="Simulate each record with parameters saved by `randvib identify --save` "
         "(or printed by --json) and report J (Eq. 11) and the RMS error per record and "
         "channel (a voltage's in volts, each record at its own --r-load).",
@@ -229,10 +232,11 @@ def _plot_target(args):
 
 def _figures(harvester, records, rows, measurement, settings, kinds, channels, plot_dir,
              plot_file, model, args) -> int:  # fmt: skip
-    """One figure per record: time history, residual, densities (the voltage's spike at 0 V)."""
+    """One figure per record, as validated (its offsets, its residual diagnostics): time history,
+    residual, densities (the voltage's spike at 0 V); the exit status: 1 if a figure could not
+    be written (the table is printed anyway)."""
     from randvib.identification.plots import figure_fit
     from randvib.identification.prediction import predict_record
-    from randvib.identification.residuals import residual_diagnostics
 
     for i, (record, row) in enumerate(zip(records, rows, strict=True)):
         # the offsets re-estimated on this record, as its J
@@ -241,14 +245,10 @@ def _figures(harvester, records, rows, measurement, settings, kinds, channels, p
         pred = predict_record(device, record, measurement=own, simulation=settings,
                               **({"outputs": kinds} if channels else {}))  # fmt: skip
         path = plot_file or plot_dir / f"{i:02d}_{record.name}.png"
-        skip = settings.skip
-        first = pred.outputs[0]
-        diagnostics = residual_diagnostics(
-            (record[first] - pred.simulated(first))[skip:], record.input[skip:]
-        )
         try:
+            # the residual diagnostics the table reports (the first channel's)
             figure_fit(pred, path, title=f"{model} model on {record.name}", validation=True,
-                       diagnostics=diagnostics)  # fmt: skip
+                       diagnostics=row.residuals, **plot_units(args))  # fmt: skip
         except OSError as exc:  # the table is the result: print it, exit 1
             print(f"randvib: could not write `--plot` {str(path)!r} ({exc})", file=sys.stderr)
             return 1
@@ -277,12 +277,7 @@ def _json(model, parameters, rows, kinds, args) -> dict:
         "outputs": list(kinds),
         "records": [
             {
-                "record": r.record,
-                "cost": r.cost,
-                "rms_error": r.rms_error,
-                "samples": r.samples,
-                "offsets": r.offsets,
-                **({"r_load": r.r_load} if r.r_load is not None else {}),
+                **r.to_dict(),
                 **(
                     {"channels": {k: {**v, "unit": unit(k)} for k, v in r.channels.items()}}
                     if r.channels
@@ -299,17 +294,33 @@ def _print(model, rows, kinds, args) -> None:
     print(f"model {model}")
     if not any(r.channels for r in rows):
         print_table(
-            [[r.record, r.samples, r.cost, r.rms_error] for r in rows],
-            ["record", "samples", "J", f"RMS error ({output_unit(args)})"],
-        )
+            [[r.record, r.samples, r.cost, r.rms_error, r.offsets_source, _verdict(r)]
+             for r in rows],
+            ["record", "samples", "J", f"RMS error ({output_unit(args)})", "offsets", "residual"],
+        )  # fmt: skip
     else:
         print_table(
             [
                 [r.record, "" if r.r_load is None else r.r_load, kind, r.samples, v["cost"],
-                 f"{v['rms_error']:.4g} {unit(kind)}"]
+                 f"{v['rms_error']:.4g} {unit(kind)}", r.offsets_source,
+                 _verdict(r) if i == 0 else ""]
                 for r in rows
-                for kind, v in r.channels.items()
+                for i, (kind, v) in enumerate(r.channels.items())
             ],
-            ["record", "R_L (ohm)", "channel", "samples", "J", "RMS error"],
+            ["record", "R_L (ohm)", "channel", "samples", "J", "RMS error", "offsets",
+             "residual"],
         )  # fmt: skip
     print(f"note: {OFFSETS_NOTE[args.offsets]}")
+    if any(r.verdict == "structured" for r in rows):
+        print(
+            "note: a structured residual (Ljung-Box p < 0.01, or correlated with the input) "
+            "is what the model misses on that record: its J is not noise alone"
+            + ("" if not any(r.channels for r in rows) else " (the first channel's residual)")
+        )
+
+
+def _verdict(row) -> str:
+    """The residual's verdict with its Ljung-Box p-value, for the table."""
+    if row.residuals is None:
+        return ""
+    return f"{row.verdict} (p = {row.residuals.ljung_box_p:.2g})"

@@ -36,8 +36,9 @@ PREDICTION_TOLERANCE = 0.02
 
 
 def within(x: Statistic, budget: float) -> bool:
-    """The budget is not significantly exceeded: the 95 % interval reaches down to it."""
-    return x.mean - x.ci95 <= budget
+    """The budget is not significantly exceeded: the 95 % interval reaches down to it (its
+    lower end: a proportion's Wilson interval is not symmetric about the mean)."""
+    return x.interval[0] <= budget
 
 
 class ConfirmedCandidates:

@@ -22,10 +22,14 @@ names the parameters to choose with their ranges. The design
    it by Monte Carlo on the confirmed candidates (each path's first time
    beyond the stroke, :class:`randvib.statistics.FirstPassage`);
 5. reports the power the excitation delivers (m S / 4 under white noise),
-   the efficiency, and the fraction of the limit: under a spectrum the
-   stationary bound at the budget's displacement variance
-   (:func:`randvib.analytic.harvesting_limit.harvesting_limit`); on a record
-   the non-causal bound on the record itself with |z| <= stroke
+   the efficiency, and the fractions of the limits: under a spectrum the
+   stationary non-causal bound at the budget's displacement variance
+   (:func:`randvib.analytic.harvesting_limit.harvesting_limit`; a bound for
+   every linear device meeting the budget, not for every device), the same
+   bound with E[z^2] <= d^2 (any device within |z| <= d), and the causal
+   bound a device can approach
+   (:func:`randvib.analytic.harvesting_limit.causal_harvesting_limit`); on
+   a record the non-causal bound on the record itself with |z| <= stroke
    (:func:`randvib.analytic.harvesting_limit.record_harvesting_limit`).
 
 An :class:`~randvib.models.assembly.Assembly` goes through the same steps
@@ -41,14 +45,17 @@ or first passage yet.
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Mapping
 from types import SimpleNamespace
 
 import numpy as np
 
 from randvib.analytic.harvesting_limit import (
+    causal_harvesting_limit,
     gaussian_displacement_budget,
     harvesting_limit,
+    predictable_spectrum,
     record_harvesting_limit,
 )
 from randvib.harvester_design.assembly_budget import stroke_budget
@@ -71,10 +78,11 @@ from randvib.harvester_design.space import DesignSpace
 from randvib.models.assembly import Assembly
 from randvib.models.excitation import Measured, as_excitation
 from randvib.models.harvester import Harvester
+from randvib.montecarlo.bridge_step import BridgeIdleWarning, bridge_input_rms, never_conducted
 from randvib.montecarlo.ensembles import Case, EnsembleResult, run_ensembles
 from randvib.montecarlo.on_record import monte_carlo_on_record
 from randvib.montecarlo.sweep import SweepSettings
-from randvib.statistics import FirstPassage, Statistic, estimate
+from randvib.statistics import FirstPassage, Statistic, estimate, proportion
 
 __all__ = ["design"]
 
@@ -223,16 +231,18 @@ def design(
                  out_dir=out_dir, executor=executor,
                  workers=workers, scheduler=scheduler), monte_carlo,
         )  # fmt: skip
-        limit = limit_kind = None  # no harvesting limit of an assembly yet
+        limits = dict(limit_kind=None)  # no harvesting limit of an assembly yet
+        limit = None
     else:
         if stroke_on is not None or transducer is not None:
             raise ValueError(
                 "`stroke_on` and `transducer` name the parts of an assembly; a single-mass "
                 "harvester has one stroke, on z, and one transducer"
             )
-        space, goal, stroke, limit, limit_kind = _single_mass_setup(
-            harvester, excitation, vary, stroke, exceedance, objective
+        space, goal, stroke, limits = _single_mass_setup(
+            harvester, excitation, vary, stroke, exceedance, objective, progress
         )
+        limit = limits.pop("limit")  # the result builders give it beside its fraction
     try:
         search = analytic_search(
             space, excitation, exceedance, goal, runners_up, min_first_passage, strikes
@@ -246,8 +256,8 @@ def design(
     confirmed_on = "record windows" if isinstance(excitation, Measured) else "simulated paths"
     common = dict(objective=goal.name, stroke=stroke, exceedance_budget=float(exceedance),
                   evaluations=0 if search is None else search.evaluations,
-                  min_first_passage=min_first_passage, limit_kind=limit_kind,
-                  max_first_passage=max_first_passage, duration=duration)  # fmt: skip
+                  min_first_passage=min_first_passage, max_first_passage=max_first_passage,
+                  duration=duration, **limits)  # fmt: skip
     if monte_carlo:
         common["monte_carlo_input"] = confirmed_on
     if space.is_assembly:
@@ -258,6 +268,7 @@ def design(
     settings = settings or SweepSettings(
         target_rel_ci=0.01, control_variates=excitation.is_white, max_paths=2048
     )
+    common["monte_carlo_precision"] = settings.target_rel_ci
     run = dict(settings=settings, out_dir=out_dir, executor=executor, workers=workers,
                scheduler=scheduler, progress=progress)  # fmt: skip
     if space.is_assembly:
@@ -271,12 +282,13 @@ def design(
             confirmed, chosen, exceedance, space, excitation, settings.seed
         )
     _require_feasible(confirmed, chosen, space, exceedance, min_first_passage)
+    _require_power(confirmed, chosen)
     common.update(_strike_fields(strikes, chosen, reliability, verdict))
     return _confirmed_result(confirmed, space, best, chosen, candidates, exceedance, limit, common)
 
 
-def _single_mass_setup(harvester, excitation, vary, stroke, exceedance, objective):
-    """A single mass's design space, objective, stroke and limit (and the limit's kind)."""
+def _single_mass_setup(harvester, excitation, vary, stroke, exceedance, objective, progress):
+    """A single mass's design space, objective, stroke and limits (:func:`_limit`)."""
     stroke = harvester.stroke if stroke is None else stroke
     if stroke is None:
         raise ValueError("`stroke` is needed: the design's budget is on P(|z| > stroke)")
@@ -286,8 +298,8 @@ def _single_mass_setup(harvester, excitation, vary, stroke, exceedance, objectiv
     refusal = goal.requires(fixed)
     if refusal:
         raise ValueError(refusal)
-    limit, limit_kind = _limit(fixed, excitation, stroke, sigma_budget)
-    return DesignSpace(fixed, vary), goal, float(stroke), limit, limit_kind
+    limits = _limit(fixed, excitation, stroke, sigma_budget, progress)
+    return DesignSpace(fixed, vary), goal, float(stroke), limits
 
 
 def _assembly_setup(
@@ -343,19 +355,55 @@ def _check_min_first_passage(min_first_passage) -> None:
         )
 
 
-def _limit(fixed: Harvester, excitation, stroke: float, sigma_budget: float):
-    """The harvesting limit (W) the result compares with, and its kind in words (or None).
+def _limit(
+    fixed: Harvester, excitation, stroke: float, sigma_budget: float, progress: bool = False
+) -> dict:
+    """The harvesting limits (W) the result compares with, each with what it bounds in words.
 
-    On a record the non-causal bound on the record itself with |z| <= stroke;
-    otherwise the stationary bound at the budget's displacement variance.
+    ``limit``: on a record the non-causal bound on the record itself with
+    |z| <= stroke; otherwise the stationary non-causal bound at the budget's
+    Gaussian displacement RMS, which bounds every device with that E[z^2]
+    (every linear device meeting the budget), not every device meeting it.
+    ``limit_hard_stroke``: the bound for any device held within |z| <= stroke
+    (E[z^2] <= d^2). ``causal_limit``: what a causal device can approach at
+    the budget's RMS (:func:`causal_harvesting_limit`; not on a record).
+    ``progress``: a bar over the record bound's chunks (seconds per thousand samples).
     """
-    if isinstance(excitation, Measured) and fixed.c_m > 0:
-        limit = record_harvesting_limit(fixed.m, fixed.c_m, excitation, stroke)
-        limit_kind = "record: non-causal, |z| <= stroke"
+    m, c_m = fixed.m, fixed.c_m
+    if isinstance(excitation, Measured) and c_m > 0:
+        limit = record_harvesting_limit(m, c_m, excitation, stroke, progress=progress)
+        return dict(
+            limit=limit, limit_hard_stroke=limit, causal_limit=None,
+            limit_kind="record, non-causal (the whole record known): any device within "
+            "|z| <= stroke, from rest",
+            causal_limit_kind="not computed on a record",
+        )  # fmt: skip
+    limit = harvesting_limit(m, c_m, excitation, sigma_budget)
+    causal = causal_harvesting_limit(m, c_m, excitation, sigma_budget)
+    if excitation.is_white:
+        causal_kind = "causal: m S / 4, the power white noise injects (any budget)"
+    elif predictable_spectrum(excitation):
+        lo, hi = excitation.support
+        causal_kind = (
+            f"causal = non-causal: the spectrum vanishes outside {lo:g}-{hi:g} Hz, so its past "
+            "determines its future (Paley-Wiener)"
+        )
     else:
-        limit = harvesting_limit(fixed.m, fixed.c_m, excitation, sigma_budget)
-        limit_kind = None if limit is None else "stationary: E[z^2] <= sigma_z^2 of the budget"
-    return limit, limit_kind
+        causal_kind = None if causal is None else (
+            "causal (Wiener-Hopf) at the budget's Gaussian RMS: the best linear active "
+            "transducer approaches it"
+        )  # fmt: skip
+    return dict(
+        limit=limit,
+        limit_kind=None if limit is None else (
+            "stationary, non-causal: any device with E[z^2] at most the budget's Gaussian "
+            "RMS squared, so every linear device meeting the budget, not every device "
+            "(limit_hard_stroke: any within |z| <= stroke)"
+        ),
+        limit_hard_stroke=harvesting_limit(m, c_m, excitation, stroke),
+        causal_limit=causal,
+        causal_limit_kind=causal_kind,
+    )  # fmt: skip
 
 
 def _analytic_result(space: DesignSpace, search, limit, common: dict) -> DesignResult:
@@ -435,6 +483,27 @@ def _require_feasible(
             f"|z| > {space.harvester.stroke:g} m) is not met by the best device within the stroke budget: "
             f"Monte Carlo gives {first.mean:.3g} ± {first.ci95:.2g} s (at {where})"
         )
+
+
+def _require_power(confirmed: ConfirmedCandidates, chosen) -> None:
+    """Refuse an optimum of zero power: no candidate delivered any, so none is best.
+
+    A diode bridge that never conducted says why (its transducer's RMS voltage
+    against the threshold) and what would help (a single mass's runs).
+    """
+    if confirmed.power(chosen).mean > 0.0:
+        return
+    why = "no candidate in the ranges delivered any power"
+    located = getattr(confirmed, "where", {}).get(id(chosen))
+    if located is None:  # an assembly's runs: no bridge diagnosis yet
+        raise ValueError(f"the design has no optimum: {why}")
+    result, i = located
+    run = result.simulation(i)
+    if run.harvester.is_rectified and never_conducted(run):
+        where = ", ".join(f"{k} = {v:.6g}" for k, v in chosen.values.items())
+        advice = run.harvester.electrical.idle_advice(bridge_input_rms(run))
+        why += f"; at {where}, {advice}"
+    raise ValueError(f"the design has no optimum: {why}")
 
 
 def _confirmed_result(
@@ -550,7 +619,9 @@ class _Confirmed(ConfirmedCandidates):
             from pathlib import Path
 
             out_dir = Path(out_dir) / f"batch{len(self.candidates)}"
-        result = run_ensembles(cases, **{**run, "out_dir": out_dir}, name="design")
+        with warnings.catch_warnings():  # a candidate whose bridge never conducts is only
+            warnings.simplefilter("ignore", BridgeIdleWarning)  # a poor one; _require_power
+            result = run_ensembles(cases, **{**run, "out_dir": out_dir}, name="design")
         for i, c in enumerate(new):
             self.where[id(c)] = (result, i)
         self.candidates += new
@@ -575,7 +646,7 @@ class _Confirmed(ConfirmedCandidates):
 
     def exceedance(self, c) -> Statistic:
         result, i = self.where[id(c)]
-        return estimate(result.averages(i).beyond_stroke)
+        return proportion(result.averages(i).beyond_stroke)  # Wilson: stays in [0, 1]
 
     def input_power(self, c) -> Statistic:
         """c_m E[z'^2] + E[z' F] + electrical power, path by path (every dissipation)."""

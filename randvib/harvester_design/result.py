@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 from randvib import _display, formatting
@@ -9,6 +10,9 @@ from randvib.quantities import parameter_unit, unit
 from randvib.statistics import FirstPassage, Statistic
 
 __all__ = ["DesignResult"]
+
+#: A stroke budget is inactive when the optimum's exceedance is below this fraction of it.
+INACTIVE_BUDGET = 0.1
 
 
 def _stat(s: Statistic | None):
@@ -48,16 +52,38 @@ class DesignResult:
     efficiency : float
         Objective power over input power (mean values).
     limit : float or None
-        The most any transducer on this mass can take (W): under a spectrum
-        :func:`randvib.analytic.harvesting_limit.harvesting_limit` at the
-        Gaussian displacement RMS of the budget; on a measured record
+        A non-causal bound (W; a transducer that sees the future): under a
+        spectrum :func:`randvib.analytic.harvesting_limit.harvesting_limit`
+        at the Gaussian displacement RMS of the budget, which bounds every
+        device with that E[z^2], so every linear device that meets the
+        budget, but not a nonlinear one (a tail budget does not bound
+        E[z^2]); on a measured record
         :func:`randvib.analytic.harvesting_limit.record_harvesting_limit`,
-        the non-causal bound on the record with |z| <= stroke. None where
-        no finite bound exists.
+        the bound on the record with |z| <= stroke, from rest. None where no
+        finite bound exists (white noise).
     limit_kind : str or None
-        Which bound ``limit`` is: ``"stationary: ..."`` or ``"record: ..."``.
+        What ``limit`` bounds, in words (``"stationary, non-causal, ..."`` or
+        ``"record, non-causal ..."``).
+    limit_hard_stroke : float or None
+        The non-causal bound for any device held within |z| <= stroke (W):
+        the stationary bound with E[z^2] <= d^2 (the record bound on a record).
+    causal_limit : float or None
+        What a causal device can approach at the budget's RMS (W,
+        :func:`randvib.analytic.harvesting_limit.causal_harvesting_limit`):
+        m S / 4 under white noise; the Wiener-Hopf bound under a rational
+        spectrum; the non-causal ``limit`` where the spectrum vanishes on a
+        band; None on a record.
+    causal_limit_kind : str or None
+        What ``causal_limit`` is, in words.
     fraction_of_limit : float or None
         The optimum's power (Monte Carlo mean, else predicted) over ``limit``.
+    fraction_of_causal_limit : float or None
+        The same power over ``causal_limit`` (a property).
+    monte_carlo_precision : float or None
+        The Monte Carlo target: 95 % half-width of the power over the power.
+    notes : list of str
+        What the numbers do not say themselves (a property): an inactive
+        stroke budget, a missed precision target.
     runners_up : list of dict
         Other candidates: ``values``, ``power_predicted``, ``exceedance_predicted``
         and, with Monte Carlo, ``power_monte_carlo``, ``stroke_exceedance_monte_carlo``
@@ -135,12 +161,66 @@ class DesignResult:
     first_passage_confirmed: bool | None = None
     monte_carlo_input: str | None = None
     limit_kind: str | None = None
+    limit_hard_stroke: float | None = None
+    causal_limit: float | None = None
+    causal_limit_kind: str | None = None
+    monte_carlo_precision: float | None = None
     objective_scope: str | None = None
     max_first_passage: float | None = None
     duration: float | None = None
     first_passage_probability_predicted: float = float("nan")
     first_passage_probability: Statistic | None = None
     first_passage_probability_confirmed: bool | None = None
+
+    @property
+    def power(self) -> float:
+        """The optimum's power (W): the Monte Carlo mean, else the prediction."""
+        if self.power_monte_carlo is not None:
+            return float(self.power_monte_carlo.mean)
+        return float(self.power_predicted)
+
+    @property
+    def fraction_of_causal_limit(self) -> float | None:
+        """The optimum's power over ``causal_limit`` (None without one)."""
+        return None if self.causal_limit is None else self.power / self.causal_limit
+
+    @property
+    def notes(self) -> list[str]:
+        """Statements the numbers need: an inactive stroke budget, a missed precision target."""
+        notes, seen = [], []  # the exceedance each source allows, and its words
+        predicted = math.isfinite(self.exceedance_predicted)
+        if predicted:
+            seen.append((self.exceedance_predicted, f"{self.exceedance_predicted:.2g} predicted"))
+        x = self.stroke_exceedance_monte_carlo
+        if x is not None:
+            # A probability's Wilson interval from n paths that saw nothing still reaches
+            # about 4 / n, far above a budget of 1e-3: beside a prediction Monte Carlo
+            # must not contradict it (its lower end); alone, its upper end must agree.
+            lower, upper = x.interval
+            seen.append((lower if predicted else upper, f"{x} by Monte Carlo"))
+        words = ", ".join(w for _, w in seen)
+        if seen and max(v for v, _ in seen) < INACTIVE_BUDGET * self.exceedance_budget:
+            notes.append(
+                f"the stroke budget is inactive: {self._budget_event()} at the optimum is "
+                f"{words}, against {self.exceedance_budget:g} allowed; the ranges or the "
+                "device limit the power, not the stroke"
+            )
+        power, target = self.power_monte_carlo, self.monte_carlo_precision
+        if power is not None and target is not None and power.mean != 0:
+            reached = power.ci95 / abs(power.mean)
+            if reached > target:
+                notes.append(
+                    f"the Monte Carlo precision target was missed: the power's 95 % interval "
+                    f"is ±{reached:.2%} of it against {target:.2%} asked; more paths "
+                    "(max_paths, --max-paths) or a looser target"
+                )
+        return notes
+
+    def _budget_event(self) -> str:
+        """``P(|z| > d m)``, or an assembly's strokes by coordinate."""
+        if isinstance(self.stroke, dict):
+            return "P(" + " or ".join(f"|{k}| > {v:g} m" for k, v in self.stroke.items()) + ")"
+        return f"P(|z| > {self.stroke:g} m)"
 
     def to_dict(self) -> dict:
         """JSON-ready: the keys of ``randvib design --json``."""
@@ -161,7 +241,13 @@ class DesignResult:
             "efficiency": self.efficiency,
             "limit": self.limit,
             "limit_kind": self.limit_kind,
+            "limit_hard_stroke": self.limit_hard_stroke,
+            "causal_limit": self.causal_limit,
+            "causal_limit_kind": self.causal_limit_kind,
             "fraction_of_limit": self.fraction_of_limit,
+            "fraction_of_causal_limit": self.fraction_of_causal_limit,
+            "monte_carlo_precision": self.monte_carlo_precision,
+            "notes": self.notes,
             "runners_up": [
                 {k: (_stat(v) if isinstance(v, Statistic) else v) for k, v in r.items()}
                 for r in self.runners_up
@@ -235,8 +321,34 @@ class DesignResult:
                 f"{self.stroke_exceedance_monte_carlo}",
                 unit("stroke_exceedance_monte_carlo"),
             ))  # fmt: skip
-        if self.limit is not None:
-            rows.append(("limit", formatting.compact(self.limit), unit("limit")))
+        rows += self.limit_rows(formatting.compact)
+        return rows
+
+    def limit_rows(self, number) -> list[tuple[str, str, str]]:
+        """(label, value, unit) of the limits and fractions, each bound labelled causal or not.
+
+        ``number`` formats a deterministic value (the table's rule).
+        """
+        rows = []
+        for key, label in (
+            ("limit", "limit (non-causal)"),
+            ("limit_hard_stroke", "limit_hard_stroke (non-causal)"),
+            ("causal_limit", "causal_limit"),
+        ):
+            value = getattr(self, key)
+            if value is not None:
+                rows.append((label, number(value), unit(key)))
+            elif key == "limit" and self.objective_scope is not None:  # an assembly's design
+                rows.append((label, "none (not computed for an assembly)", ""))
+            elif key == "limit" and self.causal_limit is not None:
+                rows.append((label, "none (unbounded for white noise)", ""))
+        for key, label in (
+            ("fraction_of_limit", "fraction_of_limit (non-causal)"),
+            ("fraction_of_causal_limit", "fraction_of_causal_limit"),
+        ):
+            value = getattr(self, key)
+            if value is not None:
+                rows.append((label, number(value), unit(key)))
         return rows
 
     def __repr__(self) -> str:
@@ -248,11 +360,11 @@ class DesignResult:
         )
 
     def __str__(self) -> str:
-        """The table of :meth:`_repr_html_` as plain text (``print(result)``)."""
-        return _display.text_table("Design", self._rows())
+        """The table of :meth:`_repr_html_` as plain text (``print(result)``), then the notes."""
+        return _display.text_table("Design", self._rows(), "; ".join(self.notes))
 
     def _repr_html_(self) -> str:
-        return _display.html_table("Design", self._rows())
+        return _display.html_table("Design", self._rows(), "; ".join(self.notes))
 
 
 def _columns(name: str, s: Statistic | None) -> dict:

@@ -325,9 +325,9 @@ def analytic_search(
             if best.exceedance > budget:
                 where = ", ".join(f"{k} = {v:.6g}" for k, v in best.values.items())
                 raise InfeasibleBudget(
-                    f"the stroke budget {space.budget_words()} <= {budget:g} "
-                    f"cannot be met in the ranges given: the best reachable exceedance is "
-                    f"{best.exceedance:.3g} (at {where})"
+                    f"the stroke budget {_budget_event(space)} <= `exceedance` = {budget:g} "
+                    f"cannot be met in the ranges given (`vary`): the best reachable exceedance "
+                    f"is {best.exceedance:.3g} (at {where})"
                 )
             within = [best]
         feasible = [c for c in within if meets(c, budget, min_first_passage, limit)]
@@ -441,9 +441,10 @@ def _longest_first_passage(evaluate, within, budget, min_first_passage, space) -
         return best  # the grid missed it: the search goes on from there
     where = ", ".join(f"{k} = {v:.6g}" for k, v in best.values.items())
     raise InfeasibleBudget(
-        f"the first-passage constraint E[tau] >= {min_first_passage:g} s (mean time to "
-        f"|z| > {space.harvester.stroke:g} m) cannot be met in the ranges given within the "
-        f"stroke budget: the longest predicted is {best.first_passage:.3g} s (at {where})"
+        f"the first-passage constraint E[tau] >= {min_first_passage:g} s "
+        f"(`min_first_passage`, the mean time to |z| > `stroke` = {space.harvester.stroke:g} m) "
+        "cannot be met in the ranges given (`vary`) within the stroke budget: the longest "
+        f"predicted is {best.first_passage:.3g} s (at {where})"
     )
 
 
@@ -459,3 +460,11 @@ def _least_exceedance(evaluate, start: Candidate, space: DesignSpace) -> Candida
     )
     end = evaluate(result.x)
     return end if end is not None and end.exceedance < start.exceedance else start
+
+
+def _budget_event(space) -> str:
+    """The budget's event, naming the argument that sets the stroke (``stroke``) for a single
+    mass; an assembly's strokes are its coordinates' (:meth:`DesignSpace.budget_words`)."""
+    if space.is_assembly:
+        return space.budget_words()
+    return f"P(|z| > `stroke` = {space.harvester.stroke:g} m)"

@@ -288,7 +288,51 @@ def identify(
     if np.isfinite(result.cost):
         result.residuals = result.diagnose(record)
     _warn_at_bound(result)
+    _warn_unidentifiable(result)
     return result
+
+
+#: What to do about estimates the record cannot tell apart, by the names involved.
+OFFSETS_ADVICE = (
+    "an input offset shifts z by a constant (-m a0 / k for a nearly linear spring), as the "
+    "output offset does: hold one at a known value (`--fix input_offset=0` for a sensor "
+    "zeroed before the test; `fixed=` in Python) and fit again"
+)
+START_ADVICE = (
+    "start from the record's first samples (`--initial-state record`) or fit a longer record"
+)
+#: The advice for any other group.
+SEPARATE = (
+    "hold one at a known value (`--fix NAME=VALUE`; `fixed=` in Python) or fit a record that "
+    "separates them (another level or input)"
+)
+
+
+def _warn_unidentifiable(result) -> None:
+    """Warn once per group of estimates the record cannot tell apart (pairs linked by
+    :attr:`~IdentificationResult.unidentifiable_pairs`, also saved in the JSON)."""
+    groups: list[set] = []
+    for a, b, _ in result.unidentifiable_pairs:
+        joined = [g for g in groups if a in g or b in g]
+        merged = set().union({a, b}, *joined)
+        groups = [g for g in groups if g not in joined] + [merged]
+    names = list(result.uncertainty.names) if groups else []
+    for group in groups:
+        members = sorted(group, key=names.index)
+        advice = []
+        if {"input_offset", "output_offset"} <= group:
+            advice.append(OFFSETS_ADVICE)
+        if group & {"z0", "v0"}:
+            advice.append(START_ADVICE)
+        listed = ", ".join(members[:-1]) + f" and {members[-1]}"
+        warnings.warn(
+            f"{listed} are not identifiable apart (correlations up to "
+            f"{max(abs(r) for a, b, r in result.unidentifiable_pairs if a in group):.4f} in "
+            f"magnitude): the record determines only a combination of them, so their separate "
+            f"values mean little; {'; or '.join(advice) or SEPARATE}",
+            UserWarning,
+            stacklevel=3,
+        )
 
 
 def _warn_at_bound(result) -> None:

@@ -59,8 +59,20 @@ def _finish(fig, path):
     return fig
 
 
+#: A legend above its axes, left (the panel's title is on the right): never over the data.
+ABOVE = dict(loc="lower left", bbox_to_anchor=(0.0, 1.0), borderaxespad=0.2, frameon=False)
+
+
 def plot_time_history(
-    prediction, ax=None, *, window=None, scale=None, unit=None, residual_ax=None, kind=None
+    prediction,
+    ax=None,
+    *,
+    window=None,
+    scale=None,
+    unit=None,
+    residual_ax=None,
+    kind=None,
+    legend=True,
 ):
     """Measured (solid black) and simulated (dashed) output channel.
 
@@ -81,6 +93,8 @@ def plot_time_history(
         window (a fit that misses shows there what it misses).
     kind : str, optional
         The channel shown (default the prediction's first scored one).
+    legend : bool
+        A legend above the axes (False: the figure has one elsewhere).
     """
     if ax is None:
         _, axes = new_figure(figsize=(7.0, 2.6))
@@ -102,7 +116,8 @@ def plot_time_history(
     shown = f"time (s); shown: {t[sel][0]:.3g} to {t[sel][-1]:.3g} s of {float(t[-1] - t[0]):.3g} s"
     cost = prediction.costs.get(kind, prediction.cost)
     ax.set_title(f"J = {cost:.3g} (Eq. 11)", loc="right")
-    ax.legend(loc="upper left", ncols=2, frameon=False)
+    if legend:
+        ax.legend(ncols=2, **ABOVE)
     if residual_ax is None:
         ax.set_xlabel(shown)
         return ax
@@ -188,16 +203,17 @@ def plot_histograms(prediction, axes=None, *, bins=None, scale=None, unit=None, 
         per = unit_text if "/" not in unit_text else f"({unit_text})"
         ax.set_ylabel(f"density (1/{per})")
         if legend:
-            ax.legend(loc="upper right", frameon=False)
+            ax.legend(ncols=2, **ABOVE)
     return axes
 
 
-def plot_residual_correlations(diagnostics, axes) -> None:
+def plot_residual_correlations(diagnostics, axes, *, legend=True) -> None:
     """Residual autocorrelation and its cross-correlation with the input, with bands.
 
     ``diagnostics`` is a
     :class:`~randvib.identification.residuals.ResidualDiagnostics`; the dashed
-    lines are its (1 - LEVEL) bands of a white, independent residual.
+    lines are its (1 - LEVEL) bands of a white, independent residual (named
+    in a legend above the first axes unless ``legend`` is False).
     """
     from randvib.identification.residuals import LEVEL
 
@@ -216,7 +232,8 @@ def plot_residual_correlations(diagnostics, axes) -> None:
         ax.set_xlabel("lag (samples)")
         ax.set_ylabel("correlation")
         ax.set_title(name, loc="right", fontsize=8)
-    ax_a.legend(loc="upper right", frameon=False)
+    if legend:
+        ax_a.legend(**ABOVE)
 
 
 @styled
@@ -249,11 +266,16 @@ def figure_fit(
     n_hist = len(histogram_panels(prediction))
     fig = _fit_layout(n_hist, diagnostics is not None)
     ax_t, ax_r, *rest = fig.axes
-    plot_time_history(prediction, ax_t, window=window, scale=scale, unit=unit, residual_ax=ax_r)
-    # one legend, in (a): in the densities it would cover a tail
+    plot_time_history(prediction, ax_t, window=window, scale=scale, unit=unit, residual_ax=ax_r,
+                      legend=False)  # fmt: skip
     plot_histograms(prediction, rest[:n_hist], scale=scale, unit=unit, legend=False)
+    handles, labels = ax_t.get_legend_handles_labels()
     if diagnostics is not None:
-        plot_residual_correlations(diagnostics, rest[n_hist:])
+        plot_residual_correlations(diagnostics, rest[n_hist:], legend=False)
+        more = rest[n_hist].get_legend_handles_labels()
+        handles, labels = handles + more[0], labels + more[1]
+    # one legend below the panels: inside (a) or (d) it covered the data
+    fig.legend(handles, labels, loc="outside lower center", ncols=len(labels), frameon=False)
     panel_letters(fig.axes)
     what = {None: "", True: "validation: ", False: "fit to the training record: "}[validation]
     fig.suptitle(f"{what}{title if title else prediction.record.name}")

@@ -84,6 +84,16 @@ class Prediction:
             f"channel {kind!r} was not simulated; simulated: {', '.join(self.outputs)}"
         )
 
+    def __repr__(self) -> str:  # the scores and the start, not the simulated samples
+        start = ", ".join(f"{k} = {float(v):.4g}" for k, v in self.initial_state.items())
+        voltage = ", voltage" if self.voltage is not None else ""
+        scored = f" of {', '.join(self.outputs)}" if self.channels else ""
+        return (
+            f"Prediction({self.record.name!r}: {self.z.shape[-1]} samples, J = {self.cost:.4g} "
+            f"(Eq. 11{scored}), RMS error {self.rms_error:.4g}"
+            f"{f'; start {start}' if start else ''}; z, v{voltage})"
+        )
+
 
 def _start_estimate(cost: CostFunction):
     """(z0, v0): the initial state that best explains the record, all else given.
@@ -276,7 +286,7 @@ def score_channels(harvester, record, measurement, simulation, outputs=None) -> 
 
 @dataclass(frozen=True)
 class ValidationRow:
-    """J (Eq. 11), RMS error and length of one record in :func:`validate`."""
+    """J (Eq. 11), RMS error, length and residual verdict of one record in :func:`validate`."""
 
     record: str
     model: str
@@ -285,11 +295,41 @@ class ValidationRow:
     samples: int
     #: The sensor offsets used on this record (re-estimated on it, or given).
     offsets: dict = field(default_factory=dict)
+    #: Where they come from: one of :data:`OFFSET_SOURCES`.
+    offsets_source: str = "given"
+    #: Whiteness of the residual and its independence of the input on this record
+    #: (:func:`~randvib.identification.residuals.residual_diagnostics`).
+    residuals: object = None
     #: With several channels: each one's J and RMS error (kind -> {"cost", "rms_error"});
     #: ``cost`` is then their sum and ``rms_error`` the first's.
     channels: dict = field(default_factory=dict)
     #: The load (ohm) the record was simulated at, with a coupling.
     r_load: float | None = None
+
+    @property
+    def verdict(self) -> str | None:
+        """``white`` or ``structured``: the residual diagnostics' verdict (None if none)."""
+        return None if self.residuals is None else self.residuals.verdict
+
+    def to_dict(self) -> dict:
+        """JSON-ready: the scores, the offsets and their source, the residual diagnostics."""
+        return {
+            "record": self.record,
+            "cost": self.cost,
+            "rms_error": self.rms_error,
+            "samples": self.samples,
+            "offsets": self.offsets,
+            "offsets_source": self.offsets_source,
+            "residuals": None if self.residuals is None else self.residuals.to_dict(),
+            **({"channels": self.channels} if self.channels else {}),
+            **({"r_load": self.r_load} if self.r_load is not None else {}),
+        }
+
+
+#: Where a validation row's offsets come from (:func:`validate`, ``offsets="per-record"``):
+#: the given ones, the output offset re-estimated on the record (the input's given),
+#: or both re-estimated; the one of lowest J is kept.
+OFFSET_SOURCES = ("given", "output re-estimated", "both re-estimated")
 
 
 #: How :func:`validate` treats the sensors' offsets.
@@ -318,19 +358,28 @@ def validate(
         ``"per-record"`` (default): the sensor offsets belong to a record, not
         to the device, so they are re-estimated on each record -- the output
         offset in closed form (the mean residual, as identify profiles it),
-        the input offset, where ``measurement`` has one, by a bounded scalar
-        search of J over the record's input mean +- half its standard
-        deviation (identify's box). ``"given"``: those of ``measurement`` on
-        every record. Each row's ``offsets`` says which were used.
+        and the input offset too, where ``measurement`` has one, by a bounded
+        scalar search of J over the record's input mean +- half its standard
+        deviation (identify's box) -- and the given offsets, the output one
+        re-estimated alone and both re-estimated are scored by the J reported
+        (the initial state estimated), the lowest kept: a re-estimate that
+        does not lower J (the pair trading off, nearly unidentifiable apart)
+        never spoils a good model. ``"given"``: those of ``measurement`` on
+        every record. Each row's ``offsets`` and ``offsets_source`` say which
+        were used, its ``residuals`` the residual's verdict on that record.
     outputs : sequence of str, optional
         The channels scored on each record (``relative_displacement``,
         ``relative_velocity``, ``voltage``, ``current``), each with its own J
-        and RMS error (``ValidationRow.channels``); then each channel's offset
-        is re-estimated per record (its mean residual) unless ``"given"``.
+        and RMS error (``ValidationRow.channels``); then, with ``"per-record"``,
+        each channel's offset is re-estimated on the record (its mean
+        residual) and kept where it lowers J, the input offset given; the
+        residual verdict is the first channel's.
     r_load : float or sequence of float, optional
         Each record's load (ohm) for a device with a coupling (default the
         device's own).
     """
+    from randvib.identification.residuals import residual_diagnostics
+
     if offsets not in OFFSET_POLICIES:
         raise ValueError(f"`offsets` must be one of {', '.join(OFFSET_POLICIES)}; got {offsets!r}")
     model = model_of(harvester.friction_name) if isinstance(harvester, Harvester) else None
@@ -342,10 +391,9 @@ def validate(
         )
     rows = []
     for record in records:
-        used = measurement
-        if offsets == "per-record":
-            used = _record_offsets(harvester, record, measurement, settings)
-        pred = predict_record(harvester, record, measurement=used, **settings)
+        source, used, pred = _best_offsets(harvester, record, measurement, offsets, settings)
+        skip = _skip(settings)
+        residual = record.z[skip:] - pred.z[skip:]
         rows.append(
             ValidationRow(
                 record.name,
@@ -354,54 +402,105 @@ def validate(
                 pred.rms_error,
                 record.n,
                 {"input_offset": used.input_offset, "output_offset": used.output_offset},
+                source,
+                residual_diagnostics(residual, record.input[skip:]),
             )
         )
     return rows
 
 
+def _skip(settings: dict) -> int:
+    """The samples left out of J at the start, from :func:`validate`'s settings."""
+    options = dict(settings)
+    (simulation,) = resolve_settings(
+        "validate", options, simulation=options.pop("simulation", None)
+    )
+    return int(simulation.skip)
+
+
+def _best_offsets(harvester, record, measurement, policy, settings):
+    """(source, measurement, prediction) of the offsets of lowest J on ``record``."""
+    candidates = {"given": measurement}
+    if policy == "per-record":
+        candidates["output re-estimated"] = _record_offsets(
+            harvester, record, measurement, settings, estimate_input=False
+        )
+        if measurement.input_offset != 0.0:
+            candidates["both re-estimated"] = _record_offsets(
+                harvester, record, measurement, settings, estimate_input=True
+            )
+    scored = {
+        source: (used, predict_record(harvester, record, measurement=used, **settings))
+        for source, used in candidates.items()
+    }
+    # a re-estimate is kept only where it lowers J (ties: the given offsets)
+    source = min(scored, key=lambda s: (scored[s][1].cost, s != "given"))
+    return (source, *scored[source])
+
+
 def _validate_channels(harvester, records, measurement, offsets, outputs, r_load, settings):
     """:func:`validate` on channels (a circuit simulated), each with its J and RMS error."""
-    from dataclasses import replace
+    from randvib.identification.residuals import residual_diagnostics
 
     records = list(records)
     loads = [r_load] * len(records) if np.ndim(r_load) == 0 else list(r_load)
     if len(loads) != len(records):
         raise ValueError(f"`r_load` gives {len(loads)} loads for {len(records)} records")
     model = model_of(harvester.friction_name)
+    skip = _skip(settings)
     rows = []
     for record, load in zip(records, loads, strict=True):
         device = harvester if load is None else harvester.updated(r_load=float(load))
-        pred = predict_record(device, record, measurement=measurement, outputs=outputs, **settings)
-        used = measurement
-        if offsets == "per-record":  # each channel's own offset: its mean residual on this record
-            skip = int(settings.get("skip", 0)) if "simulation" not in settings else 0
-            shift = {
-                k: float(np.mean((record[k] - pred.channels[k])[skip:])) for k in pred.channels
-            }
-            channel = {k: measurement.offset(k) + d for k, d in shift.items()}
-            used = replace(
-                measurement,
-                output_offset=channel.pop("relative_displacement", measurement.output_offset),
-                channel_offsets={**measurement.channel_offsets, **channel},
-            )
-            pred = predict_record(device, record, measurement=used, outputs=outputs, **settings)
+        source, used, pred = _best_channel_offsets(
+            device, record, measurement, offsets, outputs, settings, skip
+        )
+        first = pred.outputs[0]
+        residual = (record[first] - pred.simulated(first))[skip:]
         rows.append(
             ValidationRow(
                 record.name, model, pred.cost, pred.rms_error, record.n,
-                {"input_offset": float(used.input_offset),
-                 **{OFFSET_NAMES[k]: used.offset(k) for k in pred.channels}},
-                {k: {"cost": pred.costs[k], "rms_error": pred.rms_errors[k]} for k in pred.channels},
-                None if device.electrical is None else float(device.electrical.r_load),
+                offsets={"input_offset": float(used.input_offset),
+                         **{OFFSET_NAMES[k]: used.offset(k) for k in pred.channels}},
+                offsets_source=source,
+                residuals=residual_diagnostics(residual, record.input[skip:]),
+                channels={k: {"cost": pred.costs[k], "rms_error": pred.rms_errors[k]}
+                          for k in pred.channels},
+                r_load=None if device.electrical is None else float(device.electrical.r_load),
             )
         )  # fmt: skip
     return rows
 
 
-def _record_offsets(harvester, record, measurement, settings) -> MeasurementModel:
+def _best_channel_offsets(device, record, measurement, policy, outputs, settings, skip):
+    """(source, measurement, prediction) on channels: the given offsets, or with
+    ``"per-record"`` each channel's re-estimated (its mean residual) where that lowers J."""
+    from dataclasses import replace
+
+    given = predict_record(device, record, measurement=measurement, outputs=outputs, **settings)
+    if policy != "per-record":
+        return "given", measurement, given
+    shift = {k: float(np.mean((record[k] - given.channels[k])[skip:])) for k in given.channels}
+    channel = {k: measurement.offset(k) + d for k, d in shift.items()}
+    used = replace(
+        measurement,
+        output_offset=channel.pop("relative_displacement", measurement.output_offset),
+        channel_offsets={**measurement.channel_offsets, **channel},
+    )
+    pred = predict_record(device, record, measurement=used, outputs=outputs, **settings)
+    # a re-estimate is kept only where it lowers J (ties: the given offsets)
+    if pred.cost < given.cost:
+        return "output re-estimated", used, pred
+    return "given", measurement, given
+
+
+def _record_offsets(
+    harvester, record, measurement, settings, estimate_input: bool
+) -> MeasurementModel:
     """``measurement`` with the offsets that minimise J on ``record`` (see :func:`validate`).
 
     J is identify's: the output offset profiled in closed form, the start
-    z0 taken from the first sample less the record's mean (:class:`CostFunction`).
+    z0 taken from the first sample less the record's mean (:class:`CostFunction`);
+    the input offset searched too with ``estimate_input``, else kept.
     """
     from dataclasses import replace
 
@@ -418,7 +517,6 @@ def _record_offsets(harvester, record, measurement, settings) -> MeasurementMode
         device_parameters(harvester, measurement, "validate"), model_of(harvester.friction_name)
     )
     model = model_of(harvester.friction_name)
-    estimate_input = measurement.input_offset != 0.0
     fixed = {k: v for k, v in parameters.items() if k != "output_offset"}
     if estimate_input:
         fixed.pop("input_offset", None)
@@ -426,7 +524,7 @@ def _record_offsets(harvester, record, measurement, settings) -> MeasurementMode
     options = simulation.to_dict()
     options.pop("initial_state", None)
     cost = CostFunction(record, model, fixed=fixed, free=free, profile_offset=True, **options)
-    input_offset = 0.0
+    input_offset = measurement.input_offset
     if estimate_input:
         drive, _ = driving_signal(record.input, record.dt, record.input_kind)
         mean, half = float(np.mean(drive)), 0.5 * float(np.std(drive))

@@ -11,13 +11,14 @@ stopped and gets NaN samples.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from randvib._validation import check_int
 from randvib.identification.circuit import (
     ELECTRICAL_OUTPUTS,
+    OUTPUT_KINDS,
     check_output_kind,
     output_coefficients,
 )
@@ -38,12 +39,15 @@ class BatchSimulation:
         Sample times (s).
     z, v : ndarray, shape (n_pop, n)
         Relative displacement (m) and velocity (m/s) at the samples; NaN after
-        a candidate diverged.
+        a candidate diverged. One device is a batch of one: ``z[0]`` is its
+        response, and :meth:`to_record` makes a record of it.
     x : ndarray, shape (n_pop, n)
         The circuit state (a coil's current, A; a piezo element's voltage,
         V); zeros without one.
     harvester : Harvester or None
         The simulated device, whose coupling says what :meth:`output` reads.
+    record : Record or None
+        The record whose input drove the devices.
     """
 
     time: np.ndarray
@@ -51,6 +55,7 @@ class BatchSimulation:
     v: np.ndarray
     x: np.ndarray | None = None
     harvester: Harvester | None = None
+    record: Record | None = field(default=None, repr=False)
 
     def output(self, kind: str) -> np.ndarray:
         """The channel ``kind`` of :data:`~randvib.identification.circuit.OUTPUT_KINDS`.
@@ -73,6 +78,50 @@ class BatchSimulation:
         cz, cv, cx = output_coefficients(kind, name, params, r_load)
         x = self.x if self.x is not None else 0.0
         return cz * self.z + np.atleast_1d(cv)[:, None] * self.v + np.atleast_1d(cx)[:, None] * x
+
+    @property
+    def n_devices(self) -> int:
+        """How many devices the batch simulated (rows of :attr:`z`)."""
+        return self.z.shape[0]
+
+    def to_record(self, index: int | None = None, name: str | None = None) -> Record:
+        """The driving record with device ``index``'s response as ``relative_displacement``.
+
+        ``index`` may be left out for a batch of one device. The response is
+        the true one (no sensor offset): the displacement, and each output
+        channel the driving record holds (:meth:`output`) replaced by its
+        simulated value (a circuit channel dropped where the device has no
+        circuit); the record's other channels are kept.
+        """
+        if index is None:
+            if self.n_devices != 1:
+                raise ValueError(
+                    f"this batch simulated {self.n_devices} devices: give `index` "
+                    f"(0 to {self.n_devices - 1}) for the one to make a record of"
+                )
+            index = 0
+        index = check_int("index", index, minimum=-self.n_devices, maximum=self.n_devices - 1)
+        if self.record is None:
+            raise ValueError("this batch does not hold the record that drove it")
+        channels = dict(self.record.channels)
+        coupled = self.harvester is not None and self.harvester.electrical is not None
+        for kind in OUTPUT_KINDS:
+            if kind != "relative_displacement" and kind not in channels:
+                continue
+            if kind in ELECTRICAL_OUTPUTS and not coupled:
+                channels.pop(kind)  # measured, and not simulated: not this device's
+            else:
+                channels[kind] = self.output(kind)[index]
+        label = name or f"{self.record.name} (simulated)"
+        return Record(self.record.dt, time=self.record.time, name=label, **channels)
+
+    def __repr__(self) -> str:  # the sizes, not the samples
+        duration = self.time.size * (self.time[1] - self.time[0]) if self.time.size > 1 else 0.0
+        devices = "1 device" if self.n_devices == 1 else f"{self.n_devices} devices"
+        return (
+            f"BatchSimulation({devices} x {self.time.size} samples, {duration:.6g} s; "
+            f"z, v of shape {self.z.shape})"
+        )
 
 
 def record_response(
@@ -171,7 +220,7 @@ def record_response(
         x0=x0,
         response_limit=response_limit,
     )
-    return BatchSimulation(time=record.time, z=z, v=v, x=x, harvester=harvester)
+    return BatchSimulation(time=record.time, z=z, v=v, x=x, harvester=harvester, record=record)
 
 
 def _input_kind(record: Record, input_kind) -> str:

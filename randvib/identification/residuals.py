@@ -86,6 +86,9 @@ class ResidualDiagnostics:
             f"p = {self.cross_p:.3g} (Holm)"
         )
 
+    def __repr__(self) -> str:  # the verdict and its tests, not the correlation arrays
+        return f"ResidualDiagnostics({self.summary()}; N = {self.samples})"
+
     def to_dict(self) -> dict:
         return {
             "verdict": self.verdict,

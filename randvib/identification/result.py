@@ -23,6 +23,11 @@ from randvib.quantities import unit
 #: the fit and far above float64 rounding).
 BOUND_TOLERANCE = 1e-6
 
+#: |correlation| of two estimates from which they count as not identifiable apart:
+#: the variance of either, the other held, is 1 - r^2 = 0.2 % of its own (a factor
+#: 22 on the standard error): the record determines one combination of the two.
+UNIDENTIFIABLE_CORRELATION = 0.999
+
 
 @dataclass
 class IdentificationResult:
@@ -144,6 +149,21 @@ class IdentificationResult:
         return {n: se[n] for n in self.parameters if n in se}
 
     @property
+    def unidentifiable_pairs(self) -> list[tuple[str, str, float]]:
+        """Pairs of estimates whose |correlation| is at least
+        :data:`UNIDENTIFIABLE_CORRELATION`: ``(name, name, correlation)``; the record
+        determines only a combination of each pair (empty without the polish)."""
+        if self.uncertainty is None:
+            return []
+        names, r = list(self.uncertainty.names), np.asarray(self.uncertainty.correlation)
+        return [
+            (names[i], names[j], float(r[i, j]))
+            for i in range(len(names))
+            for j in range(i + 1, len(names))
+            if abs(r[i, j]) >= UNIDENTIFIABLE_CORRELATION
+        ]
+
+    @property
     def at_bound(self) -> dict:
         """Free parameters the search left on a bound: name -> ``"lower"`` or ``"upper"``.
 
@@ -219,6 +239,8 @@ class IdentificationResult:
             **({} if self.residuals is None else {"residuals": self.residuals.to_dict()}),
             # free parameters left on a search bound: not estimates, no interval
             "at_bound": self.at_bound,
+            # pairs the record cannot tell apart: [name, name, correlation]
+            "unidentifiable_pairs": [list(pair) for pair in self.unidentifiable_pairs],
             **(
                 {}
                 if self.uncertainty is None
@@ -298,28 +320,57 @@ class IdentificationResult:
     def to_frame(self):
         """The parameters as a :class:`pandas.DataFrame`, one row per parameter.
 
-        Columns ``value``, ``unit``, ``free`` (identified, not fixed) and the
-        search bounds ``lower``, ``upper`` (NaN for a fixed parameter); the
-        cost and the search's summary are in :meth:`to_dict`.
+        Columns ``value``, ``unit``, ``free`` (identified, not fixed),
+        ``std_error`` and the 95 % confidence interval ``ci95_lower``,
+        ``ci95_upper`` (:attr:`standard_errors`, :attr:`confidence_intervals`:
+        NaN for a fixed parameter, one left on a search bound, or without the
+        polish), ``status`` (``identified``, ``fixed``, ``at lower bound``,
+        ``at upper bound``), and the search box ``search_lower``,
+        ``search_upper`` (where the search looked, not an interval: NaN for
+        a fixed parameter). The cost and the search's summary are in
+        :meth:`to_dict`.
         """
         pd = _display.pandas()
+        se, ci = self.standard_errors, self.confidence_intervals
+        nan = (np.nan, np.nan)
         rows = {
             name: {
                 "value": float(value),
                 "unit": self.unit(name),
                 "free": name in self.free,
-                "lower": float(self.bounds[name][0]) if name in self.bounds else np.nan,
-                "upper": float(self.bounds[name][1]) if name in self.bounds else np.nan,
+                "std_error": float(se.get(name, np.nan)),
+                "ci95_lower": float(ci.get(name, nan)[0]),
+                "ci95_upper": float(ci.get(name, nan)[1]),
+                "status": self._status(name),
+                "search_lower": float(self.bounds[name][0]) if name in self.bounds else np.nan,
+                "search_upper": float(self.bounds[name][1]) if name in self.bounds else np.nan,
             }
             for name, value in self.parameters.items()
         }
         return pd.DataFrame.from_dict(rows, orient="index").rename_axis("parameter")
 
+    def _status(self, name: str) -> str:
+        """``identified``, ``fixed`` or ``at lower/upper bound`` (where the search stopped)."""
+        at_bound = self.at_bound
+        if name in at_bound:
+            return f"at {at_bound[name]} bound"
+        return "identified" if name in self.free else "fixed"
+
     def _rows(self):
         rows = [("cost J (Eq. 11)", formatting.compact(self.cost, 4), "")]
+        se, ci = self.standard_errors, self.confidence_intervals
         for name, value in self.parameters.items():
-            fixed = "" if name in self.free else " (fixed)"
-            rows.append((name + fixed, formatting.compact(value), self.unit(name)))
+            status = self._status(name)
+            text = formatting.compact(value)
+            if name in se:  # value ± standard error [95 % interval], the digits the error allows
+                shown, error, interval = formatting.with_standard_error(
+                    value, se[name], ci.get(name)
+                )
+                text = f"{shown} ± {error} {interval}".rstrip()
+            shown = name if status == "identified" else f"{name} ({status})"
+            rows.append((shown, text, self.unit(name)))
+        if self.residuals is not None:
+            rows.append(("residual", self.residuals.verdict, ""))
         return rows
 
     def _search_line(self) -> str:
@@ -331,18 +382,30 @@ class IdentificationResult:
 
     def __repr__(self) -> str:
         # compact: the per-generation history stays in .history, not on the screen
-        values = ", ".join(f"{name}={formatting.compact(v)}" for name, v in self.parameters.items())
+        se = self.standard_errors
+        values = ", ".join(
+            f"{name}={formatting.compact(v)}"
+            if name not in se
+            else f"{name}={' ± '.join(formatting.estimate_parts(v, se[name]))}"
+            for name, v in self.parameters.items()
+        )
+        verdict = "" if self.residuals is None else f"; residual {self.residuals.verdict}"
         return (
             f"IdentificationResult(model={self.model!r}, cost={formatting.compact(self.cost, 4)}, "
-            f"{values}; {self.nfev} simulations, {self.generations} generations)"
+            f"{values}{verdict}; {self.nfev} simulations, {self.generations} generations)"
         )
+
+    def _title(self) -> str:
+        if self.uncertainty is None:
+            return "Identification (no standard errors: the polish was skipped)"
+        return "Identification (value ± standard error [95 % interval])"
 
     def __str__(self) -> str:
         """The table of :meth:`_repr_html_` as plain text (``print(result)``)."""
-        return _display.text_table("Identification", self._rows(), self._search_line())
+        return _display.text_table(self._title(), self._rows(), self._search_line())
 
     def _repr_html_(self) -> str:
-        return _display.html_table("Identification", self._rows(), self._search_line())
+        return _display.html_table(self._title(), self._rows(), self._search_line())
 
     def harvester(self, electrical=None, *, r_load: float | None = None) -> Harvester:
         """The identified device, its damping c as c_m.

@@ -212,7 +212,14 @@ class ShinozukaSato(Envelope):
     def unit_peak(cls, b: float, c: float) -> ShinozukaSato:
         """The envelope with decay b and rise c (1/s) whose peak value is 1."""
         shape = cls(1.0, b, c)
-        return cls(1.0 / shape.peak, shape.b, shape.c)
+        peak = shape.peak
+        if not (np.isfinite(peak) and peak > 0 and np.isfinite(1.0 / peak)):
+            raise ValueError(
+                f"the envelope of `b` = {shape.b!r} 1/s and `c` = {shape.c!r} 1/s peaks at "
+                f"{peak!r}, which no amplitude `a` can scale to 1 in float64; give rates of a "
+                "physical size (1/s)"
+            )
+        return cls(1.0 / peak, shape.b, shape.c)
 
     def _value(self, t):
         return self.a * (np.exp(-self.b * t) - np.exp(-self.c * t))
@@ -229,7 +236,8 @@ class ShinozukaSato(Envelope):
 
     @property
     def peak_time(self) -> float:
-        return float(np.log(self.c / self.b) / (self.c - self.b))
+        # log c - log b: c / b overflows for a decay rate near float64's smallest
+        return float((np.log(self.c) - np.log(self.b)) / (self.c - self.b))
 
 
 class _PiecewiseLinear(Envelope):
@@ -423,6 +431,14 @@ class Enveloped:
                 f"`envelope` must be a randvib envelope ({', '.join(ENVELOPES)}), "
                 f"got {self.envelope!r}"
             )
+        peak = float(self.envelope.peak)
+        level = getattr(self.excitation, "level", 1.0)
+        if not (np.isfinite(peak * peak) and np.isfinite(float(level) * peak * peak)):
+            raise ValueError(
+                f"`envelope` peaks at {peak:.3g}: the intensity at its peak, S e^2, is beyond "
+                "float64; scale the envelope (a peak of 1 keeps S the peak's level) or the "
+                "excitation's level down"
+            )
 
     @property
     def name(self) -> str:
@@ -436,7 +452,7 @@ class Enveloped:
 
     def peak_excitation(self) -> Excitation:
         """The stationary excitation at the envelope's peak: the PSD times peak^2."""
-        return self.excitation.scaled(self.envelope.peak**2)
+        return self.excitation.scaled(self.envelope.peak * self.envelope.peak)
 
     def parameters(self) -> dict:
         """The excitation's and the envelope's parameters, ready for JSON."""

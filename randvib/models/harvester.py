@@ -376,3 +376,44 @@ class Harvester:
                 f"unknown parameter name(s) {sorted(changes)}; allowed: {', '.join(allowed)}"
             )
         return dataclasses.replace(self, friction=friction, electrical=electrical, **own)
+
+
+def harvester_from_parameters(parameters: dict) -> Harvester:
+    """The device that :meth:`Harvester.parameters` describes (a saved result's ``device``).
+
+    ``friction`` names the law (``none``: without), ``coupling`` the coupling
+    (a bridge by its name, ``inductive bridge``; absent with ``alpha``: the
+    resistive one of Eq. 3); every other key is a parameter of the device,
+    the law or the coupling. ``c_e`` is taken as given without a coupling and
+    follows from the coupling with one.
+    """
+    from randvib.models.friction import friction_law
+    from randvib.models.rectifier import RECTIFIED
+
+    rest = dict(parameters)
+    law = friction_law(rest.pop("friction", "none"))
+    friction = None if law is None else law(**_own(rest, law))
+    coupling_name = rest.pop("coupling", "resistive" if "alpha" in rest else None)
+    own = {
+        name: rest.pop(name) for name in ("m", "c_m", "c_e", "k", "k3", "stroke") if name in rest
+    }
+    if coupling_name is None:
+        _no_leftovers(rest)
+        return Harvester(friction=friction, **own)
+    classes = {cls.name: cls for cls in (*COUPLINGS.values(), *RECTIFIED.values())}
+    if coupling_name not in classes:
+        raise ValueError(f"unknown coupling {coupling_name!r}; known: {', '.join(classes)}")
+    coupling = classes[coupling_name](**_own(rest, classes[coupling_name]))
+    _no_leftovers(rest)
+    own.pop("c_e", None)  # the coupling's own
+    return Harvester.with_coupling(coupling=coupling, friction=friction, **own)
+
+
+def _own(values: dict, cls) -> dict:
+    """The entries of ``values`` that are fields of the dataclass ``cls`` (taken out)."""
+    return {f.name: values.pop(f.name) for f in fields(cls) if f.name in values}
+
+
+def _no_leftovers(values: dict) -> None:
+    if values:
+        raise ValueError(f"unknown device parameter(s) {sorted(values)}")

@@ -59,6 +59,10 @@ CHANNELS = {
 INPUT_KINDS = ("base_displacement", "base_acceleration", "force")
 #: The response channel that identification fits.
 OUTPUT_CHANNEL = "relative_displacement"
+#: The response channels a record's CSV may hold: what an output column may be
+#: declared to hold (``output_kind``, ``outputs``, ``--output-kind``); the output
+#: kinds of identification.
+OUTPUT_KINDS = ("relative_displacement", "relative_velocity", "voltage", "current")
 #: The CSV column of the sample times (s).
 TIME_COLUMN = "time"
 #: How far (in steps) a sample may lie from the uniform grid; see the module docstring.
@@ -275,6 +279,30 @@ class Record:
         )
 
 
+def _channel_accessor(name: str) -> property:
+    """``record.NAME``: the channel's samples, as ``record[NAME]``; the repr names them so."""
+
+    def get(self) -> np.ndarray:
+        if name not in self._channels:
+            raise AttributeError(
+                f"record {self._name!r} has no {name!r} channel; it has {', '.join(self._channels)}"
+            )
+        return self._channels[name]
+
+    quantity = CHANNELS[name]
+    get.__doc__ = (
+        f"The ``{name}`` channel ({quantity.unit}); AttributeError when the record has none."
+    )
+    return property(get)
+
+
+# every channel by the name the repr and the CSV give it (``voltage`` and ``z`` are above)
+for _name in CHANNELS:
+    if _name != "voltage":
+        setattr(Record, _name, _channel_accessor(_name))
+del _name
+
+
 def _check_length(n: int, name: str) -> None:
     if n < MIN_SAMPLES:
         raise ValueError(f"record {name!r} has {n} samples; at least {MIN_SAMPLES} are needed")
@@ -330,7 +358,12 @@ def _finite_column(name, values):
     except (TypeError, ValueError):
         raise ValueError(f"`{name}` must be numeric") from None
     if arr.ndim != 1:
-        raise ValueError(f"`{name}` must be one-dimensional, got shape {arr.shape}")
+        row = (
+            " (one row of a batch: take it with [0], or BatchSimulation.to_record())"
+            if arr.ndim == 2 and arr.shape[0] == 1
+            else ""
+        )
+        raise ValueError(f"`{name}` must be one-dimensional, got shape {arr.shape}{row}")
     bad = np.flatnonzero(~np.isfinite(arr))
     if bad.size:
         raise ValueError(
@@ -406,6 +439,7 @@ def read_record(
     input_column: str | None = None,
     input_kind: str | None = None,
     output_column: str | None = OUTPUT_CHANNEL,
+    output_kind: str | None = None,
     time_column: str = TIME_COLUMN,
     sample_rate: float | None = None,
     rows: tuple[int | None, int | None] | None = None,
@@ -429,8 +463,17 @@ def read_record(
         is given.
     input_kind : {'base_displacement', 'base_acceleration', 'force'}, optional
     output_column : str or None
-        Column holding the relative displacement; None for a record of the
+        Column holding the response (the relative displacement unless
+        ``output_kind`` or its name says otherwise); None for a record of the
         input alone (a measured base acceleration, :meth:`randvib.Measured.from_csv`).
+    output_kind : {'relative_displacement', 'relative_velocity', 'voltage', 'current'}, optional
+        What ``output_column`` holds, declared; needed for a column whose name
+        is not an output kind (``V2``, ``laser``: its values are then used in
+        the column's own units). Undeclared, a column named as an output kind
+        is read as that kind (``voltage``: the load voltage, not a
+        displacement); a column named as another channel than its declared
+        kind, or as no response (``force``), is refused
+        (:func:`declared_output_kind`).
     time_column : str
         Column of sample times (s); ignored when absent and ``sample_rate``
         is given.
@@ -457,7 +500,7 @@ def read_record(
     frame = read_csv(path)
     columns = list(frame.columns)
     input_column, input_kind = _input_column(path, columns, input_column, input_kind)
-    wanted = _output_columns(path, columns, output_column, outputs)
+    wanted = _output_columns(path, columns, output_column, output_kind, outputs)
     if rows is not None:
         n_rows = len(frame)
         frame = frame.iloc[slice(*rows)]
@@ -491,29 +534,79 @@ def read_record(
     return Record(step, time=time, name=name or path.stem, **channels)
 
 
-#: The response channels a record's CSV may hold (the output kinds of identification).
-OUTPUT_KINDS = ("relative_displacement", "relative_velocity", "voltage", "current")
+def declared_output_kind(source: str, column: str, kind: str | None) -> str:
+    """What the output ``column`` of ``source`` holds: ``kind`` as declared, else its name.
 
-
-def _output_columns(path: Path, columns, output_column, outputs) -> dict:
-    """``{kind: column}`` of the response channels read (``output_column`` is the displacement's)."""
-    if outputs is None:
-        wanted = {} if output_column is None else {OUTPUT_CHANNEL: output_column}
-    else:
-        if output_column not in (None, OUTPUT_CHANNEL):
-            raise ValueError("give either `output_column` or `outputs` (kind -> column), not both")
-        wanted = dict(outputs)
-    for kind, column in wanted.items():
+    The one place that decides what a column may be fitted as: a declared
+    kind must be one of :data:`OUTPUT_KINDS`, and a column named as another
+    channel (``voltage`` declared ``relative_displacement``) is refused; an
+    undeclared column must be named as an output kind (``voltage`` is then
+    read as the load voltage). A column named as a channel that is no
+    response (``force``) or by a name that says nothing (``V2``) is refused,
+    in one line that says what to declare.
+    """
+    kinds = ", ".join(OUTPUT_KINDS)
+    if kind is not None:
         if kind not in OUTPUT_KINDS:
+            raise ValueError(f"`output_kind` must be one of {kinds}; got {kind!r}")
+        if column in CHANNELS and column != kind:
+            held = CHANNELS[column]
             raise ValueError(
-                f"`outputs`: {kind!r} is not an output kind; allowed: {', '.join(OUTPUT_KINDS)}"
+                f"{source}: output column `{column}` holds the {held.description} ({held.unit}), "
+                f"not the {CHANNELS[kind].description} it is declared as (`output_kind` {kind}); "
+                + (
+                    f"declare it as what it holds (`output_kind` {column})"
+                    if column in OUTPUT_KINDS
+                    else "name the column that holds one with `output_column`"
+                )
             )
+        return kind
+    if column in OUTPUT_KINDS:
+        return column
+    if column in CHANNELS:
+        held = CHANNELS[column]
+        raise ValueError(
+            f"{source}: output column `{column}` holds the {held.description} ({held.unit}), "
+            f"not a response identification fits (`output_kind`: {kinds}); name the column "
+            "that holds one with `output_column`"
+        )
+    raise ValueError(
+        f"{source}: what output column `{column}` holds is not declared; give `output_kind` "
+        f"({kinds}, in the column's own units) if it is that"
+    )
+
+
+def _output_columns(path: Path, columns, output_column, output_kind, outputs) -> dict:
+    """``{kind: column}`` of the response channels read, each column's kind checked
+    (:func:`declared_output_kind`); ``output_column`` is one channel, ``outputs`` several."""
+    if outputs is None:
+        if output_column is None:
+            return {}
+        wanted = {declared_output_kind(path.name, output_column, output_kind): output_column}
+    else:
+        if output_column not in (None, OUTPUT_CHANNEL) or output_kind is not None:
+            raise ValueError(
+                "give either `output_column` (with `output_kind`) or `outputs` (kind -> column), "
+                "not both"
+            )
+        wanted = dict(outputs)
+        for kind, column in wanted.items():
+            if kind not in OUTPUT_KINDS:
+                raise ValueError(
+                    f"`outputs`: {kind!r} is not an output kind; allowed: {', '.join(OUTPUT_KINDS)}"
+                )
+            declared_output_kind(path.name, column, kind)
+    for kind, column in wanted.items():
         if column not in columns:
             what = QUANTITIES[kind]
             raise ValueError(
                 f"{path.name}: output column `{column}` not found ({what.description}, "
                 f"{what.unit}); columns are {_shown(columns)}; map another name with "
-                + ("`output_column`" if outputs is None else "`--output-column`")
+                + (
+                    "`output_column` and say what it holds with `output_kind`"
+                    if outputs is None
+                    else "`--output-column`"
+                )
             )
     return wanted
 

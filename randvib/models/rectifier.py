@@ -186,6 +186,42 @@ class Rectified(Coupling):
         out = self.battery if self.has_battery else v_out
         return out + 2.0 * self.v_diode
 
+    #: The transducer's voltage that must exceed the threshold, in words (for messages).
+    input_words: str = ""
+
+    def idle_advice(self, input_rms: float, v_out: float = 0.0) -> str:
+        """Why a bridge that never conducted stored nothing, and what would help (one sentence).
+
+        Parameters
+        ----------
+        input_rms : float
+            RMS of the transducer's open-circuit voltage (V): the coil's EMF
+            ``alpha z'``, the piezo's ``theta z / C_p``.
+        v_out : float
+            The storage capacitor's voltage (V); a battery's is its own.
+        """
+        threshold = self.threshold(v_out)
+        ratio = threshold / input_rms if input_rms > 0 else np.inf
+        output = "V_b + 2 V_d" if self.has_battery else "V_C + 2 V_d"
+        helps = [
+            f"a {ratio:.2g}-fold larger voltage, from more turns or a stronger coupling "
+            f"({self._coupling_name}), or a step-up transformer or converter of that ratio"
+        ]
+        if 2.0 * self.v_diode >= input_rms:
+            helps.append(
+                f"a lower-drop rectifier (Schottky or active diodes): the drops 2 V_d = "
+                f"{2.0 * self.v_diode:.3g} V alone are {2.0 * self.v_diode / input_rms:.2g} "
+                "times the RMS"
+            )
+        return (
+            f"the bridge never conducted: the {self.input_words} (RMS {input_rms:.3g} V) never "
+            f"reached {output} = {threshold:.3g} V ({ratio:.3g} times its RMS), so nothing "
+            f"was stored; what would help: {'; '.join(helps)}"
+        )
+
+    #: The coupling parameter that scales the transducer's voltage.
+    _coupling_name: str = ""
+
     def linear_surrogate(self) -> Coupling:  # pragma: no cover - abstract
         """A linear coupling with the bridge's largest damping, for the step check and start."""
         raise NotImplementedError
@@ -253,10 +289,19 @@ class BridgeCoil(Rectified):
 
     transducer = "inductive"
     name = "inductive bridge"
+    input_words = "coil's EMF alpha z'"
     _code = COIL
+    _coupling_name = "alpha"
 
     def __post_init__(self):
         super().__post_init__()
+        # the conducting bridge's damping alpha^2 / R_C, which every method uses
+        if not np.isfinite(np.float64(self.alpha) * self.alpha / self.r_coil):
+            raise ValueError(
+                f"`alpha` = {self.alpha!r} Wb/m with `r_coil` = {self.r_coil!r} ohm: the "
+                "conducting bridge's damping alpha^2 / R_C is beyond float64; give coupling "
+                "parameters of a physical size"
+            )
         if self.saturation_current is not None:
             if self.v_diode != 0.0:
                 raise ValueError(
@@ -278,6 +323,15 @@ class BridgeCoil(Rectified):
     def is_shockley(self) -> bool:
         """True for Shockley diodes (``saturation_current`` given), False for a constant drop."""
         return self.saturation_current is not None
+
+    def parameters(self) -> dict:
+        """The bridge's parameters; the Shockley law's ``ideality`` and ``thermal_voltage``
+        only for Shockley diodes (a constant drop ``v_diode`` does not use them)."""
+        out = super().parameters()
+        if not self.is_shockley:
+            out.pop("ideality", None)
+            out.pop("thermal_voltage", None)
+        return out
 
     @property
     def _shockley(self) -> tuple[float, float]:
@@ -332,7 +386,9 @@ class BridgePiezo(Rectified):
 
     transducer = "piezo"
     name = "piezo bridge"
+    input_words = "piezo's open-circuit voltage theta z / C_p"
     _code = PIEZO
+    _coupling_name = "theta"
 
     def _transducer_parameters(self):
         return self.theta, self.capacitance

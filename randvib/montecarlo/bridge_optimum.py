@@ -23,6 +23,7 @@ from randvib._progress import progress_bar, progress_wanted
 from randvib.analytic.bridge import DcOptimum
 from randvib.models.excitation import Measured
 from randvib.models.harvester import Harvester
+from randvib.montecarlo.bridge_step import bridge_input_rms, never_conducted
 from randvib.montecarlo.on_record import monte_carlo_on_record
 from randvib.montecarlo.simulation import simulate
 
@@ -68,6 +69,13 @@ def simulated_dc_optimum(
         neighbours (in log R_L for a load), ``power_stored`` Monte Carlo's at
         the best grid point, ``where`` ``"interior"`` or the end of the grid
         the best point sits on.
+
+    Raises
+    ------
+    ValueError
+        Where no grid point stores power (an optimum of zero power is no
+        optimum): the bridge never conducted, with the transducer's RMS
+        voltage against the threshold and what would help.
     """
     bridge = harvester.electrical
     if not harvester.is_rectified:
@@ -81,7 +89,7 @@ def simulated_dc_optimum(
             f"`n_grid` >= 3; got {bounds!r} and {n_grid!r}"
         )
     grid = np.geomspace(lo, hi, n_grid) if log else np.linspace(lo, hi, n_grid)
-    power = []
+    power, runs = [], []
     bar = None
     if progress_wanted() if progress is None else progress:
         bar = progress_bar(n_grid, desc="optimum", unit="point")
@@ -102,12 +110,15 @@ def simulated_dc_optimum(
                         seed=seed, progress=False,
                     )  # fmt: skip
             power.append(result.power_stored.mean)
+            runs.append(result)
             if bar is not None:
                 bar.update(1)
     finally:
         if bar is not None:
             bar.close()
     power = np.array(power)
+    if not np.max(power) > 0.0:
+        raise ValueError(_nothing_stored(parameter, lo, hi, runs, n_paths))
     k = int(np.argmax(power))
     if k == 0:
         return DcOptimum(parameter, float(grid[0]), float(power[0]), "lower bound (of the grid)",
@@ -120,3 +131,18 @@ def simulated_dc_optimum(
     best = -b / (2.0 * a) if a < 0 else x[1]
     best = float(np.exp(best) if log else best)
     return DcOptimum(parameter, best, float(power[k]), "interior", lo, hi)
+
+
+def _nothing_stored(parameter: str, lo: float, hi: float, runs, n_paths: int) -> str:
+    """Why no grid point stored power: an optimum of zero power is no optimum."""
+    what = "battery voltage" if parameter == "battery" else "storage load"
+    unit = "V" if parameter == "battery" else "ohm"
+    head = f"no {what} in [{lo:g}, {hi:g}] {unit} stores power (Monte Carlo, {n_paths} paths)"
+    # the lowest battery (the lowest threshold) or the largest load (the slowest discharge)
+    run = runs[0] if parameter == "battery" else runs[-1]
+    if never_conducted(run):
+        return f"{head}: {run.harvester.electrical.idle_advice(bridge_input_rms(run))}"
+    return (
+        f"{head}: the bridge conducts only where it stores nothing (V_b = 0): search a finer "
+        "range above the lower bound"
+    )

@@ -123,6 +123,56 @@ def check_bridge_balance(result) -> None:
         )
 
 
+class BridgeIdleWarning(RuntimeWarning):
+    """A bridge never conducted: its transducer's voltage never reached the threshold."""
+
+
+def bridge_input_rms(result) -> float:
+    """RMS of the transducer's open-circuit voltage (V) in a run whose bridge never conducted.
+
+    The coil's EMF ``alpha z'`` or the piezo's ``theta z / C_p``, from the
+    run's own E[z'^2] or E[z^2] (the motion of a bridge that never conducts
+    is the open-circuit motion).
+    """
+    bridge = result.harvester.electrical
+    averages = result.averages
+    if bridge.transducer == "piezo":
+        return bridge.theta / bridge.capacitance * float(np.sqrt(np.mean(averages.z2)))
+    return bridge.alpha * float(np.sqrt(np.mean(averages.v2)))
+
+
+def never_conducted(result) -> bool:
+    """No path of a bridge run carried current, though its threshold V_out + 2 V_d is above 0.
+
+    The current shows in the coil's and the diodes' losses and in a battery's
+    stored power (a storage capacitor's is also its discharge); a threshold
+    of 0 (a battery of 0 V or a capacitor with ideal diodes) conducts without
+    storing, which is no idle bridge.
+    """
+    averages = result.averages
+    bridge = result.harvester.electrical
+    carried = averages.coil_loss + averages.diode_loss
+    if bridge.has_battery:
+        carried = carried + averages.stored_power
+        blocked = bridge.threshold() > 0.0
+    else:
+        blocked = bridge.v_diode > 0.0
+    return blocked and bool(np.all(carried == 0.0))
+
+
+def check_bridge_conducted(result) -> None:
+    """Warn (:class:`BridgeIdleWarning`) when a bridge run stored nothing because it never
+    conducted: the transducer's voltage, its RMS and the threshold, and what would help."""
+    if not result.harvester.is_rectified or not never_conducted(result):
+        return
+    advice = result.harvester.electrical.idle_advice(bridge_input_rms(result))
+    warnings.warn(
+        f"{advice} ({result.n_paths} paths x {result.averaging_time:g} s)",
+        BridgeIdleWarning,
+        stacklevel=3,
+    )
+
+
 def storage_start(run) -> float:
     """The storage capacitor's voltage at t = 0 (V): its charge-balance level, or 0.
 

@@ -24,7 +24,7 @@ from randvib.models.excitation import Excitation, as_excitation
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import kernel
 from randvib.quantities import unit
-from randvib.statistics import FirstPassage, Statistic, estimate
+from randvib.statistics import FirstPassage, Statistic, estimate, proportion
 
 #: The statistics of a :class:`SimulationResult` that are shown, in order (their
 #: units: :mod:`randvib.quantities`).
@@ -251,12 +251,16 @@ class SimulationResult:
     def stroke_exceedance(self) -> Statistic | None:
         """Fraction of the window's time with |z| > stroke; None without a stroke.
 
+        Its 95 % interval is the Wilson interval (:func:`randvib.statistics.proportion`).
+
         For the free mass it is the fraction over this window (z is not
         stationary, so it grows with the run), not a stationary probability.
         """
         if self.harvester.stroke is None:
             return None
-        return self.statistic(self.averages.beyond_stroke)
+        # a probability: the Wilson interval stays in [0, 1] where mean +- t SE would not
+        controls = self.controls() if self.control_variates else None
+        return proportion(self.averages.beyond_stroke, controls)
 
     @property
     def stroke_first_passage(self) -> FirstPassage | None:
@@ -411,9 +415,51 @@ class SimulationResult:
         out["excitation"] = excitation.parameters()
         return out
 
-    def to_dict(self) -> dict:
-        """The same as :meth:`summary` (JSON-ready)."""
-        return self.summary()
+    def to_dict(self, per_path: bool = False) -> dict:
+        """The same as :meth:`summary` (JSON-ready).
+
+        With ``per_path=True``, also what :meth:`from_dict` rebuilds the
+        result from: ``device`` (:meth:`Harvester.parameters`), ``first_path``
+        and ``per_path`` (the per-path averages, one list per path; the
+        histograms and recorded paths are not saved).
+        """
+        out = self.summary()
+        if per_path:
+            out["device"] = self.harvester.parameters()
+            out["first_path"] = self.first_path
+            out["per_path"] = self.per_path.tolist()
+        return out
+
+    @classmethod
+    def from_dict(cls, d: dict, excitation: Excitation | None = None) -> SimulationResult:
+        """The result that :meth:`to_dict` ``(per_path=True)`` wrote (a run saved as JSON).
+
+        Every statistic is recomputed from the saved per-path averages, so it
+        equals the saved run's. ``excitation``: the input, needed only for one
+        that its parameters do not describe in full (a table, a record); white
+        noise and the named spectra are rebuilt from the saved ones.
+        """
+        from randvib.models.harvester import harvester_from_parameters
+
+        if "per_path" not in d or "device" not in d:
+            raise ValueError(
+                "this dict has the statistics only: save the run with "
+                "`to_dict(per_path=True)` to reload it"
+            )
+        return cls(
+            harvester=harvester_from_parameters(d["device"]),
+            psd=d["psd"],
+            scheme=d["method"],
+            dt=d["dt"],
+            t_end=d["t_end"],
+            burn_in=d["burn_in"],
+            seed=d["seed"],
+            first_path=d.get("first_path", 0),
+            per_path=np.array(d["per_path"], dtype=float),
+            control_variates=d["control_variates"],
+            wall_time=d.get("wall_time", 0.0),
+            excitation=_saved_excitation(d.get("excitation"), excitation),
+        )
 
     def _statistics(self) -> list[tuple[str, Statistic, str]]:
         """(name, Statistic, unit) of every statistic this run has."""
@@ -471,3 +517,24 @@ class SimulationResult:
         return _display.html_table(
             "Monte Carlo (mean ± 95 % half-width)", self._rows(), self._settings_line()
         )
+
+
+def _saved_excitation(saved: dict | None, given: Excitation | None) -> Excitation | None:
+    """The excitation of a saved run: ``given``, else rebuilt from its saved parameters
+    (None for white noise, which ``psd`` describes)."""
+    from dataclasses import fields
+
+    from randvib.models.excitation import EXCITATIONS
+
+    if given is not None:
+        return given
+    if saved is None or saved.get("excitation") == "white":
+        return None
+    values = {k: v for k, v in saved.items() if k != "excitation"}
+    cls = EXCITATIONS.get(saved.get("excitation"))
+    if cls is None or set(values) != {f.name for f in fields(cls)}:
+        raise ValueError(
+            f"the {saved.get('excitation')!r} excitation is saved by its summary only: pass it "
+            "as `excitation` to rebuild the run"
+        )
+    return cls(**values)

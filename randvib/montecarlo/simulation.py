@@ -62,7 +62,11 @@ from randvib.models.harvester import Harvester
 from randvib.montecarlo import driven
 from randvib.montecarlo.assembly_simulation import simulate_assembly
 from randvib.montecarlo.batches import batch_bounds, run_batches
-from randvib.montecarlo.bridge_step import check_bridge_balance, check_bridge_step
+from randvib.montecarlo.bridge_step import (
+    check_bridge_balance,
+    check_bridge_conducted,
+    check_bridge_step,
+)
 from randvib.montecarlo.kernel_setup import KernelSetup
 from randvib.montecarlo.options import numba_threads
 from randvib.montecarlo.resources import announce_long_run, check_resources
@@ -294,4 +298,5 @@ def execute(run: Run, *, control_variates, check_step, threads, batch_paths, pro
     )
     if check_step:  # the per-run identity: every path sums to m S / 4
         check_bridge_balance(result)
+    check_bridge_conducted(result)  # a bridge that stored nothing says why
     return result

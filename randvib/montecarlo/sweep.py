@@ -53,6 +53,7 @@ from randvib._io import (
     sha256,
     unlock_folder,
 )
+from randvib._processes import WorkerProcessWarning, caller_stacklevel, why_no_processes
 from randvib._progress import progress_bar
 from randvib._validation import MAX_SEED, check_int, check_positive
 from randvib.analytic.prediction import METHODS, predict
@@ -79,6 +80,11 @@ def cartesian(**axes) -> list[dict]:
     return [dict(zip(names, combo, strict=True)) for combo in itertools.product(*values)]
 
 
+#: Smallest target relative half-width: 1e-6 needs (2 CV / 1e-6)^2 = 4e12 CV^2 paths, far
+#: beyond any max_paths; below it a target is a typing error (1e-300), not a precision.
+MIN_TARGET_REL_CI = 1e-6
+
+
 @dataclass(frozen=True)
 class SweepSettings:
     """How each point is simulated.
@@ -101,7 +107,10 @@ class SweepSettings:
     seed : int
         Common seed of every point (common random numbers).
     control_variates : bool
-        Use the control variates (companion integrated alongside).
+        Use the control variates where they hold: the energy balance's under
+        white noise or a filtered spectrum, and under white noise with a
+        viscous c_e the friction-free companion integrated alongside; plain
+        means under a synthesised or recorded input.
     """
 
     dt: float = 1e-4
@@ -120,7 +129,12 @@ class SweepSettings:
         check_positive("window", self.window, "s")
         if not (np.isfinite(self.burn_in) and self.burn_in >= 0):
             raise ValueError(f"`burn_in` must be >= 0 s, got {self.burn_in!r}")
-        check_positive("target_rel_ci", self.target_rel_ci)
+        if not (np.isfinite(self.target_rel_ci) and self.target_rel_ci >= MIN_TARGET_REL_CI):
+            raise ValueError(
+                f"`target_rel_ci` must be >= {MIN_TARGET_REL_CI:g} (the 95 % half-width over the "
+                f"power; a mean over n paths reaches about 2 CV / sqrt(n)), got "
+                f"{self.target_rel_ci!r}"
+            )
         check_int("min_paths", self.min_paths, 8)
         check_int("batch_paths", self.batch_paths, 1)
         check_int("max_paths", self.max_paths, self.min_paths)
@@ -203,6 +217,12 @@ def simulate_to_precision(
     """
     from randvib.montecarlo.simulation import simulate
 
+    # the controls where they hold: the energy balance's under white noise or a shaping
+    # filter (Brownian increments), the companion's exact moments under white noise and
+    # a viscous c_e only (no circuit state, no bridge); elsewhere plain means
+    white = getattr(excitation, "is_white", True)
+    filtered = white or excitation.shaping_filter() is not None
+    controls = settings.control_variates and filtered
     kw = dict(
         t_end=settings.burn_in + settings.window,
         dt=settings.dt,
@@ -210,9 +230,8 @@ def simulate_to_precision(
         scheme=settings.scheme,
         seed=seed,
         initial=initial,
-        # the companion's exact moments need a viscous c_e (no circuit state, no bridge)
-        companion=settings.control_variates and not (device.has_circuit or device.is_rectified),
-        control_variates=settings.control_variates,
+        companion=controls and white and not (device.has_circuit or device.is_rectified),
+        control_variates=controls,
         threads=threads,
         progress=False,
     )
@@ -225,7 +244,9 @@ def simulate_to_precision(
         if not (rel > settings.target_rel_ci) or n >= settings.max_paths:
             return result
         # paths needed if the spread stays the same (CI ~ n^-1/2), plus 10 %
-        wanted = math.ceil(n * (rel / settings.target_rel_ci) ** 2 * 1.1)
+        # (a target far below reach asks for max_paths: the ratio's square would overflow)
+        factor = min(rel / settings.target_rel_ci, math.sqrt(settings.max_paths / n) * 2.0)
+        wanted = math.ceil(n * factor**2 * 1.1)
         extra = max(wanted - n, settings.batch_paths)
         extra = math.ceil(extra / settings.batch_paths) * settings.batch_paths
         extra = min(extra, settings.max_paths - n)
@@ -335,6 +356,14 @@ def make_executor(workers: int | None = None, scheduler: str | None = None, init
         return client.get_executor(pure=False), client.close
     workers = os.cpu_count() or 1 if workers is None else check_int("workers", workers, 1)
     if workers == 1:
+        return None, lambda: None
+    reason = why_no_processes()
+    if reason is not None:  # an unguarded script: its workers would run it again
+        warnings.warn(
+            f"running in this process, not {workers} worker processes: {reason}",
+            WorkerProcessWarning,
+            stacklevel=caller_stacklevel(),
+        )
         return None, lambda: None
     # spawn, not fork: numba's OpenMP threading layer may already be running
     # in this process, and forking it is unsafe (the child aborts)

@@ -209,7 +209,7 @@ def _check_case(harvester, event) -> None:
 
 
 def _check_resources(run, snap_steps: np.ndarray, batch_paths) -> None:
-    """The run's options, its memory and time, and the memory of the snapshots it keeps."""
+    """The run's options, its memory and time, the snapshots it keeps and the envelope's gains."""
     check_options(run, False)
     check_resources(run, batch_paths)
     check_memory(
@@ -217,6 +217,15 @@ def _check_resources(run, snap_steps: np.ndarray, batch_paths) -> None:
         8.0 * run.n_paths * (snap_steps.size * kernel.N_SNAP + kernel.N_EVENT + kernel.N_ACC),
         "give fewer `times` or fewer `n_paths`, or run in parts with `first_path`",
     )
+    check_memory(  # the envelope's gain on every step (Gauss-Legendre nodes, a few arrays)
+        f"the envelope's gain on each of the {run.grid.n_steps:.4g} steps of t_end / dt",
+        8.0 * run.grid.n_steps * (4 * ENVELOPE_NODES + 8),
+        "shorten `t_end` (the last of `times`) or lengthen `dt`",
+    )
+
+
+#: Quadrature nodes per step of the envelope's step integrals (:meth:`Envelope.step_integrals`).
+ENVELOPE_NODES = 6
 
 
 def snapshot_steps(times, dt: float, n_steps: int) -> np.ndarray:

@@ -20,7 +20,7 @@ from randvib import _display, formatting
 from randvib.models.event import Enveloped, EventStart
 from randvib.models.harvester import Harvester
 from randvib.montecarlo import kernel
-from randvib.statistics import FirstPassage, Statistic, TimeStatistics, estimate
+from randvib.statistics import FirstPassage, Statistic, TimeStatistics, estimate, proportion
 
 #: Quantiles of the peak |z| reported by :meth:`TransientResult.to_dict`.
 PEAK_QUANTILES = (0.5, 0.9, 0.99)
@@ -130,7 +130,7 @@ class TransientResult:
         if self.harvester.stroke is None:
             return None
         beyond = np.abs(self._column(kernel.SNAP_Z)) > self.harvester.stroke
-        return TimeStatistics.from_paths(beyond.astype(float))
+        return TimeStatistics.proportions(beyond.astype(float))
 
     @property
     def stroke_reached(self) -> TimeStatistics | None:
@@ -138,7 +138,7 @@ class TransientResult:
         if self.harvester.stroke is None:
             return None
         reached = self._column(kernel.SNAP_PEAK) > self.harvester.stroke
-        return TimeStatistics.from_paths(reached.astype(float))
+        return TimeStatistics.proportions(reached.astype(float))
 
     # ------------------------------------------------------------ the event
     def _energies(self, which: str) -> np.ndarray:
@@ -174,8 +174,8 @@ class TransientResult:
         return {float(q): float(np.quantile(peaks, q)) for q in levels}
 
     def peak_exceedance(self, level: float) -> Statistic:
-        """P(peak |z| over the event > ``level`` (m)), with its interval."""
-        return estimate((self.peak_displacement > level).astype(float))
+        """P(peak |z| over the event > ``level`` (m)), with its Wilson 95 % interval."""
+        return proportion((self.peak_displacement > level).astype(float))
 
     @property
     def stroke_first_passage(self) -> FirstPassage | None:
@@ -205,13 +205,20 @@ class TransientResult:
         for name, stat, _ in self._series():
             frame[name] = stat.mean
             frame[f"{name}_ci95"] = stat.ci95
+            if stat.lower is not None:  # a probability: its Wilson interval's ends
+                frame[f"{name}_lower"], frame[f"{name}_upper"] = stat.lower, stat.upper
         return frame
 
     def to_dict(self) -> dict:
-        """JSON-ready: ``times``; each statistic as [[mean, 95 % half-width], ...] over them;
-        ``energy_electrical`` as [mean, half-width]; the peak |z|; the run's settings."""
+        """JSON-ready: ``times``; each statistic as [[mean, 95 % half-width], ...] over them
+        (a probability also as ``<name>_interval``: [[lower, upper], ...], its Wilson
+        interval, and ``stroke_reached_event_interval``); ``energy_electrical`` as [mean,
+        half-width]; the peak |z|; the run's settings."""
         out = {"times": self.times.tolist()}
-        out.update({name: stat.to_list() for name, stat, _ in self._series()})
+        for name, stat, _ in self._series():
+            out[name] = stat.to_list()
+            if stat.lower is not None:
+                out[f"{name}_interval"] = stat.intervals()
         energy = self.energy_electrical
         out["energy_electrical"] = [energy.mean, energy.ci95]
         if self.energy_load is not None:
@@ -225,6 +232,7 @@ class TransientResult:
             reached = self.peak_exceedance(self.harvester.stroke)
             out["stroke"] = self.harvester.stroke
             out["stroke_reached_event"] = [reached.mean, reached.ci95]
+            out["stroke_reached_event_interval"] = list(reached.interval)
         out.update(
             n_paths=self.n_paths,
             dt=self.dt,
@@ -249,7 +257,7 @@ class TransientResult:
         return _display.time_rows(
             self.times,
             self._series(),
-            lambda stat, i: formatting.estimate(stat.mean[i], stat.ci95[i]),
+            lambda stat, i: format(stat[i], ""),  # mean ± half-width, a probability's [lo, hi]
         )
 
     def __repr__(self) -> str:

@@ -90,7 +90,8 @@ def event_tables(run, *, reference: str, stroke: float):
     -------
     results : DataFrame
         ``device``, ``level``, ``n_paths``, ``energy_mc`` (J) with ``_ci95``,
-        ``stroke_reached_mc`` with ``_ci95``, ``peak_median`` and ``peak_p90``
+        ``stroke_reached_mc`` with ``_ci95`` (the longer side of its Wilson interval,
+        ``_lower`` and ``_upper``), ``peak_median`` and ``peak_p90``
         (m), ``energy_stationary``, ``energy_lin`` (J), the linear device's
         ``stroke_poisson`` and ``stroke_vanmarcke``, the largest relative
         error of the linearised E[P_e](t) (``time_error_max``, at
@@ -116,6 +117,7 @@ def event_tables(run, *, reference: str, stroke: float):
             "device": case.labels["device"], "level": case.labels["level"], "n_paths": mc.n_paths,
             "energy_mc": energy.mean, "energy_mc_ci95": energy.ci95,
             "stroke_reached_mc": reached.mean, "stroke_reached_mc_ci95": reached.ci95,
+            "stroke_reached_mc_lower": reached.lower, "stroke_reached_mc_upper": reached.upper,
             "peak_median": peaks[0.5], "peak_p90": peaks[0.9],
             "energy_stationary": _stationary_energy(device, ev, settings.t_end),
             "energy_lin": np.nan if lin is None else lin.energy_electrical,
@@ -244,8 +246,10 @@ def energy_and_stroke_figure(results: pd.DataFrame, stroke: float, path: Path) -
             ax.plot(sub.level, 1e3 * sub.energy_stationary, ":", color=colour, lw=1,
                     label=f"{name}, stationary x duration")  # fmt: skip
         ax = axes[0, 1]
-        ax.errorbar(sub.level, sub.stroke_reached_mc, yerr=sub.stroke_reached_mc_ci95, fmt="o-",
-                    ms=4, capsize=2, color=colour, lw=1, label=f"{name}, Monte Carlo")  # fmt: skip
+        reached = sub.stroke_reached_mc
+        bars = [reached - sub.stroke_reached_mc_lower, sub.stroke_reached_mc_upper - reached]
+        ax.errorbar(sub.level, reached, yerr=bars, fmt="o-", ms=4, capsize=2, color=colour,
+                    lw=1, label=f"{name}, Monte Carlo (Wilson 95 %)")  # fmt: skip
         if sub.stroke_poisson.notna().any():
             # both approximations assume the Gaussian response of a linear device
             ax.plot(sub.level, sub.stroke_poisson, "--", color=colour, lw=1,
@@ -258,6 +262,7 @@ def energy_and_stroke_figure(results: pd.DataFrame, stroke: float, path: Path) -
                    ylabel=f"P(|z| reaches {1e3 * stroke:g} mm)", ylim=(-0.02, 1.02))  # fmt: skip
     for ax in axes[0]:
         ax.grid(alpha=0.3, lw=0.5)
-        ax.legend(fontsize=6)
+        # beside the panel, not over its points
+        ax.legend(fontsize=6, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncols=2)
     panel_letters(axes)
     return save_figure(fig, path)

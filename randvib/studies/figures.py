@@ -77,8 +77,11 @@ def power_against_friction(table: pd.DataFrame, base, psds, k3s, path: Path) -> 
         bottom.set_xlabel("Coulomb friction $F_c$ (mN)")
     axes[0, 0].set_ylabel("E[$P_e$] (mW)")
     axes[1, 0].set_ylabel("(P$_{method}$ − P$_{MC}$) / P$_{MC}$ (%)")
-    fig.legend(*axes[0, 0].get_legend_handles_labels(), loc="outside lower center", ncol=3)
-    axes[1, 0].legend(fontsize=6)
+    # one legend for both rows, below the panels (a second one inside (d) covered its points)
+    handles, labels = axes[0, 0].get_legend_handles_labels()
+    more = axes[1, 0].get_legend_handles_labels()
+    fig.legend(handles + more[0], labels + more[1], loc="outside lower center", ncol=3,
+               fontsize=6)  # fmt: skip
     panel_letters(axes)
     return save_figure(fig, path)
 
@@ -376,7 +379,9 @@ def error_against_bandwidth(results: pd.DataFrame, centres, path: Path) -> Path:
         fc = 1e3 * lin[lin.k3 == k3].fc.iloc[0]
         ax.set_title(f"F$_c$ = {fc:g} mN, k$_3$ = {num_tex(k3)} N/m$^3$", fontsize=9)
     axes[0, 0].set_ylabel("linearisation error in E[P$_e$] (%)")
-    axes[0, 0].legend(fontsize=7)
+    fig.legend(
+        *axes[0, 0].get_legend_handles_labels(), loc="outside lower center", ncol=4, fontsize=7
+    )  # fmt: skip  (below the panels, off the data)
     panel_letters(axes)
     return save_figure(fig, path)
 
@@ -401,8 +406,14 @@ def contrast_against_bandwidth(inter: pd.DataFrame, centres, labels: dict, path:
         _bandwidth_axis(ax, inter.zeta)
         ax.set_title(f"band centred {centre} the linear resonance", fontsize=9)
     axes[0, 0].set_ylabel("interaction contrast / P(F$_c$, 0) (%)")
-    axes[0, 0].legend(fontsize=7, title="markers: Monte Carlo (95 %); dashed: linearisation",
-                      title_fontsize=7)  # fmt: skip
+    fig.legend(
+        *axes[0, 0].get_legend_handles_labels(),
+        loc="outside lower center",
+        ncol=4,
+        fontsize=7,
+        title="markers: Monte Carlo (95 %); dashed: linearisation",
+        title_fontsize=7,
+    )  # fmt: skip  (below the panels, off the data)
     panel_letters(axes)
     return save_figure(fig, path)
 
