@@ -114,6 +114,14 @@ def register(sub) -> None:
         help="the power to maximise: "
         + "; ".join(f"{name}: {o.description}" for name, o in OBJECTIVES.items()),
     )
+    _add_monte_carlo_arguments(g)
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    # SweepSettings' and design's names of the options, as refusals name them
+    p.set_defaults(handler=run, api_flags={"target_rel_ci": "--precision", "stroke": "--stroke"})
+
+
+def _add_monte_carlo_arguments(g) -> None:
+    """The options of the Monte Carlo confirmation (precision, paths, seed, where it runs)."""
     g.add_argument(
         "--no-monte-carlo", action="store_true", help="the analytic search's answer only"
     )
@@ -146,9 +154,6 @@ def register(sub) -> None:
     g.add_argument("--out-dir", help="folder to keep the Monte Carlo cases in and resume from")
     g.add_argument("--scheduler", help="address of a Dask scheduler to run the cases on")
     g.add_argument("--no-progress", action="store_true", help="no progress bar")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
-    # SweepSettings' and design's names of the options, as refusals name them
-    p.set_defaults(handler=run, api_flags={"target_rel_ci": "--precision", "stroke": "--stroke"})
 
 
 def vary_option(text: str) -> tuple[str, float, float]:
