@@ -1580,19 +1580,19 @@ def run_all(chosen, full: bool = False, jobs: int = 2) -> list:
     mutation reaches) on one core, so runs side by side fill the machine.
     """
     with tempfile.TemporaryDirectory(prefix="mutants-") as tmp:
-        prepared = []
-        for mutation in chosen:  # serially: ast.parse of CPython 3.11 is not re-entrant
-            work = Path(tmp) / mutation.name
-            work.mkdir()
-            prepared.append((mutation, prepare_mutant(mutation, work)))
 
-        def run(item):
-            outcome = run_prepared(*item, full=full)
+        def run(mutation, project):
+            outcome = run_prepared(mutation, project, full=full)
             print(outcome.summary(), flush=True)
             return outcome
 
         with ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
-            return list(pool.map(run, prepared))
+            futures = []
+            for mutation in chosen:  # prepared here, one at a time: ast.parse of CPython
+                work = Path(tmp) / mutation.name  # 3.11 is not re-entrant; runs start at once
+                work.mkdir()
+                futures.append(pool.submit(run, mutation, prepare_mutant(mutation, work)))
+            return [future.result() for future in futures]
 
 
 def main(argv=None) -> int:
