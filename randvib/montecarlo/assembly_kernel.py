@@ -196,6 +196,17 @@ def bridge_constants(kind, output, p, dt) -> np.ndarray:
 # start, 1: Heun's predictor), indexed, never sliced. ``dims`` is (N, ov, oth,
 # oc, ob, of, rows, E, C, B, n_filter): the counts and row offsets as one
 # tuple of integers (:func:`dims_of`).
+#
+# Every loop over the lanes is straight-line: branches and loops over DOFs or
+# parts stay outside it, so that the compiler unrolls it (and partly
+# vectorises it). Measured against this layout (issue 31, docs/benchmarks.md),
+# each of these made the step slower, not faster: a loop over the DOFs inside
+# the lanes' loop (summing M^-1 K x per lane in a register: 5 DOFs 1.5-2x
+# slower), an inlined helper taking arrays called inside the lanes' loop
+# (reference counts in every lane: 2-3x), a tuple of arrays unpacked in the
+# time loop (2-3x), and rows carried as 8-tuples ("bundles", to free the
+# compiler from aliasing: no vector code resulted, and the helpers' calls
+# cost reference counts).
 
 
 @numba.njit(cache=True)
@@ -245,11 +256,13 @@ def _push(rs, s, ov, n, push, part, tmp):
 
 @numba.njit(cache=True, inline="always")
 def _linear_rates(ys, rs, s, dims, stiffness, damping, drive, fa, fc, tmp):
-    """x' = v and the linear part's acceleration; the filter's rates and its output's push."""
+    """The linear part's acceleration; the filter's rates and its output's push.
+
+    x' = v is not copied into ``rs``: :func:`_advance` reads the velocities.
+    """
     n, ov, of, n_filter = dims[0], dims[1], dims[5], dims[10]
     for a in range(n):
         for j in range(LANES):
-            rs[s, a, j] = ys[s, ov + a, j]
             rs[s, ov + a, j] = 0.0
         for b in range(n):
             kab = stiffness[a, b]
@@ -362,12 +375,34 @@ def _bridges_rates(ys, rs, stage, s, dims, coords, push, bridges, tmp):
 # ------------------------------------------------------------------ the step
 @numba.njit(cache=True, inline="always")
 def _advance(ys, rs, gain, noise, dt, weights, dims, predictor):
-    """Every row but the bridges': the predictor (into ys[1]) or the scheme's update (ys[0])."""
+    """Every row but the bridges': the predictor (into ys[1]) or the scheme's update (ys[0]).
+
+    The displacements' rates are the velocities (read from ``ys``, rows
+    ``ov ..``; they take no noise), and they are advanced before the
+    velocities are overwritten. The base's rows stay at zero and are skipped.
+    """
     b1, b2 = weights
-    ob, of, rows = dims[4], dims[5], dims[6]
+    n, ov, oth, ob, of, rows = dims[0], dims[1], dims[2], dims[4], dims[5], dims[6]
+    if predictor:
+        for a in range(n):
+            for j in range(LANES):
+                ys[1, a, j] = ys[0, a, j] + ys[0, ov + a, j] * dt
+    elif b2 == 0.0:
+        for a in range(n):
+            for j in range(LANES):
+                ys[0, a, j] = ys[0, a, j] + b1 * ys[0, ov + a, j] * dt
+    else:
+        for a in range(n):
+            for j in range(LANES):
+                ys[0, a, j] = ys[0, a, j] + (b1 * ys[0, ov + a, j] + b2 * ys[1, ov + a, j]) * dt
     # the bridges' rows (ob .. of - 1) take their own steps: _bridges_predictor, _bridges_update
-    for part in range(2):
-        lo, hi = (0, ob) if part == 0 else (of, rows)
+    for part in range(3):
+        if part == 0:
+            lo, hi = ov, ov + n
+        elif part == 1:
+            lo, hi = oth, ob
+        else:
+            lo, hi = of, rows
         if predictor:
             for row in range(lo, hi):
                 g = gain[row]
