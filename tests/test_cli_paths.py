@@ -28,10 +28,11 @@ SIM = ["--paths", "16", "--t-end", "0.4", "--burn-in", "0.1", "--seed", "3"]
 
 
 def table_rows(out):
-    """{first cell: other cells} of a tabulate 'simple' table."""
+    """{first cell: other cells} of a tabulate 'simple' table; a half-width's cell
+    "± 0.00094" is one cell, its number."""
     rows = {}
     for line in out.splitlines():
-        cells = line.split()
+        cells = [c for c in line.split() if c != "±"]
         if len(cells) >= 2 and not set(line) <= set("- "):
             rows[cells[0]] = cells[1:]
     return rows
@@ -189,10 +190,11 @@ def test_validate_table_and_plots(tmp_path, capsys, records):
     expected = validate_api(device, [read_record(p) for p in records], substeps=4)
     rows = table_rows(out)
     for row in expected:
-        samples, cost, rms = rows[row.record]
-        assert int(samples) == row.samples
+        samples, cost, rms, offsets = rows[row.record][:4]  # then the residual's verdict
+        assert offsets == row.offsets_source
         assert float(cost) == pytest.approx(row.cost, rel=1e-5)
         assert float(rms) == pytest.approx(row.rms_error, rel=1e-5)
+        assert int(samples) == row.samples
     pngs = sorted(plots.glob("*.png"))
     assert [p.name for p in pngs] == ["00_test3.png", "01_test6.png"]
     for p in pngs:
