@@ -5,13 +5,13 @@ the identified damping ``c`` is the mechanical one, c_m, and the coupling's
 own parameters are identified beside the mechanical ones, each record at its
 known load R_L (docs/conventions.md, :mod:`randvib.models.coupling`):
 
-=============  ============================  ================================  ===================
-coupling       identified                    motion (force on the mass)        circuit state x
-=============  ============================  ================================  ===================
-``resistive``  alpha (Wb/m), r_coil (ohm)    c_e z', c_e = alpha^2/(R_L + R_C)  none (i algebraic)
-``inductive``  alpha, r_coil, inductance (H) alpha i                           i: L i' + (R_L + R_C) i = alpha z'
-``piezo``      theta (N/V), capacitance (F)  theta V                           V: C_p V' + V / R_L = theta z'
-=============  ============================  ================================  ===================
+=============  =============================  =================================  ==================================
+coupling       identified                     motion (force on the mass)         circuit state x
+=============  =============================  =================================  ==================================
+``resistive``  alpha (Wb/m), r_coil (ohm)     c_e z', c_e = alpha^2/(R_L + R_C)  none (i algebraic)
+``inductive``  alpha, r_coil, inductance (H)  alpha i                            i: L i' + (R_L + R_C) i = alpha z'
+``piezo``      theta (N/V), capacitance (F)   theta V                            V: C_p V' + V / R_L = theta z'
+=============  =============================  =================================  ==================================
 
 What a record's output channels hold (:data:`OUTPUT_KINDS`), each a linear
 combination ``c_z z + c_v z' + c_x x`` of the simulated state
@@ -202,13 +202,13 @@ def coupling_bounds(coupling: str, scales, r_loads, dt: float) -> dict:
     With ``c_ref = 2 m w`` (critical damping at the record's frequency w) and
     the records' loads R_L:
 
-    ===========  ==============================================  ====
+    ===========  ================================================  ===
     alpha        sqrt(c_ref R_L) x [1e-3, 3]  (c_e up to 9 c_ref)  log
-    r_coil       R_L x [1e-3, 10]                                log
-    inductance   R_L x [dt / 8, 10 / w]  (time constant L / R)   log
-    theta        sqrt(c_ref / R_L) x [1e-3, 10]                  log
-    capacitance  [dt / 8, 10 / w] / R_L  (time constant R_L C_p)  log
-    ===========  ==============================================  ====
+    r_coil       R_L x [1e-3, 10]                                  log
+    inductance   R_L x [dt / 8, 10 / w]  (time constant L / R)     log
+    theta        sqrt(c_ref / R_L) x [1e-3, 10]                    log
+    capacitance  [dt / 8, 10 / w] / R_L  (time constant R_L C_p)   log
+    ===========  ================================================  ===
 
     A time constant below dt / 8 has no effect the samples resolve (it is
     the static coupling's limit); below it the circuit would also cost the
