@@ -25,8 +25,8 @@ Run by hand (not in the default suite: 50+ mutants cost about 8 CPU-minutes)::
     python tests/mutation_check.py --only noise-variance --full
 
 ``tests/test_mutations.py`` checks, in the default suite, that every mutation still
-applies to exactly one place, that the kept results name every mutation as caught by
-one of its own tests, and runs one mutant end to end.
+applies to exactly one place, that every kept outcome is a catch by one of its
+mutation's own tests, and runs one mutant end to end.
 """
 
 from __future__ import annotations
