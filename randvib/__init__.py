@@ -44,6 +44,7 @@ _EXPORTS = {
     ),
     "randvib.analytic.statistical_linearisation": (
         "LinearisationResult",
+        "LinearisationValidityWarning",
         "statistical_linearisation",
     ),
     "randvib.analytic.linear_response": ("ResponseSpectra",),

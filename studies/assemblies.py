@@ -50,7 +50,6 @@ import numpy as np
 import pandas as pd
 
 import randvib as rv
-from randvib.analytic.statistical_linearisation import LinearisationValidityWarning
 from randvib.figure_style import colour, new_figure, save_figure
 from randvib.studies import report, script_main
 from randvib.studies.assembly_cases import (
@@ -237,7 +236,7 @@ def two_mass_designs(x, fc: float, chosen=("k", "c_e")):
     two_vary = {"structure.stiffness.0.0": (0.1 * total * w**2, 10 * total * w**2),
                 "element.1.k": (INNER * (0.5 * w) ** 2, INNER * (2 * w) ** 2)}  # fmt: skip
     with warnings.catch_warnings():  # the closure's validity warnings: Monte Carlo decides
-        warnings.simplefilter("ignore", LinearisationValidityWarning)
+        warnings.simplefilter("ignore", rv.LinearisationValidityWarning)
         a = rv.design(single, x, {**(single_vary if springs else {}), **loads}, exceedance=EPS,
                       monte_carlo=False)  # fmt: skip
         b = rv.design(two, x, {**(two_vary if springs else {}), **loads}, exceedance=EPS,
