@@ -397,9 +397,9 @@ def _main(argv) -> int:
             from randvib.cli._help import kept_help
 
             text = kept_help(named)  # printed before by this package: no parser to build
-            if text is not None:
+            if text is not None:  # and ends as argparse's --help does, whichever printed it
                 sys.stdout.write(text)
-                return 0
+                raise SystemExit(0)
         parser = build_parser([] if named is None else [named])
         args, unknown = parser.parse_known_args(argv)
         # "randvib COMMAND" from here on, as argparse names it ("randvib" until then)
