@@ -36,7 +36,7 @@ print(f"P(|z| reaches 5 mm in the event): {reached} (95 % Wilson interval)")
 # Through the event: the mean-square displacement and the power (Monte Carlo
 # with its 95 % band beside the analytic curve), the energy harvested since
 # the event began (the whole event's Monte Carlo energy as one marker at its
-# end), P(|z| has reached the stroke) with its Wilson interval, and the
+# end), P(``|z|`` has reached the stroke) with its Wilson interval, and the
 # envelope's intensity e(t)^2 (dotted). ``randvib simulate --envelope ...
 # --plot FILE.png`` draws the same figure.
 rv.plot_transient({"paper's device": (simulated, linearised)})
