@@ -586,7 +586,7 @@ def _run_chunk(
     """
     dt, n_steps, n_burn = timing
     seed, first_path, n_paths = paths
-    dw, ki, wi, fi = noise
+    dw, ki, wi, fi = noise.dw, noise.ki, noise.wi, noise.fi  # no per-path start (rare events')
     rows, n_elements, n_bridges = dims[6], dims[7], dims[9]
     start_path = chunk * LANES
     lanes = min(LANES, n_paths - start_path)
