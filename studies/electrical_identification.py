@@ -230,7 +230,8 @@ def figure(rows: pd.DataFrame, path: Path) -> Path:
         ax.set_xticks(range(len(params)), params, rotation=45)
         ax.set_ylabel("estimate / truth - 1 (%)")
         ax.set_title(f"{dev} (first seed)", loc="right")
-    axes[0, 0].legend(loc="upper left", frameon=False)
+    handles, labels = axes[0, 0].get_legend_handles_labels()  # beside the data, not over it
+    fig.legend(handles, labels, loc="outside lower center", ncols=len(CHANNELS), frameon=False)
     panel_letters(axes[0])
     return save_figure(fig, path)
 
