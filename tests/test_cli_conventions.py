@@ -441,7 +441,10 @@ def test_a_commands_help_is_kept_and_printed_without_building_the_parser(capsys,
     import randvib.cli as cli
     from randvib.cli import _help
 
-    monkeypatch.setattr(_help.shutil, "get_terminal_size", lambda: os.terminal_size((97, 40)))
+    # _help.shutil is the global module: pytest's own terminal calls it, with fallback=
+    monkeypatch.setattr(
+        _help.shutil, "get_terminal_size", lambda *a, **k: os.terminal_size((97, 40))
+    )
     _help._path("record").unlink(missing_ok=True)
     with pytest.raises(SystemExit):
         cli.main(["record", "--help"])
@@ -455,7 +458,9 @@ def test_a_commands_help_is_kept_and_printed_without_building_the_parser(capsys,
     with pytest.raises(SystemExit) as kept:  # as argparse's --help ends: the same either way
         cli.main(["record", "--help"])
     assert kept.value.code == 0 and capsys.readouterr().out == built
-    monkeypatch.setattr(_help.shutil, "get_terminal_size", lambda: os.terminal_size((61, 40)))
+    monkeypatch.setattr(
+        _help.shutil, "get_terminal_size", lambda *a, **k: os.terminal_size((61, 40))
+    )
     assert _help.kept_help("record") is None  # another width: built again
     _help._path("record").unlink(missing_ok=True)
 
