@@ -29,7 +29,7 @@ from randvib.models.friction import _no_generic_kernel as NO_CALLBACK
 from randvib.models.rectifier import CAPACITOR, PIEZO
 from randvib.montecarlo import assembly_kernel as ak
 from randvib.montecarlo import kernel
-from randvib.montecarlo.rng import ZIG_FI, ZIG_KI, ZIG_WI
+from randvib.montecarlo.kernel_setup import batch_noise
 
 
 @dataclass(frozen=True)
@@ -246,10 +246,6 @@ class AssemblyKernelSetup:
     def arguments(self, run, lo: int, hi: int) -> dict:
         """The keyword arguments of :func:`run_assembly_ensemble` for paths ``lo .. hi - 1``."""
         n_record = max(0, min(run.record_paths - lo, hi - lo))
-        if run.driver is not None:
-            dw = run.driver(run.first_path + lo, hi - lo)
-        else:
-            dw = run.dW[lo:hi] if run.dW is not None else np.zeros((0, 0))
         return dict(
             scheme=self.scheme,
             layout=self.layout,
@@ -261,5 +257,5 @@ class AssemblyKernelSetup:
             paths=kernel.pack(kernel.Paths, run.seed, run.first_path + lo, hi - lo),
             start=self.start,
             recording=kernel.pack(ak.Recording, n_record, run.record_every),
-            noise=kernel.Noise(np.ascontiguousarray(dw, dtype=float), ZIG_KI, ZIG_WI, ZIG_FI),
+            noise=batch_noise(run, lo, hi),
         )

@@ -47,7 +47,12 @@ from randvib.montecarlo.assembly_step_check import AssemblyTestSystem
 from randvib.montecarlo.batches import SimulationDivergedError, batch_bounds
 from randvib.montecarlo.integrators import Integrator, integrator
 from randvib.montecarlo.options import TimeGrid, numba_threads
-from randvib.montecarlo.validation import MAX_PATH_INDEX, BridgeStartWarning, _simulated_excitation
+from randvib.montecarlo.validation import (
+    MAX_PATH_INDEX,
+    BridgeStartWarning,
+    _simulated_excitation,
+    checked_increments,
+)
 
 __all__ = ["simulate_assembly"]
 
@@ -174,7 +179,7 @@ def validated_assembly(
         initial=_initial(initial, assembly.n_dof),
         record_paths=record_paths,
         record_every=record_every,
-        dW=_increments(dW, n_paths, grid.n_steps),
+        dW=checked_increments(dW, n_paths, grid.n_steps),
         driver=driver,
     )
 
@@ -199,19 +204,6 @@ def _initial(initial, n: int) -> tuple:
             f"numbers (m, m/s), one per DOF; got {initial!r}"
         )
     return "state", x0, v0
-
-
-def _increments(dW, n_paths, n_steps):
-    if dW is None:
-        return None
-    dW = np.ascontiguousarray(dW, dtype=float)
-    if dW.shape != (n_paths, n_steps):
-        raise ValueError(
-            f"`dW` must have shape (n_paths, n_steps) = {(n_paths, n_steps)}, got {dW.shape}"
-        )
-    if not np.all(np.isfinite(dW)):
-        raise ValueError("`dW` must be finite")
-    return dW
 
 
 def execute_assembly(

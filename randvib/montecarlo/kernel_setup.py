@@ -71,10 +71,6 @@ class KernelSetup:
         """The keyword arguments of :func:`~randvib.montecarlo.kernel.run_ensemble`
         for paths ``lo .. hi - 1``."""
         n_record = max(0, min(run.record.record_paths - lo, hi - lo))
-        if run.driver is not None:
-            dw = run.driver(run.first_path + lo, hi - lo)
-        else:
-            dw = run.dW[lo:hi] if run.dW is not None else np.zeros((0, 0))
         return dict(
             scheme=self.scheme,
             device=self.device,
@@ -84,13 +80,27 @@ class KernelSetup:
             initial=self.initial,
             companion=self.companion,
             recording=self.recording._replace(n_record=n_record),
-            noise=kernel.Noise(dw, ZIG_KI, ZIG_WI, ZIG_FI),
+            noise=batch_noise(run, lo, hi),
             auxiliary=self.auxiliary,
             rectifier=self.rectifier,
             forcing=None
             if run.forcing is None
             else run.forcing.group(run.first_path + lo, hi - lo),
         )
+
+
+def batch_noise(run, lo: int, hi: int) -> kernel.Noise:
+    """The noise of paths ``lo .. hi - 1`` of a run (a single mass's or an assembly's).
+
+    Increments from the run's driver (a given base acceleration, synthesised or
+    recorded), else its given ``dW`` rows, else none: the kernel draws them from
+    the paths' own streams with the ziggurat tables.
+    """
+    if run.driver is not None:
+        dw = run.driver(run.first_path + lo, hi - lo)
+    else:
+        dw = run.dW[lo:hi] if run.dW is not None else np.zeros((0, 0))
+    return kernel.Noise(np.ascontiguousarray(dw, dtype=float), ZIG_KI, ZIG_WI, ZIG_FI)
 
 
 def _auxiliary(run: Run, linear) -> kernel.Auxiliary | None:

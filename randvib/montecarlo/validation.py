@@ -120,7 +120,7 @@ def validated(
         first_path=check_int("first_path", first_path, 0, MAX_PATH_INDEX),
         initial=InitialState.from_argument(initial),
         record=RecordOptions.validated(*record),
-        dW=_checked_increments(dW, n_paths, grid.n_steps),
+        dW=checked_increments(dW, n_paths, grid.n_steps),
         companion=bool(companion),
     )
 
@@ -184,7 +184,7 @@ def _simulated_excitation(psd) -> Excitation:
     return psd
 
 
-def _checked_increments(dW, n_paths, n_steps):
+def checked_increments(dW, n_paths, n_steps):
     """Given Brownian increments as a contiguous (n_paths, n_steps) array, or None."""
     if dW is None:
         return None
