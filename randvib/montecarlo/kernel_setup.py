@@ -90,7 +90,7 @@ class KernelSetup:
 
 
 def batch_noise(run, lo: int, hi: int) -> kernel.Noise:
-    """The noise of paths ``lo .. hi - 1`` of a run (a single mass's or an assembly's).
+    """The noise of paths ``lo`` to ``hi - 1`` of a run (a single mass's or an assembly's).
 
     Increments from the run's driver (a given base acceleration, synthesised or
     recorded), else its given ``dW`` rows, else none: the kernel draws them from
