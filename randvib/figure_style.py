@@ -347,11 +347,17 @@ def save_figure(fig, path, *, tracked: bool = True) -> Path:
     import io
 
     import matplotlib.pyplot as plt
+    from matplotlib.layout_engine import ConstrainedLayoutEngine
 
     from randvib._io import atomic_write_bytes, write_tracked
 
     path = Path(path)
     check_layout(fig, path.name)
+    if isinstance(fig.get_layout_engine(), ConstrainedLayoutEngine):
+        # the check's draw solved the layout (axes positions in figure fractions, the same
+        # at any dpi): the PNG keeps what was checked, without solving it again (the
+        # solve was most of a saved figure's time)
+        fig.set_layout_engine("none")
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png", dpi=DPI)
     plt.close(fig)
