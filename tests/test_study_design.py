@@ -35,7 +35,7 @@ def test_design_study_quick_end_to_end(tmp_path, monkeypatch, capsys):
         study, "inputs", lambda quick: {"band": band.scaled(study.LEVEL / band.variance)}
     )
     monkeypatch.setattr(study, "STROKES", {True: (0.002,)})
-    monkeypatch.setattr(study, "ZETAS", {True: (0.3, 0.05)})
+    monkeypatch.setattr(study, "ZETAS", {True: (0.3,)})  # the input's own bandwidth
     monkeypatch.setattr(study, "QUICK_MC", {"dt": 2e-4, "window": 1.0, "burn_in": 0.3,
                                             "min_paths": 24, "max_paths": 24})  # fmt: skip
     out = tmp_path / "design"
@@ -57,4 +57,7 @@ def test_design_study_quick_end_to_end(tmp_path, monkeypatch, capsys):
                       exceedance=study.EPS, monte_carlo=False)  # fmt: skip
     assert lin.power_predicted == pytest.approx(exact.power_predicted, rel=1e-9)
     assert lin.opt_k == pytest.approx(exact.optimum["k"], rel=1e-9)
+    bandwidth = pd.read_csv(out / "bandwidth.csv")
+    at_input = bandwidth[(bandwidth.zeta == 0.3) & (bandwidth.family == "linear")].iloc[0]
+    assert at_input.k == pytest.approx(exact.optimum["k"], rel=1e-9)
     assert "A nonlinear spring" in (out / "report.md").read_text()
