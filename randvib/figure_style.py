@@ -168,7 +168,11 @@ def text_overlaps(fig) -> list[str]:
     only touch (a pixel of slack).
     """
     fig.canvas.draw()
-    renderer = fig.canvas.get_renderer()
+    return _text_overlaps(fig, fig.canvas.get_renderer())
+
+
+def _text_overlaps(fig, renderer) -> list[str]:
+    """:func:`text_overlaps` of a figure just drawn with ``renderer``."""
     boxes = []
     for owner, kind, artist in _texts(fig):
         box = artist.get_window_extent(renderer)
@@ -199,11 +203,15 @@ def legends_over_data(fig) -> list[str]:
     are not counted. A line counts where a segment crosses the legend's
     frame, a marker where its centre lies inside it (less a pixel).
     """
+    fig.canvas.draw()
+    return _legends_over_data(fig, fig.canvas.get_renderer())
+
+
+def _legends_over_data(fig, renderer) -> list[str]:
+    """:func:`legends_over_data` of a figure just drawn with ``renderer``."""
     from matplotlib.collections import LineCollection, PathCollection
     from matplotlib.transforms import Bbox
 
-    fig.canvas.draw()
-    renderer = fig.canvas.get_renderer()
     legends = list(fig.legends) + [ax.get_legend() for ax in fig.axes if ax.get_legend()]
     found = []
     for legend in legends:
@@ -308,14 +316,17 @@ def check_layout(fig, name: str) -> None:
 
     if not isinstance(fig.get_layout_engine(), ConstrainedLayoutEngine):
         warnings.warn(f"figure {name}: no constrained layout", FigureLayoutWarning, stacklevel=3)
-    overlaps = text_overlaps(fig)
+    # one draw for both checks (a draw with constrained layout is most of their time)
+    fig.canvas.draw()
+    renderer = fig.canvas.get_renderer()
+    overlaps = _text_overlaps(fig, renderer)
     if overlaps:
         warnings.warn(
             f"figure {name}: overlapping texts: " + "; ".join(overlaps),
             FigureLayoutWarning,
             stacklevel=3,
         )
-    covered = legends_over_data(fig)
+    covered = _legends_over_data(fig, renderer)
     if covered:
         warnings.warn(
             f"figure {name}: legend over data: " + "; ".join(covered),
@@ -336,11 +347,17 @@ def save_figure(fig, path, *, tracked: bool = True) -> Path:
     import io
 
     import matplotlib.pyplot as plt
+    from matplotlib.layout_engine import ConstrainedLayoutEngine
 
     from randvib._io import atomic_write_bytes, write_tracked
 
     path = Path(path)
     check_layout(fig, path.name)
+    if isinstance(fig.get_layout_engine(), ConstrainedLayoutEngine):
+        # the check's draw solved the layout (axes positions in figure fractions, the same
+        # at any dpi): the PNG keeps what was checked, without solving it again (the
+        # solve was most of a saved figure's time)
+        fig.set_layout_engine("none")
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png", dpi=DPI)
     plt.close(fig)

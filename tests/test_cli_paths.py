@@ -262,17 +262,30 @@ def test_study_identification_cli(tmp_path, capsys, monkeypatch):
 
 
 def test_study_linearisation_vs_averaging_cli(tmp_path, capsys, monkeypatch):
-    from randvib.studies import load
+    """A tiny run from the command line, and its rerun: every case resumed from the store
+    (its files untouched), the same table. (The quick run's accuracy criteria:
+    tests/test_averaging.py.)"""
+    import pandas as pd
+
+    from randvib.studies import load, methods
 
     lva = load("linearisation-vs-averaging")
 
     mc = {"n_paths": 16, "window": 0.5, "burn_in": 0.2, "dt": 5e-4}
     axes = {"psds": (1.0,), "kappas": (0.0, 0.5), "k3s": (0.0, 7e6), "mc": mc}
     monkeypatch.setattr(lva, "grid", lambda quick: axes)
+    monkeypatch.setattr(methods, "FPK_REFERENCE_CELLS", 64)  # the reference is not checked here
     out = tmp_path / "lva"
     report = _study(capsys, "linearisation-vs-averaging", out)
     verdict = json.loads((out / "verdicts.json").read_text())
     assert verdict["points"] == 4 and verdict["reading"] in report
+    results = pd.read_csv(out / "results.csv")
+    stored = sorted((out / "ensembles" / "points").glob("*.npy"))
+    assert len(stored) == len(results) == 4
+    stamps = [p.stat().st_mtime_ns for p in stored]
+    _study(capsys, "linearisation-vs-averaging", out)
+    assert [p.stat().st_mtime_ns for p in stored] == stamps
+    pd.testing.assert_frame_equal(pd.read_csv(out / "results.csv"), results)
     # its Monte Carlo runs on --workers processes (rv.run_ensembles), not in-process threads
     one_line_error(
         capsys,

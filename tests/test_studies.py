@@ -31,6 +31,7 @@ import randvib as rv
 from randvib.analytic.prediction import expected_power
 from randvib.cli import main
 from randvib.formatting import plus_minus
+from randvib.montecarlo import sweep
 from randvib.montecarlo.sweep import SweepSettings
 from randvib.studies import STUDIES, load
 from randvib.studies.accuracy import trusted_limit
@@ -259,11 +260,18 @@ def _cli_study(name, out, capsys):
     return out / "report.md"
 
 
+def _no_pool(*args, **kwargs):
+    raise AssertionError("a worker-process pool started under --workers 1")
+
+
 def test_interaction_study_end_to_end(tmp_path, monkeypatch, capsys):
     grid = {"psds": (1.0,), "k3s": (0.0, 5e7), "n_fc": 2}
     out = tmp_path / "inter"
     monkeypatch.setattr(interaction, "grid", lambda quick: grid)
     monkeypatch.setattr(interaction, "settings_for", lambda quick, seed: TINY)
+    # --workers 1 runs the sweep and its half-step re-run in this process (their own
+    # default is a pool on every core: two spawned interpreters loading numba, 4x the CPU)
+    monkeypatch.setattr(sweep, "_WorkerPool", _no_pool)
     report = _cli_study("interaction", out, capsys)
     inter = pd.read_csv(out / "interaction.csv")
     assert len(inter) == 1 and inter.k3[0] == 5e7 and inter.fc[0] > 0

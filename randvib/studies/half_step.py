@@ -136,6 +136,9 @@ def sweep_with_half_step(
     from randvib.analytic.averaging import AveragingValidityWarning
 
     executor, close = study_executor(workers, scheduler)
+    # no executor means in this process (one worker, or no processes allowed): say so to
+    # the runs, whose own default (workers=None) is a pool of every core's processes
+    where = {"executor": executor} if executor is not None else {"workers": 1}
     try:
         with warnings.catch_warnings():  # in-process runs; the reports flag these points
             warnings.simplefilter("ignore", AveragingValidityWarning)
@@ -144,9 +147,9 @@ def sweep_with_half_step(
                 points,
                 settings,
                 out_dir=out / "sweep",
-                executor=executor,
                 progress=progress,
                 name=name,
+                **where,
             )
             check = half_step_rerun(
                 base,
@@ -154,8 +157,8 @@ def sweep_with_half_step(
                 settings,
                 out / "step-check",
                 result.table,
-                executor=executor,
                 progress=progress,
+                **where,
             )
     finally:
         close()

@@ -63,6 +63,8 @@ ANALYTIC = {
 CANDIDATES = ("averaging", "fpk_fast")
 #: The speed bars for a fast method: one point (s) and a 100-point sweep (s).
 POINT_BAR, SWEEP_BAR = 10e-3, 1.0
+#: Finest grid of the FPK reference (cells per direction; :func:`randvib.analytic.fokker_planck.fpk_statistics`).
+FPK_REFERENCE_CELLS = 160
 
 
 def fc_of_kappa(kappa, psd, device):
@@ -78,7 +80,7 @@ def analytic_powers(device, psd) -> dict:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", AveragingValidityWarning)
         avg = averaging_statistics(device, psd)
-    fpk_vv = fpk_statistics(device, psd, 160)[0]
+    fpk_vv = fpk_statistics(device, psd, FPK_REFERENCE_CELLS)[0]
     return {
         "power_linearisation": c_e * lin_vv,
         "power_averaging": c_e * avg.velocity_variance,
