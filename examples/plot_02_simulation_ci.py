@@ -20,8 +20,11 @@ result = rv.simulate(
 )
 power = result.power_electrical  # a Statistic, W
 print(f"Monte Carlo  E[P_e] = {1e3 * power.mean:.4f} +- {1e3 * power.ci95:.4f} mW (95 %)")
-for method in ("linearisation", "fpk-fast"):
-    print(f"{method:13s} E[P_e] = {1e3 * rv.expected_power(device, 1.0, method):.4f} mW")
+predicted = {
+    method: rv.expected_power(device, 1.0, method) for method in ("linearisation", "fpk-fast")
+}
+for method, value in predicted.items():
+    print(f"{method:13s} E[P_e] = {1e3 * value:.4f} mW")
 
 # %%
 # The same ensemble with the energy-balance control variates and the
@@ -60,8 +63,8 @@ ax.errorbar(
     capsize=6,
     label="Monte Carlo, 95 % interval",
 )
-for x, method in enumerate(("linearisation", "fpk-fast"), start=1):
-    ax.plot([x], [1e3 * rv.expected_power(device, 1.0, method)], "s", label=method)
+for x, (method, value) in enumerate(predicted.items(), start=1):
+    ax.plot([x], [1e3 * value], "s", label=method)
 ax.errorbar(
     [0.2],
     [1e3 * cv.mean],

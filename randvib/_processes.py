@@ -11,6 +11,12 @@ phase", then ``BrokenProcessPool``). :func:`why_no_processes` tells that case
 -``) from the ones that work (a guarded script, ``python -m``, a notebook, an
 interactive session, the ``randvib`` command), so that the caller runs its
 points in this process instead, with a one-line :class:`WorkerProcessWarning`.
+
+:class:`WorkerPool` and :func:`worker_start` are the local workers themselves
+(:func:`randvib.montecarlo.sweep.make_executor` builds them). They live here, in a
+module that imports nothing heavy, because a spawned worker imports the module of its
+initializer before it can do anything else: from the sweep module that was numpy,
+pandas, scipy and the analytic layer, seconds of CPU per worker before its first point.
 """
 
 from __future__ import annotations
@@ -18,6 +24,10 @@ from __future__ import annotations
 import ast
 import os
 import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+
+from randvib._interrupts import ctrl_c_blocked, worker_ignores_ctrl_c
 
 
 class WorkerProcessWarning(RuntimeWarning):
@@ -88,3 +98,48 @@ def caller_stacklevel() -> int:
     while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(root):
         frame, level = frame.f_back, level + 1
     return level
+
+
+def worker_start(parent: int, initializer=None) -> None:
+    """In each local worker: end when the parent goes, then the user's initializer.
+
+    A sweep killed with SIGTERM or SIGKILL cannot shut its pool down; its
+    workers would live on (one numba-loaded interpreter each). A daemon
+    thread in every worker checks once a second that the parent is still
+    there and ends the worker when it is not. A worker ignores SIGINT
+    (:func:`randvib._interrupts.worker_ignores_ctrl_c`): the parent alone
+    stops the sweep (keeping the finished points) and ends its workers. The
+    worker was born with SIGINT blocked (:class:`WorkerPool`), so a Ctrl-C
+    that came while it was still importing is discarded.
+    """
+    import threading
+
+    worker_ignores_ctrl_c()
+
+    def watch():
+        while True:
+            time.sleep(1.0)
+            if os.getppid() != parent:
+                os._exit(1)
+
+    threading.Thread(target=watch, name="randvib-parent-watch", daemon=True).start()
+    if initializer is not None:
+        initializer()
+
+
+class WorkerPool(ProcessPoolExecutor):
+    """A process pool whose workers are born with SIGINT blocked.
+
+    A spawned worker spends its first second or so importing numpy, numba and
+    randvib before :func:`worker_start` can ignore SIGINT; a Ctrl-C in that
+    window ended it with a KeyboardInterrupt traceback on the user's terminal.
+    The pool spawns its workers inside :meth:`submit` (one per submission
+    until it has ``max_workers``), so every submission blocks SIGINT in the
+    submitting thread (:func:`randvib._interrupts.ctrl_c_blocked`): the
+    workers inherit the mask, and a Ctrl-C meanwhile is delivered to the
+    parent when the mask is restored.
+    """
+
+    def submit(self, fn, /, *args, **kwargs):
+        with ctrl_c_blocked():
+            return super().submit(fn, *args, **kwargs)

@@ -418,7 +418,7 @@ MUTATIONS: tuple[Mutation, ...] = (
                 "cov = cov_u",
             ),
         ),
-        tests=("tests/test_measurement_model.py::test_95_percent_intervals_cover_the_truth",),
+        tests=("tests/test_measurement_model.py::test_intervals_have_the_spread_of_the_estimates",),
         why="Standard errors left in the optimiser's scaled variables (log or per-scale) "
         "instead of the parameters' units: the 95 % intervals no longer cover the truth "
         "about 95 % of the time.",

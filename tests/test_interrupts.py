@@ -250,8 +250,10 @@ def test_sweep_workers_end_when_the_sweep_is_killed(tmp_path):
         import os, sys, time
         sys.path.insert(0, sys.argv[1])
         from trust_worker import pid
-        from randvib.montecarlo.sweep import make_executor
         if __name__ == "__main__":
+            # imported here, not by the workers (which run this file first): they
+            # import only randvib._processes, the home of their entry point
+            from randvib.montecarlo.sweep import make_executor
             pool, close = make_executor(workers=2)
             print(" ".join(map(str, set(pool.map(pid, range(16))))), flush=True)
             time.sleep(120)
@@ -291,8 +293,8 @@ def test_sweep_workers_ignore_ctrl_c_while_they_are_still_starting(tmp_path):
     script = textwrap.dedent(
         """
         import os, signal
-        from randvib.montecarlo.sweep import make_executor
         if __name__ == "__main__":
+            from randvib.montecarlo.sweep import make_executor  # not in the workers
             pool, close = make_executor(workers=2)
             futures = [pool.submit(abs, i) for i in range(-8, 0)]  # spawns both workers
             pids = [p.pid for p in pool._processes.values()]

@@ -43,7 +43,6 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from randvib._interrupts import ctrl_c_blocked, worker_ignores_ctrl_c
 from randvib._io import (
     atomic_write_bytes,
     atomic_write_text,
@@ -53,7 +52,13 @@ from randvib._io import (
     sha256,
     unlock_folder,
 )
-from randvib._processes import WorkerProcessWarning, caller_stacklevel, why_no_processes
+from randvib._processes import (
+    WorkerPool,
+    WorkerProcessWarning,
+    caller_stacklevel,
+    why_no_processes,
+    worker_start,
+)
 from randvib._progress import progress_bar
 from randvib._validation import MAX_SEED, check_int, check_positive
 from randvib.analytic.prediction import METHODS, predict
@@ -288,51 +293,6 @@ def run_point(base: Harvester, point: Mapping, settings: SweepSettings, threads:
 SCHEDULER_TIMEOUT = 10
 
 
-def _worker_start(parent: int, initializer=None) -> None:
-    """In each local worker: end when the parent goes, then the user's initializer.
-
-    A sweep killed with SIGTERM or SIGKILL cannot shut its pool down; its
-    workers would live on (one numba-loaded interpreter each). A daemon
-    thread in every worker checks once a second that the parent is still
-    there and ends the worker when it is not. A worker ignores SIGINT
-    (:func:`randvib._interrupts.worker_ignores_ctrl_c`): the parent alone
-    stops the sweep (keeping the finished points) and ends its workers. The
-    worker was born with SIGINT blocked (:class:`_WorkerPool`), so a Ctrl-C
-    that came while it was still importing is discarded.
-    """
-    import threading
-
-    worker_ignores_ctrl_c()
-
-    def watch():
-        while True:
-            time.sleep(1.0)
-            if os.getppid() != parent:
-                os._exit(1)
-
-    threading.Thread(target=watch, name="randvib-parent-watch", daemon=True).start()
-    if initializer is not None:
-        initializer()
-
-
-class _WorkerPool(ProcessPoolExecutor):
-    """A process pool whose workers are born with SIGINT blocked.
-
-    A spawned worker spends its first second or so importing numpy, numba and
-    randvib before :func:`_worker_start` can ignore SIGINT; a Ctrl-C in that
-    window ended it with a KeyboardInterrupt traceback on the user's terminal.
-    The pool spawns its workers inside :meth:`submit` (one per submission
-    until it has ``max_workers``), so every submission blocks SIGINT in the
-    submitting thread (:func:`randvib._interrupts.ctrl_c_blocked`): the
-    workers inherit the mask, and a Ctrl-C meanwhile is delivered to the
-    parent when the mask is restored.
-    """
-
-    def submit(self, fn, /, *args, **kwargs):
-        with ctrl_c_blocked():
-            return super().submit(fn, *args, **kwargs)
-
-
 def make_executor(workers: int | None = None, scheduler: str | None = None, initializer=None):
     """An executor and a closer: local processes, or a Dask cluster at ``scheduler``.
 
@@ -369,10 +329,10 @@ def make_executor(workers: int | None = None, scheduler: str | None = None, init
     # in this process, and forking it is unsafe (the child aborts)
     import multiprocessing
 
-    pool = _WorkerPool(
+    pool = WorkerPool(
         max_workers=workers,
         mp_context=multiprocessing.get_context("spawn"),
-        initializer=functools.partial(_worker_start, os.getpid(), initializer),
+        initializer=functools.partial(worker_start, os.getpid(), initializer),
     )
     return pool, functools.partial(_close_pool, pool)
 

@@ -4,7 +4,7 @@ Run by hand (not collected by pytest), from the repository root::
 
     NUMBA_NUM_THREADS=1 python tests/calibration/claims.py grid 24
     NUMBA_NUM_THREADS=1 python tests/calibration/claims.py trust 24
-    NUMBA_NUM_THREADS=1 python tests/calibration/claims.py coverage 2000
+    NUMBA_NUM_THREADS=1 python tests/calibration/claims.py coverage 2000   # claims_coverage.txt
     NUMBA_NUM_THREADS=1 python tests/calibration/claims.py sweep 40
     NUMBA_NUM_THREADS=1 python tests/calibration/claims.py steps 1024
 
@@ -96,6 +96,22 @@ def coverage(n_seeds):
             summary("contrast vs FPK", z)
     print(f"coverage of the 95 % interval: {np.sum(hits)} of {len(hits)} = {np.mean(hits):.4f}")
     summary("contrast vs FPK", z)
+    spread_blocks(np.square(z), ts.SPREAD_SEEDS)
+
+
+def spread_blocks(z2, block):
+    """test_paired_contrast_intervals_have_their_nominal_size's statistic (the sum of
+    ``block`` squared z-scores, chi-square(block)) over consecutive blocks of seeds."""
+    from scipy import stats
+
+    sums = np.asarray(z2)[: len(z2) // block * block].reshape(-1, block).sum(axis=1)
+    lo, hi = stats.chi2.ppf(5e-4, block), stats.chi2.isf(5e-4, block)
+    outside = int(np.sum((sums < lo) | (sums > hi)))
+    print(
+        f"sum of {block} squared z-scores over {sums.size} blocks: {outside} outside "
+        f"[{lo:.1f}, {hi:.1f}], range {sums.min():.1f} .. {sums.max():.1f}, "
+        f"mean {sums.mean():.1f} (chi-square({block}): {block})"
+    )
 
 
 def steps(n_paths):
