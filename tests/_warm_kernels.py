@@ -6,13 +6,14 @@ once. ``tests/conftest.py`` runs the two halves below in parallel
 subprocesses before the workers start (``pytest_sessionstart``), so that the
 workers find a warm cache; the halves are balanced by compile time:
 
-* ``single``: :func:`randvib.montecarlo.kernel.run_ensemble`'s two compiled
-  loops, the lean one (white noise, nothing optional) and the full one
-  (filter or circuit, event, bridge, tones and shocks in one signature), run
-  here on every combination the suite uses so that a new one shows up;
-* ``assembly``: the assembly kernel
-  (:mod:`randvib.montecarlo.assembly_kernel`) and the record integrator of the
-  identification (:mod:`randvib.identification.record_integrator`).
+* ``single``: the full loop of :func:`randvib.montecarlo.kernel.run_ensemble`
+  (filter or circuit, event, bridge, tones and shocks in one signature, about
+  400 CPU-s cold), run on every combination the suite uses so that a new
+  signature would show up;
+* ``assembly``: that function's lean loop (white noise, nothing optional), the
+  assembly kernel (:mod:`randvib.montecarlo.assembly_kernel`) and the record
+  integrator of the identification
+  (:mod:`randvib.identification.record_integrator`), about 150 CPU-s cold.
 
 The halves share no kernel: two processes compiling the same one would each
 spend its full compile time.
@@ -48,13 +49,15 @@ def _bridge():
 
 
 def warm_single() -> None:
-    """Every combination of :func:`~randvib.montecarlo.kernel.run_ensemble`'s groups in the suite."""
+    """Every combination of :func:`~randvib.montecarlo.kernel.run_ensemble`'s groups in the suite.
+
+    The full loop only: the lean one (white noise, nothing optional) is the other half's.
+    """
     import randvib as rv
 
     band = rv.BandPass(1.0, 8.0, 0.2)
     tone = rv.Tone(25.0, 0.5)
     step = rv.Step()
-    rv.simulate(_harvester(), 1.0, **SHORT)  # the lean loop
     rv.simulate(_harvester(), band, **SHORT)  # filter
     rv.simulate(_harvester(), rv.White(1.0) + tone, **SHORT)  # tones
     rv.simulate(_harvester(), band + tone, **SHORT)  # filter and tones
@@ -65,17 +68,18 @@ def warm_single() -> None:
                           dt=1e-3, n_paths=2)  # fmt: skip
     rv.simulate_transient(_harvester(), rv.Enveloped(band, step), t_end=0.02, dt=1e-3,
                           n_paths=2)  # fmt: skip
-    # the rare-event estimators' paths: the lean loop with given starting states
-    rv.first_passage(_harvester(), 1.0, duration=0.02, stroke=1e-5, method="crude",
-                     target_cov=0.9, dt=1e-3, progress=False)  # fmt: skip
 
 
 def warm_assembly() -> None:
-    """The assembly kernel and the record integrator (no single-mass loop: the other half's)."""
+    """The lean single-mass loop, the assembly kernel and the record integrator."""
     import randvib as rv
     from randvib.identification.record_integrator import parameter_matrix, run_kernel
 
     h = _harvester(friction=rv.Coulomb(0.01))
+    rv.simulate(_harvester(), 1.0, **SHORT)  # the single mass's lean loop
+    # the rare-event estimators' paths: the lean loop with given starting states
+    rv.first_passage(_harvester(), 1.0, duration=0.02, stroke=1e-5, method="crude",
+                     target_cov=0.9, dt=1e-3, progress=False)  # fmt: skip
     rv.simulate(rv.Assembly.from_harvester(h), 1.0, **SHORT)
     matrix = parameter_matrix({"m": M, "c": C_M, "k": K, "k3": 0.0}, None)
     drive = np.sin(np.linspace(0.0, 1.0, 32))
