@@ -13,7 +13,9 @@ workers find a warm cache; the halves are balanced by compile time:
 * ``assembly``: that function's lean loop (white noise, nothing optional), the
   assembly kernel (:mod:`randvib.montecarlo.assembly_kernel`) and the record
   integrator of the identification
-  (:mod:`randvib.identification.record_integrator`), about 150 CPU-s cold.
+  (:mod:`randvib.identification.record_integrator`) and the rare-event linear
+  surrogate's responses (:mod:`randvib.montecarlo.path_simulator`), about 150
+  CPU-s cold.
 
 The halves share no kernel: two processes compiling the same one would each
 spend its full compile time.
@@ -71,7 +73,7 @@ def warm_single() -> None:
 
 
 def warm_assembly() -> None:
-    """The lean single-mass loop, the assembly kernel and the record integrator."""
+    """The lean single-mass loop, the assembly kernel, the record integrator, the surrogate."""
     import randvib as rv
     from randvib.identification.record_integrator import parameter_matrix, run_kernel
 
@@ -84,6 +86,12 @@ def warm_assembly() -> None:
     matrix = parameter_matrix({"m": M, "c": C_M, "k": K, "k3": 0.0}, None)
     drive = np.sin(np.linspace(0.0, 1.0, 32))
     run_kernel(matrix, None, drive, True, 1e-3, reference=np.zeros(32))
+    # importance sampling's linear surrogate: z_n of the linearised device, per row
+    from randvib.montecarlo.path_simulator import HarvesterPaths
+
+    paths = HarvesterPaths(_harvester(), 1.0, stroke=1e-3, duration=0.02, dt=1e-3)
+    surrogate = paths.linear_surrogate
+    surrogate.responses(np.zeros((2, surrogate.n_start + surrogate.n_steps)))
 
 
 HALVES = {"single": warm_single, "assembly": warm_assembly}
