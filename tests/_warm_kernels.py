@@ -7,15 +7,14 @@ subprocesses before the workers start (``pytest_sessionstart``), so that the
 workers find a warm cache; the halves are balanced by compile time:
 
 * ``single``: the full loop of :func:`randvib.montecarlo.kernel.run_ensemble`
-  (filter or circuit, event, bridge, tones and shocks in one signature, about
-  400 CPU-s cold), run on every combination the suite uses so that a new
-  signature would show up;
+  (filter or circuit, event, bridge, tones and shocks in one signature: the
+  longest compile, most of the 465 CPU-s that both loops took cold), run on
+  every combination the suite uses so that a new signature would show up;
 * ``assembly``: that function's lean loop (white noise, nothing optional), the
   assembly kernel (:mod:`randvib.montecarlo.assembly_kernel`) and the record
   integrator of the identification
   (:mod:`randvib.identification.record_integrator`) and the rare-event linear
-  surrogate's responses (:mod:`randvib.montecarlo.path_simulator`), about 150
-  CPU-s cold.
+  surrogate's responses (:mod:`randvib.montecarlo.path_simulator`).
 
 The halves share no kernel: two processes compiling the same one would each
 spend its full compile time.
