@@ -11,7 +11,7 @@ workers find a warm cache; the halves are balanced by compile time:
   longest compile, most of the 465 CPU-s that both loops took cold), run on
   every combination the suite uses so that a new signature would show up;
 * ``assembly``: that function's lean loop (white noise, nothing optional), the
-  assembly kernel (:mod:`randvib.montecarlo.assembly_kernel`) and the record
+  assembly kernel (:mod:`randvib.montecarlo.assembly_kernel`), the record
   integrator of the identification
   (:mod:`randvib.identification.record_integrator`) and the rare-event linear
   surrogate's responses (:mod:`randvib.montecarlo.path_simulator`).
