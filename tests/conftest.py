@@ -213,6 +213,8 @@ def pytest_configure(config):
     if getattr(config.option, "numprocesses", None) and not hasattr(config, "workerinput"):
         for name in ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
             os.environ.setdefault(name, "1")
+    if hasattr(config, "workerinput"):
+        _start_compile_log(config)
 
 
 def pytest_collection_modifyitems(config, items):
@@ -222,3 +224,133 @@ def pytest_collection_modifyitems(config, items):
         return LONG_MODULES.index(name) if name in LONG_MODULES else len(LONG_MODULES)
 
     items.sort(key=rank)  # stable: the shuffled order is kept within each rank
+
+
+# ---------------------------------------------------------------- compiled once per run
+# The compiled kernels (numba, cache=True) cost 30-100 CPU-s each on a cold cache, and
+# two workers that need the same one compiled it twice at once. Before xdist starts its
+# workers (its own pytest_sessionstart runs last), the controller runs the two halves of
+# tests/_warm_kernels.py in parallel subprocesses, which compile or load every signature
+# the suite uses; the workers then only load them. Each worker lists what it still
+# compiled (numba's "numba:compile" event, cache misses only), and the controller prints
+# the list in the summary: a kernel to add to tests/_warm_kernels.py.
+_WARM_SCRIPT = Path(__file__).with_name("_warm_kernels.py")
+_COMPILED_KEY = "randvib_compiled"
+
+
+def _parallel_controller(config) -> bool:
+    """True in the controller of a pytest-xdist run with workers (not in a worker, not -n 0)."""
+    workers = getattr(config.option, "numprocesses", None)
+    return bool(workers) and not hasattr(config, "workerinput")
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_sessionstart(session):
+    """Warm the numba cache before the workers start; one line says how long it took."""
+    config = session.config
+    if not _parallel_controller(config) or config.option.collectonly:
+        return
+    import subprocess
+    import time
+
+    import randvib  # the package the tests import; the script imports the same one
+
+    started = time.perf_counter()
+    package_root = str(Path(randvib.__file__).resolve().parents[1])
+    path = os.pathsep.join(filter(None, [package_root, os.environ.get("PYTHONPATH")]))
+    env = dict(os.environ, NUMBA_NUM_THREADS="1", PYTHONPATH=path)
+    halves = {
+        name: subprocess.Popen(
+            [sys.executable, str(_WARM_SCRIPT), name],
+            cwd=ROOT,
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+        )
+        for name in ("single", "assembly")
+    }
+    failed = []
+    for name, process in halves.items():
+        output, _ = process.communicate()
+        if process.returncode != 0:
+            last = (output.strip().splitlines() or ["no output"])[-1]
+            failed.append(f"{name}: {last}")
+    took = time.perf_counter() - started
+    reporter = config.pluginmanager.get_plugin("terminalreporter")
+    if failed:
+        line = (
+            f"numba warm-up (tests/_warm_kernels.py) failed after {took:.0f} s "
+            f"({'; '.join(failed)}); the workers compile what they need"
+        )
+    else:
+        line = f"numba kernels warmed in {took:.1f} s (tests/_warm_kernels.py)"
+    if reporter is not None:
+        reporter.write_line(line)
+
+
+class _CompileLog:
+    """The randvib functions numba compiled in this process (outermost compilations)."""
+
+    def __init__(self):
+        self.compiled = []
+        self.depth = 0
+
+    def listener(self):
+        from numba.core import event
+
+        log = self
+
+        class Listener(event.Listener):
+            def on_start(self, ev):
+                if log.depth == 0:
+                    function = ev.data["dispatcher"].py_func
+                    if function.__module__.startswith("randvib"):
+                        name = f"{function.__module__}.{function.__qualname__}"
+                        log.compiled.append(name.removeprefix("randvib."))
+                log.depth += 1
+
+            def on_end(self, ev):
+                log.depth -= 1
+
+        return Listener()
+
+
+_compile_log_key = pytest.StashKey[_CompileLog]()
+_compiled_key = pytest.StashKey[list]()
+
+
+def _start_compile_log(config):
+    """In a worker: record numba's compilations of randvib functions from now on."""
+    from numba.core import event
+
+    log = _CompileLog()
+    event.register("numba:compile", log.listener())
+    config.stash[_compile_log_key] = log
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_sessionfinish(session):
+    """In a worker: hand the list of compilations to the controller."""
+    config = session.config
+    log = config.stash.get(_compile_log_key, None)
+    if log is not None and hasattr(config, "workeroutput"):
+        config.workeroutput[_COMPILED_KEY] = log.compiled
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_testnodedown(node, error):
+    """In the controller: collect a worker's compilations."""
+    compiled = getattr(node, "workeroutput", {}).get(_COMPILED_KEY, [])
+    node.config.stash.setdefault(_compiled_key, []).extend(compiled)
+
+
+def pytest_terminal_summary(terminalreporter, config):
+    """One line naming what the workers still compiled (cache misses after the warm-up)."""
+    compiled = config.stash.get(_compiled_key, [])
+    if compiled:
+        counts = {name: compiled.count(name) for name in dict.fromkeys(compiled)}
+        names = ", ".join(f"{name} x{n}" if n > 1 else name for name, n in counts.items())
+        terminalreporter.write_line(
+            f"numba compiled during the tests (add to tests/_warm_kernels.py): {names}"
+        )

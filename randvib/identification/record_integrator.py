@@ -702,7 +702,8 @@ def run_kernel(
     state0 = np.empty((n_pop, 4))
     for j, value in enumerate((z0, v0, theta0, x0)):
         state0[:, j] = np.broadcast_to(np.asarray(value, dtype=float), (n_pop,))
-    zref = np.empty(0) if reference is None else np.ascontiguousarray(reference, dtype=float)
+    # writeable copies of read-only input: a read-only array is another compiled signature
+    zref = np.empty(0) if reference is None else np.require(reference, float, ["C", "W"])
     shape = (n_pop, n) if store else (1, 1)
     out_z = np.empty(shape)
     out_v = np.empty(shape)
@@ -719,6 +720,7 @@ def run_kernel(
         samples = fine  # the caller's reconstruct_input(drive, dt, substeps, hold), reused
     else:
         samples = drive if hold == "zero" else reconstruct_input(drive, dt, substeps, hold)
+    samples = np.require(samples, float, ["C", "W"])
     drive_args = (samples, float(dt), int(substeps), hold != "zero", bool(base_input))
     scoring = (zref, int(skip), float(response_limit), int(max_subcycles))
     sums = _run_batch(

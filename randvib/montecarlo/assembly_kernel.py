@@ -609,7 +609,7 @@ def _run_chunk(
     sqdt, given = np.sqrt(dt), dw.shape[0] > 0
     n_stages = 1 if scheme[1] == 0.0 else 2
     _start_lanes(y, rng, first_path + start_path, lanes, seed, start, ki, wi, fi)
-    _record(records, y, start_path, lanes, 0)
+    _record(records, y, start_path, lanes, np.int64(0))  # not a literal: one signature
     for n in range(n_steps):
         if n == n_burn:
             for j in range(lanes):
@@ -693,8 +693,10 @@ def run_assembly_ensemble(
     points = n_steps // recording.every + 1 if recording.n_record else 0
     records = np.zeros((recording.n_record, points, layout.n_rows))
     for chunk in numba.prange((n_paths + LANES - 1) // LANES):
+        # int64 always: the parallel loop's index is typed int64, then uint64 in the
+        # compiled gufunc, and each compiled (and cached) _run_chunk once more
         _run_chunk(
-            chunk, out, failed, records, scheme, dims, linear, parts, cb0, cb1, cb2, cb3, columns,
+            np.int64(chunk), out, failed, records, scheme, dims, linear, parts, cb0, cb1, cb2, cb3, columns,
             timing, paths, start, recording.every, noise, stop,
         )  # fmt: skip
     return out, failed, records

@@ -14,9 +14,16 @@ resistive (viscous) circuit, the compile-time fast path, and
 auxiliary states (:class:`Auxiliary`: an excitation's shaping filter and/or a
 circuit's current or voltage), one compiled path for every excitation x
 coupling combination. A diode bridge (:class:`Rectifier`) has its own
-steps in :mod:`randvib.montecarlo.rectified_kernel`, compiled only when a
-bridge is simulated; the device's drift they share with the steps here is in
-:mod:`randvib.montecarlo.drift`.
+steps in :mod:`randvib.montecarlo.rectified_kernel`; the device's drift they
+share with the steps here is in :mod:`randvib.montecarlo.drift`.
+
+The loop is compiled twice at most (:func:`run_ensemble`): a lean signature
+with no optional group (white noise, resistive circuit; every optional branch
+pruned when compiling) and a full one that takes every group (filter or
+circuit, event, bridge, tones and shocks), a missing one as an empty
+stand-in recognised at run time; every combination shares it, so a fresh
+checkout compiles it once (tests/_warm_kernels.py warms both before a
+parallel test run).
 
 Memory is O(n_paths): per-path running sums only, unless histograms or
 recorded histories are requested.
@@ -393,6 +400,23 @@ def transient_group(gain, scale_noise, filter_mask, n_start, start, snap_steps, 
     )
 
 
+def _empty_groups():
+    """The full loop's stand-ins for missing optional groups (:func:`run_ensemble`)."""
+    square = np.zeros((N_AUX, N_AUX))
+    auxiliary = Auxiliary(0, np.zeros(N_AUX_COEFFICIENTS), np.zeros(N_AUX), square)
+    transient = transient_group(np.zeros(0), False, np.zeros(N_AUX), 0, square, (), 0)
+    # kind 0: no bridge; ones, so that the loop's set-up divides by no zero
+    rectifier = Rectifier(0, 0, np.ones(9), 0.0)
+    forcing = Forcing(np.zeros(0), np.zeros(0), np.zeros((0, 0)), np.zeros((0, 0)))
+    return auxiliary, transient, rectifier, forcing
+
+
+#: No auxiliary states (``n`` 0), no event (no steps' gains), no bridge (``kind`` 0), no
+#: tones and no shocks: what the full loop gets in place of a missing group, each typed
+#: as the real ones (one compiled signature for every combination of groups).
+NO_AUXILIARY, NO_TRANSIENT, NO_RECTIFIER, NO_FORCING = _empty_groups()
+
+
 def pack(group, *values):
     """``group(*values)`` with each value cast to its field's declared type.
 
@@ -636,7 +660,6 @@ def _forced_increment(n, dt, row, omega, gain, phase, kicks):
     return u
 
 
-@numba.njit(cache=True, parallel=True, nogil=True)
 def run_ensemble(
     scheme,
     device,
@@ -654,6 +677,15 @@ def run_ensemble(
     forcing=None,
 ):
     """Integrate ``paths.count`` paths and return per-path time averages.
+
+    Two compiled loops (:func:`ensemble_loop`), so that a run compiles at most
+    twice on a cold cache: without any optional group (white noise, resistive
+    circuit: the common and benchmarked case, every optional branch pruned
+    when compiling) and with every group given, the missing ones as their
+    empty stand-ins (:data:`NO_AUXILIARY`, :data:`NO_TRANSIENT`,
+    :data:`NO_RECTIFIER`, :data:`NO_FORCING`) that the loop recognises at run
+    time. Both take the same operations in the same order for a given case,
+    so the results are the same bit for bit whichever runs it.
 
     Parameters
     ----------
@@ -688,18 +720,17 @@ def run_ensemble(
         that the caller's thread can watch for the interrupt.
     transient : Transient or None
         An event (:class:`Transient`): the per-step envelope, the filter's
-        random start and the snapshots, written into its arrays. None (the
-        stationary runs) compiles the loop without any of it.
+        random start and the snapshots, written into its arrays. None for the
+        stationary runs.
     rectifier : Rectifier or None
         A full-wave bridge (:class:`Rectifier`), stepped by
         :func:`rectified_step` with the filter's states of ``auxiliary``
         (None: white or given input); its stored power and losses go to
         ``ACC_STORED``, ``ACC_COIL_LOSS``, ``ACC_DIODE_LOSS``, its capacitors'
-        energy into ``ACC_H0``/``ACC_H1``. None compiles the loop without it.
+        energy into ``ACC_H0``/``ACC_H1``. None without one.
     forcing : Forcing or None
         Tones and shocks added to the input (:class:`Forcing`), given to the
-        velocity in two half kicks around every step. None compiles the loop
-        without them.
+        velocity in two half kicks around every step. None without them.
 
     Returns
     -------
@@ -708,6 +739,43 @@ def run_ensemble(
         First checked step with a non-finite state, or -1.
     hist : int64[n_chunks, 2, hist_bins]
     records : float64[n_record, n_records, 3]
+    """
+    groups = (auxiliary, transient, rectifier, forcing)
+    if any(group is not None for group in groups):  # the full loop: every group given
+        auxiliary = NO_AUXILIARY if auxiliary is None else auxiliary
+        transient = NO_TRANSIENT if transient is None else transient
+        rectifier = NO_RECTIFIER if rectifier is None else rectifier
+        forcing = NO_FORCING if forcing is None else forcing
+    return ensemble_loop(
+        scheme, device, friction, timing, paths, initial, companion, recording, noise,
+        auxiliary, stop, transient, rectifier, forcing,
+    )  # fmt: skip
+
+
+@numba.njit(cache=True, parallel=True, nogil=True)
+def ensemble_loop(
+    scheme,
+    device,
+    friction,
+    timing,
+    paths,
+    initial,
+    companion,
+    recording,
+    noise,
+    auxiliary,
+    stop,
+    transient,
+    rectifier,
+    forcing,
+):
+    """The compiled loop of :func:`run_ensemble` (its parameters and returns).
+
+    Compiled for two signatures only (:func:`run_ensemble`): the four optional
+    groups all None, their branches pruned when compiling (``X is not None``
+    on a None argument), or all given, some perhaps empty stand-ins, which the
+    flags ``has_aux``, ``timed``, ``bridged`` and ``forced`` recognise at run
+    time (loop-invariant branches, taken the same way at every step).
     """
     # Unpacked once into locals; the step takes the (float) scheme and drift groups.
     m, c, k, k3, noise_amp = device
@@ -726,6 +794,7 @@ def run_ensemble(
     filter_only = False
     if auxiliary is not None:
         n_aux = auxiliary.n
+        has_aux = n_aux > 0  # False: the full loop's empty block (NO_AUXILIARY)
         ac = auxiliary.coefficients
         block = (
             ac[0], ac[1], ac[2], ac[3], ac[4], ac[5], ac[6], ac[7], ac[8], ac[9],
@@ -744,6 +813,7 @@ def run_ensemble(
         )
         chol = auxiliary.start
     if transient is not None:
+        timed = transient.gain.shape[0] > 0  # False: NO_TRANSIENT
         gains = transient.gain
         snap = transient.snap_steps
         snapshots = transient.snapshots
@@ -753,6 +823,7 @@ def run_ensemble(
         n_start = transient.n_start
         filter_start = transient.start
     if rectifier is not None:
+        bridged = rectifier.kind != 0  # False: NO_RECTIFIER
         rp = rectifier.p
         # (kind, output, gain, R_C or C_p, V_d, V_b, C, R_L) and, to spare divisions
         # per step: 1/R_C, theta/C_p, 1/C, 1/(R_L C), C_p/(C_p + C), C/(C_p + C);
@@ -769,15 +840,17 @@ def run_ensemble(
         half_c = 0.5 * rp[4] if rectifier.output == 1 else 0.0
         v_c0 = rectifier.v_c0
         v_out_b = rp[3]
+        # white or given input: no filter, the noise drives the velocity (g_v = 1)
+        rblock = (
+            0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+            0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0,
+        )  # fmt: skip
         if auxiliary is not None:
-            rblock = block
-        else:  # white or given input: no filter, the noise drives the velocity (g_v = 1)
-            rblock = (
-                0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
-                0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0,
-            )  # fmt: skip
+            if has_aux:
+                rblock = block
     if forcing is not None:
         f_omega, f_gain, f_phase, f_kicks = forcing
+        forced = f_omega.shape[0] > 0 or f_kicks.shape[0] > 0  # False: NO_FORCING
     n_chunks = (n_paths + LANES - 1) // LANES
     acc = np.zeros((n_paths, N_ACC))
     failed = np.full(n_paths, -1, dtype=np.int64)
@@ -832,7 +905,7 @@ def run_ensemble(
                 v[j] = init_v * nv
                 zc[j] = comp_init_z * nz
                 vc[j] = comp_init_v * nv
-                if auxiliary is not None:
+                if auxiliary is not None and has_aux:
                     n1 = standard_normal(rng, j, ki, wi, fi)
                     x1[j] = chol[0, 0] * n1
                     if n_aux > 1:
@@ -846,10 +919,10 @@ def run_ensemble(
                 v[j] = init_v
                 zc[j] = comp_init_z
                 vc[j] = comp_init_v
-            if transient is not None:
+            if transient is not None and timed:
                 x1[j], x2[j], x3[j] = _drawn_states(rng, j, ki, wi, fi, filter_start, n_start)
                 peak[j] = abs(z[j])
-                if auxiliary is not None:
+                if auxiliary is not None and has_aux:
                     square[j] = p1 * x1[j] + p2 * x2[j] + p3 * x3[j]
             if start + j < n_record:
                 records[start + j, 0, 0] = z[j]
@@ -859,9 +932,9 @@ def run_ensemble(
             next_snap = _snapshots(snapshots, snap, 0, 0, start, lanes, z, v, square, peak)
         for n in range(n_steps):
             in_window = n >= n_burn
-            if transient is not None:
+            if transient is not None and timed:
                 gain = gains[n]
-                if auxiliary is not None:
+                if auxiliary is not None and has_aux:
                     if not scale_noise:
                         step_block = _scaled_block(block, filter_mask, gain)
             for j in range(lanes):
@@ -870,23 +943,23 @@ def run_ensemble(
                 else:
                     dwj = sqdt * standard_normal(rng, j, ki, wi, fi)
                 noise = noise_amp * dwj
-                if transient is not None:
+                if transient is not None and timed:
                     if scale_noise:
                         noise = noise * gain
                 zj = z[j]
                 vj = v[j]
                 tj = th[j]
                 vs = vj  # the velocity the step starts from: with forcing, after its half kick
-                if forcing is not None:
+                if forcing is not None and forced:
                     kick = 0.5 * _forced_increment(
                         n, dt, start + j, f_omega, f_gain, f_phase, f_kicks
                     )
                     vs = vj + kick
-                if rectifier is not None:
+                if rectifier is not None and bridged:
                     if in_window and n == n_burn:
                         a[j, ACC_H0] = half_cp * s1[j] * s1[j] + half_c * s2[j] * s2[j]
                     v_out = v_out_b if rect[1] == 0 else s2[j]  # at the step's start
-                    if auxiliary is not None:
+                    if auxiliary is not None and has_aux:
                         zn, vn, tn, x1[j], x2[j], x3[j], s1[j], s2[j], f1, e_s, e_c, e_d = (
                             rectified_step(
                                 zj, vs, tj, x1[j], x2[j], x3[j], s1[j], s2[j], dt, noise,
@@ -904,7 +977,7 @@ def run_ensemble(
                         a[j, ACC_COIL_LOSS] += e_c
                         a[j, ACC_DIODE_LOSS] += e_d
                         a[j, ACC_V_OUT] += v_out
-                elif auxiliary is not None and filter_only:
+                elif auxiliary is not None and has_aux and filter_only:
                     zn, vn, tn, x1[j], x2[j], f1 = filter_step(
                         zj,
                         vs,
@@ -920,7 +993,7 @@ def run_ensemble(
                         fr_fn,
                         step_block,
                     )
-                elif auxiliary is not None:
+                elif auxiliary is not None and has_aux:
                     x1j = x1[j]
                     x2j = x2[j]
                     x3j = x3[j]
@@ -947,7 +1020,7 @@ def run_ensemble(
                     zn, vn, tn, f1 = scheme_step(
                         zj, vs, tj, dt, noise, scheme, drift, fr_kind, fr_p, fr_fn
                     )
-                if forcing is not None:
+                if forcing is not None and forced:
                     vn += kick
                 if in_window:  # the path's peak and its up-crossings of the stroke
                     if abs(zj) > a[j, ACC_PEAK]:
@@ -977,10 +1050,10 @@ def run_ensemble(
                 z[j] = zn
                 v[j] = vn
                 th[j] = tn
-                if transient is not None:
+                if transient is not None and timed:
                     peak[j] = max(peak[j], abs(zn))
                     integrals[j, 0] += 0.5 * dt * (vj * vj + vn * vn)
-                    if auxiliary is not None:
+                    if auxiliary is not None and has_aux:
                         sq = p1 * x1[j] + p2 * x2[j] + p3 * x3[j]
                         integrals[j, 1] += 0.5 * dt * (square[j] * square[j] + sq * sq)
                         square[j] = sq
@@ -998,7 +1071,7 @@ def run_ensemble(
                     records[start + j, r, 0] = z[j]
                     records[start + j, r, 1] = v[j]
                     records[start + j, r, 2] = th[j]
-            if transient is not None:
+            if transient is not None and timed:
                 next_snap = _snapshots(
                     snapshots, snap, next_snap, n + 1, start, lanes, z, v, square, peak
                 )
@@ -1014,12 +1087,12 @@ def run_ensemble(
             zj = z[j]
             vj = v[j]
             a[j, ACC_H1] = 0.5 * m * vj * vj + 0.5 * k * zj * zj + 0.25 * k3 * zj**4
-            if rectifier is not None:
+            if rectifier is not None and bridged:
                 a[j, ACC_H1] += half_cp * s1[j] * s1[j] + half_c * s2[j] * s2[j]
             if abs(zj) > stroke and a[j, ACC_FIRST_HIT] < 0.0:
                 a[j, ACC_FIRST_HIT] = n_steps * dt  # the final state
             a[j, ACC_PEAK] = max(a[j, ACC_PEAK], abs(zj))
-            if transient is not None:
+            if transient is not None and timed:
                 event_out[p, EVENT_PEAK] = peak[j]
                 event_out[p, EVENT_V2] = integrals[j, 0]
                 event_out[p, EVENT_X2] = integrals[j, 1]

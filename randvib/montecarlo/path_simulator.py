@@ -368,7 +368,7 @@ class HarvesterPaths(PathSimulator):
             paths=kernel.pack(kernel.Paths, 0, lo, rows.shape[0]), initial=s.initial,
             companion=s.companion, recording=s.recording, noise=noise,
             auxiliary=s.auxiliary, rectifier=s.rectifier,
-            forcing=None,  # given, as kernel_setup gives it: an omitted one is another compile
+            forcing=None,  # no tones or shocks: run_ensemble then picks its lean or full loop
         )  # fmt: skip
         if rows.shape[0] * self.steps_per_path > SMALL_CALL_STEPS:
             acc, failed, _, _ = interruptible(kernel.run_ensemble, **arguments)
