@@ -78,13 +78,34 @@ def test_caughey_stumpf_closed_form_against_its_own_derivative_and_integral():
     assert v2 == pytest.approx(M / (4 * C), rel=1e-12)
 
 
+def _impulse_response(tau):
+    """(h, h') of m z'' + c z' + k z = -m a at lag tau: exp(A tau) b in closed form.
+
+    The textbook unit-impulse response of the underdamped oscillator (zeta 0.09),
+    h(tau) = -exp(-zeta w tau) sin(w_d tau) / w_d, cheaper than a matrix
+    exponential at every quadrature node (the reference cost 8 s per envelope).
+    """
+    w = np.sqrt(K / M)
+    zeta = C / (2.0 * np.sqrt(K * M))
+    wd = w * np.sqrt(1.0 - zeta**2)
+    decay = np.exp(-zeta * w * tau)
+    z = -decay * np.sin(wd * tau) / wd
+    v = -decay * (np.cos(wd * tau) - zeta * w / wd * np.sin(wd * tau))
+    return np.array([z, v])
+
+
+def test_impulse_response_is_the_matrix_exponential():
+    a = np.array([[0.0, 1.0], [-K / M, -C / M]])
+    for tau in (0.0, 0.013, 0.4, 2.7):
+        expected = linalg.expm(a * tau) @ np.array([0.0, -1.0])
+        np.testing.assert_allclose(_impulse_response(tau), expected, rtol=1e-12, atol=1e-15)
+
+
 def _convolution_covariance(envelope, level, t):
     """P(t) of the linear oscillator under e(s) w(s) from rest, by quad_vec."""
-    a = np.array([[0.0, 1.0], [-K / M, -C / M]])
-    b = np.array([0.0, -1.0])
 
     def integrand(s):
-        phi = linalg.expm(a * (t - s)) @ b
+        phi = _impulse_response(t - s)
         return float(envelope(s)) ** 2 * 0.5 * level * np.outer(phi, phi)
 
     points = [p for p in envelope.breakpoints() if p < t]

@@ -11,7 +11,8 @@ and prints, per assertion, the number of seeds, the mean and standard
 deviation of the z-scores and the largest |z| (calibrated: mean near 0, SD
 near 1, no |z| above 4), plus the smallest power margin (detect * |reference|
 / standard error, which must be >= 6). Names: the keys of COARSE (coarse-...)
-and FINE (fine-...) in the test module.
+and FINE (fine-...) in the test module. Last results of the fine-step cases (with
+their control variates): tests/calibration/coloured.txt.
 """
 
 from __future__ import annotations
@@ -31,8 +32,8 @@ CASES = {
         for name, args in t.COARSE.items()
     },
     **{
-        f"fine-{name}": (lambda s, e=ex: t.case_fine_continuous(e, s))
-        for name, ex in t.FINE.items()
+        f"fine-{name}": (lambda s, a=args: t.case_fine_continuous(*a, s))
+        for name, args in t.FINE.items()
     },
 }
 
