@@ -113,8 +113,11 @@ def _process_state_restored(request):
     restore what they change (monkeypatch, tmp_path), so that none depends on
     another.
     """
-    before = _ProcessState()
+    # The handler the process had (SIG_IGN in a job started in the background) is put
+    # back at the end; the test is judged against the state it started in.
+    inherited_int = signal.getsignal(signal.SIGINT)
     signal.signal(signal.SIGINT, signal.default_int_handler)
+    before = _ProcessState()
     yield
     for thread in set(threading.enumerate()) - before.threads:
         if isinstance(thread, threading.Timer):
@@ -122,6 +125,7 @@ def _process_state_restored(request):
             thread.join(5)
     after = _ProcessState()
     before.restore()
+    signal.signal(signal.SIGINT, inherited_int)
     left = [
         c
         for c in before.changes(after)

@@ -271,7 +271,7 @@ def test_interaction_study_end_to_end(tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(interaction, "settings_for", lambda quick, seed: TINY)
     # --workers 1 runs the sweep and its half-step re-run in this process (their own
     # default is a pool on every core: two spawned interpreters loading numba, 4x the CPU)
-    monkeypatch.setattr(sweep, "_WorkerPool", _no_pool)
+    monkeypatch.setattr(sweep, "WorkerPool", _no_pool)
     report = _cli_study("interaction", out, capsys)
     inter = pd.read_csv(out / "interaction.csv")
     assert len(inter) == 1 and inter.k3[0] == 5e7 and inter.fc[0] > 0
