@@ -9,7 +9,8 @@ both is shared: :func:`_bridge_rates` (force and state rates at a stage),
 :func:`_bridge_predictor` (the predictor's bridge states) and
 :func:`_bridge_update` (the step's bridge states and energy accounting).
 The loop (:func:`randvib.montecarlo.kernel.ensemble_loop`) compiles them into
-its full signature only, not into the lean white-noise one. Equations: docs/conventions.md, "Full-wave bridge".
+its full signature only, not into the lean white-noise one. Equations:
+docs/conventions.md, "Full-wave bridge".
 """
 
 from __future__ import annotations

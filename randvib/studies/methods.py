@@ -63,7 +63,8 @@ ANALYTIC = {
 CANDIDATES = ("averaging", "fpk_fast")
 #: The speed bars for a fast method: one point (s) and a 100-point sweep (s).
 POINT_BAR, SWEEP_BAR = 10e-3, 1.0
-#: Finest grid of the FPK reference (cells per direction; :func:`randvib.analytic.fokker_planck.fpk_statistics`).
+#: Finest grid of the FPK reference, cells per direction
+#: (:func:`randvib.analytic.fokker_planck.fpk_statistics`).
 FPK_REFERENCE_CELLS = 160
 
 
