@@ -186,27 +186,34 @@ def bridge_constants(kind, output, p, dt) -> np.ndarray:
 
 
 # ------------------------------------------------------------------ rates
-# The helpers below are inlined where they are called (``inline="always"``:
-# a compiled call passing a dozen arrays costs more than the arithmetic),
-# and they take arrays one by one: taking a field of a named tuple, unpacking
-# a tuple of arrays or slicing inside the time loop binds a new reference, two
-# atomic reference-count updates each (measured: together 3x the step). So
-# the chunk's arrays are made and unpacked once (:func:`_run_chunk`); a
-# stage's state and rates are ``ys[s]`` and ``rs[s]`` (s = 0: the step's
-# start, 1: Heun's predictor), indexed, never sliced. ``dims`` is (N, ov, oth,
-# oc, ob, of, rows, E, C, B, n_filter): the counts and row offsets as one
-# tuple of integers (:func:`dims_of`).
+# The helpers of the step below are compiled apart without reference counting
+# and inlined by LLVM where they are called (:data:`_step`). Inlined by numba
+# instead (``inline="always"``), every array a helper takes was bound to a new
+# variable, two atomic reference-count updates (calls into the runtime) each,
+# and numba's pruning left most of them in the time loop: profiled (perf, the
+# 2-DOF benchmark), the draws of the noise alone spent 8 such calls per
+# path-step, together more than half the step. They take arrays one by one
+# (taking a field of a named tuple, unpacking a tuple of arrays or slicing
+# inside the time loop binds a new reference), so the chunk's arrays are made
+# and unpacked once (:func:`_run_chunk`); a stage's state and rates are
+# ``ys[s]`` and ``rs[s]`` (s = 0: the step's start, 1: Heun's predictor),
+# indexed, never sliced. ``dims`` is (N, ov, oth, oc, ob, of, rows, E, C, B,
+# n_filter): the counts and row offsets as one tuple of integers
+# (:func:`dims_of`).
 #
 # Every loop over the lanes is straight-line: branches and loops over DOFs or
 # parts stay outside it, so that the compiler unrolls it (and partly
-# vectorises it). Measured against this layout (issue 31, docs/benchmarks.md),
-# each of these made the step slower, not faster: a loop over the DOFs inside
-# the lanes' loop (summing M^-1 K x per lane in a register: 5 DOFs 1.5-2x
-# slower), an inlined helper taking arrays called inside the lanes' loop
-# (reference counts in every lane: 2-3x), a tuple of arrays unpacked in the
-# time loop (2-3x), and rows carried as 8-tuples ("bundles", to free the
-# compiler from aliasing: no vector code resulted, and the helpers' calls
-# cost reference counts).
+# vectorises it). Measured against this layout before the helpers lost their
+# reference counts (issue 31, docs/benchmarks.md), each of these made the step
+# slower, not faster: a loop over the DOFs inside the lanes' loop (summing
+# M^-1 K x per lane in a register: 5 DOFs 1.5-2x slower), a tuple of arrays
+# unpacked in the time loop (2-3x), and rows carried as 8-tuples ("bundles",
+# to free the compiler from aliasing: no vector code resulted).
+
+#: The step's helpers: no reference counts (``_nrt=False``: they allocate
+#: nothing) and LLVM's ``alwaysinline`` (``forceinline``), so that a call
+#: passing a dozen arrays costs nothing once compiled.
+_step = numba.njit(cache=True, _nrt=False, forceinline=True)
 
 
 @numba.njit(cache=True)
@@ -217,7 +224,7 @@ def dims_of(layout):
     return (n, ov, oth, oc, ob, of, layout.n_rows, e, c, b, layout.n_filter)
 
 
-@numba.njit(cache=True, inline="always")
+@_step
 def _rect(t, b):
     """Bridge b's constants (row b of the table) as the tuple the rectified steps take."""
     return (
@@ -244,7 +251,7 @@ def _callback(slot, p, du, theta, cb0, cb1, cb2, cb3):
     return cb3(p, du, theta)
 
 
-@numba.njit(cache=True, inline="always")
+@_step
 def _push(rs, s, ov, n, push, part, tmp):
     """rs[s, v rows] -= push[part] * tmp: a force tmp on the part's coordinate, on every DOF."""
     for a in range(n):
@@ -254,7 +261,7 @@ def _push(rs, s, ov, n, push, part, tmp):
                 rs[s, ov + a, j] -= g * tmp[j]
 
 
-@numba.njit(cache=True, inline="always")
+@_step
 def _linear_rates(ys, rs, s, dims, stiffness, damping, drive, fa, fc, tmp):
     """The linear part's acceleration; the filter's rates and its output's push.
 
@@ -288,7 +295,7 @@ def _linear_rates(ys, rs, s, dims, stiffness, damping, drive, fa, fc, tmp):
         _push(rs, s, ov, n, drive, 0, tmp)
 
 
-@numba.njit(cache=True, inline="always")
+@_step
 def _element_rates(
     ys, rs, fs, s, dims, coords, push, springs, kinds, slots, fp, p, cb0, cb1, cb2, cb3, tmp
 ):
@@ -325,7 +332,7 @@ def _element_rates(
         _push(rs, s, ov, n, push, e, tmp)
 
 
-@numba.njit(cache=True, inline="always")
+@_step
 def _circuit_rates(ys, rs, s, dims, coords, push, circuits, tmp):
     """Each linear circuit's state rate ``a s + b u'`` and its force ``f s`` on its coordinate."""
     n, ov, oc, n_elements, n_circuits = dims[0], dims[1], dims[3], dims[7], dims[8]
@@ -344,7 +351,7 @@ def _circuit_rates(ys, rs, s, dims, coords, push, circuits, tmp):
         _push(rs, s, ov, n, push, part, tmp)
 
 
-@numba.njit(cache=True, inline="always")
+@_step
 def _bridges_rates(ys, rs, stage, s, dims, coords, push, bridges, tmp):
     """Each bridge's force and states' rates (:func:`~randvib.montecarlo.rectified_kernel._bridge_rates`).
 
@@ -373,7 +380,7 @@ def _bridges_rates(ys, rs, stage, s, dims, coords, push, bridges, tmp):
 
 
 # ------------------------------------------------------------------ the step
-@numba.njit(cache=True, inline="always")
+@_step
 def _advance(ys, rs, gain, noise, dt, weights, dims, predictor):
     """Every row but the bridges': the predictor (into ys[1]) or the scheme's update (ys[0]).
 
@@ -424,7 +431,7 @@ def _advance(ys, rs, gain, noise, dt, weights, dims, predictor):
                     )
 
 
-@numba.njit(cache=True, inline="always")
+@_step
 def _bridges_predictor(ys, rs, dt, dims, bridges):
     """The bridges' states at the predictor: an Euler stage, clamped or blocked."""
     ob, n_bridges = dims[4], dims[9]
@@ -437,7 +444,7 @@ def _bridges_predictor(ys, rs, dt, dims, bridges):
             )
 
 
-@numba.njit(cache=True, inline="always")
+@_step
 def _bridges_update(ys, rs, stage, dt, weights, dims, bridges, acc, first, in_window):
     """The bridges' states after the step, and (in the window) their energies into ``acc``.
 
@@ -480,8 +487,24 @@ def _bridges_update(ys, rs, stage, dt, weights, dims, bridges, acc, first, in_wi
                 acc[col + BRIDGE_DIODE, j] += diode
 
 
+@_step
+def _increments(dwl, noise_l, rng, lanes, given, dw, start_path, n, sqdt, amp, ki, wi, fi):
+    """Step n's increments dW (s^0.5) into ``dwl`` and ``amp dW`` into ``noise_l``; 0 in unused lanes.
+
+    Given increments are read from ``dw``; else each lane draws from its stream.
+    """
+    for j in range(LANES):
+        if j >= lanes:
+            dwl[j] = 0.0
+        elif given:
+            dwl[j] = dw[start_path + j, n]
+        else:
+            dwl[j] = sqdt * standard_normal(rng, j, ki, wi, fi)
+        noise_l[j] = amp * dwl[j]
+
+
 # ------------------------------------------------------------ accumulators
-@numba.njit(cache=True, inline="always")
+@_step
 def _accumulate(ys, fs, dw, dims, coords, cols, stroke_coords, limits, ito_weights, acc):
     """Add the state at the step's start to the window's sums (:class:`Columns`).
 
@@ -614,14 +637,7 @@ def _run_chunk(
         if n == n_burn:
             for j in range(lanes):
                 acc[h0, j] = _energy(y, j, dims, mass, kmat, coords, springs, circuits, bridges)
-        for j in range(LANES):  # the step's increment dW (s^0.5); none in unused lanes
-            if j >= lanes:
-                dwl[j] = 0.0
-            elif given:
-                dwl[j] = dw[start_path + j, n]
-            else:
-                dwl[j] = sqdt * standard_normal(rng, j, ki, wi, fi)
-            noise_l[j] = amp * dwl[j]
+        _increments(dwl, noise_l, rng, lanes, given, dw, start_path, n, sqdt, amp, ki, wi, fi)
         # the step; Heun's two stages through one call of each rate function, inlined once
         for s in range(n_stages):
             _linear_rates(ys, rs, s, dims, stiffness, damping, drive, fa, fc, tmp)
