@@ -927,6 +927,16 @@ MUTATIONS: tuple[Mutation, ...] = (
         "vector r; the numpy simulator's three DOFs have r = (1, 1, 0.8).",
     ),
     Mutation(
+        name="assembly-kernel-coulomb-inline",
+        path="randvib/montecarlo/assembly_kernel.py",
+        edits=(("            fc = fp[e, 0]\n", "            fc = 1.01 * fp[e, 0]\n"),),
+        tests=(
+            "tests/test_assembly_simulation.py::test_every_state_equals_an_independent_numpy_simulator",
+        ),
+        why="The assembly kernel's written-out Coulomb law 1 % stronger than the element's "
+        "F_c; the numpy simulator's Duffing harvester has Coulomb friction on DOF 1.",
+    ),
+    Mutation(
         name="modal-participation-transposed",
         path="randvib/models/structure.py",
         edits=(("r = phi @ gamma", "r = phi.T @ gamma"),),
