@@ -53,7 +53,13 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
-from randvib.models.friction import KERNEL_COULOMB, KERNEL_GENERIC, friction_force_and_rate
+from randvib.models.friction import (
+    KERNEL_COULOMB,
+    KERNEL_GENERIC,
+    KERNEL_NONE,
+    KERNEL_TANH,
+    friction_force_and_rate,
+)
 from randvib.montecarlo.kernel import CHECK_EVERY, LANES
 from randvib.montecarlo.rectified_kernel import _bridge_predictor, _bridge_rates, _bridge_update
 from randvib.montecarlo.rng import seed_path_state, standard_normal
@@ -353,9 +359,10 @@ def _element_rates(
             fc = fp[e, 0]
             for j in range(LANES):
                 du = ys[s, ov + i, j] - ys[s, ov + k, j]
-                force = fc if du > 0.0 else (-fc if du < 0.0 else 0.0)
+                # sgn(du) as (du > 0) - (du < 0): no branch on a sign the predictor misses
+                # half the time; F_c times +-1 or 0 is exactly +-F_c or 0
+                force = fc * (np.float64(du > 0.0) - np.float64(du < 0.0))
                 fs[s, e, j] = force
-                rs[s, oth + e, j] = 0.0
                 u = ys[s, i, j] - ys[s, k, j]
                 tmp[j] = (k2 + k3 * u) * u * u + force
             _push(rs, s, ov, n, push, e, tmp)
@@ -429,16 +436,42 @@ def _bridges_rates(ys, rs, stage, s, dims, coords, push, bridges, tmp):
 
 
 # ------------------------------------------------------------------ the step
+@numba.njit(cache=True)
+def _advanced_rows(dims, kinds):
+    """The rows :func:`_advance` steps besides x: v, the friction states that move, circuits, filter.
+
+    A memoryless law's state (none, Coulomb, tanh: rate 0, no noise) keeps its
+    start for ever, so its row is left out: four of the 5-DOF benchmark's 14.
+    """
+    n, ov, oth, ob, of, rows = dims[0], dims[1], dims[2], dims[4], dims[5], dims[6]
+    out = np.zeros(rows, dtype=np.int64)
+    count = 0
+    for row in range(ov, ov + n):
+        out[count] = row
+        count += 1
+    for row in range(oth, ob):  # friction states, then circuits
+        e = row - oth
+        if e < kinds.size and (KERNEL_NONE <= kinds[e] <= KERNEL_TANH):
+            continue
+        out[count] = row
+        count += 1
+    # the bridges' rows (ob .. of - 1) take their own steps: _bridges_predictor, _bridges_update
+    for row in range(of, rows):
+        out[count] = row
+        count += 1
+    return out[:count]
+
+
 @_step
-def _advance(ys, rs, gain, noise, dt, weights, dims, predictor):
-    """Every row but the bridges': the predictor (into ys[1]) or the scheme's update (ys[0]).
+def _advance(ys, rs, gain, noise, dt, weights, dims, advanced, predictor):
+    """x and the ``advanced`` rows: the predictor (into ys[1]) or the scheme's update (ys[0]).
 
     The displacements' rates are the velocities (read from ``ys``, rows
     ``ov ..``; they take no noise), and they are advanced before the
     velocities are overwritten. The base's rows stay at zero and are skipped.
     """
     b1, b2 = weights
-    n, ov, oth, ob, of, rows = dims[0], dims[1], dims[2], dims[4], dims[5], dims[6]
+    n, ov = dims[0], dims[1]
     if predictor:
         for a in range(n):
             for j in range(LANES):
@@ -451,33 +484,26 @@ def _advance(ys, rs, gain, noise, dt, weights, dims, predictor):
         for a in range(n):
             for j in range(LANES):
                 ys[0, a, j] = ys[0, a, j] + (b1 * ys[0, ov + a, j] + b2 * ys[1, ov + a, j]) * dt
-    # the bridges' rows (ob .. of - 1) take their own steps: _bridges_predictor, _bridges_update
-    for part in range(3):
-        if part == 0:
-            lo, hi = ov, ov + n
-        elif part == 1:
-            lo, hi = oth, ob
-        else:
-            lo, hi = of, rows
-        if predictor:
-            for row in range(lo, hi):
-                g = gain[row]
-                for j in range(LANES):
-                    ys[1, row, j] = ys[0, row, j] + rs[0, row, j] * dt + g * noise[j]
-        elif b2 == 0.0:
-            for row in range(lo, hi):
-                g = gain[row]
-                for j in range(LANES):
-                    ys[0, row, j] = ys[0, row, j] + b1 * rs[0, row, j] * dt + g * noise[j]
-        else:
-            for row in range(lo, hi):
-                g = gain[row]
-                for j in range(LANES):
-                    ys[0, row, j] = (
-                        ys[0, row, j]
-                        + (b1 * rs[0, row, j] + b2 * rs[1, row, j]) * dt
-                        + g * noise[j]
-                    )
+    if predictor:
+        for q in range(advanced.size):
+            row = advanced[q]
+            g = gain[row]
+            for j in range(LANES):
+                ys[1, row, j] = ys[0, row, j] + rs[0, row, j] * dt + g * noise[j]
+    elif b2 == 0.0:
+        for q in range(advanced.size):
+            row = advanced[q]
+            g = gain[row]
+            for j in range(LANES):
+                ys[0, row, j] = ys[0, row, j] + b1 * rs[0, row, j] * dt + g * noise[j]
+    else:
+        for q in range(advanced.size):
+            row = advanced[q]
+            g = gain[row]
+            for j in range(LANES):
+                ys[0, row, j] = (
+                    ys[0, row, j] + (b1 * rs[0, row, j] + b2 * rs[1, row, j]) * dt + g * noise[j]
+                )
 
 
 @_step
@@ -673,6 +699,7 @@ def _run_chunk(
     stiffness, damping, gain, drive, fa, fc, amp = linear
     k_start, k_columns, k_values = _couplings(stiffness, damping)
     coords, push, springs, kinds, slots, fp, circuits, bridges = parts
+    advanced = _advanced_rows(dims, kinds)  # x, v and the states that move
     mass, kmat, ito_weights = columns.mass, columns.stiffness, columns.ito_weights
     stroke_coords, limits = columns.stroke_coordinates, columns.stroke_limits
     cols = (columns.xx, columns.vv, columns.friction, columns.abs_du, columns.circuit,
@@ -700,10 +727,10 @@ def _run_chunk(
                     _accumulate(ys, fs, dwl, dims, coords, cols, stroke_coords, limits,
                                 ito_weights, acc)  # fmt: skip
                 if n_stages == 2:
-                    _advance(ys, rs, gain, noise_l, dt, scheme, dims, True)
+                    _advance(ys, rs, gain, noise_l, dt, scheme, dims, advanced, True)
                     _bridges_predictor(ys, rs, dt, dims, bridges)
         _bridges_update(ys, rs, stage, dt, scheme, dims, bridges, acc, cols[7], n >= n_burn)
-        _advance(ys, rs, gain, noise_l, dt, scheme, dims, False)
+        _advance(ys, rs, gain, noise_l, dt, scheme, dims, advanced, False)
         if records.shape[0] > 0 and (n + 1) % every == 0:
             _record(records, y, start_path, lanes, (n + 1) // every)
         if (n + 1) % CHECK_EVERY == 0 or n == n_steps - 1:
