@@ -303,23 +303,26 @@ def _linear_rates(ys, rs, s, dims, start, columns, values, drive, fa, fc, tmp):
     """
     n, ov, of, n_filter = dims[0], dims[1], dims[5], dims[10]
     for a in range(n):
-        for j in range(LANES):
-            rs[s, ov + a, j] = 0.0
+        if start[a] == start[a + 1]:  # a DOF coupled to nothing (its rate is the rest's)
+            for j in range(LANES):
+                rs[s, ov + a, j] = 0.0
         for q in range(start[a], start[a + 1]):
             b = columns[q]
             kab = values[q, 0]
             cab = values[q, 1]
+            first = q == start[a]  # the row's first term starts from 0.0, not from the row
             if kab != 0.0 and cab != 0.0:  # one pass for both, the same operations
                 for j in range(LANES):
-                    rs[s, ov + a, j] = (rs[s, ov + a, j] - kab * ys[s, b, j]) - cab * ys[
-                        s, ov + b, j
-                    ]
+                    r = 0.0 if first else rs[s, ov + a, j]
+                    rs[s, ov + a, j] = (r - kab * ys[s, b, j]) - cab * ys[s, ov + b, j]
             elif kab != 0.0:
                 for j in range(LANES):
-                    rs[s, ov + a, j] -= kab * ys[s, b, j]
+                    r = 0.0 if first else rs[s, ov + a, j]
+                    rs[s, ov + a, j] = r - kab * ys[s, b, j]
             else:
                 for j in range(LANES):
-                    rs[s, ov + a, j] -= cab * ys[s, ov + b, j]
+                    r = 0.0 if first else rs[s, ov + a, j]
+                    rs[s, ov + a, j] = r - cab * ys[s, ov + b, j]
     if n_filter > 0:
         for q in range(n_filter):
             for j in range(LANES):
