@@ -60,10 +60,14 @@ from randvib.models.friction import (
     KERNEL_TANH,
     friction_force_and_rate,
 )
-from randvib.montecarlo.kernel import CHECK_EVERY, LANES
+from randvib.montecarlo.kernel import CHECK_EVERY
 from randvib.montecarlo.rectified_kernel import _bridge_predictor, _bridge_rates, _bridge_update
 from randvib.montecarlo.rng import seed_path_state, standard_normal
 
+#: Paths advanced together in a chunk (the single-mass kernel's are 8): the step's loops
+#: over them are vectorised, and 32 amortise each loop's set-up (a path's result does
+#: not depend on its lane or chunk).
+LANES = 32
 #: Distinct generic (non-built-in) friction laws one assembly may use at once.
 N_CALLBACKS = 4
 #: Columns of :attr:`Parts.bridges`: the 18 constants of the single-mass kernel's
@@ -258,12 +262,12 @@ def _callback(slot, p, du, theta, cb0, cb1, cb2, cb3):
 
 
 @_step
-def _push(rs, s, ov, n, push, part, tmp):
+def _push(rs, s, ov, n, push, part, tmp, nl):
     """rs[s, v rows] -= push[part] * tmp: a force tmp on the part's coordinate, on every DOF."""
     for a in range(n):
         g = push[part, a]
         if g != 0.0:
-            for j in range(LANES):
+            for j in range(nl):
                 rs[s, ov + a, j] -= g * tmp[j]
 
 
@@ -301,41 +305,38 @@ def _linear_rates(ys, rs, s, dims, start, columns, values, drive, fa, fc, tmp):
     The couplings are :func:`_couplings`'s; each is subtracted as K_ab x_b,
     then C_ab v_b, a zero weight skipped (the order of the dense loop).
     """
-    n, ov, of, n_filter = dims[0], dims[1], dims[5], dims[10]
+    n, ov, of, n_filter, nl = dims[0], dims[1], dims[5], dims[10], dims[11]
     for a in range(n):
-        if start[a] == start[a + 1]:  # a DOF coupled to nothing (its rate is the rest's)
-            for j in range(LANES):
-                rs[s, ov + a, j] = 0.0
+        for j in range(nl):
+            rs[s, ov + a, j] = 0.0
         for q in range(start[a], start[a + 1]):
             b = columns[q]
             kab = values[q, 0]
             cab = values[q, 1]
-            first = q == start[a]  # the row's first term starts from 0.0, not from the row
             if kab != 0.0 and cab != 0.0:  # one pass for both, the same operations
-                for j in range(LANES):
-                    r = 0.0 if first else rs[s, ov + a, j]
-                    rs[s, ov + a, j] = (r - kab * ys[s, b, j]) - cab * ys[s, ov + b, j]
+                for j in range(nl):
+                    rs[s, ov + a, j] = (rs[s, ov + a, j] - kab * ys[s, b, j]) - cab * ys[
+                        s, ov + b, j
+                    ]
             elif kab != 0.0:
-                for j in range(LANES):
-                    r = 0.0 if first else rs[s, ov + a, j]
-                    rs[s, ov + a, j] = r - kab * ys[s, b, j]
+                for j in range(nl):
+                    rs[s, ov + a, j] -= kab * ys[s, b, j]
             else:
-                for j in range(LANES):
-                    r = 0.0 if first else rs[s, ov + a, j]
-                    rs[s, ov + a, j] = r - cab * ys[s, ov + b, j]
+                for j in range(nl):
+                    rs[s, ov + a, j] -= cab * ys[s, ov + b, j]
     if n_filter > 0:
         for q in range(n_filter):
-            for j in range(LANES):
+            for j in range(nl):
                 total = 0.0
                 for b in range(n_filter):
                     total += fa[q, b] * ys[s, of + b, j]
                 rs[s, of + q, j] = total
-        for j in range(LANES):
+        for j in range(nl):
             total = 0.0
             for b in range(n_filter):
                 total += fc[b] * ys[s, of + b, j]
             tmp[j] = total
-        _push(rs, s, ov, n, drive, 0, tmp)
+        _push(rs, s, ov, n, drive, 0, tmp, nl)
 
 
 @_step
@@ -351,7 +352,7 @@ def _element_rates(
     (:func:`~randvib.models.friction.friction_force_and_rate`) a branch per lane
     on the law and one on the sign cost the 5-DOF benchmark a tenth of its step.
     """
-    n, ov, oth, n_elements = dims[0], dims[1], dims[2], dims[7]
+    n, ov, oth, n_elements, nl = dims[0], dims[1], dims[2], dims[7], dims[11]
     for e in range(n_elements):
         i = coords[e, 0]
         k = coords[e, 1]
@@ -360,7 +361,7 @@ def _element_rates(
         kind = kinds[e]
         if kind == KERNEL_COULOMB:
             fc = fp[e, 0]
-            for j in range(LANES):
+            for j in range(nl):
                 du = ys[s, ov + i, j] - ys[s, ov + k, j]
                 # sgn(du) as (du > 0) - (du < 0): no branch on a sign the predictor misses
                 # half the time; F_c times +-1 or 0 is exactly +-F_c or 0
@@ -368,33 +369,34 @@ def _element_rates(
                 fs[s, e, j] = force
                 u = ys[s, i, j] - ys[s, k, j]
                 tmp[j] = (k2 + k3 * u) * u * u + force
-            _push(rs, s, ov, n, push, e, tmp)
+            _push(rs, s, ov, n, push, e, tmp, nl)
             continue
         for q in range(p.size):
             p[q] = fp[e, q]
         if kind == KERNEL_GENERIC:
             slot = slots[e]
-            for j in range(LANES):
+            for j in range(nl):
                 du = ys[s, ov + i, j] - ys[s, ov + k, j]
                 fs[s, e, j], rs[s, oth + e, j] = _callback(
                     slot, p, du, ys[s, oth + e, j], cb0, cb1, cb2, cb3
                 )
         else:
-            for j in range(LANES):
+            for j in range(nl):
                 du = ys[s, ov + i, j] - ys[s, ov + k, j]
                 fs[s, e, j], rs[s, oth + e, j] = friction_force_and_rate(
                     kind, p, du, ys[s, oth + e, j]
                 )
-        for j in range(LANES):
+        for j in range(nl):
             u = ys[s, i, j] - ys[s, k, j]
             tmp[j] = (k2 + k3 * u) * u * u + fs[s, e, j]
-        _push(rs, s, ov, n, push, e, tmp)
+        _push(rs, s, ov, n, push, e, tmp, nl)
 
 
 @_step
 def _circuit_rates(ys, rs, s, dims, coords, push, circuits, tmp):
     """Each linear circuit's state rate ``a s + b u'`` and its force ``f s`` on its coordinate."""
     n, ov, oc, n_elements, n_circuits = dims[0], dims[1], dims[3], dims[7], dims[8]
+    nl = dims[11]
     for c in range(n_circuits):
         part = n_elements + c
         i = coords[part, 0]
@@ -402,12 +404,12 @@ def _circuit_rates(ys, rs, s, dims, coords, push, circuits, tmp):
         a_s = circuits[c, 0]
         b_s = circuits[c, 1]
         f_s = circuits[c, 2]
-        for j in range(LANES):
+        for j in range(nl):
             du = ys[s, ov + i, j] - ys[s, ov + k, j]
             state = ys[s, oc + c, j]
             rs[s, oc + c, j] = a_s * state + b_s * du
             tmp[j] = f_s * state
-        _push(rs, s, ov, n, push, part, tmp)
+        _push(rs, s, ov, n, push, part, tmp, nl)
 
 
 @_step
@@ -418,13 +420,14 @@ def _bridges_rates(ys, rs, stage, s, dims, coords, push, bridges, tmp):
     conducting diodes' drop (V) at stage s.
     """
     n, ov, ob, n_parts, n_bridges = dims[0], dims[1], dims[4], dims[7] + dims[8], dims[9]
+    nl = dims[11]
     for b in range(n_bridges):
         part = n_parts + b
         i = coords[part, 0]
         k = coords[part, 1]
         rect = _rect(bridges, b)
         q = ob + 2 * b
-        for j in range(LANES):
+        for j in range(nl):
             du = ys[s, ov + i, j] - ys[s, ov + k, j]
             # with 1/m = 1 the bridge's "acceleration" is minus its force on the coordinate
             minus_force, ds1, ds2, i_b, v_drop = _bridge_rates(
@@ -435,7 +438,7 @@ def _bridges_rates(ys, rs, stage, s, dims, coords, push, bridges, tmp):
             stage[s, b, j] = i_b
             stage[2 + s, b, j] = v_drop
             tmp[j] = -minus_force
-        _push(rs, s, ov, n, push, part, tmp)
+        _push(rs, s, ov, n, push, part, tmp, nl)
 
 
 # ------------------------------------------------------------------ the step
@@ -474,36 +477,36 @@ def _advance(ys, rs, gain, noise, dt, weights, dims, advanced, predictor):
     velocities are overwritten. The base's rows stay at zero and are skipped.
     """
     b1, b2 = weights
-    n, ov = dims[0], dims[1]
+    n, ov, nl = dims[0], dims[1], dims[11]
     if predictor:
         for a in range(n):
-            for j in range(LANES):
+            for j in range(nl):
                 ys[1, a, j] = ys[0, a, j] + ys[0, ov + a, j] * dt
     elif b2 == 0.0:
         for a in range(n):
-            for j in range(LANES):
+            for j in range(nl):
                 ys[0, a, j] = ys[0, a, j] + b1 * ys[0, ov + a, j] * dt
     else:
         for a in range(n):
-            for j in range(LANES):
+            for j in range(nl):
                 ys[0, a, j] = ys[0, a, j] + (b1 * ys[0, ov + a, j] + b2 * ys[1, ov + a, j]) * dt
     if predictor:
         for q in range(advanced.size):
             row = advanced[q]
             g = gain[row]
-            for j in range(LANES):
+            for j in range(nl):
                 ys[1, row, j] = ys[0, row, j] + rs[0, row, j] * dt + g * noise[j]
     elif b2 == 0.0:
         for q in range(advanced.size):
             row = advanced[q]
             g = gain[row]
-            for j in range(LANES):
+            for j in range(nl):
                 ys[0, row, j] = ys[0, row, j] + b1 * rs[0, row, j] * dt + g * noise[j]
     else:
         for q in range(advanced.size):
             row = advanced[q]
             g = gain[row]
-            for j in range(LANES):
+            for j in range(nl):
                 ys[0, row, j] = (
                     ys[0, row, j] + (b1 * rs[0, row, j] + b2 * rs[1, row, j]) * dt + g * noise[j]
                 )
@@ -512,11 +515,11 @@ def _advance(ys, rs, gain, noise, dt, weights, dims, advanced, predictor):
 @_step
 def _bridges_predictor(ys, rs, dt, dims, bridges):
     """The bridges' states at the predictor: an Euler stage, clamped or blocked."""
-    ob, n_bridges = dims[4], dims[9]
+    ob, n_bridges, nl = dims[4], dims[9], dims[11]
     for b in range(n_bridges):
         rect = _rect(bridges, b)
         q = ob + 2 * b
-        for j in range(LANES):
+        for j in range(nl):
             ys[1, q, j], ys[1, q + 1, j] = _bridge_predictor(
                 ys[0, q, j], ys[0, q + 1, j], rs[0, q, j], rs[0, q + 1, j], dt, rect
             )
@@ -531,13 +534,13 @@ def _bridges_update(ys, rs, stage, dt, weights, dims, bridges, acc, first, in_wi
     ``first`` is the first bridge accumulator column.
     """
     b1, b2 = weights
-    ob, n_bridges = dims[4], dims[9]
+    ob, n_bridges, nl = dims[4], dims[9], dims[11]
     for b in range(n_bridges):
         rect = _rect(bridges, b)
         rkind, output, second, v_b = rect[0], rect[1], rect[3], rect[5]
         q = ob + 2 * b
         col = first + N_BRIDGE_ACC * b
-        for j in range(LANES):
+        for j in range(nl):
             s1, s2 = ys[0, q, j], ys[0, q + 1, j]
             i1, d1 = stage[0, b, j], stage[2, b, j]
             current = b1 * abs(i1)
@@ -583,41 +586,45 @@ def _increments(dwl, noise_l, rng, lanes, given, dw, start_path, n, sqdt, amp, k
 
 # ------------------------------------------------------------ accumulators
 @_step
-def _accumulate(ys, fs, dw, dims, coords, cols, stroke_coords, limits, ito_weights, acc):
+def _accumulate(ys, fs, dw, dims, coords, cols, stroke_coords, limits, ito_weights, acc, tmp):
     """Add the state at the step's start to the window's sums (:class:`Columns`).
 
-    ``cols`` is (xx, vv, friction, abs_du, circuit, ito, stroke, bridge).
+    ``cols`` is (xx, vv, friction, abs_du, circuit, ito, stroke, bridge);
+    ``tmp`` is scratch for (M r)^T v, summed over the DOFs in their order.
     """
     n, ov, oc, n_elements, n_circuits = dims[0], dims[1], dims[3], dims[7], dims[8]
+    nl = dims[11]
     xx, vv, fr, ab, ci, ito, st, _ = cols
     col = 0
     for a in range(n):
         for b in range(a, n):
-            for j in range(LANES):
+            for j in range(nl):
                 acc[xx + col, j] += ys[0, a, j] * ys[0, b, j]
                 acc[vv + col, j] += ys[0, ov + a, j] * ys[0, ov + b, j]
             col += 1
     for e in range(n_elements):
         i = coords[e, 0]
         k = coords[e, 1]
-        for j in range(LANES):
+        for j in range(nl):
             du = ys[0, ov + i, j] - ys[0, ov + k, j]
             acc[fr + e, j] += du * fs[0, e, j]
             acc[ab + e, j] += abs(du)
     for c in range(n_circuits):
-        for j in range(LANES):
+        for j in range(nl):
             acc[ci + c, j] += ys[0, oc + c, j] * ys[0, oc + c, j]
     for q in range(limits.size):
         i = stroke_coords[q, 0]
         k = stroke_coords[q, 1]
-        for j in range(LANES):
-            if abs(ys[0, i, j] - ys[0, k, j]) > limits[q]:
-                acc[st + q, j] += 1.0
-    for j in range(LANES):
-        total = 0.0
-        for a in range(n):
-            total += ito_weights[a] * ys[0, ov + a, j]
-        acc[ito, j] += total * dw[j]
+        for j in range(nl):
+            acc[st + q, j] += 1.0 if abs(ys[0, i, j] - ys[0, k, j]) > limits[q] else 0.0
+    for j in range(nl):
+        tmp[j] = 0.0
+    for a in range(n):
+        w = ito_weights[a]
+        for j in range(nl):
+            tmp[j] += w * ys[0, ov + a, j]
+    for j in range(nl):
+        acc[ito, j] += tmp[j] * dw[j]
 
 
 @numba.njit(cache=True)
@@ -691,6 +698,9 @@ def _run_chunk(
     rows, n_elements, n_bridges = dims[6], dims[7], dims[9]
     start_path = chunk * LANES
     lanes = min(LANES, n_paths - start_path)
+    # the step's loops run over the live lanes: a count the compiler cannot know, so it
+    # vectorises them (a constant 8 or 32 it unrolled into scalar code, measured)
+    sd = dims + (lanes,)
     rng = np.empty((LANES, 4), dtype=np.uint64)
     ys = np.zeros((2, rows, LANES))  # the state and Heun's predictor
     rs = np.zeros((2, rows, LANES))  # the rates at both stages
@@ -720,20 +730,20 @@ def _run_chunk(
         _increments(dwl, noise_l, rng, lanes, given, dw, start_path, n, sqdt, amp, ki, wi, fi)
         # the step; Heun's two stages through one call of each rate function, inlined once
         for s in range(n_stages):
-            _linear_rates(ys, rs, s, dims, k_start, k_columns, k_values, drive, fa, fc, tmp)
-            _element_rates(ys, rs, fs, s, dims, coords, push, springs, kinds, slots, fp, p,
+            _linear_rates(ys, rs, s, sd, k_start, k_columns, k_values, drive, fa, fc, tmp)
+            _element_rates(ys, rs, fs, s, sd, coords, push, springs, kinds, slots, fp, p,
                            cb0, cb1, cb2, cb3, tmp)  # fmt: skip
-            _circuit_rates(ys, rs, s, dims, coords, push, circuits, tmp)
-            _bridges_rates(ys, rs, stage, s, dims, coords, push, bridges, tmp)
+            _circuit_rates(ys, rs, s, sd, coords, push, circuits, tmp)
+            _bridges_rates(ys, rs, stage, s, sd, coords, push, bridges, tmp)
             if s == 0:
                 if n >= n_burn:  # the window's sums, at the step's start
-                    _accumulate(ys, fs, dwl, dims, coords, cols, stroke_coords, limits,
-                                ito_weights, acc)  # fmt: skip
+                    _accumulate(ys, fs, dwl, sd, coords, cols, stroke_coords, limits,
+                                ito_weights, acc, tmp)  # fmt: skip
                 if n_stages == 2:
-                    _advance(ys, rs, gain, noise_l, dt, scheme, dims, advanced, True)
-                    _bridges_predictor(ys, rs, dt, dims, bridges)
-        _bridges_update(ys, rs, stage, dt, scheme, dims, bridges, acc, cols[7], n >= n_burn)
-        _advance(ys, rs, gain, noise_l, dt, scheme, dims, advanced, False)
+                    _advance(ys, rs, gain, noise_l, dt, scheme, sd, advanced, True)
+                    _bridges_predictor(ys, rs, dt, sd, bridges)
+        _bridges_update(ys, rs, stage, dt, scheme, sd, bridges, acc, cols[7], n >= n_burn)
+        _advance(ys, rs, gain, noise_l, dt, scheme, sd, advanced, False)
         if records.shape[0] > 0 and (n + 1) % every == 0:
             _record(records, y, start_path, lanes, (n + 1) // every)
         if (n + 1) % CHECK_EVERY == 0 or n == n_steps - 1:
