@@ -28,10 +28,12 @@ with, or changes, the single-mass kernel (:mod:`randvib.montecarlo.kernel`).
 ``0 .. N`` hold x and a zero row for the base, rows ``N + 1 .. 2N + 1`` v and
 the base's zero velocity (so that a part on ``(i, base)`` reads row N like a
 DOF, without a branch), then the friction, circuit, bridge and filter states
-(:func:`row_offsets`). Every operation loops over the LANES paths of a
-chunk innermost: the paths' arithmetic is independent and identical, so a
+(:func:`row_offsets`). Every operation loops over the :data:`LANES` paths of
+a chunk innermost: the paths' arithmetic is independent and identical, so a
 path's result does not depend on its lane, its chunk, the threads or the
-batches, and the compiler can vectorise the loops across lanes.
+batches, and the compiler vectorises the loops across lanes (each lane's
+operations stay the same IEEE operations in the same order: the results are
+bit for bit those of scalar code).
 
 **The scheme** is the single-mass kernel's additive-noise predictor-corrector
 (:class:`randvib.montecarlo.integrators.Integrator` weights (b1, b2)):
@@ -209,16 +211,22 @@ def bridge_constants(kind, output, p, dt) -> np.ndarray:
 # ``ys[s]`` and ``rs[s]`` (s = 0: the step's start, 1: Heun's predictor),
 # indexed, never sliced. ``dims`` is (N, ov, oth, oc, ob, of, rows, E, C, B,
 # n_filter): the counts and row offsets as one tuple of integers
-# (:func:`dims_of`).
+# (:func:`dims_of`); the step's helpers get it with the chunk's live lanes
+# appended (``dims[11]``).
 #
-# Every loop over the lanes is straight-line: branches and loops over DOFs or
-# parts stay outside it, so that the compiler unrolls it (and partly
-# vectorises it). Measured against this layout before the helpers lost their
-# reference counts (issue 31, docs/benchmarks.md), each of these made the step
-# slower, not faster: a loop over the DOFs inside the lanes' loop (summing
-# M^-1 K x per lane in a register: 5 DOFs 1.5-2x slower), a tuple of arrays
-# unpacked in the time loop (2-3x), and rows carried as 8-tuples ("bundles",
-# to free the compiler from aliasing: no vector code resulted).
+# Every loop over the lanes is straight-line and runs to that run-time count:
+# branches and loops over DOFs or parts stay outside it, and the compiler,
+# not knowing the count, vectorises it (4 doubles an instruction, with a
+# run-time check that the rows written and read do not overlap). Over a
+# constant count (LANES) it unrolled the loop into scalar code instead (numba
+# keeps LLVM's straight-line vectoriser off). Measured (issue 31,
+# docs/benchmarks.md), each of these made the step slower, not faster: a
+# loop over the DOFs inside the lanes' loop (summing M^-1 K x per lane in a
+# register: 5 DOFs 1.5-2x slower), a tuple of arrays unpacked in the time
+# loop (2-3x), and rows carried as 8-tuples ("bundles": no vector code). A
+# row's acceleration is zeroed, then its couplings subtracted: starting from
+# its first coupling saves a pass over scalar code, but the select it takes
+# inside the lanes' loop may keep the loop from vectorising (not measured).
 
 #: The step's helpers: no reference counts (``_nrt=False``: they allocate
 #: nothing) and LLVM's ``alwaysinline`` (``forceinline``), so that a call
@@ -348,9 +356,11 @@ def _element_rates(
     ``fs[s, e]`` gets the friction force F alone (for the accumulators); ``p``
     is a scratch row for the law's parameters; ``cb0`` .. ``cb3`` the callbacks.
     Coulomb's law (paper Eq. 4-5, sgn(0) = 0) is written out here, spring and
-    friction in one pass: the commonest law, and as the built-ins' dispatch
-    (:func:`~randvib.models.friction.friction_force_and_rate`) a branch per lane
-    on the law and one on the sign cost the 5-DOF benchmark a tenth of its step.
+    friction in one pass without a branch (the commonest law; through the
+    built-ins' dispatch, :func:`~randvib.models.friction.friction_force_and_rate`,
+    each lane branched on the law and on the sign of u', which the branch
+    predictor misses about half the time). Its state keeps its start
+    (:func:`_advanced_rows`). The other laws' rates are written for every lane.
     """
     n, ov, oth, n_elements, nl = dims[0], dims[1], dims[2], dims[7], dims[11]
     for e in range(n_elements):
