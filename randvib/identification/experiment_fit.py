@@ -262,6 +262,8 @@ def identify_experiment(
     bridged = tests[0].bridge is not None
     if bridged:  # the switching breaks the linear symmetries: the fit's covariance decides
         structure = Identifiability((), (), (BRIDGE_STRUCTURE,))
+        known = ", ".join(f"{k} = {v:g}" for k, v in tests[0].bridge.items())
+        notes += (f"behind a full-wave diode bridge, known: {known}",)
     else:
         structure = structural_identifiability(configuration(model, coupling, tests, fixed))
     if not structure.identifiable:
