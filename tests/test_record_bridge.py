@@ -1,7 +1,8 @@
 """The record simulation behind a full-wave diode bridge, and identification from its DC side.
 
 Covers :mod:`randvib.identification.record_bridge` (the Monte Carlo kernel's
-bridge step driven by a recorded input), its use by ``record_response``,
+bridge step driven by a recorded input, checked step for step against that
+kernel on the same increments), its use by ``record_response``,
 ``randvib record --rectifier bridge`` and ``identify(rectifier=...)`` /
 ``randvib identify --rectifier bridge``, against the independent plain-numpy
 RK4 integrator of ``tests/_bridge_reference.py``.
@@ -75,6 +76,30 @@ def test_bridge_record_matches_an_independent_rk4_within_its_step_error(device, 
     assert error <= change + REFERENCE_ERROR, (error, change)
     assert relative_rms(y4, truth) / error > 3.0  # second order: 4 in the limit
     assert relative_rms(runs[8].z[0], reference[:, 0]) <= 1e-3
+
+
+def test_bridge_record_is_the_monte_carlo_kernels_bridge_on_the_same_increments():
+    """White noise given as a force record (u = m sqrt(S/2) dW / dt, zero-order hold, one
+    sub-step) makes the record simulation take the Monte Carlo kernel's Heun steps on the
+    same increments: each path's time average of the storage voltage (the kernel's
+    output-voltage accumulator, V_C at each step's start) is the record's mean V_C over the
+    same samples, to rounding. A wrong sign or scale of the input, or another step, would
+    move it by the ratio of the responses."""
+    device, psd, dt, n = bridged(STORAGE), 5.0, 5e-4, 4000
+    dw = np.random.default_rng([7, 34]).normal(0.0, np.sqrt(dt), (2, n))
+    with pytest.warns(RuntimeWarning, match="starts empty"):  # as the record's: from rest
+        mc = rv.simulate(
+            device, psd, t_end=n * dt, dt=dt, n_paths=2, dW=dw, initial="rest", burn_in=0.0,
+            scheme="heun", check_step=False, progress=False,
+        )  # fmt: skip
+    for path in range(2):
+        force = np.append(STORAGE["m"] * np.sqrt(psd / 2) * dw[path] / dt, 0.0)
+        sim = rv.record_response(device, Record(dt, force=force), substeps=1, hold="zero")
+        v_c = sim.output("voltage")[0]
+        assert v_c.max() > 0.05  # the bridge conducted
+        assert np.mean(v_c[:-1]) == pytest.approx(mc.averages.output_voltage[path], rel=1e-9)
+    with pytest.raises(ValueError, match="`substeps` = 1 leaves a step of 0.002 s"):
+        rv.record_response(device, Record(2e-3, force=force[::4]), substeps=1)
 
 
 def test_piezo_bridge_record_keeps_its_clamp_and_refuses_a_constant_channel():

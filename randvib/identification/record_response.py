@@ -11,6 +11,7 @@ stopped and gets NaN samples.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -255,11 +256,19 @@ def record_response(
 def _bridge_states(harvester, matrix, drive, substeps, hold, start, response_limit):
     """:func:`~randvib.identification.record_bridge.run_bridge` of a device behind a bridge.
 
-    Refused: a quadratic stiffness k2 (the Monte Carlo drift the bridge step
-    shares has none) and Shockley diodes with the coil's inductance (the
-    model refuses them itself).
+    Refused: a sub-step above 0.2 over the storage capacitor's fastest rate
+    (the Monte Carlo kernel's own limit for V_C's explicit step), and a
+    quadratic stiffness k2 (the Monte Carlo drift the bridge step shares has
+    none).
     """
     bridge = harvester.electrical
+    rate, step = bridge.fastest_rate(), drive[2] / substeps
+    if rate * step > 0.2:  # as the Monte Carlo kernel's check: V_C's explicit step
+        raise ValueError(
+            f"`substeps` = {substeps} leaves a step of {step:.3g} s, too large for the "
+            f"{bridge.name}'s storage capacitor (its fastest rate {rate:.3g} 1/s): use "
+            f"substeps >= {math.ceil(rate * drive[2] / 0.2)} (`--substeps`)"
+        )
     z0, v0, theta0, x0, v_c0 = start
     if np.any(np.asarray(v_c0) != 0.0) and bridge.has_battery:
         raise ValueError(
