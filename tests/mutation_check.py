@@ -1333,6 +1333,25 @@ MUTATIONS: tuple[Mutation, ...] = (
         "pathwise with an independent RK4 of the bridge's equations.",
     ),
     Mutation(
+        name="bridge-inductive-reverse-current",
+        path="randvib/montecarlo/rectified_kernel.py",
+        edits=(
+            (
+                "        if rkind == 3 and s1n * s1 < 0.0:  # the diodes block the reverse current\n"
+                "            s1n = 0.0",
+                "        if rkind == 3 and s1n * s1 < 0.0:  # the diodes block the reverse current\n"
+                "            s1n = s1n",
+            ),
+        ),
+        tests=(
+            "tests/test_record_bridge.py::"
+            "test_bridge_record_matches_an_independent_rk4_within_its_step_error",
+        ),
+        why="The coil's current with inductance is let through the diodes in reverse at the "
+        "step's end (the predictor still blocks it); the record simulation behind the bridge "
+        "is compared pathwise with an independent RK4 that blocks it.",
+    ),
+    Mutation(
         name="bridge-record-input-integral",
         path="randvib/identification/record_bridge.py",
         edits=(
