@@ -57,7 +57,7 @@ def _record_responses():
         rv.record_response(device, record)
         rv.record_response(device.updated(k=np.array([50.0, 60.0])), record)
     # behind a diode bridge: one compiled batch for every law, bridge and output
-    bridge = rv.BridgeCoil(alpha=0.2, r_coil=0.5, v_diode=0.1, storage_capacitance=1e-3, r_load=50)
+    bridge = rv.BridgeCoil(alpha=0.2, r_coil=5.0, v_diode=0.1, storage_capacitance=1e-2, r_load=50)
     rv.record_response(rv.Harvester.with_coupling(0.02, 0.05, 50.0, bridge), record)
 
 
