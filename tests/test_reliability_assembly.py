@@ -70,7 +70,11 @@ def exact_u(u, dt=DT):
     pick = np.array([-1.0, 1.0, 0.0, 0.0])
     var, lag = pick @ p @ pick, pick @ a @ p @ pick
     d = u * math.sqrt(var)
-    return d, float(special.erfc(u / math.sqrt(2.0))), gaussian_chain_upcrossing_rate(var, lag, dt, d)
+    return (
+        d,
+        float(special.erfc(u / math.sqrt(2.0))),
+        gaussian_chain_upcrossing_rate(var, lag, dt, d),
+    )
 
 
 def test_linear_start_is_the_schemes_own_stationary_law():
@@ -185,3 +189,18 @@ def test_reliability_device_json(capsys, tmp_path):
     one_line_error(capsys, ["reliability", "--preset", "figure9", "--psd", "1", "--stroke",
                             "0.01", "--duration", "1", "--stroke-on", "element.0"],
                    "`--stroke-on` names a part of an assembly")  # fmt: skip
+
+
+def test_linear_surrogate_is_the_kernel_on_the_same_rows():
+    """A coil with inductance (a circuit state) under band-pass input (a shaping filter): the
+    linear surrogate built from the kernel's tables (importance sampling's design points, the
+    exact start) gives every row the kernel's peak |u| to rounding."""
+    coil = rv.Inductive(alpha=2.0, r_load=20.0, r_coil=5.0, inductance=0.05)
+    device = rv.Assembly.from_matrices(
+        MASS, STIFFNESS, DAMPING, transducers=[rv.Transducer((1, 0), coil, stroke=0.01)]
+    )
+    sim = AssemblyPaths(device, rv.BandPass(1.0, 5.0, 0.2), duration=0.1, dt=DT)
+    rows = np.random.default_rng(6).standard_normal((16, sim.dimension))
+    z = sim.linear_surrogate.responses(rows)
+    np.testing.assert_allclose(sim(rows).peak, np.abs(z).max(axis=1), rtol=1e-9)
+    assert sim.setup.layout.n_circuits == 1 and sim.setup.layout.n_filter == 2
