@@ -14,8 +14,8 @@ path simulator (:mod:`randvib.montecarlo.path_simulator`):
 * ``subset`` - subset simulation (:mod:`randvib.montecarlo.subset_simulation`),
   for every device and input; a pilot run of ``samples_per_level`` samples
   per level gives a coefficient of variation (Au & Beck's, with the chains'
-  correlation), from which the size of one new run that reaches
-  ``target_cov`` is planned (:func:`_subset`);
+  correlation), from which five independent runs that together reach
+  ``target_cov`` are planned; their spread gives the interval (:func:`_subset`);
 * ``importance`` - importance sampling by a change of drift towards the
   design points (:mod:`randvib.montecarlo.importance_sampling`): exact design
   points for a linear device, its linearisation's scaled to the stroke
