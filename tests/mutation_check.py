@@ -703,18 +703,15 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="assembly-tones-ignored",
-        path="randvib/analytic/method.py",
+        path="randvib/analytic/assembly_linear.py",
         edits=(
-            (
-                '    if tones:\n        listed = ", ".join(f"{tone.frequency:g} Hz" for tone in tones)\n        return (\n            f"{who} does not take',
-                '    if False:\n        listed = ", ".join(f"{tone.frequency:g} Hz" for tone in tones)\n        return (\n            f"{who} does not take',
-            ),
+            ("    for tone in tones:  # superposition", "    for tone in ():  # superposition"),
         ),
         tests=(
-            "tests/test_translation.py::test_assemblies_take_shocks_and_translations_when_linear_and_refuse_tones",
+            "tests/test_translation.py::test_assemblies_take_tones_shocks_and_translations_when_linear",
         ),
-        why="An assembly answers under tones as if they were absent (the continuous part alone): "
-        "the silent wrong answer the refusal exists to prevent.",
+        why="A linear assembly answers under tones as if they were absent (the continuous part "
+        "alone): the silent wrong answer; each line must pass through the frequency response.",
     ),
     Mutation(
         name="upcrossings-one-end",
