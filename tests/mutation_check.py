@@ -714,6 +714,68 @@ MUTATIONS: tuple[Mutation, ...] = (
         "alone): the silent wrong answer; each line must pass through the frequency response.",
     ),
     Mutation(
+        name="assembly-tone-influence",
+        path="randvib/montecarlo/assembly_kernel.py",
+        edits=(
+            (
+                "        r = drive[0, a]\n        for j in range(LANES):\n            keep[a, j]",
+                "        r = 1.0\n        for j in range(LANES):\n            keep[a, j]",
+            ),
+        ),
+        tests=(
+            "tests/test_assembly_excitation.py::test_every_state_under_tones_equals_the_numpy_simulator[heun]",
+        ),
+        why="The tones' first half-kick on every DOF with unit influence, not r (the SPEC "
+        "assembly's r = 0.8 on DOF 2): a tone must reach each DOF as -r a(t), like the noise.",
+    ),
+    Mutation(
+        name="assembly-tone-amplitude",
+        path="randvib/montecarlo/assembly_kernel.py",
+        edits=(
+            (
+                "kick[j] = 0.5 * _forced_increment(",
+                "kick[j] = 0.55 * _forced_increment(",
+            ),
+        ),
+        tests=(
+            "tests/test_assembly_excitation.py::test_linear_assembly_under_tones_matches_superposition[tones-alone-heun]",
+        ),
+        why="Each half of the tones' step integral 10 % large (a force 10 % too strong): a "
+        "linear assembly under tones must give |h|^2 A^2 / 2 per DOF to the interval.",
+    ),
+    Mutation(
+        name="assembly-tone-sampled-after-kick",
+        path="randvib/montecarlo/assembly_kernel.py",
+        edits=(
+            (
+                "                    if forced:\n                        _forcing_swap(ys, keep, dims)\n"
+                "                    _accumulate(",
+                "                    _accumulate(",
+            ),
+        ),
+        tests=(
+            "tests/test_assembly_excitation.py::test_one_dof_assembly_under_forcing_equals_the_single_mass[tones-coulomb-heun]",
+        ),
+        why="The window's sums read the velocities after the first half-kick (and the swap "
+        "after them then puts the kicked state back wrongly): the single mass samples the "
+        "state before it, and a one-DOF assembly must equal it.",
+    ),
+    Mutation(
+        name="assembly-tones-alone-noise-on",
+        path="randvib/montecarlo/assembly_setup.py",
+        edits=(
+            (
+                "amplitude = 0.0 if silent else 1.0",
+                "amplitude = 1.0 if silent else 1.0",
+            ),
+        ),
+        tests=(
+            "tests/test_assembly_excitation.py::test_linear_assembly_under_tones_matches_superposition[tones-alone-heun]",
+        ),
+        why="Tones alone (psd 0) with the kernel's noise left on (at the nominal level the "
+        "step check sees): the assembly must see the tones alone.",
+    ),
+    Mutation(
         name="upcrossings-one-end",
         path="randvib/montecarlo/kernel.py",
         edits=(

@@ -167,43 +167,23 @@ def tone_covariances(a, g, tone, dt, scheme):
     return continuous, 0.5 * np.real(np.outer(y, y.conj()))
 
 
-def _check_linear(result, spec, exact, stepped, detect):
-    n = spec["M"].shape[0]
-    for i in range(n):
-        for kind, stats in (("x", result.displacement_variance), ("v", result.velocity_variance)):
-            key = f"{kind}{i}"
-            assert_matches(stats[i], exact[key], detect=detect,
-                           known_bias=stepped[key] - exact[key], what=f"E[{key}^2]")  # fmt: skip
-    for index, transducer in enumerate(result.transducers):
-        key = f"power{index}"
-        assert_matches(transducer.power_electrical, exact[key], detect=detect,
-                       known_bias=stepped[key] - exact[key], what=key)  # fmt: skip
+#: Two tones near CHAIN's modes (9.4 and 17.0 Hz), for tones alone.
+TWO_TONES = (rv.Tone(9.0, 3.0), rv.Tone(17.0, 2.0))
 
 
-@pytest.mark.parametrize(
-    "scheme, level, tones",
-    [
-        ("heun", 0.0, (rv.Tone(9.0, 3.0), rv.Tone(17.0, 2.0))),
-        ("euler-maruyama", 0.0, (rv.Tone(9.0, 3.0), rv.Tone(17.0, 2.0))),
-        ("heun", 0.2, (rv.Tone(14.0, 3.0),)),
-    ],
-    ids=["tones-alone-heun", "tones-alone-euler", "tone-on-white-heun"],
-)
-def test_linear_assembly_under_tones_matches_superposition(scheme, level, tones):
-    """CHAIN: each tone through the frequency response plus the random part's Lyapunov solution.
+def case_tones(seed, scheme="heun", level=0.0, tones=TWO_TONES):
+    """CHAIN under tones (on white noise of ``level``): rows of per-DOF variances and power.
 
-    Per DOF E[x^2], E[v^2] and the transducer's power, each within 4 standard
-    errors of the exact value plus the scheme's exact discrete bias
-    (:func:`tone_covariances`, ``covariances``) and powered to see the
-    ``detect`` error; dt = 5e-4 s. Tones alone: 64 paths x 2.57 s after 3 s
-    burn-in; a path's average varies only with its phases, over a window of no
-    whole number of periods (about 0.1 % here; a whole number would leave the
-    start's transient as the only spread), so 2 % is seen. The start's
-    transient decays as exp(-3.85 t) (the slowest mode): after 3 s its bias is
-    below 1e-6 relative (measured 2e-4 after 1.5 s, 2e-8 after 4 s), far
-    inside the interval. With noise: 128 paths x 5 s after 1 s, 10 % seen (as
-    tests/test_assembly_simulation.py); the transient's bias (about 1e-3) is
-    a tenth of the interval.
+    Each row ``(what, stat, exact, known bias, detect)``: the exact value by
+    superposition (:func:`tone_covariances` per tone, the random part's
+    Lyapunov solution), the scheme's exact discrete response minus it as the
+    known bias. dt = 5e-4 s. Tones alone: 64 paths x 2.57 s after 3 s burn-in;
+    a path's average varies only with its phases, over a window of no whole
+    number of periods (about 0.1 % here; a whole number would leave the start's
+    transient as the only spread), so 2 % is seen. The start's transient decays
+    as exp(-3.85 t) (the slowest mode): after 3 s its bias is below 1e-6
+    relative (measured 2e-4 after 1.5 s, 2e-8 after 4 s). With noise: 128 paths
+    x 5 s after 1 s, 10 % seen (as tests/test_assembly_simulation.py).
     """
     dt = 5e-4
     a, g = linear_system(CHAIN)
@@ -214,70 +194,107 @@ def test_linear_assembly_under_tones_matches_superposition(scheme, level, tones)
         c, d = tone_covariances(a, g, tone, dt, scheme)
         continuous, discrete = continuous + c, discrete + d
     exact, stepped = _quantities(CHAIN, continuous), _quantities(CHAIN, discrete)
-    excitation = tones[0] if len(tones) == 1 else tones[0] + tones[1]
+    excitation = sum(tones[1:], tones[0] + level) if level else sum(tones[1:], tones[0])
     burn_in, window, paths = (1.0, 5.0, 128) if level else (3.0, 2.57, 64)
     result = rv.simulate(
-        assembly_of(CHAIN), level + excitation if level else excitation, t_end=burn_in + window,
-        dt=dt, n_paths=paths, burn_in=burn_in, scheme=scheme, seed=11, progress=False,
-        check_step=False,
+        assembly_of(CHAIN), excitation, t_end=burn_in + window, dt=dt, n_paths=paths,
+        burn_in=burn_in, scheme=scheme, seed=seed, progress=False, check_step=False,
     )  # fmt: skip
-    _check_linear(result, CHAIN, exact, stepped, detect=0.1 if level else 0.02)
     assert result.power_input is None  # r^T M r S / 4 is white noise's alone
+    detect = 0.1 if level else 0.02
+    for i in range(2):
+        for kind, stats in (("x", result.displacement_variance), ("v", result.velocity_variance)):
+            key = f"{kind}{i}"
+            yield f"E[{key}^2]", stats[i], exact[key], stepped[key] - exact[key], detect
+    key = "power0"
+    power = result.transducers[0].power_electrical
+    yield key, power, exact[key], stepped[key] - exact[key], detect
+
+
+@pytest.mark.parametrize(
+    "scheme, level, tones",
+    [
+        ("heun", 0.0, TWO_TONES),
+        ("euler-maruyama", 0.0, TWO_TONES),
+        ("heun", 0.2, (rv.Tone(14.0, 3.0),)),
+    ],
+    ids=["tones-alone-heun", "tones-alone-euler", "tone-on-white-heun"],
+)
+def test_linear_assembly_under_tones_matches_superposition(scheme, level, tones):
+    """CHAIN: each tone through the frequency response plus the random part's Lyapunov solution.
+
+    Per DOF E[x^2], E[v^2] and the transducer's power (:func:`case_tones`), each
+    within 4 standard errors of the exact value plus the scheme's exact
+    discrete bias and powered to see 2 % (tones alone) or 10 % (on noise).
+    Calibrated over seeds by tests/calibration/assembly_excitation.py (results
+    in its .txt).
+    """
+    for what, stat, ref, bias, detect in case_tones(11, scheme, level, tones):
+        assert_matches(stat, ref, detect=detect, known_bias=bias, what=what)
 
 
 # ------------------------------------------------------------ translated input
-def test_linear_assembly_under_translated_input_has_the_spectrum_s_moments():
-    """Kurtosis 6 on a band-limited spectrum: CHAIN's second moments are the spectral integral.
+def case_translated(seed):
+    """Kurtosis 6 on a band-limited spectrum: CHAIN's second moments and the input's kurtosis.
 
     The reference is the linear response to the simulated process's achieved
     spectrum (cut at the step's Nyquist frequency), exact for any marginal;
-    96 paths x 8 s after 1 s burn-in, each estimate within 4 standard errors
-    and powered to see 15 % (the lightly damped inner mass's long memory: its
-    standard errors are about 2.2 %). The input the kernel took (the run's own
-    increments, :class:`~randvib.montecarlo.driven.TranslatedInput`) has the
-    marginal's kurtosis, within its sampling error (delta method over paths).
+    96 paths x 8 s after 1 s burn-in, powered to see 15 % (the lightly damped
+    inner mass's long memory: its standard errors are about 2.2 %). The input
+    the kernel took (the run's own increments,
+    :class:`~randvib.montecarlo.driven.TranslatedInput`) against the marginal's
+    kurtosis, its standard error by the delta method over paths, 12 % seen.
     """
     x = rv.Translated(rv.BandLimited(0.2, 4.0, 30.0), 6.0)
-    dt, seed = 1e-3, 3
+    dt = 1e-3
     result = rv.simulate(
         assembly_of(CHAIN), x, t_end=9.0, burn_in=1.0, dt=dt, n_paths=96, seed=seed,
         progress=False,
     )  # fmt: skip
     response = linear_response(assembly_of(CHAIN), x.achieved_spectrum(0.5 / dt))
     for i in range(2):
-        assert_matches(result.velocity_variance[i], response.velocity_variance[i], detect=0.15,
-                       what=f"E[v{i}^2]")  # fmt: skip
-        assert_matches(result.displacement_variance[i], response.displacement_variance[i],
-                       detect=0.15, what=f"E[x{i}^2]")  # fmt: skip
+        yield f"E[v{i}^2]", result.velocity_variance[i], response.velocity_variance[i], 0.0, 0.15
+        yield (f"E[x{i}^2]", result.displacement_variance[i], response.displacement_variance[i],
+               0.0, 0.15)  # fmt: skip
     (transducer,) = result.transducers
-    assert_matches(transducer.power_electrical, response.transducer_power(0)[0], detect=0.15,
-                   what="power")  # fmt: skip
+    yield "power", transducer.power_electrical, response.transducer_power(0)[0], 0.0, 0.15
     a = -TranslatedInput(x, 9000, dt, seed)(0, 96) / dt  # the run's base acceleration
     m2, m4 = np.mean(a**2, axis=1), np.mean(a**4, axis=1)
-    assert_matches(ratio_statistic(m4, m2), x.marginal.kurtosis, detect=0.12, what="kurtosis")
+    yield "kurtosis", ratio_statistic(m4, m2), x.marginal.kurtosis, 0.0, 0.12
+
+
+def test_linear_assembly_under_translated_input_has_the_spectrum_s_moments():
+    """A linear assembly's second moments are its input's spectrum's, whatever the marginal
+    (:func:`case_translated`); calibrated by tests/calibration/assembly_excitation.py."""
+    for what, stat, ref, bias, detect in case_translated(3):
+        assert_matches(stat, ref, detect=detect, known_bias=bias, what=what)
 
 
 # ---------------------------------------------------------------------- shocks
-def test_linear_assembly_under_shocks_matches_campbell():
-    """A shock train on white noise: CHAIN's variances are the spectral integral of the sum.
+def case_shocks(seed):
+    """A shock train on white noise: CHAIN's variances against the spectral integral of the sum.
 
     Campbell's spectrum ``2 lambda E[A^2] |P(f)|^2`` plus the white level, through
     the assembly (:func:`linear_response`, exact); 96 paths x 6 s after 1 s,
-    dt = 2e-4 s (the pulses of 4 ms resolved; time-step bias below 0.5 %),
-    each estimate within 4 standard errors and powered to see 15 % (standard
-    errors 1.4 to 2.3 %).
+    dt = 2e-4 s (the pulses of 4 ms resolved; the fastest mode's w dt = 0.02),
+    powered to see 15 % (standard errors 1.4 to 2.3 %).
     """
     excitation = rv.White(0.02) + rv.ShockTrain(20.0, 10.0, 0.004)
     result = rv.simulate(
-        assembly_of(CHAIN), excitation, t_end=7.0, burn_in=1.0, dt=2e-4, n_paths=96, seed=6,
+        assembly_of(CHAIN), excitation, t_end=7.0, burn_in=1.0, dt=2e-4, n_paths=96, seed=seed,
         progress=False,
     )  # fmt: skip
     response = linear_response(assembly_of(CHAIN), excitation)
     for i in range(2):
-        assert_matches(result.velocity_variance[i], response.velocity_variance[i], detect=0.15,
-                       what=f"E[v{i}^2]")  # fmt: skip
-        assert_matches(result.displacement_variance[i], response.displacement_variance[i],
-                       detect=0.15, what=f"E[x{i}^2]")  # fmt: skip
+        yield f"E[v{i}^2]", result.velocity_variance[i], response.velocity_variance[i], 0.0, 0.15
+        yield (f"E[x{i}^2]", result.displacement_variance[i], response.displacement_variance[i],
+               0.0, 0.15)  # fmt: skip
+
+
+def test_linear_assembly_under_shocks_matches_campbell():
+    """:func:`case_shocks`, calibrated by tests/calibration/assembly_excitation.py."""
+    for what, stat, ref, bias, detect in case_shocks(6):
+        assert_matches(stat, ref, detect=detect, known_bias=bias, what=what)
 
 
 # ------------------------------------------------------------------------ CLI
@@ -323,3 +340,33 @@ def test_forced_assembly_refusals_name_the_argument(kwargs, fragment):
     with pytest.raises(ValueError, match=fragment):
         rv.simulate(assembly_of(CHAIN), psd, t_end=0.01, dt=1e-4, n_paths=2, progress=False,
                     check_step=False, **kwargs)  # fmt: skip
+
+
+LINEAR_CHAIN = """[structure]
+chain = { mass = [0.2, 0.05], stiffness = [2000.0, 200.0], damping = [2.0, 0.3] }
+
+[[transducer]]
+between = [1, 0]
+coupling = "resistive"
+c_e = 0.2
+"""
+
+
+def test_cli_power_device_takes_tones_on_a_linear_assembly_and_refuses_them_otherwise(
+    capsys, tmp_path
+):
+    """``power --device --tone``: a linear assembly's exact answer (the API's); a nonlinear
+    one is refused in one line that points to ``simulate --device``."""
+    path = tmp_path / "chain.toml"
+    path.write_text(LINEAR_CHAIN)
+    code, out, err = run_cli(capsys, "power", "--device", path, "--psd", "0.1", "--tone", "8:0.5",
+                             "--json")  # fmt: skip
+    assert code == 0, err
+    data = json.loads(out)
+    api = rv.predict(rv.Assembly.from_toml(path), 0.1 + rv.Tone(8.0, 0.5))
+    without = rv.predict(rv.Assembly.from_toml(path), 0.1)
+    got = data["transducers"][0]["power_electrical"]
+    assert got == api.transducers[0].power_electrical > without.transducers[0].power_electrical
+    code, out, err = run_cli(capsys, "power", "--device", "two_mass_harvester", "--psd", "0.1",
+                             "--tone", "8:0.5")  # fmt: skip
+    assert code == 2 and "simulate --device" in err and len(err.strip().splitlines()) == 1
