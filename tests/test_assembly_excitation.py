@@ -308,11 +308,17 @@ def test_linear_assembly_under_shocks_matches_campbell():
              "--kurtosis", "5"],
             rv.Translated(rv.BandLimited(0.1, 4.0, 20.0), 5.0),
         ),
+        (
+            ["--psd", "0.1", "--shock-rate", "5", "--shock-amplitude", "3", "--shock-duration",
+             "0.01"],
+            0.1 + rv.ShockTrain(5.0, 3.0, 0.01),
+        ),
     ],
-    ids=["tone-on-white", "tone-alone", "kurtosis"],
+    ids=["tone-on-white", "tone-alone", "kurtosis", "shocks"],
 )  # fmt: skip
 def test_cli_simulate_device_takes_tones_and_kurtosis(capsys, extra, excitation):
-    """``simulate --device FILE --tone F:A`` / ``--kurtosis K``: the JSON equals rv.simulate."""
+    """``simulate --device FILE`` with ``--tone F:A``, ``--kurtosis K``, ``--shock-*``: the
+    JSON equals rv.simulate's."""
     path = device_path("two_harvesters_on_host")
     argv = ["simulate", "--device", "two_harvesters_on_host", *extra, "--t-end", "0.3",
             "--burn-in", "0.1", "--paths", "8", "--seed", "3", "--json"]  # fmt: skip
