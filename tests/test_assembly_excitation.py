@@ -183,7 +183,7 @@ def case_tones(seed, scheme="heun", level=0.0, tones=TWO_TONES):
     transient as the only spread), so 2 % is seen. The start's transient decays
     as exp(-3.85 t) (the slowest mode): after 3 s its bias is below 1e-6
     relative (measured 2e-4 after 1.5 s, 2e-8 after 4 s). With noise: 128 paths
-    x 5 s after 1 s, 10 % seen (as tests/test_assembly_simulation.py).
+    x 5 s after 1 s, 12 % seen (the inner mass's standard error about 2 %).
     """
     dt = 5e-4
     a, g = linear_system(CHAIN)
@@ -201,7 +201,7 @@ def case_tones(seed, scheme="heun", level=0.0, tones=TWO_TONES):
         burn_in=burn_in, scheme=scheme, seed=seed, progress=False, check_step=False,
     )  # fmt: skip
     assert result.power_input is None  # r^T M r S / 4 is white noise's alone
-    detect = 0.1 if level else 0.02
+    detect = 0.12 if level else 0.02
     for i in range(2):
         for kind, stats in (("x", result.displacement_variance), ("v", result.velocity_variance)):
             key = f"{kind}{i}"
@@ -225,7 +225,7 @@ def test_linear_assembly_under_tones_matches_superposition(scheme, level, tones)
 
     Per DOF E[x^2], E[v^2] and the transducer's power (:func:`case_tones`), each
     within 4 standard errors of the exact value plus the scheme's exact
-    discrete bias and powered to see 2 % (tones alone) or 10 % (on noise).
+    discrete bias and powered to see 2 % (tones alone) or 12 % (on noise).
     Calibrated over seeds by tests/calibration/assembly_excitation.py (results
     in its .txt).
     """
@@ -243,7 +243,8 @@ def case_translated(seed):
     inner mass's long memory: its standard errors are about 2.2 %). The input
     the kernel took (the run's own increments,
     :class:`~randvib.montecarlo.driven.TranslatedInput`) against the marginal's
-    kurtosis, its standard error by the delta method over paths, 12 % seen.
+    kurtosis, its standard error by the delta method over paths (heavy-tailed:
+    1.7 % to 4.4 % over seeds), 30 % seen: the Gaussian's 3 is far outside.
     """
     x = rv.Translated(rv.BandLimited(0.2, 4.0, 30.0), 6.0)
     dt = 1e-3
@@ -260,7 +261,7 @@ def case_translated(seed):
     yield "power", transducer.power_electrical, response.transducer_power(0)[0], 0.0, 0.15
     a = -TranslatedInput(x, 9000, dt, seed)(0, 96) / dt  # the run's base acceleration
     m2, m4 = np.mean(a**2, axis=1), np.mean(a**4, axis=1)
-    yield "kurtosis", ratio_statistic(m4, m2), x.marginal.kurtosis, 0.0, 0.12
+    yield "kurtosis", ratio_statistic(m4, m2), x.marginal.kurtosis, 0.0, 0.3
 
 
 def test_linear_assembly_under_translated_input_has_the_spectrum_s_moments():
@@ -277,7 +278,7 @@ def case_shocks(seed):
     Campbell's spectrum ``2 lambda E[A^2] |P(f)|^2`` plus the white level, through
     the assembly (:func:`linear_response`, exact); 96 paths x 6 s after 1 s,
     dt = 2e-4 s (the pulses of 4 ms resolved; the fastest mode's w dt = 0.02),
-    powered to see 15 % (standard errors 1.4 to 2.3 %).
+    powered to see 17 % (standard errors 1.4 to 2.6 % over seeds).
     """
     excitation = rv.White(0.02) + rv.ShockTrain(20.0, 10.0, 0.004)
     result = rv.simulate(
@@ -286,9 +287,9 @@ def case_shocks(seed):
     )  # fmt: skip
     response = linear_response(assembly_of(CHAIN), excitation)
     for i in range(2):
-        yield f"E[v{i}^2]", result.velocity_variance[i], response.velocity_variance[i], 0.0, 0.15
+        yield f"E[v{i}^2]", result.velocity_variance[i], response.velocity_variance[i], 0.0, 0.17
         yield (f"E[x{i}^2]", result.displacement_variance[i], response.displacement_variance[i],
-               0.0, 0.15)  # fmt: skip
+               0.0, 0.17)  # fmt: skip
 
 
 def test_linear_assembly_under_shocks_matches_campbell():
