@@ -718,8 +718,8 @@ MUTATIONS: tuple[Mutation, ...] = (
         path="randvib/montecarlo/assembly_kernel.py",
         edits=(
             (
-                "        r = drive[0, a]\n        for j in range(LANES):\n            keep[a, j]",
-                "        r = 1.0\n        for j in range(LANES):\n            keep[a, j]",
+                "        r = 0.5 * drive[0, a]\n        for j in range(LANES):\n            keep[a, j]",
+                "        r = 0.5\n        for j in range(LANES):\n            keep[a, j]",
             ),
         ),
         tests=(
@@ -733,14 +733,14 @@ MUTATIONS: tuple[Mutation, ...] = (
         path="randvib/montecarlo/assembly_kernel.py",
         edits=(
             (
-                "kick[j] = 0.5 * _forced_increment(",
-                "kick[j] = 0.55 * _forced_increment(",
+                "kick[j] -= g * np.cos(w * t + phase[start_path + j, q])",
+                "kick[j] -= 1.1 * g * np.cos(w * t + phase[start_path + j, q])",
             ),
         ),
         tests=(
             "tests/test_assembly_excitation.py::test_linear_assembly_under_tones_matches_superposition[tones-alone-heun]",
         ),
-        why="Each half of the tones' step integral 10 % large (a force 10 % too strong): a "
+        why="The tones' step integral 10 % large (a force 10 % too strong): a "
         "linear assembly under tones must give |h|^2 A^2 / 2 per DOF to the interval.",
     ),
     Mutation(

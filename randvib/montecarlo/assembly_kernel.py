@@ -37,7 +37,10 @@ batches, and the compiler can vectorise the loops across lanes.
 (:class:`randvib.montecarlo.integrators.Integrator` weights (b1, b2)):
 ``y_p = y + R(y) dt + G dW``, ``y_{n+1} = y + (b1 R(y) + b2 R(y_p)) dt + G dW``
 with the noise gain G: ``r`` on the velocities under white or given input, the
-filter's input gain on its states under a rational spectrum.
+filter's input gain on its states under a rational spectrum. Tones and shock
+trains (the single mass's :class:`~randvib.montecarlo.kernel.Forcing`) add
+their exact step integral ``u_n`` of -a(t) to the velocities as ``r u_n / 2``
+before the step and again after it (:func:`_forcing_first_half`).
 
 **Per-path accumulators** (:class:`Columns`): time averages over the window
 of x x^T and v v^T (upper triangles), of each element's friction power
@@ -54,7 +57,7 @@ import numba
 import numpy as np
 
 from randvib.models.friction import KERNEL_GENERIC, friction_force_and_rate
-from randvib.montecarlo.kernel import CHECK_EVERY, LANES, _forced_increment
+from randvib.montecarlo.kernel import CHECK_EVERY, LANES
 from randvib.montecarlo.rectified_kernel import _bridge_predictor, _bridge_rates, _bridge_update
 from randvib.montecarlo.rng import seed_path_state, standard_normal
 
@@ -492,16 +495,26 @@ def _forcing_first_half(
 ):
     """Half of step n's forcing, r u_n / 2, onto each DOF's velocity; the velocities before into ``keep``.
 
+    ``kick`` gets u_n per lane (:class:`~randvib.montecarlo.kernel.Forcing`), for the second half.
+
     ``omega``, ``gain``, ``phase``, ``kicks``: the fields of kernel.Forcing, one
     by one (a tuple of arrays unpacked in the time loop costs reference counts).
     """
     n_dof, ov = dims[0], dims[1]
+    # kernel._forced_increment's arithmetic, in its order (a one-DOF assembly follows the
+    # single mass bit for bit), one tone at a time over the lanes
     for j in range(LANES):
         kick[j] = 0.0
-        if j < lanes:
-            kick[j] = 0.5 * _forced_increment(n, dt, start_path + j, omega, gain, phase, kicks)
+    if kicks.shape[0] > 0:
+        for j in range(lanes):
+            kick[j] = kicks[start_path + j, n]
+    t = (n + 0.5) * dt
+    for q in range(omega.shape[0]):
+        w, g = omega[q], gain[q]
+        for j in range(lanes):
+            kick[j] -= g * np.cos(w * t + phase[start_path + j, q])
     for a in range(n_dof):
-        r = drive[0, a]
+        r = 0.5 * drive[0, a]
         for j in range(LANES):
             keep[a, j] = ys[0, ov + a, j]
             ys[0, ov + a, j] += r * kick[j]
@@ -523,7 +536,7 @@ def _forcing_second_half(ys, kick, dims, drive):
     """The step's other half r u_n / 2 onto each DOF's velocity, after the scheme's update."""
     n_dof, ov = dims[0], dims[1]
     for a in range(n_dof):
-        r = drive[0, a]
+        r = 0.5 * drive[0, a]
         for j in range(LANES):
             ys[0, ov + a, j] += r * kick[j]
 
