@@ -703,18 +703,77 @@ MUTATIONS: tuple[Mutation, ...] = (
     ),
     Mutation(
         name="assembly-tones-ignored",
-        path="randvib/analytic/method.py",
+        path="randvib/analytic/assembly_linear.py",
+        edits=(
+            ("    for tone in tones:  # superposition", "    for tone in ():  # superposition"),
+        ),
+        tests=(
+            "tests/test_translation.py::test_assemblies_take_tones_shocks_and_translations_when_linear",
+        ),
+        why="A linear assembly answers under tones as if they were absent (the continuous part "
+        "alone): the silent wrong answer; each line must pass through the frequency response.",
+    ),
+    Mutation(
+        name="assembly-tone-influence",
+        path="randvib/montecarlo/assembly_kernel.py",
         edits=(
             (
-                '    if tones:\n        listed = ", ".join(f"{tone.frequency:g} Hz" for tone in tones)\n        return (\n            f"{who} does not take',
-                '    if False:\n        listed = ", ".join(f"{tone.frequency:g} Hz" for tone in tones)\n        return (\n            f"{who} does not take',
+                "        r = 0.5 * drive[0, a]\n        for j in range(LANES):\n            keep[a, j]",
+                "        r = 0.5\n        for j in range(LANES):\n            keep[a, j]",
             ),
         ),
         tests=(
-            "tests/test_translation.py::test_assemblies_take_shocks_and_translations_when_linear_and_refuse_tones",
+            "tests/test_assembly_excitation.py::test_every_state_under_tones_equals_the_numpy_simulator[heun]",
         ),
-        why="An assembly answers under tones as if they were absent (the continuous part alone): "
-        "the silent wrong answer the refusal exists to prevent.",
+        why="The tones' first half-kick on every DOF with unit influence, not r (the SPEC "
+        "assembly's r = 0.8 on DOF 2): a tone must reach each DOF as -r a(t), like the noise.",
+    ),
+    Mutation(
+        name="assembly-tone-amplitude",
+        path="randvib/montecarlo/assembly_kernel.py",
+        edits=(
+            (
+                "kick[j] -= g * np.cos(w * t + phase[start_path + j, q])",
+                "kick[j] -= 1.1 * g * np.cos(w * t + phase[start_path + j, q])",
+            ),
+        ),
+        tests=(
+            "tests/test_assembly_excitation.py::test_linear_assembly_under_tones_matches_superposition[tones-alone-heun]",
+        ),
+        why="The tones' step integral 10 % large (a force 10 % too strong): a "
+        "linear assembly under tones must give |h|^2 A^2 / 2 per DOF to the interval.",
+    ),
+    Mutation(
+        name="assembly-tone-sampled-after-kick",
+        path="randvib/montecarlo/assembly_kernel.py",
+        edits=(
+            (
+                "                    if forced:\n                        _forcing_swap(ys, keep, dims)\n"
+                "                    _accumulate(",
+                "                    _accumulate(",
+            ),
+        ),
+        tests=(
+            "tests/test_assembly_excitation.py::test_one_dof_assembly_under_forcing_equals_the_single_mass[tones-coulomb-heun]",
+        ),
+        why="The window's sums read the velocities after the first half-kick (and the swap "
+        "after them then puts the kicked state back wrongly): the single mass samples the "
+        "state before it, and a one-DOF assembly must equal it.",
+    ),
+    Mutation(
+        name="assembly-tones-alone-noise-on",
+        path="randvib/montecarlo/assembly_setup.py",
+        edits=(
+            (
+                "amplitude = 0.0 if silent else 1.0",
+                "amplitude = 1.0 if silent else 1.0",
+            ),
+        ),
+        tests=(
+            "tests/test_assembly_excitation.py::test_linear_assembly_under_tones_matches_superposition[tones-alone-heun]",
+        ),
+        why="Tones alone (psd 0) with the kernel's noise left on (at the nominal level the "
+        "step check sees): the assembly must see the tones alone.",
     ),
     Mutation(
         name="upcrossings-one-end",

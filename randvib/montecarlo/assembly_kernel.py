@@ -37,7 +37,10 @@ batches, and the compiler can vectorise the loops across lanes.
 (:class:`randvib.montecarlo.integrators.Integrator` weights (b1, b2)):
 ``y_p = y + R(y) dt + G dW``, ``y_{n+1} = y + (b1 R(y) + b2 R(y_p)) dt + G dW``
 with the noise gain G: ``r`` on the velocities under white or given input, the
-filter's input gain on its states under a rational spectrum.
+filter's input gain on its states under a rational spectrum. Tones and shock
+trains (the single mass's :class:`~randvib.montecarlo.kernel.Forcing`) add
+their exact step integral ``u_n`` of -a(t) to the velocities as ``r u_n / 2``
+before the step and again after it (:func:`_forcing_first_half`).
 
 **Per-path accumulators** (:class:`Columns`): time averages over the window
 of x x^T and v v^T (upper triangles), of each element's friction power
@@ -490,6 +493,64 @@ def _bridges_update(ys, rs, stage, dt, weights, dims, bridges, acc, first, in_wi
                 acc[col + BRIDGE_DIODE, j] += diode
 
 
+# ---------------------------------------------------------------- forcing
+# Tones and shocks (kernel.Forcing) reach an assembly as they reach the single
+# mass (kernel.run_ensemble): the exact step integral u_n of -a(t), here on every
+# velocity through r (M x'' = ... - M r a), half before the scheme's step and half
+# after it (Strang splitting); the window's sums see the velocities before the
+# first half, as the single mass's do (they are swapped in and out around them).
+@numba.njit(cache=True, inline="always")
+def _forcing_first_half(
+    ys, kick, keep, n, dt, start_path, lanes, dims, drive, omega, gain, phase, kicks
+):
+    """Half of step n's forcing, r u_n / 2, onto each DOF's velocity; the velocities before into ``keep``.
+
+    ``kick`` gets u_n per lane (:class:`~randvib.montecarlo.kernel.Forcing`), for the second half.
+
+    ``omega``, ``gain``, ``phase``, ``kicks``: the fields of kernel.Forcing, one
+    by one (a tuple of arrays unpacked in the time loop costs reference counts).
+    """
+    n_dof, ov = dims[0], dims[1]
+    # kernel._forced_increment's arithmetic, in its order (a one-DOF assembly follows the
+    # single mass bit for bit), one tone at a time over the lanes
+    for j in range(LANES):
+        kick[j] = 0.0
+    if kicks.shape[0] > 0:
+        for j in range(lanes):
+            kick[j] = kicks[start_path + j, n]
+    t = (n + 0.5) * dt
+    for q in range(omega.shape[0]):
+        w, g = omega[q], gain[q]
+        for j in range(lanes):
+            kick[j] -= g * np.cos(w * t + phase[start_path + j, q])
+    for a in range(n_dof):
+        r = 0.5 * drive[0, a]
+        for j in range(LANES):
+            keep[a, j] = ys[0, ov + a, j]
+            ys[0, ov + a, j] += r * kick[j]
+
+
+@numba.njit(cache=True, inline="always")
+def _forcing_swap(ys, keep, dims):
+    """Exchange the velocities with ``keep`` (before and after the window's sums)."""
+    n_dof, ov = dims[0], dims[1]
+    for a in range(n_dof):
+        for j in range(LANES):
+            v = ys[0, ov + a, j]
+            ys[0, ov + a, j] = keep[a, j]
+            keep[a, j] = v
+
+
+@numba.njit(cache=True, inline="always")
+def _forcing_second_half(ys, kick, dims, drive):
+    """The step's other half r u_n / 2 onto each DOF's velocity, after the scheme's update."""
+    n_dof, ov = dims[0], dims[1]
+    for a in range(n_dof):
+        r = 0.5 * drive[0, a]
+        for j in range(LANES):
+            ys[0, ov + a, j] += r * kick[j]
+
+
 # ------------------------------------------------------------ accumulators
 @numba.njit(cache=True, inline="always")
 def _accumulate(ys, fs, dw, dims, coords, cols, stroke_coords, limits, ito_weights, acc, was):
@@ -600,7 +661,7 @@ def _finite(y, j):
 @numba.njit(cache=True)
 def _run_chunk(
     chunk, out, failed, records, scheme, dims, linear, parts, cb0, cb1, cb2, cb3, columns, timing,
-    paths, start, every, noise, stop,
+    paths, start, every, noise, stop, forcing,
 ):  # fmt: skip
     """Paths ``chunk * LANES ..`` of :func:`run_assembly_ensemble`, from start to finish.
 
@@ -632,6 +693,9 @@ def _run_chunk(
     p = np.zeros(fp.shape[1])
     sqdt, given = np.sqrt(dt), dw.shape[0] > 0
     n_stages = 1 if scheme[1] == 0.0 else 2
+    f_omega, f_gain, f_phase, f_kicks = forcing
+    forced = f_omega.shape[0] > 0 or f_kicks.shape[0] > 0  # False: NO_FORCING
+    kick, keep = np.zeros(LANES), np.zeros((dims[0], LANES))
     _start_lanes(y, rng, first_path + start_path, lanes, seed, start, ki, wi, fi)
     if starts.shape[0] > 0:  # each path's own start (rare events': assembly_paths)
         for j in range(lanes):
@@ -651,6 +715,9 @@ def _run_chunk(
             else:
                 dwl[j] = sqdt * standard_normal(rng, j, ki, wi, fi)
             noise_l[j] = amp * dwl[j]
+        if forced:
+            _forcing_first_half(ys, kick, keep, n, dt, start_path, lanes, dims, drive,
+                                f_omega, f_gain, f_phase, f_kicks)  # fmt: skip
         # the step; Heun's two stages through one call of each rate function, inlined once
         for s in range(n_stages):
             _linear_rates(ys, rs, s, dims, stiffness, damping, drive, fa, fc, tmp)
@@ -660,13 +727,19 @@ def _run_chunk(
             _bridges_rates(ys, rs, stage, s, dims, coords, push, bridges, tmp)
             if s == 0:
                 if n >= n_burn:  # the window's sums, at the step's start
+                    if forced:
+                        _forcing_swap(ys, keep, dims)
                     _accumulate(ys, fs, dwl, dims, coords, cols, stroke_coords, limits,
                                 ito_weights, acc, was)  # fmt: skip
+                    if forced:
+                        _forcing_swap(ys, keep, dims)
                 if n_stages == 2:
                     _advance(ys, rs, gain, noise_l, dt, scheme, dims, True)
                     _bridges_predictor(ys, rs, dt, dims, bridges)
         _bridges_update(ys, rs, stage, dt, scheme, dims, bridges, acc, cols[7], n >= n_burn)
         _advance(ys, rs, gain, noise_l, dt, scheme, dims, False)
+        if forced:
+            _forcing_second_half(ys, kick, dims, drive)
         if records.shape[0] > 0 and (n + 1) % every == 0:
             _record(records, y, start_path, lanes, (n + 1) // every)
         if (n + 1) % CHECK_EVERY == 0 or n == n_steps - 1:
@@ -691,7 +764,7 @@ def _run_chunk(
 @numba.njit(cache=True, parallel=True, nogil=True)
 def run_assembly_ensemble(
     scheme, layout, linear, parts, cb0, cb1, cb2, cb3, columns, timing, paths, start, recording,
-    noise, stop,
+    noise, stop, forcing,
 ):  # fmt: skip
     """Integrate ``paths.count`` paths of the assembly; per-path time averages (:class:`Columns`).
 
@@ -713,6 +786,12 @@ def run_assembly_ensemble(
     recording : Recording
     stop : int64[1]
         Set non-zero from another thread (Ctrl-C) to stop at the next check.
+    forcing : kernel.Forcing
+        Tones and shocks added to the input, the single mass's group
+        (:class:`randvib.montecarlo.kernel.Forcing`, built by
+        :meth:`randvib.montecarlo.forcing.ForcingInput.group`; its phases and
+        kicks per path of this batch); :data:`~randvib.montecarlo.kernel.NO_FORCING`
+        without (one compiled signature).
 
     Returns
     -------
@@ -732,7 +811,7 @@ def run_assembly_ensemble(
         # compiled gufunc, and each compiled (and cached) _run_chunk once more
         _run_chunk(
             np.int64(chunk), out, failed, records, scheme, dims, linear, parts, cb0, cb1, cb2, cb3, columns,
-            timing, paths, start, recording.every, noise, stop,
+            timing, paths, start, recording.every, noise, stop, forcing,
         )  # fmt: skip
     return out, failed, records
 
