@@ -86,6 +86,11 @@ def _numpydoc_with_one_template():
     template does not change during a build, so the compiled one is kept and handed
     to numpydoc's own parser; the rendered text is the same. Left as numpydoc has it
     where its internals differ from those this relies on.
+
+    Called from :func:`setup`, not when this file is read: numpydoc's own
+    ``setup`` puts back the ``get_doc_object`` it imported (its default
+    argument), and Sphinx runs the extensions' ``setup`` after reading this
+    file but before this file's ``setup``.
     """
     try:
         import numpydoc.numpydoc as extension
@@ -119,8 +124,6 @@ def _numpydoc_with_one_template():
 
     extension.get_doc_object = get_doc_object
 
-
-_numpydoc_with_one_template()
 
 intersphinx_mapping = {}
 
@@ -188,4 +191,5 @@ def _escape_docstring(app, what, name, obj, options, lines):
 
 
 def setup(app):
+    _numpydoc_with_one_template()
     app.connect("autodoc-process-docstring", _escape_docstring)

@@ -101,8 +101,13 @@ def numpy_drift(spec, x, v, theta, s):
     return v, acceleration, theta_rate, s_rate, currents
 
 
-def numpy_paths(spec, dw, dt, psd, x0, v0, scheme):
-    """Every path's states at every step, and each bridge's stored energy / time (V_b E|i|)."""
+def numpy_paths(spec, dw, dt, psd, x0, v0, scheme, forcing=None):
+    """Every path's states at every step, and each bridge's stored energy / time (V_b E|i|).
+
+    ``forcing``: (paths, steps) velocity increments u_n = -int a dt of tones or shocks
+    over each step, given to every velocity through r half before and half after the
+    scheme's step (docs/conventions.md, "Tones"); the states are those before the first half.
+    """
     paths, steps = dw.shape
     r = spec["r"]
     x, v = np.tile(x0, (paths, 1)), np.tile(v0, (paths, 1))
@@ -114,6 +119,8 @@ def numpy_paths(spec, dw, dt, psd, x0, v0, scheme):
         if step == steps:
             break
         noise = np.sqrt(psd / 2.0) * dw[:, step][:, None] * r[None, :]
+        half = 0.0 if forcing is None else 0.5 * forcing[:, step][:, None] * r[None, :]
+        v = v + half
         k1 = numpy_drift(spec, x, v, theta, s)
         if scheme == "euler-maruyama":
             weights, stages = (1.0,), (k1,)
@@ -125,7 +132,7 @@ def numpy_paths(spec, dw, dt, psd, x0, v0, scheme):
         def mean(q, weights=weights, stages=stages):
             return sum(w * st[q] for w, st in zip(weights, stages, strict=True))
 
-        x, v = x + mean(0) * dt, v + mean(1) * dt + noise
+        x, v = x + mean(0) * dt, v + mean(1) * dt + noise + half
         theta, s = theta + mean(2) * dt, s + mean(3) * dt
         bridges = [t for t, tr in enumerate(spec["transducers"]) if tr["kind"] == "bridge"]
         for slot, t in enumerate(bridges):
@@ -523,7 +530,10 @@ def test_cli_simulate_device_json(capsys, tmp_path):
         ({"initial": ([0.0], [0.0])}, "`initial` must be"),
         ({"dW": np.zeros((2, 3))}, "`dW` must have shape"),
         ({"control_variates": True, "psd": BandLimited(1.0, 4.0, 20.0)}, "`control_variates`"),
-        ({"psd": rv.BandPass(1.0, 8.0, 0.1) + rv.Tone(25.0, 0.5)}, "tones, shocks"),
+        (
+            {"psd": rv.BandPass(1.0, 8.0, 0.1) + rv.Tone(25.0, 0.5), "control_variates": True},
+            "`control_variates` needs Gaussian noise alone",
+        ),
     ],
 )
 def test_assembly_refusals_name_the_argument(kwargs, fragment):

@@ -157,22 +157,25 @@ def test_analytic_methods_answer_with_the_spectrum_and_warn_naming_the_kurtosis(
     assert "assumes Gaussian input; the translated input needs method='linearisation'" in refusal
 
 
-def test_assemblies_take_shocks_and_translations_when_linear_and_refuse_tones():
-    """A linear assembly's second moments are its input's spectrum's (Campbell's for shocks);
-    a one-DOF assembly must equal the single-mass answer. Tones, and non-Gaussian input on
-    nonlinear elements, are refused by name rather than answered as the continuous part."""
+def test_assemblies_take_tones_shocks_and_translations_when_linear():
+    """A linear assembly's second moments are its input's spectrum's (Campbell's for shocks)
+    plus each tone's line through its frequency response: a one-DOF assembly must equal the
+    single-mass answer. Tones, non-Gaussian input and shocks on nonlinear elements are
+    refused by name, pointing to Monte Carlo, rather than answered as the continuous part."""
     x = rv.Translated(rv.BandPass(1.0, 8.0, 0.1), 6.0)
     shocks = rv.White(0.02) + rv.ShockTrain(20.0, 10.0, 0.01)
+    tones = rv.White(0.02) + rv.Tone(8.0, 1.0) + rv.Tone(30.0, 2.0)
     one_dof = Assembly.from_harvester(DAMPED)
-    for excitation in (x, shocks):
+    for excitation in (x, shocks, tones, shocks + rv.Tone(8.0, 1.0)):
         single = rv.predict(DAMPED, excitation)
-        (transducer,) = rv.predict(one_dof, excitation).transducers
+        result = rv.predict(one_dof, excitation)
+        (transducer,) = result.transducers
         assert transducer.power_electrical == pytest.approx(single.power_electrical, rel=1e-6)
-    with pytest.raises(
-        ValueError, match=r"does not take tones on an assembly yet \(the tones 8 Hz"
-    ):
-        rv.predict(one_dof, rv.White(0.02) + rv.Tone(8.0, 1.0))
+        assert result.velocity_variance[0] == pytest.approx(single.velocity_variance, rel=1e-6)
+        assert result.power_input == pytest.approx(result.power_dissipated, rel=1e-6)
     nonlinear = Assembly.from_harvester(rv.preset("figure9"))
+    with pytest.raises(ValueError, match=r"takes tones on a linear assembly only \(the tones 8 Hz"):
+        rv.predict(nonlinear, rv.White(0.02) + rv.Tone(8.0, 1.0))
     for excitation in (x, shocks):
-        with pytest.raises(ValueError, match="input on a linear assembly only"):
+        with pytest.raises(ValueError, match="input on a linear assembly only.*simulate --device"):
             rv.predict(nonlinear, excitation)

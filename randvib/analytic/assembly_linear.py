@@ -38,6 +38,7 @@ from scipy import linalg
 from randvib._validation import check_choice
 from randvib.analytic.linear_response import VARIANCE_METHODS, frequency_rule
 from randvib.models.assembly import Assembly
+from randvib.models.combined import Combined, parts_of
 from randvib.models.excitation import Excitation
 from randvib.models.state_space import StateSpace
 
@@ -180,20 +181,43 @@ def linear_response(
     extra_stiffness = np.zeros((n, n)) if extra_stiffness is None else np.asarray(extra_stiffness)
     block = assembly_block(assembly, extra_damping, extra_stiffness)
     require_stable(block.a)
-    shaping = excitation.shaping_filter()
-    if method == "lyapunov" and shaping is None:
-        raise ValueError(
-            f"`method`='lyapunov' needs a rational spectrum (a shaping filter); the "
-            f"{excitation.name} spectrum has none: use 'spectral'"
-        )
-    if shaping is not None and method != "spectral":
-        covariance, cross = _lyapunov(block, shaping)
-        used = "lyapunov"
-    else:
-        covariance, cross = _spectral(block, excitation)
-        used = "spectral"
-    power = _injected_power(assembly, excitation, cross)
+    continuous, tones = _continuous_and_tones(excitation)
+    covariance, power, used = np.zeros_like(block.a), 0.0, "spectral"
+    if continuous is not None:
+        shaping = continuous.shaping_filter()
+        if method == "lyapunov" and shaping is None:
+            raise ValueError(
+                f"`method`='lyapunov' needs a rational spectrum (a shaping filter); the "
+                f"{continuous.name} spectrum has none: use 'spectral'"
+            )
+        if shaping is not None and method != "spectral":
+            covariance, cross = _lyapunov(block, shaping)
+            used = "lyapunov"
+        else:
+            covariance, cross = _spectral(block, continuous)
+        power = _injected_power(assembly, continuous, cross)
+    for tone in tones:  # superposition: each line through the frequency response
+        h = block.frequency_response(np.array([tone.frequency]))[:, 0]
+        covariance = covariance + tone.mean_square * np.real(np.outer(h, h.conj()))
+        if power is not None:  # -(M r)^T E[a x'], E[a X] = (A^2 / 2) Re(h)
+            n = assembly.n_dof
+            mr = assembly.mass @ assembly.influence
+            power += float(-mr @ (tone.mean_square * np.real(h[n : 2 * n])))
     return AssemblyResponse(assembly, covariance, extra_damping, extra_stiffness, power, used)
+
+
+def _continuous_and_tones(excitation: Excitation) -> tuple:
+    """(the input's part with a spectral density or None, its tones).
+
+    Tones are lines, which neither the Lyapunov equation nor the spectral
+    integral takes: the caller adds each one's response (independent inputs).
+    """
+    random, tones, shocks = parts_of(excitation)
+    if not tones:
+        return excitation, ()
+    if shocks is None:
+        return random, tones
+    return Combined(random, (), shocks), tones
 
 
 def _lyapunov(block: StateSpace, shaping):

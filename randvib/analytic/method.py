@@ -404,27 +404,30 @@ def _assembly_input_reason(assembly: Assembly, psd, who: str) -> str | None:
     """Why tones, shocks or a non-Gaussian input are beyond the assembly solver, or None.
 
     A linear assembly's second moments are its input's spectrum's, whatever
-    the marginal (a translation process) and for a shock train (Campbell's
-    spectrum, part of :meth:`Excitation.psd`): those are exact. Tones are
-    lines, which the spectral solution of an assembly does not take yet, and a
-    nonlinear element under non-Gaussian input or shocks has no measured
-    limit (Monte Carlo of assemblies has not landed either): both refused.
+    the marginal (a translation process), for a shock train (Campbell's
+    spectrum, part of :meth:`Excitation.psd`) and for tones (each line through
+    the frequency response, :func:`randvib.analytic.assembly_linear.linear_response`):
+    those are exact. A nonlinear element under tones, non-Gaussian input or
+    shocks has no combined closure for assemblies and no measured limit:
+    refused, pointing to Monte Carlo (``simulate --device``), which takes them.
     """
     if not isinstance(psd, Excitation):
         return None
     random, tones, shocks = parts_of(psd)
+    gaussian = not tones and shocks is None and (random is None or random.is_gaussian)
+    if gaussian or assembly.is_linear:
+        return None
     if tones:
         listed = ", ".join(f"{tone.frequency:g} Hz" for tone in tones)
         return (
-            f"{who} does not take tones on an assembly yet (the tones {listed}); they are "
-            "treated on the single-mass harvester"
+            f"{who} takes tones on a linear assembly only (the tones {listed}; superposition); "
+            "with nonlinear elements use Monte Carlo (`randvib simulate --device`, "
+            "randvib.simulate)"
         )
-    gaussian = shocks is None and (random is None or random.is_gaussian)
-    if gaussian or assembly.is_linear:
-        return None
     return (
         f"{who} treats the {psd.name} input on a linear assembly only (its spectrum decides "
-        "the second moments); with nonlinear elements it is treated on the single-mass harvester"
+        "the second moments); with nonlinear elements use Monte Carlo (`randvib simulate "
+        "--device`, randvib.simulate)"
     )
 
 

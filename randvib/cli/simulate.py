@@ -19,6 +19,8 @@ interval.
 coordinate's variances, as {mean, ci95}), ``displacement_variance`` and
 ``velocity_variance`` (lists per DOF, {mean, ci95}), ``elements``,
 ``power_dissipated`` and, under white noise, ``power_input`` (r^T M r S / 4).
+Tones (``--tone``), shocks (``--shock-*``) and translated input
+(``--kurtosis``, ``--marginal``) reach the assembly as they reach the single mass.
 """
 
 from __future__ import annotations
@@ -276,6 +278,7 @@ def _run_assembly(args, assembly) -> int:
         raise ValueError("`--envelope` (an event) is not implemented for `--device` assemblies")
     psd = excitation_from_args(args)
     burn_in = 2.0 if args.burn_in is None else args.burn_in
+    _refuse_what_the_input_cannot_take(args, psd, isinstance(psd, float | int))
     if args.record is not None:
         result = _on_record(assembly, psd, args, burn_in)
     else:

@@ -39,13 +39,22 @@ bit for bit those of scalar code).
 (:class:`randvib.montecarlo.integrators.Integrator` weights (b1, b2)):
 ``y_p = y + R(y) dt + G dW``, ``y_{n+1} = y + (b1 R(y) + b2 R(y_p)) dt + G dW``
 with the noise gain G: ``r`` on the velocities under white or given input, the
-filter's input gain on its states under a rational spectrum.
+filter's input gain on its states under a rational spectrum. Tones and shock
+trains (the single mass's :class:`~randvib.montecarlo.kernel.Forcing`) add
+their exact step integral ``u_n`` of -a(t) to the velocities as ``r u_n / 2``
+before the step and again after it (:func:`_forcing_first_half`).
 
 **Per-path accumulators** (:class:`Columns`): time averages over the window
 of x x^T and v v^T (upper triangles), of each element's friction power
 u' F and |u'|, of each circuit state's square, each bridge's stored power,
 coil and diode losses and output voltage, the Ito sum (M r)^T v dW / T, the
-energy H at the window's ends, and the fraction of steps beyond each stroke.
+energy H at the window's ends, and for each stroke the fraction of steps beyond
+it, the peak |u| and the number of up-crossings of |u| through it.
+
+**A given start per path** (``noise.start``, shape (paths, rows), as the
+single-mass kernel's :class:`~randvib.montecarlo.kernel.Noise`) replaces the
+drawn one: the rare-event estimators express the stationary start through
+standard normals (:mod:`randvib.montecarlo.assembly_paths`).
 """
 
 from __future__ import annotations
@@ -153,7 +162,11 @@ class Columns(NamedTuple):
     ito: int  #: (M r)^T v dW summed over the window / T
     h0: int  #: energy at the window's start (J)
     h1: int  #: energy at the end (J)
-    stroke: int  #: first of S fractions of the window's steps beyond a stroke
+    #: first of S fractions of the window's steps beyond a stroke, then S peaks of |u| over
+    #: the window's states, its end included (m), then S counts of the window's steps on
+    #: which |u| rises through its stroke (the rare-event estimators',
+    #: :mod:`randvib.montecarlo.assembly_paths`)
+    stroke: int
     n: int  #: columns in all
     mass: np.ndarray  #: float64[N, N]: M, for the kinetic energy
     stiffness: np.ndarray  #: float64[N, N]: K_lin, for the potential energy
@@ -594,12 +607,72 @@ def _increments(dwl, noise_l, rng, lanes, given, dw, start_path, n, sqdt, amp, k
         noise_l[j] = amp * dwl[j]
 
 
+# ---------------------------------------------------------------- forcing
+# Tones and shocks (kernel.Forcing) reach an assembly as they reach the single
+# mass (kernel.run_ensemble): the exact step integral u_n of -a(t), here on every
+# velocity through r (M x'' = ... - M r a), half before the scheme's step and half
+# after it (Strang splitting); the window's sums see the velocities before the
+# first half, as the single mass's do (they are swapped in and out around them).
+@_step
+def _forcing_first_half(
+    ys, kick, keep, n, dt, start_path, lanes, dims, drive, omega, gain, phase, kicks
+):
+    """Half of step n's forcing, r u_n / 2, onto each DOF's velocity; the velocities before into ``keep``.
+
+    ``kick`` gets u_n per lane (:class:`~randvib.montecarlo.kernel.Forcing`), for the second half.
+
+    ``omega``, ``gain``, ``phase``, ``kicks``: the fields of kernel.Forcing, one
+    by one (a tuple of arrays unpacked in the time loop costs reference counts).
+    """
+    n_dof, ov = dims[0], dims[1]
+    # kernel._forced_increment's arithmetic, in its order (a one-DOF assembly follows the
+    # single mass bit for bit), one tone at a time over the lanes
+    for j in range(LANES):
+        kick[j] = 0.0
+    if kicks.shape[0] > 0:
+        for j in range(lanes):
+            kick[j] = kicks[start_path + j, n]
+    t = (n + 0.5) * dt
+    for q in range(omega.shape[0]):
+        w, g = omega[q], gain[q]
+        for j in range(lanes):
+            kick[j] -= g * np.cos(w * t + phase[start_path + j, q])
+    for a in range(n_dof):
+        r = 0.5 * drive[0, a]
+        for j in range(LANES):
+            keep[a, j] = ys[0, ov + a, j]
+            ys[0, ov + a, j] += r * kick[j]
+
+
+@_step
+def _forcing_swap(ys, keep, dims):
+    """Exchange the velocities with ``keep`` (before and after the window's sums)."""
+    n_dof, ov = dims[0], dims[1]
+    for a in range(n_dof):
+        for j in range(LANES):
+            v = ys[0, ov + a, j]
+            ys[0, ov + a, j] = keep[a, j]
+            keep[a, j] = v
+
+
+@_step
+def _forcing_second_half(ys, kick, dims, drive):
+    """The step's other half r u_n / 2 onto each DOF's velocity, after the scheme's update."""
+    n_dof, ov = dims[0], dims[1]
+    for a in range(n_dof):
+        r = 0.5 * drive[0, a]
+        for j in range(LANES):
+            ys[0, ov + a, j] += r * kick[j]
+
+
 # ------------------------------------------------------------ accumulators
 @_step
-def _accumulate(ys, fs, dw, dims, coords, cols, stroke_coords, limits, ito_weights, acc, tmp):
+def _accumulate(ys, fs, dw, dims, coords, cols, stroke_coords, limits, ito_weights, acc, was, tmp):
     """Add the state at the step's start to the window's sums (:class:`Columns`).
 
     ``cols`` is (xx, vv, friction, abs_du, circuit, ito, stroke, bridge);
+    ``was`` (S, LANES) holds 1 where |u| was beyond its stroke at the state
+    before (-1 at the window's first state: no crossing counted into it);
     ``tmp`` is scratch for (M r)^T v, summed over the DOFs in their order.
     """
     n, ov, oc, n_elements, n_circuits = dims[0], dims[1], dims[3], dims[7], dims[8]
@@ -622,11 +695,12 @@ def _accumulate(ys, fs, dw, dims, coords, cols, stroke_coords, limits, ito_weigh
     for c in range(n_circuits):
         for j in range(nl):
             acc[ci + c, j] += ys[0, oc + c, j] * ys[0, oc + c, j]
-    for q in range(limits.size):
+    n_strokes = limits.size
+    for q in range(n_strokes):
         i = stroke_coords[q, 0]
         k = stroke_coords[q, 1]
         for j in range(nl):
-            acc[st + q, j] += 1.0 if abs(ys[0, i, j] - ys[0, k, j]) > limits[q] else 0.0
+            _stroke_state(acc, was, q, j, abs(ys[0, i, j] - ys[0, k, j]), limits[q], st, n_strokes)
     for j in range(nl):
         tmp[j] = 0.0
     for a in range(n):
@@ -663,6 +737,18 @@ def _energy(y, j, dims, mass, stiffness, coords, springs, circuits, bridges):
     return h
 
 
+@numba.njit(cache=True, inline="always")
+def _stroke_state(acc, was, q, j, u, limit, st, n_strokes):
+    """Stroke q's sums in lane j at a state with |u| = ``u``: beyond, peak, up-crossing."""
+    beyond = 1.0 if u > limit else 0.0
+    acc[st + q, j] += beyond
+    if u > acc[st + n_strokes + q, j]:
+        acc[st + n_strokes + q, j] = u
+    if beyond > 0.0 and was[q, j] == 0.0:
+        acc[st + 2 * n_strokes + q, j] += 1.0
+    was[q, j] = beyond
+
+
 # ---------------------------------------------------------------- the loop
 @numba.njit(cache=True)
 def _start_lanes(y, rng, first, lanes, seed, start, ki, wi, fi):
@@ -694,7 +780,7 @@ def _finite(y, j):
 @numba.njit(cache=True)
 def _run_chunk(
     chunk, out, failed, records, scheme, dims, linear, parts, cb0, cb1, cb2, cb3, columns, timing,
-    paths, start, every, noise, stop,
+    paths, start, every, noise, stop, forcing,
 ):  # fmt: skip
     """Paths ``chunk * LANES ..`` of :func:`run_assembly_ensemble`, from start to finish.
 
@@ -704,7 +790,7 @@ def _run_chunk(
     """
     dt, n_steps, n_burn = timing
     seed, first_path, n_paths = paths
-    dw, ki, wi, fi = noise.dw, noise.ki, noise.wi, noise.fi  # no per-path start (rare events')
+    dw, ki, wi, fi, starts = noise.dw, noise.ki, noise.wi, noise.fi, noise.start
     rows, n_elements, n_bridges = dims[6], dims[7], dims[9]
     start_path = chunk * LANES
     lanes = min(LANES, n_paths - start_path)
@@ -731,13 +817,24 @@ def _run_chunk(
     p = np.zeros(fp.shape[1])
     sqdt, given = np.sqrt(dt), dw.shape[0] > 0
     n_stages = 1 if scheme[1] == 0.0 else 2
+    f_omega, f_gain, f_phase, f_kicks = forcing
+    forced = f_omega.shape[0] > 0 or f_kicks.shape[0] > 0  # False: NO_FORCING
+    kick, keep = np.zeros(LANES), np.zeros((dims[0], LANES))
     _start_lanes(y, rng, first_path + start_path, lanes, seed, start, ki, wi, fi)
+    if starts.shape[0] > 0:  # each path's own start (rare events': assembly_paths)
+        for j in range(lanes):
+            for row in range(rows):
+                y[row, j] = starts[start_path + j, row]
+    was = np.full((limits.size, LANES), -1.0)  # no up-crossing into the window's first state
     _record(records, y, start_path, lanes, np.int64(0))  # not a literal: one signature
     for n in range(n_steps):
         if n == n_burn:
             for j in range(lanes):
                 acc[h0, j] = _energy(y, j, dims, mass, kmat, coords, springs, circuits, bridges)
         _increments(dwl, noise_l, rng, lanes, given, dw, start_path, n, sqdt, amp, ki, wi, fi)
+        if forced:
+            _forcing_first_half(ys, kick, keep, n, dt, start_path, lanes, dims, drive,
+                                f_omega, f_gain, f_phase, f_kicks)  # fmt: skip
         # the step; Heun's two stages through one call of each rate function, inlined once
         for s in range(n_stages):
             _linear_rates(ys, rs, s, sd, k_start, k_columns, k_values, drive, fa, fc, tmp)
@@ -747,13 +844,19 @@ def _run_chunk(
             _bridges_rates(ys, rs, stage, s, sd, coords, push, bridges, tmp)
             if s == 0:
                 if n >= n_burn:  # the window's sums, at the step's start
+                    if forced:
+                        _forcing_swap(ys, keep, dims)
                     _accumulate(ys, fs, dwl, sd, coords, cols, stroke_coords, limits,
-                                ito_weights, acc, tmp)  # fmt: skip
+                                ito_weights, acc, was, tmp)  # fmt: skip
+                    if forced:
+                        _forcing_swap(ys, keep, dims)
                 if n_stages == 2:
                     _advance(ys, rs, gain, noise_l, dt, scheme, sd, advanced, True)
                     _bridges_predictor(ys, rs, dt, sd, bridges)
         _bridges_update(ys, rs, stage, dt, scheme, sd, bridges, acc, cols[7], n >= n_burn)
         _advance(ys, rs, gain, noise_l, dt, scheme, sd, advanced, False)
+        if forced:
+            _forcing_second_half(ys, kick, dims, drive)
         if records.shape[0] > 0 and (n + 1) % every == 0:
             _record(records, y, start_path, lanes, (n + 1) // every)
         if (n + 1) % CHECK_EVERY == 0 or n == n_steps - 1:
@@ -766,13 +869,19 @@ def _run_chunk(
                 break
     for j in range(lanes):
         acc[h1, j] = _energy(y, j, dims, mass, kmat, coords, springs, circuits, bridges)
+        for q in range(limits.size):  # the final state: its peak and a last up-crossing
+            if n_steps > n_burn:
+                u = abs(y[stroke_coords[q, 0], j] - y[stroke_coords[q, 1], j])
+                beyond_sum = acc[columns.stroke + q, j]  # the final state is not a step's start
+                _stroke_state(acc, was, q, j, u, limits[q], columns.stroke, limits.size)
+                acc[columns.stroke + q, j] = beyond_sum
         _write(out, acc, start_path + j, j, columns, n_steps - n_burn, (n_steps - n_burn) * dt)
 
 
 @numba.njit(cache=True, parallel=True, nogil=True)
 def run_assembly_ensemble(
     scheme, layout, linear, parts, cb0, cb1, cb2, cb3, columns, timing, paths, start, recording,
-    noise, stop,
+    noise, stop, forcing,
 ):  # fmt: skip
     """Integrate ``paths.count`` paths of the assembly; per-path time averages (:class:`Columns`).
 
@@ -794,6 +903,12 @@ def run_assembly_ensemble(
     recording : Recording
     stop : int64[1]
         Set non-zero from another thread (Ctrl-C) to stop at the next check.
+    forcing : kernel.Forcing
+        Tones and shocks added to the input, the single mass's group
+        (:class:`randvib.montecarlo.kernel.Forcing`, built by
+        :meth:`randvib.montecarlo.forcing.ForcingInput.group`; its phases and
+        kicks per path of this batch); :data:`~randvib.montecarlo.kernel.NO_FORCING`
+        without (one compiled signature).
 
     Returns
     -------
@@ -813,7 +928,7 @@ def run_assembly_ensemble(
         # compiled gufunc, and each compiled (and cached) _run_chunk once more
         _run_chunk(
             np.int64(chunk), out, failed, records, scheme, dims, linear, parts, cb0, cb1, cb2, cb3, columns,
-            timing, paths, start, recording.every, noise, stop,
+            timing, paths, start, recording.every, noise, stop, forcing,
         )  # fmt: skip
     return out, failed, records
 
@@ -832,8 +947,9 @@ def _record(records, y, start_path, lanes, point):
 def _write(out, acc, p, j, columns, window_steps, window):
     """Path p's averages: sums over the window's steps or, for energies (J), over its time."""
     b = columns.bridge
+    extremes = columns.stroke + columns.stroke_limits.size  # peaks and counts, not averages
     for q in range(columns.n):
-        if q == columns.h0 or q == columns.h1:
+        if q == columns.h0 or q == columns.h1 or q >= extremes:
             out[p, q] = acc[q, j]
         elif q == columns.ito or (b <= q < columns.ito and (q - b) % N_BRIDGE_ACC != BRIDGE_V_OUT):
             out[p, q] = acc[q, j] / window

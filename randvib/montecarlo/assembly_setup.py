@@ -113,8 +113,13 @@ def _friction_tables(assembly: Assembly):
     return kinds, slots, p, tuple(callbacks)
 
 
-def linear_tables(assembly: Assembly, excitation, layout: ak.Layout, driven: bool) -> ak.Linear:
-    """``M^-1 K_lin``, ``M^-1 C_lin``, the rows' noise gains and the shaping filter (:class:`Linear`)."""
+def linear_tables(
+    assembly: Assembly, excitation, layout: ak.Layout, driven: bool, silent: bool = False
+) -> ak.Linear:
+    """``M^-1 K_lin``, ``M^-1 C_lin``, the rows' noise gains and the shaping filter (:class:`Linear`).
+
+    ``silent``: no random part (tones or shocks alone): the noise's amplitude is 0.
+    """
     n = assembly.n_dof
     m, c, k = assembly.linear_matrices()
     m_inv = linalg.inv(m)
@@ -129,7 +134,7 @@ def linear_tables(assembly: Assembly, excitation, layout: ak.Layout, driven: boo
         gain[of : of + nf] = system.b
     else:  # white noise, or the given increments, drives the velocities through r
         gain[ov : ov + n] = assembly.influence
-    amplitude = 1.0 if driven else np.sqrt(excitation.level / 2.0)
+    amplitude = 0.0 if silent else 1.0 if driven else np.sqrt(excitation.level / 2.0)
     return kernel.pack(
         ak.Linear,
         m_inv @ k,
@@ -159,7 +164,7 @@ def column_layout(assembly: Assembly, layout: ak.Layout) -> ak.Columns:
     m, _, k = assembly.linear_matrices()
     return ak.Columns(
         0, tri, friction, abs_du, circuit, bridge, ito, ito + 1, ito + 2, ito + 3,
-        ito + 3 + len(strokes), m, k, np.ascontiguousarray(m @ assembly.influence),
+        ito + 3 + 3 * len(strokes), m, k, np.ascontiguousarray(m @ assembly.influence),
         coordinates, limits,
     )  # fmt: skip
 
@@ -193,8 +198,23 @@ def start_state(run, layout: ak.Layout, system) -> ak.Start:
     for slot, index in enumerate(PartOrder.of(assembly).circuits):
         rows.append(oc + slot)
         keep.append(nf + 2 * n + surrogate_circuits.index(index))
-    chol = _cholesky(system.start_covariance[np.ix_(keep, keep)])
+    chol = _cholesky(_start_covariance(run, system)[np.ix_(keep, keep)])
     return ak.Start(state, np.array(rows, dtype=np.int64), chol)
+
+
+def _start_covariance(run, system) -> np.ndarray:
+    """The random start's covariance: the random part's, plus the tones' and shocks' own.
+
+    As for the single mass (:func:`randvib.montecarlo.forcing.forcing_spread`):
+    the forcing's response on the linearised assembly adds to the random
+    part's (independent inputs); tones or shocks alone (``psd`` 0) leave the
+    nominal white level the step check sees out of the start.
+    """
+    cov = system.start_covariance
+    if run.forcing is None:
+        return cov
+    forced = system.forced_covariance(run.forcing.tones, run.forcing.shocks)
+    return forced if run.psd == 0.0 else cov + forced
 
 
 def _cholesky(cov: np.ndarray) -> np.ndarray:
@@ -235,7 +255,7 @@ class AssemblyKernelSetup:
         return cls(
             scheme=run.scheme.kernel_weights,
             layout=layout,
-            linear=linear_tables(assembly, excitation, layout, driven),
+            linear=linear_tables(assembly, excitation, layout, driven, run.psd == 0.0),
             parts=parts,
             callbacks=callbacks,
             columns=column_layout(assembly, layout),
@@ -258,4 +278,7 @@ class AssemblyKernelSetup:
             start=self.start,
             recording=kernel.pack(ak.Recording, n_record, run.record_every),
             noise=batch_noise(run, lo, hi),
+            forcing=kernel.NO_FORCING
+            if run.forcing is None
+            else run.forcing.group(run.first_path + lo, hi - lo),
         )

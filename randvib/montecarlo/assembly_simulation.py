@@ -12,6 +12,12 @@ spectrum synthesised per path (:class:`randvib.montecarlo.driven.SynthesisedInpu
 and a measured record cut into segments
 (:func:`randvib.montecarlo.on_record.monte_carlo_on_record`), both as the
 step integrals of the base acceleration reaching the velocities through r.
+Beyond Gaussian noise, as for the single mass: a translated (non-Gaussian)
+input synthesised per path (:class:`randvib.montecarlo.driven.TranslatedInput`),
+and tones and shock trains added to any of these (or alone) as the kernel's
+forcing (:class:`randvib.montecarlo.forcing.ForcingInput`: the exact step
+integral of -a(t) through r, half before and half after each step; the
+phases and trains from the single mass's streams).
 
 The driver is the single mass's, part for part: arguments checked into an
 :class:`AssemblyRun` (:func:`validated_assembly`), the step checked on the
@@ -45,11 +51,14 @@ from randvib.montecarlo.assembly_results import AssemblyHistories, AssemblySimul
 from randvib.montecarlo.assembly_setup import AssemblyKernelSetup
 from randvib.montecarlo.assembly_step_check import AssemblyTestSystem
 from randvib.montecarlo.batches import SimulationDivergedError, batch_bounds
+from randvib.montecarlo.forcing import ForcingInput, nyquist_refusal
 from randvib.montecarlo.integrators import Integrator, integrator
 from randvib.montecarlo.options import TimeGrid, numba_threads
 from randvib.montecarlo.validation import (
     MAX_PATH_INDEX,
     BridgeStartWarning,
+    _driver,
+    _nominal_white,
     _simulated_excitation,
     checked_increments,
 )
@@ -74,8 +83,14 @@ class AssemblyRun:
     record_paths: int
     record_every: int
     dW: np.ndarray | None
-    #: Velocity increments of a given base acceleration, ``driver(first, count)``.
+    #: Velocity increments of a given base acceleration, ``driver(first, count)``:
+    #: a synthesised Gaussian or translated (non-Gaussian) input, or a record.
     driver: object = None
+    #: Tones and shocks added to the input (:class:`~randvib.montecarlo.forcing.ForcingInput`), or None.
+    forcing: object = None
+    #: The whole input as given; ``excitation`` is its random part, or with none (tones
+    #: or shocks alone) the nominal white level the step check and the start see.
+    input: Excitation | None = None
 
 
 def simulate_assembly(
@@ -146,31 +161,29 @@ def validated_assembly(
     if not isinstance(assembly, Assembly):
         raise ValueError(f"`assembly` must be a randvib.Assembly, got {type(assembly).__name__}")
     scheme = integrator(scheme)
-    random, tones, shocks = parts_of(as_input(psd))
-    if tones or shocks is not None or random is None or not random.is_gaussian:
-        raise ValueError(
-            "an assembly is simulated under stationary Gaussian input (white, a rational "
-            "spectrum, a band-limited or tabulated spectrum, or a record); tones, shocks and "
-            f"translated (non-Gaussian) input are not taken for assemblies yet, got {psd!r}"
-        )
-    excitation = _simulated_excitation(random)
+    whole = as_input(psd)
+    random, tones, shocks = parts_of(whole)
+    # tones or shocks alone: the linear checks and the start see a nominal white level
+    # while the kernel's noise is off (psd 0), as for the single mass
+    excitation = _simulated_excitation(random if random is not None else _nominal_white(whole))
     grid = TimeGrid.from_times(t_end, dt, burn_in)
     n_paths = check_int("n_paths", n_paths, 1)
     seed = check_int("seed", seed, 0, MAX_SEED)
-    driver = None
-    if excitation.shaping_filter() is None:
-        if dW is not None:
-            raise ValueError(
-                f"`dW` drives white noise or a shaping filter; the {excitation.name} input is "
-                "synthesised from the seed (leave dW=None)"
-            )
-        driver = driven.SynthesisedInput(excitation, grid.n_steps, grid.dt, seed)
+    driver = _driver(excitation, grid, seed, dW)
+    forcing = None
+    if tones or shocks is not None:
+        refusal = nyquist_refusal(tones, grid.dt)
+        if refusal:
+            raise ValueError(refusal)
+        forcing = ForcingInput(tones, shocks, grid.n_steps, grid.dt, seed)
     record_paths = check_int("record_paths", record[0], 0)
     record_every = check_int("record_every", record[1], 1)
     return AssemblyRun(
         assembly=assembly,
-        psd=getattr(excitation, "level", None),
+        psd=0.0 if random is None else getattr(excitation, "level", None),
         excitation=excitation,
+        forcing=forcing,
+        input=whole,
         scheme=scheme,
         grid=grid,
         n_paths=n_paths,
@@ -210,6 +223,13 @@ def execute_assembly(
     run: AssemblyRun, *, control_variates, check_step, threads, batch_paths, progress
 ):
     """Run a validated :class:`AssemblyRun`: check, set up, run in batches, wrap."""
+    beyond = run.forcing is not None or not run.excitation.is_gaussian
+    if control_variates and beyond:
+        raise ValueError(
+            "`control_variates` needs Gaussian noise alone; under the "
+            f"{(run.input or run.excitation).name} input no control has a known mean: use "
+            "control_variates=False"
+        )
     if control_variates and run.excitation.shaping_filter() is None:
         raise ValueError(
             "`control_variates` needs Brownian increments (white noise, or band-pass and "
@@ -224,7 +244,10 @@ def execute_assembly(
     _check_memory(run, setup, batch_paths)
     if progress is None:
         progress = progress_wanted()
-    if batch_paths is None and run.driver is not None:
+    # a synthesised input's samples and a shock train's step integrals are arrays of
+    # (paths in the batch) x (steps): batches bound them
+    sampled = run.driver is not None or (run.forcing is not None and run.forcing.shocks is not None)
+    if batch_paths is None and sampled:
         batch_paths = driven.batch_paths(run.grid.n_steps)
     batches = batch_bounds(run.n_paths, batch_paths, run.grid.n_steps, progress, run.record_paths)
     started = time.perf_counter()
@@ -238,7 +261,8 @@ def execute_assembly(
             times, records[:, :, :n].copy(), records[:, :, n + 1 : 2 * n + 1].copy(), records
         )
     return AssemblySimulationResult(
-        assembly=run.assembly, psd=run.psd, excitation=run.excitation, scheme=run.scheme.name,
+        assembly=run.assembly, psd=run.psd,
+        excitation=run.excitation if run.forcing is None else run.input, scheme=run.scheme.name,
         dt=run.grid.dt, t_end=run.grid.t_end, burn_in=run.grid.burn_in, seed=run.seed,
         first_path=run.first_path, per_path=per_path, columns=setup.columns,
         control_variates=control_variates, histories=histories,

@@ -39,10 +39,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import linalg
 
+from randvib.analytic.assembly_linear import _spectral
 from randvib.analytic.assembly_linearisation import linearise_assembly
 from randvib.models.assembly import Assembly
 from randvib.models.assembly_parts import Element, Transducer
 from randvib.models.excitation import Excitation, as_excitation
+from randvib.models.state_space import StateSpace
 from randvib.montecarlo.step_check import (
     MAX_STEP_BIAS,
     WARN_STEP_BIAS,
@@ -153,6 +155,33 @@ class AssemblyTestSystem:
             return self.covariance
         p = linalg.solve_continuous_lyapunov(self.drift, -(self.noise @ self.noise.T))
         return 0.5 * (p + p.T)
+
+    def forced_covariance(self, tones, shocks) -> np.ndarray:
+        """E[X X^T] of tones and a shock train alone on the test system (a random start's part).
+
+        Over the states of :attr:`start_covariance` (the filter's rows 0: the
+        forcing does not pass through it). A tone of amplitude A reaches the
+        velocities as -r A cos(omega t + phi): its response X = Re(h A e^{i(omega t + phi)})
+        with ``h = (i omega - F)^-1 b``, covariance (A^2 / 2) Re(h h^H) over
+        the random phase; the shock train by its Campbell spectrum
+        (:func:`randvib.analytic.assembly_linear._spectral`).
+        """
+        nf, n = self.n_filter, self.assembly.n_dof
+        a = self.drift[nf:, nf:]
+        size = a.shape[0]
+        b = np.zeros(size)
+        b[n : 2 * n] = -self.assembly.influence
+        names = tuple(f"s{i}" for i in range(size))
+        block = StateSpace(a, b, np.eye(size), np.zeros(size), names)
+        part = np.zeros((size, size))
+        for tone in tones:
+            h = block.frequency_response(np.array([tone.frequency]))[:, 0]
+            part += tone.mean_square * np.real(np.outer(h, h.conj()))
+        if shocks is not None:
+            part += _spectral(block, shocks)[0]
+        out = np.zeros_like(self.drift)
+        out[nf:, nf:] = part
+        return out
 
     def bias(self, scheme: str, dt: float) -> float:
         """Largest relative bias of the scheme's stationary variances at ``dt`` (inf if unstable)."""
