@@ -824,6 +824,79 @@ MUTATIONS: tuple[Mutation, ...] = (
         "equal the crossing anchor's Vanmarcke answer for the chosen device to 1e-6.",
     ),
     Mutation(
+        name="subset-runs-spread-dof",
+        path="randvib/montecarlo/reliability.py",
+        edits=(
+            (
+                "sigma2 = float(sizes @ (values - mean) ** 2) / (values.size - 1)",
+                "sigma2 = float(sizes @ (values - mean) ** 2) / values.size",
+            ),
+        ),
+        tests=("tests/test_reliability.py::test_pooled_runs_mean_and_spread_by_hand",),
+        why="Subset simulation's c.o.v. from independent runs with the biased (1/R) variance: "
+        "with five runs the interval 11 % too narrow; checked against the formula by hand.",
+    ),
+    Mutation(
+        name="assembly-rare-start-covariance",
+        path="randvib/montecarlo/assembly_paths.py",
+        edits=(
+            (
+                "covariance = linalg.solve_discrete_lyapunov(a, self.dt * (b @ b.T))",
+                "covariance = linalg.solve_discrete_lyapunov(a, 1.01 * self.dt * (b @ b.T))",
+            ),
+        ),
+        tests=(
+            "tests/test_reliability_assembly.py::"
+            "test_linear_start_is_the_schemes_own_stationary_law",
+        ),
+        why="A linear assembly's exact start 1 % too spread (not the scheme's stationary law); "
+        "the test solves Heun's discrete Lyapunov equation from M, C, K by hand.",
+    ),
+    Mutation(
+        name="assembly-kernel-upcrossing-every-step",
+        path="randvib/montecarlo/assembly_kernel.py",
+        edits=(("    if beyond > 0.0 and was[q, j] == 0.0:\n", "    if beyond > 0.0:\n"),),
+        tests=(
+            "tests/test_reliability_assembly.py::"
+            "test_paths_match_a_plain_numpy_heun_loop_on_the_same_rows",
+        ),
+        why="The assembly kernel counting every step beyond the stroke as an up-crossing; "
+        "checked path by path against a plain numpy Heun loop on the same rows.",
+    ),
+    Mutation(
+        name="assembly-kernel-linear-circuit-push",
+        path="randvib/montecarlo/assembly_paths.py",
+        edits=(
+            (
+                "f[ov : ov + n, oc + slot] -= parts.push[part] * f_s",
+                "f[ov : ov + n, oc + slot] += parts.push[part] * f_s",
+            ),
+        ),
+        tests=(
+            "tests/test_reliability_assembly.py::"
+            "test_linear_surrogate_is_the_kernel_on_the_same_rows",
+        ),
+        why="The linear system read from the kernel's tables with the coil's force reversed: "
+        "the exact start and importance sampling's design points would be another device's; "
+        "the surrogate must give every row the kernel's own peak.",
+    ),
+    Mutation(
+        name="assembly-rice-rate",
+        path="randvib/analytic/assembly_crossings.py",
+        edits=(
+            (
+                "rate = float(outcrossing_rate(u2, 0.0, v2, stroke))",
+                "rate = float(outcrossing_rate(u2, 0.0, 1.02 * v2, stroke))",
+            ),
+        ),
+        tests=(
+            "tests/test_reliability_assembly.py::"
+            "test_rice_anchor_of_a_one_mass_assembly_is_the_single_mass_one",
+        ),
+        why="An assembly coordinate's exact Rice rate 1 % high; the one-mass assembly must "
+        "give the single-mass Rice anchor to 1e-9.",
+    ),
+    Mutation(
         name="assembly-dashpot-to-ground",
         path="randvib/models/assembly.py",
         edits=(
@@ -1314,6 +1387,60 @@ MUTATIONS: tuple[Mutation, ...] = (
         ),
         why="The velocity columns name the wrong DOFs (reversed); each column's mean square "
         "is compared with its own DOF's exact variance.",
+    ),
+    Mutation(
+        name="bridge-record-one-diode-drop",
+        path="randvib/montecarlo/rectified_kernel.py",
+        edits=(
+            (
+                "over = abs(e) - v_out - 2.0 * v_d",
+                "over = abs(e) - v_out - v_d",
+            ),
+        ),
+        tests=(
+            "tests/test_record_bridge.py::"
+            "test_bridge_record_matches_an_independent_rk4_within_its_step_error",
+        ),
+        why="The coil's bridge counts one diode's drop instead of the two conducting ones; "
+        "the record simulation behind a bridge (which steps this function) is compared "
+        "pathwise with an independent RK4 of the bridge's equations.",
+    ),
+    Mutation(
+        name="bridge-inductive-reverse-current",
+        path="randvib/montecarlo/rectified_kernel.py",
+        edits=(
+            (
+                "        if rkind == 3 and s1n * s1 < 0.0:  # the diodes block the reverse current\n"
+                "            s1n = 0.0",
+                "        if rkind == 3 and s1n * s1 < 0.0:  # the diodes block the reverse current\n"
+                "            s1n = s1n",
+            ),
+        ),
+        tests=(
+            "tests/test_record_bridge.py::"
+            "test_bridge_record_matches_an_independent_rk4_within_its_step_error",
+        ),
+        why="The coil's current with inductance is let through the diodes in reverse at the "
+        "step's end (the predictor still blocks it); the record simulation behind the bridge "
+        "is compared pathwise with an independent RK4 that blocks it.",
+    ),
+    Mutation(
+        name="bridge-record-input-integral",
+        path="randvib/identification/record_bridge.py",
+        edits=(
+            (
+                "hh * (seg[1] - u_off + hh * (0.5 * seg[2] + hh * seg[3] / 3.0))",
+                "hh * (seg[1] - u_off + hh * (seg[2] + hh * seg[3] / 3.0))",
+            ),
+        ),
+        tests=(
+            "tests/test_record_bridge.py::"
+            "test_bridge_record_matches_an_independent_rk4_within_its_step_error",
+        ),
+        why="The recorded input's integral over a sub-step doubles its linear term (an "
+        "O(h^2) error per sub-step): the record simulation behind a bridge falls to first "
+        "order, which the pathwise comparison's measured order (> 3 from 4 to 8 sub-steps) "
+        "rejects.",
     ),
 )
 

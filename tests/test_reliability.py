@@ -44,7 +44,7 @@ from randvib.analytic.crossings import (
 from randvib.analytic.gibbs_marginal import GibbsDisplacement
 from randvib.montecarlo.integrators import scheme_matrices, scheme_stationary_covariance
 from randvib.montecarlo.path_simulator import HarvesterPaths
-from randvib.montecarlo.reliability import estimate_first_passage
+from randvib.montecarlo.reliability import estimate_first_passage, pooled_runs
 from randvib.montecarlo.subset_simulation import chain_mean_variance
 from randvib.statistics import Statistic
 
@@ -319,6 +319,25 @@ def test_chain_variance_counts_the_correlation_along_the_chains():
     mean, var, gamma = chain_mean_variance(independent)
     assert 0.0 <= gamma < 0.5
     assert var == pytest.approx(independent.var() / 500 * (1 + gamma), rel=1e-12)
+
+
+def test_pooled_runs_mean_and_spread_by_hand():
+    """The c.o.v. of independent runs' mean (subset simulation's interval in long windows):
+    equal runs give the sample SD / sqrt(R) / mean; runs of different sizes (variance
+    sigma^2 / size) the size-weighted mean and sigma^2 / sum(size), written out here."""
+    values = np.array([1.0, 3.0, 2.0, 6.0])
+    mean, cov = pooled_runs(values, np.ones(4))
+    assert mean == 3.0
+    assert cov == pytest.approx(np.std(values, ddof=1) / 2.0 / 3.0, rel=1e-12)
+    sizes = np.array([1.0, 2.0, 1.0, 4.0])
+    mean, cov = pooled_runs(values, sizes)
+    m = (1.0 + 6.0 + 2.0 + 24.0) / 8.0
+    s2 = ((1 - m) ** 2 + 2 * (3 - m) ** 2 + (2 - m) ** 2 + 4 * (6 - m) ** 2) / 3.0
+    assert mean == pytest.approx(m, rel=1e-12)
+    assert cov == pytest.approx(math.sqrt(s2 / 8.0) / m, rel=1e-12)
+    assert (
+        math.isnan(pooled_runs([2.0], [1.0])[1]) and pooled_runs([0.0, 0.0], [1, 1])[1] == math.inf
+    )
 
 
 def test_subset_intervals_cover_the_exact_exceedance():

@@ -170,11 +170,36 @@ def add_circuit_arguments(parser: argparse.ArgumentParser, *, identified: bool =
     )
     if identified:
         g.add_argument(
+            "--rectifier",
+            choices=("bridge",),
+            help="the coupling's output goes through a known full-wave diode bridge into "
+            "--storage-capacitance (each record's --r-load across it) or --battery; voltage is "
+            "then the DC output voltage, current the load current (a battery's charging current)",
+        )
+        g.add_argument("--v-diode", type=float, help="forward drop of each diode V_d (V); bridge")
+        g.add_argument("--storage-capacitance", type=float, help="storage capacitor C (F); bridge")
+        g.add_argument("--battery", type=float, help="battery voltage V_b (V); bridge")
+        g.add_argument(
             "--weight",
             action="append",
             metavar="KIND=W",
             help="weight of an output kind's J in the sum (default 1 each)",
         )
+
+
+#: The bridge's options of ``identify`` (:func:`bridge_options`).
+BRIDGE_FLAGS = ("v_diode", "storage_capacitance", "battery")
+
+
+def bridge_options(args) -> dict | None:
+    """``--rectifier bridge`` and its known values as ``identify``'s ``rectifier`` (None: none)."""
+    given = {n: getattr(args, n) for n in BRIDGE_FLAGS if getattr(args, n, None) is not None}
+    if getattr(args, "rectifier", None) is None:
+        if given:
+            flag = "--" + next(iter(given)).replace("_", "-")
+            raise ValueError(f"`{flag}` needs `--rectifier bridge`")
+        return None
+    return given
 
 
 def parse_weights(items) -> dict:

@@ -45,7 +45,8 @@ def _simulate(device, psd, **options):
 
 
 def _record_responses():
-    """The record simulator of identify, validate and record: each law, one device and a batch."""
+    """The record simulators of identify, validate and record: each law, one device and a
+    batch, and a device behind a bridge."""
     import numpy as np
 
     import randvib as rv
@@ -55,6 +56,9 @@ def _record_responses():
         device = _device(friction=friction)
         rv.record_response(device, record)
         rv.record_response(device.updated(k=np.array([50.0, 60.0])), record)
+    # behind a diode bridge: one compiled batch for every law, bridge and output
+    bridge = rv.BridgeCoil(alpha=0.2, r_coil=5.0, v_diode=0.1, storage_capacitance=1e-2, r_load=50)
+    rv.record_response(rv.Harvester.with_coupling(0.02, 0.05, 50.0, bridge), record)
 
 
 def _on_record():

@@ -17,6 +17,7 @@ from randvib.cli._output import print_table
 from randvib.cli._records import (
     add_circuit_arguments,
     add_record_arguments,
+    bridge_options,
     output_kinds,
     output_unit,
     parse_assignments,
@@ -158,13 +159,16 @@ def run(args) -> int:
         polish=not args.no_polish,
         search_samples=args.search_samples,
     )
+    rectifier = bridge_options(args)
     plain = len(records) == 1 and args.coupling is None and kinds == (OUTPUT_CHANNEL,)
+    plain = plain and rectifier is None
     result = identify(
         record if plain else records,
         args.model,
         m=args.m,
         coupling=args.coupling,
         r_load=r_loads(args, len(records)),
+        rectifier=rectifier,
         outputs=None if plain else kinds,
         weights=parse_weights(args.weight) or None,
         fixed=parse_assignments(args.fix, "--fix"),

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -43,6 +44,7 @@ from randvib.identification.cost import initial_velocity
 from randvib.identification.input_reconstruction import driving_signal, reconstruct_input
 from randvib.identification.least_squares import SimulationError
 from randvib.identification.models import check_model
+from randvib.identification.record_bridge import dc_channel, run_bridge
 from randvib.identification.record_integrator import (
     DEVICE_PARAMETERS,
     SEARCH_SUBCYCLES,
@@ -69,12 +71,18 @@ class RecordedTest:
     outputs : tuple of str
         The channels fitted, by kind (:data:`~randvib.identification.circuit.OUTPUT_KINDS`).
     r_load : float or None
-        The known load resistance R_L (ohm) of the record, with a coupling.
+        The known load resistance R_L (ohm) of the record, with a coupling
+        (behind a bridge with a storage capacitor: the capacitor's load).
+    bridge : dict or None
+        The known full-wave bridge between the coupling and its output
+        (:func:`known_bridge`): ``v_diode`` (V) and ``storage_capacitance``
+        (F, with ``r_load``) or ``battery`` (V); None without one.
     """
 
     record: Record
     outputs: tuple
     r_load: float | None = None
+    bridge: dict | None = None
 
 
 def own_name(name: str, index: int, count: int) -> str:
@@ -82,12 +90,13 @@ def own_name(name: str, index: int, count: int) -> str:
     return name if count == 1 else f"{name}[{index}]"
 
 
-def recorded_tests(records, outputs=None, r_load=None, coupling=None) -> tuple:
+def recorded_tests(records, outputs=None, r_load=None, coupling=None, rectifier=None) -> tuple:
     """The :class:`RecordedTest` of each record, checked.
 
     ``outputs``: kinds fitted on every record (default the relative
     displacement); ``r_load``: one load for all records or one per record
-    (ohm), needed with a coupling.
+    (ohm), needed with a coupling; ``rectifier``: the known bridge of every
+    record (:func:`known_bridge`).
     """
     records = (records,) if isinstance(records, Record) else tuple(records)
     if not records or not all(isinstance(r, Record) for r in records):
@@ -113,7 +122,63 @@ def recorded_tests(records, outputs=None, r_load=None, coupling=None) -> tuple:
             f"a `{electrical[0]}` output is the circuit's: name the coupling "
             "(`coupling=`, `--coupling resistive|inductive|piezo`) and the load (`--r-load`)"
         )
-    return tuple(RecordedTest(r, kinds, load) for r, load in zip(records, loads, strict=True))
+    bridge = known_bridge(rectifier, coupling, loads, kinds)
+    return tuple(
+        RecordedTest(r, kinds, load, bridge) for r, load in zip(records, loads, strict=True)
+    )
+
+
+#: The bridge's parameters an identification takes as known (``rectifier=``).
+BRIDGE_KEYS = ("v_diode", "storage_capacitance", "battery")
+
+
+def known_bridge(rectifier, coupling, loads, kinds) -> dict | None:
+    """The checked ``rectifier`` dict: ``v_diode`` (V, default 0) and ``storage_capacitance``
+    (F; each record's R_L its load) or ``battery`` (V); None for none.
+
+    Refused: a coupling other than ``inductive`` or ``piezo``, an unknown key,
+    both outputs or neither, a battery's ``voltage`` channel (constant V_b) and a
+    piezo element's ``current`` into a battery (its charge passes in jumps).
+    """
+    if rectifier is None:
+        return None
+    from randvib.models.rectifier import RECTIFIED
+
+    if not isinstance(rectifier, dict):
+        raise ValueError(
+            f"`rectifier` must be a dict of {', '.join(BRIDGE_KEYS)}; got {rectifier!r}"
+        )
+    if coupling not in RECTIFIED:
+        raise ValueError(
+            f"`rectifier` (--rectifier bridge) rectifies a coil or a piezo element: it needs "
+            f"`coupling` {' or '.join(map(repr, RECTIFIED))}; got {coupling!r}"
+        )
+    unknown = sorted(set(rectifier) - set(BRIDGE_KEYS))
+    if unknown:
+        raise ValueError(f"`rectifier`: unknown {unknown}; allowed: {', '.join(BRIDGE_KEYS)}")
+    out = {"v_diode": 0.0, **{k: float(v) for k, v in rectifier.items()}}
+    if ("battery" in out) == ("storage_capacitance" in out):
+        raise ValueError(
+            "`rectifier` needs exactly one output: `storage_capacitance` (F; each record's "
+            "`r_load` its load) or `battery` (V)"
+        )
+    # the model's own checks of every value, at the first record's load
+    cls = RECTIFIED[coupling]
+    probe = {"alpha": 1.0, "r_coil": 1.0} if coupling == "inductive" else {"theta": 1.0,
+             "capacitance": 1.0}  # fmt: skip
+    load = {} if "battery" in out else {"r_load": loads[0]}
+    cls(**probe, **out, **load)
+    if "battery" in out and "voltage" in kinds:
+        raise ValueError(
+            "a battery holds the bridge's output at V_b: its `voltage` channel is constant and "
+            "fixes nothing; fit the `current` (or use a storage capacitor)"
+        )
+    if "battery" in out and coupling == "piezo" and "current" in kinds:
+        raise ValueError(
+            "a piezo element's bridge charges a battery in the clamp's jumps, no current at a "
+            "sample: fit the `relative_velocity` or use a storage capacitor"
+        )
+    return out
 
 
 def check_weights(weights, tests) -> dict:
@@ -260,10 +325,18 @@ class ExperimentCost:
 
     # ------------------------------------------------------------ simulation
     def run(self, named: dict, index: int, start=None, **options):
-        """The compiled batch of record ``index`` (z, v and the circuit state stored)."""
+        """The compiled batch of record ``index`` (z, v and the circuit state stored).
+
+        Behind a bridge (:attr:`RecordedTest.bridge`) the bridge's record
+        simulation (:func:`~randvib.identification.record_bridge.run_bridge`),
+        whose ``x`` is the DC output voltage and ``x0`` the storage capacitor's
+        voltage at t = 0.
+        """
         prep = self.prepared[index]
         n_pop = max(np.size(v) for v in named.values())
         device = self.device_of(named, index)
+        if prep.test.bridge is not None:
+            return _run_bridged(self, named, prep, device, n_pop, start)
         c_e, circuit = circuit_terms(self.coupling, named, prep.test.r_load)
         device["c"] = device["c"] + c_e
         matrix = parameter_matrix(device, self.friction, circuit)
@@ -279,6 +352,9 @@ class ExperimentCost:
     def outputs(self, named: dict, index: int, run) -> dict:
         """Each fitted channel as the model gives it, without offsets: kind -> (n_pop, n)."""
         test = self.prepared[index].test
+        if test.bridge is not None:
+            battery = "battery" in test.bridge
+            return {k: dc_channel(k, battery, test.r_load, run.states) for k in test.outputs}
         out = {}
         for kind in test.outputs:
             cz, cv, cx = output_coefficients(kind, self.coupling, named, test.r_load)
@@ -379,7 +455,12 @@ class ExperimentCost:
             step = np.where(np.isfinite(step) & (step > 0), step, 1.0)
             moved = list(start)
             moved[j] = start[j] + step
-            if j == 1 and not any(k in ELECTRICAL_OUTPUTS for k in prep.test.outputs):
+            bridged = prep.test.bridge is not None  # x0 is then the capacitor's V_C
+            if (
+                j == 1
+                and not bridged
+                and not any(k in ELECTRICAL_OUTPUTS for k in prep.test.outputs)
+            ):
                 moved[2] = quasi_static_state(self.coupling, named, prep.test.r_load, moved[1])
             other = self.run(named, index, start=tuple(moved), max_subcycles=SEARCH_SUBCYCLES)
             slopes.append({
@@ -493,6 +574,14 @@ def _record_start(cost: ExperimentCost, named: dict, prep: _Prepared):
             z0 = -np.mean(np.cumsum(v, axis=1) * dt, axis=1) + 0.5 * v[:, 0] * dt
     electrical = [kind for kind in test.outputs if kind in ELECTRICAL_OUTPUTS]
     x0 = None
+    if test.bridge is not None:  # the DC side's first sample gives V_C; z0, v0 are profiled
+        z0 = 0.0 if z0 is None else z0
+        v0 = 0.0 if v0 is None else v0
+        x0 = 0.0
+        if electrical and "battery" not in test.bridge:
+            y = np.atleast_2d(less_offset(electrical[0]))[:, 0]
+            x0 = np.maximum(y if electrical[0] == "voltage" else y * test.r_load, 0.0)
+        return z0, v0, x0
     if electrical:
         kind = electrical[0]
         y = np.atleast_2d(less_offset(kind))
@@ -512,6 +601,72 @@ def _record_start(cost: ExperimentCost, named: dict, prep: _Prepared):
     if x0 is None:
         x0 = quasi_static_state(cost.coupling, named, test.r_load, v0)
     return z0, v0, x0
+
+
+class BridgeRun(NamedTuple):
+    """:meth:`ExperimentCost.run` behind a bridge: ``x`` the DC output voltage, and
+    ``states`` every column of :data:`~randvib.identification.record_bridge.BRIDGE_COLUMNS`."""
+
+    sse: np.ndarray
+    z: np.ndarray
+    v: np.ndarray
+    x: np.ndarray
+    states: np.ndarray
+
+
+def bridge_rows(coupling: str, named: dict, test: RecordedTest, n_pop: int):
+    """((transducer, output) codes, the bridge's ``p`` per parameter set (n_pop, 9)).
+
+    The coupling's parameters from ``named`` (alpha, r_coil, inductance or
+    theta, capacitance), the bridge's known ones from ``test.bridge``
+    (:meth:`randvib.models.rectifier.Rectified.kernel_parameters`'s order).
+    """
+    from randvib.models.rectifier import BATTERY, CAPACITOR, COIL, INDUCTIVE_COIL, PIEZO
+
+    known = test.bridge
+    battery = "battery" in known
+
+    def column(value):
+        return np.broadcast_to(np.asarray(value, dtype=float), (n_pop,))
+
+    if coupling == "piezo":
+        gain, second, inductance = named["theta"], named["capacitance"], 0.0
+        code = PIEZO
+    else:
+        gain, second = named["alpha"], named["r_coil"]
+        inductance = column(named.get("inductance", 0.0))
+        code = COIL
+        if np.any(inductance > 0):
+            if not np.all(inductance > 0):
+                raise ValueError(
+                    "behind a bridge the coil's `inductance` must be > 0 for every candidate, "
+                    "or fixed at 0 (`--fix inductance=0`): the two are different circuits"
+                )
+            code = INDUCTIVE_COIL
+    rows = np.column_stack([
+        column(gain), column(second), column(known["v_diode"]),
+        column(known["battery"] if battery else 0.0),
+        column(1.0 if battery else known["storage_capacitance"]),
+        column(1.0 if battery else test.r_load), np.zeros(n_pop), np.zeros(n_pop),
+        column(inductance),
+    ])  # fmt: skip
+    return (code, BATTERY if battery else CAPACITOR), rows
+
+
+def _run_bridged(cost, named, prep, device, n_pop, start) -> BridgeRun:
+    """:meth:`ExperimentCost.run` of a record behind a bridge (no c_e: the bridge's force
+    is the kernel's)."""
+    matrix = parameter_matrix(device, cost.friction)
+    if matrix.shape[0] != n_pop:
+        matrix = np.repeat(matrix, n_pop, axis=0)
+    codes, rows = bridge_rows(cost.coupling, named, prep.test, n_pop)
+    z0, v0, x0 = cost.start(named, prep.index) if start is None else start
+    states = run_bridge(
+        matrix, rows, codes, cost.friction, prep.drive, prep.base_input, prep.test.record.dt,
+        substeps=cost.substeps, hold=cost.hold, fine=prep.fine, z0=z0, v0=v0, v_c0=x0,
+        response_limit=prep.limit,
+    )  # fmt: skip
+    return BridgeRun(np.zeros(n_pop), states[..., 0], states[..., 1], states[..., 3], states)
 
 
 class ExperimentError(SimulationError):

@@ -53,6 +53,7 @@ from randvib.identification.experiment import (
 )
 from randvib.identification.identifiability import (
     Configuration,
+    Identifiability,
     IdentifiabilityError,
     _remedies,
     linear_information,
@@ -237,6 +238,14 @@ def _mass_reference(test: RecordedTest, coupling, bounds) -> float:
     return estimate
 
 
+#: What the structural analysis says behind a bridge (:func:`identify_experiment`).
+BRIDGE_STRUCTURE = (
+    "behind a diode bridge the linear symmetries of the structural analysis do not hold (the "
+    "threshold V_out + 2 V_d sets the transducer's voltage scale); what the records fix is "
+    "judged at the estimate, from the fit's covariance alone"
+)
+
+
 def identify_experiment(
     tests, model, coupling, *, m, fixed, bounds, init, quadratic, weights, search, simulation,
     progress, callback,
@@ -250,7 +259,13 @@ def identify_experiment(
             "excitation the mass is not identifiable (Eq. 1 divided by m leaves c/m, k/m, k3/m, F/m)"
         )
     fixed, notes = measurement_model(model, tests, fixed, bool(quadratic))
-    structure = structural_identifiability(configuration(model, coupling, tests, fixed))
+    bridged = tests[0].bridge is not None
+    if bridged:  # the switching breaks the linear symmetries: the fit's covariance decides
+        structure = Identifiability((), (), (BRIDGE_STRUCTURE,))
+        known = ", ".join(f"{k} = {v:g}" for k, v in tests[0].bridge.items())
+        notes += (f"behind a full-wave diode bridge, known: {known}",)
+    else:
+        structure = structural_identifiability(configuration(model, coupling, tests, fixed))
     if not structure.identifiable:
         raise IdentifiabilityError(structure.refusal())
     simulation, why = simulation.for_record(tests[0].record)
@@ -276,7 +291,7 @@ def identify_experiment(
     polished = _polish(cost, space, found, simulation, search, frozenset(bounds or ()))
     result = _result(cost, space, res, polished, time.perf_counter() - start, search,
                      simulation, structure, notes)  # fmt: skip
-    _check_locally(result, configuration(model, coupling, tests, fixed), cost)
+    _check_locally(result, configuration(model, coupling, tests, fixed), cost, not bridged)
     return result
 
 
@@ -470,18 +485,23 @@ def _spectra(cost: ExperimentCost, result: IdentificationResult) -> list:
     return out
 
 
-def _check_locally(result: IdentificationResult, config: Configuration, cost) -> None:
+def _check_locally(
+    result: IdentificationResult, config: Configuration, cost, linearised: bool = True
+) -> None:
     """Refuse a split the data do not make (after the fit); warn of one poorly determined value.
 
     Two opinions: the fit's own covariance (:func:`local_identifiability`) and
     the linearised device's Fisher information under the records' input
-    spectra and noise (:func:`linear_information`); a split either finds is
-    refused, with each parameter's larger relative standard error.
+    spectra and noise (:func:`linear_information`; not behind a bridge,
+    ``linearised`` False, whose switching no linear device has); a split
+    either finds is refused, with each parameter's larger relative standard error.
     """
     from dataclasses import replace
 
     local = local_identifiability(result.uncertainty, result.parameters)
-    linear = linear_information(config, result.parameters, _spectra(cost, result))
+    linear = {}
+    if linearised:
+        linear = linear_information(config, result.parameters, _spectra(cost, result))
     if linear:
         local["linear_response"] = linear
         local["split"] = local.get("split", []) + [

@@ -128,6 +128,7 @@ def identify(
     m: float | None = None,
     coupling: str | None = None,
     r_load=None,
+    rectifier: dict | None = None,
     outputs=None,
     weights: dict | None = None,
     fixed: dict | None = None,
@@ -185,6 +186,15 @@ def identify(
         Identify the coupling too (:mod:`randvib.identification.circuit`).
     r_load : float or sequence of float, optional
         Each record's known load resistance R_L (ohm), with ``coupling``.
+    rectifier : dict, optional
+        The coupling's output goes through a known full-wave diode bridge
+        (:mod:`randvib.models.rectifier`): ``v_diode`` (V) and
+        ``storage_capacitance`` (F, each record's ``r_load`` across it) or
+        ``battery`` (V); ``voltage`` is then the DC output voltage V_C and
+        ``current`` the load current V_C / R_L (a battery's charging current),
+        simulated by :mod:`randvib.identification.record_bridge`. The
+        structural analysis is linear and is not made; the fit's covariance
+        judges what the records fix.
     outputs : sequence of str, optional
         The channels fitted, by kind: ``relative_displacement`` (default),
         ``relative_velocity``, ``voltage`` (the load voltage), ``current``;
@@ -239,13 +249,18 @@ def identify(
             + (f"; fit its {', '.join(others)} with `outputs=` (`--output-kind`)" if others else "")
         )
     plain = outputs is None or tuple(np.atleast_1d(outputs)) == (OUTPUT_CHANNEL,)
+    if rectifier is not None and coupling is None:
+        raise ValueError(
+            "`rectifier` (--rectifier bridge) rectifies a coupling's output: name it "
+            "(`coupling='inductive'` or `'piezo'`, `--coupling`)"
+        )
     if not (single and plain and coupling is None and r_load is None and not weights):
         from randvib.identification.experiment import recorded_tests
         from randvib.identification.experiment_fit import identify_experiment
 
         coupling = check_coupling_kind(coupling)
         return identify_experiment(
-            recorded_tests(record, outputs, r_load, coupling), model, coupling, m=m,
+            recorded_tests(record, outputs, r_load, coupling, rectifier), model, coupling, m=m,
             fixed=fixed, bounds=bounds, init=init, quadratic=quadratic, weights=weights,
             search=search, simulation=simulation, progress=progress, callback=callback,
         )  # fmt: skip

@@ -213,15 +213,21 @@ class MeasurementModel:
 
 
 def device_parameters(
-    harvester: Harvester, measurement=None, function: str = "the record simulation", *, scalar=True
+    harvester: Harvester,
+    measurement=None,
+    function: str = "the record simulation",
+    *,
+    scalar=True,
+    rectified=False,
 ) -> dict:
     """The record simulation's named parameters of a device and its measurement model.
 
     ``m``, ``c`` (= c_m + c_e, the static coupling's damping included),
     ``k``, ``k3``, the friction law's parameters, ``k2`` and the offsets; a
     coupling with a circuit state is :func:`device_circuit`'s. ``function``
-    is named in refusals: anything but a Harvester, a diode bridge (the record
-    simulation has none) and, with ``scalar``, array parameters.
+    is named in refusals: anything but a Harvester, a diode bridge (unless
+    ``rectified``: :mod:`randvib.identification.record_bridge` simulates it)
+    and, with ``scalar``, array parameters.
     """
     if not isinstance(harvester, Harvester):
         raise ValueError(
@@ -236,7 +242,7 @@ def device_parameters(
         )
     if scalar:
         check_scalar_device(harvester, function)
-    if harvester.is_rectified:
+    if harvester.is_rectified and not rectified:
         raise ValueError(
             f"{function} integrates a coil or a piezo element on its load, not the "
             f"{harvester.electrical.name}'s switching; the bridge is simulated by randvib.simulate"

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from randvib.identification.circuit import OFFSET_NAMES, output_coefficients
+from randvib.identification.circuit import COUPLING_PARAMETERS, OFFSET_NAMES, output_coefficients
 from randvib.identification.cost import CostFunction, normalised_cost
 from randvib.identification.models import (
     MeasurementModel,
@@ -142,7 +142,9 @@ def predict_record(
     harvester : Harvester
         The device (a preset, or :meth:`IdentificationResult.harvester
         <randvib.identification.result.IdentificationResult.harvester>`), with
-        scalar parameters and any coupling but a diode bridge.
+        scalar parameters and any coupling; behind a diode bridge its DC side
+        is scored (:mod:`randvib.identification.record_bridge`: ``voltage`` the
+        storage capacitor's V_C, ``current`` the load's).
     record : Record
         Its input channel drives the device; its relative displacement is
         scored, or the channels ``outputs`` names.
@@ -174,7 +176,8 @@ def predict_record(
     (simulation,) = resolve_settings("predict_record", options, simulation=simulation)
     if isinstance(record, Record):  # else refused by score
         simulation, _ = simulation.for_record(record)
-    if outputs is not None or isinstance(harvester, Harvester) and harvester.has_circuit:
+    circuit = isinstance(harvester, Harvester) and (harvester.has_circuit or harvester.is_rectified)
+    if outputs is not None or circuit:
         return score_channels(harvester, record, measurement, simulation, outputs)
     parameters = device_parameters(harvester, measurement, "predict_record")
     model = model_of(harvester.friction_name)
@@ -207,20 +210,30 @@ def score(parameters: dict, model: str, record: Record, simulation, circuit=None
     )
 
 
-def _named_device(harvester: Harvester, measurement) -> tuple[str, str | None, dict, float]:
-    """(model, coupling, named parameters, r_load) of a device for the channel simulation."""
+def _named_device(harvester: Harvester, measurement):
+    """(model, coupling, named parameters, r_load, known bridge) of a device for the channel
+    simulation; the bridge (:func:`~randvib.identification.experiment.known_bridge`'s dict)
+    None without one."""
     if not isinstance(harvester, Harvester):
         raise ValueError(
             f"predict_record needs a randvib.Harvester, got {type(harvester).__name__}"
         )
-    parameters = device_parameters(harvester, measurement, "predict_record")
+    parameters = device_parameters(harvester, measurement, "predict_record", rectified=True)
     model = model_of(harvester.friction_name)
     coupling = harvester.electrical
     if coupling is None:
-        return model, None, parameters, None
+        return model, None, parameters, None, None
+    if coupling.rectified:  # the transducer's parameters named, the bridge's known
+        own = coupling.parameters()
+        named = {**parameters, "c": harvester.c_m}
+        named.update({n: own[n] for n in COUPLING_PARAMETERS[coupling.transducer] if n in own})
+        known = {n: own[n] for n in ("v_diode", "storage_capacitance", "battery") if n in own}
+        # a battery has no load: its R_L stands in for the records' (unused)
+        load = 1.0 if coupling.has_battery else coupling.r_load
+        return model, coupling.transducer, named, load, known
     named = {**parameters, "c": harvester.c_m, **coupling.parameters()}
     named.pop("r_load")
-    return model, coupling.name, named, coupling.r_load
+    return model, coupling.name, named, coupling.r_load, None
 
 
 def score_channels(harvester, record, measurement, simulation, outputs=None) -> Prediction:
@@ -239,11 +252,11 @@ def score_channels(harvester, record, measurement, simulation, outputs=None) -> 
     from randvib.identification.least_squares import Coordinates, polish
 
     measurement = measurement or MeasurementModel()
-    model, coupling, named, r_load = _named_device(harvester, measurement)
+    model, coupling, named, r_load, bridge = _named_device(harvester, measurement)
     if outputs is None:
         outputs = ("relative_displacement",) if "relative_displacement" in record else ()
         outputs += tuple(k for k in ("voltage",) if k in record and coupling)
-    (test,) = recorded_tests(record, outputs, r_load, coupling)
+    (test,) = recorded_tests(record, outputs, r_load, coupling, bridge)
     fixed = {**named, **{OFFSET_NAMES[k]: measurement.offset(k) for k in test.outputs}}
     fixed = {k: float(np.ravel(v)[0]) for k, v in fixed.items()}
     cost = ExperimentCost([test], model, coupling, fixed=fixed, free=(), simulation=simulation)
@@ -271,7 +284,9 @@ def score_channels(harvester, record, measurement, simulation, outputs=None) -> 
         costs[kind] = float(normalised_cost(measured, y[skip:])) if finite else float("inf")
         rms[kind] = float(np.sqrt(np.mean((measured - y[skip:]) ** 2))) if finite else float("inf")
     voltage = None
-    if coupling is not None:
+    if bridge is not None:
+        voltage = run.x[0]  # the DC output voltage
+    elif coupling is not None:
         cz, cv, cx = output_coefficients("voltage", coupling, values, r_load)
         voltage = (
             cz * run.z + np.atleast_1d(cv)[:, None] * run.v + np.atleast_1d(cx)[:, None] * run.x
@@ -385,7 +400,8 @@ def validate(
     model = model_of(harvester.friction_name) if isinstance(harvester, Harvester) else None
     measurement = measurement or MeasurementModel()
     circuit = isinstance(harvester, Harvester) and harvester.electrical is not None
-    if outputs is not None or r_load is not None or circuit and harvester.has_circuit:
+    dynamic = circuit and (harvester.has_circuit or harvester.is_rectified)
+    if outputs is not None or r_load is not None or dynamic:
         return _validate_channels(
             harvester, records, measurement, offsets, outputs, r_load, settings
         )

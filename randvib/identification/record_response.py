@@ -11,6 +11,7 @@ stopped and gets NaN samples.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -24,6 +25,7 @@ from randvib.identification.circuit import (
 )
 from randvib.identification.input_reconstruction import HOLDS, driving_signal
 from randvib.identification.models import MeasurementModel, device_circuit, device_parameters
+from randvib.identification.record_bridge import bridge_output, run_bridge
 from randvib.identification.record_integrator import parameter_matrix, run_kernel
 from randvib.models.harvester import Harvester
 from randvib.models.record import INPUT_KINDS, Record
@@ -43,7 +45,8 @@ class BatchSimulation:
         response, and :meth:`to_record` makes a record of it.
     x : ndarray, shape (n_pop, n)
         The circuit state (a coil's current, A; a piezo element's voltage,
-        V); zeros without one.
+        V); zeros without one. Behind a diode bridge: the coil's current
+        (signed) or the piezo element's voltage V_p.
     harvester : Harvester or None
         The simulated device, whose coupling says what :meth:`output` reads.
     record : Record or None
@@ -56,6 +59,9 @@ class BatchSimulation:
     x: np.ndarray | None = None
     harvester: Harvester | None = None
     record: Record | None = field(default=None, repr=False)
+    #: Behind a diode bridge: :data:`~randvib.identification.record_bridge.BRIDGE_COLUMNS`
+    #: at the samples, shape (n_pop, n, 5); None without one.
+    bridge_states: np.ndarray | None = field(default=None, repr=False)
 
     def output(self, kind: str) -> np.ndarray:
         """The channel ``kind`` of :data:`~randvib.identification.circuit.OUTPUT_KINDS`.
@@ -63,10 +69,15 @@ class BatchSimulation:
         ``relative_displacement`` z (m), ``relative_velocity`` z' (m/s),
         ``voltage`` the load voltage (V: R_L i of a coil, V of a piezo
         element) and ``current`` the load current (A), as the sensors would
-        read them without offset or noise; shape (n_pop, n).
+        read them without offset or noise; shape (n_pop, n). Behind a diode
+        bridge the DC side's: the storage capacitor's V_C and the load
+        current V_C / R_L, or a coil's charging current |i| into a battery
+        (:func:`~randvib.identification.record_bridge.bridge_output`).
         """
         check_output_kind(kind, "kind")
         coupling = None if self.harvester is None else self.harvester.electrical
+        if self.bridge_states is not None:  # the DC side: V_C, the load's current
+            return bridge_output(kind, coupling, self.bridge_states)
         if kind in ELECTRICAL_OUTPUTS and coupling is None:
             raise ValueError(
                 f"a `{kind}` output needs the device's circuit: build it with a coupling "
@@ -137,6 +148,7 @@ def record_response(
     v0=0.0,
     theta0=0.0,
     x0=0.0,
+    v_c0=0.0,
     response_limit: float = np.inf,
 ) -> BatchSimulation:
     """The response of Eq. 1 to a record's input, for one device or a batch at once.
@@ -152,7 +164,10 @@ def record_response(
         The device with any friction law: a static coupling as its damper
         c_e (in c = c_m + c_e), a coil with inductance or a piezo element
         with its circuit state (the current i, A, or the voltage V, V),
-        integrated with the motion; a diode bridge is refused. Its parameters
+        integrated with the motion; a diode bridge's states (the storage
+        capacitor's V_C, a coil's current with inductance, the piezo's
+        clamped voltage) by the Monte Carlo kernel's bridge step
+        (:mod:`randvib.identification.record_bridge`). Its parameters
         may be 1-D arrays of one length: a batch of devices, one response
         each, simulated in one parallel compiled call.
     record : Record
@@ -175,7 +190,11 @@ def record_response(
         Zero-phase low-pass cut-off (Hz) for the driving signal.
     z0, v0, theta0, x0 : float or array_like
         Initial displacement (m), velocity (m/s), LuGre bristle state (m),
-        circuit state (A or V).
+        circuit state (A or V; behind a bridge a coil's current with
+        inductance or the piezo's voltage).
+    v_c0 : float or array_like
+        Behind a bridge with a storage capacitor: its voltage at t = 0 (V,
+        default 0, empty).
     response_limit : float, optional
         |z| above which a candidate counts as diverged (m).
 
@@ -195,7 +214,9 @@ def record_response(
     >>> response.z.shape
     (2, 1000)
     """
-    parameters = device_parameters(harvester, measurement, "record_response", scalar=False)
+    parameters = device_parameters(
+        harvester, measurement, "record_response", scalar=False, rectified=True
+    )
     circuit = device_circuit(harvester)
     if not isinstance(record, Record):
         raise ValueError(f"`record` must be a randvib.Record, got {type(record).__name__}")
@@ -206,6 +227,15 @@ def record_response(
     friction = None if harvester.friction is None else type(harvester.friction)
     matrix = parameter_matrix(parameters, friction, circuit)
     drive, base_input = driving_signal(record[kind], record.dt, kind, lowpass)
+    if harvester.is_rectified:
+        states = _bridge_states(
+            harvester, matrix, (drive, base_input, record.dt), substeps, hold,
+            (z0, v0, theta0, x0, v_c0), response_limit,
+        )  # fmt: skip
+        return BatchSimulation(
+            time=record.time, z=states[..., 0], v=states[..., 1], x=states[..., 2],
+            harvester=harvester, record=record, bridge_states=states,
+        )  # fmt: skip
     _, z, v, x = run_kernel(
         matrix,
         friction,
@@ -221,6 +251,36 @@ def record_response(
         response_limit=response_limit,
     )
     return BatchSimulation(time=record.time, z=z, v=v, x=x, harvester=harvester, record=record)
+
+
+def _bridge_states(harvester, matrix, drive, substeps, hold, start, response_limit):
+    """:func:`~randvib.identification.record_bridge.run_bridge` of a device behind a bridge.
+
+    Refused: a sub-step above 0.2 over the storage capacitor's fastest rate
+    (the Monte Carlo kernel's own limit for V_C's explicit step), and a
+    quadratic stiffness k2 (the Monte Carlo drift the bridge step shares has
+    none).
+    """
+    bridge = harvester.electrical
+    rate, step = bridge.fastest_rate(), drive[2] / substeps
+    if rate * step > 0.2:  # as the Monte Carlo kernel's check: V_C's explicit step
+        raise ValueError(
+            f"`substeps` = {substeps} leaves a step of {step:.3g} s, too large for the "
+            f"{bridge.name}'s storage capacitor (its fastest rate {rate:.3g} 1/s): use "
+            f"substeps >= {math.ceil(rate * drive[2] / 0.2)} (`--substeps`)"
+        )
+    z0, v0, theta0, x0, v_c0 = start
+    if np.any(np.asarray(v_c0) != 0.0) and bridge.has_battery:
+        raise ValueError(
+            f"`v_c0` is a storage capacitor's voltage; the {bridge.name} has a battery"
+        )
+    code, output, p = bridge.kernel_parameters()
+    friction = None if harvester.friction is None else type(harvester.friction)
+    return run_bridge(
+        matrix, p, (code, output), friction, drive[0], drive[1], drive[2],
+        substeps=substeps, hold=hold, z0=z0, v0=v0, theta0=theta0, s1=x0, v_c0=v_c0,
+        response_limit=response_limit,
+    )  # fmt: skip
 
 
 def _input_kind(record: Record, input_kind) -> str:

@@ -43,7 +43,13 @@ filter's input gain on its states under a rational spectrum.
 of x x^T and v v^T (upper triangles), of each element's friction power
 u' F and |u'|, of each circuit state's square, each bridge's stored power,
 coil and diode losses and output voltage, the Ito sum (M r)^T v dW / T, the
-energy H at the window's ends, and the fraction of steps beyond each stroke.
+energy H at the window's ends, and for each stroke the fraction of steps beyond
+it, the peak |u| and the number of up-crossings of |u| through it.
+
+**A given start per path** (``noise.start``, shape (paths, rows), as the
+single-mass kernel's :class:`~randvib.montecarlo.kernel.Noise`) replaces the
+drawn one: the rare-event estimators express the stationary start through
+standard normals (:mod:`randvib.montecarlo.assembly_paths`).
 """
 
 from __future__ import annotations
@@ -141,7 +147,11 @@ class Columns(NamedTuple):
     ito: int  #: (M r)^T v dW summed over the window / T
     h0: int  #: energy at the window's start (J)
     h1: int  #: energy at the end (J)
-    stroke: int  #: first of S fractions of the window's steps beyond a stroke
+    #: first of S fractions of the window's steps beyond a stroke, then S peaks of |u| over
+    #: the window's states, its end included (m), then S counts of the window's steps on
+    #: which |u| rises through its stroke (the rare-event estimators',
+    #: :mod:`randvib.montecarlo.assembly_paths`)
+    stroke: int
     n: int  #: columns in all
     mass: np.ndarray  #: float64[N, N]: M, for the kinetic energy
     stiffness: np.ndarray  #: float64[N, N]: K_lin, for the potential energy
@@ -482,10 +492,12 @@ def _bridges_update(ys, rs, stage, dt, weights, dims, bridges, acc, first, in_wi
 
 # ------------------------------------------------------------ accumulators
 @numba.njit(cache=True, inline="always")
-def _accumulate(ys, fs, dw, dims, coords, cols, stroke_coords, limits, ito_weights, acc):
+def _accumulate(ys, fs, dw, dims, coords, cols, stroke_coords, limits, ito_weights, acc, was):
     """Add the state at the step's start to the window's sums (:class:`Columns`).
 
-    ``cols`` is (xx, vv, friction, abs_du, circuit, ito, stroke, bridge).
+    ``cols`` is (xx, vv, friction, abs_du, circuit, ito, stroke, bridge);
+    ``was`` (S, LANES) holds 1 where |u| was beyond its stroke at the state
+    before (-1 at the window's first state: no crossing counted into it).
     """
     n, ov, oc, n_elements, n_circuits = dims[0], dims[1], dims[3], dims[7], dims[8]
     xx, vv, fr, ab, ci, ito, st, _ = cols
@@ -506,12 +518,12 @@ def _accumulate(ys, fs, dw, dims, coords, cols, stroke_coords, limits, ito_weigh
     for c in range(n_circuits):
         for j in range(LANES):
             acc[ci + c, j] += ys[0, oc + c, j] * ys[0, oc + c, j]
-    for q in range(limits.size):
+    n_strokes = limits.size
+    for q in range(n_strokes):
         i = stroke_coords[q, 0]
         k = stroke_coords[q, 1]
         for j in range(LANES):
-            if abs(ys[0, i, j] - ys[0, k, j]) > limits[q]:
-                acc[st + q, j] += 1.0
+            _stroke_state(acc, was, q, j, abs(ys[0, i, j] - ys[0, k, j]), limits[q], st, n_strokes)
     for j in range(LANES):
         total = 0.0
         for a in range(n):
@@ -543,6 +555,18 @@ def _energy(y, j, dims, mass, stiffness, coords, springs, circuits, bridges):
         s1, s2 = y[ob + 2 * b, j], y[ob + 2 * b + 1, j]
         h += bridges[b, 18] * s1 * s1 + bridges[b, 19] * s2 * s2
     return h
+
+
+@numba.njit(cache=True, inline="always")
+def _stroke_state(acc, was, q, j, u, limit, st, n_strokes):
+    """Stroke q's sums in lane j at a state with |u| = ``u``: beyond, peak, up-crossing."""
+    beyond = 1.0 if u > limit else 0.0
+    acc[st + q, j] += beyond
+    if u > acc[st + n_strokes + q, j]:
+        acc[st + n_strokes + q, j] = u
+    if beyond > 0.0 and was[q, j] == 0.0:
+        acc[st + 2 * n_strokes + q, j] += 1.0
+    was[q, j] = beyond
 
 
 # ---------------------------------------------------------------- the loop
@@ -586,7 +610,7 @@ def _run_chunk(
     """
     dt, n_steps, n_burn = timing
     seed, first_path, n_paths = paths
-    dw, ki, wi, fi = noise.dw, noise.ki, noise.wi, noise.fi  # no per-path start (rare events')
+    dw, ki, wi, fi, starts = noise.dw, noise.ki, noise.wi, noise.fi, noise.start
     rows, n_elements, n_bridges = dims[6], dims[7], dims[9]
     start_path = chunk * LANES
     lanes = min(LANES, n_paths - start_path)
@@ -609,6 +633,11 @@ def _run_chunk(
     sqdt, given = np.sqrt(dt), dw.shape[0] > 0
     n_stages = 1 if scheme[1] == 0.0 else 2
     _start_lanes(y, rng, first_path + start_path, lanes, seed, start, ki, wi, fi)
+    if starts.shape[0] > 0:  # each path's own start (rare events': assembly_paths)
+        for j in range(lanes):
+            for row in range(rows):
+                y[row, j] = starts[start_path + j, row]
+    was = np.full((limits.size, LANES), -1.0)  # no up-crossing into the window's first state
     _record(records, y, start_path, lanes, np.int64(0))  # not a literal: one signature
     for n in range(n_steps):
         if n == n_burn:
@@ -632,7 +661,7 @@ def _run_chunk(
             if s == 0:
                 if n >= n_burn:  # the window's sums, at the step's start
                     _accumulate(ys, fs, dwl, dims, coords, cols, stroke_coords, limits,
-                                ito_weights, acc)  # fmt: skip
+                                ito_weights, acc, was)  # fmt: skip
                 if n_stages == 2:
                     _advance(ys, rs, gain, noise_l, dt, scheme, dims, True)
                     _bridges_predictor(ys, rs, dt, dims, bridges)
@@ -650,6 +679,12 @@ def _run_chunk(
                 break
     for j in range(lanes):
         acc[h1, j] = _energy(y, j, dims, mass, kmat, coords, springs, circuits, bridges)
+        for q in range(limits.size):  # the final state: its peak and a last up-crossing
+            if n_steps > n_burn:
+                u = abs(y[stroke_coords[q, 0], j] - y[stroke_coords[q, 1], j])
+                beyond_sum = acc[columns.stroke + q, j]  # the final state is not a step's start
+                _stroke_state(acc, was, q, j, u, limits[q], columns.stroke, limits.size)
+                acc[columns.stroke + q, j] = beyond_sum
         _write(out, acc, start_path + j, j, columns, n_steps - n_burn, (n_steps - n_burn) * dt)
 
 
@@ -716,8 +751,9 @@ def _record(records, y, start_path, lanes, point):
 def _write(out, acc, p, j, columns, window_steps, window):
     """Path p's averages: sums over the window's steps or, for energies (J), over its time."""
     b = columns.bridge
+    extremes = columns.stroke + columns.stroke_limits.size  # peaks and counts, not averages
     for q in range(columns.n):
-        if q == columns.h0 or q == columns.h1:
+        if q == columns.h0 or q == columns.h1 or q >= extremes:
             out[p, q] = acc[q, j]
         elif q == columns.ito or (b <= q < columns.ito and (q - b) % N_BRIDGE_ACC != BRIDGE_V_OUT):
             out[p, q] = acc[q, j] / window

@@ -159,7 +159,7 @@ def column_layout(assembly: Assembly, layout: ak.Layout) -> ak.Columns:
     m, _, k = assembly.linear_matrices()
     return ak.Columns(
         0, tri, friction, abs_du, circuit, bridge, ito, ito + 1, ito + 2, ito + 3,
-        ito + 3 + len(strokes), m, k, np.ascontiguousarray(m @ assembly.influence),
+        ito + 3 + 3 * len(strokes), m, k, np.ascontiguousarray(m @ assembly.influence),
         coordinates, limits,
     )  # fmt: skip
 

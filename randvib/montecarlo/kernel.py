@@ -37,7 +37,11 @@ import numba
 import numpy as np
 
 from randvib.montecarlo.drift import _acceleration
-from randvib.montecarlo.rectified_kernel import rectified_step, rectified_white_step
+from randvib.montecarlo.rectified_kernel import (
+    bridge_constants,
+    rectified_step,
+    rectified_white_step,
+)
 from randvib.montecarlo.rng import seed_path_state, standard_normal
 
 #: Paths advanced together inside one chunk.
@@ -1014,21 +1018,15 @@ def _auxiliary_constants(auxiliary):
 def _rectifier_constants(rectifier, dt, has_aux, block):
     """(bridged, constants, stored energy's factors, V_C(0), the block it steps with).
 
-    ``constants``: (kind, output, gain, R_C or C_p, V_d, V_b, C, R_L) and, to
-    spare divisions per step, 1/R_C, theta/C_p, 1/C, 1/(R_L C), C_p/(C_p + C),
-    C/(C_p + C); then the Shockley diodes' I_s (0: a constant drop) and
-    2 n V_T, 1/L, and dt/R_L. The factors are those of the energy held by the
-    piezo's C_p V_p^2 / 2 or the coil's L i^2 / 2 (the state s1 is V_p or i)
-    and by the storage capacitor's C V_C^2 / 2, and the battery's V_b. White
-    or given input has no filter: the noise drives the velocity (g_v = 1).
+    ``constants``: :func:`~randvib.montecarlo.rectified_kernel.bridge_constants`
+    (shared with the record simulation of a bridge). The factors are those of
+    the energy held by the piezo's C_p V_p^2 / 2 or the coil's L i^2 / 2 (the
+    state s1 is V_p or i) and by the storage capacitor's C V_C^2 / 2, and the
+    battery's V_b. White or given input has no filter: the noise drives the
+    velocity (g_v = 1).
     """
     rp = rectifier.p
-    rect = (
-        rectifier.kind, rectifier.output, rp[0], rp[1], rp[2], rp[3], rp[4], rp[5],
-        1.0 / rp[1], rp[0] / rp[1], 1.0 / rp[4], 1.0 / (rp[5] * rp[4]),
-        rp[1] / (rp[1] + rp[4]), rp[4] / (rp[1] + rp[4]), rp[6], 2.0 * rp[7],
-        1.0 / rp[8] if rp[8] > 0.0 else 0.0, dt / rp[5] if rp[5] > 0.0 else 0.0,
-    )  # fmt: skip
+    rect = bridge_constants(rectifier.kind, rectifier.output, rp, dt)
     half_cp = 0.5 * rp[1] if rectifier.kind == 2 else 0.5 * rp[8]
     half_c = 0.5 * rp[4] if rectifier.output == 1 else 0.0
     rblock = (

@@ -8,8 +8,10 @@ into the output, the coil's resistance and the diodes. The bridge's side of
 both is shared: :func:`_bridge_rates` (force and state rates at a stage),
 :func:`_bridge_predictor` (the predictor's bridge states) and
 :func:`_bridge_update` (the step's bridge states and energy accounting).
-The loop (:func:`randvib.montecarlo.kernel.full_loop`) compiles them into
-its full signature only, not into the lean white-noise one. Equations:
+The loop :func:`randvib.montecarlo.kernel.full_loop` compiles them, not the
+lean white-noise one (:func:`~randvib.montecarlo.kernel.lean_loop`); the record
+simulation of a bridge (:mod:`randvib.identification.record_bridge`) steps
+:func:`rectified_white_step` on a recorded input. Equations:
 docs/conventions.md, "Full-wave bridge".
 """
 
@@ -21,6 +23,25 @@ import numba
 import numpy as np
 
 from randvib.montecarlo.drift import _acceleration
+
+
+@numba.njit(cache=True, inline="always")
+def bridge_constants(kind, output, rp, dt):
+    """The bridge's tuple ``rect`` that the steps read, from :class:`kernel.Rectifier
+    <randvib.montecarlo.kernel.Rectifier>`'s ``kind``, ``output`` and ``p`` at the step dt.
+
+    ``(kind, output, gain, R_C or C_p, V_d, V_b, C, R_L)`` and, to spare
+    divisions per step: 1/R_C, theta/C_p, 1/C, 1/(R_L C), C_p/(C_p + C),
+    C/(C_p + C); then the Shockley diodes' I_s (0: a constant drop) and
+    2 n V_T, 1/L, and dt/R_L. Shared by the Monte Carlo loop and the record
+    simulation (:mod:`randvib.identification.record_bridge`).
+    """
+    return (
+        kind, output, rp[0], rp[1], rp[2], rp[3], rp[4], rp[5],
+        1.0 / rp[1], rp[0] / rp[1], 1.0 / rp[4], 1.0 / (rp[5] * rp[4]),
+        rp[1] / (rp[1] + rp[4]), rp[4] / (rp[1] + rp[4]), rp[6], 2.0 * rp[7],
+        1.0 / rp[8] if rp[8] > 0.0 else 0.0, dt / rp[5] if rp[5] > 0.0 else 0.0,
+    )  # fmt: skip
 
 
 @numba.njit(cache=True, inline="always")

@@ -31,7 +31,10 @@ R_j(k) the covariance of the level's indicator (or of h) k states apart
 along the same chain, estimated over all chains; level 0 is independent
 (gamma 0); delta^2 = sum_j delta_j^2 for the product (the levels taken as
 uncorrelated, Au & Beck's approximation, checked for coverage in
-tests/calibration/rare_event_coverage.py). gamma_j < 0 is taken as 0.
+tests/calibration/rare_event_coverage.py). gamma_j < 0 is taken as 0. Where
+the levels are correlated (long windows, stiff or bistable springs) this c.o.v.
+is too small; :func:`randvib.first_passage` therefore takes its interval from
+the spread of independent runs (:func:`randvib.montecarlo.reliability.pooled_runs`).
 
 Memory stays at a few times (N p0) x dimension: a level keeps its chains'
 current rows and the N p0 rows with the largest peaks so far (the next seeds),
