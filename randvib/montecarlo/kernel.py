@@ -759,15 +759,17 @@ def run_ensemble(
     )  # fmt: skip
 
 
-# The two loops share the pieces below, each inlined into the loop's parallel body
-# (inline="always": numba inlines them before compiling, so a loop compiles to
-# what it would be written out). The arrays a chunk integrates are allocated in
+# The two loops share the pieces below. Those of a step are inlined into the
+# loop's parallel body (inline="always": numba inlines them before compiling,
+# so the body compiles to what it would be written out). Those of the set-up,
+# called once per run, are not: inlined there, numba's array analysis of the
+# parallel loop mistook their returned tuples' entries for arrays' shapes (an
+# AssertionError when compiling). The arrays a chunk integrates are allocated in
 # the loops themselves, not in a helper, as a precaution: numba's parfor pass
-# hoists an allocation out of the parallel loop where it sees no write to it, and
-# one returned through a helper's tuple must not become one array every chunk shares.
-@numba.njit(cache=True, inline="always")
+# hoists an allocation out of the parallel loop where it sees no write to it.
+@numba.njit(cache=True)
 def _outputs(n_paths, n_chunks, n_steps, recording):
-    """(acc, failed, hist, records): the arrays a loop returns, zeroed (see _window_constants)."""
+    """(acc, failed, hist, records): the arrays a loop returns, zeroed."""
     hist_bins, n_record, record_every = recording[2], recording[3], recording[4]
     acc = np.zeros((n_paths, N_ACC))
     failed = np.full(n_paths, -1, dtype=np.int64)
@@ -777,13 +779,11 @@ def _outputs(n_paths, n_chunks, n_steps, recording):
     return acc, failed, hist, records
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def _window_constants(timing, recording):
     """(window (s), 1 / window's steps, sqrt(dt), (bins per m, bins per m/s)): the scales.
 
-    The last pair is that of :class:`Recording`'s (z, v) histogram. (Scalars
-    only: numba's array analysis takes a tuple that mixes arrays and numbers
-    from an inlined function for an array's shape.)
+    The last pair is that of :class:`Recording`'s (z, v) histogram.
     """
     dt, n_steps, n_burn = timing
     hist_lo, hist_hi, hist_bins = recording[0], recording[1], recording[2]
@@ -795,14 +795,15 @@ def _window_constants(timing, recording):
 
 
 @numba.njit(cache=True, inline="always")
-def _start_lane(states, j, row, rng, tables, given_start, initial, companion, chol, n_drawn):
+def _start_lane(z, v, zc, vc, x1, x2, x3, j, row, rng, tables, given_start, initial, companion,
+                chol, n_drawn):  # fmt: skip
     """Lane j's start (path ``row`` of the batch): given, random or fixed.
 
-    ``states`` is (z, v, z_c, v_c, x1, x2, x3); a random start draws the
-    device's two normals, then ``n_drawn`` for the auxiliary states (L =
-    ``chol``), from the lane's stream.
+    A random start draws the device's two normals, then ``n_drawn`` for the
+    auxiliary states (L = ``chol``), from the lane's stream. The lanes' arrays
+    are passed one by one, never in a tuple: numba's parallel loop does not
+    follow a write through a tuple's entry and dropped it as dead.
     """
-    z, v, zc, vc, x1, x2, x3 = states
     ki, wi, fi = tables
     init_random, init_z, init_v = initial
     comp_init_z, comp_init_v = companion[1], companion[2]
@@ -960,7 +961,7 @@ def lean_loop(scheme, device, friction, timing, paths, initial, companion, recor
         a[:, ACC_FIRST_HIT] = -1.0
         for j in range(lanes):
             seed_path_state(seed, first_path + start + j, rng, j)
-            _start_lane((z, v, zc, vc, x1, x2, x3), j, start + j, rng, (ki, wi, fi), given_start,
+            _start_lane(z, v, zc, vc, x1, x2, x3, j, start + j, rng, (ki, wi, fi), given_start,
                         initial, companion, no_chol, 0)  # fmt: skip
             if start + j < n_record:
                 records[start + j, 0, 0] = z[j]
@@ -992,7 +993,7 @@ def lean_loop(scheme, device, friction, timing, paths, initial, companion, recor
     return acc, failed, hist, records
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def _auxiliary_constants(auxiliary):
     """(n, in use, block, P row, filter alone, L) of an :class:`Auxiliary` group.
 
@@ -1014,7 +1015,7 @@ def _auxiliary_constants(auxiliary):
     return n_aux, n_aux > 0, block, (p1, p2, p3), filter_only, auxiliary.start
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True)
 def _rectifier_constants(rectifier, dt, has_aux, block):
     """(bridged, constants, stored energy's factors, V_C(0), the block it steps with).
 
@@ -1040,17 +1041,15 @@ def _rectifier_constants(rectifier, dt, has_aux, block):
 
 
 @numba.njit(cache=True, inline="always")
-def _bridged_lane(a, j, at_burn, in_window, lane, aux, circuit, dt, noise, scheme, drift,
+def _bridged_lane(a, j, at_burn, in_window, lane, x1, x2, x3, s1, s2, dt, noise, scheme, drift,
                   friction, rect, stored, has_aux, rblock):  # fmt: skip
     """Lane j's step through the bridge; its stored energy and losses into the window's sums.
 
-    ``lane`` is (z, v after the forcing's half kick, theta); ``aux`` and
-    ``circuit`` the lanes' (x1, x2, x3) and (s1, s2), updated here; ``stored``
+    ``lane`` is (z, v after the forcing's half kick, theta); x1, x2, x3 and
+    s1, s2 the lanes' auxiliary and circuit states, updated here; ``stored``
     as :func:`_rectifier_constants` returns it. Returns (z, v, theta, force).
     """
     zj, vs, tj = lane
-    x1, x2, x3 = aux
-    s1, s2 = circuit
     fr_kind, fr_p, fr_fn = friction
     half_cp, half_c, v_out_b = stored
     if in_window and at_burn:
@@ -1075,15 +1074,14 @@ def _bridged_lane(a, j, at_burn, in_window, lane, aux, circuit, dt, noise, schem
 
 
 @numba.njit(cache=True, inline="always")
-def _auxiliary_lane(a, j, in_window, lane, aux, row, filter_only, dt, noise, scheme, drift,
-                    friction, step_block):  # fmt: skip
+def _auxiliary_lane(a, j, in_window, lane, x1, x2, x3, row, filter_only, dt, noise, scheme,
+                    drift, friction, step_block):  # fmt: skip
     """Lane j's step with the auxiliary states (:func:`filter_step` or :func:`auxiliary_step`).
 
     ``row`` is P, whose (P x)^2 the window averages (``ACC_CIRCUIT2``).
     Returns (z, v, theta, force).
     """
     zj, vs, tj = lane
-    x1, x2, x3 = aux
     fr_kind, fr_p, fr_fn = friction
     if filter_only:
         zn, vn, tn, x1[j], x2[j], f1 = filter_step(
@@ -1103,9 +1101,8 @@ def _auxiliary_lane(a, j, in_window, lane, aux, row, filter_only, dt, noise, sch
 
 
 @numba.njit(cache=True, inline="always")
-def _event_sums(peak, integrals, square, j, zn, vj, vn, dt, has_aux, row, aux):
+def _event_sums(peak, integrals, square, j, zn, vj, vn, dt, has_aux, row, x1, x2, x3):
     """Lane j's event sums after its step: the peak |z|, int v^2 dt and int (P x)^2 dt."""
-    x1, x2, x3 = aux
     peak[j] = max(peak[j], abs(zn))
     integrals[j, 0] += 0.5 * dt * (vj * vj + vn * vn)
     if has_aux:
@@ -1164,7 +1161,7 @@ def full_loop(scheme, device, friction, timing, paths, initial, companion, recor
         peak, square, integrals = np.zeros(LANES), np.zeros(LANES), np.zeros((LANES, 2))
         for j in range(lanes):
             seed_path_state(seed, first_path + start + j, rng, j)
-            _start_lane((z, v, zc, vc, x1, x2, x3), j, start + j, rng, (ki, wi, fi), given_start,
+            _start_lane(z, v, zc, vc, x1, x2, x3, j, start + j, rng, (ki, wi, fi), given_start,
                         initial, companion, chol, n_aux if has_aux else 0)  # fmt: skip
             if timed:
                 x1[j], x2[j], x3[j] = _drawn_states(rng, j, ki, wi, fi, filter_start, n_start)
@@ -1194,11 +1191,11 @@ def full_loop(scheme, device, friction, timing, paths, initial, companion, recor
                     vs = vj + kick
                 lane = (zj, vs, th[j])
                 if bridged:
-                    zn, vn, tn, f1 = _bridged_lane(a, j, n == n_burn, in_window, lane, (x1, x2, x3),
-                        (s1, s2), dt, noise, scheme, drift, friction, rect, stored, has_aux,
+                    zn, vn, tn, f1 = _bridged_lane(a, j, n == n_burn, in_window, lane, x1, x2, x3,
+                        s1, s2, dt, noise, scheme, drift, friction, rect, stored, has_aux,
                         rblock)  # fmt: skip
                 elif has_aux:
-                    zn, vn, tn, f1 = _auxiliary_lane(a, j, in_window, lane, (x1, x2, x3), row,
+                    zn, vn, tn, f1 = _auxiliary_lane(a, j, in_window, lane, x1, x2, x3, row,
                         filter_only, dt, noise, scheme, drift, friction, step_block)  # fmt: skip
                 else:
                     zn, vn, tn, f1 = scheme_step(zj, vs, th[j], dt, noise, scheme, drift,
@@ -1212,7 +1209,7 @@ def full_loop(scheme, device, friction, timing, paths, initial, companion, recor
                 th[j] = tn
                 if timed:
                     _event_sums(peak, integrals, square, j, zn, vj, vn, dt, has_aux, row,
-                                (x1, x2, x3))  # fmt: skip
+                                x1, x2, x3)  # fmt: skip
                 if with_companion:
                     _companion_step(zc, vc, a, j, in_window, dt, noise, scheme, drift, fr_p, fr_fn)
                 _record_step(records, start + j, n, record_every, z, v, th, j)
