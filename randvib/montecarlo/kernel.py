@@ -759,6 +759,14 @@ def run_ensemble(
     )  # fmt: skip
 
 
+#: A step's pieces shared by the two loops: compiled once each, without reference
+#: counts (``_nrt=False``: they allocate nothing) and inlined by LLVM
+#: (``forceinline``). Inlined by numba instead (``inline="always"``), every array
+#: they take cost a reference count's increment and decrement per lane and step
+#: (about a quarter of the lean loop's time, measured).
+_lane_step = numba.njit(cache=True, _nrt=False, forceinline=True)
+
+
 # The two loops share the pieces below. Those of a step are inlined into the
 # loop's parallel body (inline="always": numba inlines them before compiling,
 # so the body compiles to what it would be written out). Those of the set-up,
@@ -829,7 +837,7 @@ def _start_lane(z, v, zc, vc, x1, x2, x3, j, row, rng, tables, given_start, init
         vc[j] = comp_init_v
 
 
-@numba.njit(cache=True, inline="always")
+@_lane_step
 def _window_sums(a, hist, chunk, j, n, zj, zn, vj, f1, dwj, in_window, n_burn, dt, stroke,
                  energy, hist_bins, hist_lo, hist_scale):  # fmt: skip
     """Lane j's step n into its sums: the stroke's statistics, then the window's averages.
@@ -866,16 +874,19 @@ def _window_sums(a, hist, chunk, j, n, zj, zn, vj, f1, dwj, in_window, n_burn, d
                 hist[chunk, 1, bv] += 1
 
 
-@numba.njit(cache=True, inline="always")
-def _increment(dw, row, n, rng, j, tables, sqdt):
-    """Lane j's Brownian increment dW (s^0.5) of step n: given (``dw`` not empty) or drawn."""
+@_lane_step
+def _increment(dw, row, n, rng, j, ki, wi, fi, sqdt):
+    """Lane j's Brownian increment dW (s^0.5) of step n: given (``dw`` not empty) or drawn.
+
+    The ziggurat's tables come one by one: a tuple of arrays built at every
+    step costs reference counts (numba increments each array's).
+    """
     if dw.shape[0] > 0:
         return dw[row, n]
-    ki, wi, fi = tables
     return sqdt * standard_normal(rng, j, ki, wi, fi)
 
 
-@numba.njit(cache=True, inline="always")
+@_lane_step
 def _companion_step(zc, vc, a, j, in_window, dt, noise, scheme, drift, fr_p, fr_fn):
     """Lane j's friction-free companion: its window sums, then its step on the same noise."""
     zcj = zc[j]
@@ -886,7 +897,7 @@ def _companion_step(zc, vc, a, j, in_window, dt, noise, scheme, drift, fr_p, fr_
     zc[j], vc[j], _, _ = scheme_step(zcj, vcj, 0.0, dt, noise, scheme, drift, 0, fr_p, fr_fn)
 
 
-@numba.njit(cache=True, inline="always")
+@_lane_step
 def _record_step(records, row, n, every, z, v, th, j):
     """Lane j's (z, v, theta) after step n into the recorded history, if recorded."""
     if row < records.shape[0] and (n + 1) % every == 0:
@@ -896,7 +907,7 @@ def _record_step(records, row, n, every, z, v, th, j):
         records[row, r, 2] = th[j]
 
 
-@numba.njit(cache=True, inline="always")
+@_lane_step
 def _failed_lanes(failed, start, lanes, n, z, v, th):
     """Mark the lanes whose state is no longer finite after step n; True if any."""
     stopped = False
@@ -969,7 +980,7 @@ def lean_loop(scheme, device, friction, timing, paths, initial, companion, recor
         for n in range(n_steps):
             in_window = n >= n_burn
             for j in range(lanes):
-                dwj = _increment(dw, start + j, n, rng, j, (ki, wi, fi), sqdt)
+                dwj = _increment(dw, start + j, n, rng, j, ki, wi, fi, sqdt)
                 noise = noise_amp * dwj
                 zj = z[j]
                 vj = v[j]
@@ -1040,7 +1051,7 @@ def _rectifier_constants(rectifier, dt, has_aux, block):
     return rectifier.kind != 0, rect, (half_cp, half_c, rp[3]), rectifier.v_c0, rblock
 
 
-@numba.njit(cache=True, inline="always")
+@_lane_step
 def _bridged_lane(a, j, at_burn, in_window, lane, x1, x2, x3, s1, s2, dt, noise, scheme, drift,
                   friction, rect, stored, has_aux, rblock):  # fmt: skip
     """Lane j's step through the bridge; its stored energy and losses into the window's sums.
@@ -1073,7 +1084,7 @@ def _bridged_lane(a, j, at_burn, in_window, lane, x1, x2, x3, s1, s2, dt, noise,
     return zn, vn, tn, f1
 
 
-@numba.njit(cache=True, inline="always")
+@_lane_step
 def _auxiliary_lane(a, j, in_window, lane, x1, x2, x3, row, filter_only, dt, noise, scheme,
                     drift, friction, step_block):  # fmt: skip
     """Lane j's step with the auxiliary states (:func:`filter_step` or :func:`auxiliary_step`).
@@ -1100,7 +1111,7 @@ def _auxiliary_lane(a, j, in_window, lane, x1, x2, x3, row, filter_only, dt, noi
     return zn, vn, tn, f1
 
 
-@numba.njit(cache=True, inline="always")
+@_lane_step
 def _event_sums(peak, integrals, square, j, zn, vj, vn, dt, has_aux, row, x1, x2, x3):
     """Lane j's event sums after its step: the peak |z|, int v^2 dt and int (P x)^2 dt."""
     peak[j] = max(peak[j], abs(zn))
@@ -1179,7 +1190,7 @@ def full_loop(scheme, device, friction, timing, paths, initial, companion, recor
                 if has_aux and not scale_noise:
                     step_block = _scaled_block(block, filter_mask, gain)
             for j in range(lanes):
-                dwj = _increment(dw, start + j, n, rng, j, (ki, wi, fi), sqdt)
+                dwj = _increment(dw, start + j, n, rng, j, ki, wi, fi, sqdt)
                 noise = noise_amp * dwj
                 if timed and scale_noise:
                     noise = noise * gain
