@@ -82,8 +82,8 @@ MUTATIONS: tuple[Mutation, ...] = (
         path="randvib/montecarlo/kernel.py",
         edits=(
             (
-                "dwj = sqdt * standard_normal(rng, j, ki, wi, fi)",
-                "dwj = 1.004987562112089 * sqdt * standard_normal(rng, j, ki, wi, fi)",
+                "return sqdt * standard_normal(rng, j, ki, wi, fi)",
+                "return 1.004987562112089 * sqdt * standard_normal(rng, j, ki, wi, fi)",
             ),
         ),
         tests=("tests/test_simulation.py::test_linear_oscillator_continuous_time_variances",),

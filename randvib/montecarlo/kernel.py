@@ -655,8 +655,9 @@ def _snapshots(snapshots, snap, k, state, start, lanes, z, v, square, peak):
 
 
 @numba.njit(cache=True, inline="always")
-def _forced_increment(n, dt, row, omega, gain, phase, kicks):
+def _forced_increment(n, dt, row, forcing):
     """u_n of :class:`Forcing` for the batch's path ``row`` at step ``n`` (m/s)."""
+    omega, gain, phase, kicks = forcing
     u = kicks[row, n] if kicks.shape[0] > 0 else 0.0
     t = (n + 0.5) * dt
     for q in range(omega.shape[0]):
@@ -682,14 +683,14 @@ def run_ensemble(
 ):
     """Integrate ``paths.count`` paths and return per-path time averages.
 
-    Two compiled loops (:func:`ensemble_loop`), so that a run compiles at most
-    twice on a cold cache: without any optional group (white noise, resistive
-    circuit: the common and benchmarked case, every optional branch pruned
-    when compiling) and with every group given, the missing ones as their
-    empty stand-ins (:data:`NO_AUXILIARY`, :data:`NO_TRANSIENT`,
-    :data:`NO_RECTIFIER`, :data:`NO_FORCING`) that the loop recognises at run
-    time. Both take the same operations in the same order for a given case,
-    so the results are the same bit for bit whichever runs it.
+    Two compiled loops, so that a run compiles at most twice on a cold cache:
+    :func:`lean_loop` without any optional group (white noise, resistive
+    circuit: the common and benchmarked case, with none of the optional
+    branches), and :func:`full_loop` with every group given, the missing ones
+    as their empty stand-ins (:data:`NO_AUXILIARY`, :data:`NO_TRANSIENT`,
+    :data:`NO_RECTIFIER`, :data:`NO_FORCING`) that it recognises at run time.
+    Both take the same operations in the same order for a given case, so the
+    results are the same bit for bit whichever runs it.
 
     Parameters
     ----------
@@ -745,360 +746,495 @@ def run_ensemble(
     records : float64[n_record, n_records, 3]
     """
     groups = (auxiliary, transient, rectifier, forcing)
-    if any(group is not None for group in groups):  # the full loop: every group given
-        auxiliary = NO_AUXILIARY if auxiliary is None else auxiliary
-        transient = NO_TRANSIENT if transient is None else transient
-        rectifier = NO_RECTIFIER if rectifier is None else rectifier
-        forcing = NO_FORCING if forcing is None else forcing
-    return ensemble_loop(
-        scheme, device, friction, timing, paths, initial, companion, recording, noise,
-        auxiliary, stop, transient, rectifier, forcing,
+    if all(group is None for group in groups):
+        return lean_loop(
+            scheme, device, friction, timing, paths, initial, companion, recording, noise, stop
+        )
+    return full_loop(
+        scheme, device, friction, timing, paths, initial, companion, recording, noise, stop,
+        NO_AUXILIARY if auxiliary is None else auxiliary,
+        NO_TRANSIENT if transient is None else transient,
+        NO_RECTIFIER if rectifier is None else rectifier,
+        NO_FORCING if forcing is None else forcing,
     )  # fmt: skip
 
 
-@numba.njit(cache=True, parallel=True, nogil=True)
-def ensemble_loop(
-    scheme,
-    device,
-    friction,
-    timing,
-    paths,
-    initial,
-    companion,
-    recording,
-    noise,
-    auxiliary,
-    stop,
-    transient,
-    rectifier,
-    forcing,
-):
-    """The compiled loop of :func:`run_ensemble` (its parameters and returns).
+#: A step's pieces shared by the two loops: compiled once each, without reference
+#: counts (``_nrt=False``: they allocate nothing) and inlined by LLVM
+#: (``forceinline``). Inlined by numba instead (``inline="always"``), every array
+#: they take cost a reference count's increment and decrement per lane and step
+#: (about a quarter of the lean loop's time, measured).
+_lane_step = numba.njit(cache=True, _nrt=False, forceinline=True)
 
-    Compiled for two signatures only (:func:`run_ensemble`): the four optional
-    groups all None, their branches pruned when compiling (``X is not None``
-    on a None argument), or all given, some perhaps empty stand-ins, which the
-    flags ``has_aux``, ``timed``, ``bridged`` and ``forced`` recognise at run
-    time (loop-invariant branches, taken the same way at every step).
-    """
-    # Unpacked once into locals; the step takes the (float) scheme and drift groups.
-    m, c, k, k3, noise_amp = device
-    fr_kind, fr_p, fr_fn = friction
-    dt, n_steps, n_burn = timing
-    seed, first_path, n_paths = paths
-    init_random, init_z, init_v = initial
-    with_companion, comp_init_z, comp_init_v = companion
-    hist_lo, hist_hi, hist_bins, n_record, record_every, stroke = recording
-    dw, ki, wi, fi, given_start = noise
-    # `auxiliary is None` is decided when compiling (numba prunes the dead
-    # branch for a None argument): white noise with a resistive circuit runs the
-    # plain loop, bit for bit and at its own speed; any filter or circuit
-    # compiles one second specialisation. The block's coefficients go to the
-    # step as a tuple of floats (an array would cost a reference count per step).
-    filter_only = False
-    if auxiliary is not None:
-        n_aux = auxiliary.n
-        has_aux = n_aux > 0  # False: the full loop's empty block (NO_AUXILIARY)
-        ac = auxiliary.coefficients
-        block = (
-            ac[0], ac[1], ac[2], ac[3], ac[4], ac[5], ac[6], ac[7], ac[8], ac[9],
-            ac[10], ac[11], ac[12], ac[13], ac[14], ac[15], ac[16], ac[17], ac[18],
-        )  # fmt: skip
-        p1, p2, p3 = auxiliary.square[0], auxiliary.square[1], auxiliary.square[2]
-        # a 2-state filter alone (no circuit: no square, no velocity drive, g_v = 0)
-        filter_only = (
-            n_aux == 2
-            and p1 == 0.0
-            and p2 == 0.0
-            and p3 == 0.0
-            and ac[9] == 0.0
-            and ac[10] == 0.0
-            and ac[18] == 0.0
-        )
-        chol = auxiliary.start
-    if transient is not None:
-        timed = transient.gain.shape[0] > 0  # False: NO_TRANSIENT
-        gains = transient.gain
-        snap = transient.snap_steps
-        snapshots = transient.snapshots
-        event_out = transient.event  # outputs and inputs read once, outside the parallel loop
-        scale_noise = transient.scale_noise
-        filter_mask = transient.filter_mask
-        n_start = transient.n_start
-        filter_start = transient.start
-    if rectifier is not None:
-        bridged = rectifier.kind != 0  # False: NO_RECTIFIER
-        rp = rectifier.p
-        rect = bridge_constants(rectifier.kind, rectifier.output, rp, dt)
-        # energy held by the piezo's and the storage capacitor's voltages: C_p/2, C/2
-        # the piezo's C_p V_p^2 / 2, or the coil's L i^2 / 2 (s1 is V_p or i)
-        half_cp = 0.5 * rp[1] if rectifier.kind == 2 else 0.5 * rp[8]
-        half_c = 0.5 * rp[4] if rectifier.output == 1 else 0.0
-        v_c0 = rectifier.v_c0
-        v_out_b = rp[3]
-        # white or given input: no filter, the noise drives the velocity (g_v = 1)
-        rblock = (
-            0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
-            0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0,
-        )  # fmt: skip
-        if auxiliary is not None:
-            if has_aux:
-                rblock = block
-    if forcing is not None:
-        f_omega, f_gain, f_phase, f_kicks = forcing
-        forced = f_omega.shape[0] > 0 or f_kicks.shape[0] > 0  # False: NO_FORCING
-    n_chunks = (n_paths + LANES - 1) // LANES
+
+# The two loops share the pieces below. Those of a step are inlined into the
+# loop's parallel body (inline="always": numba inlines them before compiling,
+# so the body compiles to what it would be written out). Those of the set-up,
+# called once per run, are not: inlined there, numba's array analysis of the
+# parallel loop mistook their returned tuples' entries for arrays' shapes (an
+# AssertionError when compiling). The arrays a chunk integrates are allocated in
+# the loops themselves, not in a helper, as a precaution: numba's parfor pass
+# hoists an allocation out of the parallel loop where it sees no write to it.
+@numba.njit(cache=True)
+def _outputs(n_paths, n_chunks, n_steps, recording):
+    """(acc, failed, hist, records): the arrays a loop returns, zeroed."""
+    hist_bins, n_record, record_every = recording[2], recording[3], recording[4]
     acc = np.zeros((n_paths, N_ACC))
     failed = np.full(n_paths, -1, dtype=np.int64)
     hist = np.zeros((n_chunks if hist_bins > 0 else 0, 2, max(hist_bins, 1)), dtype=np.int64)
     n_rec_points = n_steps // record_every + 1 if n_record > 0 else 0
     records = np.zeros((n_record, n_rec_points, 3))
-    given_noise = dw.shape[0] > 0
-    given_states = given_start.shape[0] > 0
-    inv_m = 1.0 / m
-    drift = (inv_m, c, k, k3)
+    return acc, failed, hist, records
+
+
+@numba.njit(cache=True)
+def _window_constants(timing, recording):
+    """(window (s), 1 / window's steps, sqrt(dt), (bins per m, bins per m/s)): the scales.
+
+    The last pair is that of :class:`Recording`'s (z, v) histogram.
+    """
+    dt, n_steps, n_burn = timing
+    hist_lo, hist_hi, hist_bins = recording[0], recording[1], recording[2]
     window = (n_steps - n_burn) * dt
     inv_window_steps = 1.0 / (n_steps - n_burn)
-    sqdt = np.sqrt(dt)
     hist_scale_z = hist_bins / (hist_hi[0] - hist_lo[0]) if hist_bins > 0 else 0.0
     hist_scale_v = hist_bins / (hist_hi[1] - hist_lo[1]) if hist_bins > 0 else 0.0
+    return window, inv_window_steps, np.sqrt(dt), (hist_scale_z, hist_scale_v)
 
+
+@numba.njit(cache=True, inline="always")
+def _start_lane(z, v, zc, vc, x1, x2, x3, j, row, rng, tables, given_start, initial, companion,
+                chol, n_drawn):  # fmt: skip
+    """Lane j's start (path ``row`` of the batch): given, random or fixed.
+
+    A random start draws the device's two normals, then ``n_drawn`` for the
+    auxiliary states (L = ``chol``), from the lane's stream. The lanes' arrays
+    are passed one by one, never in a tuple: numba's parallel loop does not
+    follow a write through a tuple's entry and dropped it as dead.
+    """
+    ki, wi, fi = tables
+    init_random, init_z, init_v = initial
+    comp_init_z, comp_init_v = companion[1], companion[2]
+    if given_start.shape[0] > 0:
+        z[j] = given_start[row, 0]
+        v[j] = given_start[row, 1]
+        x1[j] = given_start[row, 2]
+        x2[j] = given_start[row, 3]
+        x3[j] = given_start[row, 4]
+    elif init_random:
+        nz = standard_normal(rng, j, ki, wi, fi)
+        nv = standard_normal(rng, j, ki, wi, fi)
+        z[j] = init_z * nz
+        v[j] = init_v * nv
+        zc[j] = comp_init_z * nz
+        vc[j] = comp_init_v * nv
+        if n_drawn > 0:
+            x1[j], x2[j], x3[j] = _drawn_states(rng, j, ki, wi, fi, chol, n_drawn)
+    else:
+        z[j] = init_z
+        v[j] = init_v
+        zc[j] = comp_init_z
+        vc[j] = comp_init_v
+
+
+@_lane_step
+def _window_sums(a, hist, chunk, j, n, zj, zn, vj, f1, dwj, in_window, n_burn, dt, stroke,
+                 energy, hist_bins, hist_lo, hist_scale):  # fmt: skip
+    """Lane j's step n into its sums: the stroke's statistics, then the window's averages.
+
+    ``energy`` is (m, k, k3) for the device's energy at the window's start;
+    ``hist_scale`` as :func:`_window_constants` returns it.
+    """
+    m, k, k3 = energy
+    hist_scale_z, hist_scale_v = hist_scale
+    if in_window:  # the path's peak and its up-crossings of the stroke
+        if abs(zj) > a[j, ACC_PEAK]:
+            a[j, ACC_PEAK] = abs(zj)
+        if abs(zj) <= stroke and abs(zn) > stroke:
+            a[j, ACC_UPCROSS] += 1.0
+    if abs(zj) > stroke:
+        if a[j, ACC_FIRST_HIT] < 0.0:
+            a[j, ACC_FIRST_HIT] = n * dt
+        if in_window:
+            a[j, ACC_BEYOND] += 1.0
+    if in_window:
+        if n == n_burn:
+            a[j, ACC_H0] += 0.5 * m * vj * vj + 0.5 * k * zj * zj + 0.25 * k3 * zj**4
+        a[j, ACC_V2] += vj * vj
+        a[j, ACC_Z2] += zj * zj
+        a[j, ACC_ABS_V] += abs(vj)
+        a[j, ACC_VF] += vj * f1
+        a[j, ACC_VDW] += vj * dwj
+        if hist_bins > 0:
+            bz = int(np.floor((zj - hist_lo[0]) * hist_scale_z))
+            bv = int(np.floor((vj - hist_lo[1]) * hist_scale_v))
+            if 0 <= bz < hist_bins:
+                hist[chunk, 0, bz] += 1
+            if 0 <= bv < hist_bins:
+                hist[chunk, 1, bv] += 1
+
+
+@_lane_step
+def _increment(dw, row, n, rng, j, ki, wi, fi, sqdt):
+    """Lane j's Brownian increment dW (s^0.5) of step n: given (``dw`` not empty) or drawn.
+
+    The ziggurat's tables come one by one: a tuple of arrays built at every
+    step costs reference counts (numba increments each array's).
+    """
+    if dw.shape[0] > 0:
+        return dw[row, n]
+    return sqdt * standard_normal(rng, j, ki, wi, fi)
+
+
+@_lane_step
+def _companion_step(zc, vc, a, j, in_window, dt, noise, scheme, drift, fr_p, fr_fn):
+    """Lane j's friction-free companion: its window sums, then its step on the same noise."""
+    zcj = zc[j]
+    vcj = vc[j]
+    if in_window:
+        a[j, ACC_COMP_V2] += vcj * vcj
+        a[j, ACC_COMP_Z2] += zcj * zcj
+    zc[j], vc[j], _, _ = scheme_step(zcj, vcj, 0.0, dt, noise, scheme, drift, 0, fr_p, fr_fn)
+
+
+@_lane_step
+def _record_step(records, row, n, every, z, v, th, j):
+    """Lane j's (z, v, theta) after step n into the recorded history, if recorded."""
+    if row < records.shape[0] and (n + 1) % every == 0:
+        r = (n + 1) // every
+        records[row, r, 0] = z[j]
+        records[row, r, 1] = v[j]
+        records[row, r, 2] = th[j]
+
+
+@_lane_step
+def _failed_lanes(failed, start, lanes, n, z, v, th):
+    """Mark the lanes whose state is no longer finite after step n; True if any."""
+    stopped = False
+    for j in range(lanes):
+        if not (np.isfinite(z[j]) and np.isfinite(v[j]) and np.isfinite(th[j])):
+            failed[start + j] = n + 1
+            stopped = True
+    return stopped
+
+
+@numba.njit(cache=True, inline="always")
+def _finish_lane(a, j, zj, vj, energy, stroke, t_end):
+    """Lane j's end: its energy, a first hit by the final state, its peak."""
+    m, k, k3 = energy
+    a[j, ACC_H1] = 0.5 * m * vj * vj + 0.5 * k * zj * zj + 0.25 * k3 * zj**4
+    if abs(zj) > stroke and a[j, ACC_FIRST_HIT] < 0.0:
+        a[j, ACC_FIRST_HIT] = t_end  # the final state
+    a[j, ACC_PEAK] = max(a[j, ACC_PEAK], abs(zj))
+
+
+@numba.njit(cache=True, inline="always")
+def _write_lane(acc, a, j, p, window, inv_window_steps):
+    """Lane j's sums into path p's row of ``acc``: averages over the window's steps or time."""
+    for q in range(N_ACC):
+        if q == ACC_H0 or q == ACC_H1 or q == ACC_FIRST_HIT:
+            acc[p, q] = a[j, q]
+        elif q == ACC_PEAK or q == ACC_UPCROSS:  # a largest value and a count
+            acc[p, q] = a[j, q]
+        elif q == ACC_VDW or q == ACC_STORED or q == ACC_COIL_LOSS or q == ACC_DIODE_LOSS:
+            acc[p, q] = a[j, q] / window
+        else:
+            acc[p, q] = a[j, q] * inv_window_steps
+
+
+@numba.njit(cache=True, parallel=True, nogil=True)
+def lean_loop(scheme, device, friction, timing, paths, initial, companion, recording, noise, stop):
+    """:func:`run_ensemble`'s loop without optional groups: white noise, resistive circuit.
+
+    The common and benchmarked case: none of :func:`full_loop`'s run-time
+    branches for a filter, a circuit, an event, a bridge or forcing is here.
+    """
+    m, c, k, k3, noise_amp = device
+    fr_kind, fr_p, fr_fn = friction
+    dt, n_steps, n_burn = timing
+    seed, first_path, n_paths = paths
+    with_companion = companion[0]
+    hist_lo, _, hist_bins, n_record, record_every, stroke = recording
+    dw, ki, wi, fi, given_start = noise
+    n_chunks = (n_paths + LANES - 1) // LANES
+    acc, failed, hist, records = _outputs(n_paths, n_chunks, n_steps, recording)
+    window, inv_window_steps, sqdt, hist_scale = _window_constants(timing, recording)
+    drift = (1.0 / m, c, k, k3)
+    no_chol = np.zeros((0, 0))
     for chunk in numba.prange(n_chunks):
         start = chunk * LANES
         lanes = min(LANES, n_paths - start)
         rng = np.empty((LANES, 4), dtype=np.uint64)
-        z = np.zeros(LANES)
-        v = np.zeros(LANES)
-        th = np.zeros(LANES)
-        zc = np.zeros(LANES)
-        vc = np.zeros(LANES)
-        x1 = np.zeros(LANES)
-        x2 = np.zeros(LANES)
-        x3 = np.zeros(LANES)
+        z, v, th = np.zeros(LANES), np.zeros(LANES), np.zeros(LANES)
+        zc, vc = np.zeros(LANES), np.zeros(LANES)
+        x1, x2, x3 = np.zeros(LANES), np.zeros(LANES), np.zeros(LANES)
         a = np.zeros((LANES, N_ACC))
         a[:, ACC_FIRST_HIT] = -1.0
-        if rectifier is not None:
-            s1 = np.zeros(LANES)  # piezo voltage V_p (V), or the inductive coil's current (A)
-            s2 = np.full(LANES, v_c0)  # storage capacitor voltage V_C (V)
-        if auxiliary is not None:
-            step_block = block
-        if transient is not None:
-            peak = np.zeros(LANES)
-            square = np.zeros(LANES)  # P x of the circuit state, for int (P x)^2 dt
-            integrals = np.zeros((LANES, 2))
         for j in range(lanes):
             seed_path_state(seed, first_path + start + j, rng, j)
-            if given_states:
-                z[j] = given_start[start + j, 0]
-                v[j] = given_start[start + j, 1]
-                x1[j] = given_start[start + j, 2]
-                x2[j] = given_start[start + j, 3]
-                x3[j] = given_start[start + j, 4]
-            elif init_random:
-                nz = standard_normal(rng, j, ki, wi, fi)
-                nv = standard_normal(rng, j, ki, wi, fi)
-                z[j] = init_z * nz
-                v[j] = init_v * nv
-                zc[j] = comp_init_z * nz
-                vc[j] = comp_init_v * nv
-                if auxiliary is not None and has_aux:
-                    n1 = standard_normal(rng, j, ki, wi, fi)
-                    x1[j] = chol[0, 0] * n1
-                    if n_aux > 1:
-                        n2 = standard_normal(rng, j, ki, wi, fi)
-                        x2[j] = chol[1, 0] * n1 + chol[1, 1] * n2
-                        if n_aux > 2:
-                            n3 = standard_normal(rng, j, ki, wi, fi)
-                            x3[j] = chol[2, 0] * n1 + chol[2, 1] * n2 + chol[2, 2] * n3
-            else:
-                z[j] = init_z
-                v[j] = init_v
-                zc[j] = comp_init_z
-                vc[j] = comp_init_v
-            if transient is not None and timed:
-                x1[j], x2[j], x3[j] = _drawn_states(rng, j, ki, wi, fi, filter_start, n_start)
-                peak[j] = abs(z[j])
-                if auxiliary is not None and has_aux:
-                    square[j] = p1 * x1[j] + p2 * x2[j] + p3 * x3[j]
+            _start_lane(z, v, zc, vc, x1, x2, x3, j, start + j, rng, (ki, wi, fi), given_start,
+                        initial, companion, no_chol, 0)  # fmt: skip
             if start + j < n_record:
                 records[start + j, 0, 0] = z[j]
                 records[start + j, 0, 1] = v[j]
-        stopped = False
-        if transient is not None:
-            next_snap = _snapshots(snapshots, snap, 0, 0, start, lanes, z, v, square, peak)
         for n in range(n_steps):
             in_window = n >= n_burn
-            if transient is not None and timed:
-                gain = gains[n]
-                if auxiliary is not None and has_aux:
-                    if not scale_noise:
-                        step_block = _scaled_block(block, filter_mask, gain)
             for j in range(lanes):
-                if given_noise:
-                    dwj = dw[start + j, n]
-                else:
-                    dwj = sqdt * standard_normal(rng, j, ki, wi, fi)
+                dwj = _increment(dw, start + j, n, rng, j, ki, wi, fi, sqdt)
                 noise = noise_amp * dwj
-                if transient is not None and timed:
-                    if scale_noise:
-                        noise = noise * gain
                 zj = z[j]
                 vj = v[j]
-                tj = th[j]
-                vs = vj  # the velocity the step starts from: with forcing, after its half kick
-                if forcing is not None and forced:
-                    kick = 0.5 * _forced_increment(
-                        n, dt, start + j, f_omega, f_gain, f_phase, f_kicks
-                    )
-                    vs = vj + kick
-                if rectifier is not None and bridged:
-                    if in_window and n == n_burn:
-                        a[j, ACC_H0] = half_cp * s1[j] * s1[j] + half_c * s2[j] * s2[j]
-                    v_out = v_out_b if rect[1] == 0 else s2[j]  # at the step's start
-                    if auxiliary is not None and has_aux:
-                        zn, vn, tn, x1[j], x2[j], x3[j], s1[j], s2[j], f1, e_s, e_c, e_d = (
-                            rectified_step(
-                                zj, vs, tj, x1[j], x2[j], x3[j], s1[j], s2[j], dt, noise,
-                                scheme, drift, fr_kind, fr_p, fr_fn, rblock, rect,
-                            )
-                        )  # fmt: skip
-                    else:
-                        zn, vn, tn, s1[j], s2[j], f1, e_s, e_c, e_d = rectified_white_step(
-                            zj, vs, tj, s1[j], s2[j], dt, noise, scheme, drift, fr_kind,
-                            fr_p, fr_fn, rect,
-                        )  # fmt: skip
-                    if in_window:
-                        # energies (J); divided by the window (s) at the end
-                        a[j, ACC_STORED] += e_s
-                        a[j, ACC_COIL_LOSS] += e_c
-                        a[j, ACC_DIODE_LOSS] += e_d
-                        a[j, ACC_V_OUT] += v_out
-                elif auxiliary is not None and has_aux and filter_only:
-                    zn, vn, tn, x1[j], x2[j], f1 = filter_step(
-                        zj,
-                        vs,
-                        tj,
-                        x1[j],
-                        x2[j],
-                        dt,
-                        noise,
-                        scheme,
-                        drift,
-                        fr_kind,
-                        fr_p,
-                        fr_fn,
-                        step_block,
-                    )
-                elif auxiliary is not None and has_aux:
-                    x1j = x1[j]
-                    x2j = x2[j]
-                    x3j = x3[j]
-                    if in_window:
-                        sq = p1 * x1j + p2 * x2j + p3 * x3j
-                        a[j, ACC_CIRCUIT2] += sq * sq
-                    zn, vn, tn, x1[j], x2[j], x3[j], f1 = auxiliary_step(
-                        zj,
-                        vs,
-                        tj,
-                        x1j,
-                        x2j,
-                        x3j,
-                        dt,
-                        noise,
-                        scheme,
-                        drift,
-                        fr_kind,
-                        fr_p,
-                        fr_fn,
-                        step_block,
-                    )
-                else:
-                    zn, vn, tn, f1 = scheme_step(
-                        zj, vs, tj, dt, noise, scheme, drift, fr_kind, fr_p, fr_fn
-                    )
-                if forcing is not None and forced:
-                    vn += kick
-                if in_window:  # the path's peak and its up-crossings of the stroke
-                    if abs(zj) > a[j, ACC_PEAK]:
-                        a[j, ACC_PEAK] = abs(zj)
-                    if abs(zj) <= stroke and abs(zn) > stroke:
-                        a[j, ACC_UPCROSS] += 1.0
-                if abs(zj) > stroke:
-                    if a[j, ACC_FIRST_HIT] < 0.0:
-                        a[j, ACC_FIRST_HIT] = n * dt
-                    if in_window:
-                        a[j, ACC_BEYOND] += 1.0
-                if in_window:
-                    if n == n_burn:
-                        a[j, ACC_H0] += 0.5 * m * vj * vj + 0.5 * k * zj * zj + 0.25 * k3 * zj**4
-                    a[j, ACC_V2] += vj * vj
-                    a[j, ACC_Z2] += zj * zj
-                    a[j, ACC_ABS_V] += abs(vj)
-                    a[j, ACC_VF] += vj * f1
-                    a[j, ACC_VDW] += vj * dwj
-                    if hist_bins > 0:
-                        bz = int(np.floor((zj - hist_lo[0]) * hist_scale_z))
-                        bv = int(np.floor((vj - hist_lo[1]) * hist_scale_v))
-                        if 0 <= bz < hist_bins:
-                            hist[chunk, 0, bz] += 1
-                        if 0 <= bv < hist_bins:
-                            hist[chunk, 1, bv] += 1
+                zn, vn, tn, f1 = scheme_step(
+                    zj, vj, th[j], dt, noise, scheme, drift, fr_kind, fr_p, fr_fn
+                )
+                _window_sums(a, hist, chunk, j, n, zj, zn, vj, f1, dwj, in_window, n_burn, dt,
+                             stroke, (m, k, k3), hist_bins, hist_lo, hist_scale)  # fmt: skip
                 z[j] = zn
                 v[j] = vn
                 th[j] = tn
-                if transient is not None and timed:
-                    peak[j] = max(peak[j], abs(zn))
-                    integrals[j, 0] += 0.5 * dt * (vj * vj + vn * vn)
-                    if auxiliary is not None and has_aux:
-                        sq = p1 * x1[j] + p2 * x2[j] + p3 * x3[j]
-                        integrals[j, 1] += 0.5 * dt * (square[j] * square[j] + sq * sq)
-                        square[j] = sq
                 if with_companion:
-                    zcj = zc[j]
-                    vcj = vc[j]
-                    if in_window:
-                        a[j, ACC_COMP_V2] += vcj * vcj
-                        a[j, ACC_COMP_Z2] += zcj * zcj
-                    zc[j], vc[j], _, _ = scheme_step(
-                        zcj, vcj, 0.0, dt, noise, scheme, drift, 0, fr_p, fr_fn
-                    )
-                if start + j < n_record and (n + 1) % record_every == 0:
-                    r = (n + 1) // record_every
-                    records[start + j, r, 0] = z[j]
-                    records[start + j, r, 1] = v[j]
-                    records[start + j, r, 2] = th[j]
-            if transient is not None and timed:
-                next_snap = _snapshots(
-                    snapshots, snap, next_snap, n + 1, start, lanes, z, v, square, peak
-                )
+                    _companion_step(zc, vc, a, j, in_window, dt, noise, scheme, drift, fr_p, fr_fn)
+                _record_step(records, start + j, n, record_every, z, v, th, j)
             if (n + 1) % CHECK_EVERY == 0 or n == n_steps - 1:
-                for j in range(lanes):
-                    if not (np.isfinite(z[j]) and np.isfinite(v[j]) and np.isfinite(th[j])):
-                        failed[start + j] = n + 1
-                        stopped = True
-                if stopped or stop[0] != 0:
+                if _failed_lanes(failed, start, lanes, n, z, v, th) or stop[0] != 0:
                     break
         for j in range(lanes):
-            p = start + j
-            zj = z[j]
-            vj = v[j]
-            a[j, ACC_H1] = 0.5 * m * vj * vj + 0.5 * k * zj * zj + 0.25 * k3 * zj**4
-            if rectifier is not None and bridged:
-                a[j, ACC_H1] += half_cp * s1[j] * s1[j] + half_c * s2[j] * s2[j]
-            if abs(zj) > stroke and a[j, ACC_FIRST_HIT] < 0.0:
-                a[j, ACC_FIRST_HIT] = n_steps * dt  # the final state
-            a[j, ACC_PEAK] = max(a[j, ACC_PEAK], abs(zj))
-            if transient is not None and timed:
-                event_out[p, EVENT_PEAK] = peak[j]
-                event_out[p, EVENT_V2] = integrals[j, 0]
-                event_out[p, EVENT_X2] = integrals[j, 1]
-            for q in range(N_ACC):
-                if q == ACC_H0 or q == ACC_H1 or q == ACC_FIRST_HIT:
-                    acc[p, q] = a[j, q]
-                elif q == ACC_PEAK or q == ACC_UPCROSS:  # a largest value and a count
-                    acc[p, q] = a[j, q]
-                elif q == ACC_VDW or q == ACC_STORED or q == ACC_COIL_LOSS or q == ACC_DIODE_LOSS:
-                    acc[p, q] = a[j, q] / window
+            _finish_lane(a, j, z[j], v[j], (m, k, k3), stroke, n_steps * dt)
+            _write_lane(acc, a, j, start + j, window, inv_window_steps)
+    return acc, failed, hist, records
+
+
+@numba.njit(cache=True)
+def _auxiliary_constants(auxiliary):
+    """(n, in use, block, P row, filter alone, L) of an :class:`Auxiliary` group.
+
+    The block's coefficients go to the step as a tuple of floats (an array
+    would cost a reference count per step). "Filter alone": a 2-state filter
+    without a circuit (no square, no velocity drive, g_v = 0), stepped by
+    :func:`filter_step`.
+    """
+    n_aux = auxiliary.n
+    ac = auxiliary.coefficients
+    block = (
+        ac[0], ac[1], ac[2], ac[3], ac[4], ac[5], ac[6], ac[7], ac[8], ac[9],
+        ac[10], ac[11], ac[12], ac[13], ac[14], ac[15], ac[16], ac[17], ac[18],
+    )  # fmt: skip
+    p1, p2, p3 = auxiliary.square[0], auxiliary.square[1], auxiliary.square[2]
+    filter_only = (n_aux == 2 and p1 == 0.0 and p2 == 0.0 and p3 == 0.0 and ac[9] == 0.0
+                   and ac[10] == 0.0 and ac[18] == 0.0)  # fmt: skip
+    # n_aux 0: the full loop's empty block (NO_AUXILIARY)
+    return n_aux, n_aux > 0, block, (p1, p2, p3), filter_only, auxiliary.start
+
+
+@numba.njit(cache=True)
+def _rectifier_constants(rectifier, dt, has_aux, block):
+    """(bridged, constants, stored energy's factors, V_C(0), the block it steps with).
+
+    ``constants``: :func:`~randvib.montecarlo.rectified_kernel.bridge_constants`
+    (shared with the record simulation of a bridge). The factors are those of
+    the energy held by the piezo's C_p V_p^2 / 2 or the coil's L i^2 / 2 (the
+    state s1 is V_p or i) and by the storage capacitor's C V_C^2 / 2, and the
+    battery's V_b. White or given input has no filter: the noise drives the
+    velocity (g_v = 1).
+    """
+    rp = rectifier.p
+    rect = bridge_constants(rectifier.kind, rectifier.output, rp, dt)
+    half_cp = 0.5 * rp[1] if rectifier.kind == 2 else 0.5 * rp[8]
+    half_c = 0.5 * rp[4] if rectifier.output == 1 else 0.0
+    rblock = (
+        0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+        0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0,
+    )  # fmt: skip
+    if has_aux:
+        rblock = block
+    # kind 0: the full loop's stand-in (NO_RECTIFIER)
+    return rectifier.kind != 0, rect, (half_cp, half_c, rp[3]), rectifier.v_c0, rblock
+
+
+@_lane_step
+def _bridged_lane(a, j, at_burn, in_window, lane, x1, x2, x3, s1, s2, dt, noise, scheme, drift,
+                  friction, rect, stored, has_aux, rblock):  # fmt: skip
+    """Lane j's step through the bridge; its stored energy and losses into the window's sums.
+
+    ``lane`` is (z, v after the forcing's half kick, theta); x1, x2, x3 and
+    s1, s2 the lanes' auxiliary and circuit states, updated here; ``stored``
+    as :func:`_rectifier_constants` returns it. Returns (z, v, theta, force).
+    """
+    zj, vs, tj = lane
+    fr_kind, fr_p, fr_fn = friction
+    half_cp, half_c, v_out_b = stored
+    if in_window and at_burn:
+        a[j, ACC_H0] = half_cp * s1[j] * s1[j] + half_c * s2[j] * s2[j]
+    v_out = v_out_b if rect[1] == 0 else s2[j]  # at the step's start
+    if has_aux:
+        zn, vn, tn, x1[j], x2[j], x3[j], s1[j], s2[j], f1, e_s, e_c, e_d = rectified_step(
+            zj, vs, tj, x1[j], x2[j], x3[j], s1[j], s2[j], dt, noise, scheme, drift, fr_kind,
+            fr_p, fr_fn, rblock, rect,
+        )  # fmt: skip
+    else:
+        zn, vn, tn, s1[j], s2[j], f1, e_s, e_c, e_d = rectified_white_step(
+            zj, vs, tj, s1[j], s2[j], dt, noise, scheme, drift, fr_kind, fr_p, fr_fn, rect,
+        )  # fmt: skip
+    if in_window:
+        # energies (J); divided by the window (s) at the end
+        a[j, ACC_STORED] += e_s
+        a[j, ACC_COIL_LOSS] += e_c
+        a[j, ACC_DIODE_LOSS] += e_d
+        a[j, ACC_V_OUT] += v_out
+    return zn, vn, tn, f1
+
+
+@_lane_step
+def _auxiliary_lane(a, j, in_window, lane, x1, x2, x3, row, filter_only, dt, noise, scheme,
+                    drift, friction, step_block):  # fmt: skip
+    """Lane j's step with the auxiliary states (:func:`filter_step` or :func:`auxiliary_step`).
+
+    ``row`` is P, whose (P x)^2 the window averages (``ACC_CIRCUIT2``).
+    Returns (z, v, theta, force).
+    """
+    zj, vs, tj = lane
+    fr_kind, fr_p, fr_fn = friction
+    if filter_only:
+        zn, vn, tn, x1[j], x2[j], f1 = filter_step(
+            zj, vs, tj, x1[j], x2[j], dt, noise, scheme, drift, fr_kind, fr_p, fr_fn, step_block
+        )  # fmt: skip
+        return zn, vn, tn, f1
+    x1j = x1[j]
+    x2j = x2[j]
+    x3j = x3[j]
+    if in_window:
+        sq = row[0] * x1j + row[1] * x2j + row[2] * x3j
+        a[j, ACC_CIRCUIT2] += sq * sq
+    zn, vn, tn, x1[j], x2[j], x3[j], f1 = auxiliary_step(
+        zj, vs, tj, x1j, x2j, x3j, dt, noise, scheme, drift, fr_kind, fr_p, fr_fn, step_block
+    )  # fmt: skip
+    return zn, vn, tn, f1
+
+
+@_lane_step
+def _event_sums(peak, integrals, square, j, zn, vj, vn, dt, has_aux, row, x1, x2, x3):
+    """Lane j's event sums after its step: the peak |z|, int v^2 dt and int (P x)^2 dt."""
+    peak[j] = max(peak[j], abs(zn))
+    integrals[j, 0] += 0.5 * dt * (vj * vj + vn * vn)
+    if has_aux:
+        sq = row[0] * x1[j] + row[1] * x2[j] + row[2] * x3[j]
+        integrals[j, 1] += 0.5 * dt * (square[j] * square[j] + sq * sq)
+        square[j] = sq
+
+
+@numba.njit(cache=True, inline="always")
+def _write_event(event_out, p, peak, integrals, j):
+    """Lane j's peak |z|, int v^2 dt and int (P x)^2 dt into path p's row of the event's output."""
+    event_out[p, EVENT_PEAK] = peak[j]
+    event_out[p, EVENT_V2] = integrals[j, 0]
+    event_out[p, EVENT_X2] = integrals[j, 1]
+
+
+@numba.njit(cache=True, parallel=True, nogil=True)
+def full_loop(scheme, device, friction, timing, paths, initial, companion, recording, noise, stop,
+              auxiliary, transient, rectifier, forcing):  # fmt: skip
+    """:func:`run_ensemble`'s loop with every optional group given (perhaps a stand-in).
+
+    The flags ``has_aux``, ``timed``, ``bridged`` and ``forced`` recognise the
+    stand-ins at run time: loop-invariant branches, taken the same way at
+    every step. A case takes the same operations in the same order as in
+    :func:`lean_loop`, so either gives the same results bit for bit.
+    """
+    m, c, k, k3, noise_amp = device
+    fr_kind, fr_p, fr_fn = friction
+    dt, n_steps, n_burn = timing
+    seed, first_path, n_paths = paths
+    with_companion = companion[0]
+    hist_lo, _, hist_bins, n_record, record_every, stroke = recording
+    dw, ki, wi, fi, given_start = noise
+    n_aux, has_aux, block, row, filter_only, chol = _auxiliary_constants(auxiliary)
+    gains, scale_noise, filter_mask, n_start, filter_start, snap, snapshots, event_out = transient
+    timed = gains.shape[0] > 0  # False: NO_TRANSIENT
+    bridged, rect, stored, v_c0, rblock = _rectifier_constants(rectifier, dt, has_aux, block)
+    forced = forcing.omega.shape[0] > 0 or forcing.kicks.shape[0] > 0  # False: NO_FORCING
+    n_chunks = (n_paths + LANES - 1) // LANES
+    acc, failed, hist, records = _outputs(n_paths, n_chunks, n_steps, recording)
+    window, inv_window_steps, sqdt, hist_scale = _window_constants(timing, recording)
+    drift = (1.0 / m, c, k, k3)
+    for chunk in numba.prange(n_chunks):
+        start = chunk * LANES
+        lanes = min(LANES, n_paths - start)
+        rng = np.empty((LANES, 4), dtype=np.uint64)
+        z, v, th = np.zeros(LANES), np.zeros(LANES), np.zeros(LANES)
+        zc, vc = np.zeros(LANES), np.zeros(LANES)
+        x1, x2, x3 = np.zeros(LANES), np.zeros(LANES), np.zeros(LANES)
+        a = np.zeros((LANES, N_ACC))
+        a[:, ACC_FIRST_HIT] = -1.0
+        # the piezo's voltage V_p (V) or the inductive coil's current (A); the storage V_C (V)
+        s1, s2 = np.zeros(LANES), np.full(LANES, v_c0)
+        step_block = block
+        # the event's peak |z|, P x (for int (P x)^2 dt) and the integrals
+        peak, square, integrals = np.zeros(LANES), np.zeros(LANES), np.zeros((LANES, 2))
+        for j in range(lanes):
+            seed_path_state(seed, first_path + start + j, rng, j)
+            _start_lane(z, v, zc, vc, x1, x2, x3, j, start + j, rng, (ki, wi, fi), given_start,
+                        initial, companion, chol, n_aux if has_aux else 0)  # fmt: skip
+            if timed:
+                x1[j], x2[j], x3[j] = _drawn_states(rng, j, ki, wi, fi, filter_start, n_start)
+                peak[j] = abs(z[j])
+                if has_aux:
+                    square[j] = row[0] * x1[j] + row[1] * x2[j] + row[2] * x3[j]
+            if start + j < n_record:
+                records[start + j, 0, 0] = z[j]
+                records[start + j, 0, 1] = v[j]
+        next_snap = _snapshots(snapshots, snap, 0, 0, start, lanes, z, v, square, peak)
+        for n in range(n_steps):
+            in_window = n >= n_burn
+            if timed:
+                gain = gains[n]
+                if has_aux and not scale_noise:
+                    step_block = _scaled_block(block, filter_mask, gain)
+            for j in range(lanes):
+                dwj = _increment(dw, start + j, n, rng, j, ki, wi, fi, sqdt)
+                noise = noise_amp * dwj
+                if timed and scale_noise:
+                    noise = noise * gain
+                zj = z[j]
+                vj = v[j]
+                vs = vj  # the velocity the step starts from: with forcing, after its half kick
+                if forced:
+                    kick = 0.5 * _forced_increment(n, dt, start + j, forcing)
+                    vs = vj + kick
+                lane = (zj, vs, th[j])
+                if bridged:
+                    zn, vn, tn, f1 = _bridged_lane(a, j, n == n_burn, in_window, lane, x1, x2, x3,
+                        s1, s2, dt, noise, scheme, drift, friction, rect, stored, has_aux,
+                        rblock)  # fmt: skip
+                elif has_aux:
+                    zn, vn, tn, f1 = _auxiliary_lane(a, j, in_window, lane, x1, x2, x3, row,
+                        filter_only, dt, noise, scheme, drift, friction, step_block)  # fmt: skip
                 else:
-                    acc[p, q] = a[j, q] * inv_window_steps
+                    zn, vn, tn, f1 = scheme_step(zj, vs, th[j], dt, noise, scheme, drift,
+                                                 fr_kind, fr_p, fr_fn)  # fmt: skip
+                if forced:
+                    vn += kick
+                _window_sums(a, hist, chunk, j, n, zj, zn, vj, f1, dwj, in_window, n_burn, dt,
+                             stroke, (m, k, k3), hist_bins, hist_lo, hist_scale)  # fmt: skip
+                z[j] = zn
+                v[j] = vn
+                th[j] = tn
+                if timed:
+                    _event_sums(peak, integrals, square, j, zn, vj, vn, dt, has_aux, row,
+                                x1, x2, x3)  # fmt: skip
+                if with_companion:
+                    _companion_step(zc, vc, a, j, in_window, dt, noise, scheme, drift, fr_p, fr_fn)
+                _record_step(records, start + j, n, record_every, z, v, th, j)
+            if timed:
+                next_snap = _snapshots(snapshots, snap, next_snap, n + 1, start, lanes, z, v,
+                                       square, peak)  # fmt: skip
+            if (n + 1) % CHECK_EVERY == 0 or n == n_steps - 1:
+                if _failed_lanes(failed, start, lanes, n, z, v, th) or stop[0] != 0:
+                    break
+        for j in range(lanes):
+            _finish_lane(a, j, z[j], v[j], (m, k, k3), stroke, n_steps * dt)
+            if bridged:
+                a[j, ACC_H1] += stored[0] * s1[j] * s1[j] + stored[1] * s2[j] * s2[j]
+            if timed:
+                _write_event(event_out, start + j, peak, integrals, j)
+            _write_lane(acc, a, j, start + j, window, inv_window_steps)
     return acc, failed, hist, records

@@ -8,8 +8,8 @@ into the output, the coil's resistance and the diodes. The bridge's side of
 both is shared: :func:`_bridge_rates` (force and state rates at a stage),
 :func:`_bridge_predictor` (the predictor's bridge states) and
 :func:`_bridge_update` (the step's bridge states and energy accounting).
-The loop (:func:`randvib.montecarlo.kernel.ensemble_loop`) compiles them into
-its full signature only, not into the lean white-noise one; the record
+The loop :func:`randvib.montecarlo.kernel.full_loop` compiles them, not the
+lean white-noise one (:func:`~randvib.montecarlo.kernel.lean_loop`); the record
 simulation of a bridge (:mod:`randvib.identification.record_bridge`) steps
 :func:`rectified_white_step` on a recorded input. Equations:
 docs/conventions.md, "Full-wave bridge".
