@@ -7,9 +7,10 @@ subprocesses before the workers start (``pytest_sessionstart``), so that the
 workers find a warm cache; the halves are balanced by compile time:
 
 * ``single``: the full loop of :func:`randvib.montecarlo.kernel.run_ensemble`
-  (filter or circuit, event, bridge, tones and shocks in one signature: the
-  longest compile, most of the 465 CPU-s that both loops took cold), run on
-  every combination the suite uses so that a new signature would show up;
+  (filter or circuit, event, bridge, tones and shocks in one signature), run on
+  every combination the suite uses so that a new signature would show up, and
+  the record simulation behind a bridge (:mod:`randvib.identification.record_bridge`);
+  121 CPU-s cold (November 2026; the assembly half 104);
 * ``assembly``: that function's lean loop (white noise, nothing optional), the
   assembly kernel (:mod:`randvib.montecarlo.assembly_kernel`), the record
   integrator of the identification
@@ -52,7 +53,8 @@ def _bridge():
 def warm_single() -> None:
     """Every combination of :func:`~randvib.montecarlo.kernel.run_ensemble`'s groups in the suite.
 
-    The full loop only: the lean one (white noise, nothing optional) is the other half's.
+    The full loop only: the lean one (white noise, nothing optional) is the other half's;
+    and the record simulation behind a bridge.
     """
     import randvib as rv
 
@@ -69,6 +71,13 @@ def warm_single() -> None:
                           dt=1e-3, n_paths=2)  # fmt: skip
     rv.simulate_transient(_harvester(), rv.Enveloped(band, step), t_end=0.02, dt=1e-3,
                           n_paths=2)  # fmt: skip
+    # the record simulation behind a diode bridge (identification.record_bridge), here
+    # to even the halves: 45 CPU-s of compiling
+    bridge = rv.BridgeCoil(alpha=1.0, r_coil=2.0, v_diode=0.2, storage_capacitance=2e-3,
+                           r_load=50.0)  # fmt: skip
+    device = rv.Harvester.with_coupling(M, C_M, K, bridge)
+    drive = np.sin(np.linspace(0.0, 1.0, 32))
+    rv.record_response(device, rv.Record(1e-4, base_acceleration=drive), substeps=1)
 
 
 def warm_assembly() -> None:
