@@ -145,6 +145,10 @@ def worker_ignores_ctrl_c() -> None:
     signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 
+#: The name of the thread :func:`interruptible` runs a compiled loop in (none is
+#: left alive once it has returned or raised).
+KERNEL_THREAD = "randvib-kernel"
+
 #: The stop flags of the compiled loops running now (:func:`interruptible`): a
 #: Ctrl-C noticed by :func:`ctrl_c_noticed` sets them, so a loop stops even when
 #: the KeyboardInterrupt itself is swallowed on its way to the caller.
@@ -221,6 +225,11 @@ def interruptible(compiled, **kwargs):
         return compiled(stop=stop, **kwargs)  # signals only reach the main thread
     outcome = {}
     threads = numba.get_num_threads()
+    # The loop's end is told by an Event, not by Thread.join: in Python 3.11 a
+    # join(timeout) that a Ctrl-C interrupts marks the thread as stopped while it
+    # still runs (CPython gh-90882), so the join after it returned at once and the
+    # stopped run went on computing to its end in the background.
+    finished = threading.Event()
 
     def target():
         try:
@@ -228,8 +237,10 @@ def interruptible(compiled, **kwargs):
             outcome["value"] = compiled(stop=stop, **kwargs)
         except BaseException as exc:  # handed to the caller's thread
             outcome["error"] = exc
+        finally:
+            finished.set()
 
-    worker = threading.Thread(target=target, name="randvib-kernel", daemon=True)
+    worker = threading.Thread(target=target, name=KERNEL_THREAD, daemon=True)
     for noticed in list(_OPEN_WATCHES.values()):  # one swallowed before this loop began
         _raise_if_noticed(noticed)
     _RUNNING_LOOPS[id(stop)] = stop
@@ -237,14 +248,30 @@ def interruptible(compiled, **kwargs):
         with ctrl_c_noticed():
             worker.start()
             try:
-                while worker.is_alive():
-                    worker.join(0.05)
+                while not finished.wait(0.05):
+                    pass
             except KeyboardInterrupt:
                 stop[0] = 1
-                worker.join()
+                _wait_through_interrupts(finished)
                 raise
     finally:
         del _RUNNING_LOOPS[id(stop)]
     if "error" in outcome:
         raise outcome["error"]
     return outcome["value"]
+
+
+def _wait_through_interrupts(finished: threading.Event) -> None:
+    """Wait until a stopped loop has ended, through further Ctrl-Cs.
+
+    The loop sees its stop flag within CHECK_EVERY steps of each chunk of
+    paths it is on, and each chunk it starts afterwards stops at its first
+    check: a fraction of a second. Leaving before it ends would leave its thread
+    computing (and holding its arrays) after the caller has moved on.
+    """
+    while True:
+        try:
+            finished.wait()
+            return
+        except KeyboardInterrupt:
+            continue

@@ -8,6 +8,8 @@ import pytest  # imports no matplotlib, so the backend below is still in time
 
 os.environ.setdefault("MPLBACKEND", "Agg")
 
+from randvib._interrupts import KERNEL_THREAD  # noqa: E402 (imports neither numba nor matplotlib)
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -105,7 +107,9 @@ def _process_state_restored(request):
     A test starts as a fresh interpreter does: Ctrl-C raises KeyboardInterrupt
     (an xdist worker or an earlier test may have changed the handler). After
     it, timers it started are cancelled (a Ctrl-C timer firing in a later test
-    stopped the wrong test), threads it started are given a moment to end, and
+    stopped the wrong test), a compiled loop's thread it started is given a moment to
+    end (one still running fails the test: a stopped run that computed on in the
+    background cost the later tests minutes of CPU), and
     signal handlers, mask, environment, working directory, numpy's error state,
     rcParams, the friction-law registry and numba's thread count are put back. A test that changed
     the signal handlers, the signal mask or the working directory without
@@ -119,10 +123,14 @@ def _process_state_restored(request):
     signal.signal(signal.SIGINT, signal.default_int_handler)
     before = _ProcessState()
     yield
+    running = []
     for thread in set(threading.enumerate()) - before.threads:
         if isinstance(thread, threading.Timer):
             thread.cancel()
             thread.join(5)
+        elif thread.name == KERNEL_THREAD:  # a stopped run must not compute on
+            thread.join(5)
+            running += [thread] if thread.is_alive() else []
     after = _ProcessState()
     before.restore()
     signal.signal(signal.SIGINT, inherited_int)
@@ -133,6 +141,8 @@ def _process_state_restored(request):
     ]
     if left:
         pytest.fail(f"{request.node.nodeid} left {', '.join(left)} changed", pytrace=False)
+    if running:
+        pytest.fail(f"{request.node.nodeid} left a compiled loop running", pytrace=False)
 
 
 @pytest.fixture(scope="module")

@@ -2,7 +2,9 @@
 
 Covers :mod:`randvib._interrupts` as the package uses it, and the entry point
 :mod:`randvib.__main__` (an interrupt while it starts: one line): the compiled Monte
-Carlo loop (:func:`randvib.simulate`), the command line's exit statuses
+Carlo loops of one mass and of an assembly (:func:`randvib.simulate`), which read
+their stop flag with :mod:`randvib.montecarlo.stop_flag` and leave no thread
+computing once stopped, the command line's exit statuses
 (:mod:`randvib.cli`: 130 for Ctrl-C, 143 for SIGTERM, one line), a sweep's
 worker processes (:func:`randvib.montecarlo.sweep.make_executor`: they ignore
 Ctrl-C while starting and end with a killed parent), a study's folder lock
@@ -28,6 +30,7 @@ from _cli import error_lines, run
 
 import randvib as rv
 from randvib import _io
+from randvib._interrupts import KERNEL_THREAD
 from randvib.montecarlo.simulation import simulate
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -43,14 +46,33 @@ def _interrupt_after(seconds):
 def test_ctrl_c_stops_a_running_simulation():
     # compiled first, so that the interrupt lands inside the compiled loop
     simulate(BASE, 1.0, t_end=0.01, dt=1e-4, n_paths=2, progress=False)
-    # 4e9 path-steps: minutes at the least on any machine; Ctrl-C after 1 s
-    kwargs = dict(t_end=2000.0, dt=1e-4, n_paths=200, progress=False)
+    # 4e10 path-steps: many minutes on any machine (4e9 ran to its end in 60 s on two
+    # cores, too close to the bound below); Ctrl-C after 1 s
+    kwargs = dict(t_end=20000.0, dt=1e-4, n_paths=200, progress=False)
     timer = _interrupt_after(1.0)
     started = time.perf_counter()
     with pytest.raises(KeyboardInterrupt):
         simulate(BASE, 1.0, **kwargs)
     timer.cancel()
     assert time.perf_counter() - started < 60  # stopped, not run to the end
+    # and the loop itself stopped: in Python 3.11 an interrupted Thread.join marked its
+    # thread as ended while it computed on in the background (CPython gh-90882)
+    assert not [t for t in threading.enumerate() if t.name == KERNEL_THREAD]
+
+
+def test_ctrl_c_stops_a_running_assembly_simulation():
+    """The assembly kernel's loop reads its stop flag from memory at every check
+    (randvib.montecarlo.stop_flag): with a plain read, LLVM read it once before the
+    loop, and a Ctrl-C waited for the whole run to end."""
+    device = rv.Assembly.from_harvester(BASE)
+    rv.simulate(device, 1.0, t_end=0.01, dt=1e-4, n_paths=2, progress=False)
+    timer = _interrupt_after(1.0)
+    started = time.perf_counter()
+    with pytest.raises(KeyboardInterrupt):  # 4e10 path-steps: many minutes on any machine
+        rv.simulate(device, 1.0, t_end=20000.0, dt=1e-4, n_paths=200, progress=False)
+    timer.cancel()
+    assert time.perf_counter() - started < 60  # stopped, not run to the end
+    assert not [t for t in threading.enumerate() if t.name == KERNEL_THREAD]
 
 
 def test_compiled_loop_never_runs_in_the_main_thread(monkeypatch):

@@ -74,6 +74,7 @@ from randvib.models.friction import (
 from randvib.montecarlo.kernel import CHECK_EVERY
 from randvib.montecarlo.rectified_kernel import _bridge_predictor, _bridge_rates, _bridge_update
 from randvib.montecarlo.rng import seed_path_state, standard_normal
+from randvib.montecarlo.stop_flag import stop_requested
 
 #: Paths advanced together in a chunk (the single-mass kernel's are 8): the step's loops
 #: over them are vectorised, and 32 amortise each loop's set-up (a path's result does
@@ -865,7 +866,7 @@ def _run_chunk(
                 if not _finite(y, j):
                     failed[start_path + j] = n + 1
                     stopped = True
-            if stopped or stop[0] != 0:
+            if stopped or stop_requested(stop):
                 break
     for j in range(lanes):
         acc[h1, j] = _energy(y, j, dims, mass, kmat, coords, springs, circuits, bridges)

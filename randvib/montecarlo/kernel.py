@@ -43,6 +43,7 @@ from randvib.montecarlo.rectified_kernel import (
     rectified_white_step,
 )
 from randvib.montecarlo.rng import seed_path_state, standard_normal
+from randvib.montecarlo.stop_flag import stop_requested
 
 #: Paths advanced together inside one chunk.
 LANES = 8
@@ -996,7 +997,7 @@ def lean_loop(scheme, device, friction, timing, paths, initial, companion, recor
                     _companion_step(zc, vc, a, j, in_window, dt, noise, scheme, drift, fr_p, fr_fn)
                 _record_step(records, start + j, n, record_every, z, v, th, j)
             if (n + 1) % CHECK_EVERY == 0 or n == n_steps - 1:
-                if _failed_lanes(failed, start, lanes, n, z, v, th) or stop[0] != 0:
+                if _failed_lanes(failed, start, lanes, n, z, v, th) or stop_requested(stop):
                     break
         for j in range(lanes):
             _finish_lane(a, j, z[j], v[j], (m, k, k3), stroke, n_steps * dt)
@@ -1228,7 +1229,7 @@ def full_loop(scheme, device, friction, timing, paths, initial, companion, recor
                 next_snap = _snapshots(snapshots, snap, next_snap, n + 1, start, lanes, z, v,
                                        square, peak)  # fmt: skip
             if (n + 1) % CHECK_EVERY == 0 or n == n_steps - 1:
-                if _failed_lanes(failed, start, lanes, n, z, v, th) or stop[0] != 0:
+                if _failed_lanes(failed, start, lanes, n, z, v, th) or stop_requested(stop):
                     break
         for j in range(lanes):
             _finish_lane(a, j, z[j], v[j], (m, k, k3), stroke, n_steps * dt)
