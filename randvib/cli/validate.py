@@ -193,7 +193,7 @@ def _bridge(data: dict, path, args) -> dict:
         notes = data.get("notes") or []
         if not given and any(str(n).startswith(BRIDGE_NOTE) for n in notes):
             raise ValueError(
-                f"{str(path)!r} was fitted behind a diode bridge but saves no `rectifier` (an "
+                f'{str(path)!r} was fitted behind a diode bridge but saves no "rectifier" field (an '
                 "older file): give it with `--rectifier bridge --v-diode V --storage-capacitance "
                 "C | --battery V`"
             )

@@ -273,7 +273,10 @@ class IdentificationResult:
             out["coupling"] = self.coupling
             out["r_loads"] = [float(r) for r in self.r_loads]
         if self.rectifier:  # the bridge as data, not only in the notes
-            out["rectifier"] = {"kind": "bridge", **{k: float(v) for k, v in self.rectifier.items()}}
+            out["rectifier"] = {
+                "kind": "bridge",
+                **{k: float(v) for k, v in self.rectifier.items()},
+            }
         if tuple(self.outputs) != ("relative_displacement",) or self.channel_costs:
             out["outputs"] = list(self.outputs)
             out["records"] = list(self.records)
@@ -464,7 +467,7 @@ class IdentificationResult:
         note = next((n for n in self.notes if n.startswith(BRIDGE_NOTE)), None)
         if note is not None:
             raise ValueError(
-                f"this fit was made {note.rstrip('.')}, but saves no `rectifier`: add "
+                f'this fit was made {note.rstrip(".")}, but saves no "rectifier" field: add '
                 '`"rectifier": {"kind": "bridge", "v_diode": ..., "storage_capacitance" or '
                 '"battery": ...}` to its JSON, or identify again'
             )
