@@ -196,7 +196,8 @@ def test_validate_through_a_battery_bridge(capsys, tmp_path):
     """``validate`` of a fit behind a battery scores its charging current (the row has no
     load: a battery has none): the true device on its own noiseless record scores J ~ 0
     (the same record simulation, J the start estimate's residual only: measured 1.8e-8),
-    and with the battery at 0.2 V instead of 0.1 V far more (measured 104)."""
+    and with the battery at 0.2 V instead of 0.1 V far more (measured 104). A fit made
+    without a bridge is scored behind the one the flags give (the same J)."""
     data = tmp_path / "battery.csv"
     d = DEVICE
     code, _, err = run(capsys, "record", "--m", d["m"], "--c-m", d["c"], "--k", d["k"], "--k3",
@@ -215,3 +216,11 @@ def test_validate_through_a_battery_bridge(capsys, tmp_path):
         assert "r_load" not in row
         costs[volts] = row["cost"]
     assert costs[0.1] < 1e-6 and costs[0.2] > 1.0
+    # a fit made without a bridge, scored behind the one the flags give: the same J
+    plain = tmp_path / "plain.json"
+    plain.write_text(json.dumps(coil_fit().to_dict()))
+    code, out, err = run(capsys, "validate", plain, data, "--offsets", "given", "--json",
+                         "--rectifier", "bridge", "--v-diode", "0.1", "--battery", "0.1")  # fmt: skip
+    assert code == 0, err
+    assert json.loads(out)["records"][0]["cost"] == costs[0.1]
+    one_line_error(capsys, ["validate", plain, data, "--rectifier", "bridge"], "exactly one output")
