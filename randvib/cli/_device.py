@@ -90,8 +90,8 @@ def add_device_arguments(parser: argparse.ArgumentParser) -> None:
         "--from-fit",
         metavar="FILE.json",
         help="start from an identified device (`randvib identify --save`): its mechanics, "
-        "friction and, when identified, its coupling at the first record's load (--r-load "
-        "and the other options override)",
+        "friction and, when identified, its coupling at the first record's load, through the "
+        "diode bridge it was fitted behind (--r-load and the other options override)",
     )
     g.add_argument("--m", type=float, help="mass (kg)")
     g.add_argument("--c-m", type=float, help="mechanical damping (Ns/m)")
