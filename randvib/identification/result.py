@@ -428,6 +428,9 @@ class IdentificationResult:
     def harvester(self, electrical=None, *, r_load: float | None = None) -> Harvester:
         """The identified device, its damping c as c_m.
 
+        A fit made behind a diode bridge (:attr:`rectifier`) gives the
+        coupling through that bridge (:mod:`randvib.models.rectifier`).
+
         Parameters
         ----------
         electrical : Coupling, optional
@@ -439,9 +442,6 @@ class IdentificationResult:
             With an identified coupling: the load (ohm) to wire it to;
             default the first record's (a storage capacitor's load behind a
             bridge; unused with a battery).
-
-        A fit made behind a diode bridge (:attr:`rectifier`) gives the
-        coupling through that bridge (:mod:`randvib.models.rectifier`).
         """
         if self.coupling:
             if electrical is not None:
