@@ -232,7 +232,7 @@ def saved_rectifier(saved, where: str = "`rectifier`") -> dict:
         return {}
     if not isinstance(saved, dict) or saved.get("kind") not in RECTIFIER_KINDS:
         raise ValueError(
-            f"{where} must be an object with \"kind\": {' or '.join(map(repr, RECTIFIER_KINDS))}"
+            f'{where} must be an object with "kind": {" or ".join(map(repr, RECTIFIER_KINDS))}'
             f", got {saved!r}"
         )
     values = {k: v for k, v in saved.items() if k != "kind"}
