@@ -1511,6 +1511,23 @@ MUTATIONS: tuple[Mutation, ...] = (
         "order, which the pathwise comparison's measured order (> 3 from 4 to 8 sub-steps) "
         "rejects.",
     ),
+    Mutation(
+        name="fitted-bridge-ideal-diodes",
+        path="randvib/identification/circuit.py",
+        edits=(
+            (
+                "values.update({k: float(v) for k, v in bridge.items()})",
+                'values.update({k: float(v) for k, v in bridge.items() if k != "v_diode"})',
+            ),
+        ),
+        tests=(
+            "tests/test_bridge_fit.py::"
+            "test_a_bridged_fit_saves_its_bridge_and_validate_scores_through_it",
+        ),
+        why="A saved fit's bridge is rebuilt without its diodes' drop (ideal diodes): "
+        "validate on the training record, through the file's bridge, must score the fit's "
+        "own J to 1e-6.",
+    ),
 )
 
 

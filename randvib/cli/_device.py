@@ -90,8 +90,8 @@ def add_device_arguments(parser: argparse.ArgumentParser) -> None:
         "--from-fit",
         metavar="FILE.json",
         help="start from an identified device (`randvib identify --save`): its mechanics, "
-        "friction and, when identified, its coupling at the first record's load (--r-load "
-        "and the other options override)",
+        "friction and, when identified, its coupling at the first record's load, through the "
+        "diode bridge it was fitted behind (--r-load and the other options override)",
     )
     g.add_argument("--m", type=float, help="mass (kg)")
     g.add_argument("--c-m", type=float, help="mechanical damping (Ns/m)")
@@ -226,8 +226,9 @@ def fitted_device(path) -> Harvester:
     """The device a saved identification holds (``randvib identify --save`` / ``--json``).
 
     Its c is the mechanical damping c_m when the fit identified its coupling
-    (wired at the first record's load); otherwise c is the total damping of
-    the record it was fitted to and the device has no coupling.
+    (wired at the first record's load, through the diode bridge it was fitted
+    behind: :mod:`randvib.models.rectifier`); otherwise c is the total damping
+    of the record it was fitted to and the device has no coupling.
     """
     import json
 
@@ -245,6 +246,19 @@ def fitted_device(path) -> Harvester:
             f"`--from-fit` {str(path)!r} is not a saved identification (the JSON of `randvib "
             f"identify --save`){detail}"
         ) from None
+
+
+def fit_is_rectified(args) -> bool:
+    """True when ``--from-fit`` holds a device fitted behind a diode bridge (and no other
+    ``--coupling`` replaces it): the commands choose the bridge's own defaults for it."""
+    path = getattr(args, "from_fit", None)
+    if path is None:
+        return False
+    electrical = fitted_device(path).electrical
+    return getattr(electrical, "rectified", False) and getattr(args, "coupling", None) in (
+        None,
+        electrical.transducer,
+    )
 
 
 def _base_device(args):
@@ -338,12 +352,42 @@ def _bridge_from_args(args):
     return _built(cls, given, own)
 
 
+def _fitted_bridge(args, fitted):
+    """A saved fit's coupling through its diode bridge, the options given overriding it.
+
+    ``--battery`` replaces a storage capacitor and its load, ``--storage-capacitance``
+    a battery (with ``--r-load``); ``--rectifier bridge`` and the transducer's
+    ``--coupling`` may be repeated. The bridge is never dropped.
+    """
+    if args.c_e is not None:
+        raise ValueError(
+            "`--from-fit` holds the coupling and its bridge; `--c-e` cannot replace it"
+        )
+    cls = type(fitted)
+    options = _coupling_options()
+    given = {n: getattr(args, n) for n in options if getattr(args, n, None) is not None}
+    given.update({n: getattr(args, n) for n in BRIDGE_OPTIONS if getattr(args, n) is not None})
+    owners = {name: [c.name for c in couplings] for name, couplings in options.items()}
+    for name in BRIDGE_OPTIONS:
+        owners[name] = [c.name for c in RECTIFIED.values() if name in c.parameter_names()]
+    refuse_foreign_options(given, cls.parameter_names(), owners, "the {owners} coupling", cls.name)
+    values = fitted.parameters()
+    if "battery" in given:  # another output: the fit's is replaced, not mixed in
+        values.pop("storage_capacitance", None)
+        values.pop("r_load", None)
+    if "storage_capacitance" in given or "r_load" in given:
+        values.pop("battery", None)
+    return _built(cls, {**values, **given}, given)
+
+
 def _coupling_from_args(args, fitted=None):
     """The coupling from ``--coupling`` and its parameter options, or None (``--c-e``).
 
     ``fitted``: a saved fit's coupling, whose parameters the options override
     (``--r-load 20`` wires it to another load).
     """
+    if getattr(fitted, "rectified", False) and args.coupling in (None, fitted.transducer):
+        return _fitted_bridge(args, fitted)
     if getattr(args, "rectifier", None) is not None:
         return _bridge_from_args(args)
     bridge = [n for n in BRIDGE_OPTIONS if getattr(args, n, None) is not None]

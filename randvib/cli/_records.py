@@ -168,17 +168,22 @@ def add_circuit_arguments(parser: argparse.ArgumentParser, *, identified: bool =
         help="each record's known load resistance R_L (ohm), in the records' order; one value "
         "for all records",
     )
+    g.add_argument(
+        "--rectifier",
+        choices=("bridge",),
+        help="the coupling's output goes through a known full-wave diode bridge into "
+        "--storage-capacitance (each record's --r-load across it) or --battery; voltage is "
+        "then the DC output voltage, current the load current (a battery's charging current)"
+        + (
+            ""
+            if identified
+            else "; default the saved fit's bridge (flags that contradict it are refused)"
+        ),
+    )
+    g.add_argument("--v-diode", type=float, help="forward drop of each diode V_d (V); bridge")
+    g.add_argument("--storage-capacitance", type=float, help="storage capacitor C (F); bridge")
+    g.add_argument("--battery", type=float, help="battery voltage V_b (V); bridge")
     if identified:
-        g.add_argument(
-            "--rectifier",
-            choices=("bridge",),
-            help="the coupling's output goes through a known full-wave diode bridge into "
-            "--storage-capacitance (each record's --r-load across it) or --battery; voltage is "
-            "then the DC output voltage, current the load current (a battery's charging current)",
-        )
-        g.add_argument("--v-diode", type=float, help="forward drop of each diode V_d (V); bridge")
-        g.add_argument("--storage-capacitance", type=float, help="storage capacitor C (F); bridge")
-        g.add_argument("--battery", type=float, help="battery voltage V_b (V); bridge")
         g.add_argument(
             "--weight",
             action="append",

@@ -58,6 +58,7 @@ from randvib.cli import COMMAND_HELP, advice_when_done
 from randvib.cli._device import (
     add_device_arguments,
     assembly_from_args,
+    fit_is_rectified,
     harvester_from_args,
     option_flag,
 )
@@ -149,7 +150,7 @@ def _method_help() -> str:
     text = (
         f"analytic method ({each}); a non-white excitation: {coloured} only; a coil "
         f"inductance or piezo capacitance: {circuit} only; default linearisation, or "
-        "bridge-closure with --rectifier"
+        "bridge-closure with --rectifier (or a --from-fit made behind a bridge)"
     )
     return text.replace("%", "%%")  # argparse formats help with %
 
@@ -219,8 +220,9 @@ def run(args) -> int:
     # a bridge's optimum falls back to Monte Carlo where the closure refuses, unless a
     # method was asked for by name
     args.method_defaulted = args.method is None
-    if args.method is None:  # a bridge's own method, else statistical linearisation
-        args.method = "bridge-closure" if args.rectifier is not None else "linearisation"
+    if args.method is None:  # a bridge's own method (a fit's too), else statistical linearisation
+        bridged = args.rectifier is not None or fit_is_rectified(args)
+        args.method = "bridge-closure" if bridged else "linearisation"
     swept, points = _sweep(args)
     if wants_event(args):
         return power_event(args, swept, points)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import json
+import math
 import sys
 
 import numpy as np
@@ -12,10 +13,13 @@ import numpy as np
 from randvib._io import check_output_file, check_output_folder, dumps, existing_file
 from randvib._validation import check_finite
 from randvib.cli import COMMAND_HELP
+from randvib.cli._device import option_flag
 from randvib.cli._output import print_table
 from randvib.cli._records import (
+    BRIDGE_FLAGS,
     add_circuit_arguments,
     add_record_arguments,
+    bridge_options,
     output_kinds,
     output_unit,
     parse_assignments,
@@ -26,9 +30,12 @@ from randvib.cli._records import (
 )
 from randvib.identification.circuit import (
     ALL_COUPLING_PARAMETERS,
+    BRIDGE_NOTE,
     OFFSET_NAMES,
+    bridge_from_parameters,
     check_coupling_parameter,
     coupling_from_parameters,
+    saved_rectifier,
 )
 from randvib.identification.models import (
     MODELS,
@@ -140,18 +147,20 @@ def _device(model, parameters, data, path, args):
     """The saved device and its measurement model (the first record's offsets).
 
     A fit that identified its coupling is wired to each record's load
-    (``--r-load``, default the fit's first); returns (harvester, measurement,
-    loads or None).
+    (``--r-load``, default the fit's first), through the diode bridge it was
+    fitted behind (:func:`_bridge`); returns (harvester, measurement, loads or
+    None: a battery has no load).
     """
     own = {k.partition("[")[0]: v for k, v in parameters.items() if not k.endswith("]")}
     own.update({k.partition("[")[0]: v for k, v in parameters.items() if k.endswith("[0]")})
     measurement = MeasurementModel.from_parameters(own)
     coupling = data.get("coupling") or None
+    bridge = _bridge(data, path, args)
     if coupling is None:
-        if args.coupling is not None or args.r_load:
+        if args.coupling is not None or args.r_load or bridge:
             raise ValueError(
-                f"{str(path)!r} holds no identified coupling: `--coupling`/`--r-load` need a fit "
-                "made with `identify --coupling`"
+                f"{str(path)!r} holds no identified coupling: `--coupling`/`--r-load`/"
+                "`--rectifier` need a fit made with `identify --coupling`"
             )
         return device_from_parameters(model, own)[0], measurement, None
     if args.coupling not in (None, coupling):
@@ -162,8 +171,49 @@ def _device(model, parameters, data, path, args):
     if given is None and default is None:
         raise ValueError(f"{str(path)!r} saves no load: give each record's `--r-load`")
     loads = given if given is not None else default
-    electrical = coupling_from_parameters(coupling, own, np.ravel(loads)[0])
+    if bridge:
+        electrical = bridge_from_parameters(coupling, own, bridge, np.ravel(loads)[0])
+        loads = None if "battery" in bridge else loads  # the battery's is no load
+    else:
+        electrical = coupling_from_parameters(coupling, own, np.ravel(loads)[0])
     return device_from_parameters(model, own, electrical)[0], measurement, loads
+
+
+def _bridge(data: dict, path, args) -> dict:
+    """The known diode bridge to simulate through ({} for none).
+
+    The file's ``rectifier`` (a fit made behind a bridge); the bridge flags
+    may repeat its values, and one that differs is refused. A fit made
+    without a bridge is scored behind the one the flags give
+    (``--rectifier bridge`` with ``--storage-capacitance`` or ``--battery``).
+    """
+    saved = saved_rectifier(data.get("rectifier"), f"{str(path)!r}: `rectifier`")
+    given = {n: getattr(args, n) for n in BRIDGE_FLAGS if getattr(args, n, None) is not None}
+    if not saved:
+        notes = data.get("notes") or []
+        if not given and any(str(n).startswith(BRIDGE_NOTE) for n in notes):
+            raise ValueError(
+                f'{str(path)!r} was fitted behind a diode bridge but saves no "rectifier" field (an '
+                "older file): give it with `--rectifier bridge --v-diode V --storage-capacitance "
+                "C | --battery V`"
+            )
+        options = bridge_options(args) or {}
+        if args.rectifier is not None and ("battery" in options) == (
+            "storage_capacitance" in options
+        ):
+            raise ValueError(
+                "`--rectifier bridge` needs exactly one output: `--storage-capacitance C` (each "
+                "record's `--r-load` across it) or `--battery V`"
+            )
+        return {"v_diode": 0.0, **options} if options else {}
+    for name, value in given.items():
+        if name not in saved or not math.isclose(value, saved[name], rel_tol=1e-9):
+            held = ", ".join(f"{k} = {v:g}" for k, v in saved.items())
+            raise ValueError(
+                f"`{option_flag(name)} {value:g}` contradicts {str(path)!r}, fitted behind a "
+                f"bridge with {held}: drop the flag (the file's bridge is used)"
+            )
+    return saved
 
 
 def _kinds(args, data) -> tuple:

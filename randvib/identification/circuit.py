@@ -196,6 +196,58 @@ def coupling_from_parameters(coupling: str, parameters: dict, r_load: float) -> 
     return cls(r_load=float(r_load), **values)
 
 
+#: The rectifiers a saved identification names (``"rectifier": {"kind": "bridge", ...}``).
+RECTIFIER_KINDS = ("bridge",)
+#: The known values of a saved bridge: each diode's drop and exactly one output.
+RECTIFIER_KEYS = ("v_diode", "storage_capacitance", "battery")
+#: How an identification behind a bridge begins its note (files saved before the
+#: ``rectifier`` field held the bridge only there).
+BRIDGE_NOTE = "behind a full-wave diode bridge, known:"
+
+
+def bridge_from_parameters(coupling: str, parameters: dict, bridge: dict, r_load):
+    """The rectified coupling (:mod:`randvib.models.rectifier`) of identified ``parameters``.
+
+    ``coupling``: the transducer (``inductive`` or ``piezo``); ``bridge``: its
+    known ``v_diode`` (V) and ``storage_capacitance`` (F, with the load
+    ``r_load``, ohm) or ``battery`` (V; ``r_load`` unused), as
+    :func:`~randvib.identification.experiment.known_bridge` checks them.
+    """
+    from randvib.models.rectifier import rectified
+
+    values = {name: float(parameters[name]) for name in COUPLING_PARAMETERS[coupling]}
+    values.update({k: float(v) for k, v in bridge.items()})
+    if "battery" not in bridge:
+        values["r_load"] = float(r_load)
+    return rectified(coupling, **values)
+
+
+def saved_rectifier(saved, where: str = "`rectifier`") -> dict:
+    """The known bridge of a saved identification's ``rectifier`` object ({} for none).
+
+    ``{"kind": "bridge", "v_diode": V_d, "storage_capacitance": C}`` or
+    ``{..., "battery": V_b}``; refused, naming ``where``, when it is anything else.
+    """
+    if saved is None:
+        return {}
+    if not isinstance(saved, dict) or saved.get("kind") not in RECTIFIER_KINDS:
+        raise ValueError(
+            f'{where} must be an object with "kind": {" or ".join(map(repr, RECTIFIER_KINDS))}'
+            f", got {saved!r}"
+        )
+    values = {k: v for k, v in saved.items() if k != "kind"}
+    unknown = sorted(set(values) - set(RECTIFIER_KEYS))
+    if unknown or ("battery" in values) == ("storage_capacitance" in values):
+        raise ValueError(
+            f"{where}: a bridge holds `v_diode` and exactly one of `storage_capacitance`, "
+            f"`battery`; got {sorted(values)}"
+        )
+    try:
+        return {k: float(v) for k, v in values.items()}
+    except (TypeError, ValueError):
+        raise ValueError(f"{where}: its values must be numbers, got {values!r}") from None
+
+
 def coupling_bounds(coupling: str, scales, r_loads, dt: float) -> dict:
     """Default search boxes of the coupling's parameters from a record's scales.
 

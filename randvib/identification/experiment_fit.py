@@ -36,6 +36,7 @@ from randvib.identification.bounds import (
 )
 from randvib.identification.circuit import (
     ALL_COUPLING_PARAMETERS,
+    BRIDGE_NOTE,
     CIRCUIT_START,
     COUPLING_PARAMETERS,
     OFFSET_NAMES,
@@ -263,7 +264,7 @@ def identify_experiment(
     if bridged:  # the switching breaks the linear symmetries: the fit's covariance decides
         structure = Identifiability((), (), (BRIDGE_STRUCTURE,))
         known = ", ".join(f"{k} = {v:g}" for k, v in tests[0].bridge.items())
-        notes += (f"behind a full-wave diode bridge, known: {known}",)
+        notes += (f"{BRIDGE_NOTE} {known}",)
     else:
         structure = structural_identifiability(configuration(model, coupling, tests, fixed))
     if not structure.identifiable:
@@ -460,6 +461,7 @@ def _result(cost, space, res, polished, elapsed, search, simulation, structure, 
         coupling=cost.coupling or "",
         outputs=tests[0].outputs,
         r_loads=tuple(t.r_load for t in tests) if cost.coupling else (),
+        rectifier=dict(tests[0].bridge or {}),
         records=tuple(t.record.name for t in tests),
         weights=dict(cost.weights),
         channel_costs=channel_costs,

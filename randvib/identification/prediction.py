@@ -481,10 +481,17 @@ def _validate_channels(harvester, records, measurement, offsets, outputs, r_load
                 residuals=residual_diagnostics(residual, record.input[skip:]),
                 channels={k: {"cost": pred.costs[k], "rms_error": pred.rms_errors[k]}
                           for k in pred.channels},
-                r_load=None if device.electrical is None else float(device.electrical.r_load),
+                r_load=_row_load(device),
             )
         )  # fmt: skip
     return rows
+
+
+def _row_load(device) -> float | None:
+    """The load R_L a validation row was scored at; None without one (no coupling, or a
+    bridge into a battery)."""
+    load = getattr(device.electrical, "r_load", None)
+    return None if load is None else float(load)
 
 
 def _best_channel_offsets(device, record, measurement, policy, outputs, settings, skip):

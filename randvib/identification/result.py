@@ -7,7 +7,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from randvib import _display, formatting
-from randvib.identification.circuit import coupling_from_parameters
+from randvib.identification.circuit import (
+    BRIDGE_NOTE,
+    bridge_from_parameters,
+    coupling_from_parameters,
+    saved_rectifier,
+)
 from randvib.identification.identifiability import Identifiability
 from randvib.identification.models import MeasurementModel, device_from_parameters, unit_of
 from randvib.identification.prediction import Prediction, predict_record
@@ -91,6 +96,12 @@ class IdentificationResult:
         The channels fitted (``relative_displacement`` unless told).
     r_loads : tuple of float
         Each record's known load R_L (ohm), with a coupling.
+    rectifier : dict
+        The known full-wave diode bridge the coupling's output went through
+        (``v_diode``, V, and ``storage_capacitance``, F, or ``battery``, V;
+        :func:`randvib.identify`'s ``rectifier``); empty for none. Saved as
+        ``"rectifier": {"kind": "bridge", ...}``; :meth:`harvester` wires the
+        coupling through it.
     records : tuple of str
         The records' names, in the order of their ``[i]`` parameters.
     weights : dict
@@ -128,6 +139,7 @@ class IdentificationResult:
     coupling: str = ""
     outputs: tuple = ("relative_displacement",)
     r_loads: tuple = ()
+    rectifier: dict = field(default_factory=dict)
     records: tuple = ()
     weights: dict = field(default_factory=dict)
     channel_costs: list = field(default_factory=list)
@@ -260,6 +272,11 @@ class IdentificationResult:
         if self.coupling:
             out["coupling"] = self.coupling
             out["r_loads"] = [float(r) for r in self.r_loads]
+        if self.rectifier:  # the bridge as data, not only in the notes
+            out["rectifier"] = {
+                "kind": "bridge",
+                **{k: float(v) for k, v in self.rectifier.items()},
+            }
         if tuple(self.outputs) != ("relative_displacement",) or self.channel_costs:
             out["outputs"] = list(self.outputs)
             out["records"] = list(self.records)
@@ -308,6 +325,7 @@ class IdentificationResult:
             coupling=d.get("coupling", ""),
             outputs=tuple(d.get("outputs", ("relative_displacement",))),
             r_loads=tuple(float(r) for r in d.get("r_loads", ())),
+            rectifier=saved_rectifier(d.get("rectifier")),
             records=tuple(d.get("records", ())),
             weights=dict(d.get("weights", {})),
             channel_costs=list(d.get("channel_costs", [])),
@@ -410,6 +428,9 @@ class IdentificationResult:
     def harvester(self, electrical=None, *, r_load: float | None = None) -> Harvester:
         """The identified device, its damping c as c_m.
 
+        A fit made behind a diode bridge (:attr:`rectifier`) gives the
+        coupling through that bridge (:mod:`randvib.models.rectifier`).
+
         Parameters
         ----------
         electrical : Coupling, optional
@@ -419,7 +440,8 @@ class IdentificationResult:
             identified its coupling has it already (c is then c_m).
         r_load : float, optional
             With an identified coupling: the load (ohm) to wire it to;
-            default the first record's.
+            default the first record's (a storage capacitor's load behind a
+            bridge; unused with a battery).
         """
         if self.coupling:
             if electrical is not None:
@@ -428,10 +450,27 @@ class IdentificationResult:
                     "to another load, not another coupling"
                 )
             load = self.r_loads[0] if r_load is None else r_load
-            electrical = coupling_from_parameters(self.coupling, self.parameters, load)
+            if self.rectifier:
+                electrical = bridge_from_parameters(
+                    self.coupling, self.parameters, self.rectifier, load
+                )
+            else:
+                self._refuse_unsaved_bridge()
+                electrical = coupling_from_parameters(self.coupling, self.parameters, load)
         elif r_load is not None:
             raise ValueError("`r_load` needs a fit that identified its coupling (`coupling=`)")
         return device_from_parameters(self.model, self.parameters, electrical)[0]
+
+    def _refuse_unsaved_bridge(self) -> None:
+        """A fit made behind a bridge whose file predates the ``rectifier`` field (its notes
+        name the bridge) is refused rather than wired without it."""
+        note = next((n for n in self.notes if n.startswith(BRIDGE_NOTE)), None)
+        if note is not None:
+            raise ValueError(
+                f'this fit was made {note.rstrip(".")}, but saves no "rectifier" field: add '
+                '`"rectifier": {"kind": "bridge", "v_diode": ..., "storage_capacitance" or '
+                '"battery": ...}` to its JSON, or identify again'
+            )
 
     @property
     def measurement(self) -> MeasurementModel:
