@@ -282,7 +282,13 @@ def statistical_linearisation(
     # unstable: start from the white-noise closure's k_eq at the level S instead.
     k_start = k if k > 0 else _white_noise_k_eq(m, c, k, k3, _typical_level(excitation))
     c_start = c if c > 0 else 0.1 * np.sqrt(k_start * m)
-    x = solve(residual, response(c_start, k_start))
+    if friction is None and k3 == 0.0 and k > 0 and c > 0:
+        # A linear device is its own linearisation: the fixed point is its response,
+        # exactly. The root finder would spend six more solutions of the linear device
+        # to confirm it (a design's search on a linear device predicts hundreds of them).
+        x = response(c, k)
+    else:
+        x = solve(residual, response(c_start, k_start))
     c_eq, k_eq = equivalent(x)
     var_v, var_z = np.exp(x)
     _require_positive_stiffness(harvester, excitation, k + 3.0 * k3 * var_z)
