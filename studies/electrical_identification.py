@@ -185,26 +185,37 @@ def verdict(rows: pd.DataFrame, powers: pd.DataFrame) -> list[str]:
         parts = []
         for ch in CHANNELS:
             g = rows[(rows.device == dev) & (rows.channels == ch)]
-            if (g.refused != "").any():
-                why = g.refused.iloc[0].split(" (", 1)[0].split(": ", 1)[0]
-                parts.append(f"from {SAID[ch]} {why} (refused, with what to add)")
-                continue
-            relative = (g.standard_error / g.estimate.abs()).groupby(g.parameter).median()
-            fixed = [p for p in relative.index if relative[p] <= UNDETERMINED]
-            loose = [p for p in relative.index if relative[p] > UNDETERMINED]
+            refused = g[g.refused != ""]
+            seeds, lost = g.seed.nunique(), refused.seed.nunique()
+            lead = f"from {SAID[ch]}"
+            if lost:  # the refusal's reason, without the list of what to add
+                why = refused.refused.iloc[0].split(" (", 1)[0].split(": ", 1)[0]
+                if lost == seeds:
+                    parts.append(f"{lead} refused on every seed: {why} (with what to add)")
+                    continue
+                lead += f" (refused on {lost} of {seeds} seeds: {why}; on the other {seeds - lost})"
             p = powers[(powers.device == dev) & (powers.channels == ch)]
-            text = (
-                f"from {SAID[ch]} {', '.join(fixed)} are identified (median relative standard "
-                f"error {100 * float(relative[fixed].median()):.2g} %)"
-                + (f", {', '.join(loose)} not determined (relative standard error above "
-                   f"{100 * UNDETERMINED:g} %)" if loose else "")
-                + f"; {100 * float(g.covered.mean()):.0f} % of the 95 % intervals cover the "
-                f"truth; the load power at the reference load within "
-                f"{100 * float(np.max(np.abs(p.relative_error))):.2g} %"
-            )  # fmt: skip
-            parts.append(text if fixed else f"from {SAID[ch]} nothing is determined")
+            parts.append(_channel_verdict(lead, g[g.refused == ""], p))
         out.append(f"{dev}: " + "; ".join(parts) + ".")
     return out
+
+
+def _channel_verdict(lead: str, g: pd.DataFrame, p: pd.DataFrame) -> str:
+    """What one channel set's fitted seeds (rows ``g``, powers ``p``) determine, in words."""
+    relative = (g.standard_error / g.estimate.abs()).groupby(g.parameter).median()
+    fixed = [name for name in relative.index if relative[name] <= UNDETERMINED]
+    loose = [name for name in relative.index if relative[name] > UNDETERMINED]
+    if not fixed:
+        return f"{lead} nothing is determined"
+    return (
+        f"{lead} {', '.join(fixed)} are identified (median relative standard "
+        f"error {100 * float(relative[fixed].median()):.2g} %)"
+        + (f", {', '.join(loose)} not determined (relative standard error above "
+           f"{100 * UNDETERMINED:g} %)" if loose else "")
+        + f"; {100 * float(g.covered.mean()):.0f} % of the 95 % intervals cover the "
+        f"truth; the load power at the reference load within "
+        f"{100 * float(np.max(np.abs(p.relative_error))):.2g} %"
+    )  # fmt: skip
 
 
 def figure(rows: pd.DataFrame, path: Path) -> Path:

@@ -40,19 +40,27 @@ def test_verdict_says_which_channel_identifies_what():
     """From given rows: a refusal is quoted with its reason, a fit by what it fixes and
     what it leaves undetermined (relative standard error above 50 %)."""
 
-    def row(dev, ch, p, se, refused=""):
-        return dict(device=dev, channels=ch, seed=0, parameter=p, truth=1.0, estimate=1.0,
+    def row(dev, ch, p, se, refused="", seed=0):
+        return dict(device=dev, channels=ch, seed=seed, parameter=p, truth=1.0, estimate=1.0,
                     standard_error=se, lower=0.9, upper=1.1, covered=1.0, refused=refused)  # fmt: skip
 
+    why = "the records cannot determine c, alpha (why): add"
     rows = [row(d, "displacement", "c", 0.01) for d in study.DEVICES]
     rows += [row(d, "voltage", "alpha", 0.9) for d in study.DEVICES]
-    rows += [row(d, "both", "", np.nan, "the records cannot determine c, alpha (why): add")
-             for d in study.DEVICES]  # fmt: skip
+    rows += [row(d, "both", "", np.nan, why) for d in study.DEVICES]
+    # one seed refused, the other fitted (the full run's piezo from its voltage)
+    rows += [row(d, "voltage", "", np.nan, why, seed=1) for d in study.DEVICES]
+    rows += [row(d, "voltage", "alpha", 0.9, seed=2) for d in study.DEVICES]
     powers = pd.DataFrame(
         [dict(device=d, channels=c, relative_error=0.01) for d in study.DEVICES
          for c in ("displacement", "voltage")]
     )  # fmt: skip
     coil = study.verdict(pd.DataFrame(rows), powers)[0]
     assert coil.startswith("coil: from the displacement c are identified (median relative")
-    assert "from the load voltage nothing is determined" in coil
-    assert "from both channels the records cannot determine c, alpha (refused" in coil
+    assert (
+        "from the load voltage (refused on 1 of 3 seeds: the records cannot determine c, "
+        "alpha; on the other 2) nothing is determined" in coil
+    )
+    assert (
+        "from both channels refused on every seed: the records cannot determine c, alpha (" in coil
+    )
