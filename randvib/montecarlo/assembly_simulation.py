@@ -41,9 +41,8 @@ import numpy as np
 from randvib._interrupts import interruptible
 from randvib._progress import progress_bar, progress_wanted
 from randvib._resources import check_memory
-from randvib._validation import MAX_SEED, check_int
+from randvib._validation import check_int
 from randvib.models.assembly import Assembly
-from randvib.models.combined import as_input, parts_of
 from randvib.models.excitation import Excitation
 from randvib.montecarlo import driven
 from randvib.montecarlo.assembly_kernel import run_assembly_ensemble
@@ -51,17 +50,9 @@ from randvib.montecarlo.assembly_results import AssemblyHistories, AssemblySimul
 from randvib.montecarlo.assembly_setup import AssemblyKernelSetup
 from randvib.montecarlo.assembly_step_check import AssemblyTestSystem
 from randvib.montecarlo.batches import SimulationDivergedError, batch_bounds
-from randvib.montecarlo.forcing import ForcingInput, nyquist_refusal
-from randvib.montecarlo.integrators import Integrator, integrator
+from randvib.montecarlo.integrators import Integrator
 from randvib.montecarlo.options import TimeGrid, numba_threads
-from randvib.montecarlo.validation import (
-    MAX_PATH_INDEX,
-    BridgeStartWarning,
-    _driver,
-    _nominal_white,
-    _simulated_excitation,
-    checked_increments,
-)
+from randvib.montecarlo.validation import MAX_PATH_INDEX, BridgeStartWarning, checked_input
 
 __all__ = ["simulate_assembly"]
 
@@ -160,40 +151,17 @@ def validated_assembly(
     """The arguments checked in one place; messages name the argument."""
     if not isinstance(assembly, Assembly):
         raise ValueError(f"`assembly` must be a randvib.Assembly, got {type(assembly).__name__}")
-    scheme = integrator(scheme)
-    whole = as_input(psd)
-    random, tones, shocks = parts_of(whole)
-    # tones or shocks alone: the linear checks and the start see a nominal white level
-    # while the kernel's noise is off (psd 0), as for the single mass
-    excitation = _simulated_excitation(random if random is not None else _nominal_white(whole))
-    grid = TimeGrid.from_times(t_end, dt, burn_in)
-    n_paths = check_int("n_paths", n_paths, 1)
-    seed = check_int("seed", seed, 0, MAX_SEED)
-    driver = _driver(excitation, grid, seed, dW)
-    forcing = None
-    if tones or shocks is not None:
-        refusal = nyquist_refusal(tones, grid.dt)
-        if refusal:
-            raise ValueError(refusal)
-        forcing = ForcingInput(tones, shocks, grid.n_steps, grid.dt, seed)
+    common = checked_input(psd, scheme, t_end=t_end, dt=dt, burn_in=burn_in, n_paths=n_paths,
+                           seed=seed, dW=dW)  # fmt: skip
     record_paths = check_int("record_paths", record[0], 0)
     record_every = check_int("record_every", record[1], 1)
     return AssemblyRun(
         assembly=assembly,
-        psd=0.0 if random is None else getattr(excitation, "level", None),
-        excitation=excitation,
-        forcing=forcing,
-        input=whole,
-        scheme=scheme,
-        grid=grid,
-        n_paths=n_paths,
-        seed=seed,
+        **common._asdict(),  # the input, grid, paths and seed, checked alike
         first_path=check_int("first_path", first_path, 0, MAX_PATH_INDEX),
         initial=_initial(initial, assembly.n_dof),
         record_paths=record_paths,
         record_every=record_every,
-        dW=checked_increments(dW, n_paths, grid.n_steps),
-        driver=driver,
     )
 
 

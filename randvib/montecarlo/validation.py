@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -92,6 +93,42 @@ def validated(
             "`companion` needs a confining potential: the friction-free companion's exact "
             "E[z^2] (Gibbs) does not exist for the free mass (k = k3 = 0)"
         )
+    common = checked_input(psd, scheme, t_end=t_end, dt=dt, burn_in=burn_in, n_paths=n_paths,
+                           seed=seed, dW=dW)  # fmt: skip
+    return Run(
+        harvester=harvester,
+        **common._asdict(),  # the input, grid, paths and seed, checked alike
+        first_path=check_int("first_path", first_path, 0, MAX_PATH_INDEX),
+        initial=InitialState.from_argument(initial),
+        record=RecordOptions.validated(*record),
+        companion=bool(companion),
+    )
+
+
+class CheckedInput(NamedTuple):
+    """The input and time grid of a run, checked (:func:`checked_input`)."""
+
+    scheme: Integrator
+    input: Excitation  # the whole input: random part, tones, shocks
+    excitation: Excitation  # its random part as simulated (a nominal white level if none)
+    psd: float | None  # the white level the kernel draws (0: no random part)
+    grid: TimeGrid
+    n_paths: int
+    seed: int
+    driver: object
+    forcing: ForcingInput | None
+    dW: np.ndarray | None  # given Brownian increments, checked
+
+
+def checked_input(psd, scheme, *, t_end, dt, burn_in, n_paths, seed, dW) -> CheckedInput:
+    """What a single-mass and an assembly run check alike: the integrator, the input
+    split into its random part and its tones and shocks, the time grid, the number of
+    paths, the seed, the driver of coloured input, the deterministic forcing and the
+    given Brownian increments.
+
+    With tones or shocks alone, the linear checks and the start see a nominal white
+    level while the kernel's noise is off (``psd`` 0).
+    """
     scheme = integrator(scheme)
     whole = as_input(psd)
     random, tones, shocks = parts_of(whole)
@@ -106,22 +143,10 @@ def validated(
         if refusal:
             raise ValueError(refusal)
         forcing = ForcingInput(tones, shocks, grid.n_steps, grid.dt, seed)
-    return Run(
-        harvester=harvester,
-        psd=0.0 if random is None else getattr(excitation, "level", None),
-        excitation=excitation,
-        driver=driver,
-        forcing=forcing,
-        input=whole,
-        scheme=scheme,
-        grid=grid,
-        n_paths=n_paths,
-        seed=seed,
-        first_path=check_int("first_path", first_path, 0, MAX_PATH_INDEX),
-        initial=InitialState.from_argument(initial),
-        record=RecordOptions.validated(*record),
-        dW=checked_increments(dW, n_paths, grid.n_steps),
-        companion=bool(companion),
+    level = 0.0 if random is None else getattr(excitation, "level", None)
+    increments = checked_increments(dW, n_paths, grid.n_steps)
+    return CheckedInput(
+        scheme, whole, excitation, level, grid, n_paths, seed, driver, forcing, increments
     )
 
 
