@@ -361,6 +361,20 @@ def test_subset_intervals_cover_the_exact_exceedance():
 
 
 # ------------------------------------------------------------ the command line
+def test_reliability_table_marks_only_the_approximate_analytic_values(capsys):
+    """The table beside each estimate: for a linear device the exceedance and the
+    up-crossing rate are exact (unmarked), the Poisson first passage approximate (*)."""
+    code, out, _ = run(capsys, "reliability", "--m", M, "--c-m", C_M, "--c-e", C_E, "--k", K,
+                       "--psd", 1, "--stroke", 0.012, "--duration", 0.05, "--dt", DT,
+                       "--method", "importance", "--target-cov", 0.2)  # fmt: skip
+    assert code == 0
+    cells = {line.split()[0]: line.split() for line in out.splitlines() if line.strip()}
+    assert cells["probability_first_passage"][3].endswith("*")
+    for name in ("upcrossing_rate", "stationary_exceedance"):
+        assert not cells[name][3].endswith("*") and float(cells[name][3]) > 0
+    assert "* approximate (Poisson crossings)" in out
+
+
 def test_reliability_json_keys(capsys):
     code, out, _ = run(capsys, "reliability", "--m", M, "--c-m", C_M, "--c-e", C_E, "--k", K,
                        "--psd", 1, "--stroke", 0.012, "--duration", 0.05, "--dt", DT,

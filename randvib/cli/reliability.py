@@ -139,16 +139,7 @@ def run(args) -> int:
         anchor = crossing_prediction(harvester, excitation, result.stroke, result.duration)
     except ValueError:
         anchor = None
-    rows = []
-    for name in ROWS:
-        s = summary[name]
-        reference = ""
-        if anchor is not None:
-            reference = anchor.first_passage_poisson if name == ROWS[0] else getattr(anchor, name)
-        marked = anchor is not None and name in anchor.exact
-        rows.append((name, *estimate_parts(s["mean"], s["ci95"]),
-                     cell(reference) + ("" if marked or anchor is None else "*"),
-                     unit(name)))  # fmt: skip
+    rows = _rows(summary, anchor)
     print(describe_device(harvester))
     print(describe_excitation(excitation))
     title = "analytic" if anchor is None else f"analytic ({anchor.method})"
@@ -191,14 +182,7 @@ def _run_assembly(args) -> int:
     if assembly.is_linear:
         anchor = assembly_crossing_prediction(assembly, excitation, result.stroke, result.duration,
                                               summary["stroke_on"])  # fmt: skip
-    rows = []
-    for name in ROWS:
-        s = summary[name]
-        reference = ""
-        if anchor is not None:
-            reference = anchor.first_passage_poisson if name == ROWS[0] else getattr(anchor, name)
-            reference = cell(reference) + ("" if name in anchor.exact else "*")
-        rows.append((name, *estimate_parts(s["mean"], s["ci95"]), reference, unit(name)))
+    rows = _rows(summary, anchor)
     print(f"device: {args.device}: {assembly.describe()}")
     print(describe_excitation(excitation))
     title = "analytic" if anchor is None else "analytic (rice)"
@@ -211,3 +195,17 @@ def _run_assembly(args) -> int:
         f"{result.path_steps:.3g} path-steps"
     )
     return 0
+
+
+def _rows(summary: dict, anchor) -> list[tuple]:
+    """The table's rows: each quantity's estimate and 95 % half-width beside the analytic
+    value of ``anchor`` (None: none), marked * where that is the Poisson approximation."""
+    rows = []
+    for name in ROWS:
+        s = summary[name]
+        reference = ""
+        if anchor is not None:
+            value = anchor.first_passage_poisson if name == ROWS[0] else getattr(anchor, name)
+            reference = cell(value) + ("" if name in anchor.exact else "*")
+        rows.append((name, *estimate_parts(s["mean"], s["ci95"]), reference, unit(name)))
+    return rows
