@@ -130,7 +130,8 @@ def _process_state_restored(request):
             thread.join(5)
         elif thread.name == KERNEL_THREAD:  # a stopped run must not compute on
             thread.join(5)
-            running += [thread] if thread.is_alive() else []
+            if thread.is_alive():
+                running.append(thread)
     after = _ProcessState()
     before.restore()
     signal.signal(signal.SIGINT, inherited_int)

@@ -36,7 +36,7 @@ import numpy as np
 from scipy import linalg
 
 from randvib._validation import check_choice
-from randvib.analytic.linear_response import VARIANCE_METHODS, frequency_rule
+from randvib.analytic.linear_response import VARIANCE_METHODS, frequency_rule, lyapunov_shaping
 from randvib.models.assembly import Assembly
 from randvib.models.combined import Combined, parts_of
 from randvib.models.excitation import Excitation
@@ -184,13 +184,8 @@ def linear_response(
     continuous, tones = _continuous_and_tones(excitation)
     covariance, power, used = np.zeros_like(block.a), 0.0, "spectral"
     if continuous is not None:
-        shaping = continuous.shaping_filter()
-        if method == "lyapunov" and shaping is None:
-            raise ValueError(
-                f"`method`='lyapunov' needs a rational spectrum (a shaping filter); the "
-                f"{continuous.name} spectrum has none: use 'spectral'"
-            )
-        if shaping is not None and method != "spectral":
+        shaping = lyapunov_shaping(continuous, method)
+        if shaping is not None:
             covariance, cross = _lyapunov(block, shaping)
             used = "lyapunov"
         else:

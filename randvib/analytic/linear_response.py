@@ -228,6 +228,22 @@ def spectral_variances(block: StateSpace, excitation: Excitation) -> np.ndarray:
     return np.sum(np.abs(h) ** 2 * excitation.psd(nodes) * weights, axis=-1)
 
 
+def lyapunov_shaping(excitation: Excitation, method: str):
+    """The shaping filter whose Lyapunov equation gives the variances, or None (spectral).
+
+    ``method`` is one of :data:`VARIANCE_METHODS`: ``auto`` takes the Lyapunov
+    route where the spectrum is rational, ``spectral`` never, ``lyapunov``
+    always (refused, naming the excitation, for a spectrum with no shaping filter).
+    """
+    shaping = excitation.shaping_filter()
+    if method == "lyapunov" and shaping is None:
+        raise ValueError(
+            f"`method`='lyapunov' needs a rational spectrum (a shaping filter); the "
+            f"{excitation.name} spectrum has none: use 'spectral'"
+        )
+    return None if method == "spectral" else shaping
+
+
 def output_variances(block: StateSpace, excitation: Excitation, method: str = "auto") -> dict:
     """Stationary variances of the block's outputs under an excitation.
 
@@ -248,13 +264,8 @@ def output_variances(block: StateSpace, excitation: Excitation, method: str = "a
         Output name -> variance (the output's units squared).
     """
     check_choice("method", method, VARIANCE_METHODS)
-    shaping = excitation.shaping_filter()
-    if method == "lyapunov" and shaping is None:
-        raise ValueError(
-            f"`method`='lyapunov' needs a rational spectrum (a shaping filter); the "
-            f"{excitation.name} spectrum has none: use 'spectral'"
-        )
-    if shaping is not None and method != "spectral":
+    shaping = lyapunov_shaping(excitation, method)
+    if shaping is not None:
         values = np.diag(stationary_covariance(block, shaping))
     else:
         values = spectral_variances(block, excitation)

@@ -252,12 +252,15 @@ def fit_is_rectified(args) -> bool:
     """True when ``--from-fit`` holds a device fitted behind a diode bridge (and no other
     ``--coupling`` replaces it): the commands choose the bridge's own defaults for it."""
     path = getattr(args, "from_fit", None)
-    if path is None:
-        return False
-    electrical = fitted_device(path).electrical
-    return getattr(electrical, "rectified", False) and getattr(args, "coupling", None) in (
+    return path is not None and _keeps_fitted_bridge(args, fitted_device(path).electrical)
+
+
+def _keeps_fitted_bridge(args, fitted) -> bool:
+    """Whether the fit's coupling ``fitted`` has a bridge that ``args`` keep: no other
+    transducer asked for with ``--coupling``."""
+    return getattr(fitted, "rectified", False) and getattr(args, "coupling", None) in (
         None,
-        electrical.transducer,
+        fitted.transducer,
     )
 
 
@@ -386,7 +389,7 @@ def _coupling_from_args(args, fitted=None):
     ``fitted``: a saved fit's coupling, whose parameters the options override
     (``--r-load 20`` wires it to another load).
     """
-    if getattr(fitted, "rectified", False) and args.coupling in (None, fitted.transducer):
+    if _keeps_fitted_bridge(args, fitted):
         return _fitted_bridge(args, fitted)
     if getattr(args, "rectifier", None) is not None:
         return _bridge_from_args(args)
