@@ -89,7 +89,7 @@ def _gibbs_moment(m: float, c: float, k: float, k3: float, psd: float, power: in
 
     A simulation asks for the same moment three times (the step check's stiffness,
     the companion's start, its control's mean) and a sweep or a seed loop asks again
-    for every batch; each is two adaptive quadratures (about 0.5 ms).
+    for every batch; each is two adaptive quadratures (about 1 ms of CPU).
     """
     weight, z_hi, potential = _gibbs_weight(m, c, k, k3, psd)
     num = _gibbs_integral(weight, 0.0, potential, z_hi, lambda x: x**power)
