@@ -196,8 +196,14 @@ def contrast_and_reference(seed: int):
     return paired_contrast(res, BASE, COVERAGE_WEIGHTS), contrast_reference()
 
 
-def test_crn_sweep_is_what_run_sweep_computes():
-    res = run_sweep(BASE, COVERAGE_POINTS, COVERAGE_SETTINGS, workers=1, progress=False)
+@pytest.fixture(scope="module")
+def coverage_sweep():
+    """run_sweep over the coverage points, seed 0: two tests read it, neither changes it."""
+    return run_sweep(BASE, COVERAGE_POINTS, COVERAGE_SETTINGS, workers=1, progress=False)
+
+
+def test_crn_sweep_is_what_run_sweep_computes(coverage_sweep):
+    res = coverage_sweep
     fast = crn_sweep(COVERAGE_SETTINGS.seed)
     for i in range(len(COVERAGE_POINTS)):
         assert np.array_equal(res.per_path[i], fast.per_path[i])
@@ -241,12 +247,12 @@ def test_paired_contrast_intervals_have_their_nominal_size():
     assert lo <= total <= hi, f"sum of {n} squared z-scores {total:.1f} (region {lo:.1f}..{hi:.1f})"
 
 
-def test_paired_interaction_is_tighter_than_unpaired():
+def test_paired_interaction_is_tighter_than_unpaired(coverage_sweep):
     # Common random numbers: the interaction contrast's interval is far
     # narrower than the one from the four points' own intervals (README:
     # pairing cuts the variance 4-440x, so the half-width at least 2x; here
     # about 5-6x over seeds 0-4).
-    res = run_sweep(BASE, COVERAGE_POINTS, COVERAGE_SETTINGS, workers=1, progress=False)
+    res = coverage_sweep
     inter = paired_contrast(res, BASE, COVERAGE_WEIGHTS)
     t = res.table
     unpaired = np.sqrt(np.sum(t.power_electrical_ci95**2))
@@ -316,11 +322,19 @@ def test_process_pool_gives_the_same_numbers():
 
 
 def test_dask_local_cluster_on_loopback():
+    """A sweep on a Dask cluster at ``scheduler=`` gives the numbers of a local run.
+
+    One worker process: what is Dask's own here is the executor (make_executor's
+    scheduler branch, the client's futures); points finishing out of order on
+    several workers go through the same collection as the local pool's, which
+    test_process_pool_gives_the_same_numbers checks on two. A second Dask worker
+    cost about 2.5 CPU-s (its interpreter, distributed and randvib imported).
+    """
     distributed = pytest.importorskip("distributed")
     pts = cartesian(psd=[0.5], fc=[0.0, 0.02, 0.04])
     local = run_sweep(BASE, pts, FAST, workers=1, progress=False).table
     with distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, host="127.0.0.1", dashboard_address=None, processes=True
+        n_workers=1, threads_per_worker=1, host="127.0.0.1", dashboard_address=None, processes=True
     ) as cluster:
         res = run_sweep(BASE, pts, FAST, scheduler=cluster.scheduler_address, progress=False)
     assert np.array_equal(res.table.power_electrical, local.power_electrical)

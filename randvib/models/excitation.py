@@ -49,7 +49,6 @@ from __future__ import annotations
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
-from scipy import signal
 
 from randvib._validation import (
     check_int,
@@ -695,6 +694,10 @@ class Measured(Excitation):
             raise ValueError(
                 f"`segment_length` must be <= the record's {record.n} samples, got {length}"
             )
+        # imported here: scipy.signal (and the scipy.stats it loads) is a second of
+        # CPU that every process importing the models layer (a sweep's worker) paid
+        from scipy import signal
+
         f, p = signal.welch(
             self.acceleration, fs=1.0 / record.dt, window="hann", nperseg=length,
             noverlap=length // 2,

@@ -45,7 +45,7 @@ import functools
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import optimize, special, stats
+from scipy import optimize, special
 
 from randvib._validation import check_finite, check_nonnegative, check_positive, check_scalar
 from randvib.models.excitation import (
@@ -121,6 +121,8 @@ class Marginal:
             beta = 2.0
         else:
             beta = optimize.brentq(lambda b: _generalised_normal_kurtosis(b) - k, 0.05, 1e3)
+        from scipy import stats  # here, not at import: see _from_cdf
+
         law = stats.gennorm(beta)
         y = _Y_GRID
         # the upper half from the survival functions, accurate in the far tail
@@ -162,6 +164,10 @@ class Marginal:
 
     @classmethod
     def _from_cdf(cls, kind, x, cdf, description) -> Marginal:
+        # scipy.stats is imported here, not with the module: the Monte Carlo layer imports
+        # this module (input checks), and a sweep's worker paid a second of CPU for it
+        from scipy import stats
+
         keep = np.concatenate([[True], np.diff(cdf) > 0])  # a strictly increasing cdf to invert
         values = np.interp(stats.norm.cdf(_Y_GRID), cdf[keep], x[keep])
         return cls._standardised(kind, values, description)

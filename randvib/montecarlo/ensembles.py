@@ -40,9 +40,9 @@ import time
 from collections.abc import Hashable, Mapping
 from concurrent.futures import Executor
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from randvib._validation import MAX_SEED
 from randvib.models.event import Enveloped
@@ -51,6 +51,9 @@ from randvib.models.harvester import Harvester
 from randvib.montecarlo import event_cases
 from randvib.montecarlo.sweep import PointStore, SweepSettings, run_stored, simulate_to_precision
 from randvib.statistics import Statistic, estimate, median_first_passage, paired_ratio
+
+if TYPE_CHECKING:  # pandas is imported where a table is built: a worker process
+    import pandas as pd  # imports this module for run_case and never needs it
 
 __all__ = ["GROUP_SEEDS", "Case", "EnsembleResult", "run_ensembles"]
 
@@ -311,6 +314,8 @@ class EnsembleResult:
             self._one_group({i: 1.0, j: 1.0})
             n = min(self.per_path[i].shape[0], self.per_path[j].shape[0])
             rows.append(paired_ratio(self.power_samples(i)[:n], self.power_samples(j)[:n]))
+        import pandas as pd
+
         return pd.DataFrame(rows, columns=["ratio", "ratio_ci95"], index=self.table.index)
 
     def _stationary(self) -> None:
@@ -415,6 +420,8 @@ def run_ensembles(
         name=name,
         unit="case",
     )
+    import pandas as pd
+
     table = pd.DataFrame([{**case.labels, **rows[i]} for i, case in enumerate(cases)])
     return EnsembleResult(table, cases, settings, groups, per_path)
 

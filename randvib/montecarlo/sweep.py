@@ -39,9 +39,9 @@ from collections.abc import Iterable, Mapping
 from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from randvib._io import (
     atomic_write_bytes,
@@ -64,6 +64,9 @@ from randvib._validation import MAX_SEED, check_int, check_positive
 from randvib.analytic.prediction import METHODS, predict
 from randvib.models.harvester import Harvester
 from randvib.statistics import estimate
+
+if TYPE_CHECKING:  # pandas is imported where a table is built: a sweep's worker
+    import pandas as pd  # process imports this module and never needs it (0.7 CPU-s)
 
 STATISTICS = ("power_electrical", "velocity_variance", "displacement_variance", "mean_abs_velocity")
 
@@ -512,6 +515,8 @@ def _jsonable_point(point: Mapping) -> dict:
 
 
 def _table(rows: dict) -> pd.DataFrame:
+    import pandas as pd
+
     return pd.DataFrame([{"point": i, **rows[i]} for i in sorted(rows)])
 
 
