@@ -316,8 +316,10 @@ def check_layout(fig, name: str) -> None:
 
     if not isinstance(fig.get_layout_engine(), ConstrainedLayoutEngine):
         warnings.warn(f"figure {name}: no constrained layout", FigureLayoutWarning, stacklevel=3)
-    # one draw for both checks (a draw with constrained layout is most of their time)
-    fig.canvas.draw()
+    # one draw for both checks (a draw with constrained layout is most of their time),
+    # without rasterising: the checks need the solved layout and the texts' extents,
+    # not pixels (save_figure rasterises once, at its DPI)
+    fig.draw_without_rendering()
     renderer = fig.canvas.get_renderer()
     overlaps = _text_overlaps(fig, renderer)
     if overlaps:
@@ -347,6 +349,7 @@ def save_figure(fig, path, *, tracked: bool = True) -> Path:
     import io
 
     import matplotlib.pyplot as plt
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.layout_engine import ConstrainedLayoutEngine
 
     from randvib._io import atomic_write_bytes, write_tracked
@@ -359,7 +362,13 @@ def save_figure(fig, path, *, tracked: bool = True) -> Path:
         # solve was most of a saved figure's time)
         fig.set_layout_engine("none")
     buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=DPI)
+    if isinstance(fig.canvas, FigureCanvasAgg):
+        # what savefig(dpi=DPI) writes, byte for byte, less its extra (non-rasterising)
+        # draw before printing, which only a layout engine or a tight bounding box needs
+        fig.dpi = DPI
+        fig.canvas.print_png(buffer)
+    else:  # a figure of a non-Agg backend (MPLBACKEND=pdf): let savefig switch canvas
+        fig.savefig(buffer, format="png", dpi=DPI)
     plt.close(fig)
     if not tracked:
         atomic_write_bytes(path, buffer.getvalue())

@@ -70,7 +70,7 @@ RESOLVED = 0.25  #: exceedances compared with a method where Monte Carlo's half-
 QUICK_MC = {"n_paths": 128, "window": 10.0, "burn_in": 1.0, "dt": 2e-4}
 FULL_MC = {"n_paths": 512, "window": 40.0, "burn_in": 1.0, "dt": 2e-4}
 
-__all__ = ["answer", "devices", "grid", "input_of", "run_study", "verdicts"]
+__all__ = ["answer", "compute", "devices", "grid", "input_of", "run_study", "verdicts"]
 
 
 def grid(quick: bool) -> dict:
@@ -221,6 +221,18 @@ def methods_section(methods, v, figure) -> str:
 
 
 # ----------------------------------------------------------------- the study
+def compute(axes, settings, out, workers, scheduler, progress) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """results.csv (every input, level and device) and methods.csv (the analytic methods)."""
+    cases = [rv.Case({"input": name, "g": g, "level": input_of(name, g).level, "device": dev},
+                     device, input_of(name, g), group=(name, g), initial=start)
+             for name in axes["inputs"] for g in axes["levels"]
+             for dev, (device, start) in devices().items()]  # fmt: skip
+    run = rv.run_ensembles(cases, settings, out_dir=out / "ensembles", workers=workers,
+                           scheduler=scheduler, progress=progress, name=NAME)  # fmt: skip
+    results = budget.stroke_results(run, ["input", "g", "level", "device"], device="linear")
+    return results, methods_against_monte_carlo(run, axes["methods"], resolved=RESOLVED)
+
+
 def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, progress=True) -> Path:
     """Run the devices study and write ``report.md``, CSVs, figures and ``verdicts.json``.
 
@@ -232,14 +244,7 @@ def run_study(out_dir, *, quick=False, seed=0, workers=None, scheduler=None, pro
     settings = fixed_paths(**axes["mc"], seed=seed)
     out = report.prepare_output_dir(out_dir, {"study": NAME, "quick": quick, "seed": seed, **axes})
     started = time.perf_counter()
-    cases = [rv.Case({"input": name, "g": g, "level": input_of(name, g).level, "device": dev},
-                     device, input_of(name, g), group=(name, g), initial=start)
-             for name in axes["inputs"] for g in axes["levels"]
-             for dev, (device, start) in devices().items()]  # fmt: skip
-    run = rv.run_ensembles(cases, settings, out_dir=out / "ensembles", workers=workers,
-                           scheduler=scheduler, progress=progress, name=NAME)  # fmt: skip
-    results = budget.stroke_results(run, ["input", "g", "level", "device"], device="linear")
-    methods = methods_against_monte_carlo(run, axes["methods"], resolved=RESOLVED)
+    results, methods = compute(axes, settings, out, workers, scheduler, progress)
     report.write_table(out, "results.csv", results)
     report.write_table(out, "methods.csv", methods)
     v = verdicts(results, methods)

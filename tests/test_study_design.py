@@ -34,7 +34,9 @@ def test_design_study_quick_end_to_end(tmp_path, monkeypatch, capsys):
     monkeypatch.setattr(
         study, "inputs", lambda quick: {"band": band.scaled(study.LEVEL / band.variance)}
     )
-    monkeypatch.setattr(study, "STROKES", {True: (0.002,)})
+    # no stroke beyond the study's own: the budget table is then the results' rows at
+    # STROKE (checked below); its extra strokes were three more designs nothing here read
+    monkeypatch.setattr(study, "STROKES", {True: ()})
     monkeypatch.setattr(study, "ZETAS", {True: (0.3,)})  # the input's own bandwidth
     monkeypatch.setattr(study, "QUICK_MC", {"dt": 2e-4, "window": 1.0, "burn_in": 0.3,
                                             "min_paths": 24, "max_paths": 24})  # fmt: skip
@@ -57,6 +59,11 @@ def test_design_study_quick_end_to_end(tmp_path, monkeypatch, capsys):
                       exceedance=study.EPS, monte_carlo=False)  # fmt: skip
     assert lin.power_predicted == pytest.approx(exact.power_predicted, rel=1e-9)
     assert lin.opt_k == pytest.approx(exact.optimum["k"], rel=1e-9)
+    budget = pd.read_csv(out / "budget.csv")
+    assert sorted(budget.family) == sorted(study.FAMILIES) and (budget.stroke == study.STROKE).all()
+    assert budget.set_index("family").power_mc.to_dict() == pytest.approx(
+        results.set_index("family").power_mc.to_dict(), rel=1e-12
+    )
     bandwidth = pd.read_csv(out / "bandwidth.csv")
     at_input = bandwidth[(bandwidth.zeta == 0.3) & (bandwidth.family == "linear")].iloc[0]
     assert at_input.k == pytest.approx(exact.optimum["k"], rel=1e-9)
