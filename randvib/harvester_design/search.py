@@ -49,7 +49,9 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import cached_property, partial
 
 import numpy as np
 from scipy import optimize
@@ -121,6 +123,10 @@ class Candidate:
     first_passage : float
         Predicted mean first-passage time to the stroke (s) from a stationary
         start; NaN where the method's response is not Gaussian (module docstring).
+        Computed when first asked for, by ``passage_prediction`` (NaN without
+        one): a search without a first-passage bound asks it of the few devices
+        it reports, not of every point it evaluates (a Vanmarcke bandwidth each,
+        a spectral integral: a third of a linear design's search).
     """
 
     u: np.ndarray = field(repr=False)
@@ -130,7 +136,11 @@ class Candidate:
     method: str
     input_power: float
     warned: bool = False
-    first_passage: float = math.nan
+    passage_prediction: Callable[[], float] | None = field(default=None, repr=False, compare=False)
+
+    @cached_property
+    def first_passage(self) -> float:
+        return math.nan if self.passage_prediction is None else self.passage_prediction()
 
 
 @dataclass(frozen=True)
@@ -214,8 +224,14 @@ class Evaluator:
             method=method.name,
             input_power=float(prediction.c_eq * prediction.velocity_variance),
             warned=bool(caught),
-            first_passage=predicted_first_passage(
-                prediction, method, device.stroke, exceedance, device, self.excitation
+            passage_prediction=partial(
+                predicted_first_passage,
+                prediction,
+                method,
+                device.stroke,
+                exceedance,
+                device,
+                self.excitation,
             ),
         )
 
