@@ -120,13 +120,9 @@ class Candidate:
         stationary sum of every dissipation.
     warned : bool
         The method warned (beyond a declared validity limit it warns at).
-    first_passage : float
-        Predicted mean first-passage time to the stroke (s) from a stationary
-        start; NaN where the method's response is not Gaussian (module docstring).
-        Computed when first asked for, by ``passage_prediction`` (NaN without
-        one): a search without a first-passage bound asks it of the few devices
-        it reports, not of every point it evaluates (a Vanmarcke bandwidth each,
-        a spectral integral: a third of a linear design's search).
+    passage_prediction : callable or None
+        Returns the predicted mean first passage (:attr:`first_passage`) when
+        first asked for it.
     """
 
     u: np.ndarray = field(repr=False)
@@ -140,6 +136,14 @@ class Candidate:
 
     @cached_property
     def first_passage(self) -> float:
+        """Predicted mean first-passage time to the stroke (s) from a stationary start.
+
+        NaN where the method's response is not Gaussian (module docstring) or
+        without a ``passage_prediction``. Computed when first asked for: a
+        search without a first-passage bound asks it of the few devices it
+        reports, not of every point it evaluates (a Vanmarcke bandwidth each, a
+        spectral integral: a third of a linear design's search).
+        """
         return math.nan if self.passage_prediction is None else self.passage_prediction()
 
 
