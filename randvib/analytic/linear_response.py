@@ -20,6 +20,7 @@ stationary output variances (docs/conventions.md, "Beyond the paper"):
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -28,6 +29,10 @@ from scipy import linalg
 from randvib._validation import check_choice
 from randvib.models.excitation import Excitation, ShapingFilter
 from randvib.models.state_space import StateSpace
+
+_GEES, _TRSYL = linalg.get_lapack_funcs(("gees", "trsyl"), dtype=np.float64)
+#: gees's optimal work size by matrix size (its workspace query, as scipy's schur makes).
+_GEES_LWORK: dict = {}
 
 #: How :func:`output_variances` computes the variances: the values of ``method``.
 VARIANCE_METHODS = ("auto", "lyapunov", "spectral")
@@ -166,8 +171,36 @@ def stationary_covariance(block: StateSpace, shaping: ShapingFilter) -> np.ndarr
         )
     _require_stable(system)
     q = shaping.noise_intensity * np.outer(system.b, system.b)
-    p = linalg.solve_continuous_lyapunov(system.a, -q)
+    p = solve_lyapunov(system.a, -q)
     return system.c @ p @ system.c.T
+
+
+def solve_lyapunov(a: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """X with ``A X + X A^T = Q`` (real A, Q): :func:`scipy.linalg.solve_continuous_lyapunov`.
+
+    The same LAPACK calls with the same arguments (the real Schur form by ``gees``,
+    then ``trsyl``), so the same X to the last bit, without the wrapper's argument
+    handling, which cost twice the solve for the few states of a device: statistical
+    linearisation solves one per iteration, a design's search thousands.
+    """
+    if not (np.isfinite(a).all() and np.isfinite(q).all()):
+        raise ValueError("array must not contain infs or NaNs")  # scipy's check_finite
+    n = a.shape[0]
+    if n not in _GEES_LWORK:
+        _GEES_LWORK[n] = int(_GEES(lambda x, y: None, a, lwork=-1)[-2][0])
+    r, _, _, _, u, _, info = _GEES(lambda x, y: None, a, lwork=_GEES_LWORK[n])
+    if info > 0:
+        raise np.linalg.LinAlgError("Schur form not found. Possibly ill-conditioned.")
+    y, scale, info = _TRSYL(r, r, u.T @ (q @ u), tranb="T")
+    if info == 1:
+        warnings.warn(
+            'Input "a" has an eigenvalue pair whose sum is very close to or exactly zero. '
+            "The solution is obtained via perturbing the coefficients.",
+            RuntimeWarning,
+            stacklevel=3,
+        )
+    y *= scale
+    return u @ y @ u.T
 
 
 def _features(block: StateSpace, excitation: Excitation):

@@ -49,7 +49,9 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from functools import cached_property, partial
 
 import numpy as np
 from scipy import optimize
@@ -118,9 +120,9 @@ class Candidate:
         stationary sum of every dissipation.
     warned : bool
         The method warned (beyond a declared validity limit it warns at).
-    first_passage : float
-        Predicted mean first-passage time to the stroke (s) from a stationary
-        start; NaN where the method's response is not Gaussian (module docstring).
+    passage_prediction : callable or None
+        Returns the predicted mean first passage (:attr:`first_passage`) when
+        first asked for it.
     """
 
     u: np.ndarray = field(repr=False)
@@ -130,7 +132,19 @@ class Candidate:
     method: str
     input_power: float
     warned: bool = False
-    first_passage: float = math.nan
+    passage_prediction: Callable[[], float] | None = field(default=None, repr=False, compare=False)
+
+    @cached_property
+    def first_passage(self) -> float:
+        """Predicted mean first-passage time to the stroke (s) from a stationary start.
+
+        NaN where the method's response is not Gaussian (module docstring) or
+        without a ``passage_prediction``. Computed when first asked for: a
+        search without a first-passage bound asks it of the few devices it
+        reports, not of every point it evaluates (a Vanmarcke bandwidth each, a
+        spectral integral: a third of a linear design's search).
+        """
+        return math.nan if self.passage_prediction is None else self.passage_prediction()
 
 
 @dataclass(frozen=True)
@@ -214,8 +228,14 @@ class Evaluator:
             method=method.name,
             input_power=float(prediction.c_eq * prediction.velocity_variance),
             warned=bool(caught),
-            first_passage=predicted_first_passage(
-                prediction, method, device.stroke, exceedance, device, self.excitation
+            passage_prediction=partial(
+                predicted_first_passage,
+                prediction,
+                method,
+                device.stroke,
+                exceedance,
+                device,
+                self.excitation,
             ),
         )
 
