@@ -125,6 +125,48 @@ def _numpydoc_with_one_template():
     extension.get_doc_object = get_doc_object
 
 
+def _numpydoc_selected_checks_only():
+    """Make numpydoc run only the checks it reports (``numpydoc_validation_checks``).
+
+    numpydoc 1.x runs all its ~50 checks on every docstring and then reports the
+    selected ones (its own TODO in ``mangle_docstrings`` says so). Several of the
+    others read and tokenize the object's source (its definition line, whether a
+    method returns something, ``# numpydoc ignore`` comments): about a tenth of
+    this site's build (cProfile, numpydoc 1.11). The three checks kept here read the
+    parsed docstring only, and are numpydoc's own code for them (``validate.validate``);
+    randvib has no ``# numpydoc ignore`` comments. Left as numpydoc has it where the
+    selection or numpydoc's internals differ from those this relies on.
+    """
+    try:
+        import numpydoc.numpydoc as extension
+        from numpydoc import validate as numpydoc_validate
+    except ImportError:
+        return
+    if numpydoc_validation_checks != {"GL06", "GL07", "PR10"} or not all(
+        hasattr(numpydoc_validate, name) for name in ("ALLOWED_SECTIONS", "Validator", "error")
+    ):
+        return
+    allowed, error = numpydoc_validate.ALLOWED_SECTIONS, numpydoc_validate.error
+
+    def validate(obj):
+        doc = numpydoc_validate.Validator(obj)
+        errs = []
+        if doc.raw_doc:
+            titles = doc.section_titles
+            for section in titles:
+                if section not in allowed:
+                    errs.append(error("GL06", section=section, allowed_sections=", ".join(allowed)))
+            correct_order = [section for section in allowed if section in titles]
+            if correct_order != titles:
+                errs.append(error("GL07", correct_sections=", ".join(correct_order)))
+            for param in doc.doc_all_parameters:
+                if not param.startswith("*") and not doc.parameter_type(param) and ":" in param:
+                    errs.append(error("PR10", param_name=param.split(":")[0]))
+        return {"docstring": doc.clean_doc, "errors": errs}
+
+    extension.validate = validate
+
+
 intersphinx_mapping = {}
 
 # -- Markdown -----------------------------------------------------------------
@@ -192,4 +234,5 @@ def _escape_docstring(app, what, name, obj, options, lines):
 
 def setup(app):
     _numpydoc_with_one_template()
+    _numpydoc_selected_checks_only()
     app.connect("autodoc-process-docstring", _escape_docstring)
