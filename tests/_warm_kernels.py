@@ -10,7 +10,7 @@ workers find a warm cache; the halves are balanced by compile time:
   (filter or circuit, event, bridge, tones and shocks in one signature), run on
   every combination the suite uses so that a new signature would show up, and
   the record simulation behind a bridge (:mod:`randvib.identification.record_bridge`);
-  121 CPU-s cold (November 2026; the assembly half 104);
+  93 CPU-s cold (November 2026; the assembly half 100);
 * ``assembly``: that function's lean loop (white noise, nothing optional), the
   assembly kernel (:mod:`randvib.montecarlo.assembly_kernel`), the record
   integrator of the identification
@@ -72,7 +72,7 @@ def warm_single() -> None:
     rv.simulate_transient(_harvester(), rv.Enveloped(band, step), t_end=0.02, dt=1e-3,
                           n_paths=2)  # fmt: skip
     # the record simulation behind a diode bridge (identification.record_bridge), here
-    # to even the halves: 45 CPU-s of compiling
+    # to even the halves: 12 CPU-s of compiling
     bridge = rv.BridgeCoil(alpha=1.0, r_coil=2.0, v_diode=0.2, storage_capacitance=2e-3,
                            r_load=50.0)  # fmt: skip
     device = rv.Harvester.with_coupling(M, C_M, K, bridge)
