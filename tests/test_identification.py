@@ -152,7 +152,15 @@ def test_true_parameters_score_the_residual_of_the_initial_state(skip):
     assert row.cost == pytest.approx(reference, rel=1e-6)
 
 
-def test_noise_free_coulomb_not_at_rest_recovered_to_optimiser_precision():
+@pytest.fixture(scope="module")
+def coulomb_not_at_rest():
+    """(record, fit): the noise-free Coulomb record starting at (Z0, V0) and its fit with
+    the given mass (SaDE 30 x 80, seed 1), which two tests read and neither changes."""
+    rec = not_at_rest("coulomb", COULOMB)
+    return rec, identify_classic(rec, "coulomb", m=COULOMB["m"], popsize=30, maxiter=80, seed=1)
+
+
+def test_noise_free_coulomb_not_at_rest_recovered_to_optimiser_precision(coulomb_not_at_rest):
     """Coulomb record starting at (Z0, V0): every parameter to TOL = 1e-4 of the optimum.
 
     The optimum differs from the truth by the linearised offset (about 5e-4
@@ -160,8 +168,7 @@ def test_noise_free_coulomb_not_at_rest_recovered_to_optimiser_precision():
     is computed and removed. A mass scaled by 1.009 inside identify moves
     every parameter by 0.9 %; a zero initial state moves them by several %.
     """
-    rec = not_at_rest("coulomb", COULOMB)
-    res = identify_classic(rec, "coulomb", m=COULOMB["m"], popsize=30, maxiter=80, seed=1)
+    rec, res = coulomb_not_at_rest
     lin = H.Linearisation(COULOMB, "coulomb", rec, H.FREE)
     assert_at_optimum(res, COULOMB, lin, "coulomb")
     assert res.parameters["m"] == COULOMB["m"]  # the given mass, unchanged
@@ -171,10 +178,9 @@ def test_noise_free_coulomb_not_at_rest_recovered_to_optimiser_precision():
     assert set(res.to_dict()["parameters"]) == {"m", "c", "k", "k3", "fc"}
 
 
-def test_identified_forces_scale_exactly_with_the_given_mass():
+def test_identified_forces_scale_exactly_with_the_given_mass(coulomb_not_at_rest):
     """Base excitation: Eq. 1 divided by m; doubling m doubles c, k, k3 and Fc, same J."""
-    rec = not_at_rest("coulomb", COULOMB)
-    one = identify_classic(rec, "coulomb", m=COULOMB["m"], popsize=30, maxiter=80, seed=1)
+    rec, one = coulomb_not_at_rest
     two = identify_classic(rec, "coulomb", m=2 * COULOMB["m"], popsize=30, maxiter=80, seed=1)
     for name in H.FREE:
         assert two.parameters[name] / one.parameters[name] == pytest.approx(2.0, rel=TOL), name

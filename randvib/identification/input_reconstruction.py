@@ -280,19 +280,22 @@ def choose_hold(samples, dt: float, hold: str = AUTO_HOLD) -> tuple[str, str]:
             warnings.warn(why, UserWarning, stacklevel=3)
             return chosen, why
         return hold, ""
-    errors = {h: midpoint_error(x, h) for h in ("linear", "cubic", "zero")}
+    # only the one reconstruction's error that decides (each costs a band-limited
+    # interpolation of the whole input)
     if hold == AUTO_HOLD:
-        if errors["linear"] <= HOLD_TOLERANCE:
+        linear = midpoint_error(x, "linear")
+        if linear <= HOLD_TOLERANCE:
             return "linear", ""
         return "bandlimited", (
             f"input reconstructed band-limited (hold='bandlimited'): straight lines between "
-            f"samples would misrepresent its content by {100 * errors['linear']:.2g} % RMS "
+            f"samples would misrepresent its content by {100 * linear:.2g} % RMS "
             "(chosen from the record; --hold sets it)"
         )
-    if hold != "bandlimited" and errors[hold] > HOLD_TOLERANCE:
+    error = 0.0 if hold == "bandlimited" else midpoint_error(x, hold)
+    if error > HOLD_TOLERANCE:
         why = (
             f"--hold {hold} (hold={hold!r}) misrepresents this input by "
-            f"{100 * errors[hold]:.2g} % RMS between samples (it has content close to the "
+            f"{100 * error:.2g} % RMS between samples (it has content close to the "
             f"Nyquist frequency {nyquist:.4g} Hz), which biases the fit; use --hold "
             "bandlimited or leave --hold out (auto)"
         )

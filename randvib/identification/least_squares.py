@@ -460,8 +460,13 @@ def uncertainty(problem: SimulationError, u, residuals, jacobian_u) -> Uncertain
     )
 
 
-def polish(problem: SimulationError, theta0, *, max_nfev=None):
-    """Minimise |e(theta)|^2 from theta0; returns (theta, residuals, Uncertainty, message)."""
+def polish(problem: SimulationError, theta0, *, max_nfev=None, with_uncertainty: bool = True):
+    """Minimise |e(theta)|^2 from theta0; returns (theta, residuals, Uncertainty, message).
+
+    ``with_uncertainty=False`` returns None for the Uncertainty, sparing its
+    Jacobian (2 d more simulations) and covariance when only the optimum is
+    wanted (the initial-state estimate of a prediction).
+    """
     from scipy.optimize import least_squares
 
     coords = problem.coordinates
@@ -479,5 +484,7 @@ def polish(problem: SimulationError, theta0, *, max_nfev=None):
         ftol=1e-12,
         gtol=1e-12,
     )
-    unc = uncertainty(problem, res.x, res.fun, problem.covariance_jacobian(res.x))
+    unc = None
+    if with_uncertainty:
+        unc = uncertainty(problem, res.x, res.fun, problem.covariance_jacobian(res.x))
     return coords.to_theta(res.x), res.fun, unc, res.message

@@ -117,7 +117,8 @@ def _start_estimate(cost: CostFunction):
         lower=np.full(2, -np.inf),
         upper=np.full(2, np.inf),
     )
-    theta, _, _, _ = polish(SimulationError(cost, coords), np.array([cost.z0, cost.v0]))
+    problem = SimulationError(cost, coords)
+    theta, _, _, _ = polish(problem, np.array([cost.z0, cost.v0]), with_uncertainty=False)
     return float(theta[0]), float(theta[1])
 
 
@@ -269,7 +270,8 @@ def score_channels(harvester, record, measurement, simulation, outputs=None) -> 
             scale=np.array([max(abs(start[n]), 1e-9) for n in names]),
             lower=np.full(len(names), -np.inf), upper=np.full(len(names), np.inf),
         )  # fmt: skip
-        theta, _, _, _ = polish(ExperimentError(cost, coords), np.array([start[n] for n in names]))
+        problem, guess = ExperimentError(cost, coords), np.array([start[n] for n in names])
+        theta, _, _, _ = polish(problem, guess, with_uncertainty=False)
         start.update(zip(names, map(float, theta), strict=True))
     values.update({k: np.array([v]) for k, v in start.items()})
     run = cost.run(values, 0, start=tuple(np.array([start[n]]) for n in (*START, "x0")))
