@@ -47,6 +47,20 @@ _TAIL_FACTOR = 20.0  # the tail starts at this multiple of the highest feature
 _TAIL_PANELS = 8
 
 
+def _tail_rule():
+    """Nodes u in (0, 1] and weights of the tail's panels, before the map f = f_c / u."""
+    u_edges = np.linspace(0.0, 1.0, _TAIL_PANELS + 1)
+    u_half = 0.5 * np.diff(u_edges)
+    u = ((u_edges[:-1] + u_half)[:, None] + u_half[:, None] * _NODES).ravel()
+    return u, (u_half[:, None] * _WEIGHTS).ravel()
+
+
+# What frequency_rule makes the same for every block and spectrum: computed once
+# (the same operations on the same constants, so the same bits as at every call).
+_PEAK_OFFSETS = 2.0**_PEAK_POWERS
+_TAIL_NODES, _TAIL_WEIGHTS = _tail_rule()
+
+
 @dataclass(frozen=True, eq=False)
 class ResponseSpectra:
     """One-sided PSDs of the linearised response (SI units, f in Hz).
@@ -240,21 +254,20 @@ def frequency_rule(block: StateSpace, excitation: Excitation, eig=None):
     # a band edge at a subnormal frequency (f_lo = 5e-324 Hz) would make the grid
     # start at 0; below 1e-12 of the top, one panel holds a negligible, bounded integrand
     small = max(small, 1e-12 * top)
-    edges = [lo, top, *kinks, *np.geomspace(small, top, _GRID_POINTS)]
+    # the edges in arrays, not a list of numpy scalars (the same values in the same
+    # order; building the list cost most of the rule)
+    edges = [np.array([lo, top, *kinks], dtype=float), np.geomspace(small, top, _GRID_POINTS)]
     for fc, w in features:
-        offsets = w * 2.0**_PEAK_POWERS
-        edges += [fc, *(fc + offsets), *(fc - offsets[offsets < fc])]
-    edges = np.unique(np.clip(edges, lo, top))
+        offsets = w * _PEAK_OFFSETS
+        edges += [np.array([fc], dtype=float), fc + offsets, fc - offsets[offsets < fc]]
+    edges = np.unique(np.clip(np.concatenate(edges), lo, top))
     half = 0.5 * np.diff(edges)
     nodes = (edges[:-1] + half)[:, None] + half[:, None] * _NODES
     weights = half[:, None] * _WEIGHTS
     nodes, weights = [nodes.ravel()], [weights.ravel()]
     if np.isinf(hi):
-        u_edges = np.linspace(0.0, 1.0, _TAIL_PANELS + 1)
-        u_half = 0.5 * np.diff(u_edges)
-        u = ((u_edges[:-1] + u_half)[:, None] + u_half[:, None] * _NODES).ravel()
-        nodes.append(top / u)
-        weights.append((u_half[:, None] * _WEIGHTS).ravel() * top / u**2)
+        nodes.append(top / _TAIL_NODES)
+        weights.append(_TAIL_WEIGHTS * top / _TAIL_NODES**2)
     return np.concatenate(nodes), np.concatenate(weights)
 
 
