@@ -31,7 +31,7 @@ def _first_bad(arr: np.ndarray, mask: np.ndarray):
 def check_finite(name: str, value) -> np.ndarray:
     arr = as_float_array(name, value)
     bad = ~np.isfinite(arr)
-    if np.any(bad):
+    if bad.any():  # an ndarray or numpy bool: the method, without np.any's dispatch
         raise ValueError(
             f"`{name}` must be finite, got {_first_bad(arr, bad)!r}; "
             "NaN and infinite values are not allowed"
@@ -59,7 +59,7 @@ def check_positive(name: str, value, unit: str = "") -> np.ndarray:
     """Finite and strictly greater than zero (scalar or array)."""
     arr = check_finite(name, value)
     bad = arr <= 0
-    if np.any(bad):
+    if bad.any():  # an ndarray or numpy bool: the method, without np.any's dispatch
         raise ValueError(f"`{name}` must be > 0{_unit(unit)}, got {_first_bad(arr, bad)!r}")
     return arr
 
@@ -68,7 +68,7 @@ def check_nonnegative(name: str, value, unit: str = "") -> np.ndarray:
     """Finite and greater than or equal to zero (scalar or array)."""
     arr = check_finite(name, value)
     bad = arr < 0
-    if np.any(bad):
+    if bad.any():  # an ndarray or numpy bool: the method, without np.any's dispatch
         raise ValueError(f"`{name}` must be >= 0{_unit(unit)}, got {_first_bad(arr, bad)!r}")
     return arr
 

@@ -65,7 +65,7 @@ import numpy as np
 from scipy import optimize, special
 
 from randvib._validation import check_positive
-from randvib.analytic.linear_response import device_block, output_variances
+from randvib.analytic.linear_response import device_block, variances_through
 from randvib.analytic.linearisation import linear_displacement_variance
 from randvib.analytic.method import MONTE_CARLO, AnalyticMethod, Validity, non_white
 from randvib.analytic.power_prediction import PowerPrediction
@@ -173,7 +173,8 @@ def _coloured_response(harvester: Harvester, excitation, v_out: float) -> tuple[
     coil, law = harvester.electrical, harvester.friction
     m, c_m, k, k3 = (float(x) for x in (harvester.m, harvester.c_m, harvester.k, harvester.k3))
     excitation = as_excitation(excitation)
-    used = "lyapunov" if excitation.shaping_filter() else "spectral"
+    # the route (Lyapunov where the spectrum is rational) and its filter, once for the search
+    shaping = excitation.shaping_filter()
     g = coil.alpha**2 / coil.r_coil
     u0 = (v_out + 2.0 * coil.v_diode) / coil.alpha
 
@@ -184,7 +185,7 @@ def _coloured_response(harvester: Harvester, excitation, v_out: float) -> tuple[
         return c_m + friction + 2.0 * g * _tail(u0 / s), k + 3.0 * k3 * var_z
 
     def variances(c_eq, k_eq):
-        out = output_variances(device_block(m, c_eq, k_eq, None), excitation, used)
+        out = variances_through(device_block(m, c_eq, k_eq, None), excitation, shaping)
         return np.log([out["v"], out["z"]])
 
     def residual(x):

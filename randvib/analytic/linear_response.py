@@ -47,6 +47,20 @@ _TAIL_FACTOR = 20.0  # the tail starts at this multiple of the highest feature
 _TAIL_PANELS = 8
 
 
+def _tail_rule():
+    """Nodes u in (0, 1] and weights of the tail's panels, before the map f = f_c / u."""
+    u_edges = np.linspace(0.0, 1.0, _TAIL_PANELS + 1)
+    u_half = 0.5 * np.diff(u_edges)
+    u = ((u_edges[:-1] + u_half)[:, None] + u_half[:, None] * _NODES).ravel()
+    return u, (u_half[:, None] * _WEIGHTS).ravel()
+
+
+# What frequency_rule makes the same for every block and spectrum: computed once
+# (the same operations on the same constants, so the same bits as at every call).
+_PEAK_OFFSETS = 2.0**_PEAK_POWERS
+_TAIL_NODES, _TAIL_WEIGHTS = _tail_rule()
+
+
 @dataclass(frozen=True, eq=False)
 class ResponseSpectra:
     """One-sided PSDs of the linearised response (SI units, f in Hz).
@@ -139,13 +153,15 @@ def device_block(m, c, k, coupling=None) -> StateSpace:
     return StateSpace(a, [0.0, -1.0, 0.0], np.eye(3), np.zeros(3), outputs)
 
 
-def _require_stable(system: StateSpace):
+def _require_stable(system: StateSpace) -> np.ndarray:
+    """The eigenvalues of ``system.a`` (1/s), refused when one has a real part >= 0."""
     eig = np.linalg.eigvals(system.a)
-    if np.any(eig.real >= 0):
+    if (eig.real >= 0).any():  # the method, not np.any: its dispatch cost more than the test
         raise ValueError(
             "the linear(ised) system has an eigenvalue with non-negative real part "
             f"({eig[np.argmax(eig.real)]:.6g} 1/s): it has no stationary response"
         )
+    return eig
 
 
 def stationary_covariance(block: StateSpace, shaping: ShapingFilter) -> np.ndarray:
@@ -164,7 +180,7 @@ def stationary_covariance(block: StateSpace, shaping: ShapingFilter) -> np.ndarr
         E[y y^T] of the block's outputs (their units squared).
     """
     system = block.driven_by(shaping.system, "acceleration")
-    if np.any(system.d != 0):
+    if (system.d != 0).any():
         raise ValueError(
             "white noise reaches an output directly: its variance is infinite "
             f"(outputs {', '.join(system.outputs)})"
@@ -203,15 +219,22 @@ def solve_lyapunov(a: np.ndarray, q: np.ndarray) -> np.ndarray:
     return u @ y @ u.T
 
 
-def _features(block: StateSpace, excitation: Excitation):
-    """(centre, half-width) pairs (Hz): the block's modes and the spectrum's peaks."""
-    eig = np.linalg.eigvals(block.a) if block.n_states else np.zeros(0)
+def _features(block: StateSpace, excitation: Excitation, eig=None):
+    """(centre, half-width) pairs (Hz): the block's modes and the spectrum's peaks.
+
+    ``eig``: the eigenvalues of ``block.a`` where the caller has them already.
+    """
+    if eig is None:
+        eig = np.linalg.eigvals(block.a) if block.n_states else np.zeros(0)
     modes = [(abs(e.imag) / (2 * np.pi), abs(e.real) / (2 * np.pi)) for e in eig if e.imag >= 0]
     return [(fc, w) for fc, w in modes + list(excitation.features()) if w > 0]
 
 
-def frequency_rule(block: StateSpace, excitation: Excitation):
+def frequency_rule(block: StateSpace, excitation: Excitation, eig=None):
     """Nodes and weights for int_0^inf g(f) df with g = |H|^2 S (composite Gauss-Legendre).
+
+    ``eig``, optional: the eigenvalues of ``block.a`` (1/s), as
+    :func:`numpy.linalg.eigvals` gives them, where the caller has computed them.
 
     Returns
     -------
@@ -221,7 +244,7 @@ def frequency_rule(block: StateSpace, excitation: Excitation):
         f = f_c / u onto u in (0, 1], where |H|^2 S is smooth.
     """
     lo, hi = excitation.support
-    features = _features(block, excitation)
+    features = _features(block, excitation, eig)
     kinks = [b for b in excitation.breakpoints() if lo <= b <= hi]
     scales = [fc + w for fc, w in features] + [b for b in kinks if b > 0]
     if not scales:
@@ -231,21 +254,20 @@ def frequency_rule(block: StateSpace, excitation: Excitation):
     # a band edge at a subnormal frequency (f_lo = 5e-324 Hz) would make the grid
     # start at 0; below 1e-12 of the top, one panel holds a negligible, bounded integrand
     small = max(small, 1e-12 * top)
-    edges = [lo, top, *kinks, *np.geomspace(small, top, _GRID_POINTS)]
+    # the edges in arrays, not a list of numpy scalars (the same values in the same
+    # order; building the list cost most of the rule)
+    edges = [np.array([lo, top, *kinks], dtype=float), np.geomspace(small, top, _GRID_POINTS)]
     for fc, w in features:
-        offsets = w * 2.0**_PEAK_POWERS
-        edges += [fc, *(fc + offsets), *(fc - offsets[offsets < fc])]
-    edges = np.unique(np.clip(edges, lo, top))
+        offsets = w * _PEAK_OFFSETS
+        edges += [np.array([fc], dtype=float), fc + offsets, fc - offsets[offsets < fc]]
+    edges = np.unique(np.clip(np.concatenate(edges), lo, top))
     half = 0.5 * np.diff(edges)
     nodes = (edges[:-1] + half)[:, None] + half[:, None] * _NODES
     weights = half[:, None] * _WEIGHTS
     nodes, weights = [nodes.ravel()], [weights.ravel()]
     if np.isinf(hi):
-        u_edges = np.linspace(0.0, 1.0, _TAIL_PANELS + 1)
-        u_half = 0.5 * np.diff(u_edges)
-        u = ((u_edges[:-1] + u_half)[:, None] + u_half[:, None] * _NODES).ravel()
-        nodes.append(top / u)
-        weights.append((u_half[:, None] * _WEIGHTS).ravel() * top / u**2)
+        nodes.append(top / _TAIL_NODES)
+        weights.append(_TAIL_WEIGHTS * top / _TAIL_NODES**2)
     return np.concatenate(nodes), np.concatenate(weights)
 
 
@@ -255,8 +277,10 @@ def spectral_variances(block: StateSpace, excitation: Excitation) -> np.ndarray:
     Accurate to about 1e-9 relative or better for the device's resonance and the
     built-in spectra (checked against the Lyapunov solution in the tests).
     """
-    _require_stable(block)
-    nodes, weights = frequency_rule(block, excitation)
+    # the stability check's eigenvalues place the rule's panels too (the same call on
+    # the same matrix: computed once)
+    eig = _require_stable(block)
+    nodes, weights = frequency_rule(block, excitation, eig)
     h = block.frequency_response(nodes)
     return np.sum(np.abs(h) ** 2 * excitation.psd(nodes) * weights, axis=-1)
 
@@ -297,7 +321,16 @@ def output_variances(block: StateSpace, excitation: Excitation, method: str = "a
         Output name -> variance (the output's units squared).
     """
     check_choice("method", method, VARIANCE_METHODS)
-    shaping = lyapunov_shaping(excitation, method)
+    return variances_through(block, excitation, lyapunov_shaping(excitation, method))
+
+
+def variances_through(block: StateSpace, excitation: Excitation, shaping) -> dict:
+    """:func:`output_variances` with the route chosen: Lyapunov through ``shaping``, or
+    the spectral integral where it is None (:func:`lyapunov_shaping` chooses it).
+
+    For a caller that solves many blocks under one excitation (a linearisation's
+    fixed point): the excitation's filter is built once, not at every solve.
+    """
     if shaping is not None:
         values = np.diag(stationary_covariance(block, shaping))
     else:

@@ -47,14 +47,16 @@ from dataclasses import dataclass
 import numpy as np
 
 from randvib import _display, formatting
-from randvib._validation import check_scalar_device
+from randvib._validation import check_choice, check_scalar_device
 from randvib.analytic.fixed_point import TrialUndefined, solve
 from randvib.analytic.harmonic_linearisation import combined_linearisation
 from randvib.analytic.linear_response import (
+    VARIANCE_METHODS,
     ResponseSpectra,
     device_block,
-    output_variances,
+    lyapunov_shaping,
     response_spectra,
+    variances_through,
 )
 from randvib.analytic.linearisation import (
     LinearisedDevice,
@@ -232,9 +234,10 @@ def statistical_linearisation(
         )
     friction = _check_harvester(harvester)
     m, c, k, k3 = (float(x) for x in (harvester.m, harvester.c, harvester.k, harvester.k3))
-    used = (
-        method if method != "auto" else ("lyapunov" if excitation.shaping_filter() else "spectral")
-    )
+    # the route and the excitation's filter, once for the whole fixed point
+    check_choice("method", method, VARIANCE_METHODS)
+    shaping = lyapunov_shaping(excitation, method)
+    used = method if method != "auto" else ("lyapunov" if shaping else "spectral")
 
     def equivalent(log_variances):
         var_v, var_z = np.exp(log_variances)
@@ -252,7 +255,9 @@ def statistical_linearisation(
         return c + increment, k_eq
 
     def variances(c_eq, k_eq):
-        return output_variances(device_block(m, c_eq, k_eq, harvester.electrical), excitation, used)
+        return variances_through(
+            device_block(m, c_eq, k_eq, harvester.electrical), excitation, shaping
+        )
 
     def response(c_eq, k_eq):
         out = variances(c_eq, k_eq)

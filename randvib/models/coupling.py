@@ -195,7 +195,7 @@ class Inductive(Coupling):
 
     @property
     def is_dynamic(self) -> bool:
-        return bool(np.all(np.asarray(self.inductance) > 0))
+        return _all_positive(self.inductance)
 
     @property
     def resistance(self):
@@ -276,7 +276,7 @@ class Piezo(Coupling):
 
     @property
     def is_dynamic(self) -> bool:
-        return bool(np.all(np.asarray(self.capacitance) > 0))
+        return _all_positive(self.capacitance)
 
     @property
     def electrical_damping(self):
@@ -313,3 +313,15 @@ def coupling_class(name: str) -> type:
         raise ValueError(
             f"`coupling` must be one of {', '.join(COUPLINGS)}; got {name!r}"
         ) from None
+
+
+def _all_positive(value) -> bool:
+    """``value`` > 0 at every point (a number, or an array over a grid of devices).
+
+    A number is compared as is: ``np.all(np.asarray(x) > 0)`` gives the same answer
+    at many times the cost, and ``is_dynamic`` is asked at every step of a
+    linearisation's fixed point.
+    """
+    if isinstance(value, float):
+        return bool(value > 0)
+    return bool(np.all(np.asarray(value) > 0))

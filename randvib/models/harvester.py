@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, fields
+from functools import cached_property
 
 import numpy as np
 
@@ -234,6 +235,15 @@ class Harvester:
     @property
     def potential(self) -> Potential:
         """The restoring potential k z^2/2 + k3 z^4/4 and what it allows."""
+        if isinstance(self.k, float) and isinstance(self.k3, float):
+            return self._scalar_potential
+        return Potential(self.k, self.k3)
+
+    @cached_property
+    def _scalar_potential(self) -> Potential:
+        # Made once: the harvester is immutable and k, k3 are numbers (arrays, which
+        # could be changed in place, get a new Potential at every call). Every
+        # prediction asks for it several times, a design's search thousands.
         return Potential(self.k, self.k3)
 
     @property

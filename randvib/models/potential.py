@@ -89,6 +89,10 @@ class Potential:
     @property
     def kind(self):
         """One of :data:`KINDS` (an array of them for array parameters)."""
+        if isinstance(self.k, float) and isinstance(self.k3, float):
+            # the same tests on two numbers without numpy's array machinery: every
+            # prediction asks (a design's search thousands of times)
+            return _scalar_kind(self.k, self.k3)
         k, k3 = np.broadcast_arrays(np.asarray(self.k, float), np.asarray(self.k3, float))
         kinds = np.select(
             [
@@ -105,17 +109,17 @@ class Potential:
     @property
     def is_confining(self) -> bool:
         """True when U -> inf as |z| -> inf at every parameter point."""
-        return bool(np.all(np.isin(self.kind, CONFINING)))
+        return _all_in(self.kind, CONFINING)
 
     @property
     def is_free(self) -> bool:
         """True for the free mass (k = k3 = 0) at every parameter point."""
-        return bool(np.all(np.asarray(self.kind) == "free"))
+        return _all_in(self.kind, ("free",))
 
     @property
     def velocity_is_stationary(self) -> bool:
         """True when the velocity has a stationary law: confining or free at every point."""
-        return bool(np.all(np.isin(self.kind, CONFINING + ("free",))))
+        return _all_in(self.kind, CONFINING + ("free",))
 
     # ------------------------------------------------------------ shape
     def energy(self, z):
@@ -233,3 +237,23 @@ _DESCRIPTIONS = {
     "pure-cubic": "a pure cubic potential (k = 0 < k3)",
     "free": "the free mass (k = k3 = 0)",
 }
+
+
+def _scalar_kind(k: float, k3: float) -> str:
+    """:attr:`Potential.kind` of scalar parameters: np.select's conditions, in its order."""
+    if k3 < 0 or (k < 0 and k3 == 0):
+        return "non-confining"
+    if k == 0 and k3 == 0:
+        return "free"
+    if k < 0:
+        return "bistable"
+    if k == 0:
+        return "pure-cubic"
+    return "monostable"
+
+
+def _all_in(kind, kinds: tuple[str, ...]) -> bool:
+    """True when ``kind`` (one kind, or an array of them) is among ``kinds`` at every point."""
+    if isinstance(kind, str):
+        return kind in kinds
+    return bool(np.all(np.isin(kind, kinds)))
