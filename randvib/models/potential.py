@@ -94,17 +94,12 @@ class Potential:
             # prediction asks (a design's search thousands of times)
             return _scalar_kind(self.k, self.k3)
         k, k3 = np.broadcast_arrays(np.asarray(self.k, float), np.asarray(self.k3, float))
-        kinds = np.select(
-            [
-                (k3 < 0) | ((k < 0) & (k3 == 0)),
-                (k == 0) & (k3 == 0),
-                k < 0,
-                k == 0,
-            ],
-            ["non-confining", "free", "bistable", "pure-cubic"],
-            "monostable",
-        )
-        return str(kinds) if kinds.ndim == 0 else kinds
+        if k.ndim == 0:
+            return _scalar_kind(float(k), float(k3))
+        # the one rule, point by point (a grid of devices is small)
+        points = zip(k.ravel().tolist(), k3.ravel().tolist(), strict=True)  # broadcast: equal
+        kinds = [_scalar_kind(a, b) for a, b in points]
+        return np.array(kinds, dtype=f"<U{max(map(len, KINDS))}").reshape(k.shape)
 
     @property
     def is_confining(self) -> bool:
@@ -240,7 +235,7 @@ _DESCRIPTIONS = {
 
 
 def _scalar_kind(k: float, k3: float) -> str:
-    """:attr:`Potential.kind` of scalar parameters: np.select's conditions, in its order."""
+    """:attr:`Potential.kind` of one parameter point: the first test that holds."""
     if k3 < 0 or (k < 0 and k3 == 0):
         return "non-confining"
     if k == 0 and k3 == 0:
